@@ -1,0 +1,41 @@
+# tailor: the two commands a new user types are `make run` and `make test`.
+# Everything else is here for developers. All targets install missing packages first (make deps).
+
+BUILD_DIR ?= build
+JOBS ?= 2
+CMAKE_FLAGS ?=
+EXAMPLE_MESH := examples/spot.obj
+EXAMPLE_TEXTURE := examples/gravel-tile.png
+
+.PHONY: all deps configure build test run bench fuzz clean
+
+all: build
+
+deps:
+	@bash scripts/deps.sh
+
+configure: deps
+	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS) >/dev/null
+
+build: configure
+	@cmake --build $(BUILD_DIR) -j $(JOBS)
+
+# Unit, integration, CLI and browser tests (ctest runs them all), then short fuzz runs.
+test: build
+	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
+	@bash scripts/fuzz.sh short
+
+# The main job on the bundled example: textured .glb, preview pictures and stats in out/.
+run: build
+	@mkdir -p out
+	@$(BUILD_DIR)/tailor map $(EXAMPLE_MESH) --texture $(EXAMPLE_TEXTURE) -o out/example.glb \
+	   --stats out/example_stats.json --preview out/example_preview.png
+
+bench: build
+	@bash scripts/bench.sh $(BUILD_DIR)
+
+fuzz: deps
+	@bash scripts/fuzz.sh long
+
+clean:
+	rm -rf $(BUILD_DIR) build-fuzz out

@@ -1,0 +1,49 @@
+// Error lines, warnings and the progress bar of the tailor CLI.
+#include "cli.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+
+namespace tailor::cli {
+
+int report_error(const Status& status) {
+  std::fprintf(stderr, "tailor: error: %s\n", status.message().c_str());
+  return status.code() == ErrorCode::kInvalidArgument ? kExitUsage : kExitBadInput;
+}
+
+void warn(bool quiet, const std::string& text) {
+  if (!quiet) std::fprintf(stderr, "tailor: warning: %s\n", text.c_str());
+}
+
+Progress::Progress(std::string label, bool quiet)
+    : label_(std::move(label)), enabled_(!quiet && isatty(STDERR_FILENO) == 1),
+      start_(std::chrono::steady_clock::now()) {}
+
+Progress::~Progress() { done(); }
+
+bool Progress::update(double fraction) {
+  if (!enabled_) return true;
+  const int percent = static_cast<int>(fraction * 100.0);
+  if (percent == last_percent_) return true;
+  // Short work gets no bar at all: it would only flicker.
+  if (!drawn_ && seconds_since(start_) < 1.0) return true;
+  last_percent_ = percent;
+  constexpr int kWidth = 30;
+  const int filled = percent * kWidth / 100;
+  std::fprintf(stderr, "\r%s [%.*s%*s] %3d%%", label_.c_str(), filled, "==============================",
+               kWidth - filled, "", percent);
+  std::fflush(stderr);
+  drawn_ = true;
+  return true;
+}
+
+void Progress::done() {
+  if (drawn_) {
+    std::fprintf(stderr, "\r\033[K");
+    std::fflush(stderr);
+    drawn_ = false;
+  }
+}
+
+}  // namespace tailor::cli

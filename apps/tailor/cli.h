@@ -1,0 +1,60 @@
+// Shared pieces of the tailor command-line tool: exit codes, the one-line error format, a progress
+// bar on stderr, and the registration hook of each subcommand (one file per subcommand).
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <functional>
+#include <string>
+
+#include "tailor/status.h"
+
+namespace tailor::cli {
+
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitBadInput = 1;  //!< unreadable or invalid input, I/O failure
+inline constexpr int kExitUsage = 2;     //!< bad command line
+
+//! Prints "tailor: error: <file>: <what> (<where>)" on stderr; returns the exit code for `status`.
+int report_error(const Status& status);
+
+//! Prints "tailor: warning: <text>" on stderr unless quiet.
+void warn(bool quiet, const std::string& text);
+
+//! A progress bar on stderr, drawn only when stderr is a terminal and not quiet, and only once the
+//! work has run for more than ~1 s. update() is cheap enough to call per percent of work.
+class Progress {
+ public:
+  Progress(std::string label, bool quiet);
+  ~Progress();
+  //! fraction in [0, 1]; returns true (never cancels: the hook matches the library's callbacks).
+  bool update(double fraction);
+  void done();
+
+ private:
+  std::string label_;
+  bool enabled_ = false;
+  bool drawn_ = false;
+  int last_percent_ = -1;
+  std::chrono::steady_clock::time_point start_;
+};
+
+//! Seconds since `start`.
+inline double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+//! What a subcommand's CLI11 callback sets: the work to run once parsing succeeded.
+using Runner = std::function<int()>;
+
+// One registration function per subcommand, each in its own file cmd_<name>.cpp.
+void register_info(CLI::App& app, Runner& run);
+void register_map(CLI::App& app, Runner& run);
+void register_eval(CLI::App& app, Runner& run);
+void register_tile(CLI::App& app, Runner& run);
+void register_eval_tile(CLI::App& app, Runner& run);
+void register_render(CLI::App& app, Runner& run);
+void register_view(CLI::App& app, Runner& run);
+
+}  // namespace tailor::cli

@@ -1,0 +1,135 @@
+// tailor eval: UV quality metrics of any UV-mapped mesh (.obj vt, .ply s/t, .glb TEXCOORD_0).
+// Definitions: docs/metrics.md.
+#include <chrono>
+#include <cstdio>
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "cli.h"
+#include "tailor/export.h"
+#include "tailor/gltf.h"
+#include "tailor/io.h"
+#include "tailor/metrics.h"
+#include "tailor/topology.h"
+
+namespace tailor::cli {
+namespace {
+
+struct EvalOptions {
+  std::string input;
+  int texture_size = 0;  // 0 = not given: the embedded image size for .glb, else 512
+  bool json = false;
+  bool quiet = false;
+};
+
+constexpr int kDefaultTextureSize = 512;
+
+int run_eval(const EvalOptions& opt) {
+  const auto start = std::chrono::steady_clock::now();
+  Mesh mesh;
+  LoadReport report;
+  Image texture;
+  const bool glb = mesh_format_from_path(opt.input) == MeshFormat::kGlb;
+  // Only decode the embedded texture when its size is needed.
+  const Status status = glb ? read_glb_file(opt.input, mesh, opt.texture_size > 0 ? nullptr : &texture, &report)
+                            : load_mesh(opt.input, mesh, &report);
+  if (!status) return report_error(status);
+  if (mesh.corner_uvs.empty())
+    return report_error(Status::error(ErrorCode::kInvalidMesh, opt.input,
+                                      "mesh has no texture coordinates to evaluate (OBJ vt, PLY s/t or glTF TEXCOORD_0)"));
+  // glb readers weld split vertices themselves; PLY files written after splitting need it here
+  // so that seams are edges between faces again (corner UVs are unaffected).
+  const size_t welded = glb ? 0 : weld_identical_positions(mesh);
+
+  int width = kDefaultTextureSize, height = kDefaultTextureSize;
+  const char* size_source = "default";
+  if (opt.texture_size > 0) {
+    width = height = opt.texture_size;
+    size_source = "option";
+  } else if (!texture.empty()) {
+    width = texture.width;
+    height = texture.height;
+    size_source = "embedded texture";
+  }
+
+  // Texture repeats -> pixels.
+  std::vector<float> uv_px(mesh.corner_uvs.size());
+  for (size_t c = 0; c < uv_px.size() / 2; ++c) {
+    uv_px[2 * c] = mesh.corner_uvs[2 * c] * static_cast<float>(width);
+    uv_px[2 * c + 1] = mesh.corner_uvs[2 * c + 1] * static_cast<float>(height);
+  }
+  const Topology topology = build_topology(mesh);
+  UvMetrics m;
+  const MetricsOptions options{static_cast<float>(width), static_cast<float>(height)};
+  const Status metrics_status = compute_uv_metrics(mesh, topology, uv_px, {}, options, m);
+  if (!metrics_status) return report_error(metrics_status.with_file(opt.input));
+  const double seconds = seconds_since(start);
+
+  if (m.degenerate_faces > 0)
+    warn(opt.quiet || opt.json, std::to_string(m.degenerate_faces) + " faces with zero 3D area skipped by the per-face metrics");
+  if (m.zero_uv_area_faces > 0)
+    warn(opt.quiet || opt.json, std::to_string(m.zero_uv_area_faces) + " faces with zero UV area (counted as flipped)");
+
+  if (opt.json) {
+    nlohmann::json j;
+    j["file"] = opt.input;
+    j["format"] = report.format;
+    j["vertices"] = mesh.vertex_count();
+    j["faces"] = m.faces;
+    j["welded_vertices"] = glb ? report.welded_vertices : welded;
+    j["texture_width"] = width;
+    j["texture_height"] = height;
+    j["texture_size_from"] = size_source;
+    j["patches"] = m.patches;
+    j["single_face_patches"] = m.single_face_patches;
+    j["degenerate_faces"] = m.degenerate_faces;
+    j["stretch"] = m.stretch;
+    j["stretch_area_weighted"] = m.stretch_area_weighted;
+    j["distortion_deg"] = m.distortion_deg;
+    j["l2_stretch"] = m.l2_stretch;
+    j["linf_stretch"] = m.linf_stretch;
+    j["flipped"] = m.flipped;
+    j["zero_uv_area_faces"] = m.zero_uv_area_faces;
+    j["seam_edges"] = m.seam_edges;
+    j["seam_length_ratio"] = m.seam_length_ratio;
+    j["seam_gap_px"] = m.seam_gap_px;
+    j["seam_invisible_ratio"] = m.seam_invisible_ratio;
+    j["uv_scale_px2_per_unit2"] = m.uv_scale;
+    j["boundary_edges"] = topology.boundary_edges;
+    j["nonmanifold_edges"] = topology.nonmanifold_edges;
+    j["seconds"] = seconds;
+    std::printf("%s\n", j.dump(2).c_str());
+    return kExitOk;
+  }
+  std::printf(
+      "%s: %zu faces, %u patches (%zu single-face), seams %.2f%% of edge length (%zu edges), %zu flipped, "
+      "stretch %.4f (area-weighted %.4f), L2 %.4f, Linf %.4f, distortion %.2f deg (median), "
+      "seam gap %.2f px, %.1f%% invisible (texture %dx%d px, %s)\n",
+      opt.input.c_str(), m.faces, m.patches, m.single_face_patches, 100.0 * m.seam_length_ratio, m.seam_edges,
+      m.flipped, m.stretch, m.stretch_area_weighted, m.l2_stretch, m.linf_stretch, m.distortion_deg, m.seam_gap_px,
+      100.0 * m.seam_invisible_ratio, width, height, size_source);
+  return kExitOk;
+}
+
+}  // namespace
+
+void register_eval(CLI::App& app, Runner& run) {
+  auto opt = std::make_shared<EvalOptions>();
+  auto* cmd = app.add_subcommand("eval", "Print UV quality metrics of a UV-mapped mesh (.obj .ply .glb)");
+  cmd->add_option("mesh", opt->input, "UV-mapped mesh: .obj (vt), .ply (s,t) or .glb (TEXCOORD_0)")->required();
+  cmd->add_option("--texture-size", opt->texture_size,
+                  "Texture size in pixels (UVs are in repeats; this gives pixels). Default: the embedded "
+                  "texture's size for .glb, else 512")
+      ->check(CLI::Range(1, 1 << 16));
+  cmd->add_flag("--json", opt->json, "Print the full report as a JSON object");
+  cmd->add_flag("-q,--quiet", opt->quiet, "Print nothing but the result and errors");
+  cmd->footer(
+      "Metrics (docs/metrics.md): patches, seams (share of edge length), flipped faces, stretch\n"
+      "(coefficient of variation of UV/3D area ratio, 0 ideal), L2/Linf stretch (Sander 2001, 1 ideal),\n"
+      "median angle distortion, seam gap (px, modulo the texture) and share of invisible seams.\n"
+      "Example:\n  tailor eval bunny.glb\n  tailor eval spot.obj --texture-size 1024 --json");
+  cmd->callback([&run, opt] { run = [opt] { return run_eval(*opt); }; });
+}
+
+}  // namespace tailor::cli

@@ -1,0 +1,93 @@
+// tailor eval-tile: quality metrics of a (supposedly) self-tileable texture, optionally against
+// the exemplar it was made from.
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "cli.h"
+#include "tailor/image.h"
+#include "tailor/tiling.h"
+
+namespace tailor::cli {
+namespace {
+
+struct EvalTileOptions {
+  std::string tile;
+  std::string exemplar;
+  bool json = false;
+  bool quiet = false;
+};
+
+int run_eval_tile(const EvalTileOptions& opt) {
+  Image tile, exemplar;
+  if (Status s = load_image(opt.tile, tile); !s) return report_error(s);
+  const bool with_exemplar = !opt.exemplar.empty();
+  if (with_exemplar)
+    if (Status s = load_image(opt.exemplar, exemplar); !s) return report_error(s);
+  TileMetrics m;
+  if (Status s = tile_metrics(tile, with_exemplar ? &exemplar : nullptr, m); !s) return report_error(s.with_file(opt.tile));
+  std::string failed;
+  const bool met = meets_tile_targets(m, &failed);
+  if (opt.json) {
+    nlohmann::json j;
+    j["file"] = opt.tile;
+    j["width"] = tile.width;
+    j["height"] = tile.height;
+    j["wrap_ratio_x"] = m.wrap_ratio_x;
+    j["wrap_ratio_y"] = m.wrap_ratio_y;
+    j["worst_seam_ratio"] = m.worst_seam_ratio;
+    j["gradient_energy"] = m.gradient_energy;
+    if (with_exemplar) {
+      j["exemplar"] = opt.exemplar;
+      j["exemplar_worst_seam_ratio"] = m.exemplar_worst_seam_ratio;
+      j["exemplar_wrap_ratio_x"] = m.exemplar_wrap_ratio_x;
+      j["exemplar_wrap_ratio_y"] = m.exemplar_wrap_ratio_y;
+      j["histogram_l1"] = m.histogram_l1;
+      j["gradient_ratio"] = m.gradient_ratio;
+      j["patch_coherence"] = m.patch_coherence;
+      j["exemplar_patch_coherence"] = m.exemplar_patch_coherence;
+    }
+    j["targets_met"] = met;
+    if (!failed.empty()) j["targets_failed"] = failed;
+    std::printf("%s\n", j.dump(2).c_str());
+    return kExitOk;
+  }
+  if (opt.quiet) {
+    std::printf("%s\n", met ? "targets met" : ("targets NOT met: " + failed).c_str());
+    return kExitOk;
+  }
+  std::printf("%s %dx%d\n", opt.tile.c_str(), tile.width, tile.height);
+  std::printf("  wrap-seam ratio x / y   %.3f / %.3f   (~1 seamless; target [0.8, 1.2])\n", m.wrap_ratio_x, m.wrap_ratio_y);
+  if (!with_exemplar) {
+    std::printf("  worst straight seam     %.3f   (target <= 1.5)\n", m.worst_seam_ratio);
+    std::printf("  gradient energy         %.3f   (mean |dx| + |dy|, 8-bit units)\n", m.gradient_energy);
+  } else {
+    std::printf("  exemplar wrap ratio     %.3f / %.3f   (%s)\n", m.exemplar_wrap_ratio_x, m.exemplar_wrap_ratio_y,
+                opt.exemplar.c_str());
+    std::printf("  worst straight seam     %.3f   (exemplar interior %.3f; target <= max of it and 1.5)\n",
+                m.worst_seam_ratio, m.exemplar_worst_seam_ratio);
+    std::printf("  histogram L1            %.4f  (target <= 0.1)\n", m.histogram_l1);
+    std::printf("  gradient ratio          %.3f   (target >= 0.95; < 1 blurred or ghosted)\n", m.gradient_ratio);
+    std::printf("  patch coherence         %.4f  (exemplar read toroidally %.4f; 0 = all copied)\n", m.patch_coherence,
+                m.exemplar_patch_coherence);
+  }
+  std::printf("  targets                 %s\n", met ? "met" : ("NOT met: " + failed).c_str());
+  return kExitOk;
+}
+
+}  // namespace
+
+void register_eval_tile(CLI::App& app, Runner& run) {
+  auto opt = std::make_shared<EvalTileOptions>();
+  auto* cmd = app.add_subcommand("eval-tile", "Quality metrics of a tileable texture (seams, histogram, gradients, coherence)");
+  cmd->add_option("tile", opt->tile, "The tile to check (.png .jpg .tga .bmp)")->required();
+  cmd->add_option("exemplar", opt->exemplar, "The exemplar it was made from (enables histogram, gradient, coherence)");
+  cmd->add_flag("--json", opt->json, "Print a JSON object instead of text");
+  cmd->add_flag("-q,--quiet", opt->quiet, "Print only whether the targets are met");
+  cmd->footer("Example:\n  tailor tile bricks.jpg -o bricks_tile.png && tailor eval-tile bricks_tile.png bricks.jpg");
+  cmd->callback([&run, opt] { run = [opt] { return run_eval_tile(*opt); }; });
+}
+
+}  // namespace tailor::cli

@@ -1,0 +1,316 @@
+// tailor map: load -> topology -> orientation -> mapping -> metrics -> export (+ preview, stats).
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "cli.h"
+#include "internal/atomic_file.h"
+#include "tailor/export.h"
+#include "tailor/image.h"
+#include "tailor/io.h"
+#include "tailor/mapping.h"
+#include "tailor/metrics.h"
+#include "tailor/orientation.h"
+#include "tailor/render.h"
+#include "tailor/stability.h"
+#include "tailor/topology.h"
+
+namespace tailor::cli {
+namespace {
+
+struct MapOptions {
+  std::string input;
+  std::string output;
+  std::string texture;
+  int texture_size = 512;
+  std::string stats;
+  std::string preview;
+  bool preview_all = false;
+  std::string mode = "patches";
+  float scale = 800.f;
+  float threshold = 25.f;
+  float max_stretch = 0.25f;
+  uint32_t min_patch_faces = 16;
+  std::string axis = "pca";
+  uint32_t smooth = 0;
+  std::string seed_point;
+  std::string seam_faces;
+  bool stability = false;
+  bool quiet = false;
+};
+
+Status usage_error(const std::string& what) { return Status::error(ErrorCode::kInvalidArgument, "", what); }
+
+// "1.5,-2,3" -> three finite floats.
+bool parse_vec3(const std::string& text, std::array<float, 3>& v) {
+  std::istringstream in(text);
+  char comma1 = 0, comma2 = 0;
+  if (!(in >> v[0] >> comma1 >> v[1] >> comma2 >> v[2]) || comma1 != ',' || comma2 != ',') return false;
+  in >> std::ws;
+  return in.eof() && std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
+}
+
+Status parse_axis(const std::string& text, OrientationOptions& o) {
+  if (text == "pca") {
+    o.axis = AxisSource::kPca;
+    return Status::ok();
+  }
+  o.axis = AxisSource::kUser;
+  if (text == "x") o.user_axis = {1, 0, 0};
+  else if (text == "y") o.user_axis = {0, 1, 0};
+  else if (text == "z") o.user_axis = {0, 0, 1};
+  else if (!parse_vec3(text, o.user_axis))
+    return usage_error("--axis must be pca, x, y, z or three numbers X,Y,Z, got '" + text + "'");
+  return Status::ok();
+}
+
+// "out/a.png" + "patches" -> "out/a_patches.png"
+std::string sibling_path(const std::string& path, const std::string& suffix) {
+  const std::filesystem::path p(path);
+  return (p.parent_path() / (p.stem().string() + "_" + suffix + p.extension().string())).string();
+}
+
+double ms(double seconds) { return seconds * 1e3; }
+
+int run_map(const MapOptions& opt) {
+  const auto start = std::chrono::steady_clock::now();
+  // === Options (checked before any work) ===
+  const std::string ext = std::filesystem::path(opt.output).extension().string();
+  if (ext != ".glb" && ext != ".obj" && ext != ".ply")
+    return report_error(usage_error("output must end in .glb, .obj or .ply, got '" + opt.output + "'"));
+  OrientationOptions orientation_options;
+  if (Status s = parse_axis(opt.axis, orientation_options); !s) return report_error(s);
+  orientation_options.smooth_passes = opt.smooth;
+  MappingOptions mapping_options;
+  if (opt.mode == "patches") mapping_options.mode = MappingMode::kPatches;
+  else if (opt.mode == "thesis") mapping_options.mode = MappingMode::kThesis;
+  else return report_error(usage_error("--mode must be patches or thesis, got '" + opt.mode + "'"));
+  mapping_options.scale = opt.scale;
+  mapping_options.threshold_px = opt.threshold;
+  mapping_options.max_stretch = opt.max_stretch;
+  mapping_options.min_patch_faces = opt.min_patch_faces;
+  if (!opt.seed_point.empty()) {
+    if (!parse_vec3(opt.seed_point, mapping_options.seed_point))
+      return report_error(usage_error("--seed-point must be three numbers X,Y,Z, got '" + opt.seed_point + "'"));
+    mapping_options.use_seed_point = true;
+  }
+  if (opt.texture_size <= 0) return report_error(usage_error("--texture-size must be positive"));
+
+  // === Texture (read first: a bad texture should fail before minutes of work) ===
+  Image texture;
+  if (!opt.texture.empty()) {
+    if (Status s = load_image(opt.texture, texture); !s) return report_error(s);
+  }
+  const int tex_w = texture.empty() ? opt.texture_size : texture.width;
+  const int tex_h = texture.empty() ? opt.texture_size : texture.height;
+
+  // === Load, topology, orientation ===
+  Mesh mesh;
+  LoadReport load;
+  if (Status s = load_mesh(opt.input, mesh, &load); !s) return report_error(s);
+  if (load.degenerate_faces) warn(opt.quiet, opt.input + ": dropped " + std::to_string(load.degenerate_faces) + " degenerate faces");
+  if (load.duplicate_faces) warn(opt.quiet, opt.input + ": dropped " + std::to_string(load.duplicate_faces) + " duplicate faces");
+  std::vector<uint8_t> seam_faces;
+  if (!opt.seam_faces.empty()) {
+    if (Status s = load_seam_faces(opt.seam_faces, mesh.face_count(), seam_faces); !s) return report_error(s);
+    mapping_options.seam_faces = seam_faces;
+  } else if (!mesh.seam_faces.empty()) {
+    mapping_options.seam_faces = mesh.seam_faces;
+  }
+  const Topology topology = build_topology(mesh);
+  if (topology.nonmanifold_edges || topology.inconsistent_edges)
+    warn(opt.quiet, opt.input + ": " + std::to_string(topology.nonmanifold_edges) + " non-manifold and " +
+                        std::to_string(topology.inconsistent_edges) + " inconsistently oriented edges treated as boundary");
+  FaceFrames frames;
+  if (Status s = compute_orientation(mesh, topology, orientation_options, frames); !s)
+    return report_error(s.with_file(opt.input));
+
+  // === Mapping ===
+  Progress progress("mapping", opt.quiet);
+  mapping_options.progress = [&progress](float f) { return progress.update(f); };
+  Atlas atlas;
+  MappingStats stats;
+  if (Status s = map_texture(mesh, topology, frames, mapping_options, atlas, &stats); !s)
+    return report_error(s.with_file(opt.input));
+  progress.done();
+
+  // === Metrics ===
+  const auto metrics_start = std::chrono::steady_clock::now();
+  MetricsOptions metrics_options;
+  metrics_options.texture_width_px = static_cast<float>(tex_w);
+  metrics_options.texture_height_px = static_cast<float>(tex_h);
+  UvMetrics metrics;
+  if (Status s = compute_uv_metrics(mesh, topology, atlas.corner_uv, atlas.patch, metrics_options, metrics); !s)
+    return report_error(s.with_file(opt.input));
+  const double metrics_seconds = seconds_since(metrics_start);
+
+  // === Export ===
+  const auto export_start = std::chrono::steady_clock::now();
+  ExportOptions export_options;
+  export_options.texture_path = opt.texture;
+  export_options.texture_width = tex_w;
+  export_options.texture_height = tex_h;
+  if (Status s = export_mesh(opt.output, mesh, atlas, export_options); !s) return report_error(s);
+  const double export_seconds = seconds_since(export_start);
+
+  // === Previews ===
+  std::vector<std::string> previews;
+  double preview_seconds = 0;
+  if (!opt.preview.empty()) {
+    const auto preview_start = std::chrono::steady_clock::now();
+    std::vector<float> uv_repeats(atlas.corner_uv.size());
+    for (size_t i = 0; i < uv_repeats.size(); i += 2) {
+      uv_repeats[i] = atlas.corner_uv[i] / static_cast<float>(tex_w);
+      uv_repeats[i + 1] = atlas.corner_uv[i + 1] / static_cast<float>(tex_h);
+    }
+    std::vector<std::pair<PreviewView, std::string>> views = {{PreviewView::kTexture, opt.preview}};
+    if (opt.preview_all) {
+      for (PreviewView v : {PreviewView::kPatches, PreviewView::kDistortion, PreviewView::kChecker})
+        views.emplace_back(v, sibling_path(opt.preview, preview_view_name(v)));
+    }
+    for (const auto& [view, path] : views) {
+      RenderOptions render_options;
+      render_options.view = view;
+      Image picture;
+      if (Status s = render_preview(mesh, uv_repeats, atlas.patch, texture.empty() ? nullptr : &texture,
+                                    render_options, picture);
+          !s)
+        return report_error(s.with_file(path));
+      if (Status s = write_png(path, picture); !s) return report_error(s);
+      previews.push_back(path);
+    }
+    preview_seconds = seconds_since(preview_start);
+  }
+
+  // === Stability (optional: two more mappings) ===
+  StabilityReport stability;
+  if (opt.stability) {
+    MappingOptions quiet_mapping = mapping_options;
+    quiet_mapping.progress = nullptr;
+    if (Status s = measure_stability(mesh, orientation_options, quiet_mapping, stability); !s)
+      return report_error(s.with_file(opt.input));
+  }
+  const double total_seconds = seconds_since(start);
+
+  // === Report ===
+  if (!opt.stats.empty()) {
+    nlohmann::json j;
+    j["input"] = opt.input;
+    j["output"] = opt.output;
+    j["texture"] = opt.texture;
+    j["texture_size"] = {tex_w, tex_h};
+    j["options"] = {{"mode", opt.mode}, {"scale", opt.scale}, {"threshold_px", opt.threshold},
+                    {"max_stretch", opt.max_stretch}, {"min_patch_faces", opt.min_patch_faces},
+                    {"axis", opt.axis}, {"smooth", opt.smooth}, {"seed_point", opt.seed_point},
+                    {"seam_faces", opt.seam_faces}};
+    j["mesh"] = {{"format", load.format}, {"vertices", mesh.vertex_count()}, {"faces", mesh.face_count()},
+                 {"components", topology.vertex_components}, {"boundary_edges", topology.boundary_edges},
+                 {"nonmanifold_edges", topology.nonmanifold_edges},
+                 {"inconsistent_edges", topology.inconsistent_edges},
+                 {"degenerate_faces_dropped", load.degenerate_faces},
+                 {"duplicate_faces_dropped", load.duplicate_faces},
+                 {"unreferenced_vertices", load.unreferenced_vertices}};
+    j["mapping"] = {{"patches", stats.patches}, {"patches_before_absorb", stats.patches_before_absorb},
+                    {"deferrals", stats.deferrals}, {"threshold_raises", stats.threshold_raises},
+                    {"final_threshold_px", stats.final_threshold_px}, {"max_error_px", stats.max_error_px},
+                    {"max_stretch_accepted", stats.max_stretch_accepted},
+                    {"faces_three_textured", stats.faces_three_textured},
+                    {"faces_unfolded", stats.faces_unfolded}, {"faces_rigid", stats.faces_rigid},
+                    {"faces_seam", stats.faces_seam}, {"inverted_accepted", stats.inverted_accepted}};
+    j["metrics"] = {{"patches", metrics.patches}, {"single_face_patches", metrics.single_face_patches},
+                    {"stretch", metrics.stretch}, {"stretch_area_weighted", metrics.stretch_area_weighted},
+                    {"distortion_deg", metrics.distortion_deg}, {"l2_stretch", metrics.l2_stretch},
+                    {"linf_stretch", metrics.linf_stretch}, {"flipped", metrics.flipped},
+                    {"seam_edges", metrics.seam_edges}, {"seam_length_ratio", metrics.seam_length_ratio},
+                    {"seam_gap_px", metrics.seam_gap_px}, {"seam_invisible_ratio", metrics.seam_invisible_ratio},
+                    {"uv_scale", metrics.uv_scale}};
+    if (opt.stability)
+      j["stability"] = {{"removed_faces", stability.removed_faces}, {"compared_corners", stability.compared_corners},
+                        {"mean_difference_px", stability.mean_difference_px},
+                        {"max_difference_px", stability.max_difference_px},
+                        {"identical_ratio", stability.identical_ratio},
+                        {"within_1px_ratio", stability.within_1px_ratio}};
+    j["time_ms"] = {{"load", ms(load.load_seconds)}, {"topology", ms(topology.build_seconds)},
+                    {"orientation", ms(frames.seconds)}, {"mapping", ms(stats.seconds)},
+                    {"metrics", ms(metrics_seconds)}, {"export", ms(export_seconds)},
+                    {"preview", ms(preview_seconds)}, {"total", ms(total_seconds)}};
+    j["previews"] = previews;
+    const std::string text = j.dump(2) + "\n";
+    if (Status s = internal::write_file_atomic(opt.stats, text); !s) return report_error(s);
+  }
+  if (!opt.quiet) {
+    std::printf(
+        "%s: %zu faces, %u patches, seams %.2f%% of edge length, %zu flipped, stretch %.3f, L2 %.3f, "
+        "Linf %.2f, median angle %.2f deg, seam gap %.1f px (%.0f%% invisible) | load %.1f ms, topology %.1f, "
+        "orientation %.1f, mapping %.1f, export %.1f ms -> %s\n",
+        opt.input.c_str(), mesh.face_count(), metrics.patches, 100.0 * metrics.seam_length_ratio, metrics.flipped,
+        metrics.stretch, metrics.l2_stretch, metrics.linf_stretch, metrics.distortion_deg, metrics.seam_gap_px,
+        100.0 * metrics.seam_invisible_ratio, ms(load.load_seconds), ms(topology.build_seconds), ms(frames.seconds),
+        ms(stats.seconds), ms(export_seconds), opt.output.c_str());
+    if (opt.stability)
+      std::printf("stability: removed %zu faces, surviving corners moved %.3f px on average (max %.2f px), "
+                  "%.1f%% bit-identical, %.1f%% within 1 px\n",
+                  stability.removed_faces, stability.mean_difference_px, stability.max_difference_px,
+                  100.0 * stability.identical_ratio, 100.0 * stability.within_1px_ratio);
+    for (const std::string& p : previews) std::printf("preview: %s\n", p.c_str());
+    if (!opt.stats.empty()) std::printf("stats: %s\n", opt.stats.c_str());
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+void register_map(CLI::App& app, Runner& run) {
+  auto opt = std::make_shared<MapOptions>();
+  auto* cmd = app.add_subcommand(
+      "map", "Compute texture coordinates by homogeneous patch discovery and write a textured mesh");
+  cmd->add_option("mesh", opt->input, "Input mesh (.ply .obj .off .stl)")->required();
+  cmd->add_option("-o,--output", opt->output, "Output mesh: .glb (texture embedded), .obj (+ .mtl) or .ply")
+      ->required();
+  cmd->add_option("-t,--texture", opt->texture,
+                   "Texture image (PNG/JPEG), ideally self-tileable (see 'tailor tile'); sets the texture size");
+  cmd->add_option("--texture-size", opt->texture_size, "Texture size in pixels when no --texture is given")
+      ->capture_default_str();
+  cmd->add_option("--stats", opt->stats, "Write a JSON report (mesh, mapping counters, metrics, timings)");
+  cmd->add_option("--preview", opt->preview, "Render a 3/4 view of the textured mesh to this PNG");
+  cmd->add_flag("--preview-all", opt->preview_all,
+                "With --preview, also write <name>_patches.png, <name>_distortion.png and <name>_checker.png");
+  auto* group = cmd->add_option_group("Mapping");
+  group->add_option("--mode", opt->mode,
+                    "patches: per-corner UVs, bounded per-face stretch, no inverted face (default); "
+                    "thesis: the thesis as written, one UV per vertex (reference)")
+      ->capture_default_str();
+  group->add_option("--scale", opt->scale, "Texture pixels per unit of the mesh normalised into the unit cube")
+      ->capture_default_str();
+  group->add_option("--max-stretch", opt->max_stretch,
+                    "patches mode: per-face singular values must stay within [1/(1+x), 1+x]")
+      ->capture_default_str();
+  group->add_option("--min-patch-faces", opt->min_patch_faces,
+                    "patches mode: smaller patches are absorbed into a neighbour (0 keeps all)")
+      ->capture_default_str();
+  group->add_option("--threshold", opt->threshold, "thesis mode: initial error threshold in pixels")
+      ->capture_default_str();
+  group->add_option("--axis", opt->axis, "Orientation field: pca, x, y, z or X,Y,Z")->capture_default_str();
+  group->add_option("--smooth", opt->smooth, "Orientation smoothing passes over face neighbours")
+      ->capture_default_str();
+  group->add_option("--seed-point", opt->seed_point,
+                    "X,Y,Z: start at the face nearest this point (same point = stable results when parts of "
+                    "the mesh are removed)");
+  group->add_option("--seam-faces", opt->seam_faces,
+                    "File of face indices (one per line) where seams should go (PLY 'seam' property also works)");
+  cmd->add_flag("--stability", opt->stability,
+                "Also remove ~10% of the faces, re-map and report how much the remaining UVs moved");
+  cmd->add_flag("-q,--quiet", opt->quiet, "Print nothing but errors");
+  cmd->footer(
+      "Example:\n"
+      "  tailor tile gravel.png -o gravel_tile.png\n"
+      "  tailor map bunny.ply --texture gravel_tile.png -o bunny.glb --stats bunny.json --preview bunny.png\n"
+      "Prints one summary line: faces, patches, seam length, flipped faces, stretch, Sander L2/Linf,\n"
+      "median angle distortion, seam gap, and the time of each stage.");
+  cmd->callback([&run, opt] { run = [opt] { return run_map(*opt); }; });
+}
+
+}  // namespace tailor::cli

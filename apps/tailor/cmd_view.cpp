@@ -1,0 +1,202 @@
+// tailor view: serve the web viewer (web/, three.js) and one .glb on 127.0.0.1 until Ctrl-C.
+#include <unistd.h>
+
+#include <array>
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "cli.h"
+#include "http_server.h"
+#include "tailor/image.h"
+
+namespace tailor::cli {
+namespace {
+
+// Shader samplers the viewer sets aside for tile variants (web/viewer.js, kMaxVariants).
+constexpr size_t kMaxVariants = 8;
+
+std::atomic<bool> g_stop{false};
+
+extern "C" void on_stop_signal(int) { g_stop.store(true); }
+
+struct ViewArgs {
+  std::string input;
+  std::string texture;
+  std::string web_root;
+  int port = 0;
+  bool quiet = false;
+};
+
+bool file_exists(const std::string& path) { return std::ifstream(path).good(); }
+
+std::string dir_of(const std::string& path) {
+  const size_t slash = path.rfind('/');
+  return slash == std::string::npos ? std::string(".") : path.substr(0, slash);
+}
+
+std::string base_name(const std::string& path) {
+  const size_t slash = path.rfind('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+std::string extension_of(const std::string& path) {
+  const std::string base = base_name(path);
+  const size_t dot = base.rfind('.');
+  std::string ext = dot == std::string::npos ? "" : base.substr(dot + 1);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+//! The viewer's files: --web-root, else web/ next to or above the executable (build tree,
+//! install tree), else the source tree this binary was built from.
+Status find_web_root(const std::string& given, std::string& root) {
+  std::vector<std::string> candidates;
+  if (!given.empty()) {
+    candidates.push_back(given);
+  } else {
+    std::array<char, 4096> exe{};
+    const ssize_t n = ::readlink("/proc/self/exe", exe.data(), exe.size() - 1);
+    if (n > 0) {
+      const std::string dir = dir_of(std::string(exe.data(), static_cast<size_t>(n)));
+      candidates.push_back(dir + "/web");
+      candidates.push_back(dir + "/../web");
+      candidates.push_back(dir + "/../share/tailor/web");
+    }
+#ifdef TAILOR_SOURCE_DIR
+    candidates.push_back(std::string(TAILOR_SOURCE_DIR) + "/web");
+#endif
+  }
+  for (const std::string& dir : candidates) {
+    if (!file_exists(dir + "/index.html")) continue;
+    if (!file_exists(dir + "/node_modules/three/build/three.module.js")) {
+      return Status::error(ErrorCode::kIo, dir, "three.js is not installed", "run 'npm install' in that folder");
+    }
+    root = dir;
+    return Status::ok();
+  }
+  return Status::error(ErrorCode::kIo, given.empty() ? "" : given, "web viewer files (index.html) not found",
+                       "pass --web-root DIR");
+}
+
+//! Cheap check that `path` is a binary glTF 2.0 file, so a wrong file fails here with one line
+//! rather than in the browser.
+Status check_glb(const std::string& path) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) return Status::error(ErrorCode::kIo, path, "cannot open file");
+  const auto size = static_cast<uint64_t>(in.tellg());
+  in.seekg(0);
+  std::array<unsigned char, 12> head{};
+  if (size < 12 || !in.read(reinterpret_cast<char*>(head.data()), 12)) {
+    return Status::error(ErrorCode::kParse, path, "not a binary glTF file", "shorter than its 12-byte header");
+  }
+  const auto u32 = [&](size_t at) {
+    return uint32_t{head[at]} | uint32_t{head[at + 1]} << 8 | uint32_t{head[at + 2]} << 16 | uint32_t{head[at + 3]} << 24;
+  };
+  if (u32(0) != 0x46546C67u) return Status::error(ErrorCode::kParse, path, "not a binary glTF file", "bad magic");
+  if (u32(4) != 2) return Status::error(ErrorCode::kUnsupported, path, "only glTF 2.0 is supported", "version field");
+  if (u32(8) > size) return Status::error(ErrorCode::kParse, path, "truncated glTF file", "header length exceeds file");
+  return Status::ok();
+}
+
+//! Adds routes and config entries for --texture: one image, or a variants.json from `tailor tile --variants`.
+Status add_texture(const std::string& path, std::vector<Route>& routes, nlohmann::json& config, bool quiet) {
+  const std::string ext = extension_of(path);
+  if (ext != "json") {
+    Image probe;
+    TAILOR_RETURN_IF_ERROR(load_image(path, probe).with_file(path));
+    const std::string url = "/files/texture." + ext;
+    routes.push_back({url, path, "", ""});
+    config["texture"] = url;
+    return Status::ok();
+  }
+  std::ifstream in(path);
+  if (!in) return Status::error(ErrorCode::kIo, path, "cannot open file");
+  nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return Status::error(ErrorCode::kParse, path, "not a JSON object");
+  if (!j.contains("files") || !j["files"].is_array() || j["files"].empty()) {
+    return Status::error(ErrorCode::kParse, path, "no \"files\" list of tile variants");
+  }
+  nlohmann::json urls = nlohmann::json::array();
+  const std::string dir = dir_of(path);
+  size_t k = 0;
+  for (const auto& f : j["files"]) {
+    if (!f.is_string()) return Status::error(ErrorCode::kParse, path, "\"files\" must hold file names");
+    if (k == kMaxVariants) {
+      warn(quiet, path + ": the viewer uses the first " + std::to_string(kMaxVariants) + " variants");
+      break;
+    }
+    const std::string name = f.get<std::string>();
+    const std::string file = !name.empty() && name[0] == '/' ? name : dir + "/" + name;
+    Image probe;
+    TAILOR_RETURN_IF_ERROR(load_image(file, probe).with_file(file));
+    const std::string url = "/files/variant_" + std::to_string(k) + "." + extension_of(file);
+    routes.push_back({url, file, "", ""});
+    urls.push_back(url);
+    ++k;
+  }
+  const uint64_t seed = j.contains("seed") && j["seed"].is_number_unsigned() ? j["seed"].get<uint64_t>() : 1;
+  config["variants"] = {{"files", urls}, {"seed", seed % 4294967296u}};
+  return Status::ok();
+}
+
+int run_view(const ViewArgs& args) {
+  if (Status s = check_glb(args.input); !s) return report_error(s);
+  std::string root;
+  if (Status s = find_web_root(args.web_root, root); !s) return report_error(s);
+
+  std::vector<Route> routes;
+  nlohmann::json config;
+  config["model"] = "/files/model.glb";
+  config["name"] = base_name(args.input);
+  config["texture"] = nullptr;
+  config["variants"] = nullptr;
+  routes.push_back({"/files/model.glb", args.input, "", ""});
+  if (!args.texture.empty()) {
+    if (Status s = add_texture(args.texture, routes, config, args.quiet); !s) return report_error(s);
+  }
+  routes.push_back({"/config.json", "", config.dump(), "application/json"});
+
+  StaticServer server;
+  if (Status s = server.start(root, routes, args.port); !s) return report_error(s);
+
+  struct sigaction action {};
+  action.sa_handler = on_stop_signal;
+  sigemptyset(&action.sa_mask);
+  ::sigaction(SIGINT, &action, nullptr);
+  ::sigaction(SIGTERM, &action, nullptr);
+
+  // Always printed (also with --quiet): the URL is the point of the command, and scripts read it.
+  std::printf("tailor view: http://127.0.0.1:%d/  (%s; Ctrl-C to stop)\n", server.port(), base_name(args.input).c_str());
+  std::fflush(stdout);
+  server.serve(g_stop);
+  if (!args.quiet) std::fprintf(stderr, "tailor view: stopped\n");
+  return kExitOk;
+}
+
+}  // namespace
+
+void register_view(CLI::App& app, Runner& run) {
+  auto* cmd = app.add_subcommand("view", "Open a .glb in the web viewer (three.js) served on 127.0.0.1");
+  auto args = std::make_shared<ViewArgs>();
+  cmd->add_option("mesh", args->input, "binary glTF file (.glb), e.g. from 'tailor map'")->required();
+  cmd->add_option("--texture", args->texture,
+                  "texture to show instead of the embedded one: an image, or the variants .json written by "
+                  "'tailor tile --variants K' (a random variant per tile cell)");
+  cmd->add_option("--port", args->port, "port on 127.0.0.1 (default: a free one)")->check(CLI::Range(0, 65535));
+  cmd->add_option("--web-root", args->web_root, "folder holding the viewer (index.html, node_modules)");
+  cmd->add_flag("-q,--quiet", args->quiet, "print only the URL and errors");
+  cmd->footer(
+      "Examples:\n"
+      "  tailor view spot.glb                       # prints http://127.0.0.1:PORT/ : open it in a browser\n"
+      "  tailor view spot.glb --port 8080 --texture gravel_tile.png\n"
+      "  tailor view spot.glb --texture gravel_tile.json   # tile variants from 'tailor tile --variants 4'");
+  cmd->callback([&run, args] { run = [args] { return run_view(*args); }; });
+}
+
+}  // namespace tailor::cli

@@ -1,0 +1,66 @@
+// A minimal static file server for `tailor view`: HTTP/1.1 GET (and HEAD) only, bound to
+// 127.0.0.1 only, one short-lived connection per request (Connection: close).
+//
+// What it serves, in this order:
+//   1. explicit routes: an URL path mapped to one file on disk, or to bytes held in memory
+//      (the model, its textures, the generated /config.json);
+//   2. files under the web root (index.html for "/"), after refusing any path with a ".."
+//      segment, a backslash or a NUL byte, and checking that the resolved real path (symlinks
+//      followed) still lies inside the root.
+// Everything else gets 404; other methods get 405. Not meant for untrusted networks: it listens on
+// the loopback interface only.
+#pragma once
+
+#include <atomic>
+#include <string>
+#include <vector>
+
+#include "tailor/status.h"
+
+namespace tailor::cli {
+
+//! One explicit route. Exactly one of file / content is used: file when not empty.
+struct Route {
+  std::string url_path;      //!< e.g. "/files/model.glb" (decoded, leading '/')
+  std::string file;          //!< file on disk to send
+  std::string content;       //!< bytes to send when file is empty
+  std::string content_type;  //!< empty: from the extension of url_path
+};
+
+class StaticServer {
+ public:
+  StaticServer() = default;
+  StaticServer(const StaticServer&) = delete;
+  StaticServer& operator=(const StaticServer&) = delete;
+  ~StaticServer();
+
+  //! Binds 127.0.0.1:port (port 0: a free port chosen by the system) and listens.
+  //! Fails with kIo when the port is taken or sockets are unavailable, kInvalidArgument for a
+  //! port outside 0..65535 or a web root that is not a directory.
+  Status start(const std::string& web_root, std::vector<Route> routes, int port);
+
+  //! The port actually bound (after start).
+  int port() const { return port_; }
+
+  //! Answers requests until `stop` becomes true (checked at least every 200 ms), e.g. set from
+  //! a SIGINT handler. Each connection is served on its own thread; all are joined before return.
+  void serve(const std::atomic<bool>& stop);
+
+  //! Content type for a path from its extension ("application/octet-stream" when unknown).
+  static std::string content_type_for(const std::string& path);
+
+  //! The decoded path of a request target ("/a%20b.png?x=1" -> "/a b.png"), or "" when it is
+  //! malformed or unsafe (".." segment, backslash, NUL, bad %-escape, not starting with '/').
+  static std::string safe_request_path(const std::string& target);
+
+ private:
+  void handle(int client) const;
+  std::string resolve_under_root(const std::string& path) const;
+
+  int listen_fd_ = -1;
+  int port_ = 0;
+  std::string root_;  // real path of the web root, no trailing '/'
+  std::vector<Route> routes_;
+};
+
+}  // namespace tailor::cli

@@ -1,0 +1,41 @@
+// tailor: texture-map large triangle meshes by homogeneous patch discovery, and make textures
+// self-tileable. This file only wires the subcommands (one per cmd_<name>.cpp) together.
+#include <cstdio>
+
+#include "cli.h"
+
+int main(int argc, char** argv) {
+  using namespace tailor::cli;
+  CLI::App app{"tailor: texture-map large triangle meshes at millions of faces per second,\n"
+               "and make texture images self-tileable so the mapping needs no atlas."};
+  app.name("tailor");
+  app.require_subcommand(1);
+  app.footer(
+      "Examples:\n"
+      "  tailor map bunny.ply --texture bricks.png -o bunny.glb   # UVs + textured glTF\n"
+      "  tailor tile bricks.jpg -o bricks_tile.png                # self-tileable texture\n"
+      "  tailor eval bunny.glb                                    # UV quality metrics\n"
+      "  tailor info bunny.ply                                    # what a mesh file holds\n"
+      "Run 'tailor <command> --help' for the options of each command.");
+
+  Runner run;
+  register_info(app, run);
+  register_map(app, run);
+  register_eval(app, run);
+  register_tile(app, run);
+  register_eval_tile(app, run);
+  register_render(app, run);
+  register_view(app, run);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "tailor: error: %s (run 'tailor --help')\n", e.what());
+    return kExitUsage;
+  }
+  return run ? run() : kExitUsage;
+}

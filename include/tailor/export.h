@@ -1,0 +1,62 @@
+// tailor: writing a textured mesh (.glb, .obj + .mtl, .ply) and the vertex splitting behind it.
+//
+// UV convention. The Atlas holds per-corner UVs in texture pixels with u to the right and v UP the
+// texture image (the mapping's local frame is right-handed: u along the orientation field, v along
+// the bitangent, so a front-facing triangle has positive signed UV area and the texture appears
+// upright and unmirrored seen from outside). In texture repeats (OBJ vt, PLY s/t, Mesh::corner_uvs):
+//     s = u / texture_width,  t = v / texture_height            (OBJ convention: t = 0 at the image bottom)
+// and in glTF, whose v axis points down the image (0 = top row):
+//     TEXCOORD_0 = (s, 1 - t)
+// which is the usual OBJ <-> glTF conversion, so both files show the texture the same way.
+//
+// All writes are atomic (temporary file, then rename): on failure the previous file is untouched and
+// no temporary file is left behind.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "tailor/atlas.h"
+#include "tailor/mesh.h"
+#include "tailor/status.h"
+
+namespace tailor {
+
+struct ExportOptions {
+  std::string texture_path;  //!< PNG or JPEG: embedded as is (.glb) or referenced by map_Kd (.mtl); empty = no texture
+  int texture_width = 512;   //!< pixels per texture repeat along u (> 0), usually the texture's width
+  int texture_height = 512;  //!< pixels per texture repeat along v (> 0), usually the texture's height
+  bool normals = true;       //!< .glb/.obj: write smooth per-vertex normals (area-weighted, shared across seams)
+};
+
+//! Writes `mesh` with the UVs of `atlas` (atlas.corner_uv: #F*3 by 2 pixels) to `path`, the format
+//! chosen by the extension (case-insensitive): .glb (binary glTF 2.0, texture embedded, sampler
+//! REPEAT), .obj (+ <stem>.mtl next to it when a texture is given, map_Kd relative to the .obj),
+//! .ply (binary little endian, per-vertex x y z s t after splitting).
+//! Fails with kInvalidArgument on an unsupported extension, mismatched atlas size or a texture size
+//! <= 0; kInvalidImage when the texture is neither PNG nor JPEG; kIo when a file cannot be read or
+//! written. Cost: O(F) time, output-sized memory.
+Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas, const ExportOptions& options);
+
+//! A mesh whose vertices are split so that each vertex has one UV.
+struct SplitMesh {
+  std::vector<float> positions;   //!< #S by 3
+  std::vector<float> uvs;         //!< #S by 2, copied bit for bit from the corner UVs
+  std::vector<uint32_t> indices;  //!< #F by 3, into the split vertices
+  std::vector<uint32_t> xref;     //!< #S: source vertex of each split vertex
+};
+
+//! Splits vertices on (vertex index, uv bits): corners with the same vertex and bit-identical UV
+//! (-0 and +0 are merged) share one split vertex; split vertices are numbered in order of first
+//! corner. corner_uv_repeats: #F*3 by 2 (any unit; copied as is). Cost: O(F) with one flat
+//! open-addressing hash, no per-element allocation. Deterministic.
+void split_vertices(const Mesh& mesh, std::span<const float> corner_uv_repeats, SplitMesh& out);
+
+//! The inverse, for readers of split files (.glb, .ply): merges vertices with bit-identical
+//! positions (-0 and +0 merged), keeping the first one, and rewrites mesh.indices; corner UVs are
+//! per corner and stay as they are. Returns the number of vertices removed. Cost: O(V + F).
+size_t weld_identical_positions(Mesh& mesh);
+
+}  // namespace tailor

@@ -1,0 +1,43 @@
+// tailor: images.
+//
+// Layout, stated exactly (as stb_image does): pixels are stored row by row, top row first; within
+// a row left to right; within a pixel `channels` interleaved samples (1 grey, 2 grey+alpha,
+// 3 RGB, 4 RGBA). Sample (x, y, c) is at index (y * width + x) * channels + c.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "tailor/status.h"
+
+namespace tailor {
+
+//! 8-bit image, layout above.
+struct Image {
+  int width = 0;
+  int height = 0;
+  int channels = 0;
+  std::vector<uint8_t> pixels;  //!< width * height * channels samples
+  bool empty() const { return pixels.empty(); }
+};
+
+//! Float image, same layout, samples in [0, 1] for images converted from 8 bits.
+struct ImageF {
+  int width = 0;
+  int height = 0;
+  int channels = 0;
+  std::vector<float> pixels;
+  bool empty() const { return pixels.empty(); }
+};
+
+//! Largest width or height accepted by the readers (absurd sizes are rejected before decoding).
+inline constexpr int kMaxImageSide = 16384;
+
+//! Reads PNG (8 or 16 bit; 16-bit is reduced to 8), JPEG, TGA or BMP with 1-4 channels.
+Status load_image(const std::string& path, Image& image);
+
+//! Writes a PNG atomically (temporary file, then rename).
+Status write_png(const std::string& path, const Image& image);
+
+}  // namespace tailor

@@ -1,0 +1,115 @@
+// tailor: texture mapping by homogeneous patch discovery (thesis chapter 2, DESIGN.md section 4).
+//
+// A greedy front grows over the mesh face by face. Faces waiting on the front are keyed by
+// (number of placed edge neighbours, most first; then age = variation + a running factor, least
+// first), so the texture spreads through regions where the orientation field is homogeneous and
+// stops at faces where it varies (geometric edges, field singularities): those become seams.
+// A face is placed by unfolding it across an edge from a placed neighbour's corner UVs: the two
+// shared corners are copied and the third is the mean of the two predictions
+// a + scale*frame(C - A) and b + scale*frame(C - B) (thesis eq. 2.3-2.4).
+//
+// Two modes:
+//  - kPatches (default): UVs per corner. Every placement (also faces whose three corners are
+//    known from neighbours) is checked against a per-face bound on the singular values of the
+//    Jacobian of the map from the face (at `scale` pixels per unit) to UV: both must lie in
+//    [1/(1+max_stretch), 1+max_stretch], and the UV triangle must keep the face's orientation, so
+//    no inverted or zero-area UV face is ever accepted (zero-area 3D faces excepted: their UV is
+//    the degenerate image of the face). Faces that fail are deferred; when only deferred faces
+//    remain, a new patch starts from the best of them, unfolded rigidly from an already placed
+//    neighbour so the texture continues across that edge (seam gap 0 there). Patches smaller
+//    than min_patch_faces are absorbed into a neighbour afterwards.
+//  - kThesis: the thesis as written, kept as the reference: one UV per vertex, an absolute error
+//    threshold in pixels, faces with three textured vertices accepted as they are, the threshold
+//    raised by threshold_step_px whenever every waiting face exceeds it. It leaves inverted faces
+//    on dense meshes; MappingStats reports what it did.
+//
+// Seam constraints (thesis 2.5): faces flagged in seam_faces are processed after every other face
+// of their component, so the seams move onto them.
+// Determinism: the result depends only on the mesh, topology, frames and options (ties are broken
+// by face id); no randomness, single-threaded.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <span>
+
+#include "tailor/atlas.h"
+#include "tailor/mesh.h"
+#include "tailor/orientation.h"
+#include "tailor/status.h"
+#include "tailor/topology.h"
+
+namespace tailor {
+
+enum class MappingMode {
+  kPatches,  //!< per-corner UVs, bounded per-face distortion, new patch when the front is exhausted
+  kThesis,   //!< per-vertex UVs, absolute threshold raised by 10 px when stuck (reference)
+};
+
+//! Called now and then with progress in [0, 1]; return false to cancel (map_texture then returns
+//! kCancelled and leaves the atlas empty).
+using ProgressCallback = std::function<bool(float)>;
+
+struct MappingOptions {
+  MappingMode mode = MappingMode::kPatches;  //!< algorithm (CLI --mode patches|thesis)
+  float scale = 800.f;              //!< texture pixels per unit of the mesh normalised into the unit cube (> 0)
+  bool use_seed_point = false;      //!< true: first face = the face whose centroid is nearest to seed_point
+  std::array<float, 3> seed_point{0.f, 0.f, 0.f};  //!< mesh coordinates (not normalised); default rule when
+                                    //!< unused: the face nearest to the centre of the bounding box
+  double factor_step = -1.0;        //!< age added per placed face (radians); < 0 = mode default:
+                                    //!< 1e-4 in kPatches (independent of #F, for stability), 1/#F in kThesis
+  // kPatches ------------------------------------------------------------------------------------
+  float max_stretch = 0.25f;        //!< per-face bound: singular values of the face->UV Jacobian (in units of
+                                    //!< `scale`) must lie in [1/(1+x), 1+x]; 0.01..4. 0.25 keeps every face
+                                    //!< within +-25% stretch and +-14 deg shear while letting patches cross
+                                    //!< smoothly curved regions; Sander Linf <= 1.34 by construction
+  float max_seed_rotation_deg = 45.f;  //!< a new patch is rotated (at most this much) so that it continues its
+                                    //!< neighbour's texture across the seed edge; beyond, it follows the field
+                                    //!< and only the seed edge's first vertex matches (0..180)
+  uint32_t min_patch_faces = 16;    //!< patches with fewer faces are absorbed into a neighbouring patch by rigid
+                                    //!< unfolding (0 = keep all; isolated components stay whole)
+  // kThesis -------------------------------------------------------------------------------------
+  float threshold_px = 25.f;        //!< initial absolute error threshold, pixels (thesis: 25 at scale 800)
+  float threshold_step_px = 10.f;   //!< added when every waiting face exceeds the threshold (thesis: 10)
+  // Both ------------------------------------------------------------------------------------------
+  std::span<const uint8_t> seam_faces;  //!< empty, or #F flags: 1 = user-marked seam face (deferred to the end)
+  ProgressCallback progress;        //!< optional; see ProgressCallback
+};
+
+struct MappingStats {
+  uint32_t patches = 0;             //!< patches in the atlas (after absorption)
+  uint32_t patches_before_absorb = 0;  //!< patches grown before tiny ones were absorbed (kPatches)
+  uint32_t components = 0;          //!< connected components (each has at least one patch)
+  uint64_t deferrals = 0;           //!< pops that failed the bound and were put back
+  uint32_t threshold_raises = 0;    //!< kThesis: times the threshold was raised
+  float final_threshold_px = 0.f;   //!< kThesis: threshold at the end
+  float max_error_px = 0.f;         //!< largest accepted |c_A - c_B| (two-prediction disagreement), pixels
+  float max_stretch_accepted = 0.f; //!< kPatches: largest accepted max(sigma_max - 1, 1/sigma_min - 1)
+  uint64_t faces_three_textured = 0;//!< faces accepted with all three corners already known (thesis fig. 2.4)
+  uint64_t faces_unfolded = 0;      //!< faces placed from one or two known corners
+  uint64_t faces_rigid = 0;         //!< kPatches: faces placed rigidly (patch seeds, absorbed faces)
+  uint64_t faces_cut = 0;           //!< kPatches: faces joined across one edge while disagreeing with another
+                                    //!< placed neighbour of their patch (each leaves at least one cut edge)
+  uint64_t faces_seam = 0;          //!< faces flagged in seam_faces
+  uint64_t inverted_accepted = 0;   //!< kThesis: faces accepted with a non-positive UV area (always 0 in kPatches)
+  double seconds = 0.0;             //!< wall time of map_texture
+};
+
+//! Maps the texture: fills atlas.corner_uv (#F*3 by 2, pixels), atlas.patch (#F) and
+//! atlas.patch_count; every face is placed and every UV is finite.
+//! Preconditions: topology = build_topology(mesh), frames = compute_orientation(mesh, topology, ...).
+//! Fails with kInvalidArgument on bad options (scale <= 0 or non-finite, max_stretch out of range,
+//! seam_faces of the wrong size), kInvalidMesh when frames/topology do not match the mesh,
+//! kCancelled when the progress callback returns false. Cost: O(F log front) time, O(F) memory,
+//! allocated once before the loop. Deterministic.
+Status map_texture(const Mesh& mesh, const Topology& topology, const FaceFrames& frames,
+                   const MappingOptions& options, Atlas& atlas, MappingStats* stats = nullptr);
+
+//! Per-face check used by kPatches and by tests: singular values of the Jacobian of the map from
+//! the face's frame (corner positions `local`, 6 floats, normalised units, times `scale`) to the
+//! UV triangle `uv` (6 floats, pixels). Returns max(sigma_max - 1, 1/sigma_min - 1), or +inf when
+//! the UV triangle is inverted or degenerate. O(1).
+float face_stretch_error(std::span<const float, 6> local, float scale, std::span<const float, 6> uv);
+
+}  // namespace tailor

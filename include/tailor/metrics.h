@@ -1,0 +1,69 @@
+// tailor: quality metrics of a UV map (thesis ch. 4; Sander et al. 2001), as printed by
+// `tailor eval` and by `tailor map --stats`. Exact definitions and how to read them: docs/metrics.md.
+//
+// Notation: for face f, a_f is its UV area (absolute, px^2), A_f its 3D area, and
+// R = sum_f a_f / sum_f A_f the global scale (px^2 per unit^2). Faces with zero 3D area
+// (degenerate) are skipped by every per-face metric, so no metric is ever NaN or inf; they are
+// still counted in `faces` and their edges still count in the seam statistics.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "tailor/mesh.h"
+#include "tailor/status.h"
+#include "tailor/topology.h"
+
+namespace tailor {
+
+struct MetricsOptions {
+  float texture_width_px = 512;   //!< texture period along u in pixels (> 0); the seam gap is measured modulo it
+  float texture_height_px = 512;  //!< texture period along v in pixels (> 0)
+};
+
+struct UvMetrics {
+  size_t faces = 0;                  //!< faces in the mesh (degenerate included)
+  uint32_t patches = 0;              //!< distinct patch ids (given, or derived from UV connectivity)
+  size_t single_face_patches = 0;    //!< patches holding exactly one face
+  size_t degenerate_faces = 0;       //!< faces with zero 3D area, skipped by the per-face metrics
+  double stretch = 0;                //!< thesis ch.4: coefficient of variation of r_f = a_f / A_f (population std / mean); 0 ideal
+  double stretch_area_weighted = 0;  //!< same, mean and variance weighted by A_f; 0 ideal
+  double distortion_deg = 0;         //!< median over faces of sum_k |angle_uv_k - angle_3d_k|, degrees; 0 ideal
+  double l2_stretch = 0;             //!< Sander et al. 2001 L2 stretch times sqrt(R); 1 ideal, >= 1
+  double linf_stretch = 0;           //!< Sander et al. 2001 max singular value over faces times sqrt(R); 1 ideal
+  size_t flipped = 0;                //!< faces whose signed UV area has the opposite sign to the majority of their
+                                     //!< patch (zero-area UV faces count as flipped; degenerate 3D faces are skipped)
+  size_t zero_uv_area_faces = 0;     //!< non-degenerate faces with zero UV area (included in `flipped`,
+                                     //!< excluded from l2/linf where their stretch is infinite)
+  size_t seam_edges = 0;             //!< paired edges whose two faces disagree on the UV of a shared vertex
+  double seam_length_ratio = 0;      //!< 3D length of seam edges / 3D length of all distinct edges
+  double seam_gap_px = 0;            //!< 3D-length-weighted mean over seam edges of the toroidal UV distance (px,
+                                     //!< modulo the texture size) between the two sides, averaged over both endpoints
+  double seam_invisible_ratio = 0;   //!< share of seam length whose gap is < 1 px (1 when there is no seam)
+  double uv_scale = 0;               //!< R: sum of UV areas / sum of 3D areas (px^2 per unit^2)
+};
+
+//! Computes all metrics of a per-corner UV map.
+//! mesh: a finalized mesh (indices < #V). topology: build_topology(mesh).
+//! corner_uv: #F*3 by 2, u, v in pixels (finite). patch: #F patch ids (each < #F), or empty to derive
+//! them with derive_patches.
+//! Fails with kInvalidArgument when the array sizes do not match, a UV is not finite, a patch id is
+//! >= #F, the texture size is not positive, or every non-degenerate face has zero UV area (no scale).
+//! Cost: O(F) time and memory (one sort-free pass plus a median by nth_element). Deterministic.
+Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<const float> corner_uv,
+                          std::span<const uint32_t> patch, const MetricsOptions& options, UvMetrics& metrics);
+
+//! Patches = connected components of faces joined across paired edges whose two sides have
+//! bit-identical UVs at both endpoints. Fills patch (#F ids, numbered in order of lowest face) and
+//! returns the count. Precondition: corner_uv has #F*3*2 floats. Cost: O(F), union-find.
+uint32_t derive_patches(const Mesh& mesh, const Topology& topology, std::span<const float> corner_uv,
+                        std::vector<uint32_t>& patch);
+
+//! Per-face area ratio (a_f / A_f) / R for heat maps: 1 = ideal, > 1 magnified, < 1 shrunk.
+//! Faces with zero 3D area get 1 (neutral); when R is 0 every face gets 0. ratio gets #F values.
+//! Precondition: corner_uv has #F*3*2 floats. Cost: O(F).
+void face_area_stretch(const Mesh& mesh, std::span<const float> corner_uv, std::vector<float>& ratio);
+
+}  // namespace tailor

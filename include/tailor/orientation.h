@@ -1,0 +1,83 @@
+// tailor: per-face frames and the texture orientation field (thesis 2.2, DESIGN.md section 4).
+//
+// Every face f gets a unit normal n, a unit orientation o lying in the face plane (the direction
+// the texture's u axis should follow) and p = n x o, so that (o, p, n) is right-handed and a
+// counter-clockwise face maps to a counter-clockwise UV triangle (the texture is not mirrored;
+// DESIGN.md writes o x n, which mirrors it). A 3D edge d maps to the texture offset
+// scale * (d.o, d.p), in pixels, once the mesh is normalised into the unit cube.
+//
+// The orientation comes from a global axis projected onto each face: the first principal axis
+// of the vertices (PCA, the default) or a user axis. Where the projection degenerates (the axis
+// is nearly normal to the face) the second principal axis is used instead. Optional smoothing
+// averages each face's orientation with its neighbours' (N passes, renormalised in the plane).
+//
+// All outputs are flat arrays indexed by face. The mapping stage reads only `local` (corner
+// positions in the face frame), `variation` and `area`, so the frames are computed once.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "tailor/mesh.h"
+#include "tailor/status.h"
+#include "tailor/topology.h"
+
+namespace tailor {
+
+//! Where the global texture axis comes from.
+enum class AxisSource {
+  kPca,   //!< first principal axis of the referenced vertices (default, as the thesis)
+  kUser,  //!< OrientationOptions::user_axis (CLI: x|y|z|vx,vy,vz)
+};
+
+struct OrientationOptions {
+  AxisSource axis = AxisSource::kPca;          //!< source of the global axis projected on each face
+  std::array<float, 3> user_axis{0.f, 1.f, 0.f};  //!< kUser: axis, any non-zero length (normalised inside)
+  std::array<float, 3> user_axis2{0.f, 0.f, 0.f}; //!< kUser: fallback axis where user_axis is ~normal
+                                                  //!< to a face; zero = pick one perpendicular to user_axis
+  uint32_t smooth_passes = 0;                  //!< passes of neighbour averaging of o (0 = off, 0..1000)
+  float degenerate_cos = 0.995f;               //!< |axis . n| above this counts as "axis normal to face"
+                                               //!< and the second axis is projected instead (0.5..1)
+  // Normalisation into the unit cube. Leave fixed_unit_scale at 0 to derive it from the mesh's
+  // bounding box; stability runs pass the full mesh's values so a cut mesh keeps the same frame.
+  std::array<float, 3> fixed_origin{0.f, 0.f, 0.f};  //!< with fixed_unit_scale > 0: bbox minimum, mesh units
+  float fixed_unit_scale = 0.f;                //!< > 0: normalised = (x - origin) * this; 0 = 1 / longest bbox side
+};
+
+//! Per-face frames. Shapes: #F by 3 arrays are packed xyz per face.
+struct FaceFrames {
+  std::vector<float> normal;       //!< #F by 3: unit normal (any unit vector for zero-area faces)
+  std::vector<float> orientation;  //!< #F by 3: o, unit, in the face plane
+  std::vector<float> bitangent;    //!< #F by 3: p = n x o, unit
+  std::vector<float> area;         //!< #F: area in normalised units^2 (unit cube)
+  std::vector<float> local;        //!< #F by 6: corners k=0..2 as (x, y) = ((P_k - P_0).o, (P_k - P_0).p),
+                                   //!< normalised units; corner 0 is (0, 0)
+  std::vector<float> variation;    //!< #F: sum over edge neighbours g of angle(o_f, o_g), radians (thesis "age")
+  std::vector<float> anchor;       //!< #F by 2: (P_0.o, P_0.p) of normalised corner 0, so that a face placed
+                                   //!< on its own sits at a position-derived (file-order independent) UV
+  std::array<float, 3> axis{};     //!< the global axis used (unit), in mesh coordinates
+  std::array<float, 3> axis2{};    //!< the fallback axis used (unit)
+  std::array<float, 3> origin{};   //!< normalisation: normalised = (x - origin) * unit_scale
+  float unit_scale = 1.f;          //!< 1 / longest bbox side (or OrientationOptions::fixed_unit_scale)
+  uint32_t degenerate_faces = 0;   //!< zero-area faces given an arbitrary valid frame
+  uint32_t fallback_faces = 0;     //!< faces where the second axis was projected
+  double seconds = 0.0;            //!< wall time of compute_orientation
+
+  size_t face_count() const { return area.size(); }
+};
+
+//! Computes normals, areas, the orientation field, corner positions in each face's frame and the
+//! per-face variation. Inputs: a finalised mesh and its topology (build_topology(mesh)).
+//! Never produces NaN: zero-area faces get an arbitrary orthonormal frame and variation 0 to
+//! themselves. Fails with kInvalidArgument on a zero user axis or smooth_passes > 1000, and with
+//! kInvalidMesh on an empty mesh or a topology of the wrong size. Cost: O(V + F * (1 + passes)).
+//! Deterministic; safe for any mesh that passed finalize_mesh.
+Status compute_orientation(const Mesh& mesh, const Topology& topology, const OrientationOptions& options,
+                           FaceFrames& frames);
+
+//! Mean angle (radians) between the orientations of edge-adjacent faces (each interior edge once);
+//! a measure of field smoothness used by tests and benchmarks. O(F).
+double mean_neighbour_angle(const Topology& topology, const FaceFrames& frames);
+
+}  // namespace tailor

@@ -1,0 +1,42 @@
+// tailor: face adjacency through opposite edges.
+//
+// Convention (used everywhere in tailor): edge e = 3f + k of face f runs from corner k to corner
+// (k+1)%3, i.e. from vertex indices[3f+k] to indices[3f+(k+1)%3]. opposite[e] is the edge of the
+// neighbouring face that runs the other way along the same two vertices, or kInvalid.
+// The neighbour face is opposite[e] / 3 and its edge index within that face is opposite[e] % 3.
+//
+// Edges used by more than two faces (non-manifold) and pairs of faces that traverse a shared edge
+// in the same direction (inconsistent orientation) are left unpaired, i.e. treated as boundary,
+// and counted.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "tailor/mesh.h"
+
+namespace tailor {
+
+struct Topology {
+  std::vector<uint32_t> opposite;        //!< #F*3: opposite edge id or kInvalid
+  std::vector<uint32_t> face_component;  //!< #F: component id through paired edges, numbered in order of lowest face
+  uint32_t edge_components = 0;          //!< components through paired (manifold, consistent) edges
+  uint32_t vertex_components = 0;        //!< components of faces sharing a vertex (what MANIFEST.md counts)
+  size_t edges = 0;                      //!< distinct undirected edges
+  size_t boundary_edges = 0;             //!< undirected edges used by exactly one face
+  size_t nonmanifold_edges = 0;          //!< undirected edges used by three or more faces
+  size_t inconsistent_edges = 0;         //!< undirected edges shared by two faces with the same direction
+  double build_seconds = 0.0;
+};
+
+//! Builds the opposite-edge table and components. O(F) time with a flat open-addressing hash of
+//! directed edges; no per-edge allocation. Precondition: mesh passed finalize_mesh (indices < #V).
+Topology build_topology(const Mesh& mesh);
+
+//! The neighbour face across edge e, or kInvalid.
+inline uint32_t neighbour_face(const Topology& t, uint32_t e) {
+  const uint32_t o = t.opposite[e];
+  return o == kInvalid ? kInvalid : o / 3;
+}
+
+}  // namespace tailor

@@ -1,0 +1,11 @@
+#!/usr/bin/env bash
+# make bench: runs every Google Benchmark of tailor (load, topology, orientation, mapping, export,
+# end to end, tiling) and prints one line per benchmark with its throughput counters.
+# Usage: scripts/bench.sh BUILD_DIR [extra Google Benchmark flags, e.g. --benchmark_filter=Load]
+set -euo pipefail
+build=${1:-build}
+shift || true
+bin="$build/tailor_bench"
+[[ -x $bin ]] || { echo "bench: $bin not built (configure with -DTAILOR_BUILD_BENCH=ON)" >&2; exit 1; }
+echo "bench: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
+"$bin" --benchmark_counters_tabular=false "$@"

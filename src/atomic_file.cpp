@@ -1,0 +1,49 @@
+// Whole-file reads and atomic writes (see internal/atomic_file.h).
+#include "internal/atomic_file.h"
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+
+namespace tailor::internal {
+
+Status write_file_atomic(const std::string& path, std::span<const char> bytes) {
+  const std::string tmp = path + ".tmp-" + std::to_string(static_cast<long>(getpid()));
+  std::FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (!f) return Status::error(ErrorCode::kIo, path, std::string("cannot create file: ") + std::strerror(errno));
+  const bool written = bytes.empty() || std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+  const bool flushed = std::fflush(f) == 0;
+  const bool closed = std::fclose(f) == 0;
+  if (!written || !flushed || !closed) {
+    const int err = errno;
+    std::remove(tmp.c_str());
+    return Status::error(ErrorCode::kIo, path, std::string("cannot write file: ") + std::strerror(err));
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const int err = errno;
+    std::remove(tmp.c_str());
+    return Status::error(ErrorCode::kIo, path, std::string("cannot rename temporary file: ") + std::strerror(err));
+  }
+  return Status::ok();
+}
+
+Status read_file(const std::string& path, std::string& bytes) {
+  bytes.clear();
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return Status::error(ErrorCode::kIo, path, std::string("cannot open file: ") + std::strerror(errno));
+  // Read in chunks rather than trusting a size from fseek/ftell, which fails on pipes.
+  char chunk[1 << 16];
+  size_t n = 0;
+  while ((n = std::fread(chunk, 1, sizeof chunk, f)) > 0) bytes.append(chunk, n);
+  const bool failed = std::ferror(f) != 0;
+  std::fclose(f);
+  if (failed) {
+    bytes.clear();
+    return Status::error(ErrorCode::kIo, path, "read error");
+  }
+  return Status::ok();
+}
+
+}  // namespace tailor::internal

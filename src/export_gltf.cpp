@@ -1,0 +1,168 @@
+// Binary glTF 2.0 writer (.glb): one node, one mesh, one triangle primitive with POSITION (with
+// min/max), NORMAL (optional), TEXCOORD_0 and uint32 indices, one material whose base colour
+// texture is the given PNG/JPEG embedded byte for byte, sampled with REPEAT and trilinear
+// filtering. The JSON is built with nlohmann::json (keys sorted, so the output is deterministic)
+// rather than through tinygltf's writer, which would decode and re-encode the image.
+// Reference: the glTF 2.0 specification, sections 3.6 (buffers), 3.7 (geometry), 4.4 (GLB layout).
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <limits>
+
+#include "internal/atomic_file.h"
+#include "internal/export_writers.h"
+
+namespace tailor::internal {
+namespace {
+
+// glTF enumerations (spec section 5).
+constexpr int kFloat = 5126;
+constexpr int kUnsignedInt = 5125;
+constexpr int kArrayBuffer = 34962;
+constexpr int kElementArrayBuffer = 34963;
+constexpr int kLinear = 9729;
+constexpr int kLinearMipmapLinear = 9987;
+constexpr int kRepeat = 10497;
+constexpr int kTriangles = 4;
+constexpr uint32_t kGlbMagic = 0x46546C67;  // "glTF"
+constexpr uint32_t kChunkJson = 0x4E4F534A;  // "JSON"
+constexpr uint32_t kChunkBin = 0x004E4942;   // "BIN\0"
+
+void append_u32(std::string& out, uint32_t value) {
+  static_assert(std::endian::native == std::endian::little, "glb writer assumes a little-endian host");
+  char bytes[4];
+  std::memcpy(bytes, &value, 4);
+  out.append(bytes, 4);
+}
+
+template <typename T>
+void append_array(std::string& out, const T* data, size_t count) {
+  static_assert(std::endian::native == std::endian::little, "glb writer assumes a little-endian host");
+  out.append(reinterpret_cast<const char*>(data), count * sizeof(T));
+}
+
+void pad_to_4(std::string& out, char fill) {
+  while (out.size() % 4 != 0) out.push_back(fill);
+}
+
+// Adds a buffer view over bin[offset, offset + length) and returns its index.
+size_t add_view(nlohmann::json& views, size_t offset, size_t length, int target) {
+  nlohmann::json view = {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", length}};
+  if (target != 0) view["target"] = target;
+  views.push_back(view);
+  return views.size() - 1;
+}
+
+}  // namespace
+
+Status write_glb(const std::string& path, const ExportData& data, const ExportOptions& options) {
+  const SplitMesh& split = data.split;
+  const size_t vertex_count = split.xref.size();
+  const size_t index_count = split.indices.size();
+  if (vertex_count > std::numeric_limits<uint32_t>::max() / 12 || index_count > std::numeric_limits<uint32_t>::max() / 4)
+    return Status::error(ErrorCode::kLimit, path, "mesh too large for a .glb buffer (4 GiB)");
+
+  std::string texture_bytes, mime_type;
+  if (!options.texture_path.empty())
+    TAILOR_RETURN_IF_ERROR(read_texture_bytes(options.texture_path, texture_bytes, mime_type));
+
+  // glTF's v axis points down the image: TEXCOORD_0 = (s, 1 - t) (see export.h).
+  std::vector<float> texcoords(2 * vertex_count);
+  for (size_t s = 0; s < vertex_count; ++s) {
+    texcoords[2 * s] = split.uvs[2 * s];
+    texcoords[2 * s + 1] = 1.0f - split.uvs[2 * s + 1];
+  }
+  float lo[3] = {std::numeric_limits<float>::max(), std::numeric_limits<float>::max(), std::numeric_limits<float>::max()};
+  float hi[3] = {-lo[0], -lo[1], -lo[2]};
+  for (size_t s = 0; s < vertex_count; ++s)
+    for (int i = 0; i < 3; ++i) {
+      lo[i] = std::min(lo[i], split.positions[3 * s + i]);
+      hi[i] = std::max(hi[i], split.positions[3 * s + i]);
+    }
+
+  std::string bin;
+  nlohmann::json views = nlohmann::json::array(), accessors = nlohmann::json::array(), attributes;
+  // Every block is a multiple of 4 bytes long, so each starts 4-byte aligned.
+  {
+    const size_t offset = bin.size();
+    append_array(bin, split.positions.data(), split.positions.size());
+    const size_t view = add_view(views, offset, bin.size() - offset, kArrayBuffer);
+    attributes["POSITION"] = accessors.size();
+    accessors.push_back({{"bufferView", view}, {"componentType", kFloat}, {"count", vertex_count}, {"type", "VEC3"},
+                         {"min", {lo[0], lo[1], lo[2]}}, {"max", {hi[0], hi[1], hi[2]}}});
+  }
+  if (!data.normals.empty()) {
+    std::vector<float> normals(3 * vertex_count);
+    for (size_t s = 0; s < vertex_count; ++s)
+      std::memcpy(&normals[3 * s], &data.normals[3 * size_t{split.xref[s]}], 3 * sizeof(float));
+    const size_t offset = bin.size();
+    append_array(bin, normals.data(), normals.size());
+    const size_t view = add_view(views, offset, bin.size() - offset, kArrayBuffer);
+    attributes["NORMAL"] = accessors.size();
+    accessors.push_back({{"bufferView", view}, {"componentType", kFloat}, {"count", vertex_count}, {"type", "VEC3"}});
+  }
+  {
+    const size_t offset = bin.size();
+    append_array(bin, texcoords.data(), texcoords.size());
+    const size_t view = add_view(views, offset, bin.size() - offset, kArrayBuffer);
+    attributes["TEXCOORD_0"] = accessors.size();
+    accessors.push_back({{"bufferView", view}, {"componentType", kFloat}, {"count", vertex_count}, {"type", "VEC2"}});
+  }
+  size_t indices_accessor = 0;
+  {
+    const size_t offset = bin.size();
+    append_array(bin, split.indices.data(), index_count);
+    const size_t view = add_view(views, offset, bin.size() - offset, kElementArrayBuffer);
+    indices_accessor = accessors.size();
+    accessors.push_back({{"bufferView", view}, {"componentType", kUnsignedInt}, {"count", index_count}, {"type", "SCALAR"}});
+  }
+
+  nlohmann::json pbr = {{"metallicFactor", 0.0}, {"roughnessFactor", 1.0}};
+  nlohmann::json gltf = {
+      {"asset", {{"version", "2.0"}, {"generator", "tailor"}}},
+      {"scene", 0},
+      {"scenes", {{{"nodes", {0}}}}},
+      {"nodes", {{{"mesh", 0}, {"name", "tailor"}}}},
+      {"materials", nlohmann::json::array()},
+      {"meshes", {{{"primitives", {{{"attributes", attributes}, {"indices", indices_accessor}, {"material", 0},
+                                    {"mode", kTriangles}}}}}}},
+  };
+  if (!texture_bytes.empty()) {
+    if (texture_bytes.size() > std::numeric_limits<uint32_t>::max() - bin.size())
+      return Status::error(ErrorCode::kLimit, path, "texture too large for a .glb buffer");
+    const size_t offset = bin.size();
+    bin += texture_bytes;
+    const size_t view = add_view(views, offset, texture_bytes.size(), 0);
+    pad_to_4(bin, '\0');
+    gltf["images"] = {{{"bufferView", view}, {"mimeType", mime_type}}};
+    gltf["samplers"] = {{{"magFilter", kLinear}, {"minFilter", kLinearMipmapLinear}, {"wrapS", kRepeat}, {"wrapT", kRepeat}}};
+    gltf["textures"] = {{{"sampler", 0}, {"source", 0}}};
+    pbr["baseColorTexture"] = {{"index", 0}};
+  }
+  gltf["materials"].push_back({{"name", "tailor"}, {"pbrMetallicRoughness", pbr}});
+  gltf["accessors"] = accessors;
+  gltf["bufferViews"] = views;
+  gltf["buffers"] = {{{"byteLength", bin.size()}}};
+
+  std::string json = gltf.dump();
+  pad_to_4(json, ' ');
+  const size_t total = 12 + 8 + json.size() + 8 + bin.size();
+  if (total > std::numeric_limits<uint32_t>::max())
+    return Status::error(ErrorCode::kLimit, path, "output larger than the 4 GiB a .glb can hold");
+  std::string out;
+  out.reserve(total);
+  append_u32(out, kGlbMagic);
+  append_u32(out, 2);
+  append_u32(out, static_cast<uint32_t>(total));
+  append_u32(out, static_cast<uint32_t>(json.size()));
+  append_u32(out, kChunkJson);
+  out += json;
+  append_u32(out, static_cast<uint32_t>(bin.size()));
+  append_u32(out, kChunkBin);
+  out += bin;
+  return write_file_atomic(path, out);
+}
+
+}  // namespace tailor::internal

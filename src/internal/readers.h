@@ -1,0 +1,22 @@
+// Per-format mesh parsers behind load_mesh/read_mesh (io_mesh.cpp). Each one parses `data`, fills
+// positions/indices (and corner_uvs / seam_faces where the format has them) and the format fields
+// of `report`; io_mesh.cpp then runs finalize_mesh. `name` is used in error messages only.
+// Contract: never read outside `data`, never allocate from an unchecked count, never throw.
+#pragma once
+
+#include <span>
+#include <string>
+
+#include "tailor/mesh.h"
+#include "tailor/status.h"
+
+namespace tailor::internal {
+
+Status read_ply(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report);
+Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report);
+Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report);
+Status read_stl(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report);
+//! glTF 2.0 binary (.glb): first triangle primitive(s), TEXCOORD_0 into corner_uvs (io_gltf.cpp).
+Status read_glb(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report);
+
+}  // namespace tailor::internal

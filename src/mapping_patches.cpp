@@ -1,0 +1,496 @@
+// Mapping mode "patches": per-corner UVs grown by unfolding, every face within a bound relative to
+// its size, a new patch when the front is exhausted (see tailor/mapping.h and docs/mapping.md).
+//
+// This work is based on:
+//   V. Singh, A. M. Namboodiri, "Efficient texture mapping by homogeneous patch discovery",
+//   ICVGIP 2012 (thesis chapter 2): the front order and the two-prediction unfolding;
+//   P. V. Sander, J. Snyder, S. J. Gortler, H. Hoppe, "Texture mapping progressive meshes",
+//   SIGGRAPH 2001: the singular values of the face Jacobian as the per-face bound.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "internal/face_queue.h"
+#include "internal/mapping_common.h"
+
+namespace tailor::internal {
+uint64_t dbg_conflict = 0, dbg_stretch = 0;
+namespace {
+
+constexpr float kPi = 3.14159265358979f;
+constexpr uint32_t kAnyPatch = kInvalid;
+
+// Faces whose doubled frame area is below this fraction of their squared longest edge have no
+// meaningful Jacobian: they are placed by unfolding without the stretch check (their UV is the
+// degenerate image of a degenerate face).
+constexpr float kDegenerateRatio = 1e-6f;
+
+struct Rotation {
+  float c = 1.f, s = 0.f;
+  float angle() const { return std::atan2(s, c); }
+};
+
+class PatchMapper {
+ public:
+  PatchMapper(const MappingInput& in, Atlas& atlas, MappingStats& stats)
+      : in_(in), stats_(stats), atlas_(atlas) {}
+
+  Status run() {
+    const Mesh& mesh = in_.mesh;
+    const size_t face_count = mesh.face_count();
+    opposite_ = in_.topology.opposite.data();
+    local_ = in_.frames.local.data();
+    variation_ = in_.frames.variation.data();
+    anchor_ = in_.frames.anchor.data();
+    seam_ = in_.options.seam_faces.empty() ? nullptr : in_.options.seam_faces.data();
+    scale_ = in_.options.scale;
+    bound_ = in_.options.max_stretch;
+    max_seed_rotation_ = in_.options.max_seed_rotation_deg * kPi / 180.f;
+    factor_step_ = in_.factor_step;
+
+    atlas_.corner_uv.assign(6 * face_count, 0.f);
+    atlas_.patch.assign(face_count, kInvalid);
+    uv_ = atlas_.corner_uv.data();
+    patch_ = atlas_.patch.data();
+    placed_neighbours_.assign(face_count, 0);
+    indices_ = mesh.indices.data();
+    vertex_patch_.assign(mesh.vertex_count(), kInvalid);
+    vertex_uv_.assign(2 * mesh.vertex_count(), 0.f);
+    degenerate_.assign(face_count, 0);
+    for (size_t f = 0; f < face_count; ++f) {
+      const float* l = local_ + 6 * f;
+      const float twice_area = l[2] * l[5] - l[3] * l[4];
+      const float e0 = l[2] * l[2] + l[3] * l[3], e2 = l[4] * l[4] + l[5] * l[5];
+      const float e1 = (l[4] - l[2]) * (l[4] - l[2]) + (l[5] - l[3]) * (l[5] - l[3]);
+      degenerate_[f] = !(twice_area > kDegenerateRatio * std::max({e0, e1, e2}));
+    }
+    queue_.reset(face_count);
+    patch_rotation_.reserve(256);
+    patch_size_.reserve(256);
+    patch_seed_.reserve(256);
+    for (size_t f = 0; f < face_count; ++f) stats_.faces_seam += seam_ && seam_[f] ? 1 : 0;
+
+    // === Grow: one component at a time, patches one after another ===
+    for (const uint32_t seed : in_.component_seeds) {
+      if (patch_[seed] != kInvalid) continue;
+      current_ = start_patch(seed);
+      while (!queue_.empty()) {
+        if (cancelled_) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
+        const uint64_t key = queue_.pop();
+        const uint32_t f = FaceQueue::face_of(key);
+        const uint64_t cls = front_class(key);
+        if (cls == kWaiting) {
+          if (!try_place(f, current_)) {
+            ++stats_.deferrals;
+            queue_.set(with_class(key, kDeferred));
+          }
+        } else if (cls == kDeferred) {
+          // Only deferred (and seam) faces wait: the front of the current patch is exhausted.
+          current_ = start_patch(f);
+        } else if (!try_place(f, kAnyPatch)) {
+          join_rigidly(f);  // a user seam face: joins a neighbouring patch, the cut runs along it
+        }
+      }
+    }
+    if (cancelled_) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
+    stats_.patches_before_absorb = static_cast<uint32_t>(patch_size_.size());
+    absorb_small_patches();
+    renumber_patches();
+    return Status::ok();
+  }
+
+ private:
+  // === Geometry helpers ==========================================================================
+  // UVs of the two ends of face f's edge k, as the placed neighbour across it has them.
+  void neighbour_edge_uv(uint32_t f, int k, const float*& ua, const float*& ub) const {
+    const uint32_t o = opposite_[3 * f + k];
+    const uint32_t g = o / 3, kk = o % 3;
+    ua = uv_ + 6 * g + 2 * ((kk + 1) % 3);  // the neighbour's edge runs B -> A
+    ub = uv_ + 6 * g + 2 * kk;
+  }
+
+  // Frame vector from corner i to corner j of face f, in pixels, rotated by r.
+  void frame_vector(uint32_t f, int i, int j, Rotation r, float& x, float& y) const {
+    const float* l = local_ + 6 * f;
+    const float dx = (l[2 * j] - l[2 * i]) * scale_, dy = (l[2 * j + 1] - l[2 * i + 1]) * scale_;
+    x = r.c * dx - r.s * dy;
+    y = r.s * dx + r.c * dy;
+  }
+
+  // Thesis eq. 2.3-2.4: A, B copied, C the mean of its predictions from A and from B.
+  float unfold(uint32_t f, int k, const float* ua, const float* ub, Rotation r, float* out) const {
+    const int ka = k, kb = (k + 1) % 3, kc = (k + 2) % 3;
+    float ax, ay, bx, by;
+    frame_vector(f, ka, kc, r, ax, ay);
+    frame_vector(f, kb, kc, r, bx, by);
+    const float pax = ua[0] + ax, pay = ua[1] + ay;
+    const float pbx = ub[0] + bx, pby = ub[1] + by;
+    out[2 * ka] = ua[0];
+    out[2 * ka + 1] = ua[1];
+    out[2 * kb] = ub[0];
+    out[2 * kb + 1] = ub[1];
+    out[2 * kc] = 0.5f * (pax + pbx);
+    out[2 * kc + 1] = 0.5f * (pay + pby);
+    return std::sqrt((pax - pbx) * (pax - pbx) + (pay - pby) * (pay - pby));
+  }
+
+  float stretch(uint32_t f, const float* uv) const {
+    return face_stretch_error(std::span<const float, 6>(local_ + 6 * f, 6), scale_, std::span<const float, 6>(uv, 6));
+  }
+
+  // Rigid placement of face f: corner `at` goes to uv0, the rest follow the frame rotated by r.
+  void place_rigid(uint32_t f, int at, const float* uv0, Rotation r, float* out) const {
+    for (int k = 0; k < 3; ++k) {
+      float x, y;
+      frame_vector(f, at, k, r, x, y);
+      out[2 * k] = uv0[0] + x;
+      out[2 * k + 1] = uv0[1] + y;
+    }
+  }
+
+  // Angle that rotates face f's own frame edge k onto the UV edge its neighbour gives.
+  float edge_rotation(uint32_t f, int k, const float* ua, const float* ub) const {
+    float vx, vy;
+    frame_vector(f, k, (k + 1) % 3, Rotation{}, vx, vy);
+    const float wx = ub[0] - ua[0], wy = ub[1] - ua[1];
+    return std::atan2(vx * wy - vy * wx, vx * wx + vy * wy);
+  }
+
+  static float wrap_angle(float a) {
+    while (a > kPi) a -= 2 * kPi;
+    while (a < -kPi) a += 2 * kPi;
+    return a;
+  }
+
+  // === Placement ===============================================================================
+  // Tries to join face f to patch `target` (kAnyPatch: the neighbouring patch with the most shared
+  // edges). Candidates, best first: all known corners together (seamless with every placed
+  // neighbour of that patch), then unfolding across a single edge (the others become cuts), the
+  // one with the least stretch. Accepts the first within the bound.
+  bool try_place(uint32_t f, uint32_t target) {
+    int edges[3];
+    int count = 0;
+    if (target == kAnyPatch) {
+      uint32_t patches[3];
+      int n = 0;
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t o = opposite_[3 * f + k];
+        if (o != kInvalid && patch_[o / 3] != kInvalid) patches[n++] = patch_[o / 3];
+      }
+      if (n == 0) return false;
+      int best_votes = 0;
+      for (int i = 0; i < n; ++i) {
+        int votes = 0;
+        for (int j = 0; j < n; ++j) votes += patches[j] == patches[i];
+        if (votes > best_votes || (votes == best_votes && patches[i] < target)) {
+          best_votes = votes;
+          target = patches[i];
+        }
+      }
+    }
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t o = opposite_[3 * f + k];
+      if (o != kInvalid && patch_[o / 3] == target) edges[count++] = k;
+    }
+    if (count == 0) return false;
+    const Rotation r = patch_rotation_[target];
+    float candidate[6], best[6] = {0.f, 0.f, 0.f, 0.f, 0.f, 0.f};
+
+    // --- All known corners together -------------------------------------------------------------
+    float known[6] = {0.f, 0.f, 0.f, 0.f, 0.f, 0.f};
+    bool has[3] = {false, false, false};
+    bool conflict = false;
+    for (int i = 0; i < count && !conflict; ++i) {
+      const int k = edges[i];
+      const float* ends[2];
+      neighbour_edge_uv(f, k, ends[0], ends[1]);
+      for (int j = 0; j < 2; ++j) {
+        const int corner = (k + j) % 3;
+        if (!has[corner]) {
+          has[corner] = true;
+          known[2 * corner] = ends[j][0];
+          known[2 * corner + 1] = ends[j][1];
+        } else if (known[2 * corner] != ends[j][0] || known[2 * corner + 1] != ends[j][1]) {
+          conflict = true;
+        }
+      }
+    }
+    const bool degenerate = degenerate_[f] != 0;
+    if (!conflict && !(has[0] && has[1] && has[2])) {
+      // One corner unknown from edge neighbours: the patch may already hold its vertex through a
+      // face around it (the thesis's "three textured vertices"); reuse that UV when it fits.
+      const int missing = !has[0] ? 0 : (!has[1] ? 1 : 2);
+      const uint32_t v = indices_[3 * f + missing];
+      if (vertex_patch_[v] == target) {
+        std::copy(known, known + 6, candidate);
+        candidate[2 * missing] = vertex_uv_[2 * v];
+        candidate[2 * missing + 1] = vertex_uv_[2 * v + 1];
+        const float s = degenerate ? 0.f : stretch(f, candidate);
+        if (s <= bound_) {
+          accept(f, target, candidate, 0.f, s, true);
+          return true;
+        }
+      }
+    }
+    if (!conflict) {
+      if (has[0] && has[1] && has[2]) {
+        const float s = degenerate ? 0.f : stretch(f, known);
+        if (s <= bound_) {
+          accept(f, target, known, 0.f, s, true);
+          return true;
+        }
+      } else {
+        const float* ua;
+        const float* ub;
+        neighbour_edge_uv(f, edges[0], ua, ub);
+        const float err = unfold(f, edges[0], ua, ub, r, candidate);
+        const float s = degenerate ? 0.f : stretch(f, candidate);
+        if (s <= bound_) {
+          accept(f, target, candidate, err, s, false);
+          return true;
+        }
+        if (count == 1) return false;
+      }
+    }
+
+    if (conflict) ++dbg_conflict; else ++dbg_stretch;
+    // --- One edge at a time: the least stretched -------------------------------------------------
+    float best_stretch = std::numeric_limits<float>::infinity(), best_error = 0.f;
+    for (int i = 0; i < count; ++i) {
+      const float* ua;
+      const float* ub;
+      neighbour_edge_uv(f, edges[i], ua, ub);
+      const float err = unfold(f, edges[i], ua, ub, r, candidate);
+      const float s = degenerate ? err : stretch(f, candidate);
+      if (s < best_stretch) {
+        best_stretch = s;
+        best_error = err;
+        std::copy(candidate, candidate + 6, best);
+      }
+    }
+    if (degenerate || best_stretch <= bound_) {
+      ++stats_.faces_cut;
+      accept(f, target, best, best_error, degenerate ? 0.f : best_stretch, false);
+      return true;
+    }
+    return false;
+  }
+
+  // Chooses the placed neighbour edge of f whose UV edge is closest in direction to f's frame
+  // rotated by `reference` (per patch when reference_per_patch). Returns -1 when none.
+  int best_rigid_edge(uint32_t f, bool reference_per_patch, float& rotation) const {
+    int best = -1;
+    float best_delta = std::numeric_limits<float>::infinity();
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t o = opposite_[3 * f + k];
+      if (o == kInvalid || patch_[o / 3] == kInvalid) continue;
+      const float* ua;
+      const float* ub;
+      neighbour_edge_uv(f, k, ua, ub);
+      const float theta = edge_rotation(f, k, ua, ub);
+      const float reference = reference_per_patch ? patch_rotation_[patch_[o / 3]].angle() : 0.f;
+      const float delta = std::abs(wrap_angle(theta - reference));
+      if (delta < best_delta) {
+        best_delta = delta;
+        best = k;
+        rotation = theta;
+      }
+    }
+    return best;
+  }
+
+  // Starts a new patch at face f: unfolded from its best placed neighbour so the texture goes on
+  // across that edge (rotated by at most max_seed_rotation), or at a position-derived UV when it
+  // has none (the first face of a component).
+  uint32_t start_patch(uint32_t f) {
+    const uint32_t id = static_cast<uint32_t>(patch_size_.size());
+    float theta = 0.f;
+    const int k = best_rigid_edge(f, false, theta);
+    Rotation r;
+    float uv[6];
+    if (k < 0) {
+      const float anchor[2] = {anchor_[2 * f] * scale_, anchor_[2 * f + 1] * scale_};
+      place_rigid(f, 0, anchor, r, uv);
+    } else {
+      const float* ua;
+      const float* ub;
+      neighbour_edge_uv(f, k, ua, ub);
+      if (std::abs(theta) <= max_seed_rotation_) {
+        r = Rotation{std::cos(theta), std::sin(theta)};
+        place_aligned(f, k, ua, ub, r, uv);
+      } else {
+        place_rigid(f, k, ua, r, uv);  // follows the field; continuous at vertex A only
+      }
+    }
+    patch_rotation_.push_back(r);
+    patch_size_.push_back(0);
+    patch_seed_.push_back(f);
+    ++stats_.faces_rigid;
+    accept(f, id, uv, 0.f, 0.f, false);
+    --stats_.faces_unfolded;  // counted as rigid above
+    return id;
+  }
+
+  // Places face f rigidly against the neighbour edge closest to its patch's rotation, seamless on
+  // that edge; used for seam faces and absorbed faces that no unfolding fits.
+  void join_rigidly(uint32_t f) {
+    float theta = 0.f;
+    const int k = best_rigid_edge(f, true, theta);
+    if (k < 0) {
+      current_ = start_patch(f);
+      return;
+    }
+    const float* ua;
+    const float* ub;
+    neighbour_edge_uv(f, k, ua, ub);
+    float uv[6];
+    place_aligned(f, k, ua, ub, Rotation{std::cos(theta), std::sin(theta)}, uv);
+    ++stats_.faces_rigid;
+    accept(f, patch_[opposite_[3 * f + k] / 3], uv, 0.f, 0.f, false);
+    --stats_.faces_unfolded;
+  }
+
+  // Face f turned by r (which aligns its edge k with the neighbour's UV edge): the edge's two
+  // corners are copied, so that edge is seamless; the stretch is only the neighbour's edge length
+  // mismatch. Falls back to a rigid copy from corner k when even that exceeds the bound.
+  void place_aligned(uint32_t f, int k, const float* ua, const float* ub, Rotation r, float* uv) {
+    const float err = unfold(f, k, ua, ub, r, uv);
+    const float s = degenerate_[f] ? 0.f : stretch(f, uv);
+    if (s <= bound_) {
+      stats_.max_error_px = std::max(stats_.max_error_px, err);
+      stats_.max_stretch_accepted = std::max(stats_.max_stretch_accepted, s);
+    } else {
+      place_rigid(f, k, ua, r, uv);
+    }
+  }
+
+  void accept(uint32_t f, uint32_t p, const float* uv, float error_px, float stretch_error, bool three_known) {
+    std::copy(uv, uv + 6, uv_ + 6 * f);
+    patch_[f] = p;
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t v = indices_[3 * f + k];
+      if (vertex_patch_[v] == p) continue;  // the first UV a patch gives a vertex stays its hint
+      vertex_patch_[v] = p;
+      vertex_uv_[2 * v] = uv[2 * k];
+      vertex_uv_[2 * v + 1] = uv[2 * k + 1];
+    }
+    ++patch_size_[p];
+    if (three_known) ++stats_.faces_three_textured;
+    else ++stats_.faces_unfolded;
+    stats_.max_error_px = std::max(stats_.max_error_px, error_px);
+    stats_.max_stretch_accepted = std::max(stats_.max_stretch_accepted, stretch_error);
+    if (absorbing_) return;  // the absorption pass keeps its own queue
+    const float age_offset = static_cast<float>(factor_);
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t o = opposite_[3 * f + k];
+      if (o == kInvalid) continue;
+      const uint32_t h = o / 3;
+      if (patch_[h] != kInvalid) continue;
+      const uint32_t placed = ++placed_neighbours_[h];
+      const uint64_t cls = seam_ && seam_[h] ? kSeam : kWaiting;
+      queue_.set(front_key(cls, placed, variation_[h] + age_offset, h));
+    }
+    factor_ += factor_step_;
+    if (++placed_count_ % kProgressInterval == 0 && in_.options.progress) {
+      const float done = static_cast<float>(placed_count_) / static_cast<float>(in_.mesh.face_count());
+      if (!in_.options.progress(std::min(done, 1.f))) cancelled_ = true;
+    }
+  }
+
+  // === Absorption of small patches ==============================================================
+  // Faces of patches below min_patch_faces (except the largest patch of each component) are
+  // re-placed from their neighbours in kept patches, breadth first from the kept border.
+  void absorb_small_patches() {
+    const uint32_t min_faces = in_.options.min_patch_faces;
+    const size_t patch_count = patch_size_.size();
+    if (min_faces <= 1 || patch_count <= 1) return;
+    const std::vector<uint32_t>& component = in_.topology.face_component;
+    std::vector<uint32_t> largest(in_.topology.edge_components, kInvalid);
+    for (uint32_t p = 0; p < patch_count; ++p) {
+      uint32_t& l = largest[component[patch_seed_[p]]];
+      if (l == kInvalid || patch_size_[p] > patch_size_[l]) l = p;
+    }
+    std::vector<uint8_t> kept(patch_count, 0);
+    bool any_small = false;
+    for (uint32_t p = 0; p < patch_count; ++p) {
+      kept[p] = patch_size_[p] >= min_faces || largest[component[patch_seed_[p]]] == p;
+      any_small = any_small || !kept[p];
+    }
+    if (!any_small) return;
+    const size_t face_count = in_.mesh.face_count();
+    for (size_t f = 0; f < face_count; ++f) {
+      if (!kept[patch_[f]]) {
+        --patch_size_[patch_[f]];
+        patch_[f] = kInvalid;
+      }
+    }
+    absorbing_ = true;
+    std::vector<uint32_t> fifo;
+    fifo.reserve(face_count / 8 + 16);
+    for (size_t f = 0; f < face_count; ++f) {
+      if (patch_[f] != kInvalid) continue;
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t o = opposite_[3 * f + k];
+        if (o != kInvalid && patch_[o / 3] != kInvalid) {
+          fifo.push_back(static_cast<uint32_t>(f));
+          break;
+        }
+      }
+    }
+    for (size_t head = 0; head < fifo.size(); ++head) {
+      const uint32_t f = fifo[head];
+      if (patch_[f] != kInvalid) continue;
+      if (!try_place(f, kAnyPatch)) join_rigidly(f);
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t o = opposite_[3 * f + k];
+        if (o != kInvalid && patch_[o / 3] == kInvalid) fifo.push_back(o / 3);
+      }
+    }
+    absorbing_ = false;
+  }
+
+  // Dense patch ids in order of creation, dropping the emptied ones.
+  void renumber_patches() {
+    std::vector<uint32_t> remap(patch_size_.size(), kInvalid);
+    uint32_t next = 0;
+    for (size_t p = 0; p < patch_size_.size(); ++p)
+      if (patch_size_[p] > 0) remap[p] = next++;
+    for (size_t f = 0; f < in_.mesh.face_count(); ++f) patch_[f] = remap[patch_[f]];
+    atlas_.patch_count = next;
+  }
+
+  const MappingInput& in_;
+  MappingStats& stats_;
+  Atlas& atlas_;
+  const uint32_t* opposite_ = nullptr;
+  const float* local_ = nullptr;
+  const float* variation_ = nullptr;
+  const float* anchor_ = nullptr;
+  const uint8_t* seam_ = nullptr;
+  float scale_ = 1.f, bound_ = 0.f, max_seed_rotation_ = 0.f;
+  double factor_step_ = 0.0, factor_ = 0.0;
+  float* uv_ = nullptr;
+  uint32_t* patch_ = nullptr;
+  std::vector<uint8_t> placed_neighbours_;
+  const uint32_t* indices_ = nullptr;
+  std::vector<uint32_t> vertex_patch_;  // per vertex: the patch whose UV vertex_uv_ holds (a hint)
+  std::vector<float> vertex_uv_;        // per vertex: 2 floats
+  std::vector<uint8_t> degenerate_;
+  std::vector<Rotation> patch_rotation_;
+  std::vector<uint32_t> patch_size_;
+  std::vector<uint32_t> patch_seed_;
+  FaceQueue queue_;
+  uint32_t current_ = 0;
+  uint64_t placed_count_ = 0;
+  bool cancelled_ = false;
+  bool absorbing_ = false;
+};
+
+}  // namespace
+
+Status map_patches(const MappingInput& input, Atlas& atlas, MappingStats& stats) {
+  PatchMapper mapper(input, atlas, stats);
+  return mapper.run();
+}
+
+}  // namespace tailor::internal

@@ -1,0 +1,83 @@
+#!/usr/bin/env bash
+# End-to-end tests of the tailor command line, as a user runs it: exit codes, the one-line error
+# format, no partial output on failure, determinism of whole output files, and the summary lines.
+# Usage: bash tests/cli_test.sh path/to/tailor   (ctest passes the built binary)
+set -uo pipefail
+tailor=${1:?usage: cli_test.sh TAILOR_BINARY}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+passed=0
+failed=0
+ok() { passed=$((passed + 1)); }
+fail() { failed=$((failed + 1)); echo "FAIL: $*"; }
+
+# expect_error EXIT_CODE PATTERN -- cmd...: exit code and exactly one stderr line matching PATTERN.
+expect_error() {
+  local code=$1 pattern=$2
+  shift 3
+  "$@" >"$tmp/out.txt" 2>"$tmp/err.txt"
+  local got=$?
+  local lines
+  lines=$(wc -l <"$tmp/err.txt")
+  if [[ $got -ne $code ]]; then fail "$* exited $got, expected $code: $(cat "$tmp/err.txt")"; return; fi
+  if [[ $lines -ne 1 ]]; then fail "$* printed $lines error lines: $(cat "$tmp/err.txt")"; return; fi
+  if ! grep -Eq "^tailor: error: .*$pattern" "$tmp/err.txt"; then fail "$*: '$(cat "$tmp/err.txt")' !~ $pattern"; return; fi
+  ok
+}
+
+mesh=examples/spot.obj
+texture=examples/gravel.png
+
+# --- help teaches: every command has --help with an example ---
+for cmd in info map eval tile eval-tile render view; do
+  if "$tailor" "$cmd" --help >"$tmp/help.txt" 2>&1 && grep -q "Example" "$tmp/help.txt"; then ok
+  else fail "tailor $cmd --help has no example"; fi
+done
+
+# --- info on a real mesh: exact counts from MANIFEST.md ---
+"$tailor" info "$mesh" --json >"$tmp/info.json" || fail "info failed"
+grep -q '"faces": 5856' "$tmp/info.json" && grep -q '"vertices": 2930' "$tmp/info.json" &&
+  grep -q '"components": 1' "$tmp/info.json" && grep -q '"boundary_edges": 0' "$tmp/info.json" && ok ||
+  fail "info counts wrong: $(cat "$tmp/info.json")"
+
+# --- map: summary line, outputs, stats; determinism (bit-identical files) ---
+"$tailor" map "$mesh" --texture "$texture" -o "$tmp/a.glb" --stats "$tmp/a.json" >"$tmp/map.txt" 2>&1 ||
+  fail "map failed: $(cat "$tmp/map.txt")"
+grep -Eq "5856 faces, [0-9]+ patches, .* 0 flipped" "$tmp/map.txt" && ok || fail "map summary: $(cat "$tmp/map.txt")"
+[[ -s $tmp/a.glb && -s $tmp/a.json ]] && ok || fail "map outputs missing"
+"$tailor" map "$mesh" --texture "$texture" -o "$tmp/b.glb" --quiet >"$tmp/quiet.txt" 2>&1 || fail "second map failed"
+[[ ! -s $tmp/quiet.txt ]] && ok || fail "--quiet printed: $(cat "$tmp/quiet.txt")"
+cmp -s "$tmp/a.glb" "$tmp/b.glb" && ok || fail "two runs gave different .glb files"
+for ext in obj ply; do
+  "$tailor" map "$mesh" -o "$tmp/c.$ext" --quiet && [[ -s $tmp/c.$ext ]] && ok || fail "map to .$ext failed"
+done
+
+# --- bad input: clear one-line errors, exit 1, nothing written ---
+printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n' >"$tmp/truncated.ply"
+expect_error 1 "truncated.ply" -- "$tailor" map "$tmp/truncated.ply" -o "$tmp/bad.glb"
+[[ ! -e $tmp/bad.glb ]] && ok || fail "partial output left after a failed map"
+printf 'v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n' >"$tmp/nan.obj"
+expect_error 1 "nan.obj" -- "$tailor" map "$tmp/nan.obj" -o "$tmp/bad.glb"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n' >"$tmp/range.obj"
+expect_error 1 "range.obj.*(line 4|face)" -- "$tailor" info "$tmp/range.obj"
+printf '' >"$tmp/empty.off"
+expect_error 1 "empty.off" -- "$tailor" info "$tmp/empty.off"
+printf 'ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\nend_header\n' >"$tmp/huge.ply"
+expect_error 1 "huge.ply" -- timeout 10 "$tailor" info "$tmp/huge.ply"
+echo "not an image" >"$tmp/fake.png"
+expect_error 1 "fake.png" -- "$tailor" map "$mesh" --texture "$tmp/fake.png" -o "$tmp/bad.glb"
+expect_error 1 "missing.ply" -- "$tailor" info "$tmp/missing.ply"
+# The previous good file survives a failed overwrite.
+cp "$tmp/a.glb" "$tmp/keep.glb"
+expect_error 1 "nan.obj" -- "$tailor" map "$tmp/nan.obj" -o "$tmp/keep.glb"
+cmp -s "$tmp/a.glb" "$tmp/keep.glb" && ok || fail "failed map damaged the existing output"
+
+# --- bad usage: exit 2 ---
+expect_error 2 "mode" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --mode fancy
+expect_error 2 "output must end" -- "$tailor" map "$mesh" -o "$tmp/x.txt"
+expect_error 2 "" -- "$tailor" map "$mesh"
+expect_error 2 "" -- "$tailor" frobnicate
+ls "$tmp"/*.tmp-* >/dev/null 2>&1 && fail "temporary files left behind" || ok
+
+echo "$passed passed, $failed failed"
+[[ $failed -eq 0 ]]

@@ -1,0 +1,270 @@
+// Metrics on hand-computed cases (docs/metrics.md has the definitions).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "tailor/metrics.h"
+#include "tailor/topology.h"
+
+namespace tailor {
+namespace {
+
+// A flat (z = 0) grid of nx by ny unit cells, two triangles per cell, all counter-clockwise seen
+// from +z: lower (i,j) (i+1,j) (i,j+1), upper (i+1,j) (i+1,j+1) (i,j+1). Vertex (i,j) = j*(nx+1)+i.
+Mesh grid(int nx, int ny) {
+  Mesh mesh;
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) {
+      mesh.positions.push_back(static_cast<float>(i));
+      mesh.positions.push_back(static_cast<float>(j));
+      mesh.positions.push_back(0.0f);
+    }
+  const auto id = [nx](int i, int j) { return static_cast<uint32_t>(j * (nx + 1) + i); };
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      mesh.indices.insert(mesh.indices.end(), {id(i, j), id(i + 1, j), id(i, j + 1)});
+      mesh.indices.insert(mesh.indices.end(), {id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  return mesh;
+}
+
+// Corner UVs (px) from a function of the vertex position.
+template <typename F>
+std::vector<float> corner_uvs(const Mesh& mesh, F&& uv_of) {
+  std::vector<float> uv(2 * mesh.indices.size());
+  for (size_t c = 0; c < mesh.indices.size(); ++c) {
+    const float* p = &mesh.positions[3 * size_t{mesh.indices[c]}];
+    const auto [u, v] = uv_of(p[0], p[1]);
+    uv[2 * c] = u;
+    uv[2 * c + 1] = v;
+  }
+  return uv;
+}
+
+UvMetrics metrics_of(const Mesh& mesh, const std::vector<float>& uv, const std::vector<uint32_t>& patch = {},
+                     MetricsOptions options = {}) {
+  UvMetrics m;
+  const Topology topology = build_topology(mesh);
+  const Status s = compute_uv_metrics(mesh, topology, uv, patch, options, m);
+  EXPECT_TRUE(s.is_ok()) << s.message();
+  return m;
+}
+
+TEST(Metrics, IdentityMapIsIdeal) {
+  const Mesh mesh = grid(3, 2);
+  const auto uv = corner_uvs(mesh, [](float x, float y) { return std::pair{x, y}; });
+  const UvMetrics m = metrics_of(mesh, uv);
+  EXPECT_EQ(m.faces, 12u);
+  EXPECT_EQ(m.patches, 1u);
+  EXPECT_EQ(m.single_face_patches, 0u);
+  EXPECT_NEAR(m.stretch, 0.0, 1e-12);
+  EXPECT_NEAR(m.stretch_area_weighted, 0.0, 1e-12);
+  EXPECT_NEAR(m.l2_stretch, 1.0, 1e-12);
+  EXPECT_NEAR(m.linf_stretch, 1.0, 1e-12);
+  EXPECT_NEAR(m.distortion_deg, 0.0, 1e-9);
+  EXPECT_NEAR(m.uv_scale, 1.0, 1e-12);
+  EXPECT_EQ(m.flipped, 0u);
+  EXPECT_EQ(m.seam_edges, 0u);
+  EXPECT_EQ(m.seam_length_ratio, 0.0);
+  EXPECT_EQ(m.seam_invisible_ratio, 1.0);
+}
+
+TEST(Metrics, UniformScaleIsIdeal) {
+  const Mesh mesh = grid(3, 2);
+  // 800 px per unit, as the thesis's scale, and an offset: only R changes.
+  const auto uv = corner_uvs(mesh, [](float x, float y) { return std::pair{800 * x + 13, 800 * y - 7}; });
+  const UvMetrics m = metrics_of(mesh, uv);
+  EXPECT_NEAR(m.stretch, 0.0, 1e-9);
+  EXPECT_NEAR(m.l2_stretch, 1.0, 1e-9);
+  EXPECT_NEAR(m.linf_stretch, 1.0, 1e-9);
+  EXPECT_NEAR(m.distortion_deg, 0.0, 1e-6);
+  EXPECT_NEAR(m.uv_scale, 640000.0, 1e-3);
+  EXPECT_EQ(m.flipped, 0u);
+}
+
+// Shear uv = s * (x + y, y), s = 100. The 2D map M = [[1, 1], [0, 1]] has det 1 (R = s^2, every
+// r_f equal: stretch 0). M^T M = [[1, 1], [1, 2]], eigenvalues (3 +- sqrt 5) / 2, so the singular
+// values of M are phi = 1.618... and 1/phi; those of the inverse map uv -> 3D (times s) are the
+// same pair, G = phi, g = 1/phi. L2 = sqrt((G^2 + g^2) / 2) = sqrt(3 / 2), Linf = phi.
+// Angles: lower triangle (0,0) (1,0) (0,1) has 90, 45, 45 degrees; its image (0,0) (1,0) (1,1)
+// has 45, 90, 45: distortion |45-90| + |90-45| + 0 = 90. Upper triangle (1,0) (1,1) (0,1):
+// 45, 90, 45 -> image (1,0) (2,1) (1,1): 45, 45, 90: also 90. Median 90.
+TEST(Metrics, ShearHasKnownStretchAndAngles) {
+  const Mesh mesh = grid(2, 2);
+  const auto uv = corner_uvs(mesh, [](float x, float y) { return std::pair{100 * (x + y), 100 * y}; });
+  const UvMetrics m = metrics_of(mesh, uv);
+  const double phi = (1 + std::sqrt(5.0)) / 2;
+  EXPECT_NEAR(m.stretch, 0.0, 1e-9);
+  EXPECT_NEAR(m.stretch_area_weighted, 0.0, 1e-9);
+  EXPECT_NEAR(m.l2_stretch, std::sqrt(1.5), 1e-9);
+  EXPECT_NEAR(m.linf_stretch, phi, 1e-9);
+  EXPECT_NEAR(m.distortion_deg, 90.0, 1e-6);
+  EXPECT_EQ(m.flipped, 0u);
+}
+
+// Two unit right triangles with separate UVs: T0 at 10 px per unit (r = 100), T1 at 20 px per unit
+// (r = 400). Mean r 250, population std 150: stretch 0.6 (equal areas, so the weighted form too).
+// R = (50 + 200) / 1 = 250. Sander: T0 (a+c)/2 = 1/100, T1 1/400; L2 = sqrt(0.00625) * sqrt(250)
+// = 1.25; Linf = (1/10) * sqrt(250) = 1.5811.
+TEST(Metrics, UnequalScalesGiveKnownStretch) {
+  Mesh mesh;
+  mesh.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+  mesh.indices = {0, 1, 2, 1, 3, 2};
+  const std::vector<float> uv = {0, 0, 10, 0, 0, 10,           // T0
+                                 100, 0, 100, 20, 80, 20};     // T1: 20 px per unit, shifted
+  const UvMetrics m = metrics_of(mesh, uv);
+  EXPECT_NEAR(m.stretch, 0.6, 1e-9);
+  EXPECT_NEAR(m.stretch_area_weighted, 0.6, 1e-9);
+  EXPECT_NEAR(m.uv_scale, 250.0, 1e-9);
+  EXPECT_NEAR(m.l2_stretch, 1.25, 1e-9);
+  EXPECT_NEAR(m.linf_stretch, std::sqrt(250.0) / 10, 1e-9);
+  EXPECT_EQ(m.patches, 2u);
+  EXPECT_EQ(m.single_face_patches, 2u);
+
+  std::vector<float> ratio;
+  face_area_stretch(mesh, uv, ratio);
+  ASSERT_EQ(ratio.size(), 2u);
+  EXPECT_NEAR(ratio[0], 0.4f, 1e-6f);
+  EXPECT_NEAR(ratio[1], 1.6f, 1e-6f);
+}
+
+TEST(Metrics, CountsFlippedFaceAgainstPatchMajority) {
+  // 2x2 cells; moving the UV of corner vertex (2,2), used only by the last upper triangle
+  // (2,1) (2,2) (1,2), to (0.5, 0.5) inverts that triangle: signed area 0.5 * ((0.5-2)(2-1) -
+  // (1-2)(0.5-1)) = -1. UVs stay shared, so it is still one patch.
+  const Mesh mesh = grid(2, 2);
+  auto uv = corner_uvs(mesh, [](float x, float y) {
+    return (x == 2 && y == 2) ? std::pair{0.5f, 0.5f} : std::pair{x, y};
+  });
+  UvMetrics m = metrics_of(mesh, uv);
+  EXPECT_EQ(m.patches, 1u);
+  EXPECT_EQ(m.flipped, 1u);
+  EXPECT_EQ(m.zero_uv_area_faces, 0u);
+  EXPECT_EQ(m.seam_edges, 0u);
+
+  // With one explicit patch, a face whose UVs are collinear counts as flipped too.
+  const std::vector<uint32_t> one_patch(mesh.face_count(), 0);
+  uv = corner_uvs(mesh, [](float x, float y) { return std::pair{x, y}; });
+  uv[0] = uv[2] = uv[4] = 0;  // face 0: u = 0 at all three corners
+  m = metrics_of(mesh, uv, one_patch);
+  EXPECT_EQ(m.flipped, 1u);
+  EXPECT_EQ(m.zero_uv_area_faces, 1u);
+  EXPECT_TRUE(std::isfinite(m.l2_stretch));
+  EXPECT_TRUE(std::isfinite(m.linf_stretch));
+
+  // A mirrored patch is not flipped: the majority of its own faces sets the orientation.
+  uv = corner_uvs(mesh, [](float x, float y) { return std::pair{-x, y}; });
+  m = metrics_of(mesh, uv);
+  EXPECT_EQ(m.flipped, 0u);
+}
+
+// Two triangles sharing the diagonal (1,0)-(0,1); T1's UVs are T0's shifted by (du, dv) px.
+// The diagonal is the only seam: ratio sqrt(2) / (4 + sqrt(2)).
+UvMetrics seam_case(float du, float dv, MetricsOptions options = {}) {
+  Mesh mesh;
+  mesh.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+  mesh.indices = {0, 1, 2, 1, 3, 2};
+  const float s = 100;
+  const std::vector<float> uv = {0, 0, s, 0, 0, s, s + du, dv, s + du, s + dv, du, s + dv};
+  return metrics_of(mesh, uv, {}, options);
+}
+
+TEST(Metrics, SeamGapIsTheToroidalDistance) {
+  UvMetrics m = seam_case(30, 40);
+  EXPECT_EQ(m.seam_edges, 1u);
+  EXPECT_EQ(m.patches, 2u);
+  EXPECT_NEAR(m.seam_length_ratio, std::sqrt(2.0) / (4 + std::sqrt(2.0)), 1e-9);
+  EXPECT_NEAR(m.seam_gap_px, 50.0, 1e-9);
+  EXPECT_EQ(m.seam_invisible_ratio, 0.0);
+
+  // 300 px along u on a 512 px texture is 212 px the other way round.
+  m = seam_case(300, 0);
+  EXPECT_NEAR(m.seam_gap_px, 212.0, 1e-9);
+
+  // A whole number of periods: still a seam (UVs differ) but the texture matches across it.
+  m = seam_case(512, -1024);
+  EXPECT_EQ(m.seam_edges, 1u);
+  EXPECT_NEAR(m.seam_gap_px, 0.0, 1e-9);
+  EXPECT_EQ(m.seam_invisible_ratio, 1.0);
+
+  // Period from the options: 256 x 128 texture, shift (256, 128.5) -> gap 0.5 px, invisible.
+  m = seam_case(256, 128.5f, MetricsOptions{256, 128});
+  EXPECT_NEAR(m.seam_gap_px, 0.5, 1e-6);
+  EXPECT_EQ(m.seam_invisible_ratio, 1.0);
+}
+
+TEST(Metrics, DerivesPatchesOfAMeshCutInTwo) {
+  // 4x2 cells; the right half (x > 2, and x = 2 for faces of the right half) is shifted by 1000 px.
+  const Mesh mesh = grid(4, 2);
+  std::vector<float> uv(2 * mesh.indices.size());
+  for (size_t f = 0; f < mesh.face_count(); ++f) {
+    float cx = 0;
+    for (int k = 0; k < 3; ++k) cx += mesh.positions[3 * size_t{mesh.indices[3 * f + k]}];
+    const float shift = cx / 3 > 2 ? 1000.0f : 0.0f;
+    for (int k = 0; k < 3; ++k) {
+      const float* p = &mesh.positions[3 * size_t{mesh.indices[3 * f + k]}];
+      uv[2 * (3 * f + k)] = 10 * p[0] + shift;
+      uv[2 * (3 * f + k) + 1] = 10 * p[1];
+    }
+  }
+  const Topology topology = build_topology(mesh);
+  std::vector<uint32_t> patch;
+  EXPECT_EQ(derive_patches(mesh, topology, uv, patch), 2u);
+  ASSERT_EQ(patch.size(), mesh.face_count());
+  for (size_t f = 0; f < mesh.face_count(); ++f) {
+    const float cx = (mesh.positions[3 * size_t{mesh.indices[3 * f]}] + mesh.positions[3 * size_t{mesh.indices[3 * f + 1]}] +
+                      mesh.positions[3 * size_t{mesh.indices[3 * f + 2]}]) / 3;
+    EXPECT_EQ(patch[f], cx > 2 ? 1u : 0u) << "face " << f;  // numbered in order of lowest face
+  }
+  const UvMetrics m = metrics_of(mesh, uv);
+  EXPECT_EQ(m.patches, 2u);
+  EXPECT_EQ(m.seam_edges, 2u);  // the cut x = 2 crosses two cells
+  // 1000 px = 1000 - 2*512 = -24 px on the torus.
+  EXPECT_NEAR(m.seam_gap_px, 24.0, 1e-6);
+}
+
+TEST(Metrics, DegenerateFacesAreSkippedWithoutNaN) {
+  Mesh mesh = grid(2, 1);
+  // A zero-area face on three collinear vertices (0,0) (1,0) (2,0).
+  mesh.indices.insert(mesh.indices.end(), {0, 1, 2});
+  auto uv = corner_uvs(mesh, [](float x, float y) { return std::pair{5 * x, 5 * y}; });
+  const UvMetrics m = metrics_of(mesh, uv);
+  EXPECT_EQ(m.faces, 5u);
+  EXPECT_EQ(m.degenerate_faces, 1u);
+  EXPECT_EQ(m.flipped, 0u);
+  for (double v : {m.stretch, m.stretch_area_weighted, m.distortion_deg, m.l2_stretch, m.linf_stretch,
+                   m.seam_length_ratio, m.seam_gap_px, m.seam_invisible_ratio})
+    EXPECT_TRUE(std::isfinite(v));
+  EXPECT_NEAR(m.stretch, 0.0, 1e-9);
+  EXPECT_NEAR(m.l2_stretch, 1.0, 1e-9);
+
+  std::vector<float> ratio;
+  face_area_stretch(mesh, uv, ratio);
+  ASSERT_EQ(ratio.size(), 5u);
+  EXPECT_FLOAT_EQ(ratio[4], 1.0f);  // neutral
+  EXPECT_NEAR(ratio[0], 1.0f, 1e-6f);
+}
+
+TEST(Metrics, RejectsBadInput) {
+  const Mesh mesh = grid(1, 1);
+  const Topology topology = build_topology(mesh);
+  auto uv = corner_uvs(mesh, [](float x, float y) { return std::pair{x, y}; });
+  UvMetrics m;
+  EXPECT_EQ(compute_uv_metrics(mesh, topology, std::span<const float>(uv).first(4), {}, {}, m).code(),
+            ErrorCode::kInvalidArgument);
+  const std::vector<uint32_t> short_patch = {0};
+  EXPECT_EQ(compute_uv_metrics(mesh, topology, uv, short_patch, {}, m).code(), ErrorCode::kInvalidArgument);
+  const std::vector<uint32_t> bad_patch = {0, 7};
+  EXPECT_EQ(compute_uv_metrics(mesh, topology, uv, bad_patch, {}, m).code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(compute_uv_metrics(mesh, topology, uv, {}, MetricsOptions{0, 512}, m).code(), ErrorCode::kInvalidArgument);
+  auto nan_uv = uv;
+  nan_uv[3] = std::nanf("");
+  EXPECT_EQ(compute_uv_metrics(mesh, topology, nan_uv, {}, {}, m).code(), ErrorCode::kInvalidArgument);
+  const std::vector<float> collapsed(uv.size(), 3.0f);
+  EXPECT_EQ(compute_uv_metrics(mesh, topology, collapsed, {}, {}, m).code(), ErrorCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace tailor

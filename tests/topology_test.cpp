@@ -1,0 +1,150 @@
+// Topology: opposite edges, components and edge counts on real meshes (exact counts from
+// shared/data/meshes/MANIFEST.md) and on hand-built adversarial cases.
+#include <gtest/gtest.h>
+
+#include <cctype>
+#include <cmath>
+#include <string>
+
+#include "tailor/io.h"
+#include "tailor/topology.h"
+
+namespace tailor {
+namespace {
+
+Mesh make_mesh(std::vector<float> positions, std::vector<uint32_t> indices) {
+  Mesh m;
+  m.positions = std::move(positions);
+  m.indices = std::move(indices);
+  return m;
+}
+
+// Every paired edge must point back, join the same two vertices in opposite directions, and
+// belong to another face.
+void expect_consistent(const Mesh& mesh, const Topology& t) {
+  ASSERT_EQ(t.opposite.size(), mesh.indices.size());
+  for (uint32_t e = 0; e < t.opposite.size(); ++e) {
+    const uint32_t o = t.opposite[e];
+    if (o == kInvalid) continue;
+    ASSERT_LT(o, t.opposite.size());
+    EXPECT_EQ(t.opposite[o], e);
+    EXPECT_NE(o / 3, e / 3);
+    const uint32_t a = mesh.indices[e], b = mesh.indices[e - e % 3 + (e % 3 + 1) % 3];
+    const uint32_t c = mesh.indices[o], d = mesh.indices[o - o % 3 + (o % 3 + 1) % 3];
+    EXPECT_EQ(a, d);
+    EXPECT_EQ(b, c);
+  }
+}
+
+struct Expected {
+  const char* file;
+  size_t faces;
+  uint32_t components;
+  size_t boundary_edges;
+  long euler;  // referenced vertices - edges + faces
+};
+
+class RealMeshTopology : public ::testing::TestWithParam<Expected> {};
+
+TEST_P(RealMeshTopology, MatchesManifest) {
+  const Expected& x = GetParam();
+  Mesh mesh;
+  LoadReport report;
+  const Status s = load_mesh(std::string(TAILOR_TEST_DATA) + "/meshes/" + x.file, mesh, &report);
+  ASSERT_TRUE(s.is_ok()) << s.message();
+  const Topology t = build_topology(mesh);
+  expect_consistent(mesh, t);
+  EXPECT_EQ(mesh.face_count(), x.faces);
+  EXPECT_EQ(t.vertex_components, x.components);
+  EXPECT_EQ(t.boundary_edges, x.boundary_edges);
+  EXPECT_EQ(t.nonmanifold_edges, 0u);
+  EXPECT_EQ(t.inconsistent_edges, 0u);
+  const long referenced = static_cast<long>(mesh.vertex_count() - report.unreferenced_vertices);
+  EXPECT_EQ(referenced - static_cast<long>(t.edges) + static_cast<long>(mesh.face_count()), x.euler);
+  // Every paired edge is one undirected edge seen twice; boundaries once.
+  size_t paired = 0;
+  for (uint32_t o : t.opposite) paired += o != kInvalid;
+  EXPECT_EQ(paired / 2 + t.boundary_edges, t.edges);
+}
+
+INSTANTIATE_TEST_SUITE_P(Manifest, RealMeshTopology,
+                         ::testing::Values(Expected{"spot.obj", 5856, 1, 0, 2},
+                                           Expected{"fandisk.off", 14454, 1, 0, 2},
+                                           Expected{"fertility.off", 9000, 1, 0, -6},
+                                           Expected{"blobby-3cc.off", 3417, 3, 219, 2},
+                                           Expected{"featuretype.stl", 3476, 1, 576, -16},
+                                           Expected{"horse.ply", 96966, 1, 0, 2}),
+                         [](const auto& info) {
+                           std::string name = info.param.file;
+                           for (char& c : name) c = std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+                           return name;
+                         });
+
+TEST(Topology, TwoTrianglesShareOneEdge) {
+  // 0-1-2 and 2-1-3 share edge 1-2 (edge 1 of face 0 runs 1->2, edge 0 of face 1 runs 2->1).
+  const Mesh m = make_mesh({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0}, {0, 1, 2, 2, 1, 3});
+  const Topology t = build_topology(m);
+  EXPECT_EQ(t.opposite[1], 3u);
+  EXPECT_EQ(t.opposite[3], 1u);
+  EXPECT_EQ(neighbour_face(t, 1), 1u);
+  EXPECT_EQ(t.edges, 5u);
+  EXPECT_EQ(t.boundary_edges, 4u);
+  EXPECT_EQ(t.edge_components, 1u);
+}
+
+TEST(Topology, BowTieVertexJoinsByVertexOnly) {
+  // Two triangles touching at vertex 2 only.
+  const Mesh m = make_mesh({0, 0, 0, 1, 0, 0, 0.5f, 1, 0, 0, 2, 0, 1, 2, 0}, {0, 1, 2, 2, 3, 4});
+  const Topology t = build_topology(m);
+  EXPECT_EQ(t.vertex_components, 1u);
+  EXPECT_EQ(t.edge_components, 2u);
+  EXPECT_EQ(t.boundary_edges, 6u);
+  for (uint32_t o : t.opposite) EXPECT_EQ(o, kInvalid);
+}
+
+TEST(Topology, FinEdgeWithThreeFacesIsCutAndCounted) {
+  // Faces 0,1,2 all use edge 0-1.
+  const Mesh m = make_mesh({0, 0, 0, 1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1}, {0, 1, 2, 1, 0, 3, 0, 1, 4});
+  const Topology t = build_topology(m);
+  EXPECT_EQ(t.nonmanifold_edges, 1u);
+  EXPECT_EQ(t.opposite[0], kInvalid);
+  EXPECT_EQ(t.opposite[3], kInvalid);
+  EXPECT_EQ(t.opposite[6], kInvalid);
+  EXPECT_EQ(t.edge_components, 3u);
+  EXPECT_EQ(t.vertex_components, 1u);
+}
+
+TEST(Topology, FlippedFaceIsInconsistentNotPaired) {
+  // Both faces run 1 -> 2.
+  const Mesh m = make_mesh({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0}, {0, 1, 2, 1, 2, 3});
+  const Topology t = build_topology(m);
+  EXPECT_EQ(t.inconsistent_edges, 1u);
+  for (uint32_t o : t.opposite) EXPECT_EQ(o, kInvalid);
+  EXPECT_EQ(t.edge_components, 2u);
+}
+
+TEST(Topology, HighValenceFanUsesSortedMatching) {
+  // A closed fan (cone without base) of 200 triangles around vertex 0: every spoke is shared.
+  constexpr uint32_t kSpokes = 200;
+  std::vector<float> p = {0, 0, 1};
+  std::vector<uint32_t> idx;
+  for (uint32_t i = 0; i < kSpokes; ++i) {
+    const float a = 6.2831853f * static_cast<float>(i) / kSpokes;
+    p.insert(p.end(), {std::cos(a), std::sin(a), 0});
+    idx.insert(idx.end(), {0, 1 + i, 1 + (i + 1) % kSpokes});
+  }
+  const Mesh m = make_mesh(p, idx);
+  const Topology t = build_topology(m);
+  expect_consistent(m, t);
+  EXPECT_EQ(t.edges, 2u * kSpokes);
+  EXPECT_EQ(t.boundary_edges, kSpokes);
+  EXPECT_EQ(t.edge_components, 1u);
+  for (uint32_t f = 0; f < kSpokes; ++f) {
+    EXPECT_NE(t.opposite[3 * f], kInvalid);
+    EXPECT_NE(t.opposite[3 * f + 2], kInvalid);
+    EXPECT_EQ(t.opposite[3 * f + 1], kInvalid);
+  }
+}
+
+}  // namespace
+}  // namespace tailor
