@@ -5,7 +5,7 @@ BUILD_DIR ?= build
 JOBS ?= 2
 CMAKE_FLAGS ?=
 EXAMPLE_MESH := examples/spot.obj
-EXAMPLE_TEXTURE := examples/gravel-tile.png
+EXAMPLE_TEXTURE := examples/gravel.png
 
 .PHONY: all deps configure build test run bench fuzz clean
 
@@ -28,8 +28,10 @@ test: build
 # The main job on the bundled example: textured .glb, preview pictures and stats in out/.
 run: build
 	@mkdir -p out
-	@$(BUILD_DIR)/tailor map $(EXAMPLE_MESH) --texture $(EXAMPLE_TEXTURE) -o out/example.glb \
-	   --stats out/example_stats.json --preview out/example_preview.png
+	@$(BUILD_DIR)/tailor tile $(EXAMPLE_TEXTURE) -o out/gravel_tile.png
+	@$(BUILD_DIR)/tailor map $(EXAMPLE_MESH) --texture out/gravel_tile.png -o out/example.glb \
+	   --stats out/example_stats.json --preview out/example_preview.png --preview-all
+	@echo "open it in a browser: $(BUILD_DIR)/tailor view out/example.glb"
 
 bench: build
 	@bash scripts/bench.sh $(BUILD_DIR)

@@ -68,11 +68,12 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
   if (!options.texture_path.empty())
     TAILOR_RETURN_IF_ERROR(read_texture_bytes(options.texture_path, texture_bytes, mime_type));
 
-  // glTF's v axis points down the image: TEXCOORD_0 = (s, 1 - t) (see export.h).
+  // glTF's v axis points down the image: TEXCOORD_0 = (s, -t), the usual (s, 1 - t) shifted by a
+  // whole repeat (invisible with REPEAT) but exact, so a round trip is bit-exact (see export.h).
   std::vector<float> texcoords(2 * vertex_count);
   for (size_t s = 0; s < vertex_count; ++s) {
     texcoords[2 * s] = split.uvs[2 * s];
-    texcoords[2 * s + 1] = 1.0f - split.uvs[2 * s + 1];
+    texcoords[2 * s + 1] = -split.uvs[2 * s + 1];
   }
   float lo[3] = {std::numeric_limits<float>::max(), std::numeric_limits<float>::max(), std::numeric_limits<float>::max()};
   float hi[3] = {-lo[0], -lo[1], -lo[2]};

@@ -8,6 +8,8 @@
 #include <stb/stb_image_write.h>
 
 #include <climits>
+#include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 
@@ -19,7 +21,48 @@ namespace tailor {
 
 namespace {
 
-std::string size_text(int width, int height) { return std::to_string(width) + "x" + std::to_string(height); }
+std::string size_text(long width, long height) { return std::to_string(width) + "x" + std::to_string(height); }
+
+uint32_t be16(const unsigned char* p) { return (uint32_t{p[0]} << 8) | p[1]; }
+uint32_t be32(const unsigned char* p) {
+  return (uint32_t{p[0]} << 24) | (uint32_t{p[1]} << 16) | (uint32_t{p[2]} << 8) | p[3];
+}
+
+//! The size a PNG, JPEG or BMP header claims, read directly: stb_image refuses (with a vague
+//! "unknown image type") headers whose size would overflow its own limits, and the user should
+//! rather hear "too large". Returns false when the header is not recognised.
+bool claimed_size(const std::string& bytes, long& width, long& height) {
+  const auto* p = reinterpret_cast<const unsigned char*>(bytes.data());
+  const size_t n = bytes.size();
+  if (n >= 24 && std::memcmp(p, "\x89PNG\r\n\x1a\n", 8) == 0 && std::memcmp(p + 12, "IHDR", 4) == 0) {
+    width = be32(p + 16);
+    height = be32(p + 20);
+    return true;
+  }
+  if (n >= 4 && p[0] == 0xFF && p[1] == 0xD8) {  // JPEG: walk the markers up to a start-of-frame
+    size_t i = 2;
+    while (i + 9 < n && p[i] == 0xFF) {
+      const unsigned marker = p[i + 1];
+      if (marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC) {
+        height = be16(p + i + 5);
+        width = be16(p + i + 7);
+        return true;
+      }
+      i += 2 + be16(p + i + 2);
+    }
+    return false;
+  }
+  if (n >= 26 && p[0] == 'B' && p[1] == 'M') {
+    auto le32 = [&](size_t o) {
+      return static_cast<int32_t>(uint32_t{p[o]} | (uint32_t{p[o + 1]} << 8) | (uint32_t{p[o + 2]} << 16) |
+                                  (uint32_t{p[o + 3]} << 24));
+    };
+    width = std::labs(le32(18));
+    height = std::labs(le32(22));
+    return true;
+  }
+  return false;
+}
 
 }  // namespace
 
@@ -35,13 +78,18 @@ Status load_image(const std::string& path, Image& image) {
 
   int width = 0, height = 0, channels = 0;
   if (stbi_info_from_memory(data, length, &width, &height, &channels) == 0) {
+    long claimed_w = 0, claimed_h = 0;
+    if (claimed_size(bytes, claimed_w, claimed_h) && (claimed_w > kMaxImageSide || claimed_h > kMaxImageSide))
+      return Status::error(ErrorCode::kInvalidImage, path,
+                           "image too large (the limit is " + std::to_string(kMaxImageSide) + " px a side)",
+                           "header says " + size_text(claimed_w, claimed_h));
     const char* reason = stbi_failure_reason();
-    return Status::error(ErrorCode::kInvalidImage, path,
-                         "not a readable PNG, JPEG, TGA or BMP image",
+    return Status::error(ErrorCode::kInvalidImage, path, "not a readable PNG, JPEG, TGA or BMP image",
                          std::string("header: ") + (reason ? reason : "unknown format"));
   }
   if (width <= 0 || height <= 0)
-    return Status::error(ErrorCode::kInvalidImage, path, "image has no pixels", "header says " + size_text(width, height));
+    return Status::error(ErrorCode::kInvalidImage, path, "image has no pixels",
+                         "header says " + size_text(width, height));
   if (width > kMaxImageSide || height > kMaxImageSide)
     return Status::error(ErrorCode::kInvalidImage, path,
                          "image too large (the limit is " + std::to_string(kMaxImageSide) + " px a side)",

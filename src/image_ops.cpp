@@ -11,11 +11,10 @@
 namespace tailor {
 
 Status check_image(const Image& image) {
-  if (image.width < 1 || image.height < 1)
-    return Status::error(ErrorCode::kInvalidImage, "", "image has no pixels");
+  if (image.width < 1 || image.height < 1) return Status::error(ErrorCode::kInvalidImage, "", "image has no pixels");
   if (image.width > kMaxImageSide || image.height > kMaxImageSide)
-    return Status::error(ErrorCode::kInvalidImage, "", "image too large (the limit is " +
-                                                           std::to_string(kMaxImageSide) + " px a side)");
+    return Status::error(ErrorCode::kInvalidImage, "",
+                         "image too large (the limit is " + std::to_string(kMaxImageSide) + " px a side)");
   if (image.channels < 1 || image.channels > 4)
     return Status::error(ErrorCode::kInvalidImage, "", "image must have 1 to 4 channels");
   const size_t expected = static_cast<size_t>(image.width) * image.height * image.channels;
@@ -70,7 +69,8 @@ Image to_grey(const Image& image) {
 Status resize_image(const Image& image, int width, int height, Image& resized) {
   TAILOR_RETURN_IF_ERROR(check_image(image));
   if (width < 1 || height < 1 || width > kMaxImageSide || height > kMaxImageSide)
-    return Status::error(ErrorCode::kInvalidArgument, "", "resize target outside [1, " + std::to_string(kMaxImageSide) + "]");
+    return Status::error(ErrorCode::kInvalidArgument, "",
+                         "resize target outside [1, " + std::to_string(kMaxImageSide) + "]");
   try {
     const cv::Mat src(image.height, image.width, CV_8UC(image.channels), const_cast<uint8_t*>(image.pixels.data()));
     resized = Image{};

@@ -346,14 +346,14 @@ Status parse_glb(std::span<const char> data, const std::string& name, Mesh& mesh
           return Status::error(ErrorCode::kInvalidMesh, name, "index out of range", where + " index " + std::to_string(i));
         mesh.indices[first_corner + i] = static_cast<uint32_t>(base + local);
       }
-      // UVs per corner, OBJ convention (t = 1 - v_gltf); primitives without UVs get none.
+      // UVs per corner, OBJ convention up to a whole repeat (t = -v_gltf, see export.h).
       mesh.corner_uvs.resize(2 * mesh.indices.size(), 0.0f);
       if (has_uv) {
         ++with_uv;
         for (size_t i = 0; i < corner_count; ++i) {
           const size_t local = mesh.indices[first_corner + i] - base;
           mesh.corner_uvs[2 * (first_corner + i)] = read_float(uvs, local, 0);
-          mesh.corner_uvs[2 * (first_corner + i) + 1] = 1.0f - read_float(uvs, local, 1);
+          mesh.corner_uvs[2 * (first_corner + i) + 1] = -read_float(uvs, local, 1);
         }
       }
       ++triangle_primitives;

@@ -54,7 +54,7 @@ Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh,
   std::vector<uint32_t> corner_vt;     // per triangle corner: vt index or kInvalid
   std::vector<ForwardRef> forward_v, forward_vt;
   std::vector<uint32_t> poly, poly_vt;
-  size_t corners_without_vt = 0;
+  size_t corners_without_vt = 0;       // once nonzero, corner_vt is dropped and no longer filled
 
   while (!s.at_end()) {
     const std::string_view w = s.word();
@@ -111,10 +111,14 @@ Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh,
       }
       ++report.source_faces;
       if (n > 3) ++report.polygons_triangulated;
-      for (size_t k = 1; k + 1 < n; ++k) {
-        mesh.indices.insert(mesh.indices.end(), {poly[0], poly[k], poly[k + 1]});
-        corner_vt.insert(corner_vt.end(), {poly_vt[0], poly_vt[k], poly_vt[k + 1]});
-        corners_without_vt += (poly_vt[0] == kInvalid) + (poly_vt[k] == kInvalid) + (poly_vt[k + 1] == kInvalid);
+      for (size_t k = 1; k + 1 < n; ++k) mesh.indices.insert(mesh.indices.end(), {poly[0], poly[k], poly[k + 1]});
+      if (corners_without_vt == 0) {
+        for (uint32_t t : poly_vt) corners_without_vt += t == kInvalid;
+        if (corners_without_vt == 0) {
+          for (size_t k = 1; k + 1 < n; ++k) corner_vt.insert(corner_vt.end(), {poly_vt[0], poly_vt[k], poly_vt[k + 1]});
+        } else {
+          std::vector<uint32_t>().swap(corner_vt);  // no uvs after all: stop recording them
+        }
       }
       if (mesh.indices.size() / 3 > kMaxFaces) return Status::error(ErrorCode::kLimit, name, "too many faces", s.where());
     }

@@ -5,6 +5,7 @@
 #include <string_view>
 #include <vector>
 
+#include "internal/huge_pages.h"
 #include "internal/readers.h"
 #include "internal/text_scan.h"
 
@@ -78,6 +79,7 @@ Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh,
   if (nf > kMaxFaces) return Status::error(ErrorCode::kLimit, name, "too many faces (" + std::to_string(nf) + ")");
 
   // === Vertices: x y z, then anything up to the end of the line =================================
+  reserve_huge(mesh.positions, static_cast<size_t>(3 * nv));
   mesh.positions.resize(static_cast<size_t>(3 * nv));
   for (size_t i = 0; i < nv; ++i) {
     s.skip_space();
@@ -90,7 +92,7 @@ Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh,
   }
 
   // === Faces: n i0 .. i(n-1), then optional colour values =======================================
-  mesh.indices.reserve(static_cast<size_t>(3 * nf));
+  reserve_huge(mesh.indices, static_cast<size_t>(3 * nf));
   std::vector<uint32_t> poly;
   for (size_t f = 0; f < nf; ++f) {
     s.skip_space();

@@ -21,6 +21,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "internal/huge_pages.h"
 #include "internal/readers.h"
 #include "internal/text_scan.h"
 
@@ -312,8 +313,15 @@ class AsciiSource {
   // Every ascii value takes at least one character and one separator.
   uint64_t list_min_bytes(uint64_t n, PlyType) const { return n == 0 ? 0 : mul_sat(n, 2) - 1; }
 
-  bool value(PlyType, double& out) {
+  bool value(PlyType t, double& out) {
     s_.skip_space();
+    if (t == PlyType::kFloat32) {
+      // Decimal -> float directly: decimal -> double -> float can round twice.
+      float f;
+      if (!s_.read_float(f)) return false;
+      out = f;
+      return true;
+    }
     return s_.read_double(out);
   }
   bool skip(PlyType t) {
@@ -420,6 +428,7 @@ class BodyReader {
   // === Vertices =================================================================================
   Status read_vertices(const PlyElement& e) {
     // Counts were checked against the file size before this point (check_counts).
+    reserve_huge(mesh_.positions, static_cast<size_t>(3 * e.count));
     mesh_.positions.resize(static_cast<size_t>(3 * e.count));
     bool have_uv = false;
     for (const PlyProperty& p : e.props) have_uv = have_uv || p.role == Role::kU;
@@ -495,7 +504,7 @@ class BodyReader {
     const uint64_t tri_bytes =
         Source::kBinary ? type_size(ip->count_type) + 3 * type_size(ip->type) : 6;
     const uint64_t bounded = std::min<uint64_t>(e.count, src_.remaining() / tri_bytes);
-    mesh_.indices.reserve(mesh_.indices.size() + static_cast<size_t>(3 * bounded));
+    reserve_huge(mesh_.indices, mesh_.indices.size() + static_cast<size_t>(3 * bounded));
     bool have_tc = false, have_seam = false;
     for (const PlyProperty& p : e.props) {
       have_tc = have_tc || p.role == Role::kTexcoord;

@@ -135,7 +135,10 @@ Status read_stl(std::span<const char> data, const std::string& name, Mesh& mesh,
   if (data.size() >= kBinaryHeader) {
     uint32_t n = 0;
     std::memcpy(&n, data.data() + 80, 4);
-    binary = kBinaryHeader + kBinaryFacet * uint64_t{n} == data.size() || !starts_with_solid(text);
+    // ASCII STL never holds a NUL byte; binary facets nearly always do (zero coordinates,
+    // attribute bytes), which catches truncated binary files whose header says "solid".
+    binary = kBinaryHeader + kBinaryFacet * uint64_t{n} == data.size() || !starts_with_solid(text) ||
+             std::memchr(data.data(), '\0', data.size()) != nullptr;
   }
   if (!binary && !starts_with_solid(text)) {
     return Status::error(ErrorCode::kParse, name, "not an STL file (too short for binary, no 'solid' keyword)");

@@ -14,7 +14,6 @@
 #include "internal/mapping_common.h"
 
 namespace tailor::internal {
-uint64_t dbg_conflict = 0, dbg_stretch = 0;
 namespace {
 
 constexpr float kPi = 3.14159265358979f;
@@ -47,6 +46,7 @@ class PatchMapper {
     bound_ = in_.options.max_stretch;
     max_seed_rotation_ = in_.options.max_seed_rotation_deg * kPi / 180.f;
     factor_step_ = in_.factor_step;
+    relax_ = 1.f - in_.options.field_following;
 
     atlas_.corner_uv.assign(6 * face_count, 0.f);
     atlas_.patch.assign(face_count, kInvalid);
@@ -56,14 +56,6 @@ class PatchMapper {
     indices_ = mesh.indices.data();
     vertex_patch_.assign(mesh.vertex_count(), kInvalid);
     vertex_uv_.assign(2 * mesh.vertex_count(), 0.f);
-    degenerate_.assign(face_count, 0);
-    for (size_t f = 0; f < face_count; ++f) {
-      const float* l = local_ + 6 * f;
-      const float twice_area = l[2] * l[5] - l[3] * l[4];
-      const float e0 = l[2] * l[2] + l[3] * l[3], e2 = l[4] * l[4] + l[5] * l[5];
-      const float e1 = (l[4] - l[2]) * (l[4] - l[2]) + (l[5] - l[3]) * (l[5] - l[3]);
-      degenerate_[f] = !(twice_area > kDegenerateRatio * std::max({e0, e1, e2}));
-    }
     queue_.reset(face_count);
     patch_rotation_.reserve(256);
     patch_size_.reserve(256);
@@ -80,13 +72,18 @@ class PatchMapper {
         const uint32_t f = FaceQueue::face_of(key);
         const uint64_t cls = front_class(key);
         if (cls == kWaiting) {
-          if (!try_place(f, current_)) {
+          // First pass: only placements that leave no cut; the others wait, so the front flows
+          // around them and cuts are made only where it is otherwise stuck (measured: 10-35%
+          // less seam length than cutting at once, e.g. bunny 9.4% -> 8.2% of edge length).
+          if (!try_place(f, current_, false)) {
             ++stats_.deferrals;
             queue_.set(with_class(key, kDeferred));
           }
         } else if (cls == kDeferred) {
           // Only deferred (and seam) faces wait: the front of the current patch is exhausted.
-          current_ = start_patch(f);
+          // Join it (or, for a face deferred by an earlier patch, the neighbouring patch) with a
+          // cut if that fits the bound, else start a new patch there.
+          if (!try_place(f, current_, true) && !try_place(f, kAnyPatch, true)) current_ = start_patch(f);
         } else if (!try_place(f, kAnyPatch)) {
           join_rigidly(f);  // a user seam face: joins a neighbouring patch, the cut runs along it
         }
@@ -117,9 +114,19 @@ class PatchMapper {
     y = r.s * dx + r.c * dy;
   }
 
-  // Thesis eq. 2.3-2.4: A, B copied, C the mean of its predictions from A and from B.
+  // Thesis eq. 2.3-2.4: A, B copied, C the mean of its predictions from A and from B. With
+  // field_following < 1 the face's frame is first turned by that share of the angle between its
+  // edge AB and the UV edge AB, so the texture direction follows the unfolding instead of the field.
   float unfold(uint32_t f, int k, const float* ua, const float* ub, Rotation r, float* out) const {
     const int ka = k, kb = (k + 1) % 3, kc = (k + 2) % 3;
+    if (relax_ > 0.f) {
+      float vx, vy;
+      frame_vector(f, ka, kb, r, vx, vy);
+      const float wx = ub[0] - ua[0], wy = ub[1] - ua[1];
+      const float theta = relax_ * std::atan2(vx * wy - vy * wx, vx * wx + vy * wy);
+      const float c = std::cos(theta), sn = std::sin(theta);
+      r = Rotation{r.c * c - r.s * sn, r.s * c + r.c * sn};
+    }
     float ax, ay, bx, by;
     frame_vector(f, ka, kc, r, ax, ay);
     frame_vector(f, kb, kc, r, bx, by);
@@ -132,6 +139,14 @@ class PatchMapper {
     out[2 * kc] = 0.5f * (pax + pbx);
     out[2 * kc + 1] = 0.5f * (pay + pby);
     return std::sqrt((pax - pbx) * (pax - pbx) + (pay - pby) * (pay - pby));
+  }
+
+  bool is_degenerate(uint32_t f) const {
+    const float* l = local_ + 6 * f;
+    const float twice_area = l[2] * l[5] - l[3] * l[4];
+    const float e0 = l[2] * l[2] + l[3] * l[3], e2 = l[4] * l[4] + l[5] * l[5];
+    const float e1 = (l[4] - l[2]) * (l[4] - l[2]) + (l[5] - l[3]) * (l[5] - l[3]);
+    return !(twice_area > kDegenerateRatio * std::max({e0, e1, e2}));
   }
 
   float stretch(uint32_t f, const float* uv) const {
@@ -164,12 +179,15 @@ class PatchMapper {
 
   // === Placement ===============================================================================
   // Tries to join face f to patch `target` (kAnyPatch: the neighbouring patch with the most shared
-  // edges). Candidates, best first: all known corners together (seamless with every placed
-  // neighbour of that patch), then unfolding across a single edge (the others become cuts), the
-  // one with the least stretch. Accepts the first within the bound.
-  bool try_place(uint32_t f, uint32_t target) {
-    int edges[3];
-    int count = 0;
+  // edges). The face is unfolded across one edge from a placed neighbour (its two corners copied,
+  // so that edge is seamless); its third corner reuses, in this order of preference, the UV a
+  // second placed neighbour gives it (seamless with that one too; with every neighbour when they
+  // all agree), the UV the patch already gave its vertex through a face around it (the thesis's
+  // "three textured vertices"), or a fresh UV, the mean of its two predictions (thesis eq. 2.3).
+  // Reusing UVs first keeps a cut, once made, from spreading along the front. Within a tier the
+  // least stretched triangle wins; the first tier with one within the bound is accepted. Without
+  // allow_cuts, placements that disagree with a placed neighbour of the patch are not considered.
+  bool try_place(uint32_t f, uint32_t target, bool allow_cuts = true) {
     if (target == kAnyPatch) {
       uint32_t patches[3];
       int n = 0;
@@ -188,92 +206,88 @@ class PatchMapper {
         }
       }
     }
+    // Corner UVs offered by the placed neighbours of the target patch, per edge.
+    const float* ends[3][2] = {};
+    int edges[3];
+    int count = 0;
     for (int k = 0; k < 3; ++k) {
       const uint32_t o = opposite_[3 * f + k];
-      if (o != kInvalid && patch_[o / 3] == target) edges[count++] = k;
+      if (o == kInvalid || patch_[o / 3] != target) continue;
+      neighbour_edge_uv(f, k, ends[k][0], ends[k][1]);
+      edges[count++] = k;
     }
     if (count == 0) return false;
     const Rotation r = patch_rotation_[target];
+    const bool degenerate = is_degenerate(f);
     float candidate[6], best[6] = {0.f, 0.f, 0.f, 0.f, 0.f, 0.f};
-
-    // --- All known corners together -------------------------------------------------------------
-    float known[6] = {0.f, 0.f, 0.f, 0.f, 0.f, 0.f};
-    bool has[3] = {false, false, false};
-    bool conflict = false;
-    for (int i = 0; i < count && !conflict; ++i) {
-      const int k = edges[i];
-      const float* ends[2];
-      neighbour_edge_uv(f, k, ends[0], ends[1]);
-      for (int j = 0; j < 2; ++j) {
-        const int corner = (k + j) % 3;
-        if (!has[corner]) {
-          has[corner] = true;
-          known[2 * corner] = ends[j][0];
-          known[2 * corner + 1] = ends[j][1];
-        } else if (known[2 * corner] != ends[j][0] || known[2 * corner + 1] != ends[j][1]) {
-          conflict = true;
-        }
-      }
-    }
-    const bool degenerate = degenerate_[f] != 0;
-    if (!conflict && !(has[0] && has[1] && has[2])) {
-      // One corner unknown from edge neighbours: the patch may already hold its vertex through a
-      // face around it (the thesis's "three textured vertices"); reuse that UV when it fits.
-      const int missing = !has[0] ? 0 : (!has[1] ? 1 : 2);
-      const uint32_t v = indices_[3 * f + missing];
-      if (vertex_patch_[v] == target) {
-        std::copy(known, known + 6, candidate);
-        candidate[2 * missing] = vertex_uv_[2 * v];
-        candidate[2 * missing + 1] = vertex_uv_[2 * v + 1];
-        const float s = degenerate ? 0.f : stretch(f, candidate);
-        if (s <= bound_) {
-          accept(f, target, candidate, 0.f, s, true);
-          return true;
-        }
-      }
-    }
-    if (!conflict) {
-      if (has[0] && has[1] && has[2]) {
-        const float s = degenerate ? 0.f : stretch(f, known);
-        if (s <= bound_) {
-          accept(f, target, known, 0.f, s, true);
-          return true;
-        }
-      } else {
-        const float* ua;
-        const float* ub;
-        neighbour_edge_uv(f, edges[0], ua, ub);
-        const float err = unfold(f, edges[0], ua, ub, r, candidate);
-        const float s = degenerate ? 0.f : stretch(f, candidate);
-        if (s <= bound_) {
-          accept(f, target, candidate, err, s, false);
-          return true;
-        }
-        if (count == 1) return false;
-      }
-    }
-
-    if (conflict) ++dbg_conflict; else ++dbg_stretch;
-    // --- One edge at a time: the least stretched -------------------------------------------------
     float best_stretch = std::numeric_limits<float>::infinity(), best_error = 0.f;
-    for (int i = 0; i < count; ++i) {
-      const float* ua;
-      const float* ub;
-      neighbour_edge_uv(f, edges[i], ua, ub);
-      const float err = unfold(f, edges[i], ua, ub, r, candidate);
-      const float s = degenerate ? err : stretch(f, candidate);
+    bool best_cuts = false;
+    auto consider = [&](float s, float err, bool cuts) {
+      if (cuts && !allow_cuts) return;
       if (s < best_stretch) {
         best_stretch = s;
         best_error = err;
+        best_cuts = cuts;
         std::copy(candidate, candidate + 6, best);
       }
-    }
-    if (degenerate || best_stretch <= bound_) {
-      ++stats_.faces_cut;
-      accept(f, target, best, best_error, degenerate ? 0.f : best_stretch, false);
+    };
+    auto accept_best = [&](bool three_known) {
+      if (!(degenerate || best_stretch <= bound_)) return false;
+      if (best_cuts) ++stats_.faces_cut;
+      accept(f, target, best, best_error, degenerate ? 0.f : best_stretch, three_known);
       return true;
+    };
+
+    // --- Tier 1: third corner from a second placed neighbour ----------------------------------
+    if (count >= 2) {
+      for (int i = 0; i < count; ++i) {
+        const int k = edges[i], kc = (k + 2) % 3;
+        // The other edges touching corner kc: k+1 (kc is its end) and k+2 (kc is its start).
+        for (int j = 0; j < count; ++j) {
+          const int m = edges[j];
+          if (m == k) continue;
+          const float* c = (m == (k + 1) % 3) ? ends[m][1] : ends[m][0];
+          const int ka = k, kb = (k + 1) % 3;
+          candidate[2 * ka] = ends[k][0][0];
+          candidate[2 * ka + 1] = ends[k][0][1];
+          candidate[2 * kb] = ends[k][1][0];
+          candidate[2 * kb + 1] = ends[k][1][1];
+          candidate[2 * kc] = c[0];
+          candidate[2 * kc + 1] = c[1];
+          // Seamless with neighbour m only if it also agrees on the corner it shares with edge k.
+          const float* shared = (m == (k + 1) % 3) ? ends[m][0] : ends[m][1];
+          const float* mine = (m == (k + 1) % 3) ? ends[k][1] : ends[k][0];
+          const bool cuts = shared[0] != mine[0] || shared[1] != mine[1];
+          consider(degenerate ? 0.f : stretch(f, candidate), 0.f, cuts);
+          if (!cuts && best_stretch <= bound_ && !best_cuts) return accept_best(true);
+        }
+      }
+      if (accept_best(true)) return true;
     }
-    return false;
+
+    // --- Tier 2: third corner from the patch's UV of its vertex --------------------------------
+    for (int i = 0; i < count; ++i) {
+      const int k = edges[i], kc = (k + 2) % 3;
+      const uint32_t v = indices_[3 * f + kc];
+      if (vertex_patch_[v] != target) continue;
+      const int ka = k, kb = (k + 1) % 3;
+      candidate[2 * ka] = ends[k][0][0];
+      candidate[2 * ka + 1] = ends[k][0][1];
+      candidate[2 * kb] = ends[k][1][0];
+      candidate[2 * kb + 1] = ends[k][1][1];
+      candidate[2 * kc] = vertex_uv_[2 * v];
+      candidate[2 * kc + 1] = vertex_uv_[2 * v + 1];
+      consider(degenerate ? 0.f : stretch(f, candidate), 0.f, count > 1);
+    }
+    if (accept_best(true)) return true;
+
+    // --- Tier 3: a fresh third corner ----------------------------------------------------------
+    for (int i = 0; i < count; ++i) {
+      const int k = edges[i];
+      const float err = unfold(f, k, ends[k][0], ends[k][1], r, candidate);
+      consider(degenerate ? err : stretch(f, candidate), err, count > 1);
+    }
+    return accept_best(false);
   }
 
   // Chooses the placed neighbour edge of f whose UV edge is closest in direction to f's frame
@@ -355,7 +369,7 @@ class PatchMapper {
   // mismatch. Falls back to a rigid copy from corner k when even that exceeds the bound.
   void place_aligned(uint32_t f, int k, const float* ua, const float* ub, Rotation r, float* uv) {
     const float err = unfold(f, k, ua, ub, r, uv);
-    const float s = degenerate_[f] ? 0.f : stretch(f, uv);
+    const float s = is_degenerate(f) ? 0.f : stretch(f, uv);
     if (s <= bound_) {
       stats_.max_error_px = std::max(stats_.max_error_px, err);
       stats_.max_stretch_accepted = std::max(stats_.max_stretch_accepted, s);
@@ -468,6 +482,7 @@ class PatchMapper {
   const float* anchor_ = nullptr;
   const uint8_t* seam_ = nullptr;
   float scale_ = 1.f, bound_ = 0.f, max_seed_rotation_ = 0.f;
+  float relax_ = 0.f;  // 1 - field_following: share of the edge mismatch taken as rotation
   double factor_step_ = 0.0, factor_ = 0.0;
   float* uv_ = nullptr;
   uint32_t* patch_ = nullptr;
@@ -475,7 +490,6 @@ class PatchMapper {
   const uint32_t* indices_ = nullptr;
   std::vector<uint32_t> vertex_patch_;  // per vertex: the patch whose UV vertex_uv_ holds (a hint)
   std::vector<float> vertex_uv_;        // per vertex: 2 floats
-  std::vector<uint8_t> degenerate_;
   std::vector<Rotation> patch_rotation_;
   std::vector<uint32_t> patch_size_;
   std::vector<uint32_t> patch_seed_;

@@ -74,6 +74,7 @@ Status map_thesis(const MappingInput& in, Atlas& atlas, MappingStats& stats) {
       vertex_uv[2 * v + 1] = (anchor[2 * seed + 1] + local[6 * seed + 2 * k + 1]) * scale;
       textured[v] = 1;
     }
+    ++stats.faces_unfolded;
     finish_face(seed, patch);
     while (!queue.empty()) {
       if (cancelled) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
@@ -147,6 +148,7 @@ Status map_thesis(const MappingInput& in, Atlas& atlas, MappingStats& stats) {
     if (!(signed_area > 0.f)) ++stats.inverted_accepted;
   }
   atlas.patch_count = patch;
+  stats.patches_before_absorb = patch;
   stats.final_threshold_px = threshold;
   return Status::ok();
 }

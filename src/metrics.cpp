@@ -247,8 +247,10 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
   metrics.uv_scale = scale;
 
   // Pass 2: per-face quantities.
-  std::vector<double> angles;
+  std::vector<double> angles, ratios, areas;  // per non-degenerate face
   angles.reserve(nf - metrics.degenerate_faces);
+  ratios.reserve(nf - metrics.degenerate_faces);
+  areas.reserve(nf - metrics.degenerate_faces);
   double sum_r = 0;
   size_t counted = 0;
   double l2_num = 0, l2_den = 0, gamma_max = 0;
@@ -258,6 +260,8 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
     ++counted;
     const double r = std::abs(face.area_uv) / face.area3d;
     sum_r += r;
+    ratios.push_back(r);
+    areas.push_back(face.area3d);
     angles.push_back(angle_distortion_deg(face));
     // Ties (and empty votes) count as counter-clockwise, the orientation the mapping produces.
     const bool majority_positive = patch_vote[patch[f]] >= 0;
@@ -275,12 +279,10 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
   const double mean_r = sum_r / static_cast<double>(counted);
   // Second pass over r for a numerically stable variance (both forms).
   double var_sum = 0, var_w_sum = 0;
-  for (size_t f = 0; f < nf; ++f) {
-    const Face face = load_face(mesh, corner_uv, f);
-    if (face.degenerate) continue;
-    const double r = std::abs(face.area_uv) / face.area3d;
+  for (size_t i = 0; i < ratios.size(); ++i) {
+    const double r = ratios[i];
     var_sum += (r - mean_r) * (r - mean_r);
-    var_w_sum += face.area3d * (r - scale) * (r - scale);  // the area-weighted mean of r is R
+    var_w_sum += areas[i] * (r - scale) * (r - scale);  // the area-weighted mean of r is R
   }
   metrics.stretch = mean_r > 0 ? std::sqrt(var_sum / static_cast<double>(counted)) / mean_r : 0;
   metrics.stretch_area_weighted = std::sqrt(var_w_sum / sum_3d) / scale;

@@ -17,9 +17,6 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <chrono>
-static auto g_t0 = std::chrono::steady_clock::now();
-static void tick(const char* w){auto n=std::chrono::steady_clock::now();fprintf(stderr,"  %s %.3f\n",w,std::chrono::duration<double>(n-g_t0).count());g_t0=n;}
 #include <numbers>
 #include <string>
 #include <vector>
@@ -653,7 +650,6 @@ Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::s
     const int target_width = options.width * scale;
     const int target_height = options.height * scale;
 
-    tick("start");
     const Framing frame = frame_mesh(mesh);
     const std::vector<float> normals = vertex_normals(mesh);
     std::vector<Rgb> face_colors;
@@ -674,7 +670,6 @@ Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::s
       face_colors = distortion_colors(mesh, corner_uv, options.distortion_range);
     }
 
-    tick("cpu prep");
     OffscreenContext context;
     if (!context.create(target_width, target_height)) {
       return Status::error(ErrorCode::kUnsupported, "", "cannot create an off-screen OpenGL context (OSMesa)");
@@ -687,15 +682,17 @@ Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::s
                            std::to_string(max_texture) + " pixels a side");
     }
 
-    tick("context");
-    glViewport(0, 0, target_width, target_height);
+    // The distortion view keeps a band at the bottom for its legend, so the mesh never hides it.
+    const LegendBox box = legend_box(options.width, options.height);
+    const int band = options.view == PreviewView::kDistortion ? options.height - box.y + box.height : 0;
+    glViewport(0, band * scale, target_width, target_height - band * scale);
     glClearColor(kBackground[0] / 255.0f, kBackground[1] / 255.0f, kBackground[2] / 255.0f, 1.0f);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LEQUAL);
 
     // Camera: a 3/4 view from above, far enough that the bounding sphere fits both ways.
-    const double aspect = static_cast<double>(options.width) / options.height;
+    const double aspect = static_cast<double>(options.width) / (options.height - band);
     const double fovy = options.fov_degrees * std::numbers::pi / 180.0;
     const double half_fov = std::min(fovy / 2.0, std::atan(std::tan(fovy / 2.0) * aspect));
     const double distance = frame.radius / std::sin(half_fov) * 1.02;
@@ -755,20 +752,18 @@ Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::s
     glDisable(GL_TEXTURE_2D);
     draw_lines(lines, 1.25f * static_cast<float>(scale));
 
-    const LegendBox box = legend_box(options.width, options.height);
+    glViewport(0, 0, target_width, target_height);
     if (options.view == PreviewView::kDistortion) draw_legend_bar(box, target_width, target_height, scale);
     glFinish();
     if (glGetError() == GL_OUT_OF_MEMORY) {
       return Status::error(ErrorCode::kUnsupported, "", "the renderer ran out of memory");
     }
 
-    tick("lines+legend");
     out.width = options.width;
     out.height = options.height;
     out.channels = 3;
     out.pixels.assign(static_cast<size_t>(out.width) * static_cast<size_t>(out.height) * 3, 0);
     resolve(context.pixels(), target_width, scale, out);
-    tick("resolve");
     if (options.view == PreviewView::kDistortion) draw_legend_text(box, options.distortion_range, out);
     return Status::ok();
   } catch (const std::bad_alloc&) {

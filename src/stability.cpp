@@ -40,9 +40,19 @@ Status measure_stability(const Mesh& mesh, const OrientationOptions& orientation
     return Status::error(ErrorCode::kInvalidArgument, "", "remove fraction must be in (0, 0.9]");
 
   // === Full mapping ===
+  // The frame (axis and unit-cube normalisation) is resolved once on the full mesh and then given
+  // explicitly to both runs, as a client that keeps them would: the cut mesh alone would have a
+  // different bounding box and principal axis, which would move every UV.
   const Topology topology = build_topology(mesh);
   FaceFrames frames;
   TAILOR_RETURN_IF_ERROR(compute_orientation(mesh, topology, orientation, frames));
+  OrientationOptions fixed = orientation;
+  fixed.axis = AxisSource::kUser;
+  fixed.user_axis = frames.axis;
+  fixed.user_axis2 = frames.axis2;
+  fixed.fixed_origin = frames.origin;
+  fixed.fixed_unit_scale = frames.unit_scale;
+  TAILOR_RETURN_IF_ERROR(compute_orientation(mesh, topology, fixed, frames));
   MappingOptions map_options = mapping;
   map_options.progress = nullptr;
   if (!map_options.use_seed_point) {
@@ -103,15 +113,8 @@ Status measure_stability(const Mesh& mesh, const OrientationOptions& orientation
     map_options.seam_faces = cut_seams;
   }
   const Topology cut_topology = build_topology(cut);
-  // Same axis and normalisation as the full mesh, as a client that keeps them would.
-  OrientationOptions cut_orientation = orientation;
-  cut_orientation.axis = AxisSource::kUser;
-  cut_orientation.user_axis = frames.axis;
-  cut_orientation.user_axis2 = frames.axis2;
-  cut_orientation.fixed_origin = frames.origin;
-  cut_orientation.fixed_unit_scale = frames.unit_scale;
   FaceFrames cut_frames;
-  TAILOR_RETURN_IF_ERROR(compute_orientation(cut, cut_topology, cut_orientation, cut_frames));
+  TAILOR_RETURN_IF_ERROR(compute_orientation(cut, cut_topology, fixed, cut_frames));
   Atlas cut_atlas;
   MappingStats cut_stats;
   TAILOR_RETURN_IF_ERROR(map_texture(cut, cut_topology, cut_frames, map_options, cut_atlas, &cut_stats));
@@ -119,6 +122,8 @@ Status measure_stability(const Mesh& mesh, const OrientationOptions& orientation
   // === Compare surviving corners ===
   double sum = 0, worst = 0;
   size_t identical = 0, close = 0;
+  std::vector<double> differences;
+  differences.reserve(3 * original.size());
   for (size_t i = 0; i < original.size(); ++i) {
     const float* a = &full.corner_uv[6 * original[i]];
     const float* b = &cut_atlas.corner_uv[6 * i];
@@ -128,6 +133,7 @@ Status measure_stability(const Mesh& mesh, const OrientationOptions& orientation
       const double d = std::sqrt(du * du + dv * dv);
       sum += d;
       worst = std::max(worst, d);
+      differences.push_back(d);
       identical += (a[2 * k] == b[2 * k] && a[2 * k + 1] == b[2 * k + 1]) ? 1 : 0;
       close += d < 1.0 ? 1 : 0;
     }
@@ -138,6 +144,9 @@ Status measure_stability(const Mesh& mesh, const OrientationOptions& orientation
   report.compared_corners = corners;
   report.mean_difference_px = sum / static_cast<double>(corners);
   report.max_difference_px = worst;
+  std::nth_element(differences.begin(), differences.begin() + static_cast<std::ptrdiff_t>(differences.size() / 2),
+                   differences.end());
+  report.median_difference_px = differences[differences.size() / 2];
   report.identical_ratio = static_cast<double>(identical) / static_cast<double>(corners);
   report.within_1px_ratio = static_cast<double>(close) / static_cast<double>(corners);
   report.patches_full = full.patch_count;

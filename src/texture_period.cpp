@@ -4,9 +4,9 @@
 // the linear (not circular) autocorrelation; each lag is divided by its number of overlapping
 // pixel pairs (unbiased estimate) and by the lag-0 value, giving a correlation coefficient in
 // [-1, 1]. Along each axis the profile r(d) = R(d, 0) (resp. R(0, d)) is searched for peaks in
-// [3, size / 2]: the fundamental is the first peak reaching 80 % of the highest one (so harmonics
-// 2p, 3p are not taken for the period), refined to sub-pixel by a parabola and then by the
-// highest harmonic k p still in range (dividing its position by k divides the error by k).
+// [3, 2 size / 3] (at least a third of the pixels overlap): the fundamental is the first peak
+// reaching 80 % of the highest one (so harmonics 2p, 3p are not taken for the period), refined to sub-pixel by a
+// parabola and then by the highest harmonic k p still in range (dividing its position by k divides the error by k).
 #include <opencv2/core.hpp>
 
 #include <algorithm>
@@ -21,9 +21,10 @@ namespace tailor {
 namespace {
 
 constexpr int kMinLag = 3;
-constexpr double kHarmonicShare = 0.8;    // fundamental: first peak >= this share of the highest
-constexpr double kMinCorrelation = 0.25;  // a period needs a peak at least this correlated...
-constexpr double kMinConfidence = 0.3;    // ...and this far above the dip before it
+constexpr double kHarmonicShare = 0.8;      // fundamental: first peak >= this share of the highest
+constexpr double kMinCorrelation = 0.15;    // a period needs a peak at least this correlated...
+constexpr double kMinConfidence = 0.2;      // ...and this far above the dip before it
+constexpr double kMaxLagShare = 2.0 / 3.0;  // lags up to this share of the size (>= 1/3 overlap)
 
 //! Sub-pixel position of a peak at d from its two neighbours (parabola through three points).
 double parabola_peak(const std::vector<double>& r, int d) {
@@ -41,7 +42,8 @@ void find_period(const std::vector<double>& r, double& period, double& confidenc
   const int last = static_cast<int>(r.size()) - 2;  // a peak needs a right neighbour
   std::vector<int> peaks;
   for (int d = kMinLag; d <= last; ++d)
-    if (r[static_cast<size_t>(d)] >= r[static_cast<size_t>(d - 1)] && r[static_cast<size_t>(d)] > r[static_cast<size_t>(d + 1)])
+    if (r[static_cast<size_t>(d)] >= r[static_cast<size_t>(d - 1)] &&
+        r[static_cast<size_t>(d)] > r[static_cast<size_t>(d + 1)])
       peaks.push_back(d);
   if (peaks.empty()) return;
   double highest = -1.0;
@@ -63,7 +65,8 @@ void find_period(const std::vector<double>& r, double& period, double& confidenc
     const int centre = static_cast<int>(std::lround(k * p));
     int best = -1;
     for (int d = std::max(kMinLag, centre - 2); d <= std::min(last, centre + 2); ++d)
-      if (r[static_cast<size_t>(d)] >= r[static_cast<size_t>(d - 1)] && r[static_cast<size_t>(d)] > r[static_cast<size_t>(d + 1)] &&
+      if (r[static_cast<size_t>(d)] >= r[static_cast<size_t>(d - 1)] &&
+          r[static_cast<size_t>(d)] > r[static_cast<size_t>(d + 1)] &&
           (best < 0 || r[static_cast<size_t>(d)] > r[static_cast<size_t>(best)]))
         best = d;
     if (best >= 0 && r[static_cast<size_t>(best)] >= 0.5 * value) {
@@ -98,10 +101,11 @@ PeriodEstimate estimate_period(const Image& image) {
     cv::dft(power, autocorr, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
     const double zero = autocorr.at<float>(0, 0) / (static_cast<double>(w) * h);
     if (!(zero > 1e-9)) return out;  // flat image: no structure at all
-    std::vector<double> rx(static_cast<size_t>(w / 2 + 1)), ry(static_cast<size_t>(h / 2 + 1));
-    for (int d = 0; d <= w / 2; ++d)
+    const int max_x = static_cast<int>(w * kMaxLagShare), max_y = static_cast<int>(h * kMaxLagShare);
+    std::vector<double> rx(static_cast<size_t>(max_x + 1)), ry(static_cast<size_t>(max_y + 1));
+    for (int d = 0; d <= max_x; ++d)
       rx[static_cast<size_t>(d)] = autocorr.at<float>(0, d) / (static_cast<double>(w - d) * h) / zero;
-    for (int d = 0; d <= h / 2; ++d)
+    for (int d = 0; d <= max_y; ++d)
       ry[static_cast<size_t>(d)] = autocorr.at<float>(d, 0) / (static_cast<double>(h - d) * w) / zero;
     find_period(rx, out.period_x, out.confidence_x, out.found_x);
     find_period(ry, out.period_y, out.confidence_y, out.found_y);

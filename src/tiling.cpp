@@ -29,13 +29,13 @@ using internal::SplitMix64;
 namespace {
 
 constexpr int kMinTileSide = 32;
+constexpr int kChainFactor = 1;  // arm blocks are this many times longer than wide
 
 //! SSD of a masked B x B template against every B x B block of the exemplar, by FFT.
 class SsdSearch {
  public:
-  void init(const Plane& exemplar, int block) {
+  void init(const Plane& exemplar) {
     ex_ = &exemplar;
-    block_ = block;
     const int dft_w = cv::getOptimalDFTSize(exemplar.width);
     const int dft_h = cv::getOptimalDFTSize(exemplar.height);
     // Circular correlation is exact for the valid positions p <= size - block: p + q < size <= dft size.
@@ -59,36 +59,55 @@ class SsdSearch {
     accumulated_ = cv::Mat(dft_h, dft_w, CV_32F, cv::Scalar(0));
   }
 
-  int positions_x() const { return ex_->width - block_ + 1; }
-  int positions_y() const { return ex_->height - block_ + 1; }
+  int positions_x(int bw) const { return ex_->width - bw + 1; }
+  int positions_y(int bh) const { return ex_->height - bh + 1; }
 
-  //! templ: B*B*channels samples, mask: B*B weights (0 or 1). ssd: positions_x * positions_y values.
-  void search(const std::vector<float>& templ, const std::vector<float>& mask, std::vector<float>& ssd) {
-    const int b = block_;
+  //! templ: bw*bh*channels samples, mask: bw*bh weights (0 or 1), row-major.
+  //! ssd: positions_x(bw) * positions_y(bh) values.
+  void search(int bw, int bh, const std::vector<float>& templ, const std::vector<float>& mask,
+              std::vector<float>& ssd) {
     const int channels = ex_->channels;
-    double constant = 0.0;
-    accumulated_.setTo(0);
-    for (int c = -1; c < channels; ++c) {
-      // c = -1: the mask itself, correlated with the summed squares of the exemplar.
-      for (int y = 0; y < b; ++y) {
+    if (bw != last_bw_ || bh != last_bh_) {  // the template area changed: clear what it left
+      padded_.setTo(0);
+      last_bw_ = bw;
+      last_bh_ = bh;
+    }
+    // The mask term depends on the mask only, and chains repeat a few mask shapes: cache it.
+    const cv::Mat* mask_term = nullptr;
+    for (const MaskEntry& e : mask_cache_)
+      if (e.bw == bw && e.bh == bh && e.mask == mask) mask_term = &e.product;
+    if (mask_term == nullptr) {
+      for (int y = 0; y < bh; ++y) {
         float* row = padded_.ptr<float>(y);
-        for (int x = 0; x < b; ++x) {
-          const size_t i = static_cast<size_t>(y) * b + x;
-          if (c < 0) {
-            row[x] = mask[i];
-          } else {
-            const float t = templ[i * channels + c];
-            row[x] = mask[i] * t;
-            constant += static_cast<double>(mask[i]) * t * t;
-          }
+        for (int x = 0; x < bw; ++x) row[x] = mask[static_cast<size_t>(y) * bw + x];
+      }
+      cv::dft(padded_, spectrum_, 0, bh);
+      MaskEntry& slot = mask_cache_.size() < kMaskCacheSize ? mask_cache_.emplace_back() : mask_cache_[next_slot_];
+      if (mask_cache_.size() == kMaskCacheSize) next_slot_ = (next_slot_ + 1) % kMaskCacheSize;
+      slot.bw = bw;
+      slot.bh = bh;
+      slot.mask = mask;
+      cv::mulSpectrums(square_spectrum_, spectrum_, slot.product, 0, true);
+      mask_term = &slot.product;
+    }
+    mask_term->copyTo(accumulated_);
+    double constant = 0.0;
+    for (int c = 0; c < channels; ++c) {
+      for (int y = 0; y < bh; ++y) {
+        float* row = padded_.ptr<float>(y);
+        for (int x = 0; x < bw; ++x) {
+          const size_t i = static_cast<size_t>(y) * bw + x;
+          const float t = templ[i * channels + c];
+          row[x] = mask[i] * t;
+          constant += static_cast<double>(mask[i]) * t * t;
         }
       }
-      cv::dft(padded_, spectrum_, 0, b);
-      cv::mulSpectrums(c < 0 ? square_spectrum_ : spectra_[c], spectrum_, product_, 0, true);
-      cv::scaleAdd(product_, c < 0 ? 1.0 : -2.0, accumulated_, accumulated_);
+      cv::dft(padded_, spectrum_, 0, bh);
+      cv::mulSpectrums(spectra_[c], spectrum_, product_, 0, true);
+      cv::scaleAdd(product_, -2.0, accumulated_, accumulated_);
     }
-    const int nx = positions_x();
-    const int ny = positions_y();
+    const int nx = positions_x(bw);
+    const int ny = positions_y(bh);
     cv::dft(accumulated_, result_, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE, ny);
     ssd.resize(static_cast<size_t>(nx) * ny);
     for (int y = 0; y < ny; ++y) {
@@ -99,8 +118,17 @@ class SsdSearch {
   }
 
  private:
+  struct MaskEntry {
+    int bw = 0, bh = 0;
+    std::vector<float> mask;
+    cv::Mat product;  // square_spectrum_ times the conjugate spectrum of the mask
+  };
+  static constexpr size_t kMaskCacheSize = 4;
+
   const Plane* ex_ = nullptr;
-  int block_ = 0;
+  int last_bw_ = 0, last_bh_ = 0;
+  std::vector<MaskEntry> mask_cache_;
+  size_t next_slot_ = 0;
   std::vector<cv::Mat> spectra_;
   cv::Mat square_spectrum_, padded_, spectrum_, product_, accumulated_, result_;
 };
@@ -114,7 +142,8 @@ struct Exclusion {
 
 //! Minimum-error path through a strip of `length` x `width` errors (err[i * width + j], i along the
 //! strip): one j per i, |j(i) - j(i-1)| <= 1. Dynamic programming, ties to the smaller j.
-void min_error_path(const std::vector<float>& err, int length, int width, std::vector<float>& cost, std::vector<int>& path) {
+void min_error_path(const std::vector<float>& err, int length, int width, std::vector<float>& cost,
+                    std::vector<int>& path) {
   cost.assign(err.begin(), err.begin() + static_cast<size_t>(length) * width);
   for (int i = 1; i < length; ++i) {
     for (int j = 0; j < width; ++j) {
@@ -143,21 +172,28 @@ void min_error_path(const std::vector<float>& err, int length, int width, std::v
 class Quilter {
  public:
   Quilter(const Plane& exemplar, SsdSearch& search, Plane& canvas, std::vector<uint8_t>& known,
-          const std::vector<uint8_t>& locked, int block, int overlap, double tolerance, SplitMix64& rng)
-      : ex_(exemplar), search_(search), canvas_(canvas), known_(known), locked_(locked), b_(block), ov_(overlap),
-        tolerance_(tolerance), rng_(rng) {}
+          const std::vector<uint8_t>& locked, int overlap, double tolerance, SplitMix64& rng)
+      : ex_(exemplar),
+        search_(search),
+        canvas_(canvas),
+        known_(known),
+        locked_(locked),
+        ov_(overlap),
+        tolerance_(tolerance),
+        rng_(rng) {}
 
-  //! Places one block with its top-left corner at canvas (bx, by) (taken modulo the canvas size).
-  void place(int bx, int by, const Exclusion& exclusion) {
-    const int b = b_;
+  //! Places one bw x bh block with its top-left corner at canvas (bx, by) (modulo the canvas size).
+  void place(int bx, int by, int bw, int bh, const Exclusion& exclusion) {
+    bw_ = bw;
+    bh_ = bh;
     const int channels = canvas_.channels;
-    const size_t bb = static_cast<size_t>(b) * b;
-    templ_.resize(bb * channels);
-    mask_.assign(bb, 0.0f);
+    const size_t area = static_cast<size_t>(bw) * bh;
+    templ_.resize(area * channels);
+    mask_.assign(area, 0.0f);
     bool any_known = false;
-    for (int y = 0; y < b; ++y) {
-      for (int x = 0; x < b; ++x) {
-        const size_t i = static_cast<size_t>(y) * b + x;
+    for (int y = 0; y < bh; ++y) {
+      for (int x = 0; x < bw; ++x) {
+        const size_t i = static_cast<size_t>(y) * bw + x;
         const int cx = Plane::mod(bx + x, canvas_.width);
         const int cy = Plane::mod(by + y, canvas_.height);
         const float* p = canvas_.at(cx, cy);
@@ -169,14 +205,14 @@ class Quilter {
       }
     }
 
-    // Choose the exemplar block.
-    const int nx = search_.positions_x();
-    const int ny = search_.positions_y();
+    // Choose the exemplar block: at random among those within the tolerance of the best SSD.
+    const int nx = search_.positions_x(bw);
+    const int ny = search_.positions_y(bh);
     int chosen = 0;
     if (!any_known) {
       chosen = static_cast<int>(rng_.below(static_cast<uint32_t>(nx * ny)));
     } else {
-      search_.search(templ_, mask_, ssd_);
+      search_.search(bw, bh, templ_, mask_, ssd_);
       float best = std::numeric_limits<float>::max();
       float energy = 0.0f;
       for (size_t i = 0; i < templ_.size(); ++i) energy += mask_[i / channels] * templ_[i] * templ_[i];
@@ -199,10 +235,10 @@ class Quilter {
     const int py = chosen / nx;
 
     // Boundary cuts on every side whose overlap strip holds known pixels.
-    error_.assign(bb, 0.0f);
-    for (int y = 0; y < b; ++y) {
-      for (int x = 0; x < b; ++x) {
-        const size_t i = static_cast<size_t>(y) * b + x;
+    error_.assign(area, 0.0f);
+    for (int y = 0; y < bh; ++y) {
+      for (int x = 0; x < bw; ++x) {
+        const size_t i = static_cast<size_t>(y) * bw + x;
         if (mask_[i] == 0.0f) continue;
         const float* e = ex_.at(px + x, py + y);
         float sum = 0.0f;
@@ -213,15 +249,12 @@ class Quilter {
         error_[i] = sum;
       }
     }
-    take_new_.assign(bb, 1);
-    cut_side(0);
-    cut_side(1);
-    cut_side(2);
-    cut_side(3);
+    take_new_.assign(area, 1);
+    for (int side = 0; side < 4; ++side) cut_side(side);
 
-    for (int y = 0; y < b; ++y) {
-      for (int x = 0; x < b; ++x) {
-        const size_t i = static_cast<size_t>(y) * b + x;
+    for (int y = 0; y < bh; ++y) {
+      for (int x = 0; x < bw; ++x) {
+        const size_t i = static_cast<size_t>(y) * bw + x;
         const int cx = Plane::mod(bx + x, canvas_.width);
         const int cy = Plane::mod(by + y, canvas_.height);
         const size_t ci = static_cast<size_t>(cy) * canvas_.width + cx;
@@ -241,26 +274,26 @@ class Quilter {
  private:
   // side: 0 left, 1 right, 2 top, 3 bottom. Pixels beyond the cut (towards the side) keep the old value.
   void cut_side(int side) {
-    const int b = b_;
-    const int ov = ov_;
+    const int length = side < 2 ? bh_ : bw_;
+    const int ov = std::min(ov_, side < 2 ? bw_ : bh_);
     bool active = false;
-    strip_.assign(static_cast<size_t>(b) * ov, 0.0f);
-    for (int i = 0; i < b; ++i) {
+    strip_.assign(static_cast<size_t>(length) * ov, 0.0f);
+    for (int i = 0; i < length; ++i) {
       for (int j = 0; j < ov; ++j) {
         int x = 0, y = 0;
         strip_coords(side, i, j, x, y);
-        const size_t k = static_cast<size_t>(y) * b + x;
+        const size_t k = static_cast<size_t>(y) * bw_ + x;
         if (mask_[k] != 0.0f) active = true;
         strip_[static_cast<size_t>(i) * ov + j] = error_[k];
       }
     }
     if (!active) return;
-    min_error_path(strip_, b, ov, cost_, path_);
-    for (int i = 0; i < b; ++i) {
+    min_error_path(strip_, length, ov, cost_, path_);
+    for (int i = 0; i < length; ++i) {
       for (int j = 0; j < path_[static_cast<size_t>(i)]; ++j) {
         int x = 0, y = 0;
         strip_coords(side, i, j, x, y);
-        take_new_[static_cast<size_t>(y) * b + x] = 0;
+        take_new_[static_cast<size_t>(y) * bw_ + x] = 0;
       }
     }
   }
@@ -268,10 +301,22 @@ class Quilter {
   // Strip coordinates (i along the side, j = depth from the block's edge) -> block (x, y).
   void strip_coords(int side, int i, int j, int& x, int& y) const {
     switch (side) {
-      case 0: x = j; y = i; break;
-      case 1: x = b_ - 1 - j; y = i; break;
-      case 2: x = i; y = j; break;
-      default: x = i; y = b_ - 1 - j; break;
+      case 0:
+        x = j;
+        y = i;
+        break;
+      case 1:
+        x = bw_ - 1 - j;
+        y = i;
+        break;
+      case 2:
+        x = i;
+        y = j;
+        break;
+      default:
+        x = i;
+        y = bh_ - 1 - j;
+        break;
     }
   }
 
@@ -280,7 +325,8 @@ class Quilter {
   Plane& canvas_;
   std::vector<uint8_t>& known_;
   const std::vector<uint8_t>& locked_;
-  int b_, ov_;
+  int ov_;
+  int bw_ = 0, bh_ = 0;
   double tolerance_;
   SplitMix64& rng_;
   int placed_ = 0;
@@ -303,29 +349,59 @@ struct Setup {
   Plane exemplar;  // possibly period-fitted
   int block = 0;
   int overlap = 0;
+  int shift_x = 0;  // toroidal shift: tile(x, y) = exemplar((x + shift_x) % W, (y + shift_y) % H)
+  int shift_y = 0;
 };
+
+void choose_shift(const Plane& ex, int& shift_x, int& shift_y);
+
+//! Crops or extends to period_fitted_size() without resampling (the texels keep their size):
+//! a pixel beyond the input is copied from a whole number of (rounded) periods before it.
+Image fit_to_period(const Image& input, const PeriodEstimate& period) {
+  int w = input.width, h = input.height;
+  period_fitted_size(period, input.width, input.height, w, h);
+  const int px = std::max(1, static_cast<int>(std::lround(period.period_x)));
+  const int py = std::max(1, static_cast<int>(std::lround(period.period_y)));
+  auto fold = [](int v, int size, int p) {
+    while (v >= size) v -= p;
+    return v;
+  };
+  Image out;
+  out.width = w;
+  out.height = h;
+  out.channels = input.channels;
+  out.pixels.resize(static_cast<size_t>(w) * h * input.channels);
+  for (int y = 0; y < h; ++y) {
+    const int sy = fold(y, input.height, py);
+    for (int x = 0; x < w; ++x) {
+      const int sx = fold(x, input.width, px);
+      const uint8_t* s = &input.pixels[(static_cast<size_t>(sy) * input.width + sx) * input.channels];
+      std::copy(s, s + input.channels, &out.pixels[(static_cast<size_t>(y) * w + x) * input.channels]);
+    }
+  }
+  return out;
+}
 
 Status prepare(const Image& input, const TileOptions& options, Setup& setup, TileReport& report) {
   TAILOR_RETURN_IF_ERROR(check_image(input));
   if (options.block < 8 || options.block > 256)
-    return Status::error(ErrorCode::kInvalidArgument, "", "block size must be in [8, 256] px", "got " + std::to_string(options.block));
+    return Status::error(ErrorCode::kInvalidArgument, "", "block size must be in [8, 256] px",
+                         "got " + std::to_string(options.block));
   if (options.overlap != 0 && (options.overlap < 1 || options.overlap > options.block / 2 - 1))
     return Status::error(ErrorCode::kInvalidArgument, "", "overlap must be in [1, block/2 - 1] px",
                          "got " + std::to_string(options.overlap) + " for block " + std::to_string(options.block));
   if (!(options.tolerance >= 0.0 && options.tolerance <= 1.0))
     return Status::error(ErrorCode::kInvalidArgument, "", "tolerance must be in [0, 1]");
   if (input.width < kMinTileSide || input.height < kMinTileSide)
-    return Status::error(ErrorCode::kInvalidImage, "", "image too small to make tileable (at least " +
-                         std::to_string(kMinTileSide) + " px a side)",
+    return Status::error(ErrorCode::kInvalidImage, "",
+                         "image too small to make tileable (at least " + std::to_string(kMinTileSide) + " px a side)",
                          std::to_string(input.width) + "x" + std::to_string(input.height));
   Image work = input;
   if (options.fit_period) {
     report.period = estimate_period(input);
     int w = input.width, h = input.height;
     period_fitted_size(report.period, input.width, input.height, w, h);
-    if (w != input.width || h != input.height) {
-      TAILOR_RETURN_IF_ERROR(resize_image(input, w, h, work));
-    }
+    if (w != input.width || h != input.height) work = fit_to_period(input, report.period);
   }
   report.width = work.width;
   report.height = work.height;
@@ -339,12 +415,16 @@ Status prepare(const Image& input, const TileOptions& options, Setup& setup, Til
   int overlap = options.overlap == 0 ? std::max(1, block / 4) : options.overlap;
   if (overlap > block / 2 - 1) {
     const int shrunk = std::max(1, block / 4);
-    report.warnings.push_back("overlap shrunk from " + std::to_string(overlap) + " to " + std::to_string(shrunk) + " px");
+    report.warnings.push_back("overlap shrunk from " + std::to_string(overlap) + " to " + std::to_string(shrunk) +
+                              " px");
     overlap = shrunk;
   }
   setup.exemplar = internal::to_plane(work);
   setup.block = block;
   setup.overlap = overlap;
+  choose_shift(setup.exemplar, setup.shift_x, setup.shift_y);
+  report.shift_x = setup.shift_x;
+  report.shift_y = setup.shift_y;
   report.block = block;
   report.overlap = overlap;
   report.border = overlap;
@@ -358,7 +438,8 @@ Image plane_to_image(const Plane& p) {
   out.channels = p.channels;
   out.pixels.resize(p.px.size());
   // Every sample is a copy of an 8-bit exemplar sample, so the rounding is exact.
-  for (size_t i = 0; i < p.px.size(); ++i) out.pixels[i] = static_cast<uint8_t>(std::lround(std::clamp(p.px[i], 0.0f, 255.0f)));
+  for (size_t i = 0; i < p.px.size(); ++i)
+    out.pixels[i] = static_cast<uint8_t>(std::lround(std::clamp(p.px[i], 0.0f, 255.0f)));
   return out;
 }
 
@@ -367,18 +448,57 @@ uint64_t mix_seed(uint64_t seed, uint64_t stream) {
   return g.next();
 }
 
-//! Base tile: swap, then quilt the vertical arm, the horizontal arm and the centre.
+//! Where the input's column boundary (s-1, s) should become the tile's wrap: near the middle
+//! (within 1/8 of the size), on the boundary whose mean absolute difference is closest (in log
+//! ratio) to the median one, so that the new wrap is as ordinary as any interior boundary.
+void choose_shift(const Plane& ex, int& shift_x, int& shift_y) {
+  const int w = ex.width, h = ex.height, c = ex.channels;
+  std::vector<double> cols(static_cast<size_t>(w), 0.0), rows(static_cast<size_t>(h), 0.0);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const float* a = ex.at(x, y);
+      for (int k = 0; k < c; ++k) {
+        if (x > 0) cols[static_cast<size_t>(x)] += std::abs(a[k] - ex.at(x - 1, y)[k]);
+        if (y > 0) rows[static_cast<size_t>(y)] += std::abs(a[k] - ex.at(x, y - 1)[k]);
+      }
+    }
+  auto pick = [](const std::vector<double>& diff, int size) {
+    std::vector<double> interior(diff.begin() + 1, diff.end());
+    std::nth_element(interior.begin(), interior.begin() + static_cast<std::ptrdiff_t>(interior.size() / 2),
+                     interior.end());
+    const double median = std::max(interior[interior.size() / 2], 1e-9);
+    int best = size / 2;
+    double best_score = std::numeric_limits<double>::max();
+    const int reach = std::max(1, size / 8);
+    for (int d = 0; d <= reach; ++d) {
+      for (int s : {size / 2 - d, size / 2 + d}) {
+        if (s < 1 || s >= size) continue;
+        const double score = std::abs(std::log(std::max(diff[static_cast<size_t>(s)], 1e-9) / median));
+        if (score < best_score - 1e-12) {
+          best_score = score;
+          best = s;
+        }
+      }
+    }
+    return best;
+  };
+  shift_x = pick(cols, w);
+  shift_y = pick(rows, h);
+}
+
+//! Base tile: shift, then quilt the vertical arm, the horizontal arm and the centre.
 Status quilt_cross(const Setup& setup, const TileOptions& options, SsdSearch& search, Plane& canvas, int& placed) {
   const Plane& ex = setup.exemplar;
   const int w = ex.width, h = ex.height, b = setup.block, ov = setup.overlap;
+  const int sx = setup.shift_x, sy = setup.shift_y;
   canvas = ex;
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      const float* s = ex.at((x + w / 2) % w, (y + h / 2) % h);
+      const float* s = ex.at((x + sx) % w, (y + sy) % h);
       std::copy(s, s + ex.channels, canvas.at(x, y));
     }
+  const int cx = w - sx, cy = h - sy;
   // The seams lie between columns cx-1, cx and rows cy-1, cy; the zones around them are unknown.
-  const int cx = w - w / 2, cy = h - h / 2;
   const int zone = b - 2 * ov;
   const int zx = cx - zone / 2, zy = cy - zone / 2;
   std::vector<uint8_t> known(static_cast<size_t>(w) * h, 1), locked(static_cast<size_t>(w) * h, 0);
@@ -387,25 +507,30 @@ Status quilt_cross(const Setup& setup, const TileOptions& options, SsdSearch& se
       if ((x >= zx && x < zx + zone) || (y >= zy && y < zy + zone)) known[static_cast<size_t>(y) * w + x] = 0;
 
   SplitMix64 rng(mix_seed(options.seed, 0));
-  Quilter quilter(ex, search, canvas, known, locked, b, ov, options.tolerance, rng);
-  const std::vector<int> vertical = chain_positions(zy + zone, h - zone, b, ov);
-  const std::vector<int> horizontal = chain_positions(zx + zone, w - zone, b, ov);
+  Quilter quilter(ex, search, canvas, known, locked, ov, options.tolerance, rng);
+  // Arms are quilted with blocks `chain` px long: fewer chain cuts than square blocks.
+  const int chain = std::min(b * kChainFactor, std::min(w, h) / 2);
+  const std::vector<int> vertical = chain_positions(zy + zone, h - zone, chain, ov);
+  const std::vector<int> horizontal = chain_positions(zx + zone, w - zone, chain, ov);
   const double total = static_cast<double>(vertical.size() + horizontal.size() + 1);
   double done = 0.0;
-  auto tick = [&]() -> bool { done += 1.0; return !options.progress || options.progress(done / total); };
+  auto tick = [&]() -> bool {
+    done += 1.0;
+    return !options.progress || options.progress(done / total);
+  };
   const Exclusion none;
   // V1 + V2: one chain through the top/bottom border (toroidal), from below the centre to above it.
   for (int y : vertical) {
-    quilter.place(zx - ov, y, none);
+    quilter.place(zx - ov, y, b, chain, none);
     if (!tick()) return Status::error(ErrorCode::kCancelled, "", "cancelled");
   }
   // H1 + H2: likewise through the left/right border.
   for (int x : horizontal) {
-    quilter.place(x, zy - ov, none);
+    quilter.place(x, zy - ov, chain, b, none);
     if (!tick()) return Status::error(ErrorCode::kCancelled, "", "cancelled");
   }
   // C: the centre, constrained on all four sides.
-  quilter.place(zx - ov, zy - ov, none);
+  quilter.place(zx - ov, zy - ov, b, b, none);
   tick();
   placed += quilter.placed();
   return Status::ok();
@@ -436,7 +561,8 @@ Status make_tile_variants(const Image& exemplar, const TileOptions& options, int
                           TileReport* report) {
   tiles.clear();
   if (count < 1 || count > 64)
-    return Status::error(ErrorCode::kInvalidArgument, "", "variant count must be in [1, 64]", "got " + std::to_string(count));
+    return Status::error(ErrorCode::kInvalidArgument, "", "variant count must be in [1, 64]",
+                         "got " + std::to_string(count));
   TileReport local;
   TileReport& rep = report ? *report : local;
   rep = TileReport{};
@@ -446,12 +572,11 @@ Status make_tile_variants(const Image& exemplar, const TileOptions& options, int
     const Plane& ex = setup.exemplar;
     const int w = ex.width, h = ex.height, b = setup.block, ov = setup.overlap;
     SsdSearch search;
-    search.init(ex, b);
+    search.init(ex);
 
     // Progress: the base tile counts as one share, each variant as one more.
     TileOptions base_options = options;
-    if (options.progress)
-      base_options.progress = [&](double f) { return options.progress(f / count); };
+    if (options.progress) base_options.progress = [&](double f) { return options.progress(f / count); };
     Plane base;
     TAILOR_RETURN_IF_ERROR(quilt_cross(setup, base_options, search, base, rep.blocks));
     tiles.push_back(plane_to_image(base));
@@ -463,8 +588,12 @@ Status make_tile_variants(const Image& exemplar, const TileOptions& options, int
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x)
         if (x < border || y < border || x >= w - border || y >= h - border) locked[static_cast<size_t>(y) * w + x] = 1;
-    const std::vector<int> xs = chain_positions(border, w - 2 * border, b, ov);
-    const std::vector<int> ys = chain_positions(border, h - 2 * border, b, ov);
+    // 2 x 2 large blocks: few cuts, so each variant keeps the exemplar's statistics (small blocks
+    // over the whole interior drift its histogram and gradients, a known weakness of quilting).
+    const int vbw = std::max(b, (w - 2 * border + ov + 1) / 2);
+    const int vbh = std::max(b, (h - 2 * border + ov + 1) / 2);
+    const std::vector<int> xs = chain_positions(border, w - 2 * border, vbw, ov);
+    const std::vector<int> ys = chain_positions(border, h - 2 * border, vbh, ov);
     for (int k = 1; k < count; ++k) {
       Plane canvas = base;
       std::vector<uint8_t> known(static_cast<size_t>(w) * h, 0);
@@ -473,7 +602,7 @@ Status make_tile_variants(const Image& exemplar, const TileOptions& options, int
           if (x < border + ov || y < border + ov || x >= w - border - ov || y >= h - border - ov)
             known[static_cast<size_t>(y) * w + x] = 1;
       SplitMix64 rng(mix_seed(options.seed, static_cast<uint64_t>(k)));
-      Quilter quilter(ex, search, canvas, known, locked, b, ov, options.tolerance, rng);
+      Quilter quilter(ex, search, canvas, known, locked, ov, options.tolerance, rng);
       const bool flip_x = ((k - 1) & 1) != 0, flip_y = ((k - 1) & 2) != 0;
       const size_t per_variant = xs.size() * ys.size();
       size_t done = 0;
@@ -484,12 +613,13 @@ Status make_tile_variants(const Image& exemplar, const TileOptions& options, int
           // Do not simply re-copy what the base tile has there (its source in the exemplar).
           Exclusion exclusion;
           exclusion.active = true;
-          exclusion.x = (x + w / 2) % w;
-          exclusion.y = (y + h / 2) % h;
-          exclusion.radius = b / 2;
-          quilter.place(x, y, exclusion);
+          exclusion.x = (x + setup.shift_x) % w;
+          exclusion.y = (y + setup.shift_y) % h;
+          exclusion.radius = std::min(vbw, vbh) / 2;
+          quilter.place(x, y, vbw, vbh, exclusion);
           ++done;
-          if (options.progress && !options.progress((k + static_cast<double>(done) / static_cast<double>(per_variant)) / count))
+          if (options.progress &&
+              !options.progress((k + static_cast<double>(done) / static_cast<double>(per_variant)) / count))
             return Status::error(ErrorCode::kCancelled, "", "cancelled");
         }
       }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -37,8 +38,12 @@ void expect_valid(const Mesh& m) {
   ASSERT_FALSE(m.empty());
   for (uint32_t i : m.indices) ASSERT_LT(i, m.vertex_count());
   for (float x : m.positions) ASSERT_TRUE(std::isfinite(x));
-  if (!m.corner_uvs.empty()) ASSERT_EQ(m.corner_uvs.size(), 6 * m.face_count());
-  if (!m.seam_faces.empty()) ASSERT_EQ(m.seam_faces.size(), m.face_count());
+  if (!m.corner_uvs.empty()) {
+    ASSERT_EQ(m.corner_uvs.size(), 6 * m.face_count());
+  }
+  if (!m.seam_faces.empty()) {
+    ASSERT_EQ(m.seam_faces.size(), m.face_count());
+  }
 }
 
 size_t referenced_vertices(const Mesh& m) {
@@ -172,10 +177,16 @@ TEST(RealMeshes, SpotHasCornerUvsAndStlCountsWelds) {
   LoadReport r;
   const Mesh spot = load_or_die("spot.obj");
   EXPECT_EQ(spot.corner_uvs.size(), 6u * 5856);
-  for (float u : spot.corner_uvs) {
-    EXPECT_GE(u, 0.0f);
-    EXPECT_LE(u, 1.0f);
-  }
+  // The first face is "f 739/1 735/2 736/3": its first corner carries the first vt of the file.
+  std::string text;
+  ASSERT_TRUE(internal::read_file(mesh_path("spot.obj"), text).is_ok());
+  const size_t vt = text.find("\nvt ") + 4;
+  char* end = nullptr;
+  const float u0 = std::strtof(text.c_str() + vt, &end);
+  const float v0 = std::strtof(end, nullptr);
+  EXPECT_EQ(spot.corner_uvs[0], u0);
+  EXPECT_EQ(spot.corner_uvs[1], v0);
+  EXPECT_EQ(spot.indices[0], 738u);
   const Mesh stl = load_or_die("featuretype.stl", &r);
   EXPECT_EQ(r.welded_vertices, 3u * 3476 - 2010);
   EXPECT_TRUE(stl.corner_uvs.empty());
@@ -304,11 +315,11 @@ TEST(Ply, FastPathFallsBackForPolygonsMidFile) {
   put(s, uint8_t{4}, false);
   for (uint32_t i : {1u, 4u, 2u, 3u}) put(s, i, false);
   put(s, uint8_t{3}, false);
-  for (uint32_t i : {1u, 2u, 4u}) put(s, i, false);
+  for (uint32_t i : {2u, 4u, 3u}) put(s, i, false);
   Mesh m;
   LoadReport r;
   ASSERT_TRUE(parse(s, MeshFormat::kPly, m, &r).is_ok());
-  EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 3, 1, 4, 2, 1, 2, 3, 1, 2, 4}));
+  EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 3, 1, 4, 2, 1, 2, 3, 2, 4, 3}));
   EXPECT_EQ(r.source_faces, 3u);
   EXPECT_EQ(r.polygons_triangulated, 1u);
 }
@@ -495,6 +506,72 @@ TEST(Adversarial, ManyDuplicatesInOneFanBucket) {
   EXPECT_EQ(r.duplicate_faces, 117u);
 }
 
+TEST(Adversarial, HugeFanFallsBackToExactDuplicateSearch) {
+  // 300 distinct triangles around vertex 0 (more than the duplicate chain walks), then every
+  // third one again with the other winding, then a copy of a duplicate: all later copies dropped.
+  std::string s = "v 0 0 0\n";
+  for (int k = 0; k <= 300; ++k) s += "v " + std::to_string(k) + " 1 0\n";
+  for (int k = 1; k <= 300; ++k) s += "f 1 " + std::to_string(k + 1) + " " + std::to_string(k + 2) + "\n";
+  for (int k = 1; k <= 300; k += 3) s += "f 1 " + std::to_string(k + 2) + " " + std::to_string(k + 1) + "\n";
+  s += "f 2 3 1\n";
+  Mesh m;
+  LoadReport r;
+  ASSERT_TRUE(parse(s, MeshFormat::kObj, m, &r).is_ok());
+  EXPECT_EQ(m.face_count(), 300u);
+  EXPECT_EQ(r.duplicate_faces, 101u);
+  for (uint32_t k = 0; k < 300; ++k) {
+    ASSERT_EQ(m.indices[3 * k + 1], k + 1);
+    ASSERT_EQ(m.indices[3 * k + 2], k + 2);
+  }
+  EXPECT_EQ(r.zero_area_faces, 0u);
+}
+
+TEST(Adversarial, LargeMeshRepairsMatchSmallMeshRepairs) {
+  // Horse three times over (290,898 faces: large enough for finalize_mesh's second thread), the
+  // copies rotated and reversed, plus degenerate faces: repairs must match the plain horse.
+  LoadReport plain;
+  const Mesh horse = load_or_die("horse.ply", &plain);
+  Mesh big;
+  big.positions = horse.positions;
+  big.indices = horse.indices;
+  const size_t nf = horse.face_count();
+  for (size_t f = 0; f < nf; ++f) {
+    const uint32_t* t = &horse.indices[3 * f];
+    big.indices.insert(big.indices.end(), {t[1], t[2], t[0]});
+  }
+  for (size_t f = 0; f < nf; ++f) {
+    const uint32_t* t = &horse.indices[3 * f];
+    big.indices.insert(big.indices.end(), {t[2], t[1], t[0], t[0], t[0], t[1]});
+  }
+  LoadReport r;
+  ASSERT_TRUE(finalize_mesh("big", big, r).is_ok());
+  EXPECT_EQ(big.indices, horse.indices);
+  EXPECT_EQ(r.duplicate_faces, 2 * nf);
+  EXPECT_EQ(r.degenerate_faces, nf);
+  EXPECT_EQ(r.zero_area_faces, plain.zero_area_faces);
+  EXPECT_EQ(r.unreferenced_vertices, 0u);
+}
+
+TEST(Adversarial, BinaryTetrahedraWithSeamsAndExtraElements) {
+  Mesh le, be, stl;
+  LoadReport r;
+  ASSERT_TRUE(load_mesh(mesh_path("adversarial/tetra_seam_le.ply"), le, &r).is_ok());
+  EXPECT_EQ(r.format, "PLY binary_little_endian");
+  ASSERT_TRUE(load_mesh(mesh_path("adversarial/tetra_seam_be.ply"), be, &r).is_ok());
+  EXPECT_EQ(r.format, "PLY binary_big_endian");
+  EXPECT_EQ(le.positions, be.positions);
+  EXPECT_EQ(le.indices, (std::vector<uint32_t>{0, 2, 1, 0, 1, 3, 1, 2, 3, 0, 3, 2}));
+  EXPECT_EQ(be.indices, le.indices);
+  EXPECT_EQ(le.seam_faces, (std::vector<uint8_t>{0, 0, 1, 0}));
+  EXPECT_EQ(be.seam_faces, le.seam_faces);
+  ASSERT_TRUE(load_mesh(mesh_path("adversarial/tetra_binary.stl"), stl, &r).is_ok());
+  EXPECT_EQ(r.format, "STL binary");
+  // Welded vertices are numbered in order of first use: (0 0 0) (0 1 0) (1 0 0) (0 0 1).
+  EXPECT_EQ(stl.positions, (std::vector<float>{0, 0, 0, 0, 1, 0, 1, 0, 0, 0, 0, 1}));
+  EXPECT_EQ(stl.indices, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3, 2, 1, 3, 0, 3, 1}));
+  EXPECT_EQ(r.welded_vertices, 8u);
+}
+
 // ================================================================================================
 // Errors: clean Status naming the place
 // ================================================================================================
@@ -555,7 +632,7 @@ TEST(Errors, FaceWithTwoVertices) {
 TEST(Errors, HugeHeaderCountsFailBeforeAllocating) {
   Mesh m;
   std::string s =
-      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
       "property float z\nelement face 4000000000\nproperty list uchar int vertex_indices\nend_header\n";
   s.resize(200, '\0');
   Status st = parse(s, MeshFormat::kPly, m);

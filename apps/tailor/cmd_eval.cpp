@@ -128,7 +128,7 @@ void register_eval(CLI::App& app, Runner& run) {
       "Metrics (docs/metrics.md): patches, seams (share of edge length), flipped faces, stretch\n"
       "(coefficient of variation of UV/3D area ratio, 0 ideal), L2/Linf stretch (Sander 2001, 1 ideal),\n"
       "median angle distortion, seam gap (px, modulo the texture) and share of invisible seams.\n"
-      "Example:\n  tailor eval bunny.glb\n  tailor eval spot.obj --texture-size 1024 --json");
+      "Example:\n  tailor eval bunny.glb\n  tailor eval spot.obj --texture-size 1024 --json\n");
   cmd->callback([&run, opt] { run = [opt] { return run_eval(*opt); }; });
 }
 

@@ -27,7 +27,8 @@ int run_eval_tile(const EvalTileOptions& opt) {
   if (with_exemplar)
     if (Status s = load_image(opt.exemplar, exemplar); !s) return report_error(s);
   TileMetrics m;
-  if (Status s = tile_metrics(tile, with_exemplar ? &exemplar : nullptr, m); !s) return report_error(s.with_file(opt.tile));
+  if (Status s = tile_metrics(tile, with_exemplar ? &exemplar : nullptr, m); !s)
+    return report_error(s.with_file(opt.tile));
   std::string failed;
   const bool met = meets_tile_targets(m, &failed);
   if (opt.json) {
@@ -59,7 +60,8 @@ int run_eval_tile(const EvalTileOptions& opt) {
     return kExitOk;
   }
   std::printf("%s %dx%d\n", opt.tile.c_str(), tile.width, tile.height);
-  std::printf("  wrap-seam ratio x / y   %.3f / %.3f   (~1 seamless; target [0.8, 1.2])\n", m.wrap_ratio_x, m.wrap_ratio_y);
+  std::printf("  wrap-seam ratio x / y   %.3f / %.3f   (~1 seamless; target [0.8, 1.2])\n", m.wrap_ratio_x,
+              m.wrap_ratio_y);
   if (!with_exemplar) {
     std::printf("  worst straight seam     %.3f   (target <= 1.5)\n", m.worst_seam_ratio);
     std::printf("  gradient energy         %.3f   (mean |dx| + |dy|, 8-bit units)\n", m.gradient_energy);
@@ -81,7 +83,8 @@ int run_eval_tile(const EvalTileOptions& opt) {
 
 void register_eval_tile(CLI::App& app, Runner& run) {
   auto opt = std::make_shared<EvalTileOptions>();
-  auto* cmd = app.add_subcommand("eval-tile", "Quality metrics of a tileable texture (seams, histogram, gradients, coherence)");
+  auto* cmd =
+      app.add_subcommand("eval-tile", "Quality metrics of a tileable texture (seams, histogram, gradients, coherence)");
   cmd->add_option("tile", opt->tile, "The tile to check (.png .jpg .tga .bmp)")->required();
   cmd->add_option("exemplar", opt->exemplar, "The exemplar it was made from (enables histogram, gradient, coherence)");
   cmd->add_flag("--json", opt->json, "Print a JSON object instead of text");

@@ -32,7 +32,8 @@ struct TileCliOptions {
 bool ends_with_png(const std::string& path) {
   if (path.size() < 4) return false;
   std::string ext = path.substr(path.size() - 4);
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
   return ext == ".png";
 }
 
@@ -74,8 +75,12 @@ nlohmann::json metrics_json(const TileMetrics& m) {
 }
 
 nlohmann::json period_json(const PeriodEstimate& p) {
-  return {{"x", p.period_x}, {"y", p.period_y}, {"found_x", p.found_x}, {"found_y", p.found_y},
-          {"confidence_x", p.confidence_x}, {"confidence_y", p.confidence_y}};
+  return {{"x", p.period_x},
+          {"y", p.period_y},
+          {"found_x", p.found_x},
+          {"found_y", p.found_y},
+          {"confidence_x", p.confidence_x},
+          {"confidence_y", p.confidence_y}};
 }
 
 int run_tile(const TileCliOptions& opt) {
@@ -171,12 +176,13 @@ int run_tile(const TileCliOptions& opt) {
     std::string out = opt.variants == 1 ? opt.output : stem + "_{0.." + std::to_string(opt.variants - 1) + "}.png";
     std::string failed;
     const bool met = meets_tile_targets(worst, &failed);
-    std::printf("%s %dx%d -> %s %dx%d: wrap %.2f x %.2f y, worst seam %.2f (exemplar %.2f), hist L1 %.3f, "
-                "gradient %.2f, coherence %.3f (exemplar %.3f), %s, %.2f s\n",
-                opt.input.c_str(), exemplar.width, exemplar.height, out.c_str(), report.width, report.height,
-                worst.wrap_ratio_x, worst.wrap_ratio_y, worst.worst_seam_ratio, worst.exemplar_worst_seam_ratio,
-                worst.histogram_l1, worst.gradient_ratio, worst.patch_coherence, worst.exemplar_patch_coherence,
-                met ? "targets met" : ("targets NOT met: " + failed).c_str(), seconds);
+    std::printf(
+        "%s %dx%d -> %s %dx%d: wrap %.2f x %.2f y, worst seam %.2f (exemplar %.2f), hist L1 %.3f, "
+        "gradient %.2f, coherence %.3f (exemplar %.3f), %s, %.2f s\n",
+        opt.input.c_str(), exemplar.width, exemplar.height, out.c_str(), report.width, report.height,
+        worst.wrap_ratio_x, worst.wrap_ratio_y, worst.worst_seam_ratio, worst.exemplar_worst_seam_ratio,
+        worst.histogram_l1, worst.gradient_ratio, worst.patch_coherence, worst.exemplar_patch_coherence,
+        met ? "targets met" : ("targets NOT met: " + failed).c_str(), seconds);
   }
   return kExitOk;
 }
@@ -187,13 +193,16 @@ void register_tile(CLI::App& app, Runner& run) {
   auto opt = std::make_shared<TileCliOptions>();
   auto* cmd = app.add_subcommand("tile", "Make a texture image self-tileable (quadrant swap + image quilting)");
   cmd->add_option("input", opt->input, "Texture image (.png .jpg .tga .bmp, 8-bit or 16-bit PNG)")->required();
-  cmd->add_option("-o,--output", opt->output, "Output .png (with --variants: NAME_0.png ... and NAME.json)")->required();
+  cmd->add_option("-o,--output", opt->output, "Output .png (with --variants: NAME_0.png ... and NAME.json)")
+      ->required();
   cmd->add_option("--block", opt->block, "Quilting block size in px")->default_val(32)->check(CLI::Range(8, 256));
   cmd->add_option("--overlap", opt->overlap, "Block overlap in px (default block/4)")->check(CLI::Range(1, 127));
   cmd->add_option("--seed", opt->seed, "Seed of the random block choice (same seed, same output)")->default_val(1);
   cmd->add_option("--variants", opt->variants, "Number of tiles with identical borders, different interiors")
-      ->default_val(1)->check(CLI::Range(1, 64));
-  cmd->add_flag("--fit-period", opt->fit_period, "Resize to a whole number of texel periods (regular patterns)");
+      ->default_val(1)
+      ->check(CLI::Range(1, 64));
+  cmd->add_flag("--fit-period", opt->fit_period,
+                "Crop or extend to a whole number of texel periods (regular patterns)");
   cmd->add_option("--json", opt->json, "Write the metrics and settings as JSON to this file");
   cmd->add_flag("-q,--quiet", opt->quiet, "Print nothing but errors");
   cmd->footer(

@@ -6,8 +6,10 @@
 // upright and unmirrored seen from outside). In texture repeats (OBJ vt, PLY s/t, Mesh::corner_uvs):
 //     s = u / texture_width,  t = v / texture_height            (OBJ convention: t = 0 at the image bottom)
 // and in glTF, whose v axis points down the image (0 = top row):
-//     TEXCOORD_0 = (s, 1 - t)
-// which is the usual OBJ <-> glTF conversion, so both files show the texture the same way.
+//     TEXCOORD_0 = (s, -t)
+// which is the usual OBJ -> glTF conversion (s, 1 - t) shifted by one whole repeat: identical on
+// screen with the REPEAT sampler tailor writes, and exact in floating point, so UVs round-trip
+// bit for bit (1 - (1 - t) does not). Both files show the texture the same way.
 //
 // All writes are atomic (temporary file, then rename): on failure the previous file is untouched and
 // no temporary file is left behind.

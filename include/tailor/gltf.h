@@ -4,13 +4,16 @@
 // What is read: every triangle primitive (mode 4) of every mesh, concatenated, in the order of the
 // meshes array (node transforms are NOT applied); POSITION (float vec3), indices (u8/u16/u32, or none)
 // and TEXCOORD_0 (float, or normalized u8/u16), converted to Mesh::corner_uvs in the OBJ convention
-// (t = 1 - v_gltf, see export.h). Vertices with bit-identical positions are welded (glTF files split
-// vertices on UV seams) and counted in LoadReport::welded_vertices, so seams become real edges again.
+// up to a whole repeat: t = -v_gltf (the inverse of what export writes, see export.h; for files
+// from other tools t is the usual 1 - v_gltf minus one, the same texel under REPEAT).
+// Vertices with bit-identical positions are welded (glTF files split vertices on UV seams) and
+// counted in LoadReport::welded_vertices, so seams become real edges again.
 //
-// Safe for untrusted input: external URIs are never opened (only the embedded BIN chunk and data:
-// URIs are used), every accessor is bounds-checked against its buffer view and buffer before it is
-// read, every index against the vertex count, images larger than kMaxImageSide are rejected before
-// decoding, and tinygltf exceptions are caught.
+// Safe for untrusted input: no URI is ever opened or decoded (only the GLB's embedded BIN chunk is
+// used; buffers with a uri are kUnsupported, images with a uri are ignored), every accessor is
+// bounds-checked against its buffer view and the BIN chunk before it is read, every index against
+// the vertex count, output size is capped at a multiple of the file size, images larger than
+// kMaxImageSide are rejected before decoding, and nothing throws (allocation failure -> kLimit).
 #pragma once
 
 #include <span>

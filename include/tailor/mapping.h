@@ -5,8 +5,9 @@
 // first), so the texture spreads through regions where the orientation field is homogeneous and
 // stops at faces where it varies (geometric edges, field singularities): those become seams.
 // A face is placed by unfolding it across an edge from a placed neighbour's corner UVs: the two
-// shared corners are copied and the third is the mean of the two predictions
-// a + scale*frame(C - A) and b + scale*frame(C - B) (thesis eq. 2.3-2.4).
+// shared corners are copied and the third comes from a second placed neighbour, from the UV the
+// patch already gave that vertex, or is the mean of the two predictions a + scale*frame(C - A)
+// and b + scale*frame(C - B) (thesis eq. 2.3-2.4), whichever fits first.
 //
 // Two modes:
 //  - kPatches (default): UVs per corner. Every placement (also faces whose three corners are
@@ -62,11 +63,15 @@ struct MappingOptions {
   // kPatches ------------------------------------------------------------------------------------
   float max_stretch = 0.25f;        //!< per-face bound: singular values of the face->UV Jacobian (in units of
                                     //!< `scale`) must lie in [1/(1+x), 1+x]; 0.01..4. 0.25 keeps every face
-                                    //!< within +-25% stretch and +-14 deg shear while letting patches cross
-                                    //!< smoothly curved regions; Sander Linf <= 1.34 by construction
+                                    //!< within 25% of its length in any direction (so Sander Linf <= ~1.25)
+                                    //!< and the thesis stretch under 0.08 on the shared meshes; larger values
+                                    //!< give fewer seams and more distortion (docs/mapping.md)
   float max_seed_rotation_deg = 45.f;  //!< a new patch is rotated (at most this much) so that it continues its
                                     //!< neighbour's texture across the seed edge; beyond, it follows the field
                                     //!< and only the seed edge's first vertex matches (0..180)
+  float field_following = 1.f;      //!< 1: every face's texture direction follows the orientation field (thesis);
+                                    //!< 0: pure unfolding, the direction is set by the patch seed and drifts with
+                                    //!< the surface (fewer seams, less distortion, see docs/mapping.md); 0..1
   uint32_t min_patch_faces = 16;    //!< patches with fewer faces are absorbed into a neighbouring patch by rigid
                                     //!< unfolding (0 = keep all; isolated components stay whole)
   // kThesis -------------------------------------------------------------------------------------
@@ -101,15 +106,16 @@ struct MappingStats {
 //! Preconditions: topology = build_topology(mesh), frames = compute_orientation(mesh, topology, ...).
 //! Fails with kInvalidArgument on bad options (scale <= 0 or non-finite, max_stretch out of range,
 //! seam_faces of the wrong size), kInvalidMesh when frames/topology do not match the mesh,
-//! kCancelled when the progress callback returns false. Cost: O(F log front) time, O(F) memory,
-//! allocated once before the loop. Deterministic.
+//! kCancelled when the progress callback returns false. Cost: O(F log front) time, O(F + V) memory,
+//! allocated once before the loop (the atlas's capacity is reused). Deterministic. Safe for any
+//! mesh that passed finalize_mesh (non-manifold and inconsistent edges act as boundaries).
 Status map_texture(const Mesh& mesh, const Topology& topology, const FaceFrames& frames,
                    const MappingOptions& options, Atlas& atlas, MappingStats* stats = nullptr);
 
 //! Per-face check used by kPatches and by tests: singular values of the Jacobian of the map from
 //! the face's frame (corner positions `local`, 6 floats, normalised units, times `scale`) to the
 //! UV triangle `uv` (6 floats, pixels). Returns max(sigma_max - 1, 1/sigma_min - 1), or +inf when
-//! the UV triangle is inverted or degenerate. O(1).
+//! the UV triangle is inverted or degenerate, or the face's own triangle has no positive area. O(1).
 float face_stretch_error(std::span<const float, 6> local, float scale, std::span<const float, 6> uv);
 
 }  // namespace tailor

@@ -26,6 +26,8 @@ struct StabilityReport {
   size_t compared_corners = 0;    //!< corners of surviving faces
   double mean_difference_px = 0;  //!< mean |uv_full - uv_cut| over surviving corners, pixels
   double max_difference_px = 0;   //!< largest such difference, pixels
+  double median_difference_px = 0;  //!< median of the differences, pixels (robust to the few regions that a
+                                  //!< changed growth order re-places whole)
   double identical_ratio = 0;     //!< share of surviving corners with bit-identical UVs
   double within_1px_ratio = 0;    //!< share of surviving corners that moved less than 1 px
   uint32_t patches_full = 0;      //!< patches of the full mapping

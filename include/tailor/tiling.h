@@ -2,8 +2,9 @@
 //
 // make_tileable() turns a texture photograph into a tile whose right edge continues its left edge
 // and whose bottom edge continues its top edge, so that it can be repeated without visible seams:
-//   1. swap the quadrants (toroidal shift by half the size): the outer border becomes seamless,
-//      the old wrap seams now form a '+' through the middle;
+//   1. swap the quadrants (toroidal shift by about half the size: the new wrap is put on the
+//      interior column / row within 1/8 of the middle whose difference is closest to the median
+//      one, so it is as ordinary as any other); the old wrap seams now form a '+' inside;
 //   2. repair the vertical arm of the '+' (a strip of width block - 2 * overlap, treated as a ring
 //      through the top/bottom border), then the horizontal arm, then the centre, by image quilting
 //      (Efros & Freeman 2001) from the exemplar: blocks chosen by SSD over their overlap with what
@@ -12,7 +13,9 @@
 //      the shifted exemplar.
 // make_tile_variants() adds tiles whose outer ring (TileReport::border px) is bit-identical to the
 // first one while the interior is re-quilted, so they can be mixed for aperiodic tiling (thesis 3.2).
-// With fit_period the exemplar is first resized to a whole number of texel periods (thesis 3.1).
+// With fit_period the exemplar is first cropped or extended (never resampled: texels keep their
+// size) to a whole number of texel periods, extension copying the texture one period back, so
+// that a regular pattern ends in phase (thesis 3.1: 10 px stripes in 55 px -> 60 px).
 //
 // Images follow the layout of image.h (1 to 4 channels, all treated alike; alpha is just a channel).
 // Cost: O(blocks * N log N) for an N-pixel exemplar (one FFT correlation per block); about 0.3 s
@@ -35,12 +38,12 @@ namespace tailor {
 using TileProgress = std::function<bool(double)>;
 
 struct TileOptions {
-  int block = 32;            //!< quilting block side in px, [8, 256]; shrunk to min(W, H) / 4 (with a warning) for small images
-  int overlap = 0;           //!< overlap of neighbouring blocks in px, [1, block / 2 - 1]; 0 = block / 4
-  uint64_t seed = 1;         //!< seeds the random choice among near-best blocks; same seed -> same tile
-  double tolerance = 0.1;    //!< candidate blocks have SSD <= best * (1 + tolerance), [0, 1]
-  bool fit_period = false;   //!< resize the exemplar to a whole number of texel periods first (thesis 3.1)
-  TileProgress progress;     //!< optional progress callback (may be empty)
+  int block = 32;   //!< quilting block side in px, [8, 256]; shrunk to min(W, H) / 4 (with a warning) for small images
+  int overlap = 0;  //!< overlap of neighbouring blocks in px, [1, block / 2 - 1]; 0 = block / 4
+  uint64_t seed = 1;        //!< seeds the random choice among near-best blocks; same seed -> same tile
+  double tolerance = 0.1;   //!< candidate blocks have SSD <= best * (1 + tolerance), [0, 1]
+  bool fit_period = false;  //!< crop/extend to a whole number of texel periods first (thesis 3.1)
+  TileProgress progress;    //!< optional progress callback (may be empty)
 };
 
 //! Texel period found by autocorrelation (thesis 3.1), per axis.
@@ -55,11 +58,13 @@ struct PeriodEstimate {
 
 //! What make_tileable did, for reports and the variants' JSON.
 struct TileReport {
-  int width = 0;                      //!< output size (differs from the input only with fit_period)
+  int width = 0;  //!< output size (differs from the input only with fit_period)
   int height = 0;
   int block = 0;                      //!< block side actually used (px)
   int overlap = 0;                    //!< overlap actually used (px)
   int border = 0;                     //!< width of the outer ring that is bit-identical across variants (px)
+  int shift_x = 0;                    //!< toroidal shift used: tile(x, y) = input((x + shift_x) % W, (y + shift_y) % H)
+  int shift_y = 0;                    //!<   outside the repaired strips (about W/2, H/2; see make_tileable)
   int blocks = 0;                     //!< quilting blocks placed (all variants)
   PeriodEstimate period;              //!< filled when fit_period was asked for
   std::vector<std::string> warnings;  //!< e.g. "block shrunk from 32 to 16 px for a 64 px image"
@@ -79,11 +84,11 @@ Status make_tileable(const Image& exemplar, const TileOptions& options, Image& t
 //! the outer TileReport::border px ring with seed (options.seed, k) and a different raster order.
 //! All tiles share that ring bit-exactly, so any of them can be placed next to any other.
 //! Cost: about count times make_tileable (the interior is quilted block by block).
-Status make_tile_variants(const Image& exemplar, const TileOptions& options, int count,
-                          std::vector<Image>& tiles, TileReport* report = nullptr);
+Status make_tile_variants(const Image& exemplar, const TileOptions& options, int count, std::vector<Image>& tiles,
+                          TileReport* report = nullptr);
 
 //! Texel period along x and y from the normalised (unbiased) autocorrelation of the luminance,
-//! computed by FFT: the first autocorrelation peak within lags [3, size / 2] reaching 80 % of the
+//! computed by FFT: the first autocorrelation peak within lags [3, 2 size / 3] reaching 80 % of the
 //! highest one, refined to sub-pixel by a parabola. Noise-like textures give found = false.
 //! Cost O(N log N). Never fails (an invalid image gives an empty estimate).
 PeriodEstimate estimate_period(const Image& image);
@@ -96,32 +101,33 @@ void period_fitted_size(const PeriodEstimate& period, int width, int height, int
 //! Quality of a tile (thesis ch. 4 and issue 4). Column boundary x is the pair (x, x+1 mod W);
 //! its "difference" is the mean absolute 8-bit difference across it over all rows and channels.
 struct TileMetrics {
-  double wrap_ratio_x = 0.0;      //!< difference across the wrap column / median interior column difference (~1 seamless)
-  double wrap_ratio_y = 0.0;      //!< same for rows
+  double wrap_ratio_x = 0.0;  //!< difference across the wrap column / median interior column difference (~1 seamless)
+  double wrap_ratio_y = 0.0;  //!< same for rows
   double worst_seam_ratio = 0.0;  //!< max over all column and row boundaries, wrap included, of difference / median
   double gradient_energy = 0.0;   //!< mean |dx| + |dy| over interior pixels and channels (8-bit units)
   bool has_exemplar = false;      //!< the fields below are filled only when an exemplar was given
   double exemplar_worst_seam_ratio = 0.0;  //!< the exemplar's own worst interior boundary ratio (wrap excluded)
   double exemplar_wrap_ratio_x = 0.0;      //!< the exemplar's wrap ratios (how non-tileable it was)
   double exemplar_wrap_ratio_y = 0.0;
-  double histogram_l1 = 0.0;      //!< sum |p - q| of 64-bin normalised histograms, mean over channels, [0, 2]
-  double gradient_ratio = 0.0;    //!< gradient_energy of the tile / of the exemplar (< 1: blurred or ghosted)
-  double patch_coherence = 0.0;   //!< mean over 7x7 tile patches (read toroidally) of the per-sample squared distance
-                                  //!< to the nearest exemplar patch, over the exemplar's variance (0 = all copied)
+  double histogram_l1 = 0.0;     //!< sum |p - q| of 64-bin normalised histograms, mean over channels, [0, 2]
+  double gradient_ratio = 0.0;   //!< gradient_energy of the tile / of the exemplar (< 1: blurred or ghosted)
+  double patch_coherence = 0.0;  //!< mean over 7x7 tile patches (read toroidally) of the per-sample squared distance
+                                 //!< to the nearest exemplar patch, over the exemplar's variance (0 = all copied)
   double exemplar_patch_coherence = 0.0;  //!< the same for the exemplar itself read toroidally (baseline)
 };
 
 //! Computes TileMetrics of `tile`, comparing with `exemplar` when it is not null (channel counts may
-//! differ: both are then compared in luminance). Patch coherence uses PatchMatch (Barnes et al. 2009)
-//! with a fixed seed over a fixed grid of tile patches (stride chosen so at most ~16k patches),
-//! 8 iterations: an upper bound of the exact nearest-patch distance. Cost: O(N) plus ~0.2 s for
-//! the coherence of a 512 px image. Fails with kInvalidImage for an inconsistent image or one
-//! smaller than 8 px a side.
+//! differ: both are then compared in luminance). Patch coherence: tile patches on a fixed grid
+//! (stride 1 up to 128 x 128 px, else the smallest stride giving <= 16384 patches); patches copied
+//! verbatim are found exactly by hashing every exemplar patch, the others by PatchMatch (Barnes et
+//! al. 2009, constant seed, 6 iterations), so the value is an upper bound of the exact one, and
+//! deterministic. Cost: O(N) plus ~0.1 s per 512 px image. Fails with kInvalidImage for an
+//! inconsistent image or one smaller than 8 px a side. Safe for untrusted images.
 Status tile_metrics(const Image& tile, const Image* exemplar, TileMetrics& metrics);
 
 //! The issue's quality targets: wrap ratios in [0.8, 1.2], worst seam <= max(exemplar's, 1.5),
 //! histogram L1 <= 0.1, gradient ratio >= 0.95, patch coherence <= the exemplar's toroidal one
-//! (+ 0.01 slack for the estimator). Returns true when all hold; `failed` lists the others.
+//! (+ 5 % for the randomised estimator). Returns true when all hold; `failed` lists the others.
 bool meets_tile_targets(const TileMetrics& metrics, std::string* failed = nullptr);
 
 }  // namespace tailor

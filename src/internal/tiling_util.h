@@ -38,7 +38,10 @@ struct Plane {
   float* at(int x, int y) { return &px[(static_cast<size_t>(y) * width + x) * channels]; }
   //! Toroidal access: x and y may be any integers.
   const float* wrap(int x, int y) const { return at(mod(x, width), mod(y, height)); }
-  static int mod(int a, int n) { const int r = a % n; return r < 0 ? r + n : r; }
+  static int mod(int a, int n) {
+    const int r = a % n;
+    return r < 0 ? r + n : r;
+  }
 };
 
 inline Plane to_plane(const Image& image) {

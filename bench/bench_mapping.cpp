@@ -1,0 +1,139 @@
+// Orientation and mapping throughput (M faces/s) with the quality of the result on the same line,
+// on the 1.55 M face subdivided horse (bench_meshes.h) and on every mesh of the shared data set
+// (TAILOR_SHARED_DATA/meshes, skipped when absent), in both mapping modes.
+// Targets (docs/mapping.md): mapping >= 10 M faces/s single-threaded; on every shared mesh
+// 0 flipped, Sander L2 <= 1.02, Linf <= 3, thesis stretch <= 0.08, no single-face patches.
+//
+// Run: tailor_bench --benchmark_filter='Orientation|Mapping'
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bench_meshes.h"
+#include "tailor/io.h"
+#include "tailor/mapping.h"
+#include "tailor/metrics.h"
+#include "tailor/orientation.h"
+#include "tailor/topology.h"
+
+namespace {
+
+struct Prepared {
+  tailor::Mesh mesh;
+  tailor::Topology topology;
+  tailor::FaceFrames frames;
+  bool ok = false;
+  std::string error;
+};
+
+// Loaded once per process and mesh (the registry owns them; benchmarks run one at a time).
+const Prepared& prepared(const std::string& key) {
+  static std::map<std::string, std::unique_ptr<Prepared>> cache;
+  auto it = cache.find(key);
+  if (it != cache.end()) return *it->second;
+  auto p = std::make_unique<Prepared>();
+  if (key == "horse_x16") {
+    p->mesh = subdivided_horse();
+  } else {
+    const tailor::Status s = tailor::load_mesh(key, p->mesh);
+    if (!s.is_ok()) p->error = s.message();
+  }
+  if (p->error.empty()) {
+    p->topology = tailor::build_topology(p->mesh);
+    const tailor::Status s = tailor::compute_orientation(p->mesh, p->topology, {}, p->frames);
+    if (!s.is_ok()) p->error = s.message();
+  }
+  p->ok = p->error.empty();
+  return *cache.emplace(key, std::move(p)).first->second;
+}
+
+void BM_Orientation(benchmark::State& state, const std::string& key) {
+  const Prepared& p = prepared(key);
+  if (!p.ok) {
+    state.SkipWithError(p.error.c_str());
+    return;
+  }
+  tailor::FaceFrames frames;
+  for (auto _ : state) {
+    if (!tailor::compute_orientation(p.mesh, p.topology, {}, frames).is_ok()) {
+      state.SkipWithError("orientation failed");
+      return;
+    }
+    benchmark::DoNotOptimize(frames.local.data());
+  }
+  const double faces = static_cast<double>(p.mesh.face_count());
+  state.counters["faces"] = faces;
+  state.counters["Mfaces/s"] =
+      benchmark::Counter(faces * 1e-6 * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+}
+
+void BM_Mapping(benchmark::State& state, const std::string& key, tailor::MappingMode mode) {
+  const Prepared& p = prepared(key);
+  if (!p.ok) {
+    state.SkipWithError(p.error.c_str());
+    return;
+  }
+  tailor::MappingOptions options;
+  options.mode = mode;
+  tailor::Atlas atlas;
+  tailor::MappingStats stats;
+  for (auto _ : state) {
+    if (!tailor::map_texture(p.mesh, p.topology, p.frames, options, atlas, &stats).is_ok()) {
+      state.SkipWithError("mapping failed");
+      return;
+    }
+    benchmark::DoNotOptimize(atlas.corner_uv.data());
+  }
+  const double faces = static_cast<double>(p.mesh.face_count());
+  state.counters["faces"] = faces;
+  state.counters["Mfaces/s"] =
+      benchmark::Counter(faces * 1e-6 * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  tailor::UvMetrics m;
+  if (!tailor::compute_uv_metrics(p.mesh, p.topology, atlas.corner_uv, atlas.patch, {}, m).is_ok()) {
+    state.SkipWithError("metrics failed");
+    return;
+  }
+  state.counters["patches"] = m.patches;
+  state.counters["single"] = static_cast<double>(m.single_face_patches);
+  state.counters["seam%"] = 100.0 * m.seam_length_ratio;
+  state.counters["gap_px"] = m.seam_gap_px;
+  state.counters["flipped"] = static_cast<double>(m.flipped);
+  state.counters["stretch"] = m.stretch;
+  state.counters["angle_deg"] = m.distortion_deg;
+  state.counters["L2"] = m.l2_stretch;
+  state.counters["Linf"] = m.linf_stretch;
+  if (mode == tailor::MappingMode::kThesis) state.counters["thr_px"] = stats.final_threshold_px;
+}
+
+// Registers one orientation and two mapping benchmarks per mesh at static initialisation.
+[[maybe_unused]] const bool registered = [] {
+  std::vector<std::pair<std::string, std::string>> meshes = {{"horse_x16", "horse_x16"}};
+  const std::filesystem::path dir = std::filesystem::path(TAILOR_SHARED_DATA) / "meshes";
+  std::error_code ec;
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string ext = entry.path().extension().string();
+    if (ext == ".ply" || ext == ".obj" || ext == ".off" || ext == ".stl") files.push_back(entry.path());
+  }
+  std::sort(files.begin(), files.end());
+  for (const auto& f : files) meshes.emplace_back(f.stem().string(), f.string());
+  for (const auto& [name, key] : meshes) {
+    benchmark::RegisterBenchmark(("Orientation/" + name).c_str(), BM_Orientation, key)
+        ->Unit(benchmark::kMillisecond)
+        ->MinTime(0.2);
+    benchmark::RegisterBenchmark(("Mapping/patches/" + name).c_str(), BM_Mapping, key, tailor::MappingMode::kPatches)
+        ->Unit(benchmark::kMillisecond)
+        ->MinTime(0.2);
+    benchmark::RegisterBenchmark(("Mapping/thesis/" + name).c_str(), BM_Mapping, key, tailor::MappingMode::kThesis)
+        ->Unit(benchmark::kMillisecond)
+        ->MinTime(0.2);
+  }
+  return true;
+}();
+
+}  // namespace

@@ -1,0 +1,530 @@
+// Export (.glb / .obj / .ply), vertex splitting, the glb reader and `tailor eval`.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <stb/stb_image.h>
+#include <stb/stb_image_write.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+
+#include "internal/atomic_file.h"
+#include "tailor/export.h"
+#include "tailor/gltf.h"
+#include "tailor/io.h"
+#include "tailor/mapping.h"
+#include "tailor/orientation.h"
+#include "tailor/metrics.h"
+#include "tailor/topology.h"
+
+namespace tailor {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kTexture = std::string(TAILOR_TEST_DATA) + "/textures/vistex-tile04-128.png";
+const std::string kSpot = std::string(TAILOR_TEST_DATA) + "/meshes/spot.obj";
+constexpr float kPixelsPerUnit = 64;
+
+// Unit cube, 8 vertices, 12 triangles counter-clockwise from outside; each side is its own patch
+// with an identity map (64 px per unit) offset by 100 px per patch along u.
+void make_cube(Mesh& mesh, Atlas& atlas) {
+  mesh = Mesh{};
+  atlas = Atlas{};
+  for (int v = 0; v < 8; ++v) {
+    mesh.positions.push_back(static_cast<float>(v & 1));
+    mesh.positions.push_back(static_cast<float>((v >> 1) & 1));
+    mesh.positions.push_back(static_cast<float>((v >> 2) & 1));
+  }
+  const uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  const float quad_uv[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  for (uint32_t q = 0; q < 6; ++q) {
+    const int tris[2][3] = {{0, 1, 2}, {0, 2, 3}};
+    for (const auto& tri : tris) {
+      for (int k : tri) {
+        mesh.indices.push_back(quads[q][k]);
+        atlas.corner_uv.push_back(kPixelsPerUnit * quad_uv[k][0] + 100.0f * static_cast<float>(q));
+        atlas.corner_uv.push_back(kPixelsPerUnit * quad_uv[k][1]);
+      }
+      atlas.patch.push_back(q);
+    }
+  }
+  atlas.patch_count = 6;
+}
+
+class ExportTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("tailor_export_test_" + std::to_string(getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    make_cube(cube_, cube_atlas_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  // Names of the files in the test folder that contain ".tmp-" (left-over temporaries).
+  size_t temporaries() const {
+    size_t n = 0;
+    for (const auto& entry : fs::recursive_directory_iterator(dir_))
+      if (entry.path().filename().string().find(".tmp-") != std::string::npos) ++n;
+    return n;
+  }
+  fs::path dir_;
+  Mesh cube_;
+  Atlas cube_atlas_;
+};
+
+std::string read_all(const std::string& file) {
+  std::string bytes;
+  EXPECT_TRUE(internal::read_file(file, bytes).is_ok()) << file;
+  return bytes;
+}
+
+// Runs a shell command, returns its exit status and stdout+stderr.
+int run_command(const std::string& command, std::string& output) {
+  output.clear();
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return -1;
+  char buffer[4096];
+  size_t n = 0;
+  while ((n = fread(buffer, 1, sizeof buffer, pipe)) > 0) output.append(buffer, n);
+  const int status = pclose(pipe);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+bool have_node() {
+  std::string out;
+  return run_command("command -v node", out) == 0;
+}
+
+// Runs the Khronos validator; expects no error and no warning.
+void expect_valid_gltf(const std::string& file) {
+  if (!have_node()) GTEST_SKIP() << "node not installed: glTF validation skipped";
+  std::string out;
+  const int rc = run_command(std::string("node ") + TAILOR_SOURCE_DIR + "/tests/tools/validate_gltf.mjs --strict '" + file + "'", out);
+  EXPECT_EQ(rc, 0) << out;
+  EXPECT_NE(out.find("errors 0 warnings 0"), std::string::npos) << out;
+}
+
+// The JSON chunk of a glb file.
+nlohmann::json glb_json(const std::string& bytes) {
+  uint32_t length = 0;
+  std::memcpy(&length, bytes.data() + 12, 4);
+  return nlohmann::json::parse(bytes.substr(20, length));
+}
+
+// Re-packs a glb from a JSON document and the original file's BIN chunk.
+std::string rebuild_glb(const nlohmann::json& json, const std::string& original) {
+  uint32_t json_length = 0;
+  std::memcpy(&json_length, original.data() + 12, 4);
+  const std::string bin_chunk = original.substr(20 + json_length);
+  std::string text = json.dump();
+  while (text.size() % 4) text += ' ';
+  std::string out(20, '\0');
+  const uint32_t header[5] = {0x46546C67, 2, static_cast<uint32_t>(20 + text.size() + bin_chunk.size()),
+                              static_cast<uint32_t>(text.size()), 0x4E4F534A};
+  std::memcpy(out.data(), header, 20);
+  return out + text + bin_chunk;
+}
+
+UvMetrics metrics_px(const Mesh& mesh, std::span<const float> uv_px, float size) {
+  UvMetrics m;
+  const Status s = compute_uv_metrics(mesh, build_topology(mesh), uv_px, {}, MetricsOptions{size, size}, m);
+  EXPECT_TRUE(s.is_ok()) << s.message();
+  return m;
+}
+
+std::vector<float> repeats_to_px(const std::vector<float>& repeats, float size) {
+  std::vector<float> px(repeats.size());
+  for (size_t i = 0; i < px.size(); ++i) px[i] = repeats[i] * size;
+  return px;
+}
+
+TEST_F(ExportTest, SplitsVerticesOnUvAndWeldsThemBack) {
+  SplitMesh split;
+  split_vertices(cube_, cube_atlas_.corner_uv, split);
+  // Each side has its own 4 UVs: 6 * 4 split vertices, numbered in order of first corner.
+  EXPECT_EQ(split.xref.size(), 24u);
+  EXPECT_EQ(split.positions.size(), 72u);
+  ASSERT_EQ(split.indices.size(), cube_.indices.size());
+  EXPECT_EQ(split.indices[0], 0u);
+  EXPECT_EQ(split.indices[1], 1u);
+  EXPECT_EQ(split.indices[2], 2u);
+  EXPECT_EQ(split.indices[3], 0u);  // second triangle of the first side reuses corner 0
+  for (size_t c = 0; c < cube_.indices.size(); ++c) {
+    const uint32_t s = split.indices[c];
+    EXPECT_EQ(split.xref[s], cube_.indices[c]);
+    EXPECT_EQ(split.uvs[2 * s], cube_atlas_.corner_uv[2 * c]);
+    EXPECT_EQ(split.uvs[2 * s + 1], cube_atlas_.corner_uv[2 * c + 1]);
+    EXPECT_EQ(std::memcmp(&split.positions[3 * s], &cube_.positions[3 * size_t{cube_.indices[c]}], 12), 0);
+  }
+  // -0 and +0 are one UV.
+  Atlas signed_zero = cube_atlas_;
+  signed_zero.corner_uv[1] = -0.0f;  // corner 0 has v = +0 elsewhere (corner 3)
+  split_vertices(cube_, signed_zero.corner_uv, split);
+  EXPECT_EQ(split.xref.size(), 24u);
+
+  Mesh welded;
+  welded.positions = split.positions;
+  welded.indices = split.indices;
+  EXPECT_EQ(weld_identical_positions(welded), 16u);
+  EXPECT_EQ(welded.vertex_count(), 8u);
+  for (size_t c = 0; c < cube_.indices.size(); ++c)
+    EXPECT_EQ(std::memcmp(&welded.positions[3 * size_t{welded.indices[c]}], &cube_.positions[3 * size_t{cube_.indices[c]}], 12), 0);
+}
+
+TEST_F(ExportTest, GlbRoundTripsAndValidates) {
+  ExportOptions options;
+  options.texture_path = kTexture;
+  options.texture_width = options.texture_height = 128;
+  const std::string out = path("cube.glb");
+  ASSERT_TRUE(export_mesh(out, cube_, cube_atlas_, options).is_ok());
+  EXPECT_EQ(temporaries(), 0u);
+
+  Mesh back;
+  Image texture;
+  LoadReport report;
+  const Status s = read_glb_file(out, back, &texture, &report);
+  ASSERT_TRUE(s.is_ok()) << s.message();
+  EXPECT_EQ(back.face_count(), 12u);
+  EXPECT_EQ(back.vertex_count(), 8u);  // 24 split vertices welded back
+  EXPECT_EQ(report.welded_vertices, 16u);
+  ASSERT_EQ(back.corner_uvs.size(), cube_atlas_.corner_uv.size());
+  for (size_t c = 0; c < 36; ++c) {
+    EXPECT_EQ(back.corner_uvs[2 * c], cube_atlas_.corner_uv[2 * c] / 128.0f);
+    EXPECT_EQ(back.corner_uvs[2 * c + 1], cube_atlas_.corner_uv[2 * c + 1] / 128.0f);
+    EXPECT_EQ(std::memcmp(&back.positions[3 * size_t{back.indices[c]}], &cube_.positions[3 * size_t{cube_.indices[c]}], 12), 0);
+  }
+  // The embedded texture decodes to the file's pixels.
+  int w = 0, h = 0, n = 0;
+  unsigned char* pixels = stbi_load(kTexture.c_str(), &w, &h, &n, 0);
+  ASSERT_NE(pixels, nullptr);
+  EXPECT_EQ(texture.width, w);
+  EXPECT_EQ(texture.height, h);
+  EXPECT_EQ(texture.channels, n);
+  EXPECT_EQ(texture.pixels.size(), size_t(w) * size_t(h) * size_t(n));
+  EXPECT_EQ(std::memcmp(texture.pixels.data(), pixels, texture.pixels.size()), 0);
+  stbi_image_free(pixels);
+
+  // Same metrics before and after (the seams come back through welding).
+  const UvMetrics before = metrics_px(cube_, cube_atlas_.corner_uv, 128);
+  const UvMetrics after = metrics_px(back, repeats_to_px(back.corner_uvs, 128), 128);
+  EXPECT_EQ(before.patches, 6u);
+  EXPECT_EQ(before.seam_edges, 12u);
+  EXPECT_EQ(after.patches, before.patches);
+  EXPECT_EQ(after.seam_edges, before.seam_edges);
+  EXPECT_EQ(after.flipped, 0u);
+  EXPECT_NEAR(after.l2_stretch, 1.0, 1e-5);
+  EXPECT_NEAR(after.seam_gap_px, before.seam_gap_px, 1e-3);
+
+  // Structure: REPEAT sampler, mipmapped filtering, PNG embedded byte for byte, POSITION min/max.
+  const std::string bytes = read_all(out);
+  const nlohmann::json j = glb_json(bytes);
+  EXPECT_EQ(j["samplers"][0]["wrapS"], 10497);
+  EXPECT_EQ(j["samplers"][0]["wrapT"], 10497);
+  EXPECT_EQ(j["samplers"][0]["minFilter"], 9987);
+  EXPECT_EQ(j["images"][0]["mimeType"], "image/png");
+  const std::string png = read_all(kTexture);
+  const size_t view = j["images"][0]["bufferView"];
+  const size_t offset = j["bufferViews"][view]["byteOffset"];
+  uint32_t json_length = 0;
+  std::memcpy(&json_length, bytes.data() + 12, 4);
+  EXPECT_EQ(bytes.substr(20 + json_length + 8 + offset, png.size()), png);
+  const size_t position = j["meshes"][0]["primitives"][0]["attributes"]["POSITION"];
+  EXPECT_EQ(j["accessors"][position]["min"], nlohmann::json({0.0, 0.0, 0.0}));
+  EXPECT_EQ(j["accessors"][position]["max"], nlohmann::json({1.0, 1.0, 1.0}));
+  EXPECT_EQ(j["accessors"][j["meshes"][0]["primitives"][0]["indices"].get<size_t>()]["componentType"], 5125);
+
+  expect_valid_gltf(out);
+}
+
+TEST_F(ExportTest, GlbEmbedsJpegAndWorksWithoutTexture) {
+  int w = 0, h = 0, n = 0;
+  unsigned char* pixels = stbi_load(kTexture.c_str(), &w, &h, &n, 0);
+  ASSERT_NE(pixels, nullptr);
+  const std::string jpeg = path("texture.jpg");
+  ASSERT_NE(stbi_write_jpg(jpeg.c_str(), w, h, n, pixels, 90), 0);
+  stbi_image_free(pixels);
+
+  ExportOptions options;
+  options.texture_path = jpeg;
+  ASSERT_TRUE(export_mesh(path("jpeg.glb"), cube_, cube_atlas_, options).is_ok());
+  EXPECT_EQ(glb_json(read_all(path("jpeg.glb")))["images"][0]["mimeType"], "image/jpeg");
+  Mesh back;
+  Image texture;
+  ASSERT_TRUE(read_glb_file(path("jpeg.glb"), back, &texture).is_ok());
+  EXPECT_EQ(texture.width, w);
+  expect_valid_gltf(path("jpeg.glb"));
+
+  options = ExportOptions{};
+  options.normals = false;
+  ASSERT_TRUE(export_mesh(path("plain.glb"), cube_, cube_atlas_, options).is_ok());
+  const nlohmann::json j = glb_json(read_all(path("plain.glb")));
+  EXPECT_FALSE(j.contains("images"));
+  EXPECT_FALSE(j["meshes"][0]["primitives"][0]["attributes"].contains("NORMAL"));
+  ASSERT_TRUE(read_glb_file(path("plain.glb"), back, &texture).is_ok());
+  EXPECT_TRUE(texture.empty());
+  EXPECT_EQ(back.face_count(), 12u);
+  expect_valid_gltf(path("plain.glb"));
+}
+
+TEST_F(ExportTest, ObjRoundTripsWithMaterial) {
+  ExportOptions options;
+  options.texture_path = kTexture;
+  options.texture_width = options.texture_height = 128;
+  fs::create_directories(dir_ / "sub");
+  const std::string out = path("sub/cube.obj");
+  ASSERT_TRUE(export_mesh(out, cube_, cube_atlas_, options).is_ok());
+  const std::string mtl = read_all(path("sub/cube.mtl"));
+  const std::string expected = fs::relative(kTexture, dir_ / "sub").generic_string();
+  EXPECT_NE(mtl.find("map_Kd " + expected + "\n"), std::string::npos) << mtl;
+  EXPECT_NE(read_all(out).find("mtllib cube.mtl\n"), std::string::npos);
+
+  Mesh back;
+  const Status s = load_mesh(out, back);
+  ASSERT_TRUE(s.is_ok()) << s.message();
+  EXPECT_EQ(back.face_count(), 12u);
+  EXPECT_EQ(back.vertex_count(), 8u);  // shared v, one vt per split vertex
+  EXPECT_EQ(back.indices, cube_.indices);
+  ASSERT_EQ(back.corner_uvs.size(), cube_atlas_.corner_uv.size());
+  for (size_t i = 0; i < back.corner_uvs.size(); ++i)
+    EXPECT_FLOAT_EQ(back.corner_uvs[i], cube_atlas_.corner_uv[i] / 128.0f) << i;
+  EXPECT_EQ(temporaries(), 0u);
+}
+
+TEST_F(ExportTest, PlyRoundTripsWithSplitVertices) {
+  ExportOptions options;
+  options.texture_width = options.texture_height = 256;
+  const std::string out = path("cube.ply");
+  ASSERT_TRUE(export_mesh(out, cube_, cube_atlas_, options).is_ok());
+  EXPECT_EQ(read_all(out).rfind("ply\nformat binary_little_endian 1.0\n", 0), 0u);
+  Mesh back;
+  const Status s = load_mesh(out, back);
+  ASSERT_TRUE(s.is_ok()) << s.message();
+  EXPECT_EQ(back.face_count(), 12u);
+  EXPECT_EQ(back.vertex_count(), 24u);
+  ASSERT_EQ(back.corner_uvs.size(), cube_atlas_.corner_uv.size());
+  for (size_t i = 0; i < back.corner_uvs.size(); ++i)
+    EXPECT_FLOAT_EQ(back.corner_uvs[i], cube_atlas_.corner_uv[i] / 256.0f) << i;
+  EXPECT_EQ(weld_identical_positions(back), 16u);
+  EXPECT_EQ(metrics_px(back, repeats_to_px(back.corner_uvs, 256), 256).seam_edges, 12u);
+}
+
+// A real UV-mapped mesh (spot.obj's own atlas) through all three formats.
+TEST_F(ExportTest, RealMeshRoundTripsThroughAllFormats) {
+  Mesh spot;
+  const Status loaded = load_mesh(kSpot, spot);
+  ASSERT_TRUE(loaded.is_ok()) << loaded.message();
+  ASSERT_EQ(spot.face_count(), 5856u);
+  ASSERT_FALSE(spot.corner_uvs.empty());
+  const float size = 128;
+  Atlas atlas;
+  atlas.corner_uv = repeats_to_px(spot.corner_uvs, size);
+  std::vector<uint32_t> patch;
+  atlas.patch_count = derive_patches(spot, build_topology(spot), atlas.corner_uv, patch);
+  atlas.patch = patch;
+  const UvMetrics original = metrics_px(spot, atlas.corner_uv, size);
+
+  ExportOptions options;
+  options.texture_path = kTexture;
+  options.texture_width = options.texture_height = 128;
+  for (const char* name : {"spot.glb", "spot.obj", "spot.ply"}) {
+    SCOPED_TRACE(name);
+    const std::string out = path(name);
+    ASSERT_TRUE(export_mesh(out, spot, atlas, options).is_ok());
+    Mesh back;
+    const Status s = std::string(name).ends_with(".glb") ? read_glb_file(out, back, nullptr) : load_mesh(out, back);
+    ASSERT_TRUE(s.is_ok()) << s.message();
+    if (std::string(name).ends_with(".ply")) weld_identical_positions(back);
+    EXPECT_EQ(back.face_count(), spot.face_count());
+    EXPECT_EQ(back.vertex_count(), spot.vertex_count());
+    ASSERT_EQ(back.corner_uvs.size(), spot.corner_uvs.size());
+    double max_error = 0;
+    for (size_t i = 0; i < spot.corner_uvs.size(); ++i)
+      max_error = std::max(max_error, double(std::abs(back.corner_uvs[i] - spot.corner_uvs[i])));
+    EXPECT_EQ(max_error, 0.0);  // pixels / 128 and back are exact; every format stores floats exactly
+    const UvMetrics m = metrics_px(back, repeats_to_px(back.corner_uvs, size), size);
+    EXPECT_EQ(m.patches, original.patches);
+    EXPECT_EQ(m.seam_edges, original.seam_edges);
+    EXPECT_EQ(m.flipped, original.flipped);
+    EXPECT_NEAR(m.stretch, original.stretch, 1e-4);
+  }
+  expect_valid_gltf(path("spot.glb"));
+}
+
+// The mapping's own output (fandisk, default options) exports to a valid glb whose texture is
+// upright and unmirrored: every face keeps a positive signed UV area (t up) after the round trip.
+TEST_F(ExportTest, MappedMeshExportsUpright) {
+  Mesh mesh;
+  ASSERT_TRUE(load_mesh(std::string(TAILOR_TEST_DATA) + "/meshes/fandisk.off", mesh).is_ok());
+  const Topology topology = build_topology(mesh);
+  FaceFrames frames;
+  ASSERT_TRUE(compute_orientation(mesh, topology, OrientationOptions{}, frames).is_ok());
+  Atlas atlas;
+  const Status mapped = map_texture(mesh, topology, frames, MappingOptions{}, atlas);
+  ASSERT_TRUE(mapped.is_ok()) << mapped.message();
+  UvMetrics before;
+  ASSERT_TRUE(compute_uv_metrics(mesh, topology, atlas.corner_uv, atlas.patch, {}, before).is_ok());
+
+  ExportOptions options;
+  options.texture_path = kTexture;
+  options.texture_width = options.texture_height = 128;
+  ASSERT_TRUE(export_mesh(path("fandisk.glb"), mesh, atlas, options).is_ok());
+  Mesh back;
+  ASSERT_TRUE(read_glb_file(path("fandisk.glb"), back, nullptr).is_ok());
+  ASSERT_EQ(back.face_count(), mesh.face_count());
+  size_t positive = 0;
+  for (size_t f = 0; f < back.face_count(); ++f) {
+    const float* t = &back.corner_uvs[6 * f];
+    if ((t[2] - t[0]) * (t[5] - t[1]) - (t[4] - t[0]) * (t[3] - t[1]) > 0) ++positive;
+  }
+  EXPECT_EQ(positive + before.flipped, mesh.face_count());
+  const UvMetrics after = metrics_px(back, repeats_to_px(back.corner_uvs, 128), 128);
+  EXPECT_EQ(after.seam_edges, before.seam_edges);
+  EXPECT_EQ(after.flipped, before.flipped);
+  EXPECT_NEAR(after.stretch, before.stretch, 1e-6);
+  expect_valid_gltf(path("fandisk.glb"));
+}
+
+TEST_F(ExportTest, OutputIsDeterministic) {
+  ExportOptions options;
+  options.texture_path = kTexture;
+  fs::create_directories(dir_ / "a");
+  fs::create_directories(dir_ / "b");
+  for (const char* name : {"a/m.glb", "b/m.glb", "a/m.obj", "b/m.obj", "a/m.ply", "b/m.ply"})
+    ASSERT_TRUE(export_mesh(path(name), cube_, cube_atlas_, options).is_ok());
+  for (const char* name : {"m.glb", "m.obj", "m.mtl", "m.ply"})
+    EXPECT_EQ(read_all(path(std::string("a/") + name)), read_all(path(std::string("b/") + name))) << name;
+}
+
+TEST_F(ExportTest, FailuresLeaveNoPartialFile) {
+  ExportOptions options;
+  // Unsupported extension: usage error, nothing written.
+  EXPECT_EQ(export_mesh(path("cube.fbx"), cube_, cube_atlas_, options).code(), ErrorCode::kInvalidArgument);
+  EXPECT_FALSE(fs::exists(path("cube.fbx")));
+  // Missing directory.
+  EXPECT_EQ(export_mesh(path("missing/cube.glb"), cube_, cube_atlas_, options).code(), ErrorCode::kIo);
+  EXPECT_FALSE(fs::exists(path("missing")));
+
+  // A good file, then failing exports over it: it stays byte-identical.
+  const std::string out = path("cube.glb");
+  ASSERT_TRUE(export_mesh(out, cube_, cube_atlas_, options).is_ok());
+  const std::string good = read_all(out);
+  ExportOptions bad_texture;
+  bad_texture.texture_path = path("no-such-texture.png");
+  EXPECT_EQ(export_mesh(out, cube_, cube_atlas_, bad_texture).code(), ErrorCode::kIo);
+  bad_texture.texture_path = kSpot;  // exists, but not an image
+  EXPECT_EQ(export_mesh(out, cube_, cube_atlas_, bad_texture).code(), ErrorCode::kInvalidImage);
+  Atlas short_atlas = cube_atlas_;
+  short_atlas.corner_uv.pop_back();
+  EXPECT_EQ(export_mesh(out, cube_, short_atlas, options).code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(read_all(out), good);
+
+  // The target is a directory: the rename fails and the temporary file is removed.
+  fs::create_directories(dir_ / "taken.glb");
+  EXPECT_EQ(export_mesh(path("taken.glb"), cube_, cube_atlas_, options).code(), ErrorCode::kIo);
+  EXPECT_TRUE(fs::is_directory(dir_ / "taken.glb"));
+  EXPECT_EQ(temporaries(), 0u);
+}
+
+TEST_F(ExportTest, GlbReaderRejectsDamagedFiles) {
+  const std::string out = path("cube.glb");
+  ExportOptions options;
+  options.texture_path = kTexture;
+  ASSERT_TRUE(export_mesh(out, cube_, cube_atlas_, options).is_ok());
+  const std::string good = read_all(out);
+  Mesh mesh;
+  Image texture;
+  // Every truncation fails cleanly (the file's length field no longer matches).
+  for (size_t length = 0; length < good.size(); length += (length < 2048 ? 1 : 97)) {
+    const Status s = read_glb_memory(std::span<const char>(good.data(), length), "cut.glb", mesh, &texture);
+    EXPECT_FALSE(s.is_ok()) << length;
+    EXPECT_TRUE(mesh.empty());
+  }
+  // Random byte damage never crashes (the result may or may not be ok).
+  std::mt19937 rng(12345);
+  for (int trial = 0; trial < 300; ++trial) {
+    std::string damaged = good;
+    for (int k = 0; k < 4; ++k) damaged[rng() % damaged.size()] = static_cast<char>(rng());
+    (void)read_glb_memory(damaged, "damaged.glb", mesh, &texture);
+  }
+  // Accessors that lie about their size, and out-of-range indices.
+  nlohmann::json j = glb_json(good);
+  const size_t position = j["meshes"][0]["primitives"][0]["attributes"]["POSITION"];
+  nlohmann::json lie = j;
+  lie["accessors"][position]["count"] = 1u << 30;
+  EXPECT_EQ(read_glb_memory(rebuild_glb(lie, good), "lie.glb", mesh, nullptr).code(), ErrorCode::kParse);
+  lie = j;
+  lie["bufferViews"][0]["byteOffset"] = 1u << 31;
+  EXPECT_EQ(read_glb_memory(rebuild_glb(lie, good), "lie.glb", mesh, nullptr).code(), ErrorCode::kParse);
+  lie = j;
+  lie["images"][0]["bufferView"] = 99;  // texture unreachable: the mesh still loads, no texture
+  EXPECT_TRUE(read_glb_memory(rebuild_glb(lie, good), "lie.glb", mesh, &texture).is_ok());
+  EXPECT_TRUE(texture.empty());
+  lie = j;
+  lie["accessors"][position]["count"] = 3;  // fewer vertices than the indices use
+  lie["accessors"][j["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"].get<size_t>()]["count"] = 3;
+  lie["accessors"][position].erase("min");
+  lie["accessors"][position].erase("max");
+  EXPECT_EQ(read_glb_memory(rebuild_glb(lie, good), "lie.glb", mesh, nullptr).code(), ErrorCode::kInvalidMesh);
+  lie = j;
+  lie["buffers"][0]["uri"] = "/etc/passwd";
+  EXPECT_EQ(read_glb_memory(rebuild_glb(lie, good), "lie.glb", mesh, nullptr).code(), ErrorCode::kUnsupported);
+  EXPECT_EQ(read_glb_memory(std::string("not a glb at all, just text......"), "t.glb", mesh, nullptr).code(),
+            ErrorCode::kParse);
+  // The load_mesh route (no texture) reads the same mesh.
+  ASSERT_TRUE(load_mesh(out, mesh).is_ok());
+  EXPECT_EQ(mesh.face_count(), 12u);
+  EXPECT_EQ(mesh.vertex_count(), 8u);
+}
+
+TEST_F(ExportTest, EvalCommandReportsMetrics) {
+  ExportOptions options;
+  options.texture_path = kTexture;
+  options.texture_width = options.texture_height = 128;
+  ASSERT_TRUE(export_mesh(path("cube.glb"), cube_, cube_atlas_, options).is_ok());
+  ASSERT_TRUE(export_mesh(path("cube.obj"), cube_, cube_atlas_, options).is_ok());
+  std::string out;
+  ASSERT_EQ(run_command(std::string(TAILOR_BINARY) + " eval --json " + path("cube.glb"), out), 0) << out;
+  nlohmann::json j = nlohmann::json::parse(out);
+  EXPECT_EQ(j["faces"], 12);
+  EXPECT_EQ(j["patches"], 6);
+  EXPECT_EQ(j["seam_edges"], 12);
+  EXPECT_EQ(j["flipped"], 0);
+  EXPECT_EQ(j["texture_width"], 128);  // from the embedded image
+  EXPECT_NEAR(j["l2_stretch"].get<double>(), 1.0, 1e-5);
+  EXPECT_NEAR(j["stretch"].get<double>(), 0.0, 1e-5);
+  // Patch q is offset by 100 q px: across the seams gaps are k*100 px modulo 128, never 0 here.
+  EXPECT_GT(j["seam_gap_px"].get<double>(), 1.0);
+
+  // OBJ: UVs in repeats times --texture-size.
+  ASSERT_EQ(run_command(std::string(TAILOR_BINARY) + " eval --json --texture-size 128 " + path("cube.obj"), out), 0) << out;
+  nlohmann::json k = nlohmann::json::parse(out);
+  EXPECT_EQ(k["patches"], 6);
+  EXPECT_NEAR(k["seam_gap_px"].get<double>(), j["seam_gap_px"].get<double>(), 1e-3);
+  ASSERT_EQ(run_command(std::string(TAILOR_BINARY) + " eval " + path("cube.obj"), out), 0) << out;
+  EXPECT_NE(out.find("12 faces, 6 patches"), std::string::npos) << out;
+  EXPECT_NE(out.find("512x512"), std::string::npos) << out;
+
+  // PLY (split vertices): eval welds them, so the 12 seams come back.
+  ASSERT_TRUE(export_mesh(path("cube.ply"), cube_, cube_atlas_, options).is_ok());
+  ASSERT_EQ(run_command(std::string(TAILOR_BINARY) + " eval --json --texture-size 128 " + path("cube.ply"), out), 0) << out;
+  k = nlohmann::json::parse(out);
+  EXPECT_EQ(k["seam_edges"], 12);
+  EXPECT_EQ(k["welded_vertices"], 16);
+
+  // No UVs: a clear one-line error, exit 1. Bad option: exit 2.
+  std::ofstream(path("tri.off")) << "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  EXPECT_EQ(run_command(std::string(TAILOR_BINARY) + " eval " + path("tri.off"), out), 1);
+  EXPECT_NE(out.find("no texture coordinates"), std::string::npos) << out;
+  EXPECT_EQ(run_command(std::string(TAILOR_BINARY) + " eval --texture-size 0 " + path("cube.obj"), out), 2) << out;
+}
+
+}  // namespace
+}  // namespace tailor

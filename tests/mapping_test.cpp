@@ -1,0 +1,410 @@
+// Texture mapping by patch discovery (tailor/mapping.h) and its stability (tailor/stability.h).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "tailor/io.h"
+#include "tailor/mapping.h"
+#include "tailor/metrics.h"
+#include "tailor/orientation.h"
+#include "tailor/stability.h"
+#include "tailor/topology.h"
+
+namespace tailor {
+namespace {
+
+struct Mapped {
+  Mesh mesh;
+  Topology topology;
+  FaceFrames frames;
+  Atlas atlas;
+  MappingStats stats;
+};
+
+Mesh load(const std::string& name) {
+  Mesh mesh;
+  const Status s = load_mesh(std::string(TAILOR_TEST_DATA) + "/meshes/" + name, mesh);
+  EXPECT_TRUE(s.is_ok()) << name << ": " << s.message();
+  return mesh;
+}
+
+void map_mesh(Mapped& m, const MappingOptions& options = {}) {
+  m.topology = build_topology(m.mesh);
+  ASSERT_TRUE(compute_orientation(m.mesh, m.topology, {}, m.frames).is_ok());
+  const Status s = map_texture(m.mesh, m.topology, m.frames, options, m.atlas, &m.stats);
+  ASSERT_TRUE(s.is_ok()) << s.message();
+}
+
+// A flat grid of n by n unit squares in the z = 0 plane.
+Mesh grid(int n) {
+  Mesh mesh;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) mesh.positions.insert(mesh.positions.end(), {float(i), float(j), 0.f});
+  auto id = [n](int i, int j) { return static_cast<uint32_t>(j * (n + 1) + i); };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      mesh.indices.insert(mesh.indices.end(), {id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      mesh.indices.insert(mesh.indices.end(), {id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  return mesh;
+}
+
+// An open cylinder of radius 1 around y: m segments around, h rings of height 0.1.
+Mesh cylinder(int m, int h) {
+  Mesh mesh;
+  const double pi = std::acos(-1.0);
+  for (int j = 0; j <= h; ++j)
+    for (int i = 0; i < m; ++i)
+      mesh.positions.insert(mesh.positions.end(), {float(std::cos(2 * pi * i / m)), 0.1f * float(j),
+                                                   float(std::sin(2 * pi * i / m))});
+  auto id = [m](int i, int j) { return static_cast<uint32_t>(j * m + (i % m)); };
+  for (int j = 0; j < h; ++j)
+    for (int i = 0; i < m; ++i) {
+      mesh.indices.insert(mesh.indices.end(), {id(i, j), id(i, j + 1), id(i + 1, j + 1)});
+      mesh.indices.insert(mesh.indices.end(), {id(i, j), id(i + 1, j + 1), id(i + 1, j)});
+    }
+  return mesh;
+}
+
+UvMetrics metrics_of(const Mapped& m) {
+  UvMetrics metrics;
+  const Status s = compute_uv_metrics(m.mesh, m.topology, m.atlas.corner_uv, m.atlas.patch, {}, metrics);
+  EXPECT_TRUE(s.is_ok()) << s.message();
+  return metrics;
+}
+
+bool is_degenerate(const FaceFrames& frames, size_t f) {
+  const float* l = &frames.local[6 * f];
+  const float twice_area = l[2] * l[5] - l[3] * l[4];
+  float longest = 0;
+  for (int k = 1; k < 3; ++k) longest = std::max(longest, l[2 * k] * l[2 * k] + l[2 * k + 1] * l[2 * k + 1]);
+  longest = std::max(longest, (l[4] - l[2]) * (l[4] - l[2]) + (l[5] - l[3]) * (l[5] - l[3]));
+  return !(twice_area > 1e-6f * longest);
+}
+
+// The invariants every patches-mode atlas must hold.
+void expect_valid_patches_atlas(const Mapped& m, const MappingOptions& options, const std::string& name) {
+  const size_t face_count = m.mesh.face_count();
+  ASSERT_EQ(m.atlas.corner_uv.size(), 6 * face_count) << name;
+  ASSERT_EQ(m.atlas.patch.size(), face_count) << name;
+  std::vector<uint32_t> patch_faces(m.atlas.patch_count, 0);
+  size_t checked = 0;
+  for (size_t f = 0; f < face_count; ++f) {
+    ASSERT_LT(m.atlas.patch[f], m.atlas.patch_count) << name << " face " << f;
+    ++patch_faces[m.atlas.patch[f]];
+    const float* uv = &m.atlas.corner_uv[6 * f];
+    for (int i = 0; i < 6; ++i) ASSERT_TRUE(std::isfinite(uv[i])) << name << " face " << f;
+    if (is_degenerate(m.frames, f)) continue;
+    const float error = face_stretch_error(std::span<const float, 6>(&m.frames.local[6 * f], 6), options.scale,
+                                           std::span<const float, 6>(uv, 6));
+    // Rigid placements may differ from the bound's own rounding by a few ulps.
+    ASSERT_LE(error, options.max_stretch + 1e-3f) << name << " face " << f;
+    ++checked;
+  }
+  EXPECT_GT(checked, face_count * 9 / 10) << name;
+  for (uint32_t p = 0; p < m.atlas.patch_count; ++p) EXPECT_GT(patch_faces[p], 0u) << name << " patch " << p;
+  const UvMetrics metrics = metrics_of(m);
+  EXPECT_EQ(metrics.flipped, 0u) << name;
+  EXPECT_EQ(metrics.zero_uv_area_faces, 0u) << name;
+  EXPECT_EQ(metrics.single_face_patches, 0u) << name;
+  EXPECT_LT(metrics.l2_stretch, 1.02) << name;
+  EXPECT_LT(metrics.linf_stretch, 1.0 + options.max_stretch + 0.01) << name;
+  EXPECT_EQ(m.stats.patches, m.atlas.patch_count) << name;
+}
+
+TEST(Mapping, EveryTestMeshMapsCompletelyWithinTheBound) {
+  const std::filesystem::path dir = std::filesystem::path(TAILOR_TEST_DATA) / "meshes";
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    const std::string ext = entry.path().extension().string();
+    if (entry.is_regular_file() && (ext == ".obj" || ext == ".off" || ext == ".ply" || ext == ".stl"))
+      names.push_back(entry.path().filename().string());
+  }
+  std::sort(names.begin(), names.end());
+  ASSERT_GE(names.size(), 4u);
+  const MappingOptions options;
+  for (const std::string& name : names) {
+    Mapped m;
+    m.mesh = load(name);
+    map_mesh(m, options);
+    expect_valid_patches_atlas(m, options, name);
+  }
+}
+
+TEST(Mapping, PureUnfoldingAndLooserBoundsStayValid) {
+  Mapped follow, unfold;
+  follow.mesh = load("fertility.off");
+  unfold.mesh = follow.mesh;
+  map_mesh(follow);
+  MappingOptions options;
+  options.field_following = 0.f;
+  map_mesh(unfold, options);
+  expect_valid_patches_atlas(unfold, options, "fertility.off unfolded");
+  // Without the field's shear the faces keep their shape better (median angle distortion).
+  EXPECT_LT(metrics_of(unfold).distortion_deg, metrics_of(follow).distortion_deg);
+  Mapped loose;
+  loose.mesh = follow.mesh;
+  options = {};
+  options.max_stretch = 0.5f;
+  map_mesh(loose, options);
+  expect_valid_patches_atlas(loose, options, "fertility.off max_stretch 0.5");
+  EXPECT_GT(loose.stats.max_stretch_accepted, 0.25f);
+  options.field_following = 2.f;
+  EXPECT_EQ(map_texture(loose.mesh, loose.topology, loose.frames, options, loose.atlas).code(),
+            ErrorCode::kInvalidArgument);
+}
+
+TEST(Mapping, FlatGridIsOnePatchWithoutSeamOrDistortion) {
+  Mapped m;
+  m.mesh = grid(30);
+  map_mesh(m);
+  const UvMetrics metrics = metrics_of(m);
+  EXPECT_EQ(m.atlas.patch_count, 1u);
+  EXPECT_EQ(metrics.seam_edges, 0u);
+  EXPECT_NEAR(metrics.l2_stretch, 1.0, 1e-4);
+  EXPECT_NEAR(metrics.linf_stretch, 1.0, 1e-3);
+  EXPECT_LT(m.stats.max_stretch_accepted, 1e-3f);
+  // About half the faces close a gap with all three corners known (thesis fig. 2.4).
+  EXPECT_GT(m.stats.faces_three_textured, m.mesh.face_count() * 4 / 10);
+}
+
+TEST(Mapping, CylinderIsCutAlongOneLine) {
+  Mapped m;
+  m.mesh = cylinder(60, 40);  // 4800 faces, 40 rings of 60 faces each
+  map_mesh(m);
+  const UvMetrics metrics = metrics_of(m);
+  EXPECT_EQ(m.atlas.patch_count, 1u);
+  EXPECT_EQ(metrics.flipped, 0u);
+  // One cut from bottom to top: about one seam edge per ring (a few more where it steps sideways).
+  EXPECT_GE(metrics.seam_edges, 40u);
+  EXPECT_LE(metrics.seam_edges, 100u);
+}
+
+TEST(Mapping, IsDeterministic) {
+  Mapped a, b;
+  a.mesh = load("fertility.off");
+  b.mesh = a.mesh;
+  map_mesh(a);
+  map_mesh(b);
+  EXPECT_EQ(a.atlas.corner_uv, b.atlas.corner_uv);
+  EXPECT_EQ(a.atlas.patch, b.atlas.patch);
+  MappingOptions thesis;
+  thesis.mode = MappingMode::kThesis;
+  map_mesh(a, thesis);
+  map_mesh(b, thesis);
+  EXPECT_EQ(a.atlas.corner_uv, b.atlas.corner_uv);
+}
+
+TEST(Mapping, SeedPointChoosesTheFirstPatch) {
+  Mapped m;
+  m.mesh = load("spot.obj");
+  // Centroid of face 1000: the nearest face to it is face 1000 itself.
+  double c[3] = {0, 0, 0};
+  for (int k = 0; k < 3; ++k)
+    for (int i = 0; i < 3; ++i) c[i] += m.mesh.positions[3 * m.mesh.indices[3 * 1000 + k] + i] / 3.0;
+  MappingOptions options;
+  options.min_patch_faces = 0;  // keep the seed's own patch even if small
+  options.use_seed_point = true;
+  options.seed_point = {float(c[0]), float(c[1]), float(c[2])};
+  map_mesh(m, options);
+  EXPECT_EQ(m.atlas.patch[1000], 0u);
+  // The seed sits at the UV its own position gives (origin independent of the file order).
+  const float expected_u = (m.frames.anchor[2 * 1000] + m.frames.local[6 * 1000]) * options.scale;
+  EXPECT_FLOAT_EQ(m.atlas.corner_uv[6 * 1000], expected_u);
+}
+
+TEST(Mapping, ThesisModeReproducesItsCounters) {
+  Mapped m;
+  m.mesh = load("spot.obj");
+  MappingOptions options;
+  options.mode = MappingMode::kThesis;
+  map_mesh(m, options);
+  const size_t face_count = m.mesh.face_count();
+  // Thesis fig. 2.4: about half the faces are textured with all three vertices already known.
+  EXPECT_GT(m.stats.faces_three_textured, face_count * 35 / 100);
+  EXPECT_LT(m.stats.faces_three_textured, face_count * 65 / 100);
+  EXPECT_EQ(m.stats.faces_three_textured + m.stats.faces_unfolded, face_count);
+  EXPECT_GT(m.stats.deferrals, 0u);
+  EXPECT_LE(m.stats.max_error_px, m.stats.final_threshold_px);
+  EXPECT_EQ(m.atlas.patch_count, 1u);
+  // One UV per vertex: every corner of a vertex carries the same UV, so there is no seam at all.
+  std::vector<float> first(2 * m.mesh.vertex_count(), std::numeric_limits<float>::quiet_NaN());
+  for (size_t c = 0; c < 3 * face_count; ++c) {
+    const uint32_t v = m.mesh.indices[c];
+    if (std::isnan(first[2 * v])) {
+      first[2 * v] = m.atlas.corner_uv[2 * c];
+      first[2 * v + 1] = m.atlas.corner_uv[2 * c + 1];
+    }
+    ASSERT_EQ(first[2 * v], m.atlas.corner_uv[2 * c]);
+  }
+  const UvMetrics metrics = metrics_of(m);
+  EXPECT_EQ(metrics.seam_edges, 0u);
+  // What the thesis leaves behind: inverted faces (accepted with three textured vertices).
+  EXPECT_GT(m.stats.inverted_accepted, 0u);
+  EXPECT_GT(metrics.flipped, 0u);
+
+  // With a threshold the front cannot meet, it is raised in 10 px steps until everything is placed.
+  options.threshold_px = 1.f;
+  map_mesh(m, options);
+  EXPECT_GE(m.stats.threshold_raises, 1u);
+  EXPECT_FLOAT_EQ(m.stats.final_threshold_px, 1.f + 10.f * static_cast<float>(m.stats.threshold_raises));
+  EXPECT_LE(m.stats.max_error_px, m.stats.final_threshold_px);
+  EXPECT_GT(m.stats.max_error_px, m.stats.final_threshold_px - 10.f);
+}
+
+TEST(Mapping, ThesisModeInvertsFacesOnADenseMeshWherePatchesModeDoesNot) {
+  // The measurement on horse (97k faces): 4,708 inverted faces, Sander L2 30.6.
+  Mapped thesis, patches;
+  thesis.mesh = load("horse.ply");
+  patches.mesh = thesis.mesh;
+  MappingOptions options;
+  options.mode = MappingMode::kThesis;
+  map_mesh(thesis, options);
+  map_mesh(patches);
+  const UvMetrics t = metrics_of(thesis);
+  const UvMetrics p = metrics_of(patches);
+  EXPECT_GT(thesis.stats.inverted_accepted, 3000u);  // measured 4,729
+  EXPECT_GT(t.flipped, 3000u);
+  EXPECT_GT(t.l2_stretch, 10.0);  // measured 26.7
+  EXPECT_EQ(p.flipped, 0u);
+  EXPECT_LT(p.l2_stretch, 1.01);
+}
+
+// Seam edges touching the marked faces.
+size_t seam_edges_on(const Mapped& m, const std::vector<uint8_t>& marked) {
+  size_t count = 0;
+  for (size_t e = 0; e < m.topology.opposite.size(); ++e) {
+    const uint32_t o = m.topology.opposite[e];
+    if (o == kInvalid || o < e) continue;
+    const size_t f = e / 3, g = o / 3;
+    if (!marked[f] && !marked[g]) continue;
+    const float* a0 = &m.atlas.corner_uv[2 * e];
+    const float* a1 = &m.atlas.corner_uv[2 * (3 * f + (e + 1) % 3)];
+    const float* b0 = &m.atlas.corner_uv[2 * (3 * g + (o + 1) % 3)];  // the opposite edge runs back
+    const float* b1 = &m.atlas.corner_uv[2 * o];
+    if (a0[0] != b0[0] || a0[1] != b0[1] || a1[0] != b1[0] || a1[1] != b1[1]) ++count;
+  }
+  return count;
+}
+
+TEST(Mapping, SeamFacesAttractTheSeams) {
+  Mapped plain, constrained;
+  plain.mesh = load("spot.obj");
+  constrained.mesh = plain.mesh;
+  map_mesh(plain);
+  // Mark a band of faces: centroids with x in the middle 10% of the bounding box.
+  float lo = INFINITY, hi = -INFINITY;
+  for (size_t v = 0; v < plain.mesh.vertex_count(); ++v) {
+    lo = std::min(lo, plain.mesh.positions[3 * v]);
+    hi = std::max(hi, plain.mesh.positions[3 * v]);
+  }
+  std::vector<uint8_t> marked(plain.mesh.face_count(), 0);
+  size_t marked_count = 0;
+  for (size_t f = 0; f < plain.mesh.face_count(); ++f) {
+    float x = 0;
+    for (int k = 0; k < 3; ++k) x += plain.mesh.positions[3 * plain.mesh.indices[3 * f + k]] / 3.f;
+    const float t = (x - lo) / (hi - lo);
+    marked[f] = t > 0.45f && t < 0.55f;
+    marked_count += marked[f];
+  }
+  ASSERT_GT(marked_count, 100u);
+  MappingOptions options;
+  options.seam_faces = marked;
+  map_mesh(constrained, options);
+  expect_valid_patches_atlas(constrained, options, "spot.obj with seam faces");
+  EXPECT_EQ(constrained.stats.faces_seam, marked_count);
+  const size_t before = seam_edges_on(plain, marked);
+  const size_t after = seam_edges_on(constrained, marked);
+  RecordProperty("seam_edges_on_band_before", static_cast<int>(before));
+  RecordProperty("seam_edges_on_band_after", static_cast<int>(after));
+  EXPECT_GT(after, before + before / 4) << "before " << before << " after " << after;
+}
+
+TEST(Mapping, FaceStretchErrorMeasuresSingularValues) {
+  const float local[6] = {0.f, 0.f, 1.f, 0.f, 0.f, 1.f};
+  const float same[6] = {5.f, 5.f, 15.f, 5.f, 5.f, 15.f};  // scale 10, translated
+  EXPECT_NEAR(face_stretch_error(local, 10.f, same), 0.f, 1e-6);
+  const float stretched[6] = {0.f, 0.f, 12.f, 0.f, 0.f, 10.f};  // 20% longer along u
+  EXPECT_NEAR(face_stretch_error(local, 10.f, stretched), 0.2f, 1e-5);
+  const float shrunk[6] = {0.f, 0.f, 8.f, 0.f, 0.f, 10.f};  // sigma_min 0.8 -> 1/0.8 - 1
+  EXPECT_NEAR(face_stretch_error(local, 10.f, shrunk), 0.25f, 1e-5);
+  const float rotated[6] = {0.f, 0.f, 0.f, 10.f, -10.f, 0.f};  // 90 degrees: no stretch
+  EXPECT_NEAR(face_stretch_error(local, 10.f, rotated), 0.f, 1e-5);
+  const float mirrored[6] = {0.f, 0.f, 10.f, 0.f, 0.f, -10.f};
+  EXPECT_TRUE(std::isinf(face_stretch_error(local, 10.f, mirrored)));
+  const float flat[6] = {0.f, 0.f, 10.f, 0.f, 20.f, 0.f};
+  EXPECT_TRUE(std::isinf(face_stretch_error(local, 10.f, flat)));
+}
+
+TEST(Mapping, ProgressCanCancel) {
+  Mapped m;
+  m.mesh = load("horse.ply");  // more faces than one progress interval
+  m.topology = build_topology(m.mesh);
+  ASSERT_TRUE(compute_orientation(m.mesh, m.topology, {}, m.frames).is_ok());
+  MappingOptions options;
+  int calls = 0;
+  options.progress = [&calls](float done) {
+    EXPECT_GE(done, 0.f);
+    EXPECT_LE(done, 1.f);
+    ++calls;
+    return false;
+  };
+  const Status s = map_texture(m.mesh, m.topology, m.frames, options, m.atlas, &m.stats);
+  EXPECT_EQ(s.code(), ErrorCode::kCancelled);
+  EXPECT_EQ(calls, 1);
+  EXPECT_TRUE(m.atlas.corner_uv.empty());
+}
+
+TEST(Mapping, RejectsBadOptionsAndMismatchedInputs) {
+  Mapped m;
+  m.mesh = grid(3);
+  map_mesh(m);
+  MappingOptions options;
+  options.scale = 0.f;
+  EXPECT_EQ(map_texture(m.mesh, m.topology, m.frames, options, m.atlas).code(), ErrorCode::kInvalidArgument);
+  options = {};
+  options.scale = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_EQ(map_texture(m.mesh, m.topology, m.frames, options, m.atlas).code(), ErrorCode::kInvalidArgument);
+  options = {};
+  options.max_stretch = 0.f;
+  EXPECT_EQ(map_texture(m.mesh, m.topology, m.frames, options, m.atlas).code(), ErrorCode::kInvalidArgument);
+  options = {};
+  const std::vector<uint8_t> wrong_size(3, 1);
+  options.seam_faces = wrong_size;
+  EXPECT_EQ(map_texture(m.mesh, m.topology, m.frames, options, m.atlas).code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(map_texture(m.mesh, m.topology, FaceFrames{}, {}, m.atlas).code(), ErrorCode::kInvalidMesh);
+  EXPECT_EQ(map_texture(m.mesh, Topology{}, m.frames, {}, m.atlas).code(), ErrorCode::kInvalidMesh);
+}
+
+TEST(Mapping, SeveralComponentsEachGetTheirPatches) {
+  Mapped m;
+  m.mesh = load("blobby-3cc.off");
+  map_mesh(m);
+  EXPECT_EQ(m.stats.components, m.topology.edge_components);
+  EXPECT_GE(m.atlas.patch_count, m.stats.components);
+}
+
+TEST(Stability, RemovingTenPercentKeepsMostOfTheMapping) {
+  const Mesh mesh = load("fandisk.off");
+  StabilityReport report;
+  const Status s = measure_stability(mesh, {}, {}, report);
+  ASSERT_TRUE(s.is_ok()) << s.message();
+  EXPECT_EQ(report.faces, mesh.face_count());
+  EXPECT_NEAR(static_cast<double>(report.removed_faces), 0.1 * static_cast<double>(mesh.face_count()), 1.0);
+  EXPECT_EQ(report.compared_corners, 3 * (report.faces - report.removed_faces));
+  EXPECT_TRUE(std::isfinite(report.mean_difference_px));
+  EXPECT_GE(report.max_difference_px, report.mean_difference_px);
+  EXPECT_GE(report.within_1px_ratio, report.identical_ratio);
+  // The part grown before the front reaches the hole is reproduced bit for bit (measured: 82%).
+  EXPECT_GT(report.identical_ratio, 0.5);
+  StabilityOptions bad;
+  bad.remove_fraction = 0.f;
+  EXPECT_EQ(measure_stability(mesh, {}, {}, report, bad).code(), ErrorCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace tailor

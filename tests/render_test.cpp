@@ -1,0 +1,282 @@
+// Tests of the headless preview renderer (render.h): picture size, non-blank content, views that
+// differ from each other, texture orientation, determinism and input validation.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "tailor/image.h"
+#include "tailor/io.h"
+#include "tailor/render.h"
+
+namespace tailor {
+namespace {
+
+const std::string kData = std::string(TAILOR_TEST_DATA) + "/";
+
+struct Fixture {
+  Mesh mesh;
+  Image texture;
+};
+
+const Fixture& spot() {
+  static const Fixture f = [] {
+    Fixture x;
+    EXPECT_TRUE(load_mesh(kData + "meshes/spot.obj", x.mesh).is_ok());
+    EXPECT_TRUE(load_image(kData + "textures/vistex-tile04-128.png", x.texture).is_ok());
+    return x;
+  }();
+  return f;
+}
+
+RenderOptions small(PreviewView view) {
+  RenderOptions o;
+  o.width = 320;
+  o.height = 240;
+  o.view = view;
+  return o;
+}
+
+Image render_ok(const Mesh& mesh, const Image* texture, const RenderOptions& options,
+                std::span<const uint32_t> patch = {}) {
+  Image out;
+  const Status s = render_preview(mesh, mesh.corner_uvs, patch, texture, options, out);
+  EXPECT_TRUE(s.is_ok()) << s.message();
+  return out;
+}
+
+double luminance_variance(const Image& img) {
+  double sum = 0, sum2 = 0;
+  const size_t n = static_cast<size_t>(img.width) * static_cast<size_t>(img.height);
+  for (size_t i = 0; i < n; ++i) {
+    const double l = 0.299 * img.pixels[3 * i] + 0.587 * img.pixels[3 * i + 1] + 0.114 * img.pixels[3 * i + 2];
+    sum += l;
+    sum2 += l * l;
+  }
+  const double mean = sum / static_cast<double>(n);
+  return sum2 / static_cast<double>(n) - mean * mean;
+}
+
+//! Share of pixels that differ from the background colour (the top-left pixel).
+double covered_share(const Image& img) {
+  size_t covered = 0;
+  const size_t n = static_cast<size_t>(img.width) * static_cast<size_t>(img.height);
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t c = 0; c < 3; ++c) {
+      if (std::abs(int{img.pixels[3 * i + c]} - int{img.pixels[c]}) > 4) {
+        ++covered;
+        break;
+      }
+    }
+  }
+  return static_cast<double>(covered) / static_cast<double>(n);
+}
+
+double mean_abs_difference(const Image& a, const Image& b) {
+  double sum = 0;
+  for (size_t i = 0; i < a.pixels.size(); ++i) sum += std::abs(int{a.pixels[i]} - int{b.pixels[i]});
+  return sum / static_cast<double>(a.pixels.size());
+}
+
+const uint8_t* pixel(const Image& img, int x, int y) {
+  return &img.pixels[(static_cast<size_t>(y) * static_cast<size_t>(img.width) + static_cast<size_t>(x)) * 3];
+}
+
+TEST(RenderPreview, EveryViewHasTheRequestedSizeAndIsNotBlank) {
+  const Fixture& f = spot();
+  ASSERT_FALSE(f.mesh.corner_uvs.empty());
+  for (const PreviewView view : {PreviewView::kTexture, PreviewView::kPatches, PreviewView::kDistortion,
+                                 PreviewView::kChecker}) {
+    SCOPED_TRACE(preview_view_name(view));
+    const Image img = render_ok(f.mesh, &f.texture, small(view));
+    EXPECT_EQ(img.width, 320);
+    EXPECT_EQ(img.height, 240);
+    EXPECT_EQ(img.channels, 3);
+    ASSERT_EQ(img.pixels.size(), 320u * 240u * 3u);
+    EXPECT_GT(luminance_variance(img), 100.0);
+    // Spot framed by its bounding sphere covers a good part of the picture, not all of it.
+    EXPECT_GT(covered_share(img), 0.10);
+    EXPECT_LT(covered_share(img), 0.80);
+  }
+}
+
+TEST(RenderPreview, PatchCheckerAndDistortionViewsDifferFromTheTextureView) {
+  const Fixture& f = spot();
+  const Image texture = render_ok(f.mesh, &f.texture, small(PreviewView::kTexture));
+  for (const PreviewView view : {PreviewView::kPatches, PreviewView::kDistortion, PreviewView::kChecker}) {
+    SCOPED_TRACE(preview_view_name(view));
+    const Image other = render_ok(f.mesh, &f.texture, small(view));
+    // Over the whole picture (background included) the views differ by several grey levels.
+    EXPECT_GT(mean_abs_difference(texture, other), 5.0);
+  }
+}
+
+TEST(RenderPreview, SameInputGivesIdenticalPictures) {
+  const Fixture& f = spot();
+  const Image a = render_ok(f.mesh, &f.texture, small(PreviewView::kTexture));
+  const Image b = render_ok(f.mesh, &f.texture, small(PreviewView::kTexture));
+  EXPECT_EQ(a.pixels, b.pixels);
+}
+
+TEST(RenderPreview, SizeOptionIsHonoured) {
+  const Fixture& f = spot();
+  RenderOptions o = small(PreviewView::kChecker);
+  o.width = 200;
+  o.height = 300;
+  o.supersample = 1;
+  const Image img = render_ok(f.mesh, nullptr, o);
+  EXPECT_EQ(img.width, 200);
+  EXPECT_EQ(img.height, 300);
+}
+
+TEST(RenderPreview, DistortionViewDrawsItsColourBarLegend) {
+  const Fixture& f = spot();
+  const Image img = render_ok(f.mesh, nullptr, small(PreviewView::kDistortion));
+  // The legend runs along the bottom band, below the mesh: its ends are saturated blue and red.
+  bool blue = false, red = false;
+  for (int y = img.height * 85 / 100; y < img.height; ++y) {
+    for (int x = 0; x < img.width; ++x) {
+      const uint8_t* p = pixel(img, x, y);
+      blue = blue || (p[2] > 150 && p[0] < 90);
+      red = red || (p[0] > 150 && p[2] < 60);
+    }
+  }
+  EXPECT_TRUE(blue);
+  EXPECT_TRUE(red);
+}
+
+//! A unit square in the xy plane facing +z, UVs = xy (texture repeats, v up).
+Mesh unit_square() {
+  Mesh m;
+  m.positions = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+  m.indices = {0, 1, 2, 0, 2, 3};
+  for (const uint32_t v : m.indices) {
+    m.corner_uvs.push_back(m.positions[3 * v]);
+    m.corner_uvs.push_back(m.positions[3 * v + 1]);
+  }
+  return m;
+}
+
+TEST(RenderPreview, TextureTopRowAppearsAtTheTopForVUp) {
+  // Image top half red, bottom half blue (image rows run top first).
+  Image tex;
+  tex.width = tex.height = 8;
+  tex.channels = 3;
+  for (int y = 0; y < 8; ++y) {
+    for (int x = 0; x < 8; ++x) {
+      const bool top = y < 4;
+      tex.pixels.insert(tex.pixels.end(), {uint8_t(top ? 255 : 0), 0, uint8_t(top ? 0 : 255)});
+    }
+  }
+  const Mesh square = unit_square();
+  RenderOptions o = small(PreviewView::kTexture);
+  o.yaw_degrees = 0.0f;  // camera on +z, looking at the square's front
+  o.pitch_degrees = 0.0f;
+  const Image img = render_ok(square, &tex, o);
+  const uint8_t* upper = pixel(img, img.width / 2, img.height * 35 / 100);
+  const uint8_t* lower = pixel(img, img.width / 2, img.height * 65 / 100);
+  EXPECT_GT(upper[0], 150);
+  EXPECT_LT(upper[2], 60);
+  EXPECT_GT(lower[2], 150);
+  EXPECT_LT(lower[0], 60);
+}
+
+TEST(RenderPreview, ExplicitPatchIdsColourFacesApart) {
+  const Mesh square = unit_square();
+  RenderOptions o = small(PreviewView::kPatches);
+  o.yaw_degrees = 0.0f;
+  o.pitch_degrees = 0.0f;
+  const std::vector<uint32_t> one = {0, 0};
+  const std::vector<uint32_t> two = {0, 1};
+  const Image same = render_ok(square, nullptr, o, one);
+  const Image apart = render_ok(square, nullptr, o, two);
+  // Face 0 is the lower-right triangle, face 1 the upper-left one: sample inside each.
+  const uint8_t* a0 = pixel(same, same.width * 58 / 100, same.height * 60 / 100);
+  const uint8_t* a1 = pixel(same, same.width * 42 / 100, same.height * 40 / 100);
+  const uint8_t* b0 = pixel(apart, apart.width * 58 / 100, apart.height * 60 / 100);
+  const uint8_t* b1 = pixel(apart, apart.width * 42 / 100, apart.height * 40 / 100);
+  int same_diff = 0, apart_diff = 0;
+  for (int c = 0; c < 3; ++c) {
+    same_diff += std::abs(int{a0[c]} - int{a1[c]});
+    apart_diff += std::abs(int{b0[c]} - int{b1[c]});
+  }
+  EXPECT_LT(same_diff, 10);
+  EXPECT_GT(apart_diff, 60);
+}
+
+TEST(RenderPreview, MissingTextureFallsBackToANeutralChecker) {
+  const Fixture& f = spot();
+  const Image img = render_ok(f.mesh, nullptr, small(PreviewView::kTexture));
+  EXPECT_GT(luminance_variance(img), 100.0);
+  // Grey checker under white light: every pixel is (nearly) grey.
+  for (size_t i = 0; i < img.pixels.size(); i += 3) {
+    ASSERT_LE(std::abs(int{img.pixels[i]} - int{img.pixels[i + 1]}), 8);
+    ASSERT_LE(std::abs(int{img.pixels[i + 1]} - int{img.pixels[i + 2]}), 8);
+  }
+}
+
+TEST(RenderPreview, PatchesViewWorksWithoutUvs) {
+  Mesh m = unit_square();
+  m.corner_uvs.clear();
+  Image out;
+  EXPECT_TRUE(render_preview(m, {}, {}, nullptr, small(PreviewView::kPatches), out).is_ok());
+  EXPECT_EQ(out.width, 320);
+}
+
+TEST(RenderPreview, RejectsBadInput) {
+  const Mesh square = unit_square();
+  Image out;
+  // UV array of the wrong size.
+  std::vector<float> short_uv(4, 0.0f);
+  Status s = render_preview(square, short_uv, {}, nullptr, small(PreviewView::kTexture), out);
+  EXPECT_EQ(s.code(), ErrorCode::kInvalidArgument);
+  EXPECT_TRUE(out.empty());
+  // Views that need UVs without UVs.
+  s = render_preview(square, {}, {}, nullptr, small(PreviewView::kChecker), out);
+  EXPECT_EQ(s.code(), ErrorCode::kInvalidArgument);
+  // Patch ids of the wrong size.
+  const std::vector<uint32_t> patch(5, 0);
+  s = render_preview(square, square.corner_uvs, patch, nullptr, small(PreviewView::kPatches), out);
+  EXPECT_EQ(s.code(), ErrorCode::kInvalidArgument);
+  // Sizes out of range.
+  RenderOptions o = small(PreviewView::kTexture);
+  o.width = 0;
+  EXPECT_EQ(render_preview(square, square.corner_uvs, {}, nullptr, o, out).code(), ErrorCode::kInvalidArgument);
+  o = small(PreviewView::kTexture);
+  o.height = 100000;
+  EXPECT_EQ(render_preview(square, square.corner_uvs, {}, nullptr, o, out).code(), ErrorCode::kInvalidArgument);
+  o = small(PreviewView::kTexture);
+  o.pitch_degrees = NAN;
+  EXPECT_EQ(render_preview(square, square.corner_uvs, {}, nullptr, o, out).code(), ErrorCode::kInvalidArgument);
+  // Empty mesh, index out of range.
+  EXPECT_EQ(render_preview(Mesh{}, {}, {}, nullptr, small(PreviewView::kPatches), out).code(), ErrorCode::kInvalidMesh);
+  Mesh broken = square;
+  broken.indices[4] = 99;
+  EXPECT_EQ(render_preview(broken, broken.corner_uvs, {}, nullptr, small(PreviewView::kTexture), out).code(),
+            ErrorCode::kInvalidMesh);
+  // Inconsistent texture image.
+  Image bad_texture;
+  bad_texture.width = bad_texture.height = 4;
+  bad_texture.channels = 3;
+  bad_texture.pixels.resize(5);
+  EXPECT_EQ(render_preview(square, square.corner_uvs, {}, &bad_texture, small(PreviewView::kTexture), out).code(),
+            ErrorCode::kInvalidImage);
+}
+
+TEST(RenderPreview, ViewNamesRoundTrip) {
+  for (const PreviewView view : {PreviewView::kTexture, PreviewView::kPatches, PreviewView::kDistortion,
+                                 PreviewView::kChecker}) {
+    PreviewView parsed = PreviewView::kTexture;
+    ASSERT_TRUE(preview_view_from_name(preview_view_name(view), parsed));
+    EXPECT_EQ(parsed, view);
+  }
+  PreviewView parsed = PreviewView::kChecker;
+  EXPECT_FALSE(preview_view_from_name("normals", parsed));
+  EXPECT_FALSE(preview_view_from_name("", parsed));
+  EXPECT_EQ(parsed, PreviewView::kChecker);
+}
+
+}  // namespace
+}  // namespace tailor

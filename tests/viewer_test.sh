@@ -1,0 +1,118 @@
+#!/usr/bin/env bash
+# End-to-end test of `tailor view` and `tailor render`, run by ctest from the repo root as
+#   bash tests/viewer_test.sh <tailor-binary>
+# 0. unit-tests the viewer's mesh analysis (web/mesh_data.js) in node;
+# 1. makes a .glb with `tailor map` from the bundled example;
+# 2. `tailor render`: every view writes a PNG, bad input gives one error line and exit 1;
+# 3. `tailor view`: serves on 127.0.0.1, answers GET, refuses path traversal and POST;
+# 4. a real browser (headless Chromium + playwright-core) opens the viewer, waits for the first
+#    frame, checks for console errors, a non-blank canvas and that the views change the picture;
+# 5. the same with tile variants from `tailor tile --variants 3`;
+# 6. Ctrl-C (SIGINT) stops the server with exit status 0.
+# Never skips: a missing Chromium or node_modules is a failure.
+set -euo pipefail
+
+tailor="${1:?usage: bash tests/viewer_test.sh <tailor-binary>}"
+tailor="$(cd "$(dirname "$tailor")" && pwd)/$(basename "$tailor")"
+repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$repo"
+
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+[ -x /usr/bin/chromium ] || fail "/usr/bin/chromium is missing (apt-get install chromium)"
+command -v node >/dev/null || fail "node is missing"
+for pkg in three playwright-core; do
+  [ -d "web/node_modules/$pkg" ] || fail "web/node_modules/$pkg is missing (run 'npm install' in web/)"
+done
+
+timeout 60 node web/test/mesh_data_test.mjs || fail "web/mesh_data.js unit test failed"
+
+tmp="$(mktemp -d)"
+server_pid=""
+stop_server() {
+  if [ -n "$server_pid" ]; then
+    kill "$server_pid" 2>/dev/null || true
+    wait "$server_pid" 2>/dev/null || true
+    server_pid=""
+  fi
+}
+cleanup() { stop_server; rm -rf "$tmp"; }
+trap cleanup EXIT
+
+# --- 1. a textured .glb from the bundled example -------------------------------------------------
+timeout 60 "$tailor" map examples/spot.obj --texture examples/gravel.png -o "$tmp/spot.glb" -q \
+  || fail "tailor map could not make the test .glb"
+[ -s "$tmp/spot.glb" ] || fail "tailor map wrote no .glb"
+
+# --- 2. tailor render ------------------------------------------------------------------------------
+for view in texture patches distortion checker; do
+  out="$(timeout 60 "$tailor" render "$tmp/spot.glb" -o "$tmp/spot_$view.png" --view "$view" --size 320x240)" \
+    || fail "tailor render --view $view failed"
+  [ -s "$tmp/spot_$view.png" ] || fail "tailor render --view $view wrote nothing"
+  case "$out" in *"$tmp/spot_$view.png"*" s"*) ;; *) fail "tailor render did not print its output and time: $out" ;; esac
+done
+printf 'not a glb' > "$tmp/bad.glb"
+set +e
+err="$("$tailor" render "$tmp/bad.glb" -o "$tmp/bad.png" 2>&1 >/dev/null)"; rc=$?
+set -e
+[ "$rc" -eq 1 ] || fail "tailor render on a bad .glb exited $rc, expected 1"
+[ "$(printf '%s\n' "$err" | wc -l)" -eq 1 ] || fail "tailor render on a bad .glb printed more than one line: $err"
+case "$err" in "tailor: error: "*) ;; *) fail "unexpected error line: $err" ;; esac
+[ ! -e "$tmp/bad.png" ] || fail "tailor render wrote a picture for a bad .glb"
+
+# --- 3. tailor view: bad input, then a running server ----------------------------------------------
+set +e
+err="$("$tailor" view "$tmp/bad.glb" 2>&1 >/dev/null)"; rc=$?
+set -e
+[ "$rc" -eq 1 ] || fail "tailor view on a bad .glb exited $rc, expected 1"
+case "$err" in "tailor: error: "*) ;; *) fail "unexpected error line from view: $err" ;; esac
+
+# Starts `tailor view ARGS...` in the background and sets $url once it printed its address.
+start_server() {
+  "$tailor" view "$@" >"$tmp/view.log" 2>&1 &
+  server_pid=$!
+  url=""
+  for _ in $(seq 1 100); do
+    url="$(grep -o 'http://127\.0\.0\.1:[0-9]*/' "$tmp/view.log" || true)"
+    [ -n "$url" ] && return 0
+    kill -0 "$server_pid" 2>/dev/null || fail "tailor view exited early: $(cat "$tmp/view.log")"
+    sleep 0.1
+  done
+  fail "tailor view printed no URL within 10 s"
+}
+
+status_of() { curl -s -o /dev/null -w '%{http_code}' --max-time 10 "$@"; }
+
+start_server "$tmp/spot.glb"
+echo "viewer at $url"
+[ "$(status_of "$url")" = 200 ] || fail "GET / is not 200"
+[ "$(status_of "${url}config.json")" = 200 ] || fail "GET /config.json is not 200"
+[ "$(status_of "${url}node_modules/three/build/three.module.js")" = 200 ] || fail "three.js is not served"
+size="$(curl -s --max-time 10 "${url}files/model.glb" | wc -c)"
+[ "$size" -eq "$(wc -c <"$tmp/spot.glb")" ] || fail "the served model has $size bytes, not the file's"
+[ "$(status_of --path-as-is "${url}../CMakeLists.txt")" = 403 ] || fail "path traversal with .. was not refused"
+[ "$(status_of "${url}%2e%2e/CMakeLists.txt")" = 403 ] || fail "path traversal with %2e%2e was not refused"
+[ "$(status_of "${url}nothing-here.js")" = 404 ] || fail "a missing file is not 404"
+[ "$(status_of -X POST "${url}")" = 405 ] || fail "POST is not refused"
+
+# --- 4. the browser ---------------------------------------------------------------------------------
+timeout 120 node web/test/viewer_browser_test.mjs "$url" || fail "browser test failed"
+
+# --- 6. Ctrl-C stops the server cleanly ---------------------------------------------------------------
+kill -INT "$server_pid"
+set +e
+timeout 10 tail --pid="$server_pid" -f /dev/null
+wait "$server_pid"; rc=$?
+set -e
+server_pid=""
+[ "$rc" -eq 0 ] || fail "tailor view exited $rc after SIGINT, expected 0"
+
+# --- 5. tile variants (a small exemplar keeps `tailor tile` fast) ------------------------------------
+timeout 60 "$tailor" tile tests/data/textures/vistex-tile04-128.png --variants 3 -o "$tmp/tile.png" -q \
+  || fail "tailor tile --variants 3 failed"
+[ -s "$tmp/tile.json" ] || fail "tailor tile wrote no variants .json"
+start_server "$tmp/spot.glb" --texture "$tmp/tile.json"
+timeout 120 node web/test/viewer_browser_test.mjs "$url" --variants || fail "browser test with tile variants failed"
+stop_server
+
+echo "PASS: tailor render and tailor view (browser) work"

@@ -1,0 +1,266 @@
+// tailor's web viewer: loads the .glb served by `tailor view` (see /config.json), shows it with
+// orbit controls and a panel (view, texture scale and rotation, wireframe, tile variants).
+// Frames are drawn only when something changed, so a 1 M face mesh costs nothing while idle.
+// A small test hook (window.tailorViewer) lets the browser test switch views and read pixels.
+import * as THREE from 'three';
+import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { buildSurface } from './mesh_data.js';
+import { createSurfaceMaterial, updateSurfaceMaterial, kMaxVariants, kViews } from './surface_material.js';
+
+const state = {
+  view: 'texture',
+  scale: 1,
+  rotationDeg: 0,
+  wireframe: false,
+  seams: true,
+  useVariants: true,
+  seed: 1,
+  checkerSquares: 8,
+  distortionRange: 2,
+};
+const textures = { map: null, variants: [], blank: null };
+const stats = { faces: 0, patches: 0, seamEdges: 0, loadSeconds: 0, analysisSeconds: 0 };
+let frames = 0;
+let dirty = true;
+let ready = false;
+
+const container = document.getElementById('view');
+const renderer = new THREE.WebGLRenderer({ antialias: true });
+renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
+renderer.setSize(container.clientWidth, container.clientHeight);
+// The shader writes display values itself (as the CPU preview does): no output conversion.
+renderer.outputColorSpace = THREE.LinearSRGBColorSpace;
+renderer.setClearColor(new THREE.Color(236 / 255, 238 / 255, 242 / 255), 1);
+container.appendChild(renderer.domElement);
+
+const scene = new THREE.Scene();
+const camera = new THREE.PerspectiveCamera(35, container.clientWidth / container.clientHeight, 0.01, 100);
+const controls = new OrbitControls(camera, renderer.domElement);
+controls.enableDamping = true;
+let sceneRadius = 1;
+controls.addEventListener('change', () => {
+  // Keep the depth range tight around the model wherever the camera goes (zooming in past the
+  // initial near plane would cut the model open).
+  const d = camera.position.distanceTo(controls.target);
+  camera.near = Math.max(d - 1.5 * sceneRadius, sceneRadius * 1e-3);
+  camera.far = d + 1.5 * sceneRadius;
+  camera.updateProjectionMatrix();
+  dirty = true;
+});
+const material = createSurfaceMaterial();
+
+function showError(text) {
+  const box = document.getElementById('error');
+  box.textContent = text;
+  box.style.display = 'block';
+  console.error(text);
+}
+
+window.addEventListener('error', (e) => showError(`error: ${e.message}`));
+window.addEventListener('unhandledrejection', (e) => showError(`error: ${e.reason && e.reason.message ? e.reason.message : e.reason}`));
+
+/** Textures are sampled as raw data (no colour-space decoding) and repeat, with mipmaps. */
+function prepareTexture(texture) {
+  texture.colorSpace = THREE.NoColorSpace;
+  texture.wrapS = THREE.RepeatWrapping;
+  texture.wrapT = THREE.RepeatWrapping;
+  texture.minFilter = THREE.LinearMipmapLinearFilter;
+  texture.magFilter = THREE.LinearFilter;
+  texture.anisotropy = renderer.capabilities.getMaxAnisotropy();
+  texture.generateMipmaps = true;
+  // glTF's uv has v pointing down the image, like three's textures with flipY off.
+  texture.flipY = false;
+  texture.needsUpdate = true;
+  return texture;
+}
+
+function loadTexture(url) {
+  return new THREE.TextureLoader().loadAsync(url).then(prepareTexture);
+}
+
+function applyState() {
+  updateSurfaceMaterial(material, state, textures);
+  document.getElementById('legend').style.display = state.view === 'distortion' ? 'block' : 'none';
+  dirty = true;
+}
+
+/** Places the camera at a 3/4 view from above, like `tailor render`, fitting the bounding sphere. */
+function frameCamera(object) {
+  const box = new THREE.Box3().setFromObject(object);
+  const sphere = box.getBoundingSphere(new THREE.Sphere());
+  const radius = sphere.radius > 0 ? sphere.radius : 1;
+  sceneRadius = radius;
+  const fovy = THREE.MathUtils.degToRad(camera.fov);
+  const half = Math.min(fovy / 2, Math.atan(Math.tan(fovy / 2) * camera.aspect));
+  const distance = (radius / Math.sin(half)) * 1.02;
+  const yaw = THREE.MathUtils.degToRad(35);
+  const pitch = THREE.MathUtils.degToRad(25);
+  const dir = new THREE.Vector3(Math.cos(pitch) * Math.sin(yaw), Math.sin(pitch), Math.cos(pitch) * Math.cos(yaw));
+  camera.position.copy(sphere.center).addScaledVector(dir, distance);
+  camera.near = Math.max(distance - radius * 1.5, distance * 1e-3);
+  camera.far = distance + radius * 1.5;
+  camera.updateProjectionMatrix();
+  controls.target.copy(sphere.center);
+  controls.maxDistance = distance * 10;
+  controls.update();
+}
+
+async function load() {
+  const start = performance.now();
+  const config = await (await fetch('/config.json')).json();
+  document.getElementById('title').textContent = config.name || 'tailor viewer';
+  document.title = `${config.name} - tailor viewer`;
+  const gltf = await new GLTFLoader().loadAsync(config.model);
+
+  const meshes = [];
+  gltf.scene.traverse((o) => { if (o.isMesh) meshes.push(o); });
+  if (meshes.length === 0) throw new Error(`${config.name}: no triangle mesh in the file`);
+  let hasUv = false;
+  for (const mesh of meshes) {
+    if (!textures.map && mesh.material && mesh.material.map) textures.map = prepareTexture(mesh.material.map);
+    const analysisStart = performance.now();
+    const surface = buildSurface(mesh.geometry);
+    stats.analysisSeconds += (performance.now() - analysisStart) / 1000;
+    mesh.geometry.dispose();
+    mesh.geometry = surface.geometry;
+    mesh.material = material;
+    stats.faces += surface.faces;
+    stats.patches += surface.patches;
+    stats.seamEdges += surface.seamEdges;
+    hasUv = hasUv || surface.hasUv;
+  }
+  // UVs are texture pixels / the embedded texture's size: a replacement texture of another size
+  // starts at the scale that keeps the same texel density on the surface.
+  const embeddedWidth = textures.map && textures.map.image ? textures.map.image.width : 0;
+  if (config.texture) textures.map = await loadTexture(config.texture);
+  if (config.variants) {
+    textures.variants = await Promise.all(config.variants.files.slice(0, kMaxVariants).map(loadTexture));
+    state.seed = config.variants.seed >>> 0;
+    document.getElementById('variant-controls').style.display = 'block';
+    document.getElementById('variant-count').textContent = `(${textures.variants.length})`;
+    document.getElementById('seed').value = String(state.seed);
+  }
+  const shown = textures.variants.length > 0 ? textures.variants[0] : textures.map;
+  if (embeddedWidth > 0 && shown && shown.image && shown.image.width > 0 && shown.image.width !== embeddedWidth) {
+    setScale(embeddedWidth / shown.image.width);
+  }
+  textures.blank = new THREE.DataTexture(new Uint8Array([255, 255, 255, 255]), 1, 1);
+  textures.blank.needsUpdate = true;
+  if (!hasUv) console.warn(`${config.name}: no texture coordinates; only the patches view is meaningful`);
+
+  scene.add(gltf.scene);
+  frameCamera(gltf.scene);
+  stats.loadSeconds = (performance.now() - start) / 1000;
+  document.getElementById('info').textContent =
+    `${stats.faces.toLocaleString('en')} faces, ${stats.patches.toLocaleString('en')} patches, ` +
+    `loaded in ${stats.loadSeconds.toFixed(2)} s (patches, seams, stretch: ${stats.analysisSeconds.toFixed(2)} s)`;
+  applyState();
+}
+
+function bindPanel() {
+  for (const input of document.querySelectorAll('input[name=view]')) {
+    input.addEventListener('change', () => setView(input.value));
+  }
+  const scale = document.getElementById('scale');
+  scale.addEventListener('input', () => setScale(Math.pow(2, Number(scale.value))));
+  const rotation = document.getElementById('rotation');
+  rotation.addEventListener('input', () => {
+    state.rotationDeg = Number(rotation.value);
+    document.getElementById('rotation-value').textContent = `${state.rotationDeg}\u00b0`;
+    applyState();
+  });
+  const wireframe = document.getElementById('wireframe');
+  wireframe.addEventListener('change', () => { state.wireframe = wireframe.checked; applyState(); });
+  const variants = document.getElementById('variants');
+  variants.addEventListener('change', () => { state.useVariants = variants.checked; applyState(); });
+  const seed = document.getElementById('seed');
+  seed.addEventListener('input', () => { state.seed = Number(seed.value) >>> 0; applyState(); });
+  window.addEventListener('keydown', (e) => {
+    if (e.target instanceof HTMLInputElement && e.target.type === 'number') return;
+    const n = Number(e.key);
+    if (n >= 1 && n <= kViews.length) setView(kViews[n - 1]);
+    if (e.key === 'w') { wireframe.checked = !wireframe.checked; state.wireframe = wireframe.checked; applyState(); }
+  });
+  window.addEventListener('resize', () => {
+    camera.aspect = container.clientWidth / container.clientHeight;
+    camera.updateProjectionMatrix();
+    renderer.setSize(container.clientWidth, container.clientHeight);
+    dirty = true;
+  });
+}
+
+/** Texture repeats per UV unit (the slider is logarithmic, 1/8 .. 8). */
+function setScale(value) {
+  state.scale = value;
+  document.getElementById('scale').value = String(Math.log2(value));
+  document.getElementById('scale-value').textContent = value.toFixed(2);
+  applyState();
+}
+
+function setView(view) {
+  if (!kViews.includes(view)) throw new Error(`unknown view '${view}'`);
+  state.view = view;
+  const radio = document.querySelector(`input[name=view][value=${view}]`);
+  if (radio) radio.checked = true;
+  applyState();
+}
+
+function animate() {
+  requestAnimationFrame(animate);
+  controls.update();
+  if (!dirty || !ready) return;
+  dirty = false;
+  renderer.render(scene, camera);
+  frames += 1;
+}
+
+/**
+ * Renders now and returns the luminance mean and variance of the canvas plus a 100x75 RGB
+ * thumbnail (box means, 22500 values) to compare pictures.
+ */
+function pixelStats() {
+  renderer.render(scene, camera);
+  const gl = renderer.getContext();
+  const w = gl.drawingBufferWidth;
+  const h = gl.drawingBufferHeight;
+  const px = new Uint8Array(w * h * 4);
+  gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, px);
+  const tw = 100;
+  const th = 75;
+  const thumb = new Float64Array(tw * th * 3);
+  const counts = new Float64Array(tw * th);
+  let sum = 0;
+  let sum2 = 0;
+  for (let y = 0; y < h; ++y) {
+    const ty = Math.min(th - 1, Math.floor((th * y) / h));
+    for (let x = 0; x < w; ++x) {
+      const i = 4 * (y * w + x);
+      const l = 0.299 * px[i] + 0.587 * px[i + 1] + 0.114 * px[i + 2];
+      sum += l;
+      sum2 += l * l;
+      const cell = ty * tw + Math.min(tw - 1, Math.floor((tw * x) / w));
+      for (let c = 0; c < 3; ++c) thumb[3 * cell + c] += px[i + c];
+      counts[cell] += 1;
+    }
+  }
+  const n = w * h;
+  const mean = sum / n;
+  const grid = Array.from(thumb, (v, k) => v / counts[Math.floor(k / 3)]);
+  return { width: w, height: h, mean, variance: sum2 / n - mean * mean, grid };
+}
+
+window.tailorViewer = {
+  get ready() { return ready; },
+  get frames() { return frames; },
+  get stats() { return { ...stats }; },
+  get state() { return { ...state }; },
+  setView,
+  pixelStats,
+};
+
+bindPanel();
+animate();
+load()
+  .then(() => { ready = true; dirty = true; })
+  .catch((e) => showError(`cannot load the model: ${e.message}`));
