@@ -38,7 +38,7 @@ CC=clang CXX=clang++ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebI
   -DTAILOR_FUZZ=ON -DTAILOR_SANITIZE=ON -DTAILOR_BUILD_TESTS=OFF -DTAILOR_BUILD_BENCH=OFF >"$tmp/configure.log" 2>&1 ||
   { cat "$tmp/configure.log" >&2; echo "fuzz: configure failed" >&2; exit 1; }
 
-targets=(ply_fuzz obj_fuzz off_fuzz stl_fuzz)
+targets=(ply_fuzz obj_fuzz off_fuzz stl_fuzz glb_fuzz)
 cmake --build "$build" -j"$jobs" --target "${targets[@]}" >"$tmp/build.log" 2>&1 ||
   { tail -n 40 "$tmp/build.log" >&2; echo "fuzz: build failed" >&2; exit 1; }
 

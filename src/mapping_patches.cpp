@@ -222,6 +222,16 @@ class PatchMapper {
     float candidate[6], best[6] = {0.f, 0.f, 0.f, 0.f, 0.f, 0.f};
     float best_stretch = std::numeric_limits<float>::infinity(), best_error = 0.f;
     bool best_cuts = false;
+    // Whether the candidate disagrees with any placed neighbour of the patch on a shared corner.
+    auto cuts_any = [&]() {
+      for (int i = 0; i < count; ++i) {
+        const int e = edges[i], e1 = (e + 1) % 3;
+        if (candidate[2 * e] != ends[e][0][0] || candidate[2 * e + 1] != ends[e][0][1] ||
+            candidate[2 * e1] != ends[e][1][0] || candidate[2 * e1 + 1] != ends[e][1][1])
+          return true;
+      }
+      return false;
+    };
     auto consider = [&](float s, float err, bool cuts) {
       if (cuts && !allow_cuts) return;
       if (s < best_stretch) {
@@ -254,10 +264,7 @@ class PatchMapper {
           candidate[2 * kb + 1] = ends[k][1][1];
           candidate[2 * kc] = c[0];
           candidate[2 * kc + 1] = c[1];
-          // Seamless with neighbour m only if it also agrees on the corner it shares with edge k.
-          const float* shared = (m == (k + 1) % 3) ? ends[m][0] : ends[m][1];
-          const float* mine = (m == (k + 1) % 3) ? ends[k][1] : ends[k][0];
-          const bool cuts = shared[0] != mine[0] || shared[1] != mine[1];
+          const bool cuts = cuts_any();
           consider(degenerate ? 0.f : stretch(f, candidate), 0.f, cuts);
           if (!cuts && best_stretch <= bound_ && !best_cuts) return accept_best(true);
         }
@@ -277,7 +284,7 @@ class PatchMapper {
       candidate[2 * kb + 1] = ends[k][1][1];
       candidate[2 * kc] = vertex_uv_[2 * v];
       candidate[2 * kc + 1] = vertex_uv_[2 * v + 1];
-      consider(degenerate ? 0.f : stretch(f, candidate), 0.f, count > 1);
+      consider(degenerate ? 0.f : stretch(f, candidate), 0.f, count > 1 && cuts_any());
     }
     if (accept_best(true)) return true;
 

@@ -1,6 +1,7 @@
 // Texture mapping by patch discovery (tailor/mapping.h) and its stability (tailor/stability.h).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <limits>

@@ -1,6 +1,7 @@
 // Self-tileable textures (thesis chapter 3): quality targets on real exemplars, bit-exact borders,
 // determinism, variants, period detection, and the `tailor tile` / `tailor eval-tile` commands.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -83,6 +84,8 @@ struct TargetCase {
   double coherence_factor;  // allowed tile / exemplar patch coherence (target 1.05, see below)
   double seam_factor;       // allowed tile worst seam / max(exemplar worst, 1.5) (target 1.0)
 };
+
+void PrintTo(const TargetCase& c, std::ostream* os) { *os << c.file; }
 
 // Known shortfalls, measured and reported in docs/tiling.md: on the 128 px bark and sand the
 // repaired '+' is a large share of the image and their patch coherence is 10-20 % above the

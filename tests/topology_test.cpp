@@ -44,6 +44,8 @@ struct Expected {
   long euler;  // referenced vertices - edges + faces
 };
 
+void PrintTo(const Expected& x, std::ostream* os) { *os << x.file; }
+
 class RealMeshTopology : public ::testing::TestWithParam<Expected> {};
 
 TEST_P(RealMeshTopology, MatchesManifest) {
@@ -74,8 +76,8 @@ INSTANTIATE_TEST_SUITE_P(Manifest, RealMeshTopology,
                                            Expected{"blobby-3cc.off", 3417, 3, 219, 2},
                                            Expected{"featuretype.stl", 3476, 1, 576, -16},
                                            Expected{"horse.ply", 96966, 1, 0, 2}),
-                         [](const auto& info) {
-                           std::string name = info.param.file;
+                         [](const auto& param_info) {
+                           std::string name = param_info.param.file;
                            for (char& c : name) c = std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
                            return name;
                          });

@@ -33,6 +33,7 @@ struct MapOptions {
   float scale = 800.f;
   float threshold = 25.f;
   float max_stretch = 0.25f;
+  float field_following = 1.f;
   uint32_t min_patch_faces = 16;
   std::string axis = "pca";
   uint32_t smooth = 0;
@@ -91,6 +92,7 @@ int run_map(const MapOptions& opt) {
   mapping_options.scale = opt.scale;
   mapping_options.threshold_px = opt.threshold;
   mapping_options.max_stretch = opt.max_stretch;
+  mapping_options.field_following = opt.field_following;
   mapping_options.min_patch_faces = opt.min_patch_faces;
   if (!opt.seed_point.empty()) {
     if (!parse_vec3(opt.seed_point, mapping_options.seed_point))
@@ -203,7 +205,8 @@ int run_map(const MapOptions& opt) {
     j["texture"] = opt.texture;
     j["texture_size"] = {tex_w, tex_h};
     j["options"] = {{"mode", opt.mode}, {"scale", opt.scale}, {"threshold_px", opt.threshold},
-                    {"max_stretch", opt.max_stretch}, {"min_patch_faces", opt.min_patch_faces},
+                    {"max_stretch", opt.max_stretch},
+                    {"field_following", opt.field_following}, {"min_patch_faces", opt.min_patch_faces},
                     {"axis", opt.axis}, {"smooth", opt.smooth}, {"seed_point", opt.seed_point},
                     {"seam_faces", opt.seam_faces}};
     j["mesh"] = {{"format", load.format}, {"vertices", mesh.vertex_count()}, {"faces", mesh.face_count()},
@@ -287,6 +290,10 @@ void register_map(CLI::App& app, Runner& run) {
       ->capture_default_str();
   group->add_option("--max-stretch", opt->max_stretch,
                     "patches mode: per-face singular values must stay within [1/(1+x), 1+x]")
+      ->capture_default_str();
+  group->add_option("--field-following", opt->field_following,
+                    "patches mode: 1 = texture direction follows the orientation field (thesis), 0 = faces are "
+                    "unfolded rigidly (fewer seams, direction drifts); values between blend")
       ->capture_default_str();
   group->add_option("--min-patch-faces", opt->min_patch_faces,
                     "patches mode: smaller patches are absorbed into a neighbour (0 keeps all)")

@@ -15,9 +15,11 @@ namespace tailor {
 //! Sentinel for "no element" in every uint32 id array (opposite edge, patch, vertex...).
 inline constexpr uint32_t kInvalid = std::numeric_limits<uint32_t>::max();
 
-//! Largest number of faces or vertices tailor indexes: corner ids 3F must fit in uint32 below kInvalid.
+//! Largest number of faces tailor indexes: corner ids 3F must fit in uint32 below kInvalid.
 inline constexpr size_t kMaxFaces = (size_t{kInvalid} - 1) / 3;
-inline constexpr size_t kMaxVertices = size_t{kInvalid} - 1;
+//! Largest number of vertices: 2^31 - 1, so that topology can pack (vertex, direction) in 32 bits.
+//! (Positions alone would take 24 GiB at that count.)
+inline constexpr size_t kMaxVertices = (size_t{1} << 31) - 1;
 
 //! A triangle mesh.
 //! Corner c = 3f + k is corner k of face f; indices[c] is its vertex.
