@@ -1,6 +1,7 @@
 # tailor: the two commands a new user types are `make run` and `make test`.
 # Everything else is here for developers. All targets install missing packages first (make deps).
 
+MAKEFLAGS += --no-print-directory
 BUILD_DIR ?= build
 JOBS ?= 2
 CMAKE_FLAGS ?=
