@@ -11,32 +11,13 @@
 #include <cmath>
 #include <limits>
 
+#include "internal/face_stretch.h"
 #include "internal/mapping_common.h"
 
 namespace tailor {
 
 float face_stretch_error(std::span<const float, 6> local, float scale, std::span<const float, 6> uv) {
-  // Q: the face's edges in its frame (pixels); U: the UV edges. J = U * Q^-1 maps face to UV.
-  const float q1x = (local[2] - local[0]) * scale, q1y = (local[3] - local[1]) * scale;
-  const float q2x = (local[4] - local[0]) * scale, q2y = (local[5] - local[1]) * scale;
-  const float det_q = q1x * q2y - q2x * q1y;
-  constexpr float kInf = std::numeric_limits<float>::infinity();
-  if (!(det_q > 0.f)) return kInf;
-  const float u1x = uv[2] - uv[0], u1y = uv[3] - uv[1];
-  const float u2x = uv[4] - uv[0], u2y = uv[5] - uv[1];
-  const float inv = 1.f / det_q;
-  const float a = (u1x * q2y - u2x * q1y) * inv;
-  const float b = (u2x * q1x - u1x * q2x) * inv;
-  const float c = (u1y * q2y - u2y * q1y) * inv;
-  const float d = (u2y * q1x - u1y * q2x) * inv;
-  // Closed-form singular values of a 2x2 matrix: sigma = |q| +- |r| with q, r its conformal and
-  // anti-conformal parts; sigma_min is signed (negative when J reverses orientation).
-  const float e = 0.5f * (a + d), h = 0.5f * (c - b);
-  const float f = 0.5f * (a - d), g = 0.5f * (c + b);
-  const float qn = std::sqrt(e * e + h * h), rn = std::sqrt(f * f + g * g);
-  const float sigma_max = qn + rn, sigma_min = qn - rn;
-  if (!(sigma_min > 1e-6f) || !(a * d - b * c > 0.f)) return kInf;
-  return std::max(sigma_max - 1.f, 1.f / sigma_min - 1.f);
+  return internal::stretch_error(internal::stretch_frame(local.data(), scale), uv.data());
 }
 
 namespace internal {

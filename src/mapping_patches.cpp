@@ -10,6 +10,7 @@
 #include <cmath>
 #include <limits>
 
+#include "internal/face_stretch.h"
 #include "internal/front_buckets.h"
 #include "internal/mapping_common.h"
 
@@ -202,7 +203,7 @@ class PatchMapper {
   bool is_degenerate(uint32_t f) const { return rec_[f].degenerate != 0; }
 
   float stretch(uint32_t f, const float* uv) const {
-    return face_stretch_error(std::span<const float, 6>(rec_[f].local, 6), scale_, std::span<const float, 6>(uv, 6));
+    return stretch_error(stretch_frame(rec_[f].local, scale_), uv);
   }
 
   // Rigid placement of face f: corner `at` goes to uv0, the rest follow the frame rotated by r.
@@ -272,6 +273,7 @@ class PatchMapper {
     if (count == 0) return false;
     const Rotation r = patch_rotation_[target];
     const bool degenerate = is_degenerate(f);
+    const StretchFrame frame = stretch_frame(self.local, scale_);
     float candidate[6], best[6] = {0.f, 0.f, 0.f, 0.f, 0.f, 0.f};
     float best_stretch = std::numeric_limits<float>::infinity(), best_error = 0.f;
     bool best_cuts = false;
@@ -318,7 +320,7 @@ class PatchMapper {
           candidate[2 * kc] = c[0];
           candidate[2 * kc + 1] = c[1];
           const bool cuts = cuts_any();
-          consider(degenerate ? 0.f : stretch(f, candidate), 0.f, cuts);
+          consider(degenerate ? 0.f : stretch_error(frame, candidate), 0.f, cuts);
           if (!cuts && best_stretch <= bound_ && !best_cuts) return accept_best(true);
         }
       }
@@ -337,7 +339,7 @@ class PatchMapper {
       candidate[2 * kb + 1] = ends[k][1][1];
       candidate[2 * kc] = hint.u;
       candidate[2 * kc + 1] = hint.v;
-      consider(degenerate ? 0.f : stretch(f, candidate), 0.f, count > 1 && cuts_any());
+      consider(degenerate ? 0.f : stretch_error(frame, candidate), 0.f, count > 1 && cuts_any());
     }
     if (accept_best(true)) return true;
 
@@ -345,7 +347,7 @@ class PatchMapper {
     for (int i = 0; i < count; ++i) {
       const int k = edges[i];
       const float err = unfold(f, k, ends[k][0], ends[k][1], r, candidate);
-      consider(degenerate ? err : stretch(f, candidate), err, count > 1);
+      consider(degenerate ? err : stretch_error(frame, candidate), err, count > 1);
     }
     return accept_best(false);
   }

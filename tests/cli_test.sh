@@ -52,6 +52,13 @@ for ext in obj ply; do
   "$tailor" map "$mesh" -o "$tmp/c.$ext" --quiet && [[ -s $tmp/c.$ext ]] && ok || fail "map to .$ext failed"
 done
 
+# --- eval: metrics of our own output agree with map's (0 flipped), stability experiment runs ---
+"$tailor" eval "$tmp/a.glb" >"$tmp/eval.txt" 2>&1 && grep -Eq "5856 faces, .* 0 flipped" "$tmp/eval.txt" && ok ||
+  fail "eval of map output: $(cat "$tmp/eval.txt")"
+"$tailor" eval tests/data/meshes/fertility.off --stability --json >"$tmp/stab.json" 2>&1 &&
+  grep -q '"removed_faces"' "$tmp/stab.json" && ok || fail "eval --stability: $(cat "$tmp/stab.json")"
+expect_error 1 "no texture coordinates" -- "$tailor" eval tests/data/meshes/fandisk.off
+
 # --- bad input: clear one-line errors, exit 1, nothing written ---
 printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n' >"$tmp/truncated.ply"
 expect_error 1 "truncated.ply" -- "$tailor" map "$tmp/truncated.ply" -o "$tmp/bad.glb"

@@ -1,6 +1,7 @@
 // tailor eval: UV quality metrics of any UV-mapped mesh (.obj vt, .ply s/t, .glb TEXCOORD_0).
 // Definitions: docs/metrics.md.
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 
@@ -10,7 +11,9 @@
 #include "tailor/export.h"
 #include "tailor/gltf.h"
 #include "tailor/io.h"
+#include "tailor/mapping.h"
 #include "tailor/metrics.h"
+#include "tailor/stability.h"
 #include "tailor/topology.h"
 
 namespace tailor::cli {
@@ -21,11 +24,58 @@ struct EvalOptions {
   int texture_size = 0;  // 0 = not given: the embedded image size for .glb, else 512
   bool json = false;
   bool quiet = false;
+  bool stability = false;
+  std::string seed_point;
+  float remove_fraction = 0.1f;
 };
 
 constexpr int kDefaultTextureSize = 512;
 
+// --stability: the remove-a-ball experiment of thesis 2.6 on tailor's own mapping of the mesh.
+int run_stability(const EvalOptions& opt) {
+  Mesh mesh;
+  if (Status s = load_mesh(opt.input, mesh); !s) return report_error(s);
+  MappingOptions mapping;
+  if (!opt.seed_point.empty()) {
+    char c1 = 0, c2 = 0, rest = 0;
+    auto& p = mapping.seed_point;
+    if (std::sscanf(opt.seed_point.c_str(), "%f %c %f %c %f %c", &p[0], &c1, &p[1], &c2, &p[2], &rest) != 5 ||
+        c1 != ',' || c2 != ',' || !std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+      return report_error(Status::error(ErrorCode::kInvalidArgument, "",
+                                        "--seed-point must be three numbers X,Y,Z, got '" + opt.seed_point + "'"));
+    mapping.use_seed_point = true;
+  }
+  StabilityOptions options;
+  options.remove_fraction = opt.remove_fraction;
+  StabilityReport r;
+  if (Status s = measure_stability(mesh, OrientationOptions{}, mapping, r, options); !s)
+    return report_error(s.with_file(opt.input));
+  if (opt.json) {
+    nlohmann::json j;
+    j["file"] = opt.input;
+    j["faces"] = r.faces;
+    j["removed_faces"] = r.removed_faces;
+    j["compared_corners"] = r.compared_corners;
+    j["mean_difference_px"] = r.mean_difference_px;
+    j["max_difference_px"] = r.max_difference_px;
+    j["identical_ratio"] = r.identical_ratio;
+    j["within_1px_ratio"] = r.within_1px_ratio;
+    j["patches_full"] = r.patches_full;
+    j["patches_cut"] = r.patches_cut;
+    j["seconds"] = r.seconds;
+    std::printf("%s\n", j.dump(2).c_str());
+  } else if (!opt.quiet) {
+    std::printf("%s: stability: removed %zu of %zu faces, surviving corners moved %.3f px on average (max %.2f px), "
+                "%.1f%% bit-identical, %.1f%% within 1 px; patches %u -> %u (%.0f ms)\n",
+                opt.input.c_str(), r.removed_faces, r.faces, r.mean_difference_px, r.max_difference_px,
+                100.0 * r.identical_ratio, 100.0 * r.within_1px_ratio, r.patches_full, r.patches_cut,
+                r.seconds * 1e3);
+  }
+  return kExitOk;
+}
+
 int run_eval(const EvalOptions& opt) {
+  if (opt.stability) return run_stability(opt);
   const auto start = std::chrono::steady_clock::now();
   Mesh mesh;
   LoadReport report;
@@ -117,18 +167,26 @@ int run_eval(const EvalOptions& opt) {
 void register_eval(CLI::App& app, Runner& run) {
   auto opt = std::make_shared<EvalOptions>();
   auto* cmd = app.add_subcommand("eval", "Print UV quality metrics of a UV-mapped mesh (.obj .ply .glb)");
-  cmd->add_option("mesh", opt->input, "UV-mapped mesh: .obj (vt), .ply (s,t) or .glb (TEXCOORD_0)")->required();
+  cmd->add_option("mesh", opt->input, "UV-mapped mesh: .obj (vt), .ply (s,t) or .glb (TEXCOORD_0); any mesh with --stability")->required();
   cmd->add_option("--texture-size", opt->texture_size,
                   "Texture size in pixels (UVs are in repeats; this gives pixels). Default: the embedded "
                   "texture's size for .glb, else 512")
       ->check(CLI::Range(1, 1 << 16));
   cmd->add_flag("--json", opt->json, "Print the full report as a JSON object");
   cmd->add_flag("-q,--quiet", opt->quiet, "Print nothing but the result and errors");
+  cmd->add_flag("--stability", opt->stability,
+                "Instead: map the mesh with tailor (default options), remove the faces in a ball holding "
+                "~10% of them, re-map, and report how far the surviving UVs moved (thesis 2.6)");
+  cmd->add_option("--seed-point", opt->seed_point, "With --stability: X,Y,Z where both mappings start");
+  cmd->add_option("--remove-fraction", opt->remove_fraction, "With --stability: share of faces removed")
+      ->check(CLI::Range(0.01f, 0.9f))
+      ->capture_default_str();
   cmd->footer(
       "Metrics (docs/metrics.md): patches, seams (share of edge length), flipped faces, stretch\n"
       "(coefficient of variation of UV/3D area ratio, 0 ideal), L2/Linf stretch (Sander 2001, 1 ideal),\n"
       "median angle distortion, seam gap (px, modulo the texture) and share of invisible seams.\n"
-      "Example:\n  tailor eval bunny.glb\n  tailor eval spot.obj --texture-size 1024 --json\n");
+      "Example:\n  tailor eval bunny.glb\n  tailor eval spot.obj --texture-size 1024 --json\n"
+      "  tailor eval bunny.ply --stability --seed-point 0,0.1,0\n");
   cmd->callback([&run, opt] { run = [opt] { return run_eval(*opt); }; });
 }
 
