@@ -18,6 +18,9 @@ namespace tailor::internal {
 namespace {
 
 constexpr float kPi = 3.14159265358979f;
+// Next and previous corner of a face (cheaper than % 3 in the inner loops).
+constexpr int kNext[3] = {1, 2, 0};
+constexpr int kPrev[3] = {2, 0, 1};
 constexpr uint32_t kAnyPatch = kInvalid;
 
 // Faces whose doubled frame area is below this fraction of their squared longest edge have no
@@ -92,6 +95,9 @@ class PatchMapper {
       for (uint64_t key; queue_.pop(live, key);) {
         if (cancelled_) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
         const uint32_t f = FrontBuckets::face_of(key);
+        // The next pop is most likely the current top (new entries come from f's neighbours,
+        // which accept() touches anyway): start loading its record now.
+        if (const uint32_t next = queue_.peek_face(); next != FrontBuckets::kNone) __builtin_prefetch(rec + next);
         const uint64_t cls = front_class(key);
         if (cls == kWaiting) {
           // First pass: only placements that leave no cut; the others wait, so the front flows
@@ -160,8 +166,8 @@ class PatchMapper {
   // UVs of the two ends of face f's edge k, as the placed neighbour across it has them.
   void neighbour_edge_uv(uint32_t f, int k, const float*& ua, const float*& ub) const {
     const uint32_t o = rec_[f].opposite[k];
-    const uint32_t g = o / 3, kk = o % 3;
-    ua = uv_ + 6 * g + 2 * ((kk + 1) % 3);  // the neighbour's edge runs B -> A
+    const uint32_t g = o / 3, kk = o - 3 * g;
+    ua = uv_ + 6 * g + 2 * kNext[kk];  // the neighbour's edge runs B -> A
     ub = uv_ + 6 * g + 2 * kk;
   }
 
@@ -177,7 +183,7 @@ class PatchMapper {
   // field_following < 1 the face's frame is first turned by that share of the angle between its
   // edge AB and the UV edge AB, so the texture direction follows the unfolding instead of the field.
   float unfold(uint32_t f, int k, const float* ua, const float* ub, Rotation r, float* out) const {
-    const int ka = k, kb = (k + 1) % 3, kc = (k + 2) % 3;
+    const int ka = k, kb = kNext[k], kc = kPrev[k];
     if (relax_ > 0.f) {
       float vx, vy;
       frame_vector(f, ka, kb, r, vx, vy);
@@ -219,7 +225,7 @@ class PatchMapper {
   // Angle that rotates face f's own frame edge k onto the UV edge its neighbour gives.
   float edge_rotation(uint32_t f, int k, const float* ua, const float* ub) const {
     float vx, vy;
-    frame_vector(f, k, (k + 1) % 3, Rotation{}, vx, vy);
+    frame_vector(f, k, kNext[k], Rotation{}, vx, vy);
     const float wx = ub[0] - ua[0], wy = ub[1] - ua[1];
     return std::atan2(vx * wy - vy * wx, vx * wx + vy * wy);
   }
@@ -277,10 +283,13 @@ class PatchMapper {
     float candidate[6], best[6] = {0.f, 0.f, 0.f, 0.f, 0.f, 0.f};
     float best_stretch = std::numeric_limits<float>::infinity(), best_error = 0.f;
     bool best_cuts = false;
-    // Whether the candidate disagrees with any placed neighbour of the patch on a shared corner.
-    auto cuts_any = [&]() {
+    // Whether the candidate disagrees with any placed neighbour of the patch on a shared corner;
+    // `copied` is the edge the candidate copied from its neighbour (equal by construction: UVs
+    // are always finite).
+    auto cuts_any = [&](int copied) {
       for (int i = 0; i < count; ++i) {
-        const int e = edges[i], e1 = (e + 1) % 3;
+        const int e = edges[i], e1 = kNext[e];
+        if (e == copied) continue;
         if (candidate[2 * e] != ends[e][0][0] || candidate[2 * e + 1] != ends[e][0][1] ||
             candidate[2 * e1] != ends[e][1][0] || candidate[2 * e1 + 1] != ends[e][1][1])
           return true;
@@ -306,20 +315,20 @@ class PatchMapper {
     // --- Tier 1: third corner from a second placed neighbour ----------------------------------
     if (count >= 2) {
       for (int i = 0; i < count; ++i) {
-        const int k = edges[i], kc = (k + 2) % 3;
+        const int k = edges[i], kc = kPrev[k];
         // The other edges touching corner kc: k+1 (kc is its end) and k+2 (kc is its start).
         for (int j = 0; j < count; ++j) {
           const int m = edges[j];
           if (m == k) continue;
-          const float* c = (m == (k + 1) % 3) ? ends[m][1] : ends[m][0];
-          const int ka = k, kb = (k + 1) % 3;
+          const float* c = (m == kNext[k]) ? ends[m][1] : ends[m][0];
+          const int ka = k, kb = kNext[k];
           candidate[2 * ka] = ends[k][0][0];
           candidate[2 * ka + 1] = ends[k][0][1];
           candidate[2 * kb] = ends[k][1][0];
           candidate[2 * kb + 1] = ends[k][1][1];
           candidate[2 * kc] = c[0];
           candidate[2 * kc + 1] = c[1];
-          const bool cuts = cuts_any();
+          const bool cuts = cuts_any(k);
           consider(degenerate ? 0.f : stretch_error(frame, candidate), 0.f, cuts);
           if (!cuts && best_stretch <= bound_ && !best_cuts) return accept_best(true);
         }
@@ -329,17 +338,17 @@ class PatchMapper {
 
     // --- Tier 2: third corner from the patch's UV of its vertex --------------------------------
     for (int i = 0; i < count; ++i) {
-      const int k = edges[i], kc = (k + 2) % 3;
+      const int k = edges[i], kc = kPrev[k];
       const VertexHint& hint = hint_[self.vertex[kc]];
       if (hint.patch != target) continue;
-      const int ka = k, kb = (k + 1) % 3;
+      const int ka = k, kb = kNext[k];
       candidate[2 * ka] = ends[k][0][0];
       candidate[2 * ka + 1] = ends[k][0][1];
       candidate[2 * kb] = ends[k][1][0];
       candidate[2 * kb + 1] = ends[k][1][1];
       candidate[2 * kc] = hint.u;
       candidate[2 * kc + 1] = hint.v;
-      consider(degenerate ? 0.f : stretch_error(frame, candidate), 0.f, count > 1 && cuts_any());
+      consider(degenerate ? 0.f : stretch_error(frame, candidate), 0.f, count > 1 && cuts_any(k));
     }
     if (accept_best(true)) return true;
 

@@ -3,7 +3,9 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
+#include <sstream>
 
 namespace tailor::cli {
 
@@ -14,6 +16,14 @@ int report_error(const Status& status) {
 
 void warn(bool quiet, const std::string& text) {
   if (!quiet) std::fprintf(stderr, "tailor: warning: %s\n", text.c_str());
+}
+
+bool parse_vec3(const std::string& text, std::array<float, 3>& v) {
+  std::istringstream in(text);
+  char comma1 = 0, comma2 = 0;
+  if (!(in >> v[0] >> comma1 >> v[1] >> comma2 >> v[2]) || comma1 != ',' || comma2 != ',') return false;
+  in >> std::ws;
+  return in.eof() && std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
 }
 
 Progress::Progress(std::string label, bool quiet)

@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <array>
 #include <chrono>
 #include <functional>
 #include <string>
@@ -21,6 +22,9 @@ int report_error(const Status& status);
 
 //! Prints "tailor: warning: <text>" on stderr unless quiet.
 void warn(bool quiet, const std::string& text);
+
+//! Parses "X,Y,Z" into three finite floats; false when the text is anything else.
+bool parse_vec3(const std::string& text, std::array<float, 3>& v);
 
 //! A progress bar on stderr, drawn only when stderr is a terminal and not quiet, and only once the
 //! work has run for more than ~1 s. update() is cheap enough to call per percent of work.

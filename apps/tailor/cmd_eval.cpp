@@ -1,7 +1,6 @@
 // tailor eval: UV quality metrics of any UV-mapped mesh (.obj vt, .ply s/t, .glb TEXCOORD_0).
 // Definitions: docs/metrics.md.
 #include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <memory>
 
@@ -37,10 +36,7 @@ int run_stability(const EvalOptions& opt) {
   if (Status s = load_mesh(opt.input, mesh); !s) return report_error(s);
   MappingOptions mapping;
   if (!opt.seed_point.empty()) {
-    char c1 = 0, c2 = 0, rest = 0;
-    auto& p = mapping.seed_point;
-    if (std::sscanf(opt.seed_point.c_str(), "%f %c %f %c %f %c", &p[0], &c1, &p[1], &c2, &p[2], &rest) != 5 ||
-        c1 != ',' || c2 != ',' || !std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+    if (!parse_vec3(opt.seed_point, mapping.seed_point))
       return report_error(Status::error(ErrorCode::kInvalidArgument, "",
                                         "--seed-point must be three numbers X,Y,Z, got '" + opt.seed_point + "'"));
     mapping.use_seed_point = true;

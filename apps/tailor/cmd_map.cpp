@@ -2,7 +2,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -44,15 +43,6 @@ struct MapOptions {
 };
 
 Status usage_error(const std::string& what) { return Status::error(ErrorCode::kInvalidArgument, "", what); }
-
-// "1.5,-2,3" -> three finite floats.
-bool parse_vec3(const std::string& text, std::array<float, 3>& v) {
-  std::istringstream in(text);
-  char comma1 = 0, comma2 = 0;
-  if (!(in >> v[0] >> comma1 >> v[1] >> comma2 >> v[2]) || comma1 != ',' || comma2 != ',') return false;
-  in >> std::ws;
-  return in.eof() && std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
-}
 
 Status parse_axis(const std::string& text, OrientationOptions& o) {
   if (text == "pca") {

@@ -37,6 +37,13 @@ class FrontBuckets {
   static uint32_t face_of(uint64_t key) { return static_cast<uint32_t>(key); }
   static uint32_t bucket_of(uint64_t key) { return static_cast<uint32_t>(key >> 60); }
 
+  //! Face of the smallest entry (live or not), kNone when empty: the likely next pop, to prefetch.
+  uint32_t peek_face() const {
+    if (mask_ == 0) return kNone;
+    return face_of(heaps_[std::countr_zero(mask_)].front());
+  }
+  static constexpr uint32_t kNone = ~uint32_t{0};
+
   //! Adds an entry. `key`'s low 32 bits must be the face id, its top 4 bits (class, rank) at most 11.
   //! The caller records which entry of the face is live (see pop).
   void push(uint64_t key) {
