@@ -296,8 +296,8 @@ class PatchMapper {
       }
       return false;
     };
+    // Callers skip the stretch of candidates that cut when cuts are not allowed (never kept).
     auto consider = [&](float s, float err, bool cuts) {
-      if (cuts && !allow_cuts) return;
       if (s < best_stretch) {
         best_stretch = s;
         best_error = err;
@@ -329,7 +329,7 @@ class PatchMapper {
           candidate[2 * kc] = c[0];
           candidate[2 * kc + 1] = c[1];
           const bool cuts = cuts_any(k);
-          consider(degenerate ? 0.f : stretch_error(frame, candidate), 0.f, cuts);
+          if (allow_cuts || !cuts) consider(degenerate ? 0.f : stretch_error(frame, candidate), 0.f, cuts);
           if (!cuts && best_stretch <= bound_ && !best_cuts) return accept_best(true);
         }
       }
@@ -348,11 +348,13 @@ class PatchMapper {
       candidate[2 * kb + 1] = ends[k][1][1];
       candidate[2 * kc] = hint.u;
       candidate[2 * kc + 1] = hint.v;
-      consider(degenerate ? 0.f : stretch_error(frame, candidate), 0.f, count > 1 && cuts_any(k));
+      const bool cuts = count > 1 && cuts_any(k);
+      if (allow_cuts || !cuts) consider(degenerate ? 0.f : stretch_error(frame, candidate), 0.f, cuts);
     }
     if (accept_best(true)) return true;
 
     // --- Tier 3: a fresh third corner ----------------------------------------------------------
+    if (count > 1 && !allow_cuts) return false;  // a fresh corner cuts from all but one neighbour
     for (int i = 0; i < count; ++i) {
       const int k = edges[i];
       const float err = unfold(f, k, ends[k][0], ends[k][1], r, candidate);
