@@ -1,6 +1,7 @@
 // Mesh loading front end: format detection, dispatch to the per-format parsers, and the
 // validation / repair pass shared by all of them (finalize_mesh). See include/tailor/io.h.
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -10,7 +11,7 @@
 #include <utility>
 #include <vector>
 
-#include "internal/atomic_file.h"
+#include "internal/file_view.h"
 #include "internal/huge_pages.h"
 #include "internal/readers.h"
 #include "tailor/io.h"
@@ -66,12 +67,15 @@ inline uint64_t sorted_pair(const uint32_t* idx, size_t f, uint32_t& lo) {
   return uint64_t{b} << 32 | c;
 }
 
-template <class T>
-std::vector<T> huge_vector(size_t n, T value) {
-  std::vector<T> v;
-  internal::reserve_huge(v, n);
-  v.assign(n, value);
-  return v;
+// True when triangle (a, b, c) has exactly zero area. The cross product in double from float
+// inputs is exact for all but extreme exponent ranges, so "zero" means exactly collinear.
+inline bool is_zero_area(const float* pos, uint32_t a, uint32_t b, uint32_t c) {
+  const double ux = double{pos[3 * b]} - pos[3 * a], uy = double{pos[3 * b + 1]} - pos[3 * a + 1],
+               uz = double{pos[3 * b + 2]} - pos[3 * a + 2];
+  const double vx = double{pos[3 * c]} - pos[3 * a], vy = double{pos[3 * c + 1]} - pos[3 * a + 1],
+               vz = double{pos[3 * c + 2]} - pos[3 * a + 2];
+  const double cx = uy * vz - uz * vy, cy = uz * vx - ux * vz, cz = ux * vy - uy * vx;
+  return cx == 0.0 && cy == 0.0 && cz == 0.0;
 }
 
 // Per smallest vertex: the last kept face with that smallest vertex, and a 32-bit signature
@@ -88,6 +92,30 @@ constexpr uint8_t kKeep = 1;
 // ~50 us, the geometry pass ~4 ns per face).
 constexpr size_t kThreadedFaces = 200000;
 
+// Faces per chunk of the shared geometry pass (~0.5 ms of work: few atomic operations, and a
+// thread that finishes early waits at most one chunk for the other).
+constexpr size_t kGeometryChunk = 65536;
+
+// The geometry pass over the chunks this thread takes from next_chunk (kGeometryChunk faces
+// each): marks the vertices of non-degenerate faces in `used` and returns how many of those faces
+// have zero area. Faces with an index >= nv are skipped (reported by the caller). Plain pointer
+// parameters: the byte stores to `used` would otherwise force reloads of captured variables.
+size_t zero_area_in_chunks(const uint32_t* idx, const float* pos, size_t nf, uint32_t nv, size_t chunks,
+                           std::atomic<size_t>& next_chunk, uint8_t* used) {
+  size_t zeros = 0;
+  for (size_t k = next_chunk.fetch_add(1, std::memory_order_relaxed); k < chunks;
+       k = next_chunk.fetch_add(1, std::memory_order_relaxed)) {
+    const size_t end = std::min(nf, (k + 1) * kGeometryChunk);
+    for (size_t f = k * kGeometryChunk; f < end; ++f) {
+      const uint32_t a = idx[3 * f], b = idx[3 * f + 1], c = idx[3 * f + 2];
+      if ((a == b) | (b == c) | (a == c) | (std::max(a, std::max(b, c)) >= nv)) continue;
+      used[a] = used[b] = used[c] = 1;  // a duplicate uses the same vertices as its kept twin
+      zeros += is_zero_area(pos, a, b, c);
+    }
+  }
+  return zeros;
+}
+
 // Longest duplicate chain walked per face before switching to the bucket sort; real meshes have
 // a handful of faces per smallest vertex, only fans of thousands of faces exceed it.
 constexpr size_t kMaxChain = 64;
@@ -95,8 +123,8 @@ constexpr size_t kMaxChain = 64;
 // Exact duplicate marking by a counting sort on the smallest vertex and a sort of each bucket by
 // (pair, face). Clears kKeep on every face whose sorted triple equals an earlier kept face's and
 // returns the number marked. O(F + V + sum k log k) for buckets of size k.
-size_t mark_duplicates_by_buckets(const std::vector<uint32_t>& indices, std::vector<uint8_t>& flags) {
-  const size_t nf = flags.size();
+size_t mark_duplicates_by_buckets(const std::vector<uint32_t>& indices, uint8_t* flags) {
+  const size_t nf = indices.size() / 3;
   uint32_t nv = 0;
   for (uint32_t i : indices) nv = std::max(nv, i + 1);
   auto lowest = [&](size_t f) {
@@ -180,8 +208,10 @@ Status read_mesh(std::span<const char> data, MeshFormat format, const std::strin
 Status load_mesh(const std::string& path, Mesh& mesh, LoadReport* report) {
   const auto t0 = std::chrono::steady_clock::now();
   mesh = Mesh{};
-  std::string bytes;
-  TAILOR_RETURN_IF_ERROR(internal::read_file(path, bytes));
+  // Mapped, not copied: a read into a fresh buffer cost a quarter of loading a large binary PLY.
+  internal::FileView file;
+  TAILOR_RETURN_IF_ERROR(internal::view_file(path, file));
+  const std::span<const char> bytes = file.bytes();
   MeshFormat format = mesh_format_from_path(path);
   if (format == MeshFormat::kUnknown) {
     format = sniff_format(bytes);
@@ -218,23 +248,111 @@ Status finalize_mesh(const std::string& name, Mesh& mesh, LoadReport& report) {
   }
   if (nf == 0) return Status::error(ErrorCode::kInvalidMesh, name, "mesh has no faces");
 
-  // === Finite coordinates ========================================================================
-  // Branch-free scan of the exponent bits (vectorizes); the slow search runs only on failure.
-  {
+  // === Three passes over the faces, on two threads ==============================================
+  // The worker checks the coordinates, then starts on the geometry (zero-area faces, referenced
+  // vertices); this thread checks index ranges, finds degenerate and duplicate faces, then helps
+  // with the geometry. They read the same arrays and write disjoint ones; every result is a count,
+  // a per-face flag or a union of marks, so nothing depends on the thread timing. A face with an
+  // out-of-range index is skipped by both and reported after the join (the range check is folded
+  // into the face loops instead of a pass of its own).
+  const uint32_t* idx = mesh.indices.data();
+  const float* pos = mesh.positions.data();
+  const uint32_t nv32 = static_cast<uint32_t>(nv);  // nv <= kMaxVertices < 2^32
+  // Everything is allocated before the thread starts: nothing below may throw while it runs.
+  // Each thread marks referenced vertices in its own array (no shared writes); they are merged after.
+  internal::HugeArray<uint8_t> used_main = internal::huge_zeroed<uint8_t>(nv);
+  internal::HugeArray<uint8_t> used_worker = internal::huge_zeroed<uint8_t>(nv);
+  internal::HugeArray<uint8_t> flags = internal::huge_uninitialized<uint8_t>(nf);  // kKeep or 0
+  internal::HugeArray<Chain> chains = internal::huge_zeroed<Chain>(nv);
+  internal::HugeArray<uint32_t> next = internal::huge_uninitialized<uint32_t>(nf);
+  // The geometry pass is shared out in chunks: the worker starts on it at once, this thread joins
+  // in when its duplicate pass is done. Which thread takes a chunk varies from run to run; the
+  // results (a sum and the union of the marks) do not.
+  std::atomic<size_t> next_chunk{0};
+  const size_t chunks = (nf + kGeometryChunk - 1) / kGeometryChunk;
+  auto geometry = [idx, pos, nf, nv32, chunks, &next_chunk](uint8_t* used) {
+    return zero_area_in_chunks(idx, pos, nf, nv32, chunks, next_chunk, used);
+  };
+  bool non_finite = false;
+  size_t zero_area = 0;
+  auto worker_job = [&, np = mesh.positions.size(), used = used_worker.get()] {
+    // Finite coordinates: a branch-free scan of the exponent bits (vectorizes).
     uint32_t all_ones = 0;
-    const size_t np = mesh.positions.size();
-    const float* p = mesh.positions.data();
     for (size_t i = 0; i < np; ++i) {
       uint32_t bits;
-      std::memcpy(&bits, p + i, 4);
+      std::memcpy(&bits, pos + i, 4);
       all_ones |= static_cast<uint32_t>((bits & 0x7f800000u) == 0x7f800000u);
     }
-    if (all_ones) {
-      for (size_t i = 0; i < np; ++i) {
-        if (!std::isfinite(p[i])) {
-          return Status::error(ErrorCode::kInvalidMesh, name, "non-finite vertex coordinate",
-                               "vertex " + std::to_string(i / 3));
-        }
+    non_finite = all_ones != 0;
+    zero_area = geometry(used);
+  };
+  std::thread worker;
+  if (nf >= kThreadedFaces) {
+    try {
+      worker = std::thread(worker_job);
+    } catch (...) {  // no thread available: run it inline below
+    }
+  }
+
+  // Duplicates (same vertex set, any order; the first is kept) are found through a chain per
+  // smallest vertex: chains[v].head is 1 + the last kept face whose smallest vertex is v (0: none),
+  // next[f] the same for the one before it, and chains[v].signature filters out most walks.
+  // Meshes store faces with vertex locality, so this stays in cache where a hash of 1.5M triples
+  // costs a cache miss per face. A chain longer than kMaxChain (a huge fan, i.e. adversarial
+  // input) switches to the exact bucket sort in mark_duplicates_by_buckets, so the worst case is
+  // O(F log F), never quadratic. Both give the same result.
+  size_t degenerate = 0, duplicates = 0;
+  bool chain_overflow = false;
+  uint32_t max_index = 0;
+  for (size_t f = 0; f < nf; ++f) {
+    const uint32_t a = idx[3 * f], b = idx[3 * f + 1], c = idx[3 * f + 2];
+    uint32_t lo = 0, unused = 0;
+    const uint64_t key = sorted_pair(idx, f, lo);
+    const uint32_t hi = static_cast<uint32_t>(key);
+    max_index = std::max(max_index, hi);
+    if ((a == b) | (b == c) | (a == c) | (hi >= nv32)) {
+      degenerate += hi < nv32;
+      flags[f] = 0;
+      continue;
+    }
+    flags[f] = kKeep;
+    if (chain_overflow) continue;
+    Chain& chain = chains[lo];
+    const uint32_t bit = 1u << ((key * 0x9e3779b97f4a7c15ULL) >> 59);
+    if (chain.signature & bit) {  // possibly a duplicate: walk the chain (exact)
+      size_t steps = 0;
+      uint32_t g = chain.head;
+      while (g != 0 && sorted_pair(idx, g - 1, unused) != key && ++steps <= kMaxChain) g = next[g - 1];
+      if (steps > kMaxChain) {
+        chain_overflow = true;
+        continue;
+      }
+      if (g != 0) {
+        flags[f] = 0;
+        ++duplicates;
+        continue;
+      }
+    }
+    next[f] = chain.head;
+    chain.head = static_cast<uint32_t>(f + 1);
+    chain.signature |= bit;
+  }
+  chains.reset();
+  next.reset();
+  const size_t main_zeros = geometry(used_main.get());
+  if (worker.joinable()) worker.join();
+  else worker_job();
+  zero_area += main_zeros;
+  size_t unreferenced = 0;
+  for (size_t v = 0; v < nv; ++v) unreferenced += (used_main[v] | used_worker[v]) == 0;
+
+  // === Errors, in a fixed order whatever the thread timing ======================================
+  // The slow searches below run only on failure, to name the first offending element.
+  if (non_finite) {
+    for (size_t i = 0; i < mesh.positions.size(); ++i) {
+      if (!std::isfinite(pos[i])) {
+        return Status::error(ErrorCode::kInvalidMesh, name, "non-finite vertex coordinate",
+                             "vertex " + std::to_string(i / 3));
       }
     }
   }
@@ -244,112 +362,29 @@ Status finalize_mesh(const std::string& name, Mesh& mesh, LoadReport& report) {
                            "face " + std::to_string(i / 6));
     }
   }
-
-  // === Index range ===============================================================================
-  // Checked first and branch-free (vectorizes), so that the passes below may read positions.
-  const uint32_t* idx = mesh.indices.data();
-  {
-    uint32_t max_index = 0;
-    for (size_t c = 0; c < 3 * nf; ++c) max_index = std::max(max_index, idx[c]);
-    if (max_index >= nv) {
-      for (size_t c = 0; c < 3 * nf; ++c) {
-        if (idx[c] >= nv) {
-          return Status::error(ErrorCode::kInvalidMesh, name,
-                               "face index " + std::to_string(idx[c]) + " out of range (mesh has " +
-                                   std::to_string(nv) + " vertices)",
-                               "face " + std::to_string(c / 3));
-        }
+  if (max_index >= nv) {
+    for (size_t c = 0; c < 3 * nf; ++c) {
+      if (idx[c] >= nv) {
+        return Status::error(ErrorCode::kInvalidMesh, name,
+                             "face index " + std::to_string(idx[c]) + " out of range (mesh has " +
+                                 std::to_string(nv) + " vertices)",
+                             "face " + std::to_string(c / 3));
       }
     }
   }
-
-  // === Two independent passes over the faces, run side by side ==================================
-  // Geometry (zero-area flags, referenced vertices) and connectivity (degenerate and duplicate
-  // faces) read the same indices but write disjoint arrays, so they run on two threads when
-  // the mesh is large; the results do not depend on it.
-  std::vector<uint8_t> zero = huge_vector<uint8_t>(nf, 0);
-  std::vector<uint8_t> used = huge_vector<uint8_t>(nv, 0);
-  auto geometry = [&] {
-    // Zero area: the cross product in double from float inputs is exact for all but extreme
-    // exponent ranges, so "zero" means exactly collinear. Degenerate faces are skipped (dropped).
-    const float* pos = mesh.positions.data();
-    for (size_t f = 0; f < nf; ++f) {
-      const uint32_t a = idx[3 * f], b = idx[3 * f + 1], c = idx[3 * f + 2];
-      if ((a == b) | (b == c) | (a == c)) continue;
-      used[a] = used[b] = used[c] = 1;  // a duplicate uses the same vertices as its kept twin
-      const double ux = double{pos[3 * b]} - pos[3 * a], uy = double{pos[3 * b + 1]} - pos[3 * a + 1],
-                   uz = double{pos[3 * b + 2]} - pos[3 * a + 2];
-      const double vx = double{pos[3 * c]} - pos[3 * a], vy = double{pos[3 * c + 1]} - pos[3 * a + 1],
-                   vz = double{pos[3 * c + 2]} - pos[3 * a + 2];
-      const double cx = uy * vz - uz * vy, cy = uz * vx - ux * vz, cz = ux * vy - uy * vx;
-      zero[f] = (cx == 0.0 && cy == 0.0 && cz == 0.0) ? 1 : 0;
-    }
-  };
-  // Everything is allocated before the thread starts: nothing below may throw while it runs.
-  std::vector<uint8_t> flags = huge_vector<uint8_t>(nf, 0);  // kKeep
-  std::vector<Chain> chains = huge_vector<Chain>(nv, Chain{kInvalid, 0});
-  std::vector<uint32_t> next = huge_vector<uint32_t>(nf, kInvalid);
-  std::thread worker;
-  if (nf >= kThreadedFaces) {
-    try {
-      worker = std::thread(geometry);
-    } catch (...) {  // no thread available: run it inline below
-    }
-  }
-
-  // Duplicates (same vertex set, any order; the first is kept) are found through a chain per
-  // smallest vertex: chains[v].head is the last kept face whose smallest vertex is v, next[f] the
-  // one before it, and chains[v].signature filters out most walks. Meshes store faces with vertex
-  // locality, so this stays in cache where a hash of 1.5M triples costs a cache miss per face.
-  // A chain longer than kMaxChain (a huge fan, i.e. adversarial input) switches to the exact
-  // bucket sort in mark_duplicates_by_buckets, so the worst case is O(F log F), never quadratic.
-  // Both give the same result.
-  size_t degenerate = 0, duplicates = 0;
-  bool chain_overflow = false;
-  for (size_t f = 0; f < nf; ++f) {
-    const uint32_t a = idx[3 * f], b = idx[3 * f + 1], c = idx[3 * f + 2];
-    if ((a == b) | (b == c) | (a == c)) {
-      ++degenerate;
-      continue;
-    }
-    uint32_t lo = 0, unused = 0;
-    const uint64_t key = sorted_pair(idx, f, lo);
-    flags[f] = kKeep;
-    if (chain_overflow) continue;
-    Chain& chain = chains[lo];
-    const uint32_t bit = 1u << ((key * 0x9e3779b97f4a7c15ULL) >> 59);
-    if (chain.signature & bit) {  // possibly a duplicate: walk the chain (exact)
-      size_t steps = 0;
-      uint32_t g = chain.head;
-      while (g != kInvalid && sorted_pair(idx, g, unused) != key && ++steps <= kMaxChain) g = next[g];
-      if (steps > kMaxChain) {
-        chain_overflow = true;
-        continue;
-      }
-      if (g != kInvalid) {
-        flags[f] = 0;
-        ++duplicates;
-        continue;
-      }
-    }
-    next[f] = chain.head;
-    chain.head = static_cast<uint32_t>(f);
-    chain.signature |= bit;
-  }
-  if (worker.joinable()) worker.join();
-  else geometry();
-  std::vector<Chain>().swap(chains);
-  std::vector<uint32_t>().swap(next);
-  if (chain_overflow) duplicates += mark_duplicates_by_buckets(mesh.indices, flags);
+  if (chain_overflow) duplicates += mark_duplicates_by_buckets(mesh.indices, flags.get());
 
   // === Compact, keeping corner_uvs and seam_faces in step ======================================
-  size_t zero_area = 0;
   if (degenerate + duplicates > 0) {
     size_t out = 0;
     const bool uvs = !mesh.corner_uvs.empty(), seams = !mesh.seam_faces.empty();
     for (size_t f = 0; f < nf; ++f) {
-      if (!(flags[f] & kKeep)) continue;
-      zero_area += zero[f];
+      if (!(flags[f] & kKeep)) {
+        const uint32_t a = idx[3 * f], b = idx[3 * f + 1], c = idx[3 * f + 2];
+        // The geometry pass counted every non-degenerate face; a dropped duplicate is not kept.
+        if ((a != b) & (b != c) & (a != c)) zero_area -= is_zero_area(pos, a, b, c);
+        continue;
+      }
       if (out != f) {
         std::memmove(&mesh.indices[3 * out], &mesh.indices[3 * f], 3 * sizeof(uint32_t));
         if (uvs) std::memmove(&mesh.corner_uvs[6 * out], &mesh.corner_uvs[6 * f], 6 * sizeof(float));
@@ -360,15 +395,11 @@ Status finalize_mesh(const std::string& name, Mesh& mesh, LoadReport& report) {
     mesh.indices.resize(3 * out);
     if (uvs) mesh.corner_uvs.resize(6 * out);
     if (seams) mesh.seam_faces.resize(out);
-  } else {
-    for (size_t f = 0; f < nf; ++f) zero_area += zero[f];
   }
   report.degenerate_faces += degenerate;
   report.duplicate_faces += duplicates;
   report.zero_area_faces += zero_area;
   if (mesh.indices.empty()) return Status::error(ErrorCode::kInvalidMesh, name, "mesh has no faces");
-  size_t unreferenced = 0;
-  for (size_t v = 0; v < nv; ++v) unreferenced += used[v] == 0;
   report.unreferenced_vertices += unreferenced;
   return Status::ok();
 }

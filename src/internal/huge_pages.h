@@ -9,6 +9,10 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
+#include <memory>
+#include <new>
+#include <type_traits>
 #include <vector>
 
 #if defined(__linux__)
@@ -42,6 +46,37 @@ void reserve_huge(std::vector<T>& v, size_t n) {
   const bool fresh = v.empty();
   v.reserve(n);
   if (fresh) advise_huge_pages(v.data(), n * sizeof(T));
+}
+
+//! Frees memory from malloc/calloc (deleter of HugeArray).
+struct FreeDeleter {
+  void operator()(void* p) const noexcept { std::free(p); }
+};
+
+//! A scratch array of trivial values from malloc/calloc (no per-element construction).
+template <class T>
+using HugeArray = std::unique_ptr<T[], FreeDeleter>;
+
+//! n uninitialized Ts for arrays the caller overwrites before reading (a std::vector would
+//! zero-fill them first), huge pages advised. Throws std::bad_alloc on failure.
+template <class T>
+HugeArray<T> huge_uninitialized(size_t n) {
+  static_assert(std::is_trivially_default_constructible_v<T> && std::is_trivially_destructible_v<T>);
+  void* p = std::malloc(n == 0 ? sizeof(T) : n * sizeof(T));
+  if (p == nullptr) throw std::bad_alloc();
+  advise_huge_pages(p, n * sizeof(T));
+  return HugeArray<T>(static_cast<T*>(p));
+}
+
+//! n zero-bytes Ts. calloc skips clearing memory that comes fresh from the kernel (already zero),
+//! where std::vector would write every byte again. Throws std::bad_alloc on failure.
+template <class T>
+HugeArray<T> huge_zeroed(size_t n) {
+  static_assert(std::is_trivially_default_constructible_v<T> && std::is_trivially_destructible_v<T>);
+  void* p = std::calloc(n == 0 ? 1 : n, sizeof(T));
+  if (p == nullptr) throw std::bad_alloc();
+  advise_huge_pages(p, n * sizeof(T));
+  return HugeArray<T>(static_cast<T*>(p));
 }
 
 }  // namespace tailor::internal
