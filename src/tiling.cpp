@@ -15,7 +15,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <exception>
 #include <limits>
 
@@ -32,7 +31,9 @@ namespace {
 constexpr int kMinTileSide = 32;
 constexpr int kChainFactor = 1;  // arm blocks are this many times longer than wide
 constexpr int kArmDivisor = 2;  // the '+' is repaired with blocks and overlaps this many times smaller
-constexpr int kCandidatePool = 32;  // near-best blocks compared by the patch cost of their cuts
+constexpr int kCandidatePool = 32;
+constexpr double kSmoothPenalty = 2.0;  // cost * (mean gradient / block gradient)^this for smooth blocks
+constexpr double kStrongEdge = 2.0;     // exemplars whose interior worst seam ratio exceeds this get kSmoothPenalty  // near-best blocks compared by the patch cost of their cuts
 
 //! SSD of a masked B x B template against every B x B block of the exemplar, by FFT.
 class SsdSearch {
@@ -176,7 +177,7 @@ class Quilter {
  public:
   Quilter(const Plane& exemplar, SsdSearch& search, Plane& canvas, std::vector<uint8_t>& known,
           const std::vector<uint8_t>& locked, int overlap, double tolerance, SplitMix64& rng,
-          std::vector<int32_t>* source = nullptr, int pool = 1)
+          std::vector<int32_t>* source = nullptr, int pool = 1, double gradient_penalty = 0.0)
       : ex_(exemplar),
         search_(search),
         canvas_(canvas),
@@ -186,7 +187,8 @@ class Quilter {
         tolerance_(tolerance),
         rng_(rng),
         source_(source),
-        pool_(pool) {}
+        pool_(pool),
+        gradient_penalty_(gradient_penalty) {}
 
   //! Places one bw x bh block with its top-left corner at canvas (bx, by) (modulo the canvas size).
   void place(int bx, int by, int bw, int bh, const Exclusion& exclusion) {
@@ -194,90 +196,71 @@ class Quilter {
     bh_ = bh;
     const int channels = canvas_.channels;
     const size_t area = static_cast<size_t>(bw) * bh;
-    // The block is matched with a margin of known context around it: a 7 x 7 patch straddling a
-    // cut near the block's edge also sees the exemplar's pixels just outside the block.
-    static const int env_m = std::getenv("TQ_M") ? std::atoi(std::getenv("TQ_M")) : 0;
-    const int m = env_m;
-    const int ew = bw + 2 * m, eh = bh + 2 * m;
-    const size_t ext_area = static_cast<size_t>(ew) * eh;
-    ext_templ_.resize(ext_area * channels);
-    ext_mask_.assign(ext_area, 0.0f);
     templ_.resize(area * channels);
     mask_.assign(area, 0.0f);
     bool any_known = false;
-    for (int y = 0; y < eh; ++y) {
-      for (int x = 0; x < ew; ++x) {
-        const size_t i = static_cast<size_t>(y) * ew + x;
-        const int cx = Plane::mod(bx - m + x, canvas_.width);
-        const int cy = Plane::mod(by - m + y, canvas_.height);
+    for (int y = 0; y < bh; ++y) {
+      for (int x = 0; x < bw; ++x) {
+        const size_t i = static_cast<size_t>(y) * bw + x;
+        const int cx = Plane::mod(bx + x, canvas_.width);
+        const int cy = Plane::mod(by + y, canvas_.height);
         const float* p = canvas_.at(cx, cy);
-        std::copy(p, p + channels, &ext_templ_[i * channels]);
-        const bool inside = x >= m && y >= m && x < m + bw && y < m + bh;
-        const size_t k = inside ? static_cast<size_t>(y - m) * bw + (x - m) : 0;
-        if (inside) std::copy(p, p + channels, &templ_[k * channels]);
+        std::copy(p, p + channels, &templ_[i * channels]);
         if (known_[static_cast<size_t>(cy) * canvas_.width + cx]) {
-          ext_mask_[i] = 1.0f;
-          if (inside) {
-            mask_[k] = 1.0f;
-            any_known = true;
-          }
+          mask_[i] = 1.0f;
+          any_known = true;
         }
       }
     }
 
-    // Choose the exemplar block: at random among those within the tolerance of the best SSD.
-    const int nx = search_.positions_x(ew);
-    const int ny = search_.positions_y(eh);
+    // Choose the exemplar block among those within the tolerance of the best SSD.
+    const int nx = search_.positions_x(bw);
+    const int ny = search_.positions_y(bh);
     int chosen = 0;
     if (!any_known) {
       chosen = static_cast<int>(rng_.below(static_cast<uint32_t>(nx * ny)));
     } else {
-      search_.search(ew, eh, ext_templ_, ext_mask_, ssd_);
+      search_.search(bw, bh, templ_, mask_, ssd_);
       float best = std::numeric_limits<float>::max();
       float energy = 0.0f;
-      for (size_t i = 0; i < ext_templ_.size(); ++i)
-        energy += ext_mask_[i / channels] * ext_templ_[i] * ext_templ_[i];
+      for (size_t i = 0; i < templ_.size(); ++i) energy += mask_[i / channels] * templ_[i] * templ_[i];
       for (int y = 0; y < ny; ++y)
         for (int x = 0; x < nx; ++x)
-          if (!exclusion.contains(x + m, y + m)) best = std::min(best, ssd_[static_cast<size_t>(y) * nx + x]);
+          if (!exclusion.contains(x, y)) best = std::min(best, ssd_[static_cast<size_t>(y) * nx + x]);
       const bool use_exclusion = best < std::numeric_limits<float>::max();
       if (!use_exclusion)
         for (float v : ssd_) best = std::min(best, v);
       // The small absolute term absorbs FFT round-off (relative ~1e-6 of the template energy).
-      static const double env_tol = std::getenv("TQ_TOL") ? std::atof(std::getenv("TQ_TOL")) : -1.0;
-      const double tol = env_tol >= 0.0 ? env_tol : tolerance_;
-      const float threshold = best * static_cast<float>(1.0 + tol) + 1e-5f * energy + 1e-3f;
+      const float threshold = best * static_cast<float>(1.0 + tolerance_) + 1e-5f * energy + 1e-3f;
       candidates_.clear();
       for (int y = 0; y < ny; ++y)
         for (int x = 0; x < nx; ++x)
-          if (ssd_[static_cast<size_t>(y) * nx + x] <= threshold && !(use_exclusion && exclusion.contains(x + m, y + m)))
+          if (ssd_[static_cast<size_t>(y) * nx + x] <= threshold && !(use_exclusion && exclusion.contains(x, y)))
             candidates_.push_back(y * nx + x);
-      static const int env_k = std::getenv("TQ_K") ? std::atoi(std::getenv("TQ_K")) : -1;
-      const int pool = env_k > 0 ? env_k : pool_;
-      if (pool <= 1 || source_ == nullptr) {
+      if (pool_ <= 1 || source_ == nullptr) {
         chosen = candidates_[rng_.below(static_cast<uint32_t>(candidates_.size()))];
       } else {
         // Draw up to `pool` candidates at random (seeded); keep the one whose cut patches are
-        // closest to exemplar patches (what the patch coherence of the tile measures).
-        const size_t k = std::min(candidates_.size(), static_cast<size_t>(pool));
+        // closest to exemplar patches (what the tile's patch coherence measures). SSD alone
+        // treats every overlap pixel alike, while a 7 x 7 patch across a cut is cheap only if
+        // both sides agree near the cut.
+        const size_t k = std::min(candidates_.size(), static_cast<size_t>(pool_));
         for (size_t i = 0; i < k; ++i) {
           const size_t j = i + rng_.below(static_cast<uint32_t>(candidates_.size() - i));
           std::swap(candidates_[i], candidates_[j]);
         }
         double best_cost = std::numeric_limits<double>::max();
         for (size_t i = 0; i < k; ++i) {
-          const int cx = candidates_[i] % nx + m, cy = candidates_[i] / nx + m;
+          const int cx = candidates_[i] % nx, cy = candidates_[i] / nx;
           compute_error(cx, cy);
           take_new_.assign(area, 1);
           for (int side = 0; side < 4; ++side) cut_side(side);
-          static const double env_gp = std::getenv("TQ_GP") ? std::atof(std::getenv("TQ_GP")) : 0.0;
           double cost = patch_cost(bx, by, cx, cy);
-          if (env_gp > 0.0) {
-            static const int env_ax = std::getenv("TQ_AX") ? std::atoi(std::getenv("TQ_AX")) : 0;
-            const int ax = env_ax ? axis_ : 0;
-            const double g = block_gradient(cx, cy, ax);
-            const double target = mean_gradient(ax);
-            if (g < target) cost *= std::pow(target / std::max(g, 1e-6), env_gp);
+          // Optional: penalise blocks smoother than the exemplar on average (smooth blocks match
+          // more easily, and a strip of them lowers the tile's median boundary difference).
+          if (gradient_penalty_ > 0.0) {
+            const double g = block_gradient(cx, cy);
+            if (g < mean_gradient()) cost *= std::pow(mean_gradient() / std::max(g, 1e-6), gradient_penalty_);
           }
           if (cost < best_cost) {
             best_cost = cost;
@@ -286,8 +269,8 @@ class Quilter {
         }
       }
     }
-    const int px = chosen % nx + m;
-    const int py = chosen / nx + m;
+    const int px = chosen % nx;
+    const int py = chosen / nx;
 
     // Boundary cuts on every side whose overlap strip holds known pixels.
     compute_error(px, py);
@@ -334,7 +317,8 @@ class Quilter {
     }
   }
 
-  double block_gradient(int px, int py, int ax) const {
+  //! Mean |dx| + |dy| of the exemplar block at (px, py).
+  double block_gradient(int px, int py) const {
     const int channels = canvas_.channels;
     double sum = 0.0;
     for (int y = 0; y + 1 < bh_; ++y)
@@ -342,12 +326,13 @@ class Quilter {
         const float* a = ex_.at(px + x, py + y);
         const float* r = ex_.at(px + x + 1, py + y);
         const float* d = ex_.at(px + x, py + y + 1);
-        for (int c = 0; c < channels; ++c) sum += (ax != 2 ? std::abs(a[c] - r[c]) : 0.0f) + (ax != 1 ? std::abs(a[c] - d[c]) : 0.0f);
+        for (int c = 0; c < channels; ++c) sum += std::abs(a[c] - r[c]) + std::abs(a[c] - d[c]);
       }
     return sum / (static_cast<double>(bw_ - 1) * (bh_ - 1) * channels);
   }
-  double mean_gradient(int ax) {
-    if (mean_gradient_[ax] < 0.0) {
+  //! Mean |dx| + |dy| of the whole exemplar (computed once).
+  double mean_gradient() {
+    if (mean_gradient_ < 0.0) {
       const int channels = canvas_.channels;
       double sum = 0.0;
       for (int y = 0; y + 1 < ex_.height; ++y)
@@ -355,11 +340,11 @@ class Quilter {
           const float* a = ex_.at(x, y);
           const float* r = ex_.at(x + 1, y);
           const float* d = ex_.at(x, y + 1);
-          for (int c = 0; c < channels; ++c) sum += (ax != 2 ? std::abs(a[c] - r[c]) : 0.0f) + (ax != 1 ? std::abs(a[c] - d[c]) : 0.0f);
+          for (int c = 0; c < channels; ++c) sum += std::abs(a[c] - r[c]) + std::abs(a[c] - d[c]);
         }
-      mean_gradient_[ax] = sum / (static_cast<double>(ex_.width - 1) * (ex_.height - 1) * channels);
+      mean_gradient_ = sum / (static_cast<double>(ex_.width - 1) * (ex_.height - 1) * channels);
     }
-    return mean_gradient_[ax];
+    return mean_gradient_;
   }
 
   //! Sum over the 7 x 7 canvas patches that would hold pixels of the block at exemplar (px, py)
@@ -438,7 +423,7 @@ class Quilter {
   }
 
   // side: 0 left, 1 right, 2 top, 3 bottom. Pixels beyond the cut (towards the side) keep the old value.
-  double cut_side(int side) {
+  void cut_side(int side) {
     const int length = side < 2 ? bh_ : bw_;
     const int ov = std::min(ov_, side < 2 ? bw_ : bh_);
     bool active = false;
@@ -452,7 +437,7 @@ class Quilter {
         strip_[static_cast<size_t>(i) * ov + j] = error_[k];
       }
     }
-    if (!active) return 0.0;
+    if (!active) return;
     min_error_path(strip_, length, ov, cost_, path_);
     for (int i = 0; i < length; ++i) {
       for (int j = 0; j < path_[static_cast<size_t>(i)]; ++j) {
@@ -461,7 +446,6 @@ class Quilter {
         take_new_[static_cast<size_t>(y) * bw_ + x] = 0;
       }
     }
-    return *std::min_element(cost_.end() - ov, cost_.end());
   }
 
   // Strip coordinates (i along the side, j = depth from the block's edge) -> block (x, y).
@@ -496,15 +480,13 @@ class Quilter {
   double tolerance_;
   SplitMix64& rng_;
   int placed_ = 0;
-  std::vector<float> templ_, mask_, ext_templ_, ext_mask_, ssd_, error_, strip_, cost_;
+  std::vector<float> templ_, mask_, ssd_, error_, strip_, cost_;
   std::vector<int> candidates_, path_;
   std::vector<uint8_t> take_new_;
   std::vector<int32_t>* source_;
   int pool_;
-  double mean_gradient_[3] = {-1.0, -1.0, -1.0};
- public:
-  int axis_ = 0;
- private:
+  double gradient_penalty_;
+  double mean_gradient_ = -1.0;
   std::vector<float> region_val_;
   std::vector<int32_t> region_src_;
   std::vector<uint8_t> region_known_;
@@ -661,16 +643,43 @@ void choose_shift(const Plane& ex, int& shift_x, int& shift_y) {
   shift_y = pick(rows, h);
 }
 
+//! Largest (mean absolute difference across a column or row boundary) / (median one), the wrap
+//! boundaries included or not: the worst-seam figure of tile_metrics(). O(N).
+double worst_seam_ratio(const Plane& p, bool include_wrap) {
+  const int w = p.width, h = p.height, c = p.channels;
+  std::vector<double> cols(static_cast<size_t>(w), 0.0), rows(static_cast<size_t>(h), 0.0);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const float* a = p.at(x, y);
+      const float* right = p.at((x + 1) % w, y);
+      const float* down = p.at(x, (y + 1) % h);
+      for (int k = 0; k < c; ++k) {
+        cols[static_cast<size_t>(x)] += std::abs(a[k] - right[k]);
+        rows[static_cast<size_t>(y)] += std::abs(a[k] - down[k]);
+      }
+    }
+  double worst = 0.0;
+  for (const std::vector<double>* diff : {&cols, &rows}) {
+    std::vector<double> interior(diff->begin(), diff->end() - 1);
+    std::nth_element(interior.begin(), interior.begin() + static_cast<std::ptrdiff_t>(interior.size() / 2),
+                     interior.end());
+    const double median = std::max(interior[interior.size() / 2], 1e-9);
+    const size_t n = include_wrap ? diff->size() : diff->size() - 1;
+    for (size_t i = 0; i < n; ++i) worst = std::max(worst, (*diff)[i] / median);
+  }
+  return worst;
+}
+
 //! Base tile: shift, then quilt the vertical arm, the horizontal arm and the centre.
-Status quilt_cross(const Setup& setup, const TileOptions& options, SsdSearch& search, Plane& canvas, int& placed) {
+Status quilt_cross(const Setup& setup, const TileOptions& options, double gradient_penalty, SsdSearch& search,
+                   Plane& canvas, int& placed) {
   const Plane& ex = setup.exemplar;
   const int w = ex.width, h = ex.height;
   // The '+' is repaired with half-size blocks (and overlaps): a narrower strip holds fewer 7 x 7
   // patches that straddle a cut (patch coherence 0.92-1.03x the exemplar's toroidal one on the
   // stochastic exemplars, against 1.10-1.38x with full-size blocks).
-  static const int env_div = std::getenv("TQ_DIV") ? std::atoi(std::getenv("TQ_DIV")) : kArmDivisor;
-  const int b = std::max(8, setup.block / env_div);
-  const int ov = std::clamp(setup.overlap / env_div, 1, b / 2 - 1);
+  const int b = std::max(8, setup.block / kArmDivisor);
+  const int ov = std::clamp(setup.overlap / kArmDivisor, 1, b / 2 - 1);
   const int sx = setup.shift_x, sy = setup.shift_y;
   canvas = ex;
   for (int y = 0; y < h; ++y)
@@ -693,10 +702,9 @@ Status quilt_cross(const Setup& setup, const TileOptions& options, SsdSearch& se
     for (int x = 0; x < w; ++x)
       if (known[static_cast<size_t>(y) * w + x]) source[static_cast<size_t>(y) * w + x] = ((y + sy) % h) * w + (x + sx) % w;
   SplitMix64 rng(mix_seed(options.seed, 0));
-  Quilter quilter(ex, search, canvas, known, locked, ov, options.tolerance, rng, &source, kCandidatePool);
+  Quilter quilter(ex, search, canvas, known, locked, ov, options.tolerance, rng, &source, kCandidatePool, gradient_penalty);
   // Arms are quilted with blocks `chain` px long: fewer chain cuts than square blocks.
-  static const int env_cf = std::getenv("TQ_CF") ? std::atoi(std::getenv("TQ_CF")) : kChainFactor;
-  const int chain = std::min(b * env_cf, std::min(w, h) / 2);
+  const int chain = std::min(b * kChainFactor, std::min(w, h) / 2);
   const std::vector<int> vertical = chain_positions(zy + zone, h - zone, chain, ov);
   const std::vector<int> horizontal = chain_positions(zx + zone, w - zone, chain, ov);
   const double total = static_cast<double>(vertical.size() + horizontal.size() + 1);
@@ -707,13 +715,11 @@ Status quilt_cross(const Setup& setup, const TileOptions& options, SsdSearch& se
   };
   const Exclusion none;
   // V1 + V2: one chain through the top/bottom border (toroidal), from below the centre to above it.
-  quilter.axis_ = 1;
   for (int y : vertical) {
     quilter.place(zx - ov, y, b, chain, none);
     if (!tick()) return Status::error(ErrorCode::kCancelled, "", "cancelled");
   }
   // H1 + H2: likewise through the left/right border.
-  quilter.axis_ = 2;
   for (int x : horizontal) {
     quilter.place(x, zy - ov, chain, b, none);
     if (!tick()) return Status::error(ErrorCode::kCancelled, "", "cancelled");
@@ -766,8 +772,16 @@ Status make_tile_variants(const Image& exemplar, const TileOptions& options, int
     // Progress: the base tile counts as one share, each variant as one more.
     TileOptions base_options = options;
     if (options.progress) base_options.progress = [&](double f) { return options.progress(f / count); };
+    // Blocks chosen for their cut patches can be smoother than the exemplar on average. When the
+    // exemplar's own strongest edge decides the worst seam (ornamental tiles, water, brick:
+    // interior worst > kStrongEdge x median), a strip of smooth blocks lowers the tile's median
+    // boundary difference and lifts that edge's ratio above the exemplar's: penalise them there.
+    // Elsewhere the 1.5 floor leaves room, and the penalty would cost patch coherence.
+    const double penalty = worst_seam_ratio(ex, false) > kStrongEdge ? kSmoothPenalty : 0.0;
     Plane base;
-    TAILOR_RETURN_IF_ERROR(quilt_cross(setup, base_options, search, base, rep.blocks));
+    int base_blocks = 0;
+    TAILOR_RETURN_IF_ERROR(quilt_cross(setup, base_options, penalty, search, base, base_blocks));
+    rep.blocks += base_blocks;
     tiles.push_back(plane_to_image(base));
 
     // Variants: re-quilt everything inside a ring of `border` px, in a raster order that changes
