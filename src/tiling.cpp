@@ -32,6 +32,7 @@ constexpr int kMinTileSide = 32;
 constexpr int kChainFactor = 1;  // arm blocks are this many times longer than wide
 constexpr int kArmDivisor = 2;  // the '+' is repaired with blocks and overlaps this many times smaller
 constexpr int kCandidatePool = 32;
+constexpr double kCostTolerance = 0.01;  // blocks whose patch cost is within this of the best are ties
 constexpr double kSmoothPenalty = 2.0;  // cost * (mean gradient / block gradient)^this for smooth blocks
 constexpr double kStrongEdge = 2.0;     // exemplars whose interior worst seam ratio exceeds this get kSmoothPenalty  // near-best blocks compared by the patch cost of their cuts
 
@@ -249,6 +250,7 @@ class Quilter {
           const size_t j = i + rng_.below(static_cast<uint32_t>(candidates_.size() - i));
           std::swap(candidates_[i], candidates_[j]);
         }
+        costs_.resize(k);
         double best_cost = std::numeric_limits<double>::max();
         for (size_t i = 0; i < k; ++i) {
           const int cx = candidates_[i] % nx, cy = candidates_[i] / nx;
@@ -262,11 +264,15 @@ class Quilter {
             const double g = block_gradient(cx, cy);
             if (g < mean_gradient()) cost *= std::pow(mean_gradient() / std::max(g, 1e-6), gradient_penalty_);
           }
-          if (cost < best_cost) {
-            best_cost = cost;
-            chosen = candidates_[i];
-          }
+          costs_[i] = cost;
+          best_cost = std::min(best_cost, cost);
         }
+        // Near ties (within kCostTolerance) are broken at random, so that the seed still matters
+        // when the whole SSD candidate set fits in the pool.
+        size_t ties = 0;
+        for (size_t i = 0; i < k; ++i)
+          if (costs_[i] <= best_cost * (1.0 + kCostTolerance)) candidates_[ties++] = candidates_[i];
+        chosen = candidates_[rng_.below(static_cast<uint32_t>(ties))];
       }
     }
     const int px = chosen % nx;
@@ -484,6 +490,7 @@ class Quilter {
   std::vector<int> candidates_, path_;
   std::vector<uint8_t> take_new_;
   std::vector<int32_t>* source_;
+  std::vector<double> costs_;
   int pool_;
   double gradient_penalty_;
   double mean_gradient_ = -1.0;
