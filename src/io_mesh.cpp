@@ -78,9 +78,10 @@ inline bool is_zero_area(const float* pos, uint32_t a, uint32_t b, uint32_t c) {
   return cx == 0.0 && cy == 0.0 && cz == 0.0;
 }
 
-// Per smallest vertex: the last kept face with that smallest vertex, and a 32-bit signature
-// (one bit per face, chosen by a hash of its other two vertices). A face whose bit is not yet set
-// cannot be a duplicate, so the chain is walked for ~1 face in 10 on real meshes instead of all.
+// Per smallest vertex: 1 + the last kept face with that smallest vertex (0: none, so that an
+// all-zero array from calloc is a set of empty chains), and a 32-bit signature (one bit per face,
+// chosen by a hash of its other two vertices). A face whose bit is not yet set cannot be a
+// duplicate, so the chain is walked for ~1 face in 10 on real meshes instead of all.
 struct Chain {
   uint32_t head;
   uint32_t signature;
@@ -88,8 +89,8 @@ struct Chain {
 
 constexpr uint8_t kKeep = 1;
 
-// Meshes with at least this many faces check geometry on a second thread (thread start-up costs
-// ~50 us, the geometry pass ~4 ns per face).
+// Meshes with at least this many faces use a second thread (thread start-up costs ~50 us, the
+// geometry pass ~4-8 ns per face).
 constexpr size_t kThreadedFaces = 200000;
 
 // Faces per chunk of the shared geometry pass (~0.5 ms of work: few atomic operations, and a
@@ -301,6 +302,11 @@ Status finalize_mesh(const std::string& name, Mesh& mesh, LoadReport& report) {
   // costs a cache miss per face. A chain longer than kMaxChain (a huge fan, i.e. adversarial
   // input) switches to the exact bucket sort in mark_duplicates_by_buckets, so the worst case is
   // O(F log F), never quadratic. Both give the same result.
+  // Raw pointers in locals: the byte stores to keep[] could otherwise alias the array owners,
+  // whose addresses the worker lambda holds, and force a reload of each per face.
+  uint8_t* const keep = flags.get();
+  Chain* const chain_of = chains.get();
+  uint32_t* const before = next.get();
   size_t degenerate = 0, duplicates = 0;
   bool chain_overflow = false;
   uint32_t max_index = 0;
@@ -312,28 +318,28 @@ Status finalize_mesh(const std::string& name, Mesh& mesh, LoadReport& report) {
     max_index = std::max(max_index, hi);
     if ((a == b) | (b == c) | (a == c) | (hi >= nv32)) {
       degenerate += hi < nv32;
-      flags[f] = 0;
+      keep[f] = 0;
       continue;
     }
-    flags[f] = kKeep;
+    keep[f] = kKeep;
     if (chain_overflow) continue;
-    Chain& chain = chains[lo];
+    Chain& chain = chain_of[lo];
     const uint32_t bit = 1u << ((key * 0x9e3779b97f4a7c15ULL) >> 59);
     if (chain.signature & bit) {  // possibly a duplicate: walk the chain (exact)
       size_t steps = 0;
       uint32_t g = chain.head;
-      while (g != 0 && sorted_pair(idx, g - 1, unused) != key && ++steps <= kMaxChain) g = next[g - 1];
+      while (g != 0 && sorted_pair(idx, g - 1, unused) != key && ++steps <= kMaxChain) g = before[g - 1];
       if (steps > kMaxChain) {
         chain_overflow = true;
         continue;
       }
       if (g != 0) {
-        flags[f] = 0;
+        keep[f] = 0;
         ++duplicates;
         continue;
       }
     }
-    next[f] = chain.head;
+    before[f] = chain.head;
     chain.head = static_cast<uint32_t>(f + 1);
     chain.signature |= bit;
   }

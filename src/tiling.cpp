@@ -29,11 +29,13 @@ using internal::SplitMix64;
 namespace {
 
 constexpr int kMinTileSide = 32;
-constexpr int kChainFactor = 1;  // arm blocks are this many times longer than wide
+constexpr int kChainPercent = 100;  // arm blocks are this many percent as long as wide (fewer chain cuts and searches)
 constexpr int kArmDivisor = 2;  // the '+' is repaired with blocks and overlaps this many times smaller
 constexpr int kCandidatePool = 32;
 constexpr double kCostTolerance = 0.01;  // blocks whose patch cost is within this of the best are ties
 constexpr double kSmoothPenalty = 2.0;  // cost * (mean gradient / block gradient)^this for smooth blocks
+constexpr double kRetryPenalty = 1.0;   // the same for the second try of the other exemplars
+constexpr double kSeamFloor = 1.5;      // worst-seam target: max(exemplar's interior worst, this)
 constexpr double kStrongEdge = 2.0;     // exemplars whose interior worst seam ratio exceeds this get kSmoothPenalty  // near-best blocks compared by the patch cost of their cuts
 
 //! SSD of a masked B x B template against every B x B block of the exemplar, by FFT.
@@ -41,18 +43,21 @@ class SsdSearch {
  public:
   void init(const Plane& exemplar) {
     ex_ = &exemplar;
+    // Colour exemplars are searched in luminance (one correlation instead of three); the near-best
+    // candidates are then ranked in full colour by their cut patches (Quilter::patch_cost).
+    search_channels_ = exemplar.channels >= 3 ? 1 : exemplar.channels;
     const int dft_w = cv::getOptimalDFTSize(exemplar.width);
     const int dft_h = cv::getOptimalDFTSize(exemplar.height);
     // Circular correlation is exact for the valid positions p <= size - block: p + q < size <= dft size.
     cv::Mat plane(dft_h, dft_w, CV_32F, cv::Scalar(0));
     cv::Mat square(dft_h, dft_w, CV_32F, cv::Scalar(0));
-    spectra_.assign(static_cast<size_t>(exemplar.channels), cv::Mat());
-    for (int c = 0; c < exemplar.channels; ++c) {
+    spectra_.assign(static_cast<size_t>(search_channels_), cv::Mat());
+    for (int c = 0; c < search_channels_; ++c) {
       for (int y = 0; y < exemplar.height; ++y) {
         float* row = plane.ptr<float>(y);
         float* sq = square.ptr<float>(y);
         for (int x = 0; x < exemplar.width; ++x) {
-          const float v = exemplar.at(x, y)[c];
+          const float v = sample(exemplar.at(x, y), c);
           row[x] = v;
           sq[x] += v * v;
         }
@@ -62,6 +67,12 @@ class SsdSearch {
     cv::dft(square, square_spectrum_, 0, exemplar.height);
     padded_ = cv::Mat(dft_h, dft_w, CV_32F, cv::Scalar(0));
     accumulated_ = cv::Mat(dft_h, dft_w, CV_32F, cv::Scalar(0));
+  }
+
+  //! Search sample c of a pixel: the channel itself, or the luminance (Rec. 601) of a colour pixel.
+  float sample(const float* p, int c) const {
+    if (search_channels_ == ex_->channels) return p[c];
+    return 0.299f * p[0] + 0.587f * p[1] + 0.114f * p[2];
   }
 
   int positions_x(int bw) const { return ex_->width - bw + 1; }
@@ -97,12 +108,12 @@ class SsdSearch {
     }
     mask_term->copyTo(accumulated_);
     double constant = 0.0;
-    for (int c = 0; c < channels; ++c) {
+    for (int c = 0; c < search_channels_; ++c) {
       for (int y = 0; y < bh; ++y) {
         float* row = padded_.ptr<float>(y);
         for (int x = 0; x < bw; ++x) {
           const size_t i = static_cast<size_t>(y) * bw + x;
-          const float t = templ[i * channels + c];
+          const float t = sample(&templ[i * channels], c);
           row[x] = mask[i] * t;
           constant += static_cast<double>(mask[i]) * t * t;
         }
@@ -131,6 +142,7 @@ class SsdSearch {
   static constexpr size_t kMaskCacheSize = 4;
 
   const Plane* ex_ = nullptr;
+  int search_channels_ = 0;
   int last_bw_ = 0, last_bh_ = 0;
   std::vector<MaskEntry> mask_cache_;
   size_t next_slot_ = 0;
@@ -245,7 +257,10 @@ class Quilter {
         // closest to exemplar patches (what the tile's patch coherence measures). SSD alone
         // treats every overlap pixel alike, while a 7 x 7 patch across a cut is cheap only if
         // both sides agree near the cut.
-        const size_t k = std::min(candidates_.size(), static_cast<size_t>(pool_));
+        // When the whole set fits in the pool, one random candidate is left out so that the seed
+        // still matters.
+        const size_t n = candidates_.size();
+        const size_t k = std::min(n > 2 && n <= static_cast<size_t>(pool_) ? n - 1 : n, static_cast<size_t>(pool_));
         for (size_t i = 0; i < k; ++i) {
           const size_t j = i + rng_.below(static_cast<uint32_t>(candidates_.size() - i));
           std::swap(candidates_[i], candidates_[j]);
@@ -267,8 +282,7 @@ class Quilter {
           costs_[i] = cost;
           best_cost = std::min(best_cost, cost);
         }
-        // Near ties (within kCostTolerance) are broken at random, so that the seed still matters
-        // when the whole SSD candidate set fits in the pool.
+        // Near ties (within kCostTolerance) are broken at random.
         size_t ties = 0;
         for (size_t i = 0; i < k; ++i)
           if (costs_[i] <= best_cost * (1.0 + kCostTolerance)) candidates_[ties++] = candidates_[i];
@@ -711,7 +725,7 @@ Status quilt_cross(const Setup& setup, const TileOptions& options, double gradie
   SplitMix64 rng(mix_seed(options.seed, 0));
   Quilter quilter(ex, search, canvas, known, locked, ov, options.tolerance, rng, &source, kCandidatePool, gradient_penalty);
   // Arms are quilted with blocks `chain` px long: fewer chain cuts than square blocks.
-  const int chain = std::min(b * kChainFactor, std::min(w, h) / 2);
+  const int chain = std::min(b * kChainPercent / 100, std::min(w, h) / 2);
   const std::vector<int> vertical = chain_positions(zy + zone, h - zone, chain, ov);
   const std::vector<int> horizontal = chain_positions(zx + zone, w - zone, chain, ov);
   const double total = static_cast<double>(vertical.size() + horizontal.size() + 1);
@@ -782,12 +796,27 @@ Status make_tile_variants(const Image& exemplar, const TileOptions& options, int
     // Blocks chosen for their cut patches can be smoother than the exemplar on average. When the
     // exemplar's own strongest edge decides the worst seam (ornamental tiles, water, brick:
     // interior worst > kStrongEdge x median), a strip of smooth blocks lowers the tile's median
-    // boundary difference and lifts that edge's ratio above the exemplar's: penalise them there.
-    // Elsewhere the 1.5 floor leaves room, and the penalty would cost patch coherence.
-    const double penalty = worst_seam_ratio(ex, false) > kStrongEdge ? kSmoothPenalty : 0.0;
+    // boundary difference and lifts that edge's ratio above the exemplar's: penalise them there
+    // from the start. Elsewhere the 1.5 floor usually leaves room and the penalty would cost patch
+    // coherence, so it is used only for a second try when the worst seam misses its target
+    // (the median-based ratio is O(N)); the better worst seam is kept.
+    const double exemplar_worst = worst_seam_ratio(ex, false);
+    const double penalty = exemplar_worst > kStrongEdge ? kSmoothPenalty : 0.0;
     Plane base;
     int base_blocks = 0;
     TAILOR_RETURN_IF_ERROR(quilt_cross(setup, base_options, penalty, search, base, base_blocks));
+    const double worst = worst_seam_ratio(base, true);
+    if (penalty == 0.0 && worst > std::max(exemplar_worst, kSeamFloor)) {
+      Plane retry;
+      int retry_blocks = 0;
+      TileOptions retry_options = base_options;
+      retry_options.progress = nullptr;
+      TAILOR_RETURN_IF_ERROR(quilt_cross(setup, retry_options, kRetryPenalty, search, retry, retry_blocks));
+      if (worst_seam_ratio(retry, true) < worst) {
+        base = std::move(retry);
+        base_blocks = retry_blocks;
+      }
+    }
     rep.blocks += base_blocks;
     tiles.push_back(plane_to_image(base));
 

@@ -87,15 +87,14 @@ struct TargetCase {
 
 void PrintTo(const TargetCase& c, std::ostream* os) { *os << c.file; }
 
-// Known shortfalls, measured and reported in docs/tiling.md: on the 128 px bark and sand the
-// repaired '+' is a large share of the image and their patch coherence is 10-20 % above the
-// toroidal baseline (two boundary cuts per repaired seam against one raw seam); on the water
-// photo the quilted strips favour smooth blocks, which lowers the row-difference median by ~10 %
-// and lifts the ratio of the photo's own strongest edge above its value in the exemplar.
+// Known shortfall, measured and reported in docs/tiling.md: on the water photo the worst seam is
+// the photo's own strongest edge (kept verbatim), and the quilted strips lower the median row
+// difference by a few percent, which lifts that edge's ratio 3 % above its value in the exemplar.
 const TargetCase kCases[] = {
-    {"brick-gray-512.png", 1.05, 1.0},    {"vistex-fabric02-128.png", 1.05, 1.0},
-    {"vistex-tile04-128.png", 1.05, 1.0}, {"vistex-sand05-128.png", 1.15, 1.0},
-    {"vistex-bark11-128.png", 1.25, 1.0}, {"water-caustics-300.jpg", 1.05, 1.15},
+    {"brick-gray-512.png", 1.05, 1.0},    {"grass-gray-512.png", 1.05, 1.0},
+    {"gravel-gray-512.png", 1.05, 1.0},   {"vistex-fabric02-128.png", 1.05, 1.0},
+    {"vistex-tile04-128.png", 1.05, 1.0}, {"vistex-sand05-128.png", 1.05, 1.0},
+    {"vistex-bark11-128.png", 1.05, 1.0}, {"water-caustics-300.jpg", 1.05, 1.05},
 };
 
 class TileTargets : public ::testing::TestWithParam<TargetCase> {};

@@ -5,6 +5,8 @@
 // parsing a binary PLY. Asking the kernel for 2 MiB pages on the untouched range before the first
 // write (madvise MADV_HUGEPAGE, honoured when THP is in "madvise" or "always" mode) cut that to
 // 5 ms. Elsewhere, or when the kernel refuses, this is a no-op: correctness never depends on it.
+// Scratch arrays that need no std::vector (huge_uninitialized, huge_zeroed) also skip the
+// zero-fill a vector does on resize, which the kernel has already done for fresh pages.
 #pragma once
 
 #include <cstddef>
