@@ -7,8 +7,12 @@
 //     that keeps the outer border; variants from different weight maps (3.2); period fitting (3.1).
 //
 // The SSD of a masked template against every exemplar position is computed with FFTs
-// (SSD = sum M T^2 - 2 sum_c corr(M T_c, E_c) + corr(M, sum_c E_c^2)); the exemplar's spectra are
-// computed once, so each block costs channels + 1 forward real DFTs of the template and one inverse.
+// (SSD = sum M T^2 - 2 sum_c corr(M T_c, E_c) + corr(M, sum_c E_c^2); colour in luminance); the
+// exemplar's spectra are computed once, so each block costs one or two forward real DFTs of the
+// template and one inverse. Among the blocks within the SSD tolerance, up to kCandidatePool are
+// ranked by the 7 x 7 patches their cuts would create (distance to the exemplar patches their
+// pixels came from), the quantity the patch-coherence metric charges (Barnes et al. 2009 for the
+// metric; the per-source candidate patches are PatchMatch's "coherent" candidates, Ashikhmin 2001).
 #include "tailor/tiling.h"
 
 #include <opencv2/core.hpp>
@@ -29,14 +33,14 @@ using internal::SplitMix64;
 namespace {
 
 constexpr int kMinTileSide = 32;
-constexpr int kChainPercent = 100;  // arm blocks are this many percent as long as wide (fewer chain cuts and searches)
-constexpr int kArmDivisor = 2;  // the '+' is repaired with blocks and overlaps this many times smaller
-constexpr int kCandidatePool = 32;
-constexpr double kCostTolerance = 0.01;  // blocks whose patch cost is within this of the best are ties
+constexpr int kChainPercent = 100;      // arm blocks are this many percent as long as wide (150, 200: faster, worse seams)
+constexpr int kArmDivisor = 2;          // the '+' is repaired with blocks and overlaps this many times smaller
+constexpr int kCandidatePool = 32;      // near-best (SSD) blocks compared by the patch cost of their cuts
+constexpr double kCostTolerance = 0.01; // blocks whose patch cost is within this of the best are ties
 constexpr double kSmoothPenalty = 2.0;  // cost * (mean gradient / block gradient)^this for smooth blocks
 constexpr double kRetryPenalty = 1.0;   // the same for the second try of the other exemplars
 constexpr double kSeamFloor = 1.5;      // worst-seam target: max(exemplar's interior worst, this)
-constexpr double kStrongEdge = 2.0;     // exemplars whose interior worst seam ratio exceeds this get kSmoothPenalty  // near-best blocks compared by the patch cost of their cuts
+constexpr double kStrongEdge = 2.0;     // exemplars whose interior worst seam ratio exceeds this get kSmoothPenalty
 
 //! SSD of a masked B x B template against every B x B block of the exemplar, by FFT.
 class SsdSearch {
@@ -400,7 +404,6 @@ class Quilter {
         }
       }
     }
-    // Row-wise count of unknown pixels lets a patch be skipped quickly.
     double total = 0.0;
     const int ew = ex_.width, eh = ex_.height;
     for (int j = 0; j + kR < rh; ++j) {
@@ -529,6 +532,8 @@ struct Setup {
   int overlap = 0;
   int shift_x = 0;  // toroidal shift: tile(x, y) = exemplar((x + shift_x) % W, (y + shift_y) % H)
   int shift_y = 0;
+  int fold_x = 0;  // px added by fit_period extension: its fold seam lies fold_x px before the wrap
+  int fold_y = 0;
 };
 
 void choose_shift(const Plane& ex, int& shift_x, int& shift_y);
@@ -598,6 +603,8 @@ Status prepare(const Image& input, const TileOptions& options, Setup& setup, Til
     overlap = shrunk;
   }
   setup.exemplar = internal::to_plane(work);
+  setup.fold_x = std::clamp(work.width - input.width, 0, work.width / 4);
+  setup.fold_y = std::clamp(work.height - input.height, 0, work.height / 4);
   setup.block = block;
   setup.overlap = overlap;
   choose_shift(setup.exemplar, setup.shift_x, setup.shift_y);
@@ -710,12 +717,15 @@ Status quilt_cross(const Setup& setup, const TileOptions& options, double gradie
     }
   const int cx = w - sx, cy = h - sy;
   // The seams lie between columns cx-1, cx and rows cy-1, cy; the zones around them are unknown.
-  const int zone = b - 2 * ov;
-  const int zx = cx - zone / 2, zy = cy - zone / 2;
+  // A period-fitted extension adds a fold seam fold px before each: the zone covers both.
+  const int margin = b - 2 * ov;
+  const int zone_x = margin + setup.fold_x, zone_y = margin + setup.fold_y;
+  const int zx = cx - setup.fold_x - margin / 2, zy = cy - setup.fold_y - margin / 2;
+  const int arm_x = zone_x + 2 * ov, arm_y = zone_y + 2 * ov;  // block extent across each arm
   std::vector<uint8_t> known(static_cast<size_t>(w) * h, 1), locked(static_cast<size_t>(w) * h, 0);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
-      if ((x >= zx && x < zx + zone) || (y >= zy && y < zy + zone)) known[static_cast<size_t>(y) * w + x] = 0;
+      if ((x >= zx && x < zx + zone_x) || (y >= zy && y < zy + zone_y)) known[static_cast<size_t>(y) * w + x] = 0;
 
   // Exemplar pixel each canvas pixel was copied from (index y * W + x), -1 where unknown.
   std::vector<int32_t> source(static_cast<size_t>(w) * h, -1);
@@ -726,8 +736,8 @@ Status quilt_cross(const Setup& setup, const TileOptions& options, double gradie
   Quilter quilter(ex, search, canvas, known, locked, ov, options.tolerance, rng, &source, kCandidatePool, gradient_penalty);
   // Arms are quilted with blocks `chain` px long: fewer chain cuts than square blocks.
   const int chain = std::min(b * kChainPercent / 100, std::min(w, h) / 2);
-  const std::vector<int> vertical = chain_positions(zy + zone, h - zone, chain, ov);
-  const std::vector<int> horizontal = chain_positions(zx + zone, w - zone, chain, ov);
+  const std::vector<int> vertical = chain_positions(zy + zone_y, h - zone_y, chain, ov);
+  const std::vector<int> horizontal = chain_positions(zx + zone_x, w - zone_x, chain, ov);
   const double total = static_cast<double>(vertical.size() + horizontal.size() + 1);
   double done = 0.0;
   auto tick = [&]() -> bool {
@@ -737,16 +747,16 @@ Status quilt_cross(const Setup& setup, const TileOptions& options, double gradie
   const Exclusion none;
   // V1 + V2: one chain through the top/bottom border (toroidal), from below the centre to above it.
   for (int y : vertical) {
-    quilter.place(zx - ov, y, b, chain, none);
+    quilter.place(zx - ov, y, arm_x, chain, none);
     if (!tick()) return Status::error(ErrorCode::kCancelled, "", "cancelled");
   }
   // H1 + H2: likewise through the left/right border.
   for (int x : horizontal) {
-    quilter.place(x, zy - ov, chain, b, none);
+    quilter.place(x, zy - ov, chain, arm_y, none);
     if (!tick()) return Status::error(ErrorCode::kCancelled, "", "cancelled");
   }
   // C: the centre, constrained on all four sides.
-  quilter.place(zx - ov, zy - ov, b, b, none);
+  quilter.place(zx - ov, zy - ov, arm_x, arm_y, none);
   tick();
   placed += quilter.placed();
   return Status::ok();

@@ -81,7 +81,7 @@ Image checkers(int width, int height, int cell) {
 
 struct TargetCase {
   const char* file;
-  double coherence_factor;  // allowed tile / exemplar patch coherence (target 1.05, see below)
+  double coherence_factor;  // allowed tile / exemplar patch coherence (issue target: 1.0)
   double seam_factor;       // allowed tile worst seam / max(exemplar worst, 1.5) (target 1.0)
 };
 
@@ -91,10 +91,10 @@ void PrintTo(const TargetCase& c, std::ostream* os) { *os << c.file; }
 // the photo's own strongest edge (kept verbatim), and the quilted strips lower the median row
 // difference by a few percent, which lifts that edge's ratio 3 % above its value in the exemplar.
 const TargetCase kCases[] = {
-    {"brick-gray-512.png", 1.05, 1.0},    {"grass-gray-512.png", 1.05, 1.0},
-    {"gravel-gray-512.png", 1.05, 1.0},   {"vistex-fabric02-128.png", 1.05, 1.0},
-    {"vistex-tile04-128.png", 1.05, 1.0}, {"vistex-sand05-128.png", 1.05, 1.0},
-    {"vistex-bark11-128.png", 1.05, 1.0}, {"water-caustics-300.jpg", 1.05, 1.05},
+    {"brick-gray-512.png", 1.0, 1.0},    {"grass-gray-512.png", 1.0, 1.0},
+    {"gravel-gray-512.png", 1.0, 1.0},   {"vistex-fabric02-128.png", 1.0, 1.0},
+    {"vistex-tile04-128.png", 1.0, 1.0}, {"vistex-sand05-128.png", 1.0, 1.0},
+    {"vistex-bark11-128.png", 1.0, 1.0}, {"water-caustics-300.jpg", 1.0, 1.05},
 };
 
 class TileTargets : public ::testing::TestWithParam<TargetCase> {};
@@ -143,7 +143,8 @@ TEST(Tiling, PixelsOutsideTheRepairedStripsAreBitExactShiftedCopies) {
   EXPECT_NEAR(r.shift_y, 256, 64);
   const int w = ex.width, h = ex.height;
   const int cx = w - r.shift_x, cy = h - r.shift_y;
-  // The strips span block px around the old seams (zone of block - 2 overlap, plus the cut bands).
+  // The strips span block / 2 px around the old seams (the '+' is repaired with half-size blocks:
+  // a zone of block / 2 - overlap plus the cut bands); block / 2 on each side is a safe bound.
   auto in_strip = [&](int v, int centre, int size) {
     const int d = std::abs(((v - centre) % size + size + size / 2) % size - size / 2);
     return d <= r.block / 2;

@@ -5,12 +5,16 @@
 //   1. swap the quadrants (toroidal shift by about half the size: the new wrap is put on the
 //      interior column / row within 1/8 of the middle whose difference is closest to the median
 //      one, so it is as ordinary as any other); the old wrap seams now form a '+' inside;
-//   2. repair the vertical arm of the '+' (a strip of width block - 2 * overlap, treated as a ring
+//   2. repair the vertical arm of the '+' (a strip of width block/2 - overlap, treated as a ring
 //      through the top/bottom border), then the horizontal arm, then the centre, by image quilting
-//      (Efros & Freeman 2001) from the exemplar: blocks chosen by SSD over their overlap with what
-//      is already there, at random (seeded) among those within `tolerance` of the best, pasted with
-//      a minimum-error boundary cut. Pixels outside the repaired strips stay bit-exact copies of
-//      the shifted exemplar.
+//      (Efros & Freeman 2001) from the exemplar with half-size blocks (block/2, overlap/2): blocks
+//      within `tolerance` of the best SSD over their overlap (colour searched in luminance), of
+//      which up to 32 drawn at random (seeded) are ranked by the 7 x 7 patches their
+//      minimum-error boundary cuts would create (distance to the exemplar patches their pixels
+//      came from, i.e. what the patch-coherence metric charges); smooth blocks are penalised on
+//      exemplars whose strongest interior edge decides the worst seam, and once more (second
+//      try) when the worst seam misses its target. Pixels outside the repaired strips stay
+//      bit-exact copies of the shifted exemplar.
 // make_tile_variants() adds tiles whose outer ring (TileReport::border px) is bit-identical to the
 // first one while the interior is re-quilted with 2 x 2 large blocks, so they can be mixed for
 // aperiodic tiling (thesis 3.2).
@@ -18,11 +22,13 @@
 // size) to a whole number of texel periods, extension copying the texture one period back, so
 // that a regular pattern ends in phase (thesis 3.1: 10 px stripes in 55 px -> 60 px).
 //
-// Images follow the layout of image.h (1 to 4 channels, all treated alike; alpha is just a channel).
-// Cost: O(blocks * N log N) for an N-pixel exemplar (one FFT correlation per block); about 0.6 s
-// for a 512 x 512 RGB exemplar on one core (0.3 s grey, 5 s for 1024 x 1024 RGB). Memory: a few
-// float copies of the exemplar plus (channels + 6) FFT spectra. Deterministic: same input + options -> bit-identical
-// output. Safe for untrusted images (sizes are checked; nothing is assumed about the pixel values).
+// Images follow the layout of image.h (1 to 4 channels; alpha is just a channel, except that the
+// FFT search of 3- and 4-channel images runs on the RGB luminance; the ranking uses all channels).
+// Cost: O(blocks * N log N) for an N-pixel exemplar (one FFT correlation per block); about 0.5 s
+// for a 512 x 512 RGB or grey exemplar on one core (5 s for 1024 x 1024), twice that when the
+// second try is needed. Memory: a few float copies of the exemplar plus up to 8 FFT spectra.
+// Deterministic: same input + options -> bit-identical output. Safe for untrusted images (sizes
+// are checked; nothing is assumed about the pixel values).
 #pragma once
 
 #include <cstdint>
@@ -39,7 +45,8 @@ namespace tailor {
 using TileProgress = std::function<bool(double)>;
 
 struct TileOptions {
-  int block = 32;   //!< quilting block side in px, [8, 256]; shrunk to min(W, H) / 4 (with a warning) for small images
+  int block = 32;   //!< quilting block side in px, [8, 256]; shrunk to min(W, H) / 4 (with a warning) for small images;
+                   //!< the '+' is repaired with blocks of max(8, block / 2), variants with large blocks
   int overlap = 0;  //!< overlap of neighbouring blocks in px, [1, block / 2 - 1]; 0 = block / 4
   uint64_t seed = 1;        //!< seeds the random choice among near-best blocks; same seed -> same tile
   double tolerance = 0.1;   //!< candidate blocks have SSD <= best * (1 + tolerance), [0, 1]
