@@ -40,6 +40,11 @@ Status read_file(const std::string& path, std::string& bytes) {
   struct stat st;
   if (fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {
     const size_t n = static_cast<size_t>(st.st_size);
+    if (n > kMaxReadBytes) {
+      std::fclose(f);
+      return Status::error(ErrorCode::kLimit, path,
+                           "file is larger than " + std::to_string(kMaxReadBytes >> 30) + " GiB");
+    }
     bytes.reserve(n);
     advise_huge_pages(bytes.data(), n);
     bytes.resize(n);
@@ -47,7 +52,16 @@ Status read_file(const std::string& path, std::string& bytes) {
   }
   char chunk[1 << 16];
   size_t n = 0;
-  while ((n = std::fread(chunk, 1, sizeof chunk, f)) > 0) bytes.append(chunk, n);
+  while ((n = std::fread(chunk, 1, sizeof chunk, f)) > 0) {
+    // Pipes and devices have no size: stop an endless stream (/dev/zero) before it eats memory.
+    if (bytes.size() + n > kMaxReadBytes) {
+      std::fclose(f);
+      bytes.clear();
+      return Status::error(ErrorCode::kLimit, path,
+                           "file is larger than " + std::to_string(kMaxReadBytes >> 30) + " GiB");
+    }
+    bytes.append(chunk, n);
+  }
   const bool failed = std::ferror(f) != 0;
   std::fclose(f);
   if (failed) {

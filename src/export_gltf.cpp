@@ -147,7 +147,8 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
   gltf["bufferViews"] = views;
   gltf["buffers"] = {{{"byteLength", bin.size()}}};
 
-  std::string json = gltf.dump();
+  // Strings may come from file names, which need not be UTF-8: replace, never throw.
+  std::string json = gltf.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   pad_to_4(json, ' ');
   const size_t total = 12 + 8 + json.size() + 8 + bin.size();
   if (total > std::numeric_limits<uint32_t>::max())

@@ -30,7 +30,7 @@ Status load_seam_faces(const std::string& path, size_t face_count, std::vector<u
                            "line " + std::to_string(line));
     }
     if (face >= face_count) {
-      return Status::error(ErrorCode::kInvalidArgument, path,
+      return Status::error(ErrorCode::kParse, path,
                            "face index " + std::to_string(face) + " out of range (mesh has " +
                                std::to_string(face_count) + " faces)",
                            "line " + std::to_string(line));

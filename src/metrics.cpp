@@ -206,7 +206,7 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
     return Status::error(ErrorCode::kInvalidArgument, "", "texture size must be positive");
   for (size_t i = 0; i < corner_uv.size(); ++i)
     if (!std::isfinite(corner_uv[i]))
-      return Status::error(ErrorCode::kInvalidArgument, "", "UV is not finite", "corner " + std::to_string(i / 2));
+      return Status::error(ErrorCode::kInvalidMesh, "", "UV is not finite", "corner " + std::to_string(i / 2));
   for (size_t f = 0; f < patch_in.size(); ++f)
     if (patch_in[f] >= nf)
       return Status::error(ErrorCode::kInvalidArgument, "", "patch id out of range", "face " + std::to_string(f));
@@ -240,9 +240,9 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
     if (patch_faces[p] == 1) ++metrics.single_face_patches;
   }
   if (!(sum_3d > 0))
-    return Status::error(ErrorCode::kInvalidArgument, "", "every face has zero 3D area");
+    return Status::error(ErrorCode::kInvalidMesh, "", "every face has zero 3D area");
   if (!(sum_uv > 0))
-    return Status::error(ErrorCode::kInvalidArgument, "", "every face has zero UV area");
+    return Status::error(ErrorCode::kInvalidMesh, "", "every face has zero UV area");
   const double scale = sum_uv / sum_3d;  // R
   metrics.uv_scale = scale;
 

@@ -79,6 +79,17 @@ cp "$tmp/a.glb" "$tmp/keep.glb"
 expect_error 1 "nan.obj" -- "$tailor" map "$tmp/nan.obj" -o "$tmp/keep.glb"
 cmp -s "$tmp/a.glb" "$tmp/keep.glb" && ok || fail "failed map damaged the existing output"
 
+# --- outputs checked before any work: nothing written when one of them cannot be ---
+expect_error 2 "share" -- "$tailor" map "$mesh" -o "$tmp/same.glb" --preview "$tmp/same.glb"
+expect_error 2 "overwrite an input" -- "$tailor" map "$mesh" -o "$tmp/z.obj" --texture "$tmp/z.mtl"
+expect_error 2 "does not exist" -- "$tailor" map "$mesh" -o "$tmp/ok.glb" --stats "$tmp/missing/s.json"
+[[ ! -e $tmp/ok.glb && ! -e $tmp/same.glb ]] && ok || fail "outputs written although the run was refused"
+expect_error 2 "scale" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --scale 1e-30
+# File names need not be UTF-8: JSON output must not abort on them.
+cp "$mesh" "$tmp/bad"$'\xff'".obj"
+"$tailor" info "$tmp/bad"$'\xff'".obj" --json >"$tmp/badname.json" 2>&1 && grep -q '"faces": 5856' "$tmp/badname.json" && ok ||
+  fail "info --json on a non-UTF-8 file name: $(cat "$tmp/badname.json")"
+
 # --- bad usage: exit 2 ---
 expect_error 2 "mode" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --mode fancy
 expect_error 2 "output must end" -- "$tailor" map "$mesh" -o "$tmp/x.txt"

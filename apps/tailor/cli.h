@@ -3,6 +3,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include <array>
 #include <chrono>
@@ -22,6 +23,11 @@ int report_error(const Status& status);
 
 //! Prints "tailor: warning: <text>" on stderr unless quiet.
 void warn(bool quiet, const std::string& text);
+
+//! JSON text that never throws: bytes that are not UTF-8 (file names can hold any) become U+FFFD.
+inline std::string json_text(const nlohmann::json& j, int indent = 2) {
+  return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
+}
 
 //! Parses "X,Y,Z" into three finite floats; false when the text is anything else.
 bool parse_vec3(const std::string& text, std::array<float, 3>& v);

@@ -59,7 +59,7 @@ int run_stability(const EvalOptions& opt) {
     j["patches_full"] = r.patches_full;
     j["patches_cut"] = r.patches_cut;
     j["seconds"] = r.seconds;
-    std::printf("%s\n", j.dump(2).c_str());
+    std::printf("%s\n", json_text(j).c_str());
   } else if (!opt.quiet) {
     std::printf("%s: stability: removed %zu of %zu faces, surviving corners moved %.3f px on average (max %.2f px), "
                 "%.1f%% bit-identical, %.1f%% within 1 px; patches %u -> %u (%.0f ms)\n",
@@ -145,7 +145,7 @@ int run_eval(const EvalOptions& opt) {
     j["boundary_edges"] = topology.boundary_edges;
     j["nonmanifold_edges"] = topology.nonmanifold_edges;
     j["seconds"] = seconds;
-    std::printf("%s\n", j.dump(2).c_str());
+    std::printf("%s\n", json_text(j).c_str());
     return kExitOk;
   }
   std::printf(

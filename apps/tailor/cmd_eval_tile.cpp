@@ -27,8 +27,11 @@ int run_eval_tile(const EvalTileOptions& opt) {
   if (with_exemplar)
     if (Status s = load_image(opt.exemplar, exemplar); !s) return report_error(s);
   TileMetrics m;
-  if (Status s = tile_metrics(tile, with_exemplar ? &exemplar : nullptr, m); !s)
-    return report_error(s.with_file(opt.tile));
+  if (Status s = tile_metrics(tile, with_exemplar ? &exemplar : nullptr, m); !s) {
+    // Name the image the complaint is about ("exemplar ..." messages concern the exemplar).
+    const bool about_exemplar = with_exemplar && s.what().rfind("exemplar", 0) == 0;
+    return report_error(s.with_file(about_exemplar ? opt.exemplar : opt.tile));
+  }
   std::string failed;
   const bool met = meets_tile_targets(m, &failed);
   if (opt.json) {
@@ -52,7 +55,7 @@ int run_eval_tile(const EvalTileOptions& opt) {
     }
     j["targets_met"] = met;
     if (!failed.empty()) j["targets_failed"] = failed;
-    std::printf("%s\n", j.dump(2).c_str());
+    std::printf("%s\n", json_text(j).c_str());
     return kExitOk;
   }
   if (opt.quiet) {

@@ -62,7 +62,7 @@ int run_info(const InfoOptions& opt) {
     j["bbox_max"] = {hi[0], hi[1], hi[2]};
     j["load_ms"] = report.load_seconds * 1e3;
     j["topology_ms"] = topology.build_seconds * 1e3;
-    std::printf("%s\n", j.dump(2).c_str());
+    std::printf("%s\n", json_text(j).c_str());
     return kExitOk;
   }
 

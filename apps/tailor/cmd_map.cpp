@@ -66,6 +66,51 @@ std::string sibling_path(const std::string& path, const std::string& suffix) {
 
 double ms(double seconds) { return seconds * 1e3; }
 
+// The preview pictures to write: the texture view, plus the other views with --preview-all.
+std::vector<std::pair<PreviewView, std::string>> preview_paths(const MapOptions& opt) {
+  std::vector<std::pair<PreviewView, std::string>> views;
+  if (opt.preview.empty()) return views;
+  views.emplace_back(PreviewView::kTexture, opt.preview);
+  if (opt.preview_all) {
+    for (PreviewView v : {PreviewView::kPatches, PreviewView::kDistortion, PreviewView::kChecker})
+      views.emplace_back(v, sibling_path(opt.preview, preview_view_name(v)));
+  }
+  return views;
+}
+
+// Before any work: every output goes to an existing directory, no two outputs share a path, and
+// no output overwrites an input. A run then fails before writing anything, not half way through.
+Status check_outputs(const MapOptions& opt) {
+  namespace fs = std::filesystem;
+  auto key = [](const std::string& p) { return fs::absolute(fs::path(p)).lexically_normal().string(); };
+  std::vector<std::pair<std::string, std::string>> outputs = {{opt.output, "--output"}};
+  if (std::filesystem::path(opt.output).extension() == ".obj")
+    outputs.emplace_back(fs::path(opt.output).replace_extension(".mtl").string(), "the .mtl of --output");
+  if (!opt.stats.empty()) outputs.emplace_back(opt.stats, "--stats");
+  for (const auto& [view, path] : preview_paths(opt)) outputs.emplace_back(path, "--preview");
+  const std::vector<std::string> inputs = {opt.input, opt.texture, opt.seam_faces};
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    const auto& [path, what] = outputs[i];
+    const fs::path parent = fs::path(path).parent_path();
+    std::error_code ec;
+    if (fs::is_directory(path, ec))
+      return Status::error(ErrorCode::kInvalidArgument, path, "output (" + what + ") is a directory");
+    if (!parent.empty() && !fs::is_directory(parent, ec))
+      return Status::error(ErrorCode::kInvalidArgument, path,
+                           "directory of the output (" + what + ") does not exist");
+    for (const std::string& in : inputs) {
+      if (!in.empty() && key(in) == key(path))
+        return Status::error(ErrorCode::kInvalidArgument, path, "output (" + what + ") would overwrite an input");
+    }
+    for (size_t j = 0; j < i; ++j) {
+      if (key(outputs[j].first) == key(path))
+        return Status::error(ErrorCode::kInvalidArgument, path,
+                             "two outputs share this path (" + outputs[j].second + " and " + what + ")");
+    }
+  }
+  return Status::ok();
+}
+
 int run_map(const MapOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
   // === Options (checked before any work) ===
@@ -90,6 +135,10 @@ int run_map(const MapOptions& opt) {
     mapping_options.use_seed_point = true;
   }
   if (opt.texture_size <= 0) return report_error(usage_error("--texture-size must be positive"));
+  // Below ~1e-3 px per unit every UV rounds to the same float; above 1e7 faces span millions of px.
+  if (!(opt.scale >= 1e-3f && opt.scale <= 1e7f))
+    return report_error(usage_error("--scale must be between 0.001 and 1e7 pixels per unit"));
+  if (Status s = check_outputs(opt); !s) return report_error(s);
 
   // === Texture (read first: a bad texture should fail before minutes of work) ===
   Image texture;
@@ -139,44 +188,6 @@ int run_map(const MapOptions& opt) {
     return report_error(s.with_file(opt.input));
   const double metrics_seconds = seconds_since(metrics_start);
 
-  // === Export ===
-  const auto export_start = std::chrono::steady_clock::now();
-  ExportOptions export_options;
-  export_options.texture_path = opt.texture;
-  export_options.texture_width = tex_w;
-  export_options.texture_height = tex_h;
-  if (Status s = export_mesh(opt.output, mesh, atlas, export_options); !s) return report_error(s);
-  const double export_seconds = seconds_since(export_start);
-
-  // === Previews ===
-  std::vector<std::string> previews;
-  double preview_seconds = 0;
-  if (!opt.preview.empty()) {
-    const auto preview_start = std::chrono::steady_clock::now();
-    std::vector<float> uv_repeats(atlas.corner_uv.size());
-    for (size_t i = 0; i < uv_repeats.size(); i += 2) {
-      uv_repeats[i] = atlas.corner_uv[i] / static_cast<float>(tex_w);
-      uv_repeats[i + 1] = atlas.corner_uv[i + 1] / static_cast<float>(tex_h);
-    }
-    std::vector<std::pair<PreviewView, std::string>> views = {{PreviewView::kTexture, opt.preview}};
-    if (opt.preview_all) {
-      for (PreviewView v : {PreviewView::kPatches, PreviewView::kDistortion, PreviewView::kChecker})
-        views.emplace_back(v, sibling_path(opt.preview, preview_view_name(v)));
-    }
-    for (const auto& [view, path] : views) {
-      RenderOptions render_options;
-      render_options.view = view;
-      Image picture;
-      if (Status s = render_preview(mesh, uv_repeats, atlas.patch, texture.empty() ? nullptr : &texture,
-                                    render_options, picture);
-          !s)
-        return report_error(s.with_file(path));
-      if (Status s = write_png(path, picture); !s) return report_error(s);
-      previews.push_back(path);
-    }
-    preview_seconds = seconds_since(preview_start);
-  }
-
   // === Stability (optional: two more mappings) ===
   StabilityReport stability;
   if (opt.stability) {
@@ -185,6 +196,44 @@ int run_map(const MapOptions& opt) {
     if (Status s = measure_stability(mesh, orientation_options, quiet_mapping, stability); !s)
       return report_error(s.with_file(opt.input));
   }
+
+  // === Previews, rendered before anything is written ===
+  std::vector<std::pair<std::string, Image>> pictures;
+  double preview_seconds = 0;
+  if (!opt.preview.empty()) {
+    const auto preview_start = std::chrono::steady_clock::now();
+    std::vector<float> uv_repeats(atlas.corner_uv.size());
+    for (size_t i = 0; i < uv_repeats.size(); i += 2) {
+      uv_repeats[i] = atlas.corner_uv[i] / static_cast<float>(tex_w);
+      uv_repeats[i + 1] = atlas.corner_uv[i + 1] / static_cast<float>(tex_h);
+    }
+    for (const auto& [view, path] : preview_paths(opt)) {
+      RenderOptions render_options;
+      render_options.view = view;
+      Image picture;
+      if (Status s = render_preview(mesh, uv_repeats, atlas.patch, texture.empty() ? nullptr : &texture,
+                                    render_options, picture);
+          !s)
+        return report_error(s.with_file(path));
+      pictures.emplace_back(path, std::move(picture));
+    }
+    preview_seconds = seconds_since(preview_start);
+  }
+
+  // === Export, then the pictures (every output was checked up front) ===
+  const auto export_start = std::chrono::steady_clock::now();
+  ExportOptions export_options;
+  export_options.texture_path = opt.texture;
+  export_options.texture_width = tex_w;
+  export_options.texture_height = tex_h;
+  if (Status s = export_mesh(opt.output, mesh, atlas, export_options); !s) return report_error(s);
+  const double export_seconds = seconds_since(export_start);
+  std::vector<std::string> previews;
+  for (const auto& [path, picture] : pictures) {
+    if (Status s = write_png(path, picture); !s) return report_error(s);
+    previews.push_back(path);
+  }
+
   const double total_seconds = seconds_since(start);
 
   // === Report ===
@@ -231,7 +280,7 @@ int run_map(const MapOptions& opt) {
                     {"metrics", ms(metrics_seconds)}, {"export", ms(export_seconds)},
                     {"preview", ms(preview_seconds)}, {"total", ms(total_seconds)}};
     j["previews"] = previews;
-    const std::string text = j.dump(2) + "\n";
+    const std::string text = json_text(j) + "\n";
     if (Status s = internal::write_file_atomic(opt.stats, text); !s) return report_error(s);
   }
   if (!opt.quiet) {

@@ -129,7 +129,7 @@ int run_tile(const TileCliOptions& opt) {
     nlohmann::json names = nlohmann::json::array();
     for (const std::string& f : files) names.push_back(base_name(f));  // next to the JSON
     j["files"] = names;
-    if (Status s = write_text_atomic(stem + ".json", j.dump(2) + "\n"); !s) return report_error(s);
+    if (Status s = write_text_atomic(stem + ".json", json_text(j) + "\n"); !s) return report_error(s);
   }
 
   if (opt.quiet && opt.json.empty()) return kExitOk;
@@ -170,7 +170,7 @@ int run_tile(const TileCliOptions& opt) {
     }
     j["tiles"] = list;
     j["targets_met"] = meets_tile_targets(worst);
-    if (Status s = write_text_atomic(opt.json, j.dump(2) + "\n"); !s) return report_error(s);
+    if (Status s = write_text_atomic(opt.json, json_text(j) + "\n"); !s) return report_error(s);
   }
   if (!opt.quiet) {
     std::string out = opt.variants == 1 ? opt.output : stem + "_{0.." + std::to_string(opt.variants - 1) + "}.png";

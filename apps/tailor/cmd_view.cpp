@@ -160,7 +160,7 @@ int run_view(const ViewArgs& args) {
   if (!args.texture.empty()) {
     if (Status s = add_texture(args.texture, routes, config, args.quiet); !s) return report_error(s);
   }
-  routes.push_back({"/config.json", "", config.dump(), "application/json"});
+  routes.push_back({"/config.json", "", json_text(config, -1), "application/json"});
 
   StaticServer server;
   if (Status s = server.start(root, routes, args.port); !s) return report_error(s);

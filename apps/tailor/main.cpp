@@ -1,6 +1,8 @@
 // tailor: texture-map large triangle meshes by homogeneous patch discovery, and make textures
 // self-tileable. This file only wires the subcommands (one per cmd_<name>.cpp) together.
 #include <cstdio>
+#include <exception>
+#include <new>
 
 #include "cli.h"
 
@@ -37,5 +39,15 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "tailor: error: %s (run 'tailor --help')\n", e.what());
     return kExitUsage;
   }
-  return run ? run() : kExitUsage;
+  if (!run) return kExitUsage;
+  // The library returns Status and never throws; this is the last line of defence (out of memory,
+  // a bug) so that a failure is still one line and exit 1, never an abort.
+  try {
+    return run();
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "tailor: error: out of memory\n");
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "tailor: error: internal error: %s\n", e.what());
+  }
+  return kExitBadInput;
 }

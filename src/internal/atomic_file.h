@@ -13,6 +13,9 @@ namespace tailor::internal {
 //! is left as it was.
 Status write_file_atomic(const std::string& path, std::span<const char> bytes);
 
+//! Largest file read_file accepts (also what stops an endless pipe or device).
+inline constexpr size_t kMaxReadBytes = size_t{4} << 30;
+
 //! Reads a whole file into `bytes`. Fails with kIo on open or read errors.
 Status read_file(const std::string& path, std::string& bytes);
 
