@@ -261,9 +261,10 @@ TEST(Metrics, RejectsBadInput) {
   EXPECT_EQ(compute_uv_metrics(mesh, topology, uv, {}, MetricsOptions{0, 512}, m).code(), ErrorCode::kInvalidArgument);
   auto nan_uv = uv;
   nan_uv[3] = std::nanf("");
-  EXPECT_EQ(compute_uv_metrics(mesh, topology, nan_uv, {}, {}, m).code(), ErrorCode::kInvalidArgument);
+  // Bad data rather than a bad call: the CLI reports these as bad input (exit 1).
+  EXPECT_EQ(compute_uv_metrics(mesh, topology, nan_uv, {}, {}, m).code(), ErrorCode::kInvalidMesh);
   const std::vector<float> collapsed(uv.size(), 3.0f);
-  EXPECT_EQ(compute_uv_metrics(mesh, topology, collapsed, {}, {}, m).code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(compute_uv_metrics(mesh, topology, collapsed, {}, {}, m).code(), ErrorCode::kInvalidMesh);
 }
 
 }  // namespace

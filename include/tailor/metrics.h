@@ -49,8 +49,9 @@ struct UvMetrics {
 //! mesh: a finalized mesh (indices < #V). topology: build_topology(mesh).
 //! corner_uv: #F*3 by 2, u, v in pixels (finite). patch: #F patch ids (each < #F), or empty to derive
 //! them with derive_patches.
-//! Fails with kInvalidArgument when the array sizes do not match, a UV is not finite, a patch id is
-//! >= #F, the texture size is not positive, or every non-degenerate face has zero UV area (no scale).
+//! Fails with kInvalidArgument when the array sizes do not match, a patch id is >= #F or the texture
+//! size is not positive (caller errors), and with kInvalidMesh when a UV is not finite, every face
+//! has zero 3D area or every non-degenerate face has zero UV area (bad data: no scale).
 //! Cost: O(F) time and memory (one sort-free pass plus a median by nth_element). Deterministic.
 Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<const float> corner_uv,
                           std::span<const uint32_t> patch, const MetricsOptions& options, UvMetrics& metrics);
