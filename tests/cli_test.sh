@@ -85,6 +85,9 @@ expect_error 2 "overwrite an input" -- "$tailor" map "$mesh" -o "$tmp/z.obj" --t
 expect_error 2 "does not exist" -- "$tailor" map "$mesh" -o "$tmp/ok.glb" --stats "$tmp/missing/s.json"
 [[ ! -e $tmp/ok.glb && ! -e $tmp/same.glb ]] && ok || fail "outputs written although the run was refused"
 expect_error 2 "scale" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --scale 1e-30
+expect_error 2 "share" -- "$tailor" tile "$texture" -o "$tmp/v.png" --variants 2 --json "$tmp/v.json"
+expect_error 2 "does not exist" -- "$tailor" tile "$texture" -o "$tmp/missing/t.png"
+[[ ! -e $tmp/v_0.png ]] && ok || fail "tile wrote variants although the run was refused"
 # File names need not be UTF-8: JSON output must not abort on them.
 cp "$mesh" "$tmp/bad"$'\xff'".obj"
 "$tailor" info "$tmp/bad"$'\xff'".obj" --json >"$tmp/badname.json" 2>&1 && grep -q '"faces": 5856' "$tmp/badname.json" && ok ||

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <sstream>
 
 namespace tailor::cli {
@@ -16,6 +17,36 @@ int report_error(const Status& status) {
 
 void warn(bool quiet, const std::string& text) {
   if (!quiet) std::fprintf(stderr, "tailor: warning: %s\n", text.c_str());
+}
+
+Status check_outputs(const std::vector<OutputPath>& outputs, const std::vector<std::string>& inputs) {
+  namespace fs = std::filesystem;
+  auto key = [](const std::string& p) {
+    std::error_code ec;
+    const fs::path absolute = fs::absolute(fs::path(p), ec);
+    return (ec ? fs::path(p) : absolute).lexically_normal().string();
+  };
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    const auto& [path, option] = outputs[i];
+    const fs::path parent = fs::path(path).parent_path();
+    std::error_code ec;
+    if (fs::is_directory(path, ec))
+      return Status::error(ErrorCode::kInvalidArgument, path, "output (" + option + ") is a directory");
+    if (!parent.empty() && !fs::is_directory(parent, ec))
+      return Status::error(ErrorCode::kInvalidArgument, path,
+                           "directory of the output (" + option + ") does not exist");
+    for (const std::string& in : inputs) {
+      if (!in.empty() && key(in) == key(path))
+        return Status::error(ErrorCode::kInvalidArgument, path,
+                             "output (" + option + ") would overwrite an input");
+    }
+    for (size_t j = 0; j < i; ++j) {
+      if (key(outputs[j].path) == key(path))
+        return Status::error(ErrorCode::kInvalidArgument, path,
+                             "two outputs share this path (" + outputs[j].option + " and " + option + ")");
+    }
+  }
+  return Status::ok();
 }
 
 bool parse_vec3(const std::string& text, std::array<float, 3>& v) {

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "tailor/status.h"
 
@@ -28,6 +29,17 @@ void warn(bool quiet, const std::string& text);
 inline std::string json_text(const nlohmann::json& j, int indent = 2) {
   return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
 }
+
+//! An output file and the option that names it, for check_outputs.
+struct OutputPath {
+  std::string path;
+  std::string option;  //!< e.g. "--output", "--preview"
+};
+
+//! Before any work: every output goes to an existing directory and is not itself a directory, no
+//! two outputs share a path, and no output overwrites one of `inputs` (empty entries ignored).
+//! Fails with kInvalidArgument (exit 2), so a refused run writes nothing.
+Status check_outputs(const std::vector<OutputPath>& outputs, const std::vector<std::string>& inputs);
 
 //! Parses "X,Y,Z" into three finite floats; false when the text is anything else.
 bool parse_vec3(const std::string& text, std::array<float, 3>& v);

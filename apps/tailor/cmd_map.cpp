@@ -78,37 +78,14 @@ std::vector<std::pair<PreviewView, std::string>> preview_paths(const MapOptions&
   return views;
 }
 
-// Before any work: every output goes to an existing directory, no two outputs share a path, and
-// no output overwrites an input. A run then fails before writing anything, not half way through.
-Status check_outputs(const MapOptions& opt) {
-  namespace fs = std::filesystem;
-  auto key = [](const std::string& p) { return fs::absolute(fs::path(p)).lexically_normal().string(); };
-  std::vector<std::pair<std::string, std::string>> outputs = {{opt.output, "--output"}};
+// Every file this run will write, with the option that names it.
+std::vector<OutputPath> output_paths(const MapOptions& opt) {
+  std::vector<OutputPath> outputs = {{opt.output, "--output"}};
   if (std::filesystem::path(opt.output).extension() == ".obj")
-    outputs.emplace_back(fs::path(opt.output).replace_extension(".mtl").string(), "the .mtl of --output");
-  if (!opt.stats.empty()) outputs.emplace_back(opt.stats, "--stats");
-  for (const auto& [view, path] : preview_paths(opt)) outputs.emplace_back(path, "--preview");
-  const std::vector<std::string> inputs = {opt.input, opt.texture, opt.seam_faces};
-  for (size_t i = 0; i < outputs.size(); ++i) {
-    const auto& [path, what] = outputs[i];
-    const fs::path parent = fs::path(path).parent_path();
-    std::error_code ec;
-    if (fs::is_directory(path, ec))
-      return Status::error(ErrorCode::kInvalidArgument, path, "output (" + what + ") is a directory");
-    if (!parent.empty() && !fs::is_directory(parent, ec))
-      return Status::error(ErrorCode::kInvalidArgument, path,
-                           "directory of the output (" + what + ") does not exist");
-    for (const std::string& in : inputs) {
-      if (!in.empty() && key(in) == key(path))
-        return Status::error(ErrorCode::kInvalidArgument, path, "output (" + what + ") would overwrite an input");
-    }
-    for (size_t j = 0; j < i; ++j) {
-      if (key(outputs[j].first) == key(path))
-        return Status::error(ErrorCode::kInvalidArgument, path,
-                             "two outputs share this path (" + outputs[j].second + " and " + what + ")");
-    }
-  }
-  return Status::ok();
+    outputs.push_back({std::filesystem::path(opt.output).replace_extension(".mtl").string(), "the .mtl of --output"});
+  if (!opt.stats.empty()) outputs.push_back({opt.stats, "--stats"});
+  for (const auto& view_path : preview_paths(opt)) outputs.push_back({view_path.second, "--preview"});
+  return outputs;
 }
 
 int run_map(const MapOptions& opt) {
@@ -138,7 +115,8 @@ int run_map(const MapOptions& opt) {
   // Below ~1e-3 px per unit every UV rounds to the same float; above 1e7 faces span millions of px.
   if (!(opt.scale >= 1e-3f && opt.scale <= 1e7f))
     return report_error(usage_error("--scale must be between 0.001 and 1e7 pixels per unit"));
-  if (Status s = check_outputs(opt); !s) return report_error(s);
+  if (Status s = check_outputs(output_paths(opt), {opt.input, opt.texture, opt.seam_faces}); !s)
+    return report_error(s);
 
   // === Texture (read first: a bad texture should fail before minutes of work) ===
   Image texture;

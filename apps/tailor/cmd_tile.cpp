@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.h"
+#include "internal/atomic_file.h"
 #include "tailor/image.h"
 #include "tailor/tiling.h"
 
@@ -44,16 +45,7 @@ std::string base_name(const std::string& path) {
 
 //! Writes text to path through a temporary file and a rename, so readers never see half a file.
 Status write_text_atomic(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp-" + std::to_string(static_cast<long>(getpid()));
-  std::FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f) return Status::error(ErrorCode::kIo, path, "cannot create file");
-  const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-  const bool closed = std::fclose(f) == 0;
-  if (!ok || !closed || std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    return Status::error(ErrorCode::kIo, path, "cannot write file");
-  }
-  return Status::ok();
+  return internal::write_file_atomic(path, text);
 }
 
 nlohmann::json metrics_json(const TileMetrics& m) {
@@ -86,6 +78,16 @@ nlohmann::json period_json(const PeriodEstimate& p) {
 int run_tile(const TileCliOptions& opt) {
   if (!ends_with_png(opt.output))
     return report_error(Status::error(ErrorCode::kInvalidArgument, opt.output, "output must be a .png file"));
+  // Every file this run writes, checked before any work so that a refused run writes nothing.
+  const std::string stem = opt.output.substr(0, opt.output.size() - 4);
+  std::vector<OutputPath> outputs;
+  for (int k = 0; k < opt.variants; ++k)
+    outputs.push_back({opt.variants == 1 ? opt.output : stem + "_" + std::to_string(k) + ".png", "--output"});
+  if (opt.variants > 1) outputs.push_back({stem + ".json", "the variants' JSON"});
+  if (!opt.json.empty()) outputs.push_back({opt.json, "--json"});
+  if (opt.variants >= 1 && opt.variants <= 64) {  // other counts: make_tile_variants refuses them
+    if (Status s = check_outputs(outputs, {opt.input}); !s) return report_error(s);
+  }
   Image exemplar;
   if (Status s = load_image(opt.input, exemplar); !s) return report_error(s);
 
@@ -107,7 +109,6 @@ int run_tile(const TileCliOptions& opt) {
   for (const std::string& w : report.warnings) warn(opt.quiet, opt.input + ": " + w);
 
   // Output names: OUT itself, or OUT-without-.png + "_k.png" for variants.
-  const std::string stem = opt.output.substr(0, opt.output.size() - 4);
   std::vector<std::string> files;
   for (size_t k = 0; k < tiles.size(); ++k) {
     const std::string path = opt.variants == 1 ? opt.output : stem + "_" + std::to_string(k) + ".png";
