@@ -28,7 +28,7 @@ void load_file(benchmark::State& state, const std::string& path) {
     benchmark::DoNotOptimize(mesh.indices.data());
   }
   const double n = static_cast<double>(state.iterations());
-  state.counters["Mfaces/s"] = benchmark::Counter(n * static_cast<double>(faces) * 1e-6, benchmark::Counter::kIsRate);
+  set_faces_rate(state, faces);
   state.counters["MB/s"] = benchmark::Counter(n * bytes * 1e-6, benchmark::Counter::kIsRate);
 }
 
@@ -44,9 +44,7 @@ void BM_Topology(benchmark::State& state) {
     tailor::Topology t = tailor::build_topology(mesh);
     benchmark::DoNotOptimize(t.opposite.data());
   }
-  state.counters["Mfaces/s"] = benchmark::Counter(
-      static_cast<double>(state.iterations()) * static_cast<double>(mesh.face_count()) * 1e-6,
-      benchmark::Counter::kIsRate);
+  set_faces_rate(state, mesh.face_count());
 }
 BENCHMARK(BM_Topology)->Unit(benchmark::kMillisecond)->MinTime(1.0)->UseRealTime();
 

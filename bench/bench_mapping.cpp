@@ -68,8 +68,7 @@ void BM_Orientation(benchmark::State& state, const std::string& key) {
   }
   const double faces = static_cast<double>(p.mesh.face_count());
   state.counters["faces"] = faces;
-  state.counters["Mfaces/s"] =
-      benchmark::Counter(faces * 1e-6 * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  set_faces_rate(state, p.mesh.face_count());
 }
 
 void BM_Mapping(benchmark::State& state, const std::string& key, tailor::MappingMode mode) {
@@ -91,8 +90,7 @@ void BM_Mapping(benchmark::State& state, const std::string& key, tailor::Mapping
   }
   const double faces = static_cast<double>(p.mesh.face_count());
   state.counters["faces"] = faces;
-  state.counters["Mfaces/s"] =
-      benchmark::Counter(faces * 1e-6 * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  set_faces_rate(state, p.mesh.face_count());
   tailor::UvMetrics m;
   if (!tailor::compute_uv_metrics(p.mesh, p.topology, atlas.corner_uv, atlas.patch, {}, m).is_ok()) {
     state.SkipWithError("metrics failed");

@@ -37,8 +37,7 @@ void BM_EndToEndPlyToGlb(benchmark::State& state) {
   }
   std::remove(output.c_str());
   state.counters["faces"] = static_cast<double>(faces);
-  state.counters["Mfaces/s"] = benchmark::Counter(static_cast<double>(faces) * 1e-6 * static_cast<double>(state.iterations()),
-                                                  benchmark::Counter::kIsRate);
+  set_faces_rate(state, faces);
 }
 BENCHMARK(BM_EndToEndPlyToGlb)->Unit(benchmark::kMillisecond)->Iterations(3);
 

@@ -43,11 +43,6 @@ std::string base_name(const std::string& path) {
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
-//! Writes text to path through a temporary file and a rename, so readers never see half a file.
-Status write_text_atomic(const std::string& path, const std::string& text) {
-  return internal::write_file_atomic(path, text);
-}
-
 nlohmann::json metrics_json(const TileMetrics& m) {
   nlohmann::json j;
   j["wrap_ratio_x"] = m.wrap_ratio_x;
@@ -130,7 +125,7 @@ int run_tile(const TileCliOptions& opt) {
     nlohmann::json names = nlohmann::json::array();
     for (const std::string& f : files) names.push_back(base_name(f));  // next to the JSON
     j["files"] = names;
-    if (Status s = write_text_atomic(stem + ".json", json_text(j) + "\n"); !s) return report_error(s);
+    if (Status s = internal::write_file_atomic(stem + ".json", json_text(j) + "\n"); !s) return report_error(s);
   }
 
   if (opt.quiet && opt.json.empty()) return kExitOk;
@@ -171,7 +166,7 @@ int run_tile(const TileCliOptions& opt) {
     }
     j["tiles"] = list;
     j["targets_met"] = meets_tile_targets(worst);
-    if (Status s = write_text_atomic(opt.json, json_text(j) + "\n"); !s) return report_error(s);
+    if (Status s = internal::write_file_atomic(opt.json, json_text(j) + "\n"); !s) return report_error(s);
   }
   if (!opt.quiet) {
     std::string out = opt.variants == 1 ? opt.output : stem + "_{0.." + std::to_string(opt.variants - 1) + "}.png";
