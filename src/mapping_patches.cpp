@@ -59,8 +59,8 @@ struct Rotation {
 
 class PatchMapper {
  public:
-  PatchMapper(const MappingInput& in, Atlas& atlas, MappingStats& stats)
-      : in_(in), stats_(stats), atlas_(atlas) {}
+  PatchMapper(const MappingInput& in, Atlas& atlas, MappingStats& stats, std::vector<uint8_t>& seam_mark)
+      : in_(in), stats_(stats), atlas_(atlas), seam_mark_(seam_mark) {}
 
   Status run() {
     const Mesh& mesh = in_.mesh;
@@ -475,6 +475,19 @@ class PatchMapper {
     else ++stats_.faces_unfolded;
     stats_.max_error_px = std::max(stats_.max_error_px, error_px);
     stats_.max_stretch_accepted = std::max(stats_.max_stretch_accepted, stretch_error);
+    // Faces that disagree with a placed neighbour (in any patch) are where seams lie: the seam
+    // shortening afterwards starts from them. The neighbours' UVs were just read by try_place.
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t o = self.opposite[k];
+      if (o == kInvalid || rec_[o / 3].patch == kInvalid) continue;
+      const float* ua;
+      const float* ub;
+      neighbour_edge_uv(f, k, ua, ub);
+      if (uv[2 * k] != ua[0] || uv[2 * k + 1] != ua[1] || uv[2 * kNext[k]] != ub[0] || uv[2 * kNext[k] + 1] != ub[1]) {
+        seam_mark_[f] = 1;
+        seam_mark_[o / 3] = 1;
+      }
+    }
     if (absorbing_) return;  // the absorption pass keeps its own queue
     const float age_offset = static_cast<float>(factor_);
     for (int k = 0; k < 3; ++k) {
@@ -575,6 +588,7 @@ class PatchMapper {
   std::vector<uint32_t> patch_size_;
   std::vector<uint32_t> patch_seed_;
   FrontBuckets queue_;
+  std::vector<uint8_t>& seam_mark_;  // per face: 1 = placed on a seam (for shorten_seams)
   uint32_t current_ = 0;
   uint64_t placed_count_ = 0;
   bool cancelled_ = false;
@@ -584,8 +598,11 @@ class PatchMapper {
 }  // namespace
 
 Status map_patches(const MappingInput& input, Atlas& atlas, MappingStats& stats) {
-  PatchMapper mapper(input, atlas, stats);
-  return mapper.run();
+  std::vector<uint8_t> seam_mark(input.mesh.face_count(), 0);
+  PatchMapper mapper(input, atlas, stats, seam_mark);
+  TAILOR_RETURN_IF_ERROR(mapper.run());
+  if (input.options.shorten_seams) stats.faces_reseamed = shorten_seams(input, seam_mark, atlas);
+  return Status::ok();
 }
 
 }  // namespace tailor::internal

@@ -21,6 +21,8 @@
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <cstdlib>
+#include <cstdio>
 
 #include "internal/tiling_util.h"
 #include "tailor/image_ops.h"
@@ -241,9 +243,10 @@ class Quilter {
       float best = std::numeric_limits<float>::max();
       float energy = 0.0f;
       for (size_t i = 0; i < templ_.size(); ++i) energy += mask_[i / channels] * templ_[i] * templ_[i];
+      const std::vector<uint8_t>* adm = detail_quantile_ > 0.0 ? &admissible(bw, bh) : nullptr;
       for (int y = 0; y < ny; ++y)
         for (int x = 0; x < nx; ++x)
-          if (!exclusion.contains(x, y)) best = std::min(best, ssd_[static_cast<size_t>(y) * nx + x]);
+          if (!exclusion.contains(x, y) && (adm == nullptr || (*adm)[static_cast<size_t>(y) * nx + x])) best = std::min(best, ssd_[static_cast<size_t>(y) * nx + x]);
       const bool use_exclusion = best < std::numeric_limits<float>::max();
       if (!use_exclusion)
         for (float v : ssd_) best = std::min(best, v);
@@ -252,7 +255,7 @@ class Quilter {
       candidates_.clear();
       for (int y = 0; y < ny; ++y)
         for (int x = 0; x < nx; ++x)
-          if (ssd_[static_cast<size_t>(y) * nx + x] <= threshold && !(use_exclusion && exclusion.contains(x, y)))
+          if (ssd_[static_cast<size_t>(y) * nx + x] <= threshold && !(use_exclusion && (exclusion.contains(x, y) || (adm != nullptr && !(*adm)[static_cast<size_t>(y) * nx + x]))))
             candidates_.push_back(y * nx + x);
       if (pool_ <= 1 || source_ == nullptr) {
         chosen = candidates_[rng_.below(static_cast<uint32_t>(candidates_.size()))];
@@ -280,8 +283,20 @@ class Quilter {
           // Optional: penalise blocks smoother than the exemplar on average (smooth blocks match
           // more easily, and a strip of them lowers the tile's median boundary difference).
           if (gradient_penalty_ > 0.0) {
-            const double g = block_gradient(cx, cy);
-            if (g < mean_gradient()) cost *= std::pow(mean_gradient() / std::max(g, 1e-6), gradient_penalty_);
+            static const int mode = getenv("TP_MODE") ? atoi(getenv("TP_MODE")) : 0;
+            static const double pw = getenv("TP_PEN") ? atof(getenv("TP_PEN")) : -1;
+            const double pen = pw >= 0 ? pw : gradient_penalty_;
+            if (mode == 0) {
+              const double g = block_gradient(cx, cy);
+              if (g < mean_gradient()) cost *= std::pow(mean_gradient() / std::max(g, 1e-6), pen);
+            } else {
+              double gx = 0, gy = 0;
+              placed_gradient(cx, cy, gx, gy);
+              mean_gradient();
+              double rel = mode == 1 ? (gx + gy) / (mean_dx_ + mean_dy_) : std::min(gx / mean_dx_, gy / mean_dy_);
+              if (getenv("TP_DBG")) fprintf(stderr, "blk %d %d cand %d rel %.3f gx %.2f gy %.2f cost %.1f\n", bx, by, (int)i, rel, gx, gy, cost);
+              if (rel < 1.0) cost *= std::pow(1.0 / std::max(rel, 1e-6), pen);
+            }
           }
           costs_[i] = cost;
           best_cost = std::min(best_cost, cost);
@@ -320,6 +335,41 @@ class Quilter {
   }
 
   int placed() const { return placed_; }
+  double detail_quantile_ = 0.0;
+  int adm_bw_ = 0, adm_bh_ = 0;
+  std::vector<uint8_t> adm_;
+  const std::vector<uint8_t>& admissible(int bw, int bh) {
+    if (bw == adm_bw_ && bh == adm_bh_) return adm_;
+    adm_bw_ = bw; adm_bh_ = bh;
+    const int w = ex_.width, h = ex_.height, c = ex_.channels;
+    std::vector<double> sat(static_cast<size_t>(w + 1) * (h + 1), 0.0);
+    for (int y = 0; y < h; ++y) {
+      double row = 0.0;
+      for (int x = 0; x < w; ++x) {
+        const float* a = ex_.at(x, y);
+        double g = 0.0;
+        for (int k = 0; k < c; ++k) {
+          if (x + 1 < w) g += std::abs(a[k] - ex_.at(x + 1, y)[k]);
+          if (y + 1 < h) g += std::abs(a[k] - ex_.at(x, y + 1)[k]);
+        }
+        row += g;
+        sat[static_cast<size_t>(y + 1) * (w + 1) + x + 1] = sat[static_cast<size_t>(y) * (w + 1) + x + 1] + row;
+      }
+    }
+    const int nx = w - bw + 1, ny = h - bh + 1;
+    std::vector<double> v(static_cast<size_t>(nx) * ny);
+    for (int y = 0; y < ny; ++y)
+      for (int x = 0; x < nx; ++x)
+        v[static_cast<size_t>(y) * nx + x] = sat[static_cast<size_t>(y + bh) * (w + 1) + x + bw] - sat[static_cast<size_t>(y) * (w + 1) + x + bw] -
+                                             sat[static_cast<size_t>(y + bh) * (w + 1) + x] + sat[static_cast<size_t>(y) * (w + 1) + x];
+    std::vector<double> sorted = v;
+    const size_t q = static_cast<size_t>(detail_quantile_ * static_cast<double>(sorted.size() - 1));
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(q), sorted.end());
+    const double t = sorted[q];
+    adm_.resize(v.size());
+    for (size_t i = 0; i < v.size(); ++i) adm_[i] = v[i] >= t ? 1 : 0;
+    return adm_;
+  }
 
  private:
   //! error_ = per-pixel squared difference between the template and the exemplar block at (px, py).
@@ -354,6 +404,23 @@ class Quilter {
       }
     return sum / (static_cast<double>(bw_ - 1) * (bh_ - 1) * channels);
   }
+  void placed_gradient(int px, int py, double& gx, double& gy) const {
+    const int channels = canvas_.channels;
+    double sx = 0, sy = 0; long n = 0;
+    for (int y = 0; y + 1 < bh_; ++y)
+      for (int x = 0; x + 1 < bw_; ++x) {
+        const size_t i = static_cast<size_t>(y) * bw_ + x;
+        if (!(take_new_[i] || mask_[i] == 0.0f)) continue;
+        const float* a = ex_.at(px + x, py + y);
+        const float* r = ex_.at(px + x + 1, py + y);
+        const float* d = ex_.at(px + x, py + y + 1);
+        for (int c = 0; c < channels; ++c) { sx += std::abs(a[c] - r[c]); sy += std::abs(a[c] - d[c]); }
+        ++n;
+      }
+    gx = sx / std::max(1.0, static_cast<double>(n) * channels);
+    gy = sy / std::max(1.0, static_cast<double>(n) * channels);
+  }
+  double mean_dx_ = 0, mean_dy_ = 0;
   //! Mean |dx| + |dy| of the whole exemplar (computed once).
   double mean_gradient() {
     if (mean_gradient_ < 0.0) {
@@ -364,8 +431,10 @@ class Quilter {
           const float* a = ex_.at(x, y);
           const float* r = ex_.at(x + 1, y);
           const float* d = ex_.at(x, y + 1);
-          for (int c = 0; c < channels; ++c) sum += std::abs(a[c] - r[c]) + std::abs(a[c] - d[c]);
+          for (int c = 0; c < channels; ++c) { sum += std::abs(a[c] - r[c]) + std::abs(a[c] - d[c]); mean_dx_ += std::abs(a[c] - r[c]); mean_dy_ += std::abs(a[c] - d[c]); }
         }
+      mean_dx_ /= (static_cast<double>(ex_.width - 1) * (ex_.height - 1) * channels);
+      mean_dy_ /= (static_cast<double>(ex_.width - 1) * (ex_.height - 1) * channels);
       mean_gradient_ = sum / (static_cast<double>(ex_.width - 1) * (ex_.height - 1) * channels);
     }
     return mean_gradient_;
@@ -734,6 +803,7 @@ Status quilt_cross(const Setup& setup, const TileOptions& options, double gradie
       if (known[static_cast<size_t>(y) * w + x]) source[static_cast<size_t>(y) * w + x] = ((y + sy) % h) * w + (x + sx) % w;
   SplitMix64 rng(mix_seed(options.seed, 0));
   Quilter quilter(ex, search, canvas, known, locked, ov, options.tolerance, rng, &source, kCandidatePool, gradient_penalty);
+  if (getenv("TP_Q")) quilter.detail_quantile_ = atof(getenv("TP_Q"));
   // Arms are quilted with blocks `chain` px long: fewer chain cuts than square blocks.
   const int chain = std::min(b * kChainPercent / 100, std::min(w, h) / 2);
   const std::vector<int> vertical = chain_positions(zy + zone_y, h - zone_y, chain, ov);

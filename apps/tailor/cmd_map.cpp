@@ -34,6 +34,7 @@ struct MapOptions {
   float max_stretch = 0.25f;
   float field_following = 1.f;
   uint32_t min_patch_faces = 16;
+  bool keep_seams = false;
   std::string axis = "pca";
   uint32_t smooth = 0;
   std::string seed_point;
@@ -106,6 +107,7 @@ int run_map(const MapOptions& opt) {
   mapping_options.max_stretch = opt.max_stretch;
   mapping_options.field_following = opt.field_following;
   mapping_options.min_patch_faces = opt.min_patch_faces;
+  mapping_options.shorten_seams = !opt.keep_seams;
   if (!opt.seed_point.empty()) {
     if (!parse_vec3(opt.seed_point, mapping_options.seed_point))
       return report_error(usage_error("--seed-point must be three numbers X,Y,Z, got '" + opt.seed_point + "'"));
@@ -224,6 +226,7 @@ int run_map(const MapOptions& opt) {
     j["options"] = {{"mode", opt.mode}, {"scale", opt.scale}, {"threshold_px", opt.threshold},
                     {"max_stretch", opt.max_stretch},
                     {"field_following", opt.field_following}, {"min_patch_faces", opt.min_patch_faces},
+                    {"shorten_seams", !opt.keep_seams},
                     {"axis", opt.axis}, {"smooth", opt.smooth}, {"seed_point", opt.seed_point},
                     {"seam_faces", opt.seam_faces}};
     j["mesh"] = {{"format", load.format}, {"vertices", mesh.vertex_count()}, {"faces", mesh.face_count()},
@@ -239,6 +242,7 @@ int run_map(const MapOptions& opt) {
                     {"max_stretch_accepted", stats.max_stretch_accepted},
                     {"faces_three_textured", stats.faces_three_textured},
                     {"faces_unfolded", stats.faces_unfolded}, {"faces_rigid", stats.faces_rigid},
+                    {"faces_reseamed", stats.faces_reseamed},
                     {"faces_seam", stats.faces_seam}, {"inverted_accepted", stats.inverted_accepted}};
     j["metrics"] = {{"patches", metrics.patches}, {"single_face_patches", metrics.single_face_patches},
                     {"stretch", metrics.stretch}, {"stretch_area_weighted", metrics.stretch_area_weighted},
@@ -315,6 +319,8 @@ void register_map(CLI::App& app, Runner& run) {
   group->add_option("--min-patch-faces", opt->min_patch_faces,
                     "patches mode: smaller patches are absorbed into a neighbour (0 keeps all)")
       ->capture_default_str();
+  group->add_flag("--no-seam-shortening", opt->keep_seams,
+                  "patches mode: keep the seams as the growth left them (no re-placing of faces along them)");
   group->add_option("--threshold", opt->threshold, "thesis mode: initial error threshold in pixels")
       ->capture_default_str();
   group->add_option("--axis", opt->axis, "Orientation field: pca, x, y, z or X,Y,Z")->capture_default_str();

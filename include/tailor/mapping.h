@@ -18,7 +18,8 @@
 //    the degenerate image of the face). Faces that fail are deferred; when only deferred faces
 //    remain, a new patch starts from the best of them, unfolded rigidly from an already placed
 //    neighbour so the texture continues across that edge (seam gap 0 there). Patches smaller
-//    than min_patch_faces are absorbed into a neighbour afterwards.
+//    than min_patch_faces are absorbed into a neighbour afterwards; last, faces on seams are re-placed
+//    from their neighbours where that shortens the seams and stays within the bound.
 //  - kThesis: the thesis as written, kept as the reference: one UV per vertex, an absolute error
 //    threshold in pixels, faces with three textured vertices accepted as they are, the threshold
 //    raised by threshold_step_px whenever every waiting face exceeds it. It leaves inverted faces
@@ -72,6 +73,9 @@ struct MappingOptions {
   float field_following = 1.f;      //!< 1: every face's texture direction follows the orientation field (thesis);
                                     //!< 0: pure unfolding, the direction is set by the patch seed and drifts with
                                     //!< the surface (fewer seams, less distortion, see docs/mapping.md); 0..1
+  bool shorten_seams = true;        //!< after the growth, re-place faces on seams from their neighbours where
+                                    //!< that shortens the seams within the bound (jagged cuts lose their teeth:
+                                    //!< 6-11% less seam length on the shared meshes, docs/mapping.md)
   uint32_t min_patch_faces = 16;    //!< patches with fewer faces are absorbed into a neighbouring patch by rigid
                                     //!< unfolding (0 = keep all; isolated components stay whole)
   // kThesis -------------------------------------------------------------------------------------
@@ -96,6 +100,7 @@ struct MappingStats {
   uint64_t faces_rigid = 0;         //!< kPatches: faces placed rigidly (patch seeds, absorbed faces)
   uint64_t faces_cut = 0;           //!< kPatches: faces joined across one edge while disagreeing with another
                                     //!< placed neighbour of their patch (each leaves at least one cut edge)
+  uint64_t faces_reseamed = 0;      //!< kPatches: faces re-placed after the growth to shorten the seams
   uint64_t faces_seam = 0;          //!< faces flagged in seam_faces
   uint64_t inverted_accepted = 0;   //!< kThesis: faces accepted with a non-positive UV area (always 0 in kPatches)
   double seconds = 0.0;             //!< wall time of map_texture

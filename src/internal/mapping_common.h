@@ -52,6 +52,12 @@ std::vector<uint32_t> component_seed_faces(const Mesh& mesh, const Topology& top
                                            const MappingOptions& options);
 
 Status map_patches(const MappingInput& input, Atlas& atlas, MappingStats& stats);
+//! Re-places faces on seams from their neighbours where that shortens the seams and keeps them
+//! within options.max_stretch (patches mode, after the growth); drops emptied patches. seam_mark:
+//! #F flags, 1 on every face with a seam edge (others may be 1 too), cleared on return. Returns the
+//! number of moves. Deterministic; O(F) once, then O(faces on seams) per pass, bounded passes.
+uint64_t shorten_seams(const MappingInput& input, std::vector<uint8_t>& seam_mark, Atlas& atlas);
+
 Status map_thesis(const MappingInput& input, Atlas& atlas, MappingStats& stats);
 
 //! Progress reporting cadence (placed faces between callback calls).

@@ -1,0 +1,210 @@
+// Seam shortening, the last step of the patches mode: faces on a seam are re-placed from their
+// neighbours when that makes the seams shorter and keeps the face within the stretch bound.
+//
+// Why: the growth cuts a face off wherever the front reaches it with disagreeing neighbours, so
+// the cut lines it leaves are jagged: teeth (faces with two seam edges) and notches alternate along
+// them. Once every face is placed, a tooth can often take the UVs its two neighbours on the other
+// side give it; the seam then runs along its third edge instead of the two others. This is a local
+// descent on total seam length: each move strictly shortens it, so the pass ends.
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "internal/face_stretch.h"
+#include "internal/mapping_common.h"
+
+namespace tailor::internal {
+namespace {
+
+constexpr int kNext[3] = {1, 2, 0};
+constexpr int kPrev[3] = {2, 0, 1};
+// Passes over the changed faces' neighbourhoods; each strictly shortens the seams, the cap only
+// bounds the time on adversarial input (measured: 3-5 passes settle the shared meshes).
+constexpr int kMaxPasses = 16;
+
+class SeamShortener {
+ public:
+  SeamShortener(const MappingInput& in, Atlas& atlas) : in_(in), atlas_(atlas) {}
+
+  //! seam_mark: per face, 1 on every face with a seam edge (others may be 1 too); cleared.
+  uint64_t run(std::vector<uint8_t>& seam_mark) {
+
+    opposite_ = in_.topology.opposite.data();
+    uv_ = atlas_.corner_uv.data();
+    bound_ = in_.options.max_stretch;
+    scale_ = in_.options.scale;
+    seam_flags_ = in_.options.seam_faces.empty() ? nullptr : in_.options.seam_faces.data();
+    const uint64_t moves = move_faces(seam_mark);
+    compact_patches();
+    return moves;
+  }
+
+ private:
+  // === Face moves ================================================================================
+  uint64_t move_faces(std::vector<uint8_t>& queued) {
+    std::vector<uint32_t> current, next;
+    for (uint32_t f = 0; f < queued.size(); ++f)
+      if (queued[f]) current.push_back(f);
+    uint64_t moved = 0;
+    for (int pass = 0; pass < kMaxPasses && !current.empty(); ++pass) {
+      next.clear();
+      for (const uint32_t f : current) {
+        queued[f] = 0;
+        // User seam faces keep the seams the user asked for.
+        if (seam_flags_ && seam_flags_[f]) continue;
+        if (!improve(f)) continue;
+        ++moved;
+        for (int k = 0; k < 3; ++k) {
+          const uint32_t o = opposite_[3 * f + k];
+          if (o == kInvalid || queued[o / 3]) continue;
+          queued[o / 3] = 1;
+          next.push_back(o / 3);
+        }
+      }
+      std::sort(next.begin(), next.end());  // face order: the result does not depend on visit order
+      current.swap(next);
+    }
+    for (const uint32_t f : current) queued[f] = 0;  // left by the pass cap
+    return moved;
+  }
+
+  // Whether f's edge k has different UVs on its two sides (the metrics' definition of a seam).
+  // `uv` is f's 6 UVs (its own or a candidate's).
+  bool seam_edge(uint32_t f, int k, const float* uv) const {
+    const uint32_t o = opposite_[3 * f + k];
+    if (o == kInvalid) return false;
+    const float* g = uv_ + 6 * (o / 3);
+    const int kk = static_cast<int>(o % 3);
+    // f's edge runs corner k -> k+1; the neighbour's runs the other way, kk -> kk+1.
+    return uv[2 * k] != g[2 * kNext[kk]] || uv[2 * k + 1] != g[2 * kNext[kk] + 1] ||
+           uv[2 * kNext[k]] != g[2 * kk] || uv[2 * kNext[k] + 1] != g[2 * kk + 1];
+  }
+
+  // Zero-area faces as the growth judges them (mapping_patches.cpp, kDegenerateRatio): placed
+  // without the stretch check.
+  bool is_degenerate(uint32_t f) const {
+    const float* l = in_.frames.local.data() + 6 * f;
+    const float twice_area = l[2] * l[5] - l[3] * l[4];
+    const float e0 = l[2] * l[2] + l[3] * l[3], e2 = l[4] * l[4] + l[5] * l[5];
+    const float e1 = (l[4] - l[2]) * (l[4] - l[2]) + (l[5] - l[3]) * (l[5] - l[3]);
+    return !(twice_area > 1e-6f * std::max({e0, e1, e2}));
+  }
+
+  float edge_length(uint32_t f, int k) const {
+    const float* p = in_.mesh.positions.data();
+    const uint32_t a = in_.mesh.indices[3 * f + k], b = in_.mesh.indices[3 * f + kNext[k]];
+    const float dx = p[3 * b] - p[3 * a], dy = p[3 * b + 1] - p[3 * a + 1], dz = p[3 * b + 2] - p[3 * a + 2];
+    return std::sqrt(dx * dx + dy * dy + dz * dz);
+  }
+
+  float seam_cost(uint32_t f, const float* uv, const float* length) const {
+    float cost = 0.f;
+    for (int k = 0; k < 3; ++k)
+      if (seam_edge(f, k, uv)) cost += length[k];
+    return cost;
+  }
+
+  // Re-places f if some placement copied from its neighbours shortens the seams around it and is
+  // within the bound. Candidates: two corners from the neighbour across edge k, the third from the
+  // neighbour across another edge, or from f's own triangle carried along by the similarity that
+  // takes its edge k onto the neighbour's.
+  bool improve(uint32_t f) {
+    float* own = uv_ + 6 * f;
+    const float length[3] = {edge_length(f, 0), edge_length(f, 1), edge_length(f, 2)};
+    const float before = seam_cost(f, own, length);
+    if (before == 0.f) return false;
+    const StretchFrame frame = stretch_frame(in_.frames.local.data() + 6 * f, scale_);
+    const bool degenerate = is_degenerate(f);
+
+    const float* ends[3][2] = {};
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t o = opposite_[3 * f + k];
+      if (o == kInvalid) continue;
+      const float* g = uv_ + 6 * (o / 3);
+      const int kk = static_cast<int>(o % 3);
+      ends[k][0] = g + 2 * kNext[kk];
+      ends[k][1] = g + 2 * kk;
+    }
+    float best[6];
+    float best_gain = 0.f, best_stretch = 0.f;
+    int best_edge = -1;
+    auto consider = [&](const float* candidate, int k) {
+      const float gain = before - seam_cost(f, candidate, length);
+      // A gain must be a whole edge (not rounding): lengths are positive, so require a tenth of
+      // the shortest edge of f.
+      const float min_gain = 0.1f * std::min({length[0], length[1], length[2]});
+      if (!(gain > min_gain) || gain < best_gain) return;
+      const float s = degenerate ? 0.f : stretch_error(frame, candidate);
+      if (!(s <= bound_)) return;
+      if (gain == best_gain && best_edge >= 0 && s >= best_stretch) return;
+      best_gain = gain;
+      best_stretch = s;
+      best_edge = k;
+      std::copy(candidate, candidate + 6, best);
+    };
+    float candidate[6];
+    for (int k = 0; k < 3; ++k) {
+      if (!ends[k][0]) continue;
+      const int ka = k, kb = kNext[k], kc = kPrev[k];
+      candidate[2 * ka] = ends[k][0][0];
+      candidate[2 * ka + 1] = ends[k][0][1];
+      candidate[2 * kb] = ends[k][1][0];
+      candidate[2 * kb + 1] = ends[k][1][1];
+      // Third corner from another neighbour: edge k+1 ends at kc, edge k+2 starts at it.
+      if (ends[kNext[k]][1]) {
+        candidate[2 * kc] = ends[kNext[k]][1][0];
+        candidate[2 * kc + 1] = ends[kNext[k]][1][1];
+        consider(candidate, k);
+      }
+      if (ends[kPrev[k]][0]) {
+        candidate[2 * kc] = ends[kPrev[k]][0][0];
+        candidate[2 * kc + 1] = ends[kPrev[k]][0][1];
+        consider(candidate, k);
+      }
+      // Third corner carried by the similarity own AB -> new AB (z -> a' + (z - a) w / v in
+      // complex numbers, v = own B - A, w = new B - A).
+      const float vx = own[2 * kb] - own[2 * ka], vy = own[2 * kb + 1] - own[2 * ka + 1];
+      const float wx = candidate[2 * kb] - candidate[2 * ka], wy = candidate[2 * kb + 1] - candidate[2 * ka + 1];
+      const float vv = vx * vx + vy * vy;
+      if (vv > 0.f) {
+        const float zx = own[2 * kc] - own[2 * ka], zy = own[2 * kc + 1] - own[2 * ka + 1];
+        // (z * conj(v) * w) / |v|^2
+        const float tx = zx * vx + zy * vy, ty = zy * vx - zx * vy;
+        candidate[2 * kc] = candidate[2 * ka] + (tx * wx - ty * wy) / vv;
+        candidate[2 * kc + 1] = candidate[2 * ka + 1] + (tx * wy + ty * wx) / vv;
+        if (std::isfinite(candidate[2 * kc]) && std::isfinite(candidate[2 * kc + 1])) consider(candidate, k);
+      }
+    }
+    if (best_edge < 0) return false;
+    std::copy(best, best + 6, own);
+    atlas_.patch[f] = atlas_.patch[opposite_[3 * f + best_edge] / 3];
+    return true;
+  }
+
+  // Patches that lost all their faces are dropped; the others keep their order.
+  void compact_patches() {
+    std::vector<uint32_t> remap(atlas_.patch_count, 0);
+    for (const uint32_t p : atlas_.patch) remap[p] = 1;
+    uint32_t next = 0;
+    for (uint32_t& r : remap) r = r ? next++ : kInvalid;
+    if (next == atlas_.patch_count) return;
+    for (uint32_t& p : atlas_.patch) p = remap[p];
+    atlas_.patch_count = next;
+  }
+
+  const MappingInput& in_;
+  Atlas& atlas_;
+  const uint32_t* opposite_ = nullptr;
+  float* uv_ = nullptr;
+  const uint8_t* seam_flags_ = nullptr;  // user seam faces, or nullptr
+  float bound_ = 0.f, scale_ = 1.f;
+};
+
+}  // namespace
+
+uint64_t shorten_seams(const MappingInput& input, std::vector<uint8_t>& seam_mark, Atlas& atlas) {
+  SeamShortener shortener(input, atlas);
+  return shortener.run(seam_mark);
+}
+
+}  // namespace tailor::internal
