@@ -100,6 +100,8 @@ Status map_texture(const Mesh& mesh, const Topology& topology, const FaceFrames&
   if (!(options.threshold_px > 0.f) || !std::isfinite(options.threshold_px) || !(options.threshold_step_px > 0.f) ||
       !std::isfinite(options.threshold_step_px))
     return Status::error(ErrorCode::kInvalidArgument, "", "threshold and its step must be positive pixels");
+  if (!(options.hop_age >= 0.f && options.hop_age <= 1.f))
+    return Status::error(ErrorCode::kInvalidArgument, "", "hop age must be in [0, 1] radians");
   if (!std::isfinite(options.factor_step) || options.factor_step > 1.0)
     return Status::error(ErrorCode::kInvalidArgument, "", "factor step must be finite and at most 1");
   if (!options.seam_faces.empty() && options.seam_faces.size() != face_count)
@@ -110,7 +112,8 @@ Status map_texture(const Mesh& mesh, const Topology& topology, const FaceFrames&
 
   const bool thesis = options.mode == MappingMode::kThesis;
   double factor_step = options.factor_step;
-  if (factor_step < 0) factor_step = thesis ? 1.0 / static_cast<double>(face_count) : 1e-4;
+  // Patches mode: negative = the hop rule (hop_age); with hop_age 0, the global counter at 1e-4.
+  if (factor_step < 0 && (thesis || options.hop_age == 0.f)) factor_step = thesis ? 1.0 / static_cast<double>(face_count) : 1e-4;
   internal::MappingInput input{mesh, topology, frames, options, factor_step,
                                internal::component_seed_faces(mesh, topology, frames, options)};
   MappingStats local_stats;

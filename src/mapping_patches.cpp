@@ -76,6 +76,8 @@ class PatchMapper {
     uv_ = atlas_.corner_uv.data();
     fill_records();
     hint_.assign(mesh.vertex_count(), VertexHint{kInvalid, 0.f, 0.f});
+    hop_age_ = in_.factor_step < 0 ? in_.options.hop_age : 0.f;
+    if (hop_age_ > 0.f) hops_.assign(face_count, 0);
     queue_.clear();
     patch_rotation_.reserve(256);
     patch_size_.reserve(256);
@@ -489,7 +491,25 @@ class PatchMapper {
       }
     }
     if (absorbing_) return;  // the absorption pass keeps its own queue
-    const float age_offset = static_cast<float>(factor_);
+    // Age offset of the neighbours pushed now. Default: grows with the length of f's path from its
+    // patch's seed in faces (hops: one more than its fewest among placed neighbours of the patch),
+    // so the order in which two faces are reached depends only on the faces between them and the
+    // seed, not on how many faces elsewhere were placed first. With the thesis's global counter,
+    // removing a part of the mesh shifted every later key and reordered the growth everywhere
+    // (stability, removing 10%: bit-identical corners 14-97% -> 94-99.9%, docs/mapping.md).
+    float age_offset;
+    if (hop_age_ > 0.f) {
+      uint32_t fewest = kInvalid;
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t o = self.opposite[k];
+        if (o != kInvalid && rec_[o / 3].patch == p) fewest = std::min(fewest, hops_[o / 3]);
+      }
+      const uint32_t hops = fewest == kInvalid ? 0 : fewest + 1;
+      hops_[f] = hops;
+      age_offset = hop_age_ * static_cast<float>(hops + 1);
+    } else {
+      age_offset = static_cast<float>(factor_);
+    }
     for (int k = 0; k < 3; ++k) {
       const uint32_t o = self.opposite[k];
       if (o == kInvalid) continue;
@@ -580,7 +600,9 @@ class PatchMapper {
   const float* anchor_ = nullptr;
   float scale_ = 1.f, bound_ = 0.f, max_seed_rotation_ = 0.f;
   float relax_ = 0.f;  // 1 - field_following: share of the edge mismatch taken as rotation
-  double factor_step_ = 0.0, factor_ = 0.0;
+  double factor_step_ = 0.0, factor_ = 0.0;  // the thesis's global age counter (when hop_age_ is 0)
+  float hop_age_ = 0.f;  // age per hop from the patch seed; 0 = the global counter
+  std::vector<uint32_t> hops_;  // per face: hops from its patch's seed (hop_age_ > 0)
   float* uv_ = nullptr;
   std::unique_ptr<FaceRecord[]> rec_;  // per face
   std::vector<VertexHint> hint_;  // per vertex: the UV its patch first gave it

@@ -257,6 +257,18 @@ class Quilter {
         for (int x = 0; x < nx; ++x)
           if (ssd_[static_cast<size_t>(y) * nx + x] <= threshold && !(use_exclusion && (exclusion.contains(x, y) || (adm != nullptr && !(*adm)[static_cast<size_t>(y) * nx + x]))))
             candidates_.push_back(y * nx + x);
+      static const size_t min_cand = getenv("TP_MINC") ? static_cast<size_t>(atoi(getenv("TP_MINC"))) : 0;
+      if (candidates_.size() < min_cand && profile_axis_ != 0) {
+        std::vector<std::pair<float, int>> order;
+        for (int y = 0; y < ny; ++y)
+          for (int x = 0; x < nx; ++x)
+            if (!(use_exclusion && (exclusion.contains(x, y) || (adm != nullptr && !(*adm)[static_cast<size_t>(y) * nx + x]))))
+              order.push_back({ssd_[static_cast<size_t>(y) * nx + x], y * nx + x});
+        const size_t m = std::min(min_cand, order.size());
+        std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(m), order.end());
+        candidates_.clear();
+        for (size_t i = 0; i < m; ++i) candidates_.push_back(order[i].second);
+      }
       if (pool_ <= 1 || source_ == nullptr) {
         chosen = candidates_[rng_.below(static_cast<uint32_t>(candidates_.size()))];
       } else {
@@ -280,6 +292,11 @@ class Quilter {
           take_new_.assign(area, 1);
           for (int side = 0; side < 4; ++side) cut_side(side);
           double cost = patch_cost(bx, by, cx, cy);
+          if (profile_axis_ != 0 && original_ != nullptr) {
+            const double d = profile_deficit(bx, by, cx, cy);
+            if (getenv("TP_DBG2")) fprintf(stderr, "blk %d %d cand %d deficit %.3f cost %.1f\n", bx, by, (int)i, d, cost);
+            cost *= std::pow(1.0 + d, profile_power_);
+          }
           // Optional: penalise blocks smoother than the exemplar on average (smooth blocks match
           // more easily, and a strip of them lowers the tile's median boundary difference).
           if (gradient_penalty_ > 0.0) {
@@ -336,6 +353,47 @@ class Quilter {
 
   int placed() const { return placed_; }
   double detail_quantile_ = 0.0;
+  // 1: rows (vertical arm: per-row |dy| sums), 2: columns (horizontal arm: per-column |dx| sums)
+  int profile_axis_ = 0;
+  int skip_lo_ = 0, skip_hi_ = -1;  // canvas rows (axis 1) / columns (axis 2) not checked
+  double profile_power_ = 4.0;
+  const Plane* original_ = nullptr;
+  //! Relative shortfall of the block's straight-boundary differences against the original content.
+  double profile_deficit(int bx, int by, int px, int py) const {
+    const int channels = canvas_.channels;
+    auto value = [&](int x, int y) -> const float* {
+      const int cx = Plane::mod(bx + x, canvas_.width);
+      const int cy = Plane::mod(by + y, canvas_.height);
+      const size_t ci = static_cast<size_t>(cy) * canvas_.width + cx;
+      const size_t i = static_cast<size_t>(y) * bw_ + x;
+      if (!locked_[ci] && (take_new_[i] || mask_[i] == 0.0f)) return ex_.at(px + x, py + y);
+      return canvas_.at(cx, cy);
+    };
+    double deficit = 0.0, total = 0.0;
+    const bool rows = profile_axis_ == 1;
+    const int outer = rows ? bh_ - 1 : bw_ - 1, inner = rows ? bw_ : bh_;
+    for (int o = 0; o < outer; ++o) {
+      const int line = Plane::mod((rows ? by : bx) + o, rows ? canvas_.height : canvas_.width);
+      if (line >= skip_lo_ && line <= skip_hi_) continue;
+      double n = 0.0, orig = 0.0;
+      for (int k = 0; k < inner; ++k) {
+        const int x0 = rows ? k : o, y0 = rows ? o : k;
+        const int x1 = rows ? k : o + 1, y1 = rows ? o + 1 : k;
+        const float* a = value(x0, y0);
+        const float* b = value(x1, y1);
+        const float* oa = original_->wrap(bx + x0, by + y0);
+        const float* ob = original_->wrap(bx + x1, by + y1);
+        for (int c = 0; c < channels; ++c) {
+          n += std::abs(a[c] - b[c]);
+          orig += std::abs(oa[c] - ob[c]);
+        }
+      }
+      static const double exc = getenv("TP_EXC") ? atof(getenv("TP_EXC")) : 0.0;
+      deficit += std::max(0.0, orig - n) + exc * std::max(0.0, n - orig);
+      total += orig;
+    }
+    return total > 0.0 ? deficit / total : 0.0;
+  }
   int adm_bw_ = 0, adm_bh_ = 0;
   std::vector<uint8_t> adm_;
   const std::vector<uint8_t>& admissible(int bw, int bh) {
@@ -803,7 +861,7 @@ Status quilt_cross(const Setup& setup, const TileOptions& options, double gradie
       if (known[static_cast<size_t>(y) * w + x]) source[static_cast<size_t>(y) * w + x] = ((y + sy) % h) * w + (x + sx) % w;
   SplitMix64 rng(mix_seed(options.seed, 0));
   Quilter quilter(ex, search, canvas, known, locked, ov, options.tolerance, rng, &source, kCandidatePool, gradient_penalty);
-  if (getenv("TP_Q")) quilter.detail_quantile_ = atof(getenv("TP_Q"));
+  if (getenv("TP_Q") && gradient_penalty > 1.5) quilter.detail_quantile_ = atof(getenv("TP_Q"));
   // Arms are quilted with blocks `chain` px long: fewer chain cuts than square blocks.
   const int chain = std::min(b * kChainPercent / 100, std::min(w, h) / 2);
   const std::vector<int> vertical = chain_positions(zy + zone_y, h - zone_y, chain, ov);
@@ -816,15 +874,22 @@ Status quilt_cross(const Setup& setup, const TileOptions& options, double gradie
   };
   const Exclusion none;
   // V1 + V2: one chain through the top/bottom border (toroidal), from below the centre to above it.
+  const Plane original = canvas;
+  const int tp_axis = getenv("TP_PROF") ? atoi(getenv("TP_PROF")) : 0;
+  if (getenv("TP_PPOW")) quilter.profile_power_ = atof(getenv("TP_PPOW"));
+  quilter.original_ = &original;
+  if (tp_axis && gradient_penalty > 1.5) { quilter.profile_axis_ = 1; quilter.skip_lo_ = zy - ov; quilter.skip_hi_ = zy + zone_y + ov - 1; }
   for (int y : vertical) {
     quilter.place(zx - ov, y, arm_x, chain, none);
     if (!tick()) return Status::error(ErrorCode::kCancelled, "", "cancelled");
   }
   // H1 + H2: likewise through the left/right border.
+  if (tp_axis && gradient_penalty > 1.5) { quilter.profile_axis_ = 2; quilter.skip_lo_ = zx - ov; quilter.skip_hi_ = zx + zone_x + ov - 1; }
   for (int x : horizontal) {
     quilter.place(x, zy - ov, chain, arm_y, none);
     if (!tick()) return Status::error(ErrorCode::kCancelled, "", "cancelled");
   }
+  quilter.profile_axis_ = 0;
   // C: the centre, constrained on all four sides.
   quilter.place(zx - ov, zy - ov, arm_x, arm_y, none);
   tick();

@@ -35,6 +35,7 @@ struct MapOptions {
   float field_following = 1.f;
   uint32_t min_patch_faces = 16;
   bool keep_seams = false;
+  float hop_age = 0.02f;
   std::string axis = "pca";
   uint32_t smooth = 0;
   std::string seed_point;
@@ -108,6 +109,7 @@ int run_map(const MapOptions& opt) {
   mapping_options.field_following = opt.field_following;
   mapping_options.min_patch_faces = opt.min_patch_faces;
   mapping_options.shorten_seams = !opt.keep_seams;
+  mapping_options.hop_age = opt.hop_age;
   if (!opt.seed_point.empty()) {
     if (!parse_vec3(opt.seed_point, mapping_options.seed_point))
       return report_error(usage_error("--seed-point must be three numbers X,Y,Z, got '" + opt.seed_point + "'"));
@@ -117,6 +119,8 @@ int run_map(const MapOptions& opt) {
   // Below ~1e-3 px per unit every UV rounds to the same float; above 1e7 faces span millions of px.
   if (!(opt.scale >= 1e-3f && opt.scale <= 1e7f))
     return report_error(usage_error("--scale must be between 0.001 and 1e7 pixels per unit"));
+  if (!(opt.hop_age >= 0.f && opt.hop_age <= 1.f))
+    return report_error(usage_error("--hop-age must be between 0 and 1 radians"));
   if (Status s = check_outputs(output_paths(opt), {opt.input, opt.texture, opt.seam_faces}); !s)
     return report_error(s);
 
@@ -226,7 +230,7 @@ int run_map(const MapOptions& opt) {
     j["options"] = {{"mode", opt.mode}, {"scale", opt.scale}, {"threshold_px", opt.threshold},
                     {"max_stretch", opt.max_stretch},
                     {"field_following", opt.field_following}, {"min_patch_faces", opt.min_patch_faces},
-                    {"shorten_seams", !opt.keep_seams},
+                    {"shorten_seams", !opt.keep_seams}, {"hop_age", opt.hop_age},
                     {"axis", opt.axis}, {"smooth", opt.smooth}, {"seed_point", opt.seed_point},
                     {"seam_faces", opt.seam_faces}};
     j["mesh"] = {{"format", load.format}, {"vertices", mesh.vertex_count()}, {"faces", mesh.face_count()},
@@ -318,6 +322,10 @@ void register_map(CLI::App& app, Runner& run) {
       ->capture_default_str();
   group->add_option("--min-patch-faces", opt->min_patch_faces,
                     "patches mode: smaller patches are absorbed into a neighbour (0 keeps all)")
+      ->capture_default_str();
+  group->add_option("--hop-age", opt->hop_age,
+                    "patches mode: growth-order age per face of path from the patch seed, radians (0..1); keeps the "
+                    "order local so removing part of a mesh changes little elsewhere; 0 = the thesis's global counter")
       ->capture_default_str();
   group->add_flag("--no-seam-shortening", opt->keep_seams,
                   "patches mode: keep the seams as the growth left them (no re-placing of faces along them)");

@@ -1,8 +1,8 @@
 // tailor: texture mapping by homogeneous patch discovery (thesis chapter 2, DESIGN.md section 4).
 //
 // A greedy front grows over the mesh face by face. Faces waiting on the front are keyed by
-// (number of placed edge neighbours, most first; then age = variation + a running factor, least
-// first), so the texture spreads through regions where the orientation field is homogeneous and
+// (number of placed edge neighbours, most first; then age = variation + hop_age times the face's
+// path length from its patch's seed, least first), so the texture spreads through regions where the orientation field is homogeneous and
 // stops at faces where it varies (geometric edges, field singularities): those become seams.
 // A face is placed by unfolding it across an edge from a placed neighbour's corner UVs: the two
 // shared corners are copied and the third comes from a second placed neighbour, from the UV the
@@ -59,8 +59,13 @@ struct MappingOptions {
   bool use_seed_point = false;      //!< true: first face = the face whose centroid is nearest to seed_point
   std::array<float, 3> seed_point{0.f, 0.f, 0.f};  //!< mesh coordinates (not normalised); default rule when
                                     //!< unused: the face nearest to the centre of the bounding box
-  double factor_step = -1.0;        //!< age added per placed face (radians); < 0 = mode default:
-                                    //!< 1e-4 in kPatches (independent of #F, for stability), 1/#F in kThesis
+  double factor_step = -1.0;        //!< age added per placed face, a global counter (radians); < 0 = mode default:
+                                    //!< 1/#F in kThesis (as the thesis), the hop rule below in kPatches (1e-4
+                                    //!< per face when hop_age is 0); >= 0 in kPatches: this counter, no hops
+  float hop_age = 0.02f;            //!< kPatches: age added per face of path from the patch's seed (radians,
+                                    //!< 0..1; 0 = use the global counter). Local, so removing part of a mesh
+                                    //!< leaves the growth order elsewhere unchanged (stability); larger values
+                                    //!< grow rounder patches (more seam), smaller follow the field's variation
   // kPatches ------------------------------------------------------------------------------------
   float max_stretch = 0.25f;        //!< per-face bound: singular values of the face->UV Jacobian (in units of
                                     //!< `scale`) must lie in [1/(1+x), 1+x]; 0.01..4. 0.25 keeps every face
