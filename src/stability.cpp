@@ -63,10 +63,6 @@ Status measure_stability(const Mesh& mesh, const OrientationOptions& orientation
     map_options.use_seed_point = true;
     map_options.seed_point = {static_cast<float>(c[0]), static_cast<float>(c[1]), static_cast<float>(c[2])};
   }
-  Atlas full;
-  MappingStats full_stats;
-  TAILOR_RETURN_IF_ERROR(map_texture(mesh, topology, frames, map_options, full, &full_stats));
-
   // === The ball: centred on the face farthest from the seed, holding remove_fraction of faces ===
   const double seed[3] = {map_options.seed_point[0], map_options.seed_point[1], map_options.seed_point[2]};
   size_t far_face = 0;
@@ -95,6 +91,28 @@ Status measure_stability(const Mesh& mesh, const OrientationOptions& orientation
                    by_distance.end());
   std::vector<uint8_t> gone(face_count, 0);
   for (size_t i = 0; i < removed; ++i) gone[by_distance[i].second] = 1;
+  // On meshes whose face density varies a lot (CAD parts) the ball can reach the seed; both runs
+  // then start at the surviving face nearest to it, or the experiment would measure a new seed.
+  {
+    uint32_t nearest = kInvalid;
+    double nearest_d2 = 0;
+    for (size_t f = 0; f < face_count; ++f) {
+      if (gone[f]) continue;
+      double c[3];
+      face_centroid(mesh, f, c);
+      const double d2 = distance2(c, seed);
+      if (nearest == kInvalid || d2 < nearest_d2) {
+        nearest = static_cast<uint32_t>(f);
+        nearest_d2 = d2;
+      }
+    }
+    double c[3];
+    face_centroid(mesh, nearest, c);
+    map_options.seed_point = {static_cast<float>(c[0]), static_cast<float>(c[1]), static_cast<float>(c[2])};
+  }
+  Atlas full;
+  MappingStats full_stats;
+  TAILOR_RETURN_IF_ERROR(map_texture(mesh, topology, frames, map_options, full, &full_stats));
 
   // === The cut mesh: same vertices (ids kept), surviving faces in their original order ===
   Mesh cut;

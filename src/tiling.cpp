@@ -353,6 +353,24 @@ class Quilter {
 
   int placed() const { return placed_; }
   double detail_quantile_ = 0.0;
+  bool min_cand_on_ = false;
+  std::vector<uint8_t> strong_lines_;
+  void set_profile(int axis, int lo, int hi, double strong) {
+    profile_axis_ = axis; skip_lo_ = lo; skip_hi_ = hi;
+    const Plane& o = *original_;
+    const bool rows = axis == 1;
+    const int n = rows ? o.height : o.width;
+    std::vector<double> d(static_cast<size_t>(n), 0.0);
+    for (int y = 0; y < o.height; ++y)
+      for (int x = 0; x < o.width; ++x)
+        for (int c = 0; c < o.channels; ++c)
+          d[static_cast<size_t>(rows ? y : x)] += std::abs(o.at(x, y)[c] - (rows ? o.wrap(x, y + 1) : o.wrap(x + 1, y))[c]);
+    std::vector<double> sorted = d;
+    std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.end());
+    const double med = sorted[static_cast<size_t>(n / 2)];
+    strong_lines_.assign(static_cast<size_t>(n), 0);
+    for (int i = 0; i < n; ++i) strong_lines_[static_cast<size_t>(i)] = d[static_cast<size_t>(i)] >= strong * med ? 1 : 0;
+  }
   // 1: rows (vertical arm: per-row |dy| sums), 2: columns (horizontal arm: per-column |dx| sums)
   int profile_axis_ = 0;
   int skip_lo_ = 0, skip_hi_ = -1;  // canvas rows (axis 1) / columns (axis 2) not checked
@@ -389,7 +407,10 @@ class Quilter {
         }
       }
       static const double exc = getenv("TP_EXC") ? atof(getenv("TP_EXC")) : 0.0;
-      deficit += std::max(0.0, orig - n) + exc * std::max(0.0, n - orig);
+      if (!strong_lines_.empty() && strong_lines_[static_cast<size_t>(line)])
+        deficit += std::max(0.0, n - orig);
+      else
+        deficit += std::max(0.0, orig - n) + exc * std::max(0.0, n - orig);
       total += orig;
     }
     return total > 0.0 ? deficit / total : 0.0;
@@ -878,13 +899,17 @@ Status quilt_cross(const Setup& setup, const TileOptions& options, double gradie
   const int tp_axis = getenv("TP_PROF") ? atoi(getenv("TP_PROF")) : 0;
   if (getenv("TP_PPOW")) quilter.profile_power_ = atof(getenv("TP_PPOW"));
   quilter.original_ = &original;
-  if (tp_axis && gradient_penalty > 1.5) { quilter.profile_axis_ = 1; quilter.skip_lo_ = zy - ov; quilter.skip_hi_ = zy + zone_y + ov - 1; }
+  quilter.min_cand_on_ = gradient_penalty > 1.5 || getenv("TP_MINC_ALL");
+  static const double strong = getenv("TP_STRONG") ? atof(getenv("TP_STRONG")) : 2.0;
+  static const int axes = getenv("TP_AXES") ? atoi(getenv("TP_AXES")) : 3;
+  if (tp_axis && gradient_penalty > 1.5 && (axes & 1)) quilter.set_profile(1, zy - ov, zy + zone_y + ov - 1, strong);
   for (int y : vertical) {
     quilter.place(zx - ov, y, arm_x, chain, none);
     if (!tick()) return Status::error(ErrorCode::kCancelled, "", "cancelled");
   }
   // H1 + H2: likewise through the left/right border.
-  if (tp_axis && gradient_penalty > 1.5) { quilter.profile_axis_ = 2; quilter.skip_lo_ = zx - ov; quilter.skip_hi_ = zx + zone_x + ov - 1; }
+  quilter.profile_axis_ = 0;
+  if (tp_axis && gradient_penalty > 1.5 && (axes & 2)) quilter.set_profile(2, zx - ov, zx + zone_x + ov - 1, strong);
   for (int x : horizontal) {
     quilter.place(x, zy - ov, chain, arm_y, none);
     if (!tick()) return Status::error(ErrorCode::kCancelled, "", "cancelled");

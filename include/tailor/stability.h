@@ -1,7 +1,8 @@
 // tailor: stability of the mapping under removal of part of the mesh (thesis 2.6, DESIGN.md 5).
 //
 // Maps the whole mesh, removes the faces whose centroids lie in a ball holding ~remove_fraction
-// of the faces (centred on the face farthest from the seed face, so the seed survives), maps
+// of the faces (centred on the face farthest from the seed face; if it still holds the seed, both
+// runs start at the surviving face nearest to the seed instead), maps
 // what is left with the same seed point, the same global axis and the same unit-cube
 // normalisation (as a streaming client that keeps them would), and compares the UVs of the
 // surviving corners.
