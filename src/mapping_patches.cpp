@@ -282,9 +282,15 @@ class PatchMapper {
     const float* ends[3][2] = {};
     int edges[3];
     int count = 0;
+    bool other_patch = false;  // a placed neighbour in another patch: a seam edge for sure
     for (int k = 0; k < 3; ++k) {
       const uint32_t o = self.opposite[k];
-      if (o == kInvalid || rec_[o / 3].patch != target) continue;
+      if (o == kInvalid) continue;
+      const uint32_t q = rec_[o / 3].patch;
+      if (q != target) {
+        other_patch = other_patch || q != kInvalid;
+        continue;
+      }
       neighbour_edge_uv(f, k, ends[k][0], ends[k][1]);
       edges[count++] = k;
     }
@@ -320,7 +326,7 @@ class PatchMapper {
     auto accept_best = [&](bool three_known) {
       if (!(degenerate || best_stretch <= bound_)) return false;
       if (best_cuts) ++stats_.faces_cut;
-      accept(f, target, best, best_error, degenerate ? 0.f : best_stretch, three_known);
+      accept(f, target, best, best_error, degenerate ? 0.f : best_stretch, three_known, best_cuts || other_patch);
       return true;
     };
 
@@ -425,7 +431,7 @@ class PatchMapper {
     patch_size_.push_back(0);
     patch_seed_.push_back(f);
     ++stats_.faces_rigid;
-    accept(f, id, uv, 0.f, 0.f, false);
+    accept(f, id, uv, 0.f, 0.f, false, true);
     --stats_.faces_unfolded;  // counted as rigid above
     return id;
   }
@@ -445,7 +451,7 @@ class PatchMapper {
     float uv[6];
     place_aligned(f, k, ua, ub, Rotation{std::cos(theta), std::sin(theta)}, uv);
     ++stats_.faces_rigid;
-    accept(f, rec_[rec_[f].opposite[k] / 3].patch, uv, 0.f, 0.f, false);
+    accept(f, rec_[rec_[f].opposite[k] / 3].patch, uv, 0.f, 0.f, false, true);
     --stats_.faces_unfolded;
   }
 
@@ -463,7 +469,9 @@ class PatchMapper {
     }
   }
 
-  void accept(uint32_t f, uint32_t p, const float* uv, float error_px, float stretch_error, bool three_known) {
+  // on_seam: f may disagree with a placed neighbour (a cut, another patch, a rigid placement).
+  void accept(uint32_t f, uint32_t p, const float* uv, float error_px, float stretch_error, bool three_known,
+              bool on_seam) {
     std::copy(uv, uv + 6, uv_ + 6 * f);
     FaceRecord& self = rec_[f];
     self.patch = p;
@@ -477,17 +485,13 @@ class PatchMapper {
     else ++stats_.faces_unfolded;
     stats_.max_error_px = std::max(stats_.max_error_px, error_px);
     stats_.max_stretch_accepted = std::max(stats_.max_stretch_accepted, stretch_error);
-    // Faces that disagree with a placed neighbour (in any patch) are where seams lie: the seam
-    // shortening afterwards starts from them. The neighbours' UVs were just read by try_place.
-    for (int k = 0; k < 3; ++k) {
-      const uint32_t o = self.opposite[k];
-      if (o == kInvalid || rec_[o / 3].patch == kInvalid) continue;
-      const float* ua;
-      const float* ub;
-      neighbour_edge_uv(f, k, ua, ub);
-      if (uv[2 * k] != ua[0] || uv[2 * k + 1] != ua[1] || uv[2 * kNext[k]] != ub[0] || uv[2 * kNext[k] + 1] != ub[1]) {
-        seam_mark_[f] = 1;
-        seam_mark_[o / 3] = 1;
+    // Where seams lie: the seam shortening afterwards starts from these faces and their neighbours.
+    if (on_seam) {
+      seam_mark_[f] = 1;
+      // Placed neighbours only: one placed later that disagrees with f is marked when it is placed.
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t o = self.opposite[k];
+        if (o != kInvalid && rec_[o / 3].patch != kInvalid) seam_mark_[o / 3] = 1;
       }
     }
     if (absorbing_) return;  // the absorption pass keeps its own queue

@@ -68,18 +68,6 @@ class SeamShortener {
     return moved;
   }
 
-  // Whether f's edge k has different UVs on its two sides (the metrics' definition of a seam).
-  // `uv` is f's 6 UVs (its own or a candidate's).
-  bool seam_edge(uint32_t f, int k, const float* uv) const {
-    const uint32_t o = opposite_[3 * f + k];
-    if (o == kInvalid) return false;
-    const float* g = uv_ + 6 * (o / 3);
-    const int kk = static_cast<int>(o % 3);
-    // f's edge runs corner k -> k+1; the neighbour's runs the other way, kk -> kk+1.
-    return uv[2 * k] != g[2 * kNext[kk]] || uv[2 * k + 1] != g[2 * kNext[kk] + 1] ||
-           uv[2 * kNext[k]] != g[2 * kk] || uv[2 * kNext[k] + 1] != g[2 * kk + 1];
-  }
-
   // Zero-area faces as the growth judges them (mapping_patches.cpp, kDegenerateRatio): placed
   // without the stretch check.
   bool is_degenerate(uint32_t f) const {
@@ -97,25 +85,14 @@ class SeamShortener {
     return std::sqrt(dx * dx + dy * dy + dz * dz);
   }
 
-  float seam_cost(uint32_t f, const float* uv, const float* length) const {
-    float cost = 0.f;
-    for (int k = 0; k < 3; ++k)
-      if (seam_edge(f, k, uv)) cost += length[k];
-    return cost;
-  }
-
   // Re-places f if some placement copied from its neighbours shortens the seams around it and is
   // within the bound. Candidates: two corners from the neighbour across edge k, the third from the
   // neighbour across another edge, or from f's own triangle carried along by the similarity that
   // takes its edge k onto the neighbour's.
   bool improve(uint32_t f) {
     float* own = uv_ + 6 * f;
-    const float length[3] = {edge_length(f, 0), edge_length(f, 1), edge_length(f, 2)};
-    const float before = seam_cost(f, own, length);
-    if (before == 0.f) return false;
-    const StretchFrame frame = stretch_frame(in_.frames.local.data() + 6 * f, scale_);
-    const bool degenerate = is_degenerate(f);
-
+    // The neighbours' UVs of f's edges (f's edge k runs corner k -> k+1, the neighbour's the
+    // other way), read once: every candidate is compared against them.
     const float* ends[3][2] = {};
     for (int k = 0; k < 3; ++k) {
       const uint32_t o = opposite_[3 * f + k];
@@ -125,14 +102,38 @@ class SeamShortener {
       ends[k][0] = g + 2 * kNext[kk];
       ends[k][1] = g + 2 * kk;
     }
+    auto seam_at = [&](const float* uv, int k) {
+      if (!ends[k][0]) return false;
+      const int k1 = kNext[k];
+      return uv[2 * k] != ends[k][0][0] || uv[2 * k + 1] != ends[k][0][1] || uv[2 * k1] != ends[k][1][0] ||
+             uv[2 * k1 + 1] != ends[k][1][1];
+    };
+    const bool seam[3] = {seam_at(own, 0), seam_at(own, 1), seam_at(own, 2)};
+    const int seams = seam[0] + seam[1] + seam[2];
+    if (seams == 0) return false;
+    const float length[3] = {edge_length(f, 0), edge_length(f, 1), edge_length(f, 2)};
+    // With one seam edge f agrees with its two other neighbours, which fix all three of its
+    // corners: a move breaks at least one of those edges, so it can only pay when the seam edge is
+    // the longer (the seam slides onto a shorter edge). Most faces on a seam are of this kind.
+    if (seams == 1) {
+      const int k = seam[0] ? 0 : seam[1] ? 1 : 2;
+      if (!(length[k] > std::min(length[kNext[k]], length[kPrev[k]]))) return false;
+    }
+    auto seam_cost = [&](const float* uv) {
+      return (seam_at(uv, 0) ? length[0] : 0.f) + (seam_at(uv, 1) ? length[1] : 0.f) +
+             (seam_at(uv, 2) ? length[2] : 0.f);
+    };
+    const float before = seam_cost(own);
+    const StretchFrame frame = stretch_frame(in_.frames.local.data() + 6 * f, scale_);
+    const bool degenerate = is_degenerate(f);
+    // A gain must be a whole edge (not rounding): a tenth of the shortest edge of f.
+    const float min_gain = 0.1f * std::min({length[0], length[1], length[2]});
+
     float best[6];
     float best_gain = 0.f, best_stretch = 0.f;
     int best_edge = -1;
     auto consider = [&](const float* candidate, int k) {
-      const float gain = before - seam_cost(f, candidate, length);
-      // A gain must be a whole edge (not rounding): lengths are positive, so require a tenth of
-      // the shortest edge of f.
-      const float min_gain = 0.1f * std::min({length[0], length[1], length[2]});
+      const float gain = before - seam_cost(candidate);
       if (!(gain > min_gain) || gain < best_gain) return;
       const float s = degenerate ? 0.f : stretch_error(frame, candidate);
       if (!(s <= bound_)) return;
