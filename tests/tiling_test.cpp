@@ -79,32 +79,11 @@ Image checkers(int width, int height, int cell) {
 // ------------------------------------------------------------------------------------------------
 // Quality targets (issue 4) on each exemplar copied into tests/data/textures.
 
-struct TargetCase {
-  const char* file;
-  double coherence_factor;  // allowed tile / exemplar patch coherence (issue target: 1.0)
-  double seam_factor;       // allowed tile worst seam / max(exemplar worst, 1.5) (target 1.0)
-};
-
-void PrintTo(const TargetCase& c, std::ostream* os) { *os << c.file; }
-
-// Known shortfall, measured and reported in docs/tiling.md: on the water photo the worst seam is
-// the photo's own strongest edge (kept verbatim), and the quilted strips lower the median row
-// difference by a few percent, which lifts that edge's ratio 3 % above its value in the exemplar.
-const TargetCase kCases[] = {
-    {"brick-gray-512.png", 1.0, 1.0},    {"grass-gray-512.png", 1.0, 1.0},
-    {"gravel-gray-512.png", 1.0, 1.0},   {"vistex-fabric02-128.png", 1.0, 1.0},
-    {"vistex-tile04-128.png", 1.0, 1.0}, {"vistex-sand05-128.png", 1.0, 1.0},
-    {"vistex-bark11-128.png", 1.0, 1.0}, {"water-caustics-300.jpg", 1.0, 1.05},
-};
-
-class TileTargets : public ::testing::TestWithParam<TargetCase> {};
-
-TEST_P(TileTargets, MeetsQualityTargets) {
-  const TargetCase c = GetParam();
-  const Image ex = load(c.file);
-  Image tile;
-  TileReport report;
-  ASSERT_TRUE(make_tileable(ex, TileOptions{}, tile, &report).is_ok());
+// Every issue 4 target, no allowance: wrap ratios in [0.8, 1.2], worst straight seam <= max(the
+// exemplar's own interior worst, 1.5), histogram L1 <= 0.1, gradient ratio >= 0.95, patch
+// coherence <= the exemplar's own read toroidally.
+void expect_targets(const Image& ex, const Image& tile, const std::string& what) {
+  SCOPED_TRACE(what);
   EXPECT_EQ(tile.width, ex.width);
   EXPECT_EQ(tile.height, ex.height);
   EXPECT_EQ(tile.channels, ex.channels);
@@ -116,15 +95,48 @@ TEST_P(TileTargets, MeetsQualityTargets) {
   EXPECT_LE(m.wrap_ratio_x, 1.2);
   EXPECT_GE(m.wrap_ratio_y, 0.8);
   EXPECT_LE(m.wrap_ratio_y, 1.2);
-  EXPECT_LE(m.worst_seam_ratio, c.seam_factor * std::max(m.exemplar_worst_seam_ratio, 1.5));
+  EXPECT_LE(m.worst_seam_ratio, std::max(m.exemplar_worst_seam_ratio, 1.5));
   EXPECT_LE(m.histogram_l1, 0.1);
   EXPECT_GE(m.gradient_ratio, 0.95);
-  EXPECT_LE(m.patch_coherence, c.coherence_factor * m.exemplar_patch_coherence);
+  EXPECT_LE(m.patch_coherence, m.exemplar_patch_coherence);
+  std::string failed;
+  EXPECT_TRUE(meets_tile_targets(m, &failed)) << failed;
 }
 
-INSTANTIATE_TEST_SUITE_P(Exemplars, TileTargets, ::testing::ValuesIn(kCases),
-                         [](const ::testing::TestParamInfo<TargetCase>& param) {
-                           std::string name = param.param.file;
+class TileTargets : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(TileTargets, MeetsQualityTargets) {
+  const Image ex = load(GetParam());
+  Image tile;
+  TileReport report;
+  ASSERT_TRUE(make_tileable(ex, TileOptions{}, tile, &report).is_ok());
+  expect_targets(ex, tile, GetParam());
+}
+
+// The hardest exemplars: water and the ornamental tiles, whose own strongest edge decides the
+// worst seam (the tile must not lift its ratio at all), and bark, with the thinnest margins
+// against the 1.5 floor and the coherence target. Seed 1 is the default, checked above.
+TEST(TileTargets, MeetsQualityTargetsForOtherSeedsOnTheHardestExemplars) {
+  for (const char* file : {"water-caustics-300.jpg", "vistex-tile04-128.png", "vistex-bark11-128.png"}) {
+    const Image ex = load(file);
+    for (uint64_t seed = 2; seed <= 5; ++seed) {
+      TileOptions o;
+      o.seed = seed;
+      Image tile;
+      ASSERT_TRUE(make_tileable(ex, o, tile).is_ok());
+      expect_targets(ex, tile, std::string(file) + " seed " + std::to_string(seed));
+    }
+  }
+}
+
+const char* const kExemplars[] = {
+    "brick-gray-512.png",      "grass-gray-512.png",    "gravel-gray-512.png",   "vistex-fabric02-128.png",
+    "vistex-tile04-128.png",   "vistex-sand05-128.png", "vistex-bark11-128.png", "water-caustics-300.jpg",
+};
+
+INSTANTIATE_TEST_SUITE_P(Exemplars, TileTargets, ::testing::ValuesIn(kExemplars),
+                         [](const ::testing::TestParamInfo<const char*>& param) {
+                           std::string name = param.param;
                            name = name.substr(0, name.find('.'));
                            std::replace(name.begin(), name.end(), '-', '_');
                            return name;

@@ -98,16 +98,23 @@ size="$(curl -s --max-time 10 "${url}files/model.glb" | wc -c)"
 # --- 4. the browser ---------------------------------------------------------------------------------
 timeout 120 node web/test/viewer_browser_test.mjs "$url" || fail "browser test failed"
 
-# --- 6. Ctrl-C stops the server cleanly ---------------------------------------------------------------
+# --- 6. a client that never finishes its request holds up neither others nor Ctrl-C -----------------
+port="${url#http://127.0.0.1:}"; port="${port%/}"
+exec 3<>"/dev/tcp/127.0.0.1/$port"
+printf 'GET / HTTP/1.1\r\nHost: x' >&3
+[ "$(curl -s -o /dev/null -w '%{http_code}' --max-time 2 "$url")" = 200 ] || fail "a stalled client blocked other requests"
+
+# --- 7. Ctrl-C stops the server cleanly and promptly, the stalled client still connected ---------------
 kill -INT "$server_pid"
 set +e
-timeout 10 tail --pid="$server_pid" -f /dev/null
+timeout 3 tail --pid="$server_pid" -f /dev/null || fail "tailor view took more than 3 s to stop after SIGINT"
+exec 3<&-
 wait "$server_pid"; rc=$?
 set -e
 server_pid=""
 [ "$rc" -eq 0 ] || fail "tailor view exited $rc after SIGINT, expected 0"
 
-# --- 5. tile variants (a small exemplar keeps `tailor tile` fast) ------------------------------------
+# --- 8. tile variants (a small exemplar keeps `tailor tile` fast) ------------------------------------
 timeout 60 "$tailor" tile tests/data/textures/vistex-tile04-128.png --variants 3 -o "$tmp/tile.png" -q \
   || fail "tailor tile --variants 3 failed"
 [ -s "$tmp/tile.json" ] || fail "tailor tile wrote no variants .json"

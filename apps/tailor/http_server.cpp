@@ -8,26 +8,48 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
+#include <chrono>
 #include <climits>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <list>
 #include <thread>
 
 namespace tailor::cli {
 namespace {
 
 constexpr size_t kMaxHeaderBytes = 16 * 1024;  // a GET from a browser is well under 2 KB
-constexpr int kPollMillis = 200;               // how often serve() looks at the stop flag
-constexpr int kClientTimeoutSeconds = 10;      // a silent client (speculative connection) is dropped
+constexpr int kPollMillis = 200;               // how often the server and its workers look at the stop flag
+constexpr int kHeaderSeconds = 10;   // a client must send its whole request within this (slow or silent ones
+                                     // are dropped: a per-recv timeout would let a trickle hold a worker forever)
+constexpr int kStallSeconds = 30;    // a client that accepts no byte of the answer for this long is dropped
+constexpr size_t kMaxWorkers = 64;   // connections served at once; more get 503
 
-bool send_all(int fd, const char* data, size_t size) {
+using Clock = std::chrono::steady_clock;
+
+// Waits until fd is ready for `events`, the stop flag is set, or the deadline passes.
+bool wait_ready(int fd, short events, const std::atomic<bool>& stop, Clock::time_point deadline) {
+  while (!stop.load()) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
+    if (left <= 0) return false;
+    pollfd pfd{fd, events, 0};
+    const int ready = ::poll(&pfd, 1, static_cast<int>(std::min<long long>(left, kPollMillis)));
+    if (ready > 0) return true;
+    if (ready < 0 && errno != EINTR) return false;
+  }
+  return false;
+}
+
+bool send_all(int fd, const char* data, size_t size, const std::atomic<bool>& stop) {
   while (size > 0) {
-    const ssize_t n = ::send(fd, data, size, MSG_NOSIGNAL);
-    if (n < 0 && errno == EINTR) continue;
+    if (!wait_ready(fd, POLLOUT, stop, Clock::now() + std::chrono::seconds(kStallSeconds))) return false;
+    const ssize_t n = ::send(fd, data, size, MSG_NOSIGNAL | MSG_DONTWAIT);
+    if (n < 0 && (errno == EINTR || errno == EAGAIN || errno == EWOULDBLOCK)) continue;
     if (n <= 0) return false;
     data += n;
     size -= static_cast<size_t>(n);
@@ -35,13 +57,12 @@ bool send_all(int fd, const char* data, size_t size) {
   return true;
 }
 
-void send_status(int fd, int code, const char* reason) {
+void send_status(int fd, int code, const char* reason, const std::atomic<bool>& stop) {
   const std::string body = std::to_string(code) + " " + reason + "\n";
   const std::string head = "HTTP/1.1 " + std::to_string(code) + " " + reason +
                            "\r\nContent-Type: text/plain\r\nContent-Length: " + std::to_string(body.size()) +
                            "\r\nConnection: close\r\n\r\n";
-  send_all(fd, head.data(), head.size());
-  send_all(fd, body.data(), body.size());
+  send_all(fd, (head + body).data(), head.size() + body.size(), stop);
 }
 
 std::string header_for(size_t length, const std::string& type) {
@@ -148,27 +169,43 @@ Status StaticServer::start(const std::string& web_root, std::vector<Route> route
 }
 
 void StaticServer::serve(const std::atomic<bool>& stop) {
-  std::vector<std::thread> workers;
+  // One thread per connection; finished ones are joined as soon as they are done, so one slow
+  // client never holds up the others or the accept loop.
+  struct Worker {
+    std::thread thread;
+    std::atomic<bool> done{false};
+  };
+  std::list<Worker> workers;
+  auto reap = [&workers](bool all) {
+    for (auto it = workers.begin(); it != workers.end();) {
+      if (!all && !it->done.load()) {
+        ++it;
+        continue;
+      }
+      it->thread.join();
+      it = workers.erase(it);
+    }
+  };
   while (!stop.load()) {
+    reap(false);
     pollfd pfd{listen_fd_, POLLIN, 0};
     const int ready = ::poll(&pfd, 1, kPollMillis);
     if (ready <= 0) continue;  // timeout, or EINTR from Ctrl-C: look at the flag again
     const int client = ::accept4(listen_fd_, nullptr, nullptr, SOCK_CLOEXEC);
     if (client < 0) continue;
-    timeval tv{kClientTimeoutSeconds, 0};
-    ::setsockopt(client, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
-    ::setsockopt(client, SOL_SOCKET, SO_SNDTIMEO, &tv, sizeof tv);
-    workers.emplace_back([this, client] {
-      handle(client);
+    if (workers.size() >= kMaxWorkers) {
+      send_status(client, 503, "Service Unavailable", stop);
       ::close(client);
-    });
-    // Reap finished workers now and then so a long session does not pile up threads.
-    if (workers.size() > 64) {
-      for (auto& w : workers) w.join();
-      workers.clear();
+      continue;
     }
+    Worker& w = workers.emplace_back();
+    w.thread = std::thread([this, client, &stop, &w] {
+      handle(client, stop);
+      ::close(client);
+      w.done.store(true);
+    });
   }
-  for (auto& w : workers) w.join();
+  reap(true);  // workers see the flag within kPollMillis
 }
 
 std::string StaticServer::resolve_under_root(const std::string& path) const {
@@ -182,13 +219,15 @@ std::string StaticServer::resolve_under_root(const std::string& path) const {
   return is_regular_file(resolved) ? resolved : std::string();
 }
 
-void StaticServer::handle(int client) const {
+void StaticServer::handle(int client, const std::atomic<bool>& stop) const {
   std::string request;
   std::array<char, 4096> buf{};
+  const auto deadline = Clock::now() + std::chrono::seconds(kHeaderSeconds);
   while (request.find("\r\n\r\n") == std::string::npos) {
-    if (request.size() > kMaxHeaderBytes) return send_status(client, 431, "Request Header Fields Too Large");
-    const ssize_t n = ::recv(client, buf.data(), buf.size(), 0);
-    if (n < 0 && errno == EINTR) continue;
+    if (request.size() > kMaxHeaderBytes) return send_status(client, 431, "Request Header Fields Too Large", stop);
+    if (!wait_ready(client, POLLIN, stop, deadline)) return;
+    const ssize_t n = ::recv(client, buf.data(), buf.size(), MSG_DONTWAIT);
+    if (n < 0 && (errno == EINTR || errno == EAGAIN || errno == EWOULDBLOCK)) continue;
     if (n <= 0) return;
     request.append(buf.data(), static_cast<size_t>(n));
   }
@@ -196,13 +235,13 @@ void StaticServer::handle(int client) const {
   const std::string line = request.substr(0, line_end);
   const size_t sp1 = line.find(' ');
   const size_t sp2 = sp1 == std::string::npos ? std::string::npos : line.find(' ', sp1 + 1);
-  if (sp2 == std::string::npos) return send_status(client, 400, "Bad Request");
+  if (sp2 == std::string::npos) return send_status(client, 400, "Bad Request", stop);
   const std::string method = line.substr(0, sp1);
   const std::string target = line.substr(sp1 + 1, sp2 - sp1 - 1);
-  if (method != "GET" && method != "HEAD") return send_status(client, 405, "Method Not Allowed");
+  if (method != "GET" && method != "HEAD") return send_status(client, 405, "Method Not Allowed", stop);
   const bool head_only = method == "HEAD";
   const std::string path = safe_request_path(target);
-  if (path.empty()) return send_status(client, 403, "Forbidden");
+  if (path.empty()) return send_status(client, 403, "Forbidden", stop);
 
   std::string file;
   for (const Route& r : routes_) {
@@ -210,27 +249,28 @@ void StaticServer::handle(int client) const {
     const std::string type = r.content_type.empty() ? content_type_for(path) : r.content_type;
     if (r.file.empty()) {
       const std::string head = header_for(r.content.size(), type);
-      if (send_all(client, head.data(), head.size()) && !head_only) send_all(client, r.content.data(), r.content.size());
+      if (send_all(client, head.data(), head.size(), stop) && !head_only)
+        send_all(client, r.content.data(), r.content.size(), stop);
       return;
     }
     file = r.file;
     break;
   }
   if (file.empty()) file = resolve_under_root(path);
-  if (file.empty()) return send_status(client, 404, "Not Found");
+  if (file.empty()) return send_status(client, 404, "Not Found", stop);
 
   std::ifstream in(file, std::ios::binary | std::ios::ate);
-  if (!in) return send_status(client, 404, "Not Found");
+  if (!in) return send_status(client, 404, "Not Found", stop);
   const auto size = static_cast<size_t>(in.tellg());
   in.seekg(0);
   const std::string head = header_for(size, content_type_for(file));
-  if (!send_all(client, head.data(), head.size()) || head_only) return;
+  if (!send_all(client, head.data(), head.size(), stop) || head_only) return;
   std::vector<char> chunk(1 << 16);
   size_t left = size;
   while (left > 0 && in) {
     const size_t n = std::min(left, chunk.size());
     in.read(chunk.data(), static_cast<std::streamsize>(n));
-    if (!send_all(client, chunk.data(), static_cast<size_t>(in.gcount()))) return;
+    if (!send_all(client, chunk.data(), static_cast<size_t>(in.gcount()), stop)) return;
     left -= static_cast<size_t>(in.gcount());
   }
 }

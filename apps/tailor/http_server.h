@@ -43,7 +43,9 @@ class StaticServer {
   int port() const { return port_; }
 
   //! Answers requests until `stop` becomes true (checked at least every 200 ms), e.g. set from
-  //! a SIGINT handler. Each connection is served on its own thread; all are joined before return.
+  //! a SIGINT handler. Each connection is served on its own thread (at most 64 at once, more get
+  //! 503), joined as soon as it ends; a client must send its request within 10 s and take each
+  //! part of the answer within 30 s. Workers also watch `stop`, so the return is prompt.
   void serve(const std::atomic<bool>& stop);
 
   //! Content type for a path from its extension ("application/octet-stream" when unknown).
@@ -54,7 +56,7 @@ class StaticServer {
   static std::string safe_request_path(const std::string& target);
 
  private:
-  void handle(int client) const;
+  void handle(int client, const std::atomic<bool>& stop) const;
   std::string resolve_under_root(const std::string& path) const;
 
   int listen_fd_ = -1;
