@@ -233,6 +233,26 @@ Mat4 look_at(const std::array<double, 3>& eye) {
   return m;
 }
 
+// Rotation taking the chosen up axis to +y (column-major; each is a proper rotation, so the
+// winding and the lighting stay right).
+Mat4 up_rotation(UpAxis up) {
+  // Rows of the 3x3 part: new (x, y, z) from old (x, y, z).
+  std::array<std::array<float, 3>, 3> r{};
+  switch (up) {
+    case UpAxis::kPosY: r = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}}; break;
+    case UpAxis::kPosZ: r = {{{1, 0, 0}, {0, 0, 1}, {0, -1, 0}}}; break;
+    case UpAxis::kPosX: r = {{{0, -1, 0}, {1, 0, 0}, {0, 0, 1}}}; break;
+    case UpAxis::kNegY: r = {{{1, 0, 0}, {0, -1, 0}, {0, 0, -1}}}; break;
+    case UpAxis::kNegZ: r = {{{1, 0, 0}, {0, 0, -1}, {0, 1, 0}}}; break;
+    case UpAxis::kNegX: r = {{{0, 1, 0}, {-1, 0, 0}, {0, 0, 1}}}; break;
+  }
+  Mat4 m{};
+  for (size_t row = 0; row < 3; ++row)
+    for (size_t col = 0; col < 3; ++col) m[4 * col + row] = r[row][col];
+  m[15] = 1.0f;
+  return m;
+}
+
 Mat4 orthographic(double width, double height) {
   Mat4 m{};
   m[0] = static_cast<float>(2.0 / width);
@@ -629,6 +649,20 @@ bool preview_view_from_name(std::string_view name, PreviewView& view) {
   return false;
 }
 
+bool up_axis_from_name(std::string_view name, UpAxis& up) {
+  if (!name.empty() && name.front() == '+') name.remove_prefix(1);
+  constexpr std::pair<std::string_view, UpAxis> kNames[] = {{"y", UpAxis::kPosY},  {"z", UpAxis::kPosZ},
+                                                            {"x", UpAxis::kPosX},  {"-y", UpAxis::kNegY},
+                                                            {"-z", UpAxis::kNegZ}, {"-x", UpAxis::kNegX}};
+  for (const auto& [text, axis] : kNames) {
+    if (name == text) {
+      up = axis;
+      return true;
+    }
+  }
+  return false;
+}
+
 const char* preview_view_name(PreviewView view) {
   switch (view) {
     case PreviewView::kTexture: return "texture";
@@ -725,6 +759,8 @@ Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::s
     glShadeModel(GL_SMOOTH);
     const Mat4 view = look_at(eye);
     glLoadMatrixf(view.data());
+    const Mat4 turn = up_rotation(options.up);
+    glMultMatrixf(turn.data());
 
     glColor4ub(255, 255, 255, 255);
     if (textured) {

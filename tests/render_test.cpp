@@ -2,6 +2,8 @@
 // differ from each other, texture orientation, determinism and input validation.
 #include <gtest/gtest.h>
 
+#include <utility>
+
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -263,6 +265,59 @@ TEST(RenderPreview, RejectsBadInput) {
   bad_texture.pixels.resize(5);
   EXPECT_EQ(render_preview(square, square.corner_uvs, {}, &bad_texture, small(PreviewView::kTexture), out).code(),
             ErrorCode::kInvalidImage);
+}
+
+// Closed box [0,sx] x [0,sy] x [0,sz], outward faces.
+Mesh box(float sx, float sy, float sz) {
+  Mesh m;
+  for (int i = 0; i < 8; ++i)
+    m.positions.insert(m.positions.end(), {(i & 1) ? sx : 0.f, (i & 2) ? sy : 0.f, (i & 4) ? sz : 0.f});
+  m.indices = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4,
+               2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
+  return m;
+}
+
+// Width and height of the box around the pixels that differ from the background.
+std::pair<int, int> covered_extent(const Image& img) {
+  int x0 = img.width, y0 = img.height, x1 = -1, y1 = -1;
+  for (int y = 0; y < img.height; ++y) {
+    for (int x = 0; x < img.width; ++x) {
+      const uint8_t* p = pixel(img, x, y);
+      if (std::abs(int{p[0]} - int{img.pixels[0]}) + std::abs(int{p[1]} - int{img.pixels[1]}) +
+              std::abs(int{p[2]} - int{img.pixels[2]}) <= 12)
+        continue;
+      x0 = std::min(x0, x);
+      x1 = std::max(x1, x);
+      y0 = std::min(y0, y);
+      y1 = std::max(y1, y);
+    }
+  }
+  return {x1 - x0 + 1, y1 - y0 + 1};
+}
+
+TEST(RenderPreview, UpAxisStandsAZUpPillarUpright) {
+  const Mesh pillar = box(0.2f, 0.2f, 2.f);  // tall along z, as scans often are
+  RenderOptions o = small(PreviewView::kPatches);
+  o.yaw_degrees = 0.f;
+  o.pitch_degrees = 0.f;
+  o.up = UpAxis::kPosZ;
+  const auto [w_up, h_up] = covered_extent(render_ok(pillar, nullptr, o));
+  EXPECT_GT(h_up, 3 * w_up) << w_up << "x" << h_up;
+  o.up = UpAxis::kPosY;  // seen end-on from +z: a small square
+  const auto [w_y, h_y] = covered_extent(render_ok(pillar, nullptr, o));
+  EXPECT_LT(h_y, 2 * w_y) << w_y << "x" << h_y;
+  o.up = UpAxis::kNegZ;  // upside down, still upright
+  const auto [w_down, h_down] = covered_extent(render_ok(pillar, nullptr, o));
+  EXPECT_GT(h_down, 3 * w_down) << w_down << "x" << h_down;
+  UpAxis parsed = UpAxis::kPosY;
+  EXPECT_TRUE(up_axis_from_name("z", parsed));
+  EXPECT_EQ(parsed, UpAxis::kPosZ);
+  EXPECT_TRUE(up_axis_from_name("-x", parsed));
+  EXPECT_EQ(parsed, UpAxis::kNegX);
+  EXPECT_TRUE(up_axis_from_name("+y", parsed));
+  EXPECT_EQ(parsed, UpAxis::kPosY);
+  EXPECT_FALSE(up_axis_from_name("w", parsed));
+  EXPECT_FALSE(up_axis_from_name("", parsed));
 }
 
 TEST(RenderPreview, ViewNamesRoundTrip) {

@@ -25,6 +25,7 @@ struct MapOptions {
   std::string output;
   std::string texture;
   int texture_size = 512;
+  std::string preview_up = "y";
   std::string stats;
   std::string preview;
   bool preview_all = false;
@@ -119,6 +120,9 @@ int run_map(const MapOptions& opt) {
   // Below ~1e-3 px per unit every UV rounds to the same float; above 1e7 faces span millions of px.
   if (!(opt.scale >= 1e-3f && opt.scale <= 1e7f))
     return report_error(usage_error("--scale must be between 0.001 and 1e7 pixels per unit"));
+  UpAxis up;
+  if (!up_axis_from_name(opt.preview_up, up))
+    return report_error(usage_error("--preview-up must be x, y, z, -x, -y or -z, got '" + opt.preview_up + "'"));
   if (!(opt.hop_age >= 0.f && opt.hop_age <= 1.f))
     return report_error(usage_error("--hop-age must be between 0 and 1 radians"));
   if (Status s = check_outputs(output_paths(opt), {opt.input, opt.texture, opt.seam_faces}); !s)
@@ -194,6 +198,7 @@ int run_map(const MapOptions& opt) {
     for (const auto& [view, path] : preview_paths(opt)) {
       RenderOptions render_options;
       render_options.view = view;
+      up_axis_from_name(opt.preview_up, render_options.up);  // checked before any work
       Image picture;
       if (Status s = render_preview(mesh, uv_repeats, atlas.patch, texture.empty() ? nullptr : &texture,
                                     render_options, picture);
@@ -306,6 +311,9 @@ void register_map(CLI::App& app, Runner& run) {
   cmd->add_option("--preview", opt->preview, "Render a 3/4 view of the textured mesh to this PNG");
   cmd->add_flag("--preview-all", opt->preview_all,
                 "With --preview, also write <name>_patches.png, <name>_distortion.png and <name>_checker.png");
+  cmd->add_option("--preview-up", opt->preview_up,
+                  "Mesh axis that points up in the previews: y (default, glTF), z (most scans), x, -x, -y, -z")
+      ->capture_default_str();
   auto* group = cmd->add_option_group("Mapping");
   group->add_option("--mode", opt->mode,
                     "patches: per-corner UVs, bounded per-face stretch, no inverted face (default); "

@@ -20,6 +20,7 @@ struct RenderArgs {
   std::string texture;
   std::string view = "texture";
   std::string size = "1024x768";
+  std::string up = "y";
   float yaw = RenderOptions{}.yaw_degrees;
   float pitch = RenderOptions{}.pitch_degrees;
   float checker = RenderOptions{}.checker_squares;
@@ -46,6 +47,10 @@ int run_render(const RenderArgs& args) {
   if (!parse_size(args.size, options.width, options.height)) {
     return report_error(Status::error(ErrorCode::kInvalidArgument, "", "bad --size '" + args.size + "'",
                                       "expected WIDTHxHEIGHT, e.g. 1024x768"));
+  }
+  if (!up_axis_from_name(args.up, options.up)) {
+    return report_error(Status::error(ErrorCode::kInvalidArgument, "", "bad --up '" + args.up + "'",
+                                      "use x, y, z, -x, -y or -z"));
   }
   options.yaw_degrees = args.yaw;
   options.pitch_degrees = args.pitch;
@@ -94,7 +99,8 @@ void register_render(CLI::App& app, Runner& run) {
       ->check(CLI::IsMember({"texture", "patches", "distortion", "checker"}));
   cmd->add_option("--size", args->size, "picture size WIDTHxHEIGHT (default 1024x768)");
   cmd->add_option("--texture", args->texture, "texture image to use instead of the one in the .glb");
-  cmd->add_option("--yaw", args->yaw, "camera azimuth in degrees around +y (default 35)");
+  cmd->add_option("--up", args->up, "mesh axis that points up in the picture: y (default, glTF), z (most scans), x, -x, -y, -z");
+  cmd->add_option("--yaw", args->yaw, "camera azimuth in degrees around the up axis (default 35)");
   cmd->add_option("--pitch", args->pitch, "camera elevation in degrees (default 25)");
   cmd->add_option("--checker", args->checker, "checker squares per texture repeat (default 8)");
   cmd->add_flag("-q,--quiet", args->quiet, "print nothing but errors");

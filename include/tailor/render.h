@@ -33,11 +33,18 @@ bool preview_view_from_name(std::string_view name, PreviewView& view);
 //! The lowercase name of a view ("texture", ...).
 const char* preview_view_name(PreviewView view);
 
+//! Which mesh axis points up in the picture (scans are often z-up; glTF is y-up).
+enum class UpAxis { kPosY, kPosZ, kPosX, kNegY, kNegZ, kNegX };
+
+//! Parses "y", "z", "x", "-y", "-z" or "-x" (also with a leading '+'); false for anything else.
+bool up_axis_from_name(std::string_view name, UpAxis& up);
+
 struct RenderOptions {
   int width = 1024;                        //!< output width in pixels, 16..8192
   int height = 768;                        //!< output height in pixels, 16..8192
   PreviewView view = PreviewView::kTexture;  //!< what the surface shows
-  float yaw_degrees = 35.0f;               //!< camera azimuth around the up (+y) axis, from +z towards +x
+  UpAxis up = UpAxis::kPosY;               //!< mesh axis shown pointing up (the mesh is turned, not the light)
+  float yaw_degrees = 35.0f;               //!< camera azimuth around the up axis (for +y: from +z towards +x)
   float pitch_degrees = 25.0f;             //!< camera elevation above the horizontal plane, -89..89
   float fov_degrees = 35.0f;               //!< vertical field of view, 5..120
   float checker_squares = 8.0f;            //!< kChecker (and the fallback texture): squares per texture repeat, > 0
