@@ -13,6 +13,11 @@
 // ranked by the 7 x 7 patches their cuts would create (distance to the exemplar patches their
 // pixels came from), the quantity the patch-coherence metric charges (Barnes et al. 2009 for the
 // metric; the per-source candidate patches are PatchMatch's "coherent" candidates, Ashikhmin 2001).
+// Small tolerance sets are topped up with the next best blocks by SSD (on stochastic exemplars
+// the 10 % set often holds one or two smooth blocks, the same for every seed). Where the
+// exemplar's own strongest edge decides the worst seam, the arms' blocks are also ranked by the
+// straight-boundary profile they leave (Quilter::profile_deficit), and a few whole attempts are
+// compared by O(N) checks (make_tile_variants).
 #include "tailor/tiling.h"
 
 #include <opencv2/core.hpp>
@@ -21,8 +26,6 @@
 #include <cmath>
 #include <exception>
 #include <limits>
-#include <cstdio>
-#include <cstdlib>
 
 #include "internal/tiling_util.h"
 #include "tailor/image_ops.h"
@@ -44,6 +47,7 @@ constexpr double kRetryPenalty = 1.0;   // the same for the second try of the ot
 constexpr double kSeamFloor = 1.5;      // worst-seam target: max(exemplar's interior worst, this)
 constexpr double kStrongEdge = 2.0;     // exemplars whose interior worst seam ratio exceeds this get kSmoothPenalty
 constexpr double kSeamHeadroom = 0.998; // an attempt meets the worst-seam target with this much room (a tie is a miss)
+constexpr size_t kScanKeep = 8;         // the SSD scan keeps at least this many lowest positions (see select_candidates)
 constexpr int kMinCandidates = 8;       // a tolerance set smaller than this is topped up with the next best (SSD) blocks
 constexpr int kProfileCandidates = 16;  // the same where the straight-boundary profile is checked
 constexpr double kProfilePower = 8.0;   // cost * (1 + relative profile deficit)^this
@@ -247,33 +251,9 @@ class Quilter {
       chosen = static_cast<int>(rng_.below(static_cast<uint32_t>(nx * ny)));
     } else {
       search_.search(bw, bh, templ_, mask_, ssd_);
-      float best = std::numeric_limits<float>::max();
       float energy = 0.0f;
       for (size_t i = 0; i < templ_.size(); ++i) energy += mask_[i / channels] * templ_[i] * templ_[i];
-      for (int y = 0; y < ny; ++y)
-        for (int x = 0; x < nx; ++x)
-          if (!exclusion.contains(x, y)) best = std::min(best, ssd_[static_cast<size_t>(y) * nx + x]);
-      const bool use_exclusion = best < std::numeric_limits<float>::max();
-      if (!use_exclusion)
-        for (float v : ssd_) best = std::min(best, v);
-      // The small absolute term absorbs FFT round-off (relative ~1e-6 of the template energy).
-      const float threshold = best * static_cast<float>(1.0 + tolerance_) + 1e-5f * energy + 1e-3f;
-      candidates_.clear();
-      for (int y = 0; y < ny; ++y)
-        for (int x = 0; x < nx; ++x)
-          if (ssd_[static_cast<size_t>(y) * nx + x] <= threshold && !(use_exclusion && exclusion.contains(x, y)))
-            candidates_.push_back(y * nx + x);
-      if (candidates_.size() < static_cast<size_t>(min_candidates_)) {
-        ranked_.clear();
-        for (int y = 0; y < ny; ++y)
-          for (int x = 0; x < nx; ++x)
-            if (!(use_exclusion && exclusion.contains(x, y))) ranked_.push_back({ssd_[static_cast<size_t>(y) * nx + x], y * nx + x});
-        const size_t m = std::min(static_cast<size_t>(min_candidates_), ranked_.size());
-        // Ties in SSD are broken by position, so the order does not depend on the sort.
-        std::partial_sort(ranked_.begin(), ranked_.begin() + static_cast<std::ptrdiff_t>(m), ranked_.end());
-        candidates_.clear();
-        for (size_t i = 0; i < m; ++i) candidates_.push_back(ranked_[i].second);
-      }
+      select_candidates(nx, ny, energy, exclusion);
       if (pool_ <= 1 || source_ == nullptr) {
         chosen = candidates_[rng_.below(static_cast<uint32_t>(candidates_.size()))];
       } else {
@@ -296,14 +276,16 @@ class Quilter {
           compute_error(cx, cy);
           take_new_.assign(area, 1);
           for (int side = 0; side < 4; ++side) cut_side(side);
-          double cost = patch_cost(bx, by, cx, cy);
           // Optional: penalise blocks smoother than the exemplar on average (smooth blocks match
           // more easily, and a strip of them lowers the tile's median boundary difference).
+          double smooth_factor = 1.0, profile_factor = 1.0;
           if (gradient_penalty_ > 0.0) {
             const double g = block_gradient(cx, cy);
-            if (g < mean_gradient()) cost *= std::pow(mean_gradient() / std::max(g, 1e-6), gradient_penalty_);
+            if (g < mean_gradient()) smooth_factor = std::pow(mean_gradient() / std::max(g, 1e-6), gradient_penalty_);
           }
-          if (profile_axes_ != 0) cost *= std::pow(1.0 + profile_deficit(bx, by, cx, cy), kProfilePower);
+          if (profile_axes_ != 0) profile_factor = std::pow(1.0 + profile_deficit(bx, by, cx, cy), kProfilePower);
+          // A candidate whose partial cost already exceeds the ties' bound can be neither.
+          const double cost = patch_cost(bx, by, cx, cy, smooth_factor, profile_factor, best_cost * (1.0 + kCostTolerance));
           costs_[i] = cost;
           best_cost = std::min(best_cost, cost);
         }
@@ -346,6 +328,7 @@ class Quilter {
   }
 
   int placed() const { return placed_; }
+
   //! Sum of the ranking costs of the blocks chosen so far (patch cost of their cuts, penalties
   //! included): lower means cuts that the patch-coherence metric charges less.
   double cut_cost() const { return cut_cost_; }
@@ -385,6 +368,65 @@ class Quilter {
   }
 
  private:
+  //! candidates_ = the positions within the SSD tolerance of the best (raster order), excluded
+  //! ones left out (unless all are excluded); fewer than min_candidates_ -> the min_candidates_
+  //! lowest (SSD, position) pairs instead, lowest first (ties to the lower position, so nothing
+  //! depends on a sort order). Without exclusion one pass usually suffices: the kScanKeep lowest
+  //! pairs give the best SSD, and hold the whole tolerance set when their last one is above it.
+  void select_candidates(int nx, int ny, float energy, const Exclusion& exclusion) {
+    const size_t top = static_cast<size_t>(min_candidates_);
+    candidates_.clear();
+    ranked_.clear();
+    // The small absolute term absorbs FFT round-off (relative ~1e-6 of the template energy).
+    auto threshold_of = [&](float best) { return best * static_cast<float>(1.0 + tolerance_) + 1e-5f * energy + 1e-3f; };
+    auto keep_lowest = [&](const std::pair<float, int>& entry, size_t m) {
+      if (ranked_.size() == m) {
+        if (!(entry < ranked_.back())) return;
+        ranked_.pop_back();
+      }
+      ranked_.insert(std::upper_bound(ranked_.begin(), ranked_.end(), entry), entry);
+    };
+    if (!exclusion.active) {
+      const size_t m = std::max(top, kScanKeep);
+      float kept_worst = std::numeric_limits<float>::max();
+      for (size_t i = 0; i < ssd_.size(); ++i) {
+        if (ssd_[i] > kept_worst) continue;
+        keep_lowest({ssd_[i], static_cast<int>(i)}, m);
+        if (ranked_.size() == m) kept_worst = ranked_.back().first;
+      }
+      const float threshold = threshold_of(ranked_.front().first);
+      if (ranked_.size() < m || ranked_.back().first > threshold) {
+        for (const auto& entry : ranked_)
+          if (entry.first <= threshold) candidates_.push_back(entry.second);
+        std::sort(candidates_.begin(), candidates_.end());  // raster order, as a full scan gives
+      } else {
+        for (size_t i = 0; i < ssd_.size(); ++i)
+          if (ssd_[i] <= threshold) candidates_.push_back(static_cast<int>(i));
+      }
+      ranked_.resize(std::min(ranked_.size(), top));
+    } else {
+      float best = std::numeric_limits<float>::max();
+      for (int y = 0; y < ny; ++y)
+        for (int x = 0; x < nx; ++x)
+          if (!exclusion.contains(x, y)) best = std::min(best, ssd_[static_cast<size_t>(y) * nx + x]);
+      const bool use_exclusion = best < std::numeric_limits<float>::max();
+      if (!use_exclusion)
+        for (float v : ssd_) best = std::min(best, v);
+      const float threshold = threshold_of(best);
+      for (int y = 0; y < ny; ++y)
+        for (int x = 0; x < nx; ++x) {
+          if (use_exclusion && exclusion.contains(x, y)) continue;
+          const std::pair<float, int> entry{ssd_[static_cast<size_t>(y) * nx + x], y * nx + x};
+          if (entry.first <= threshold) candidates_.push_back(entry.second);
+          if (top > 0) keep_lowest(entry, top);
+        }
+    }
+    if (candidates_.size() < top) {
+      candidates_.clear();
+      for (const auto& entry : ranked_) candidates_.push_back(entry.second);
+    }
+  }
+
   //! error_ = per-pixel squared difference between the template and the exemplar block at (px, py).
   void compute_error(int px, int py) {
     const int channels = canvas_.channels;
@@ -486,7 +528,9 @@ class Quilter {
   //! (cut by take_new_) and pixels of another source, of the squared distance to the nearest of
   //! the exemplar patches their corner and centre pixels came from: an upper bound of what the
   //! patch coherence metric charges them. Patches still holding unknown pixels are skipped.
-  double patch_cost(int bx, int by, int px, int py) {
+  //! The result is multiplied by factor_a then factor_b; once that exceeds `bound` the sum stops
+  //! and the result is +infinity (the caller only needs costs up to its bound).
+  double patch_cost(int bx, int by, int px, int py, double factor_a, double factor_b, double bound) {
     constexpr int kP = 7, kR = kP - 1;
     const int channels = canvas_.channels;
     const int rw = bw_ + 2 * kR, rh = bh_ + 2 * kR;
@@ -517,16 +561,38 @@ class Quilter {
     }
     double total = 0.0;
     const int ew = ex_.width, eh = ex_.height;
+    // Summed-area tables of: unknown pixels, and pixel pairs (right, down) that are not one
+    // translated copy of the exemplar. A window with none of the latter is an exemplar patch
+    // (cost 0, what the first probe would find), so only windows across a cut are measured.
+    const int sw = rw + 1;
+    sat_unknown_.assign(static_cast<size_t>(sw) * (rh + 1), 0);
+    sat_right_.assign(static_cast<size_t>(sw) * (rh + 1), 0);
+    sat_down_.assign(static_cast<size_t>(sw) * (rh + 1), 0);
+    for (int j = 0; j < rh; ++j) {
+      int row_unknown = 0, row_right = 0, row_down = 0;
+      for (int i = 0; i < rw; ++i) {
+        const size_t r = static_cast<size_t>(j) * rw + i;
+        const bool known = region_known_[r] != 0;
+        row_unknown += known ? 0 : 1;
+        if (i + 1 < rw) row_right += known && region_known_[r + 1] && region_src_[r + 1] == region_src_[r] + 1 ? 0 : 1;
+        if (j + 1 < rh) row_down += known && region_known_[r + static_cast<size_t>(rw)] &&
+                                            region_src_[r + static_cast<size_t>(rw)] == region_src_[r] + ew
+                                        ? 0
+                                        : 1;
+        const size_t k = static_cast<size_t>(j + 1) * sw + i + 1;
+        sat_unknown_[k] = sat_unknown_[k - static_cast<size_t>(sw)] + row_unknown;
+        sat_right_[k] = sat_right_[k - static_cast<size_t>(sw)] + row_right;
+        sat_down_[k] = sat_down_[k - static_cast<size_t>(sw)] + row_down;
+      }
+    }
+    auto box = [&](const std::vector<int>& sat, int x0, int y0, int x1, int y1) {  // sum over [x0, x1) x [y0, y1)
+      return sat[static_cast<size_t>(y1) * sw + x1] - sat[static_cast<size_t>(y0) * sw + x1] -
+             sat[static_cast<size_t>(y1) * sw + x0] + sat[static_cast<size_t>(y0) * sw + x0];
+    };
     for (int j = 0; j + kR < rh; ++j) {
       for (int i = 0; i + kR < rw; ++i) {
-        bool complete = true;
-        for (int b = 0; b < kP && complete; ++b)
-          for (int a = 0; a < kP; ++a)
-            if (!region_known_[static_cast<size_t>(j + b) * rw + i + a]) {
-              complete = false;
-              break;
-            }
-        if (!complete) continue;
+        if (box(sat_unknown_, i, j, i + kP, j + kP) != 0) continue;  // still holds unknown pixels
+        if (box(sat_right_, i, j, i + kR, j + kP) == 0 && box(sat_down_, i, j, i + kP, j + kR) == 0) continue;
         static constexpr int kProbe[5][2] = {{0, 0}, {kR, 0}, {0, kR}, {kR, kR}, {kR / 2, kR / 2}};
         int32_t tried[5];
         int n_tried = 0;
@@ -551,9 +617,10 @@ class Quilter {
           if (best == 0.0f) break;
         }
         total += best;
+        if (total * factor_a * factor_b > bound) return std::numeric_limits<double>::infinity();
       }
     }
-    return total;
+    return total * factor_a * factor_b;
   }
 
   // side: 0 left, 1 right, 2 top, 3 bottom. Pixels beyond the cut (towards the side) keep the old value.
@@ -625,6 +692,7 @@ class Quilter {
   std::vector<float> region_val_;
   std::vector<int32_t> region_src_;
   std::vector<uint8_t> region_known_;
+  std::vector<int> sat_unknown_, sat_right_, sat_down_;
   int min_candidates_ = 0;
   std::vector<std::pair<float, int>> ranked_;
   double cut_cost_ = 0.0;
@@ -953,7 +1021,8 @@ Status make_tile_variants(const Image& exemplar, const TileOptions& options, int
     // small exemplars get a few attempts with derived random streams (best of them by cut cost,
     // the proxy of patch coherence), and a smooth-block penalty is a last try when the worst seam
     // misses its target. Each check of the worst seam is O(N); the better result is kept.
-    const double exemplar_worst = worst_seam_ratio(ex, false);
+    // The reference is the input as given (with fit_period, `ex` also holds the fold seam).
+    const double exemplar_worst = worst_seam_ratio(internal::to_plane(exemplar), false);
     const double target = std::max(exemplar_worst, kSeamFloor);
     std::vector<CrossPlan> plans;
     if (exemplar_worst > kStrongEdge) {
@@ -973,14 +1042,14 @@ Status make_tile_variants(const Image& exemplar, const TileOptions& options, int
       // Later plans of strong-edge exemplars, and the smooth-penalty retry, run only if needed.
       if (i >= retry_plan && base_meets) break;
       TileOptions plan_options = base_options;
-      if (i > 0) plan_options.progress = nullptr;
+      // Later attempts report the base share as done, and can still be cancelled.
+      if (i > 0 && base_options.progress) plan_options.progress = [&](double) { return base_options.progress(1.0); };
       Plane canvas;
       int blocks = 0;
       double cost = 0.0;
       TAILOR_RETURN_IF_ERROR(quilt_cross(setup, plan_options, plans[i], search, canvas, blocks, cost));
       const double worst = worst_seam_ratio(canvas, true);
       const bool meets = worst <= target * kSeamHeadroom;
-      if (getenv("TP_DBG")) fprintf(stderr, "plan %zu worst %.5f target %.5f cost %.1f\n", i, worst, target, cost);
       // Meeting the seam target first, then the lower cut cost (or, both missing, the lower worst seam).
       const bool better = i == 0 || (meets && !base_meets) ||
                           (meets == base_meets && (meets ? cost < base_cost : worst < base_worst));

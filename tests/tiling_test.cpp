@@ -259,6 +259,24 @@ TEST(Tiling, SmallAndNonSquareImagesWork) {
   EXPECT_LT(m.wrap_ratio_y, 1.5);
 }
 
+// Regression: above ~900 px the coherence grid's stride exceeds 6, and its last patch used to stop
+// short of the wrap, so an image's own toroidal coherence read 0 whatever its wrap seam.
+TEST(Tiling, ToroidalCoherenceSeesTheWrapSeamOfLargeImages) {
+  Image ramp;
+  ramp.width = 1000;
+  ramp.height = 1000;
+  ramp.channels = 1;
+  ramp.pixels.resize(static_cast<size_t>(ramp.width) * ramp.height);
+  for (int y = 0; y < ramp.height; ++y)
+    for (int x = 0; x < ramp.width; ++x)
+      ramp.pixels[static_cast<size_t>(y) * ramp.width + x] = static_cast<uint8_t>((x * 255) / (ramp.width - 1));
+  TileMetrics m;
+  ASSERT_TRUE(tile_metrics(ramp, &ramp, m).is_ok());
+  EXPECT_GT(m.exemplar_wrap_ratio_x, 10.0);     // a hard seam: 255 -> 0
+  EXPECT_GT(m.exemplar_patch_coherence, 1e-3);  // was exactly 0
+  EXPECT_DOUBLE_EQ(m.patch_coherence, m.exemplar_patch_coherence);
+}
+
 TEST(Tiling, BadInputsAndOptionsAreErrors) {
   Image tiny = stripes(20, 20, 4);
   Image out;

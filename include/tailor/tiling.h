@@ -11,10 +11,18 @@
 //      within `tolerance` of the best SSD over their overlap (colour searched in luminance), of
 //      which up to 32 drawn at random (seeded) are ranked by the 7 x 7 patches their
 //      minimum-error boundary cuts would create (distance to the exemplar patches their pixels
-//      came from, i.e. what the patch-coherence metric charges); smooth blocks are penalised on
-//      exemplars whose strongest interior edge decides the worst seam, and once more (second
-//      try) when the worst seam misses its target. Pixels outside the repaired strips stay
-//      bit-exact copies of the shifted exemplar.
+//      came from, i.e. what the patch-coherence metric charges); a tolerance set of fewer than 8
+//      blocks is topped up with the next best by SSD so that the ranking has a choice.
+//      On exemplars whose strongest interior edge decides the worst seam (interior worst > 2 x
+//      median), that edge is kept verbatim, so its ratio must not rise at all: there smooth
+//      blocks are penalised and each arm's blocks are also ranked by how much they smooth the
+//      straight row (column) boundaries they cross, or strengthen a strong one, against the
+//      shifted exemplar (tops up to 16 blocks); if the worst seam still misses, the vertical arm
+//      is redone without that check. On the other exemplars, images under 226 x 226 px get 2 to
+//      4 attempts (floor(320^2 / pixels)) with derived random streams (kept: the one meeting the
+//      worst-seam target with the lowest total cut cost), and a smooth-block penalty is a last
+//      try when none meets it.
+//      Pixels outside the repaired strips stay bit-exact copies of the shifted exemplar.
 // make_tile_variants() adds tiles whose outer ring (TileReport::border px) is bit-identical to the
 // first one while the interior is re-quilted with 2 x 2 large blocks, so they can be mixed for
 // aperiodic tiling (thesis 3.2).
@@ -24,9 +32,10 @@
 //
 // Images follow the layout of image.h (1 to 4 channels; alpha is just a channel, except that the
 // FFT search of 3- and 4-channel images runs on the RGB luminance; the ranking uses all channels).
-// Cost: O(blocks * N log N) for an N-pixel exemplar (one FFT correlation per block); about 0.5 s
-// for a 512 x 512 RGB or grey exemplar on one core (5 s for 1024 x 1024), twice that when the
-// second try is needed. Memory: a few float copies of the exemplar plus up to 8 FFT spectra.
+// Cost: O(blocks * N log N) for an N-pixel exemplar (one FFT correlation per block); about 0.6 s
+// for a 512 x 512 RGB or grey exemplar on one core (5-6 s for 1024 x 1024), twice that when a
+// second try is needed; about 0.07 s for 128 x 128 (several attempts). Memory: a few float
+// copies of the exemplar plus up to 8 FFT spectra.
 // Deterministic: same input + options -> bit-identical output. Safe for untrusted images (sizes
 // are checked; nothing is assumed about the pixel values).
 #pragma once
@@ -127,7 +136,8 @@ struct TileMetrics {
 
 //! Computes TileMetrics of `tile`, comparing with `exemplar` when it is not null (channel counts may
 //! differ: both are then compared in luminance). Patch coherence: tile patches on a fixed grid
-//! (stride 1 up to 128 x 128 px, else the smallest stride giving <= 16384 patches); patches copied
+//! (stride 1 up to 128 x 128 px, else the smallest stride giving <= 16384 patches; the last patch
+//! of each row and column straddles the wrap, so the wrap seam is always sampled); patches copied
 //! verbatim are found exactly by hashing every exemplar patch, the others by PatchMatch (Barnes et
 //! al. 2009, constant seed, 6 iterations), so the value is an upper bound of the exact one, and
 //! deterministic. Cost: O(N) plus ~0.1 s per 512 px image. Fails with kInvalidImage for an
@@ -136,7 +146,7 @@ Status tile_metrics(const Image& tile, const Image* exemplar, TileMetrics& metri
 
 //! The quality targets: wrap ratios in [0.8, 1.2], worst seam <= max(exemplar's, 1.5),
 //! histogram L1 <= 0.1, gradient ratio >= 0.95, patch coherence <= the exemplar's toroidal one
-//! (+ 5 % for the randomised estimator). Returns true when all hold; `failed` lists the others.
+//! (no allowance). Returns true when all hold; `failed` lists the others.
 bool meets_tile_targets(const TileMetrics& metrics, std::string* failed = nullptr);
 
 }  // namespace tailor
