@@ -146,6 +146,9 @@ class SeamShortener {
     float candidate[6];
     for (int k = 0; k < 3; ++k) {
       if (!ends[k][0]) continue;
+      // With one seam edge, only copying that edge from across it can close it: copying an edge
+      // f already shares keeps the seam and at best moves one corner onto it.
+      if (seams == 1 && !seam[k]) continue;
       const int ka = k, kb = kNext[k], kc = kPrev[k];
       candidate[2 * ka] = ends[k][0][0];
       candidate[2 * ka + 1] = ends[k][0][1];
