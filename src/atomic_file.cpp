@@ -10,6 +10,37 @@
 #include <cstring>
 
 namespace tailor::internal {
+namespace {
+thread_local FileBatch* active_batch = nullptr;
+}  // namespace
+
+FileBatch::FileBatch() : outer_(active_batch) { active_batch = this; }
+
+FileBatch::~FileBatch() {
+  for (const auto& [temporary, path] : staged_) std::remove(temporary.c_str());
+  active_batch = outer_;
+}
+
+void FileBatch::add(std::string temporary, std::string path) {
+  // The same path written twice in one batch: its temporary file holds the last bytes already.
+  for (const auto& staged : staged_)
+    if (staged.second == path) return;
+  staged_.emplace_back(std::move(temporary), std::move(path));
+}
+
+Status FileBatch::commit() {
+  std::vector<std::pair<std::string, std::string>> staged;
+  staged.swap(staged_);
+  for (size_t i = 0; i < staged.size(); ++i) {
+    if (std::rename(staged[i].first.c_str(), staged[i].second.c_str()) != 0) {
+      const int err = errno;
+      for (size_t j = i; j < staged.size(); ++j) std::remove(staged[j].first.c_str());
+      return Status::error(ErrorCode::kIo, staged[i].second,
+                           std::string("cannot rename temporary file: ") + std::strerror(err));
+    }
+  }
+  return Status::ok();
+}
 
 Status write_file_atomic(const std::string& path, std::span<const char> bytes) {
   const std::string tmp = path + ".tmp-" + std::to_string(static_cast<long>(getpid()));
@@ -22,6 +53,10 @@ Status write_file_atomic(const std::string& path, std::span<const char> bytes) {
     const int err = errno;
     std::remove(tmp.c_str());
     return Status::error(ErrorCode::kIo, path, std::string("cannot write file: ") + std::strerror(err));
+  }
+  if (active_batch) {
+    active_batch->add(tmp, path);
+    return Status::ok();
   }
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
     const int err = errno;

@@ -710,6 +710,49 @@ TEST(LoadMesh, SniffsContentAndReportsIoErrors) {
   EXPECT_EQ(mesh_format_from_path("d.stl.bak"), MeshFormat::kUnknown);
 }
 
+TEST(AtomicFiles, ABatchLandsWholeOrNotAtAll) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(::testing::TempDir()) / "io_test_batch";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string a = (dir / "a.txt").string(), b = (dir / "b.txt").string();
+  ASSERT_TRUE(internal::write_file_atomic(a, std::string("old a\n")).is_ok());
+  auto content = [](const std::string& path) {
+    std::string bytes;
+    return internal::read_file(path, bytes).is_ok() ? bytes : std::string("<missing>");
+  };
+  auto entries = [&dir] {
+    size_t n = 0;
+    for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) ++n;
+    return n;
+  };
+  {
+    // A command that fails after its first write: nothing lands, the old file stays, no temp left.
+    internal::FileBatch batch;
+    ASSERT_TRUE(internal::write_file_atomic(a, std::string("new a\n")).is_ok());
+    ASSERT_TRUE(internal::write_file_atomic(b, std::string("new b\n")).is_ok());
+    EXPECT_EQ(content(a), "old a\n");
+    EXPECT_EQ(content(b), "<missing>");
+  }
+  EXPECT_EQ(content(a), "old a\n");
+  EXPECT_EQ(content(b), "<missing>");
+  EXPECT_EQ(entries(), 1u);
+  {
+    internal::FileBatch batch;
+    ASSERT_TRUE(internal::write_file_atomic(a, std::string("new a\n")).is_ok());
+    ASSERT_TRUE(internal::write_file_atomic(b, std::string("first b\n")).is_ok());
+    ASSERT_TRUE(internal::write_file_atomic(b, std::string("new b\n")).is_ok());  // last write wins
+    ASSERT_TRUE(batch.commit().is_ok());
+  }
+  EXPECT_EQ(content(a), "new a\n");
+  EXPECT_EQ(content(b), "new b\n");
+  EXPECT_EQ(entries(), 2u);
+  // Without a batch, writes land at once again.
+  ASSERT_TRUE(internal::write_file_atomic(b, std::string("plain\n")).is_ok());
+  EXPECT_EQ(content(b), "plain\n");
+  fs::remove_all(dir);
+}
+
 TEST(Errors, FinalizeRejectsBadArraysAndLimits) {
   Mesh m;
   m.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0};

@@ -209,7 +209,9 @@ int run_map(const MapOptions& opt) {
     preview_seconds = seconds_since(preview_start);
   }
 
-  // === Export, then the pictures (every output was checked up front) ===
+  // === Export, then the pictures, then the report (every output was checked up front) ===
+  // Staged together: they land only when all of them were written (nothing on a late failure).
+  internal::FileBatch batch;
   const auto export_start = std::chrono::steady_clock::now();
   ExportOptions export_options;
   export_options.texture_path = opt.texture;
@@ -274,6 +276,7 @@ int run_map(const MapOptions& opt) {
     const std::string text = json_text(j) + "\n";
     if (Status s = internal::write_file_atomic(opt.stats, text); !s) return report_error(s);
   }
+  if (Status s = batch.commit(); !s) return report_error(s);
   if (!opt.quiet) {
     std::printf(
         "%s: %zu faces, %u patches, seams %.2f%% of edge length, %zu flipped, stretch %.3f, L2 %.3f, "

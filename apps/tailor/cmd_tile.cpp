@@ -103,7 +103,9 @@ int run_tile(const TileCliOptions& opt) {
   if (!status) return report_error(status.with_file(opt.input));
   for (const std::string& w : report.warnings) warn(opt.quiet, opt.input + ": " + w);
 
-  // Output names: OUT itself, or OUT-without-.png + "_k.png" for variants.
+  // Output names: OUT itself, or OUT-without-.png + "_k.png" for variants. All outputs are staged
+  // and land together at the end (none on a failure half-way).
+  internal::FileBatch batch;
   std::vector<std::string> files;
   for (size_t k = 0; k < tiles.size(); ++k) {
     const std::string path = opt.variants == 1 ? opt.output : stem + "_" + std::to_string(k) + ".png";
@@ -128,7 +130,10 @@ int run_tile(const TileCliOptions& opt) {
     if (Status s = internal::write_file_atomic(stem + ".json", json_text(j) + "\n"); !s) return report_error(s);
   }
 
-  if (opt.quiet && opt.json.empty()) return kExitOk;
+  if (opt.quiet && opt.json.empty()) {
+    if (Status s = batch.commit(); !s) return report_error(s);
+    return kExitOk;
+  }
   // Metrics against the input as given (also when the tile was period-fitted).
   std::vector<TileMetrics> metrics(tiles.size());
   for (size_t k = 0; k < tiles.size(); ++k)
@@ -168,6 +173,7 @@ int run_tile(const TileCliOptions& opt) {
     j["targets_met"] = meets_tile_targets(worst);
     if (Status s = internal::write_file_atomic(opt.json, json_text(j) + "\n"); !s) return report_error(s);
   }
+  if (Status s = batch.commit(); !s) return report_error(s);
   if (!opt.quiet) {
     std::string out = opt.variants == 1 ? opt.output : stem + "_{0.." + std::to_string(opt.variants - 1) + "}.png";
     std::string failed;
