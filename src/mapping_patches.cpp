@@ -496,17 +496,25 @@ class PatchMapper {
     }
     if (absorbing_) return;  // the absorption pass keeps its own queue
     // Age offset of the neighbours pushed now. Default: grows with the length of f's path from its
-    // patch's seed in faces (hops: one more than its fewest among placed neighbours of the patch),
-    // so the order in which two faces are reached depends only on the faces between them and the
-    // seed, not on how many faces elsewhere were placed first. With the thesis's global counter,
+    // component's seed in faces (hops: one more than its fewest among placed neighbours of its
+    // patch; a patch's first face continues from its placed neighbours in other patches), so the
+    // order in which two faces are reached depends only on the faces between them and the seed,
+    // not on how many faces elsewhere were placed first; and the deferred face that seeds the
+    // next patch is the one nearest the seed among equals. With the thesis's global counter,
     // removing a part of the mesh shifted every later key and reordered the growth everywhere
-    // (stability, removing 10%: bit-identical corners 14-97% -> 94-99.9%, docs/mapping.md).
+    // (stability, removing 10%: bit-identical corners 14-97% -> 84-99.9%, docs/mapping.md).
     float age_offset;
     if (hop_age_ > 0.f) {
       uint32_t fewest = kInvalid;
       for (int k = 0; k < 3; ++k) {
         const uint32_t o = self.opposite[k];
         if (o != kInvalid && rec_[o / 3].patch == p) fewest = std::min(fewest, hops_[o / 3]);
+      }
+      if (fewest == kInvalid) {  // a new patch's seed
+        for (int k = 0; k < 3; ++k) {
+          const uint32_t o = self.opposite[k];
+          if (o != kInvalid && rec_[o / 3].patch != kInvalid) fewest = std::min(fewest, hops_[o / 3]);
+        }
       }
       const uint32_t hops = fewest == kInvalid ? 0 : fewest + 1;
       hops_[f] = hops;

@@ -28,12 +28,16 @@ class SeamShortener {
 
   //! seam_mark: per face, 1 on every face with a seam edge (others may be 1 too); cleared.
   uint64_t run(std::vector<uint8_t>& seam_mark) {
-
     opposite_ = in_.topology.opposite.data();
     uv_ = atlas_.corner_uv.data();
     bound_ = in_.options.max_stretch;
     scale_ = in_.options.scale;
     seam_flags_ = in_.options.seam_faces.empty() ? nullptr : in_.options.seam_faces.data();
+    // A move must not shrink its patch under the absorption's minimum (a patch may still vanish
+    // when its last face leaves): the shortening never makes tiny or single-face patches.
+    min_keep_ = std::max<uint32_t>(in_.options.min_patch_faces, 2);
+    patch_size_.assign(atlas_.patch_count, 0);
+    for (const uint32_t p : atlas_.patch) ++patch_size_[p];
     const uint64_t moves = move_faces(seam_mark);
     compact_patches();
     return moves;
@@ -180,8 +184,14 @@ class SeamShortener {
       }
     }
     if (best_edge < 0) return false;
+    const uint32_t from = atlas_.patch[f], to = atlas_.patch[opposite_[3 * f + best_edge] / 3];
+    if (from != to) {
+      if (patch_size_[from] != 1 && patch_size_[from] - 1 < min_keep_) return false;
+      --patch_size_[from];
+      ++patch_size_[to];
+    }
     std::copy(best, best + 6, own);
-    atlas_.patch[f] = atlas_.patch[opposite_[3 * f + best_edge] / 3];
+    atlas_.patch[f] = to;
     return true;
   }
 
@@ -202,6 +212,8 @@ class SeamShortener {
   float* uv_ = nullptr;
   const uint8_t* seam_flags_ = nullptr;  // user seam faces, or nullptr
   float bound_ = 0.f, scale_ = 1.f;
+  uint32_t min_keep_ = 2;
+  std::vector<uint32_t> patch_size_;  // faces per patch, kept up to date by the moves
 };
 
 }  // namespace

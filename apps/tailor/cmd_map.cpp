@@ -335,7 +335,7 @@ void register_map(CLI::App& app, Runner& run) {
                     "patches mode: smaller patches are absorbed into a neighbour (0 keeps all)")
       ->capture_default_str();
   group->add_option("--hop-age", opt->hop_age,
-                    "patches mode: growth-order age per face of path from the patch seed, radians (0..1); keeps the "
+                    "patches mode: growth-order age per face of path from the seed, radians (0..1); keeps the "
                     "order local so removing part of a mesh changes little elsewhere; 0 = the thesis's global counter")
       ->capture_default_str();
   group->add_flag("--no-seam-shortening", opt->keep_seams,

@@ -2,7 +2,7 @@
 //
 // A greedy front grows over the mesh face by face. Faces waiting on the front are keyed by
 // (number of placed edge neighbours, most first; then age = variation + hop_age times the face's
-// path length from its patch's seed, least first), so the texture spreads through regions where the orientation field is homogeneous and
+// path length from its component's seed, least first), so the texture spreads through regions where the orientation field is homogeneous and
 // stops at faces where it varies (geometric edges, field singularities): those become seams.
 // A face is placed by unfolding it across an edge from a placed neighbour's corner UVs: the two
 // shared corners are copied and the third comes from a second placed neighbour, from the UV the
@@ -62,7 +62,7 @@ struct MappingOptions {
   double factor_step = -1.0;        //!< age added per placed face, a global counter (radians); < 0 = mode default:
                                     //!< 1/#F in kThesis (as the thesis), the hop rule below in kPatches (1e-4
                                     //!< per face when hop_age is 0); >= 0 in kPatches: this counter, no hops
-  float hop_age = 0.02f;            //!< kPatches: age added per face of path from the patch's seed (radians,
+  float hop_age = 0.02f;            //!< kPatches: age added per face of path from the component's seed (radians,
                                     //!< 0..1; 0 = use the global counter). Local, so removing part of a mesh
                                     //!< leaves the growth order elsewhere unchanged (stability); larger values
                                     //!< grow rounder patches (more seam), smaller follow the field's variation
