@@ -136,7 +136,33 @@ class SeamShortener {
     float best[6];
     float best_gain = 0.f, best_stretch = 0.f;
     int best_edge = -1;
+    // Which neighbours' patches f may join: its own always; another only if f's patch keeps at
+    // least the absorption minimum and stays in one piece without f.
+    const uint32_t from = atlas_.patch[f];
+    bool may_join[3] = {false, false, false};
+    int may_leave = -1;  // -1 unknown, 0 no, 1 yes
+    for (int k = 0; k < 3; ++k) {
+      if (!ends[k][0]) continue;
+      const uint32_t to = atlas_.patch[opposite_[3 * f + k] / 3];
+      if (to == from) {
+        may_join[k] = true;
+        continue;
+      }
+      if (may_leave < 0) may_leave = can_leave(f) ? 1 : 0;
+      may_join[k] = may_leave == 1;
+    }
+    // Edges towards user seam faces keep their state: the seams asked for stay where they are.
+    bool fixed[3] = {false, false, false};
+    if (seam_flags_) {
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t o = opposite_[3 * f + k];
+        fixed[k] = o != kInvalid && seam_flags_[o / 3];
+      }
+    }
     auto consider = [&](const float* candidate, int k) {
+      if (!may_join[k]) return;
+      for (int j = 0; j < 3; ++j)
+        if (fixed[j] && seam_at(candidate, j) != seam[j]) return;
       const float gain = before - seam_cost(candidate);
       if (!(gain > min_gain) || gain < best_gain) return;
       const float s = degenerate ? 0.f : stretch_error(frame, candidate);
@@ -184,15 +210,57 @@ class SeamShortener {
       }
     }
     if (best_edge < 0) return false;
-    const uint32_t from = atlas_.patch[f], to = atlas_.patch[opposite_[3 * f + best_edge] / 3];
+    const uint32_t to = atlas_.patch[opposite_[3 * f + best_edge] / 3];
     if (from != to) {
-      if (patch_size_[from] != 1 && patch_size_[from] - 1 < min_keep_) return false;
       --patch_size_[from];
       ++patch_size_[to];
     }
     std::copy(best, best + 6, own);
     atlas_.patch[f] = to;
     return true;
+  }
+
+  // Whether f may leave its patch: the patch keeps at least min_keep_ faces (or vanishes with its
+  // last one) and stays in one piece. A patch is edge-connected, so it can only fall apart when
+  // f links two of its faces; f has at most two neighbours in the patch here (it joins another
+  // patch through the third edge), and those two share f's corner between their edges: the patch
+  // stays whole if the fan of faces around that corner joins them without f. This misses only
+  // links through longer detours (then the move is refused, never wrongly allowed).
+  bool can_leave(uint32_t f) const {
+    const uint32_t from = atlas_.patch[f];
+    if (patch_size_[from] != 1 && patch_size_[from] - 1 < min_keep_) return false;
+    int inside[2];
+    int count = 0;
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t o = opposite_[3 * f + k];
+      if (o != kInvalid && atlas_.patch[o / 3] == from) {
+        if (count == 2) return false;
+        inside[count++] = k;
+      }
+    }
+    if (count < 2) return true;
+    // Edges inside[0] and inside[1] share one corner of f: the end of one is the start of the other.
+    const int ka = inside[0], kb = inside[1];
+    const int corner = kNext[ka] == kb ? kb : ka;
+    const uint32_t v = in_.mesh.indices[3 * f + corner];
+    const uint32_t na = opposite_[3 * f + ka] / 3, nb = opposite_[3 * f + kb] / 3;
+    if (na == nb) return true;
+    // Walk the fan around v from na, away from f, through faces of the patch, until nb.
+    uint32_t e = opposite_[3 * f + ka];
+    for (int steps = 0; steps < 64 && e != kInvalid; ++steps) {
+      const uint32_t g = e / 3;
+      if (g == nb) return true;
+      if (g == f || atlas_.patch[g] != from) return false;
+      // g's two edges at v: edge j (v -> next) and edge j-1 (prev -> v); leave by the one not
+      // entered through.
+      int j = 0;
+      while (j < 3 && in_.mesh.indices[3 * g + static_cast<uint32_t>(j)] != v) ++j;
+      if (j == 3) return false;
+      const int entered = static_cast<int>(e % 3);
+      const int leave = entered == j ? kPrev[j] : j;
+      e = opposite_[3 * g + static_cast<uint32_t>(leave)];
+    }
+    return false;
   }
 
   // Patches that lost all their faces are dropped; the others keep their order.

@@ -87,6 +87,31 @@ bool is_degenerate(const FaceFrames& frames, size_t f) {
   return !(twice_area > 1e-6f * longest);
 }
 
+// Every patch is one edge-connected region (flood fill within each patch id).
+void expect_connected_patches(const Mapped& m, const std::string& name) {
+  const size_t face_count = m.mesh.face_count();
+  std::vector<uint8_t> seen(face_count, 0);
+  std::vector<uint32_t> regions(m.atlas.patch_count, 0), stack;
+  for (size_t start = 0; start < face_count; ++start) {
+    if (seen[start]) continue;
+    const uint32_t p = m.atlas.patch[start];
+    ++regions[p];
+    seen[start] = 1;
+    stack.assign(1, static_cast<uint32_t>(start));
+    while (!stack.empty()) {
+      const uint32_t f = stack.back();
+      stack.pop_back();
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t o = m.topology.opposite[3 * f + k];
+        if (o == kInvalid || seen[o / 3] || m.atlas.patch[o / 3] != p) continue;
+        seen[o / 3] = 1;
+        stack.push_back(o / 3);
+      }
+    }
+  }
+  for (uint32_t p = 0; p < m.atlas.patch_count; ++p) EXPECT_EQ(regions[p], 1u) << name << " patch " << p;
+}
+
 // The invariants every patches-mode atlas must hold.
 void expect_valid_patches_atlas(const Mapped& m, const MappingOptions& options, const std::string& name) {
   const size_t face_count = m.mesh.face_count();
@@ -108,6 +133,7 @@ void expect_valid_patches_atlas(const Mapped& m, const MappingOptions& options, 
   }
   EXPECT_GT(checked, face_count * 9 / 10) << name;
   for (uint32_t p = 0; p < m.atlas.patch_count; ++p) EXPECT_GT(patch_faces[p], 0u) << name << " patch " << p;
+  expect_connected_patches(m, name);
   const UvMetrics metrics = metrics_of(m);
   EXPECT_EQ(metrics.flipped, 0u) << name;
   EXPECT_EQ(metrics.zero_uv_area_faces, 0u) << name;
@@ -177,6 +203,15 @@ TEST(Mapping, SeamShorteningShortensSeamsWithinTheBound) {
     EXPECT_LT(with.seam_edges, without.seam_edges) << name;
     EXPECT_LE(with.patches, without.patches) << name;
   }
+  // Without absorption, patches are small and many: moving a face out of one must never cut it in
+  // two (it did on the horse before the fan check: 3 patches split).
+  Mapped small;
+  small.mesh = load("horse.ply");
+  MappingOptions keep_all;
+  keep_all.min_patch_faces = 0;
+  map_mesh(small, keep_all);
+  EXPECT_GT(small.stats.faces_reseamed, 0u);
+  expect_connected_patches(small, "horse.ply, min_patch_faces 0");
 }
 
 TEST(Mapping, FlatGridIsOnePatchWithoutSeamOrDistortion) {
@@ -343,6 +378,12 @@ TEST(Mapping, SeamFacesAttractTheSeams) {
   RecordProperty("seam_edges_on_band_before", static_cast<int>(before));
   RecordProperty("seam_edges_on_band_after", static_cast<int>(after));
   EXPECT_GT(after, before + before / 4) << "before " << before << " after " << after;
+  // The seam shortening leaves the edges around marked faces as the growth put them.
+  Mapped unshortened;
+  unshortened.mesh = plain.mesh;
+  options.shorten_seams = false;
+  map_mesh(unshortened, options);
+  EXPECT_GE(after, seam_edges_on(unshortened, marked));
 }
 
 TEST(Mapping, FaceStretchErrorMeasuresSingularValues) {

@@ -105,7 +105,8 @@ struct MappingStats {
   uint64_t faces_rigid = 0;         //!< kPatches: faces placed rigidly (patch seeds, absorbed faces)
   uint64_t faces_cut = 0;           //!< kPatches: faces joined across one edge while disagreeing with another
                                     //!< placed neighbour of their patch (each leaves at least one cut edge)
-  uint64_t faces_reseamed = 0;      //!< kPatches: faces re-placed after the growth to shorten the seams
+  uint64_t faces_reseamed = 0;      //!< kPatches: re-placements after the growth that shortened the seams (a face
+                                    //!< can move more than once)
   uint64_t faces_seam = 0;          //!< faces flagged in seam_faces
   uint64_t inverted_accepted = 0;   //!< kThesis: faces accepted with a non-positive UV area (always 0 in kPatches)
   double seconds = 0.0;             //!< wall time of map_texture
