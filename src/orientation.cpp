@@ -10,7 +10,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <string>
+#include <thread>
 
 #include "internal/huge_pages.h"
 
@@ -47,6 +49,8 @@ Vec3 perpendicular(const Vec3& a) {
 // A face is degenerate when its doubled area is below this fraction of its squared longest edge
 // (or the edge itself vanishes): its normal is then numerically meaningless.
 constexpr double kDegenerateRatio = 1e-10;
+// Below this many faces per thread, starting threads costs more than it saves.
+constexpr size_t kFacesPerThread = 100000;
 
 inline Vec3 load(const float* v) { return {v[0], v[1], v[2]}; }
 inline void store(float* out, const Vec3& v) {
@@ -177,31 +181,57 @@ Status compute_orientation(const Mesh& mesh, const Topology& topology, const Ori
     frames.anchor[2 * f] = static_cast<float>(dot(p0, o));
     frames.anchor[2 * f + 1] = static_cast<float>(dot(p0, p));
   };
-  for (size_t f = 0; f < face_count; ++f) {
-    const Vec3 p0 = corner(f, 0), p1 = corner(f, 1), p2 = corner(f, 2);
-    const Vec3 e1 = sub(p1, p0), e2 = sub(p2, p0);
-    Vec3 n = cross(e1, e2);
-    const double twice_area = norm(n);
-    const double longest2 = std::max({dot(e1, e1), dot(e2, e2), dot(sub(p2, p1), sub(p2, p1))});
-    Vec3 o;
-    if (!(twice_area > kDegenerateRatio * longest2) || !(longest2 > 0)) {
-      // Zero-area face: any orthonormal frame; o along its longest edge when there is one.
-      degenerate[f] = 1;
-      ++frames.degenerate_faces;
-      n = perpendicular(axis);
-      if (!project(axis, n, degenerate_cos, o)) o = perpendicular(n);
-    } else {
-      n = mul(n, 1.0 / twice_area);
-      if (!project(axis, n, degenerate_cos, o)) {
-        ++frames.fallback_faces;
-        if (!project(axis2, n, degenerate_cos, o)) o = perpendicular(n);
+  // Faces are independent here: large meshes are split into one contiguous range per thread
+  // (each writes only its own faces; counters are summed after), so the result is the same
+  // bit for bit whatever the thread count.
+  auto frame_faces = [&](size_t begin, size_t end, size_t& degenerate_faces, size_t& fallback_faces) {
+    for (size_t f = begin; f < end; ++f) {
+      const Vec3 p0 = corner(f, 0), p1 = corner(f, 1), p2 = corner(f, 2);
+      const Vec3 e1 = sub(p1, p0), e2 = sub(p2, p0);
+      Vec3 n = cross(e1, e2);
+      const double twice_area = norm(n);
+      const double longest2 = std::max({dot(e1, e1), dot(e2, e2), dot(sub(p2, p1), sub(p2, p1))});
+      Vec3 o;
+      if (!(twice_area > kDegenerateRatio * longest2) || !(longest2 > 0)) {
+        // Zero-area face: any orthonormal frame; o along its longest edge when there is one.
+        degenerate[f] = 1;
+        ++degenerate_faces;
+        n = perpendicular(axis);
+        if (!project(axis, n, degenerate_cos, o)) o = perpendicular(n);
+      } else {
+        n = mul(n, 1.0 / twice_area);
+        if (!project(axis, n, degenerate_cos, o)) {
+          ++fallback_faces;
+          if (!project(axis2, n, degenerate_cos, o)) o = perpendicular(n);
+        }
       }
+      store(&frames.normal[3 * f], n);
+      store(&frames.orientation[3 * f], o);
+      frames.area[f] = static_cast<float>(0.5 * twice_area);
+      // Without smoothing the frame is final: finish the face while its corners are in cache.
+      if (options.smooth_passes == 0) write_corner_frame(f, p0, p1, p2);
     }
-    store(&frames.normal[3 * f], n);
-    store(&frames.orientation[3 * f], o);
-    frames.area[f] = static_cast<float>(0.5 * twice_area);
-    // Without smoothing the frame is final: finish the face while its corners are in cache.
-    if (options.smooth_passes == 0) write_corner_frame(f, p0, p1, p2);
+  };
+  const size_t threads = options.threads != 0 ? std::min<size_t>(options.threads, 64)
+                         : std::clamp<size_t>(std::min<size_t>(std::thread::hardware_concurrency(),
+                                                               face_count / kFacesPerThread),
+                                              1, 8);
+  std::vector<size_t> degenerate_count(threads, 0), fallback_count(threads, 0);
+  if (threads == 1) {
+    frame_faces(0, face_count, degenerate_count[0], fallback_count[0]);
+  } else {
+    std::vector<std::thread> workers;
+    workers.reserve(threads - 1);
+    auto range = [&](size_t t) { return face_count * t / threads; };
+    for (size_t t = 1; t < threads; ++t)
+      workers.emplace_back(frame_faces, range(t), range(t + 1), std::ref(degenerate_count[t]),
+                           std::ref(fallback_count[t]));
+    frame_faces(0, range(1), degenerate_count[0], fallback_count[0]);
+    for (std::thread& w : workers) w.join();
+  }
+  for (size_t t = 0; t < threads; ++t) {
+    frames.degenerate_faces += static_cast<uint32_t>(degenerate_count[t]);
+    frames.fallback_faces += static_cast<uint32_t>(fallback_count[t]);
   }
 
   // === Optional smoothing: Jacobi passes (double-buffered, so the result is order independent) ===

@@ -188,6 +188,26 @@ TEST(Orientation, VariationSumsNeighbourAngles) {
   EXPECT_NEAR(folded.variation[1], std::acos(-1.0) / 2, 1e-5);
 }
 
+TEST(Orientation, ThreadCountDoesNotChangeTheFrames) {
+  const Mesh mesh = load("horse.ply");
+  const Topology topology = build_topology(mesh);
+  FaceFrames one, three;
+  OrientationOptions options;
+  options.threads = 1;
+  ASSERT_TRUE(compute_orientation(mesh, topology, options, one).is_ok());
+  options.threads = 3;  // uneven ranges on purpose
+  ASSERT_TRUE(compute_orientation(mesh, topology, options, three).is_ok());
+  EXPECT_EQ(one.normal, three.normal);
+  EXPECT_EQ(one.orientation, three.orientation);
+  EXPECT_EQ(one.bitangent, three.bitangent);
+  EXPECT_EQ(one.area, three.area);
+  EXPECT_EQ(one.local, three.local);
+  EXPECT_EQ(one.anchor, three.anchor);
+  EXPECT_EQ(one.variation, three.variation);
+  EXPECT_EQ(one.fallback_faces, three.fallback_faces);
+  EXPECT_EQ(one.degenerate_faces, three.degenerate_faces);
+}
+
 TEST(Orientation, RejectsBadOptionsAndMismatchedTopology) {
   const Mesh mesh = box(1.f, 1.f, 1.f, 1);
   const Topology topology = build_topology(mesh);
