@@ -24,11 +24,6 @@ constexpr int kNext[3] = {1, 2, 0};
 constexpr int kPrev[3] = {2, 0, 1};
 constexpr uint32_t kAnyPatch = kInvalid;
 
-// Faces whose doubled frame area is below this fraction of their squared longest edge have no
-// meaningful Jacobian: they are placed by unfolding without the stretch check (their UV is the
-// degenerate image of a degenerate face).
-constexpr float kDegenerateRatio = 1e-6f;
-
 // Everything the growth reads or writes about one face, in one cache line: the popped face's
 // geometry and connectivity, and the state its neighbours' placements update. Reading these from
 // nine separate arrays (topology, frames, atlas, scratch) cost a cache line per array per face
@@ -42,7 +37,7 @@ struct alignas(64) FaceRecord {
   uint8_t placed;        // placed edge neighbours (0..3)
   uint8_t front;         // 1 + bucket of the face's live front entry, 0 = not on the front
   uint8_t seam;          // user seam face
-  uint8_t degenerate;    // no meaningful Jacobian (see kDegenerateRatio)
+  uint8_t degenerate;    // no meaningful Jacobian (is_zero_area_frame)
 };
 static_assert(sizeof(FaceRecord) == 64);
 
@@ -161,11 +156,7 @@ class PatchMapper {
       r.front = 0;
       r.seam = seam && seam[f] ? 1 : 0;
       stats_.faces_seam += r.seam;
-      // Zero-area faces: the doubled area against the squared longest edge.
-      const float twice_area = l[2] * l[5] - l[3] * l[4];
-      const float e0 = l[2] * l[2] + l[3] * l[3], e2 = l[4] * l[4] + l[5] * l[5];
-      const float e1 = (l[4] - l[2]) * (l[4] - l[2]) + (l[5] - l[3]) * (l[5] - l[3]);
-      r.degenerate = !(twice_area > kDegenerateRatio * std::max({e0, e1, e2}));
+      r.degenerate = is_zero_area_frame(l);
     }
   }
 
@@ -502,20 +493,17 @@ class PatchMapper {
     // not on how many faces elsewhere were placed first; and the deferred face that seeds the
     // next patch is the one nearest the seed among equals. With the thesis's global counter,
     // removing a part of the mesh shifted every later key and reordered the growth everywhere
-    // (stability, removing 10%: bit-identical corners 14-97% -> 84-99.9%, docs/mapping.md).
+    // (stability, removing 10%: bit-identical corners 14-97% -> 83-99.9%, docs/mapping.md).
     float age_offset;
     if (hop_age_ > 0.f) {
-      uint32_t fewest = kInvalid;
+      uint32_t fewest = kInvalid, fewest_any = kInvalid;
       for (int k = 0; k < 3; ++k) {
         const uint32_t o = self.opposite[k];
-        if (o != kInvalid && rec_[o / 3].patch == p) fewest = std::min(fewest, hops_[o / 3]);
+        if (o == kInvalid || rec_[o / 3].patch == kInvalid) continue;
+        fewest_any = std::min(fewest_any, hops_[o / 3]);
+        if (rec_[o / 3].patch == p) fewest = std::min(fewest, hops_[o / 3]);
       }
-      if (fewest == kInvalid) {  // a new patch's seed
-        for (int k = 0; k < 3; ++k) {
-          const uint32_t o = self.opposite[k];
-          if (o != kInvalid && rec_[o / 3].patch != kInvalid) fewest = std::min(fewest, hops_[o / 3]);
-        }
-      }
+      if (fewest == kInvalid) fewest = fewest_any;  // a new patch's seed
       const uint32_t hops = fewest == kInvalid ? 0 : fewest + 1;
       hops_[f] = hops;
       age_offset = hop_age_ * static_cast<float>(hops + 1);
@@ -613,8 +601,8 @@ class PatchMapper {
   float scale_ = 1.f, bound_ = 0.f, max_seed_rotation_ = 0.f;
   float relax_ = 0.f;  // 1 - field_following: share of the edge mismatch taken as rotation
   double factor_step_ = 0.0, factor_ = 0.0;  // the thesis's global age counter (when hop_age_ is 0)
-  float hop_age_ = 0.f;  // age per hop from the patch seed; 0 = the global counter
-  std::vector<uint32_t> hops_;  // per face: hops from its patch's seed (hop_age_ > 0)
+  float hop_age_ = 0.f;  // age per hop from the component's seed; 0 = the global counter
+  std::vector<uint32_t> hops_;  // per face: hops from its component's seed (hop_age_ > 0)
   float* uv_ = nullptr;
   std::unique_ptr<FaceRecord[]> rec_;  // per face
   std::vector<VertexHint> hint_;  // per vertex: the UV its patch first gave it

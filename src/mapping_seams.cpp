@@ -72,16 +72,6 @@ class SeamShortener {
     return moved;
   }
 
-  // Zero-area faces as the growth judges them (mapping_patches.cpp, kDegenerateRatio): placed
-  // without the stretch check.
-  bool is_degenerate(uint32_t f) const {
-    const float* l = in_.frames.local.data() + 6 * f;
-    const float twice_area = l[2] * l[5] - l[3] * l[4];
-    const float e0 = l[2] * l[2] + l[3] * l[3], e2 = l[4] * l[4] + l[5] * l[5];
-    const float e1 = (l[4] - l[2]) * (l[4] - l[2]) + (l[5] - l[3]) * (l[5] - l[3]);
-    return !(twice_area > 1e-6f * std::max({e0, e1, e2}));
-  }
-
   float edge_length(uint32_t f, int k) const {
     const float* p = in_.mesh.positions.data();
     const uint32_t a = in_.mesh.indices[3 * f + k], b = in_.mesh.indices[3 * f + kNext[k]];
@@ -128,8 +118,9 @@ class SeamShortener {
              (seam_at(uv, 2) ? length[2] : 0.f);
     };
     const float before = seam_cost(own);
-    const StretchFrame frame = stretch_frame(in_.frames.local.data() + 6 * f, scale_);
-    const bool degenerate = is_degenerate(f);
+    const float* local = in_.frames.local.data() + 6 * f;
+    const StretchFrame frame = stretch_frame(local, scale_);
+    const bool degenerate = is_zero_area_frame(local);
     // A gain must be a whole edge (not rounding): a tenth of the shortest edge of f.
     const float min_gain = 0.1f * std::min({length[0], length[1], length[2]});
 
@@ -265,10 +256,9 @@ class SeamShortener {
 
   // Patches that lost all their faces are dropped; the others keep their order.
   void compact_patches() {
-    std::vector<uint32_t> remap(atlas_.patch_count, 0);
-    for (const uint32_t p : atlas_.patch) remap[p] = 1;
+    std::vector<uint32_t> remap(atlas_.patch_count);
     uint32_t next = 0;
-    for (uint32_t& r : remap) r = r ? next++ : kInvalid;
+    for (size_t p = 0; p < remap.size(); ++p) remap[p] = patch_size_[p] > 0 ? next++ : kInvalid;
     if (next == atlas_.patch_count) return;
     for (uint32_t& p : atlas_.patch) p = remap[p];
     atlas_.patch_count = next;

@@ -68,10 +68,11 @@ Status measure_stability(const Mesh& mesh, const OrientationOptions& orientation
   size_t far_face = 0;
   double far_d2 = -1;
   std::vector<std::pair<double, uint32_t>> by_distance(face_count);
+  std::vector<double> to_seed(face_count);  // squared distance of each centroid to the seed point
   for (size_t f = 0; f < face_count; ++f) {
     double c[3];
     face_centroid(mesh, f, c);
-    const double d2 = distance2(c, seed);
+    const double d2 = to_seed[f] = distance2(c, seed);
     if (d2 > far_d2) {
       far_d2 = d2;
       far_face = f;
@@ -97,14 +98,9 @@ Status measure_stability(const Mesh& mesh, const OrientationOptions& orientation
     uint32_t nearest = kInvalid;
     double nearest_d2 = 0;
     for (size_t f = 0; f < face_count; ++f) {
-      if (gone[f]) continue;
-      double c[3];
-      face_centroid(mesh, f, c);
-      const double d2 = distance2(c, seed);
-      if (nearest == kInvalid || d2 < nearest_d2) {
-        nearest = static_cast<uint32_t>(f);
-        nearest_d2 = d2;
-      }
+      if (gone[f] || (nearest != kInvalid && to_seed[f] >= nearest_d2)) continue;
+      nearest = static_cast<uint32_t>(f);
+      nearest_d2 = to_seed[f];
     }
     double c[3];
     face_centroid(mesh, nearest, c);

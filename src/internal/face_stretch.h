@@ -9,6 +9,18 @@
 
 namespace tailor::internal {
 
+//! Whether a face (its 3 corners in its frame, 6 floats) has no meaningful Jacobian: its doubled
+//! area is below 1e-6 of its squared longest edge. Such faces are placed without the stretch check
+//! (their UV is the degenerate image of a degenerate face); the growth and the seam shortening
+//! must agree on which they are.
+inline bool is_zero_area_frame(const float* l) {
+  constexpr float kZeroAreaRatio = 1e-6f;
+  const float twice_area = l[2] * l[5] - l[3] * l[4];
+  const float e0 = l[2] * l[2] + l[3] * l[3], e2 = l[4] * l[4] + l[5] * l[5];
+  const float e1 = (l[4] - l[2]) * (l[4] - l[2]) + (l[5] - l[3]) * (l[5] - l[3]);
+  return !(twice_area > kZeroAreaRatio * std::max({e0, e1, e2}));
+}
+
 //! The face's edges in its frame, in pixels, and the inverse of their determinant.
 struct StretchFrame {
   float q1x = 0.f, q1y = 0.f, q2x = 0.f, q2y = 0.f, inv = 0.f;
