@@ -11,17 +11,22 @@ import * as THREE from 'three';
 export const kMaxVariants = 8;
 export const kViews = ['texture', 'patches', 'distortion', 'checker'];
 
-const vertexShader = /* glsl */ `
-attribute vec3 bary;
-attribute vec3 seam;
-attribute vec3 patchColor;
-attribute float stretch;
+// What the vertex shader hands to the fragment shader (both must declare the same).
+const varyings = /* glsl */ `
 varying vec3 vNormal;
 varying vec2 vUv;
 varying vec3 vBary;
 varying vec3 vSeam;
 varying vec3 vPatch;
 varying float vStretch;
+`;
+
+const vertexShader = /* glsl */ `
+attribute vec3 bary;
+attribute vec3 seam;
+attribute vec3 patchColor;
+attribute float stretch;
+${varyings}
 void main() {
   vNormal = normalize(normalMatrix * normal);
   vUv = uv;
@@ -60,13 +65,7 @@ uniform float checkerSquares;
 uniform float distortionRange;
 uniform bool wireframe;
 uniform bool showSeams;
-varying vec3 vNormal;
-varying vec2 vUv;
-varying vec3 vBary;
-varying vec3 vSeam;
-varying vec3 vPatch;
-varying float vStretch;
-
+${varyings}
 // Moreland's cool-to-warm end points, through light grey; t in [-1, 1].
 vec3 coolWarm(float t) {
   t = clamp(t, -1.0, 1.0);

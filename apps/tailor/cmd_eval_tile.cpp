@@ -35,26 +35,12 @@ int run_eval_tile(const EvalTileOptions& opt) {
   std::string failed;
   const bool met = meets_tile_targets(m, &failed);
   if (opt.json) {
-    nlohmann::json j;
+    nlohmann::json j = tile_metrics_json(m, with_exemplar);
     j["file"] = opt.tile;
     j["width"] = tile.width;
     j["height"] = tile.height;
-    j["wrap_ratio_x"] = m.wrap_ratio_x;
-    j["wrap_ratio_y"] = m.wrap_ratio_y;
-    j["worst_seam_ratio"] = m.worst_seam_ratio;
     j["gradient_energy"] = m.gradient_energy;
-    if (with_exemplar) {
-      j["exemplar"] = opt.exemplar;
-      j["exemplar_worst_seam_ratio"] = m.exemplar_worst_seam_ratio;
-      j["exemplar_wrap_ratio_x"] = m.exemplar_wrap_ratio_x;
-      j["exemplar_wrap_ratio_y"] = m.exemplar_wrap_ratio_y;
-      j["histogram_l1"] = m.histogram_l1;
-      j["gradient_ratio"] = m.gradient_ratio;
-      j["patch_coherence"] = m.patch_coherence;
-      j["exemplar_patch_coherence"] = m.exemplar_patch_coherence;
-    }
-    j["targets_met"] = met;
-    if (!failed.empty()) j["targets_failed"] = failed;
+    if (with_exemplar) j["exemplar"] = opt.exemplar;
     std::printf("%s\n", json_text(j).c_str());
     return kExitOk;
   }

@@ -43,24 +43,6 @@ std::string base_name(const std::string& path) {
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
-nlohmann::json metrics_json(const TileMetrics& m) {
-  nlohmann::json j;
-  j["wrap_ratio_x"] = m.wrap_ratio_x;
-  j["wrap_ratio_y"] = m.wrap_ratio_y;
-  j["worst_seam_ratio"] = m.worst_seam_ratio;
-  j["exemplar_worst_seam_ratio"] = m.exemplar_worst_seam_ratio;
-  j["exemplar_wrap_ratio_x"] = m.exemplar_wrap_ratio_x;
-  j["exemplar_wrap_ratio_y"] = m.exemplar_wrap_ratio_y;
-  j["histogram_l1"] = m.histogram_l1;
-  j["gradient_ratio"] = m.gradient_ratio;
-  j["patch_coherence"] = m.patch_coherence;
-  j["exemplar_patch_coherence"] = m.exemplar_patch_coherence;
-  std::string failed;
-  j["targets_met"] = meets_tile_targets(m, &failed);
-  if (!failed.empty()) j["targets_failed"] = failed;
-  return j;
-}
-
 nlohmann::json period_json(const PeriodEstimate& p) {
   return {{"x", p.period_x},
           {"y", p.period_y},
@@ -165,7 +147,7 @@ int run_tile(const TileCliOptions& opt) {
     j["warnings"] = report.warnings;
     nlohmann::json list = nlohmann::json::array();
     for (size_t k = 0; k < tiles.size(); ++k) {
-      nlohmann::json t = metrics_json(metrics[k]);
+      nlohmann::json t = tile_metrics_json(metrics[k], true);
       t["file"] = files[k];
       list.push_back(t);
     }

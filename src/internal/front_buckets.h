@@ -69,10 +69,8 @@ class FrontBuckets {
  private:
   static constexpr uint64_t kLowMask = (uint64_t{1} << 60) - 1;
 
-  static void push(std::vector<uint64_t>& heap, uint64_t key) {
-    size_t i = heap.size();
-    heap.push_back(key);
-    uint64_t* h = heap.data();
+  // Moves the hole at i up until key fits there, and puts key in it.
+  static void sift_up(uint64_t* h, size_t i, uint64_t key) {
     while (i > 0) {
       const size_t parent = (i - 1) / 4;
       if (h[parent] <= key) break;
@@ -80,6 +78,12 @@ class FrontBuckets {
       i = parent;
     }
     h[i] = key;
+  }
+
+  static void push(std::vector<uint64_t>& heap, uint64_t key) {
+    const size_t i = heap.size();
+    heap.push_back(key);
+    sift_up(heap.data(), i, key);
   }
 
   static uint64_t pop_min(std::vector<uint64_t>& heap) {
@@ -109,13 +113,7 @@ class FrontBuckets {
       }
     }
     // Then the former last entry up from that leaf.
-    while (i > 0) {
-      const size_t parent = (i - 1) / 4;
-      if (h[parent] <= last) break;
-      h[i] = h[parent];
-      i = parent;
-    }
-    h[i] = last;
+    sift_up(h, i, last);
     return result;
   }
 
