@@ -120,8 +120,8 @@ int run_map(const MapOptions& opt) {
   // Below ~1e-3 px per unit every UV rounds to the same float; above 1e7 faces span millions of px.
   if (!(opt.scale >= 1e-3f && opt.scale <= 1e7f))
     return report_error(usage_error("--scale must be between 0.001 and 1e7 pixels per unit"));
-  UpAxis up;
-  if (!up_axis_from_name(opt.preview_up, up))
+  UpAxis preview_up = UpAxis::kPosY;
+  if (!up_axis_from_name(opt.preview_up, preview_up))
     return report_error(usage_error("--preview-up must be x, y, z, -x, -y or -z, got '" + opt.preview_up + "'"));
   if (!(opt.hop_age >= 0.f && opt.hop_age <= 1.f))
     return report_error(usage_error("--hop-age must be between 0 and 1 radians"));
@@ -198,7 +198,7 @@ int run_map(const MapOptions& opt) {
     for (const auto& [view, path] : preview_paths(opt)) {
       RenderOptions render_options;
       render_options.view = view;
-      up_axis_from_name(opt.preview_up, render_options.up);  // checked before any work
+      render_options.up = preview_up;
       Image picture;
       if (Status s = render_preview(mesh, uv_repeats, atlas.patch, texture.empty() ? nullptr : &texture,
                                     render_options, picture);
