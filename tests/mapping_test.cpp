@@ -214,6 +214,62 @@ TEST(Mapping, SeamShorteningShortensSeamsWithinTheBound) {
   expect_connected_patches(small, "horse.ply, min_patch_faces 0");
 }
 
+// Whether the two faces of half-edge e disagree on the UV of a shared corner.
+bool is_seam_edge(const Mapped& m, uint32_t e) {
+  const uint32_t o = m.topology.opposite[e];
+  if (o == kInvalid) return false;
+  const uint32_t f = e / 3, g = o / 3, k = e % 3, kk = o % 3;
+  const float* a = &m.atlas.corner_uv[6 * f];
+  const float* b = &m.atlas.corner_uv[6 * g];
+  // f's edge runs corner k -> k+1, g's the other way.
+  const uint32_t k1 = (k + 1) % 3, kk1 = (kk + 1) % 3;
+  return a[2 * k] != b[2 * kk1] || a[2 * k + 1] != b[2 * kk1 + 1] || a[2 * k1] != b[2 * kk] ||
+         a[2 * k1 + 1] != b[2 * kk + 1];
+}
+
+TEST(Mapping, CrackClosingZipsCracksWithinTheBound) {
+  for (const char* name : {"horse.ply", "spot.obj"}) {
+    Mapped closed, open;
+    closed.mesh = load(name);
+    open.mesh = closed.mesh;
+    MappingOptions options;
+    map_mesh(closed, options);
+    options.close_cracks = false;
+    map_mesh(open, options);
+    EXPECT_GT(closed.stats.cracks_closed, 100u) << name;
+    EXPECT_EQ(open.stats.cracks_closed, 0u) << name;
+    expect_valid_patches_atlas(closed, options, std::string(name) + " cracks closed");
+    // Zips only join UVs: faces keep their patches, and no seamless edge becomes a seam.
+    EXPECT_EQ(closed.atlas.patch, open.atlas.patch) << name;
+    size_t opened = 0, zipped = 0;
+    for (uint32_t e = 0; e < closed.topology.opposite.size(); ++e) {
+      const bool was = is_seam_edge(open, e), is = is_seam_edge(closed, e);
+      opened += !was && is;
+      zipped += was && !is;
+    }
+    EXPECT_EQ(opened, 0u) << name;
+    EXPECT_GT(zipped, 0u) << name;
+    // Every face a zip moved keeps its area within 1/1.2..1.2 of the surface's.
+    size_t moved = 0;
+    for (size_t f = 0; f < closed.mesh.face_count(); ++f) {
+      const float* uv = &closed.atlas.corner_uv[6 * f];
+      if (std::equal(uv, uv + 6, &open.atlas.corner_uv[6 * f]) || is_degenerate(closed.frames, f)) continue;
+      ++moved;
+      const float* l = &closed.frames.local[6 * f];
+      const double uv_area = (uv[2] - uv[0]) * (uv[5] - uv[1]) - (uv[4] - uv[0]) * (uv[3] - uv[1]);
+      const double frame_area = (l[2] * l[5] - l[3] * l[4]) * double(options.scale) * options.scale;
+      EXPECT_LE(uv_area / frame_area, 1.2 + 1e-3) << name << " face " << f;
+      EXPECT_GE(uv_area / frame_area, 1 / 1.2 - 1e-3) << name << " face " << f;
+    }
+    EXPECT_GT(moved, 0u) << name;
+    // Measured: horse 7.0% -> 4.3%, spot 11.4% -> 6.4% of edge length; assert at least 25% less,
+    // with the thesis stretch (the area ratio's variation) still under the 0.08.
+    const UvMetrics with = metrics_of(closed), without = metrics_of(open);
+    EXPECT_LT(with.seam_length_ratio, 0.75 * without.seam_length_ratio) << name;
+    EXPECT_LT(with.stretch, 0.08) << name;
+  }
+}
+
 TEST(Mapping, FlatGridIsOnePatchWithoutSeamOrDistortion) {
   Mapped m;
   m.mesh = grid(30);
@@ -384,6 +440,13 @@ TEST(Mapping, SeamFacesAttractTheSeams) {
   options.shorten_seams = false;
   map_mesh(unshortened, options);
   EXPECT_GE(after, seam_edges_on(unshortened, marked));
+  // So does the crack closing.
+  Mapped unzipped;
+  unzipped.mesh = plain.mesh;
+  options.shorten_seams = true;
+  options.close_cracks = false;
+  map_mesh(unzipped, options);
+  EXPECT_GE(after, seam_edges_on(unzipped, marked));
 }
 
 TEST(Mapping, FaceStretchErrorMeasuresSingularValues) {
@@ -440,6 +503,11 @@ TEST(Mapping, RejectsBadOptionsAndMismatchedInputs) {
   options.hop_age = std::numeric_limits<float>::quiet_NaN();
   EXPECT_EQ(map_texture(m.mesh, m.topology, m.frames, options, m.atlas).code(), ErrorCode::kInvalidArgument);
   options = {};
+  options.crack_rings = 1;
+  EXPECT_EQ(map_texture(m.mesh, m.topology, m.frames, options, m.atlas).code(), ErrorCode::kInvalidArgument);
+  options.crack_rings = 65;
+  EXPECT_EQ(map_texture(m.mesh, m.topology, m.frames, options, m.atlas).code(), ErrorCode::kInvalidArgument);
+  options = {};
   const std::vector<uint8_t> wrong_size(3, 1);
   options.seam_faces = wrong_size;
   EXPECT_EQ(map_texture(m.mesh, m.topology, m.frames, options, m.atlas).code(), ErrorCode::kInvalidArgument);
@@ -467,19 +535,29 @@ TEST(Stability, RemovingTenPercentKeepsMostOfTheMapping) {
   EXPECT_GE(report.max_difference_px, report.mean_difference_px);
   EXPECT_GE(report.within_1px_ratio, report.identical_ratio);
   // The growth order is local (hop rule), so almost everything is reproduced bit for bit
-  // (measured: 99.1%; 84% with the thesis's global counter).
-  EXPECT_GT(report.identical_ratio, 0.95);
+  // (measured: 99.1%; 84% with the thesis's global counter). Crack closing relaxes regions that
+  // overlap along a crack, so a crack passing near the removed part changes in the last bits
+  // along its length (measured: 92.2% bit-identical, 98.7% within 1 px, mean 0.05 px).
+  EXPECT_GT(report.identical_ratio, 0.9);
+  EXPECT_GT(report.within_1px_ratio, 0.97);
   EXPECT_LT(report.mean_difference_px, 1.0);
   // On the horse the hop rule keeps 99% of the corners bit-identical and the mean change under
-  // 1 px (measured 0.5 px); the global counter re-places whole regions (83%, 3.5 px).
+  // 1 px (measured 0.5 px); the global counter re-places whole regions (83%, 3.5 px). Compared
+  // without crack closing, which would blur the difference (see above).
   const Mesh horse = load("horse.ply");
-  StabilityReport hops, counter;
-  ASSERT_TRUE(measure_stability(horse, {}, {}, hops).is_ok());
-  MappingOptions global_counter;
+  StabilityReport hops, counter, closed;
+  MappingOptions growth_only;
+  growth_only.close_cracks = false;
+  ASSERT_TRUE(measure_stability(horse, {}, growth_only, hops).is_ok());
+  MappingOptions global_counter = growth_only;
   global_counter.hop_age = 0.f;
   ASSERT_TRUE(measure_stability(horse, {}, global_counter, counter).is_ok());
   EXPECT_GT(hops.identical_ratio, 0.97);
   EXPECT_LT(hops.mean_difference_px, 1.0);
+  // With crack closing (default): measured 91.1% bit-identical, 98.6% within 1 px, 0.53 px.
+  ASSERT_TRUE(measure_stability(horse, {}, {}, closed).is_ok());
+  EXPECT_GT(closed.within_1px_ratio, 0.97);
+  EXPECT_LT(closed.mean_difference_px, 1.0);
   EXPECT_LT(counter.identical_ratio, 0.9);
   EXPECT_GT(counter.mean_difference_px, 2.0 * hops.mean_difference_px);
   StabilityOptions bad;

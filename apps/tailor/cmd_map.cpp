@@ -36,6 +36,8 @@ struct MapOptions {
   float field_following = 1.f;
   uint32_t min_patch_faces = 16;
   bool keep_seams = false;
+  bool keep_cracks = false;
+  uint32_t crack_rings = 16;
   float hop_age = 0.02f;
   std::string axis = "pca";
   uint32_t smooth = 0;
@@ -110,6 +112,8 @@ int run_map(const MapOptions& opt) {
   mapping_options.field_following = opt.field_following;
   mapping_options.min_patch_faces = opt.min_patch_faces;
   mapping_options.shorten_seams = !opt.keep_seams;
+  mapping_options.close_cracks = !opt.keep_cracks;
+  mapping_options.crack_rings = opt.crack_rings;
   mapping_options.hop_age = opt.hop_age;
   if (!opt.seed_point.empty()) {
     if (!parse_vec3(opt.seed_point, mapping_options.seed_point))
@@ -237,7 +241,7 @@ int run_map(const MapOptions& opt) {
     j["options"] = {{"mode", opt.mode}, {"scale", opt.scale}, {"threshold_px", opt.threshold},
                     {"max_stretch", opt.max_stretch},
                     {"field_following", opt.field_following}, {"min_patch_faces", opt.min_patch_faces},
-                    {"shorten_seams", !opt.keep_seams}, {"hop_age", opt.hop_age},
+                    {"shorten_seams", !opt.keep_seams}, {"close_cracks", !opt.keep_cracks}, {"crack_rings", opt.crack_rings}, {"hop_age", opt.hop_age},
                     {"axis", opt.axis}, {"smooth", opt.smooth}, {"seed_point", opt.seed_point},
                     {"seam_faces", opt.seam_faces}};
     j["mesh"] = {{"format", load.format}, {"vertices", mesh.vertex_count()}, {"faces", mesh.face_count()},
@@ -253,7 +257,7 @@ int run_map(const MapOptions& opt) {
                     {"max_stretch_accepted", stats.max_stretch_accepted},
                     {"faces_three_textured", stats.faces_three_textured},
                     {"faces_unfolded", stats.faces_unfolded}, {"faces_rigid", stats.faces_rigid},
-                    {"faces_reseamed", stats.faces_reseamed},
+                    {"faces_reseamed", stats.faces_reseamed}, {"cracks_closed", stats.cracks_closed},
                     {"faces_seam", stats.faces_seam}, {"inverted_accepted", stats.inverted_accepted}};
     j["metrics"] = {{"patches", metrics.patches}, {"single_face_patches", metrics.single_face_patches},
                     {"stretch", metrics.stretch}, {"stretch_area_weighted", metrics.stretch_area_weighted},
@@ -340,6 +344,14 @@ void register_map(CLI::App& app, Runner& run) {
       ->capture_default_str();
   group->add_flag("--no-seam-shortening", opt->keep_seams,
                   "patches mode: keep the seams as the growth left them (no re-placing of faces along them)");
+  group->add_flag("--no-crack-closing", opt->keep_cracks,
+                  "patches mode: leave the cracks (cuts inside a patch) open; 3-6x faster mapping, 30-50% more seam "
+                  "length");
+  group->add_option("--crack-rings", opt->crack_rings,
+                    "patches mode: largest region, in rings of faces, that zipping a crack may relax (2..64); "
+                    "more closes wider cracks and takes longer")
+      ->check(CLI::Range(2u, 64u))
+      ->capture_default_str();
   group->add_option("--threshold", opt->threshold, "thesis mode: initial error threshold in pixels")
       ->capture_default_str();
   group->add_option("--axis", opt->axis, "Orientation field: pca, x, y, z or X,Y,Z")->capture_default_str();

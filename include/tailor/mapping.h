@@ -81,6 +81,11 @@ struct MappingOptions {
   bool shorten_seams = true;        //!< after the growth, re-place faces on seams from their neighbours where
                                     //!< that shortens the seams within the bound (jagged cuts lose their teeth:
                                     //!< 6-11% less seam length on the shared meshes, docs/mapping.md)
+  bool close_cracks = true;         //!< last, zip cracks (seams inside one patch) shut from their tips, spreading
+                                    //!< each gap over the faces around it within max_stretch (ARAP relaxation):
+                                    //!< 30-50% less seam length, mapping 3-6x slower (docs/mapping.md)
+  uint32_t crack_rings = 16;        //!< largest region a zip relaxes, in rings of faces around it (2..64): more
+                                    //!< closes wider gaps, costs more time
   uint32_t min_patch_faces = 16;    //!< patches with fewer faces are absorbed into a neighbouring patch by rigid
                                     //!< unfolding (0 = keep all; isolated components stay whole)
   // kThesis -------------------------------------------------------------------------------------
@@ -107,6 +112,7 @@ struct MappingStats {
                                     //!< placed neighbour of their patch (each leaves at least one cut edge)
   uint64_t faces_reseamed = 0;      //!< kPatches: re-placements after the growth that shortened the seams (a face
                                     //!< can move more than once)
+  uint64_t cracks_closed = 0;       //!< kPatches: crack vertices zipped shut (one UV where there were two)
   uint64_t faces_seam = 0;          //!< faces flagged in seam_faces
   uint64_t inverted_accepted = 0;   //!< kThesis: faces accepted with a non-positive UV area (always 0 in kPatches)
   double seconds = 0.0;             //!< wall time of map_texture

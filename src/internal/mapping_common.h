@@ -58,6 +58,13 @@ Status map_patches(const MappingInput& input, Atlas& atlas, MappingStats& stats)
 //! number of moves. Deterministic; O(F) once, then O(faces on seams) per pass, bounded passes.
 uint64_t shorten_seams(const MappingInput& input, std::vector<uint8_t>& seam_mark, Atlas& atlas);
 
+//! Zips cracks (seam edges between two faces of one patch) shut from their tips, relaxing the UVs
+//! around each zip (ARAP); a zip is kept only if every face it moved stays within
+//! options.max_stretch (patches mode, last step). zipped: the number of zipped vertices.
+//! progress (may be empty) gets the share done; false cancels (kCancelled, atlas half-zipped).
+//! Deterministic; O(F) setup, then O(rings^2) per crack vertex tried.
+Status close_cracks(const MappingInput& input, const ProgressCallback& progress, Atlas& atlas, uint64_t& zipped);
+
 Status map_thesis(const MappingInput& input, Atlas& atlas, MappingStats& stats);
 
 //! Progress reporting cadence (placed faces between callback calls).
