@@ -8,8 +8,13 @@
 //   SIGGRAPH 2001: the singular values of the face Jacobian as the per-face bound.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <memory>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "internal/face_stretch.h"
 #include "internal/front_buckets.h"
@@ -27,9 +32,11 @@ constexpr uint32_t kAnyPatch = kInvalid;
 // Everything the growth reads or writes about one face, in one cache line: the popped face's
 // geometry and connectivity, and the state its neighbours' placements update. Reading these from
 // nine separate arrays (topology, frames, atlas, scratch) cost a cache line per array per face
-// touched; the records halve the L1 misses of try_place (cachegrind, bunny).
+// touched; the records halve the L1 misses of try_place (cachegrind, bunny). The neighbours are
+// kept as face ids and edge indices (Topology::opposite split once): every use needs one or the
+// other, and the division by 3 took a few instructions at each of them.
 struct alignas(64) FaceRecord {
-  uint32_t opposite[3];  // Topology::opposite
+  uint32_t neighbour[3];  // face across edge k (Topology::opposite / 3), kInvalid on a boundary
   uint32_t vertex[3];    // Mesh::indices
   float local[6];        // FaceFrames::local
   float variation;       // FaceFrames::variation
@@ -38,14 +45,20 @@ struct alignas(64) FaceRecord {
   uint8_t front;         // 1 + bucket of the face's live front entry, 0 = not on the front
   uint8_t seam;          // user seam face
   uint8_t degenerate;    // no meaningful Jacobian (is_zero_area_frame)
+  uint8_t across;        // bits 2k, 2k+1: the neighbour's index of the edge it shares with edge k
 };
 static_assert(sizeof(FaceRecord) == 64);
 
 // Per vertex: the patch whose UV the hint holds, and that UV.
 struct VertexHint {
   uint32_t patch;
-  float u, v;
+  float u, v;  // contiguous: read as one UV
 };
+
+#if defined(__SSE2__)
+// Two floats (a UV or a frame corner) into the low lanes.
+inline __m128 load_uv(const float* p) { return _mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p))); }
+#endif
 
 struct Rotation {
   float c = 1.f, s = 0.f;
@@ -72,7 +85,8 @@ class PatchMapper {
     fill_records();
     hint_.assign(mesh.vertex_count(), VertexHint{kInvalid, 0.f, 0.f});
     hop_age_ = in_.factor_step < 0 ? in_.options.hop_age : 0.f;
-    if (hop_age_ > 0.f) hops_.assign(face_count, 0);
+    // Not initialised: a face's entry is written when it is placed, and only placed faces' are read.
+    if (hop_age_ > 0.f) hops_.reset(new uint32_t[face_count]);
     queue_.clear();
     patch_rotation_.reserve(256);
     patch_size_.reserve(256);
@@ -80,12 +94,11 @@ class PatchMapper {
 
     // === Grow: one component at a time, patches one after another ===
     FaceRecord* rec = rec_.get();
-    // A front entry is live while it is the face's latest (see front_buckets.h).
+    // A front entry is live while it is the face's latest (see front_buckets.h); the popped one's
+    // face leaves the front (its front byte is cleared below, not here: the queue may ask about
+    // every entry when it purges).
     auto live = [rec](uint64_t key) {
-      FaceRecord& r = rec[FrontBuckets::face_of(key)];
-      if (r.front != FrontBuckets::bucket_of(key) + 1) return false;
-      r.front = 0;
-      return true;
+      return rec[FrontBuckets::face_of(key)].front == FrontBuckets::bucket_of(key) + 1;
     };
     for (const uint32_t seed : in_.component_seeds) {
       if (rec[seed].patch != kInvalid) continue;
@@ -93,6 +106,7 @@ class PatchMapper {
       for (uint64_t key; queue_.pop(live, key);) {
         if (cancelled_) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
         const uint32_t f = FrontBuckets::face_of(key);
+        rec[f].front = 0;
         // The next pop is most likely the current top (new entries come from f's neighbours,
         // which accept() touches anyway): start loading its record now.
         if (const uint32_t next = queue_.peek_face(); next != FrontBuckets::kNone) __builtin_prefetch(rec + next);
@@ -115,10 +129,10 @@ class PatchMapper {
         }
         // The top's record was requested above; request what try_place will read through it.
         if (const uint32_t next = queue_.peek_face(); next != FrontBuckets::kNone) {
-          for (const uint32_t o : rec[next].opposite) {
-            if (o == kInvalid) continue;
-            __builtin_prefetch(rec + o / 3);
-            __builtin_prefetch(uv_ + 6 * (o / 3));
+          for (const uint32_t g : rec[next].neighbour) {
+            if (g == kInvalid) continue;
+            __builtin_prefetch(rec + g);
+            __builtin_prefetch(uv_ + 6 * g);
           }
         }
       }
@@ -142,34 +156,43 @@ class PatchMapper {
     const float* local = in_.frames.local.data();
     const float* variation = in_.frames.variation.data();
     const uint8_t* seam = in_.options.seam_faces.empty() ? nullptr : in_.options.seam_faces.data();
+    uint64_t seam_count = 0;
     for (size_t f = 0; f < face_count; ++f) {
       FaceRecord& r = rec_[f];
+      uint32_t across = 0;
       for (int k = 0; k < 3; ++k) {
-        r.opposite[k] = opposite[3 * f + k];
-        r.vertex[k] = indices[3 * f + k];
+        const uint32_t o = opposite[3 * f + k];
+        const uint32_t g = o / 3;  // kInvalid = 3 * (kInvalid / 3): its remainder adds nothing
+        r.neighbour[k] = o == kInvalid ? kInvalid : g;
+        across |= (o - 3 * g) << (2 * k);
       }
+      r.across = static_cast<uint8_t>(across);
+      std::memcpy(r.vertex, indices + 3 * f, sizeof r.vertex);
       const float* l = local + 6 * f;
-      for (int i = 0; i < 6; ++i) r.local[i] = l[i];
+      std::memcpy(r.local, l, sizeof r.local);
       r.variation = variation[f];
       r.patch = kInvalid;
       r.placed = 0;
       r.front = 0;
       r.seam = seam && seam[f] ? 1 : 0;
-      stats_.faces_seam += r.seam;
+      seam_count += r.seam;
       r.degenerate = is_zero_area_frame(l);
     }
+    stats_.faces_seam += seam_count;
   }
 
   void push_front(uint64_t key) {
-    rec_[FrontBuckets::face_of(key)].front = static_cast<uint8_t>(FrontBuckets::bucket_of(key) + 1);
+    FaceRecord& r = rec_[FrontBuckets::face_of(key)];
+    if (r.front != 0) queue_.supersede(r.front - 1u);
+    r.front = static_cast<uint8_t>(FrontBuckets::bucket_of(key) + 1);
     queue_.push(key);
   }
 
   // === Geometry helpers ==========================================================================
   // UVs of the two ends of face f's edge k, as the placed neighbour across it has them.
   void neighbour_edge_uv(uint32_t f, int k, const float*& ua, const float*& ub) const {
-    const uint32_t o = rec_[f].opposite[k];
-    const uint32_t g = o / 3, kk = o - 3 * g;
+    const FaceRecord& r = rec_[f];
+    const uint32_t g = r.neighbour[k], kk = (r.across >> (2 * k)) & 3u;
     ua = uv_ + 6 * g + 2 * kNext[kk];  // the neighbour's edge runs B -> A
     ub = uv_ + 6 * g + 2 * kk;
   }
@@ -195,6 +218,31 @@ class PatchMapper {
       const float c = std::cos(theta), sn = std::sin(theta);
       r = Rotation{r.c * c - r.s * sn, r.s * c + r.c * sn};
     }
+#if defined(__SSE2__)
+    // Both predictions at once, lane by lane the operations of the scalar code below (same bits,
+    // checked on 2e7 random cases; x - y is x + (-y) and a sum does not depend on operand order).
+    const float* l = rec_[f].local;
+    const __m128 c = load_uv(l + 2 * kc);
+    const __m128 ab = _mm_movelh_ps(load_uv(l + 2 * ka), load_uv(l + 2 * kb));
+    const __m128 d = _mm_mul_ps(_mm_sub_ps(_mm_movelh_ps(c, c), ab), _mm_set1_ps(scale_));  // C - A, C - B, pixels
+    const __m128 swapped = _mm_shuffle_ps(d, d, _MM_SHUFFLE(2, 3, 0, 1));
+    const __m128 negate_x = _mm_setr_ps(-0.f, 0.f, -0.f, 0.f);
+    const __m128 turned =
+        _mm_add_ps(_mm_mul_ps(_mm_set1_ps(r.c), d), _mm_xor_ps(_mm_mul_ps(_mm_set1_ps(r.s), swapped), negate_x));
+    const __m128 p = _mm_add_ps(_mm_movelh_ps(load_uv(ua), load_uv(ub)), turned);  // pax pay pbx pby
+    const __m128 pb = _mm_movehl_ps(p, p);
+    const __m128 mid = _mm_mul_ps(_mm_set1_ps(0.5f), _mm_add_ps(p, pb));
+    const __m128 gap = _mm_sub_ps(p, pb);
+    const __m128 gap2 = _mm_mul_ps(gap, gap);
+    const float err = _mm_cvtss_f32(_mm_sqrt_ss(_mm_add_ss(gap2, _mm_shuffle_ps(gap2, gap2, 1))));
+    out[2 * ka] = ua[0];
+    out[2 * ka + 1] = ua[1];
+    out[2 * kb] = ub[0];
+    out[2 * kb + 1] = ub[1];
+    out[2 * kc] = _mm_cvtss_f32(mid);
+    out[2 * kc + 1] = _mm_cvtss_f32(_mm_shuffle_ps(mid, mid, 1));
+    return err;
+#else
     float ax, ay, bx, by;
     frame_vector(f, ka, kc, r, ax, ay);
     frame_vector(f, kb, kc, r, bx, by);
@@ -207,7 +255,11 @@ class PatchMapper {
     out[2 * kc] = 0.5f * (pax + pbx);
     out[2 * kc + 1] = 0.5f * (pay + pby);
     return std::sqrt((pax - pbx) * (pax - pbx) + (pay - pby) * (pay - pby));
+#endif
   }
+
+  // Whether two UVs (2 floats each) have the same bits.
+  static bool same_uv(const float* a, const float* b) { return std::memcmp(a, b, 2 * sizeof(float)) == 0; }
 
   bool is_degenerate(uint32_t f) const { return rec_[f].degenerate != 0; }
 
@@ -255,8 +307,8 @@ class PatchMapper {
       uint32_t patches[3];
       int n = 0;
       for (int k = 0; k < 3; ++k) {
-        const uint32_t o = self.opposite[k];
-        if (o != kInvalid && rec_[o / 3].patch != kInvalid) patches[n++] = rec_[o / 3].patch;
+        const uint32_t g = self.neighbour[k];
+        if (g != kInvalid && rec_[g].patch != kInvalid) patches[n++] = rec_[g].patch;
       }
       if (n == 0) return false;
       int best_votes = 0;
@@ -269,15 +321,16 @@ class PatchMapper {
         }
       }
     }
-    // Corner UVs offered by the placed neighbours of the target patch, per edge.
-    const float* ends[3][2] = {};
+    // Corner UVs offered by the placed neighbours of the target patch, per edge (set for the
+    // edges listed in `edges` only: nothing else is read).
+    const float* ends[3][2];
     int edges[3];
     int count = 0;
     bool other_patch = false;  // a placed neighbour in another patch: a seam edge for sure
     for (int k = 0; k < 3; ++k) {
-      const uint32_t o = self.opposite[k];
-      if (o == kInvalid) continue;
-      const uint32_t q = rec_[o / 3].patch;
+      const uint32_t g = self.neighbour[k];
+      if (g == kInvalid) continue;
+      const uint32_t q = rec_[g].patch;
       if (q != target) {
         other_patch = other_patch || q != kInvalid;
         continue;
@@ -286,7 +339,6 @@ class PatchMapper {
       edges[count++] = k;
     }
     if (count == 0) return false;
-    const Rotation r = patch_rotation_[target];
     const bool degenerate = is_degenerate(f);
     const StretchFrame frame = stretch_frame(self.local, scale_);
     float candidate[6], best[6] = {0.f, 0.f, 0.f, 0.f, 0.f, 0.f};
@@ -321,27 +373,68 @@ class PatchMapper {
       return true;
     };
 
+    // Tiers 1 and 2 often rebuild a triangle already tried in this call: two neighbours that agree
+    // on their shared corner give the same candidate from either edge, and the patch's UV of a
+    // vertex is mostly the one a neighbour gives it. A repeat cannot change the outcome (its
+    // stretch equals the first one's, which best_stretch is already at or below, and it cuts
+    // exactly when the first one did, so the early accept cannot fire on it either): the repeats
+    // found cheaply below are skipped (horse: 41% of the candidates of tiers 1 and 2 were repeats).
+    // UVs are compared bit for bit, so one differing only in the sign of a zero is still tried.
+
     // --- Tier 1: third corner from a second placed neighbour ----------------------------------
-    if (count >= 2) {
-      for (int i = 0; i < count; ++i) {
-        const int k = edges[i], kc = kPrev[k];
-        // The other edges touching corner kc: k+1 (kc is its end) and k+2 (kc is its start).
-        for (int j = 0; j < count; ++j) {
-          const int m = edges[j];
-          if (m == k) continue;
-          const float* c = (m == kNext[k]) ? ends[m][1] : ends[m][0];
-          const int ka = k, kb = kNext[k];
-          candidate[2 * ka] = ends[k][0][0];
-          candidate[2 * ka + 1] = ends[k][0][1];
-          candidate[2 * kb] = ends[k][1][0];
-          candidate[2 * kb + 1] = ends[k][1][1];
-          candidate[2 * kc] = c[0];
-          candidate[2 * kc + 1] = c[1];
-          const bool cuts = cuts_any(k);
-          if (allow_cuts || !cuts) consider(degenerate ? 0.f : stretch_error(frame, candidate), 0.f, cuts);
-          if (!cuts && best_stretch <= bound_ && !best_cuts) return accept_best(true);
+    // Candidate: edge k copied, corner kc from edge m (one of the other edges touching it: k+1,
+    // which ends there, or k+2, which starts there). Returns whether it is accepted at once.
+    auto try_pair = [&](int k, int m, bool cuts) {
+      const int ka = k, kb = kNext[k], kc = kPrev[k];
+      const float* c = (m == kb) ? ends[m][1] : ends[m][0];
+      candidate[2 * ka] = ends[k][0][0];
+      candidate[2 * ka + 1] = ends[k][0][1];
+      candidate[2 * kb] = ends[k][1][0];
+      candidate[2 * kb + 1] = ends[k][1][1];
+      candidate[2 * kc] = c[0];
+      candidate[2 * kc + 1] = c[1];
+      consider(degenerate ? 0.f : stretch_error(frame, candidate), 0.f, cuts);
+      return !cuts && best_stretch <= bound_ && !best_cuts;
+    };
+    // Every corner touched by two of the edges has two sources: the neighbour across the edge
+    // starting there (ends[c][0]) and the one across the edge ending there (ends[c - 1][1]).
+    // Every candidate takes the other corners from their only source, so it cuts exactly when
+    // two sources disagree (the same for all candidates), and two candidates coincide when they
+    // differ only at corners whose sources agree bit for bit.
+    if (count == 2) {
+      // One corner has two sources, the one the edges share (the end of one, the start of the
+      // other); the second candidate is the first when they agree there.
+      const int k = edges[0], m = edges[1];
+      const float* from_k = m == kNext[k] ? ends[k][1] : ends[k][0];
+      const float* from_m = m == kNext[k] ? ends[m][0] : ends[m][1];
+      const bool cuts = from_k[0] != from_m[0] || from_k[1] != from_m[1];
+      if (allow_cuts || !cuts) {
+        if (try_pair(k, m, cuts)) return accept_best(true);
+        if (!same_uv(from_k, from_m) && try_pair(m, k, cuts)) return accept_best(true);
+      }
+    } else if (count == 3) {
+      // The candidates' picks (bit c set: corner c from the edge ending there), reduced to the
+      // corners whose sources disagree, are each tried once.
+      uint32_t agree = 0, seen = 0;
+      bool cuts = false;
+      for (int c = 0; c < 3; ++c) {
+        const float* a = ends[c][0];
+        const float* b = ends[kPrev[c]][1];
+        agree |= same_uv(a, b) ? 1u << c : 0u;
+        cuts = cuts || a[0] != b[0] || a[1] != b[1];
+      }
+      if (allow_cuts || !cuts) {
+        for (int k = 0; k < 3; ++k) {
+          for (const int m : {std::min(kNext[k], kPrev[k]), std::max(kNext[k], kPrev[k])}) {  // edge order
+            const uint32_t pick = ((1u << kNext[k]) | (m == kNext[k] ? 1u << kPrev[k] : 0u)) & ~agree;
+            if (seen >> pick & 1u) continue;
+            seen |= 1u << pick;
+            if (try_pair(k, m, cuts)) return accept_best(true);
+          }
         }
       }
+    }
+    if (count >= 2) {
       if (accept_best(true)) return true;
     }
 
@@ -350,6 +443,16 @@ class PatchMapper {
       const int k = edges[i], kc = kPrev[k];
       const VertexHint& hint = hint_[self.vertex[kc]];
       if (hint.patch != target) continue;
+      // Tier 1 tried edge k with corner kc from each other edge (or a candidate identical to it):
+      // a hint with the same bits as one of those corners repeats it.
+      if (count >= 2) {
+        bool tried = false;
+        for (int j = 0; j < count; ++j) {
+          const int m = edges[j];
+          if (m != k) tried = tried || same_uv(&hint.u, m == kNext[k] ? ends[m][1] : ends[m][0]);
+        }
+        if (tried) continue;
+      }
       const int ka = k, kb = kNext[k];
       candidate[2 * ka] = ends[k][0][0];
       candidate[2 * ka + 1] = ends[k][0][1];
@@ -364,6 +467,7 @@ class PatchMapper {
 
     // --- Tier 3: a fresh third corner ----------------------------------------------------------
     if (count > 1 && !allow_cuts) return false;  // a fresh corner cuts from all but one neighbour
+    const Rotation r = patch_rotation_[target];
     for (int i = 0; i < count; ++i) {
       const int k = edges[i];
       const float err = unfold(f, k, ends[k][0], ends[k][1], r, candidate);
@@ -378,13 +482,13 @@ class PatchMapper {
     int best = -1;
     float best_delta = std::numeric_limits<float>::infinity();
     for (int k = 0; k < 3; ++k) {
-      const uint32_t o = rec_[f].opposite[k];
-      if (o == kInvalid || rec_[o / 3].patch == kInvalid) continue;
+      const uint32_t g = rec_[f].neighbour[k];
+      if (g == kInvalid || rec_[g].patch == kInvalid) continue;
       const float* ua;
       const float* ub;
       neighbour_edge_uv(f, k, ua, ub);
       const float theta = edge_rotation(f, k, ua, ub);
-      const float reference = reference_per_patch ? patch_rotation_[rec_[o / 3].patch].angle() : 0.f;
+      const float reference = reference_per_patch ? patch_rotation_[rec_[g].patch].angle() : 0.f;
       const float delta = std::abs(wrap_angle(theta - reference));
       if (delta < best_delta) {
         best_delta = delta;
@@ -442,7 +546,7 @@ class PatchMapper {
     float uv[6];
     place_aligned(f, k, ua, ub, Rotation{std::cos(theta), std::sin(theta)}, uv);
     ++stats_.faces_rigid;
-    accept(f, rec_[rec_[f].opposite[k] / 3].patch, uv, 0.f, 0.f, false, true);
+    accept(f, rec_[rec_[f].neighbour[k]].patch, uv, 0.f, 0.f, false, true);
     --stats_.faces_unfolded;
   }
 
@@ -463,7 +567,7 @@ class PatchMapper {
   // on_seam: f may disagree with a placed neighbour (a cut, another patch, a rigid placement).
   void accept(uint32_t f, uint32_t p, const float* uv, float error_px, float stretch_error, bool three_known,
               bool on_seam) {
-    std::copy(uv, uv + 6, uv_ + 6 * f);
+    std::memcpy(uv_ + 6 * f, uv, 6 * sizeof(float));  // a constant size: no library call
     FaceRecord& self = rec_[f];
     self.patch = p;
     for (int k = 0; k < 3; ++k) {
@@ -476,16 +580,30 @@ class PatchMapper {
     else ++stats_.faces_unfolded;
     stats_.max_error_px = std::max(stats_.max_error_px, error_px);
     stats_.max_stretch_accepted = std::max(stats_.max_stretch_accepted, stretch_error);
-    // Where seams lie: the seam shortening afterwards starts from these faces and their neighbours.
-    if (on_seam) {
-      seam_mark_[f] = 1;
-      // Placed neighbours only: one placed later that disagrees with f is marked when it is placed.
-      for (int k = 0; k < 3; ++k) {
-        const uint32_t o = self.opposite[k];
-        if (o != kInvalid && rec_[o / 3].patch != kInvalid) seam_mark_[o / 3] = 1;
+    // One pass over the neighbours: the placed ones are marked (on a seam) and give the hops, the
+    // others are pushed below, in edge order.
+    // Where seams lie: the seam shortening afterwards starts from these faces and their neighbours
+    // (placed neighbours only: one placed later that disagrees with f is marked when it is placed).
+    if (on_seam) seam_mark_[f] = 1;
+    const bool hop = hop_age_ > 0.f && !absorbing_;  // the absorption pass keeps its own queue
+    uint32_t unplaced[3];
+    int unplaced_count = 0;
+    uint32_t fewest = kInvalid, fewest_any = kInvalid;
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t g = self.neighbour[k];
+      if (g == kInvalid) continue;
+      const uint32_t q = rec_[g].patch;
+      if (q == kInvalid) {
+        unplaced[unplaced_count++] = g;
+        continue;
+      }
+      if (on_seam) seam_mark_[g] = 1;
+      if (hop) {
+        fewest_any = std::min(fewest_any, hops_[g]);
+        if (q == p) fewest = std::min(fewest, hops_[g]);
       }
     }
-    if (absorbing_) return;  // the absorption pass keeps its own queue
+    if (absorbing_) return;
     // Age offset of the neighbours pushed now. Default: grows with the length of f's path from its
     // component's seed in faces (hops: one more than its fewest among placed neighbours of its
     // patch; a patch's first face continues from its placed neighbours in other patches), so the
@@ -495,14 +613,7 @@ class PatchMapper {
     // removing a part of the mesh shifted every later key and reordered the growth everywhere
     // (stability, removing 10%: bit-identical corners 14-97% -> 83-99.9%, docs/mapping.md).
     float age_offset;
-    if (hop_age_ > 0.f) {
-      uint32_t fewest = kInvalid, fewest_any = kInvalid;
-      for (int k = 0; k < 3; ++k) {
-        const uint32_t o = self.opposite[k];
-        if (o == kInvalid || rec_[o / 3].patch == kInvalid) continue;
-        fewest_any = std::min(fewest_any, hops_[o / 3]);
-        if (rec_[o / 3].patch == p) fewest = std::min(fewest, hops_[o / 3]);
-      }
+    if (hop) {
       if (fewest == kInvalid) fewest = fewest_any;  // a new patch's seed
       const uint32_t hops = fewest == kInvalid ? 0 : fewest + 1;
       hops_[f] = hops;
@@ -510,15 +621,13 @@ class PatchMapper {
     } else {
       age_offset = static_cast<float>(factor_);
     }
-    for (int k = 0; k < 3; ++k) {
-      const uint32_t o = self.opposite[k];
-      if (o == kInvalid) continue;
-      const uint32_t h = o / 3;
+    for (int i = 0; i < unplaced_count; ++i) {
+      const uint32_t h = unplaced[i];
       FaceRecord& r = rec_[h];
-      if (r.patch != kInvalid) continue;
       const uint32_t placed = ++r.placed;
       const uint64_t cls = r.seam ? kSeam : kWaiting;
       const uint64_t key = front_key(cls, placed, r.variation + age_offset, h);
+      if (r.front != 0) queue_.supersede(r.front - 1u);
       r.front = static_cast<uint8_t>(FrontBuckets::bucket_of(key) + 1);
       queue_.push(key);
     }
@@ -550,22 +659,25 @@ class PatchMapper {
       any_small = any_small || !kept[p];
     }
     if (!any_small) return;
+    // Every face is placed after the growth: the unplaced ones are those removed here, in face
+    // order, so the border is found among them instead of in a second pass over all faces.
     const size_t face_count = in_.mesh.face_count();
+    std::vector<uint32_t> removed;
     for (size_t f = 0; f < face_count; ++f) {
       if (!kept[rec[f].patch]) {
         --patch_size_[rec[f].patch];
         rec[f].patch = kInvalid;
+        removed.push_back(static_cast<uint32_t>(f));
       }
     }
     absorbing_ = true;
     std::vector<uint32_t> fifo;
-    fifo.reserve(face_count / 8 + 16);
-    for (size_t f = 0; f < face_count; ++f) {
-      if (rec[f].patch != kInvalid) continue;
+    fifo.reserve(removed.size() + 16);
+    for (const uint32_t f : removed) {
       for (int k = 0; k < 3; ++k) {
-        const uint32_t o = rec[f].opposite[k];
-        if (o != kInvalid && rec[o / 3].patch != kInvalid) {
-          fifo.push_back(static_cast<uint32_t>(f));
+        const uint32_t g = rec[f].neighbour[k];
+        if (g != kInvalid && rec[g].patch != kInvalid) {
+          fifo.push_back(f);
           break;
         }
       }
@@ -575,8 +687,8 @@ class PatchMapper {
       if (rec[f].patch != kInvalid) continue;
       if (!try_place(f, kAnyPatch)) join_rigidly(f);
       for (int k = 0; k < 3; ++k) {
-        const uint32_t o = rec[f].opposite[k];
-        if (o != kInvalid && rec[o / 3].patch == kInvalid) fifo.push_back(o / 3);
+        const uint32_t g = rec[f].neighbour[k];
+        if (g != kInvalid && rec[g].patch == kInvalid) fifo.push_back(g);
       }
     }
     absorbing_ = false;
@@ -602,7 +714,7 @@ class PatchMapper {
   float relax_ = 0.f;  // 1 - field_following: share of the edge mismatch taken as rotation
   double factor_step_ = 0.0, factor_ = 0.0;  // the thesis's global age counter (when hop_age_ is 0)
   float hop_age_ = 0.f;  // age per hop from the component's seed; 0 = the global counter
-  std::vector<uint32_t> hops_;  // per face: hops from its component's seed (hop_age_ > 0)
+  std::unique_ptr<uint32_t[]> hops_;  // per face: hops from its component's seed (hop_age_ > 0)
   float* uv_ = nullptr;
   std::unique_ptr<FaceRecord[]> rec_;  // per face
   std::vector<VertexHint> hint_;  // per vertex: the UV its patch first gave it

@@ -8,6 +8,7 @@
 // descent on total seam length: each move strictly shortens it, so the pass ends.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include "internal/face_stretch.h"
@@ -128,20 +129,15 @@ class SeamShortener {
     float best_gain = 0.f, best_stretch = 0.f;
     int best_edge = -1;
     // Which neighbours' patches f may join: its own always; another only if f's patch keeps at
-    // least the absorption minimum and stays in one piece without f.
+    // least the absorption minimum and stays in one piece without f. Asked only for the edges
+    // whose candidates are built (with one seam edge, that one).
     const uint32_t from = atlas_.patch[f];
-    bool may_join[3] = {false, false, false};
     int may_leave = -1;  // -1 unknown, 0 no, 1 yes
-    for (int k = 0; k < 3; ++k) {
-      if (!ends[k][0]) continue;
-      const uint32_t to = atlas_.patch[opposite_[3 * f + k] / 3];
-      if (to == from) {
-        may_join[k] = true;
-        continue;
-      }
+    auto may_join = [&](int k) {
+      if (atlas_.patch[opposite_[3 * f + k] / 3] == from) return true;
       if (may_leave < 0) may_leave = can_leave(f) ? 1 : 0;
-      may_join[k] = may_leave == 1;
-    }
+      return may_leave == 1;
+    };
     // Edges towards user seam faces keep their state: the seams asked for stay where they are.
     bool fixed[3] = {false, false, false};
     if (seam_flags_) {
@@ -150,11 +146,16 @@ class SeamShortener {
         fixed[k] = o != kInvalid && seam_flags_[o / 3];
       }
     }
+    // Every candidate copies edge k from across it, so that edge is never a seam (UVs are finite):
+    // only the two others are compared. Their cost is summed in the order of seam_cost (adding the
+    // zero of edge k changes no bit), so gains are the same floats.
     auto consider = [&](const float* candidate, int k) {
-      if (!may_join[k]) return;
-      for (int j = 0; j < 3; ++j)
-        if (fixed[j] && seam_at(candidate, j) != seam[j]) return;
-      const float gain = before - seam_cost(candidate);
+      const int lo = k == 0 ? 1 : 0, hi = k == 2 ? 1 : 2;
+      const bool seam_lo = seam_at(candidate, lo), seam_hi = seam_at(candidate, hi);
+      if (seam_flags_ && ((fixed[k] && seam[k]) || (fixed[lo] && seam_lo != seam[lo]) ||
+                          (fixed[hi] && seam_hi != seam[hi])))
+        return;
+      const float gain = before - ((seam_lo ? length[lo] : 0.f) + (seam_hi ? length[hi] : 0.f));
       if (!(gain > min_gain) || gain < best_gain) return;
       const float s = degenerate ? 0.f : stretch_error(frame, candidate);
       if (!(s <= bound_)) return;
@@ -170,6 +171,7 @@ class SeamShortener {
       // With one seam edge, only copying that edge from across it can close it: copying an edge
       // f already shares keeps the seam and at best moves one corner onto it.
       if (seams == 1 && !seam[k]) continue;
+      if (!may_join(k)) continue;  // every candidate below would join that neighbour's patch
       const int ka = k, kb = kNext[k], kc = kPrev[k];
       candidate[2 * ka] = ends[k][0][0];
       candidate[2 * ka + 1] = ends[k][0][1];
@@ -181,9 +183,12 @@ class SeamShortener {
         candidate[2 * kc + 1] = ends[kNext[k]][1][1];
         consider(candidate, k);
       }
-      if (ends[kPrev[k]][0]) {
-        candidate[2 * kc] = ends[kPrev[k]][0][0];
-        candidate[2 * kc + 1] = ends[kPrev[k]][0][1];
+      // The same corner from the neighbour on the other side is skipped when bit-identical (always
+      // so around a face with one seam edge): the same candidate cannot change the best.
+      if (const float* c = ends[kPrev[k]][0];
+          c && !(ends[kNext[k]][1] && std::memcmp(c, ends[kNext[k]][1], 2 * sizeof(float)) == 0)) {
+        candidate[2 * kc] = c[0];
+        candidate[2 * kc + 1] = c[1];
         consider(candidate, k);
       }
       // Third corner carried by the similarity own AB -> new AB (z -> a' + (z - a) w / v in
