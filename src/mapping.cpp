@@ -31,19 +31,11 @@ std::vector<uint32_t> component_seed_faces(const Mesh& mesh, const Topology& top
   if (options.use_seed_point) {
     for (int i = 0; i < 3; ++i) target[i] = options.seed_point[i];
   } else {
-    // Centre of the bounding box of the referenced vertices (mesh coordinates; float min/max are
-    // exact, so doubles are only needed for the centre).
-    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (size_t c = 0; c < 3 * face_count; ++c) {
-      const float* p = pos + 3 * idx[c];
-      for (int i = 0; i < 3; ++i) {
-        lo[i] = std::min(lo[i], p[i]);
-        hi[i] = std::max(hi[i], p[i]);
-      }
-    }
-    for (int i = 0; i < 3; ++i) target[i] = 0.5 * (static_cast<double>(lo[i]) + hi[i]);
+    // Centre of the bounding box of the referenced vertices (found by the orientation; float
+    // min/max are exact, so doubles are only needed for the centre).
+    for (int i = 0; i < 3; ++i)
+      target[i] = 0.5 * (static_cast<double>(frames.bbox_min[static_cast<size_t>(i)]) + frames.bbox_max[static_cast<size_t>(i)]);
   }
-  (void)frames;
   const uint32_t components = topology.edge_components;
   std::vector<double> best_distance(components, INFINITY);
   std::vector<uint32_t> best_face(components, kInvalid);

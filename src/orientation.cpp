@@ -293,6 +293,8 @@ Status compute_orientation(const Mesh& mesh, const Topology& topology, const Ori
   store(frames.axis.data(), axis);
   store(frames.axis2.data(), axis2);
   store(frames.origin.data(), origin);
+  store(frames.bbox_min.data(), lo);
+  store(frames.bbox_max.data(), hi);
   frames.unit_scale = static_cast<float>(unit_scale);
   frames.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return Status::ok();

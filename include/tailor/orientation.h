@@ -61,6 +61,7 @@ struct FaceFrames {
   std::array<float, 3> axis{};     //!< the global axis used (unit), in mesh coordinates
   std::array<float, 3> axis2{};    //!< the fallback axis used (unit)
   std::array<float, 3> origin{};   //!< normalisation: normalised = (x - origin) * unit_scale
+  std::array<float, 3> bbox_min{}, bbox_max{};  //!< bounding box of the referenced vertices (mesh coordinates)
   float unit_scale = 1.f;          //!< 1 / longest bbox side (or OrientationOptions::fixed_unit_scale)
   uint32_t degenerate_faces = 0;   //!< zero-area faces given an arbitrary valid frame
   uint32_t fallback_faces = 0;     //!< faces where the second axis was projected
