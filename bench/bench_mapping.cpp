@@ -1,6 +1,7 @@
 // Orientation and mapping throughput (M faces/s) with the quality of the result on the same line,
 // on the 1.55 M face subdivided horse (bench_meshes.h) and on every mesh of the shared data set
-// (TAILOR_SHARED_DATA/meshes, skipped when absent), in both mapping modes.
+// (TAILOR_SHARED_DATA/meshes, skipped when absent), in both mapping modes, and the patches mode's
+// growth without its crack closing.
 // Targets (docs/mapping.md): mapping >= 10 M faces/s single-threaded; on every shared mesh
 // 0 flipped, Sander L2 <= 1.02, Linf <= 3, thesis stretch <= 0.08, no single-face patches.
 //
@@ -71,14 +72,12 @@ void BM_Orientation(benchmark::State& state, const std::string& key) {
   set_faces_rate(state, p.mesh.face_count());
 }
 
-void BM_Mapping(benchmark::State& state, const std::string& key, tailor::MappingMode mode) {
+void BM_Mapping(benchmark::State& state, const std::string& key, const tailor::MappingOptions& options) {
   const Prepared& p = prepared(key);
   if (!p.ok) {
     state.SkipWithError(p.error.c_str());
     return;
   }
-  tailor::MappingOptions options;
-  options.mode = mode;
   tailor::Atlas atlas;
   tailor::MappingStats stats;
   for (auto _ : state) {
@@ -105,10 +104,12 @@ void BM_Mapping(benchmark::State& state, const std::string& key, tailor::Mapping
   state.counters["angle_deg"] = m.distortion_deg;
   state.counters["L2"] = m.l2_stretch;
   state.counters["Linf"] = m.linf_stretch;
-  if (mode == tailor::MappingMode::kThesis) state.counters["thr_px"] = stats.final_threshold_px;
+  if (options.mode == tailor::MappingMode::kThesis) state.counters["thr_px"] = stats.final_threshold_px;
 }
 
-// Registers one orientation and two mapping benchmarks per mesh at static initialisation.
+// Registers one orientation and four mapping benchmarks per mesh at static initialisation:
+// patches mode (default options), its growth alone (no crack closing), the fewest-seams setting
+// (pure unfolding, crack closing at 32 rings), thesis mode.
 [[maybe_unused]] const bool registered = [] {
   std::vector<std::pair<std::string, std::string>> meshes = {{"horse_x16", "horse_x16"}};
   const std::filesystem::path dir = std::filesystem::path(TAILOR_SHARED_DATA) / "meshes";
@@ -120,14 +121,25 @@ void BM_Mapping(benchmark::State& state, const std::string& key, tailor::Mapping
   }
   std::sort(files.begin(), files.end());
   for (const auto& f : files) meshes.emplace_back(f.stem().string(), f.string());
+  tailor::MappingOptions patches, growth, fewest_seams, thesis;
+  growth.close_cracks = false;
+  fewest_seams.field_following = 0.f;  // `--field-following 0 --crack-rings 32`
+  fewest_seams.crack_rings = 32;
+  thesis.mode = tailor::MappingMode::kThesis;
   for (const auto& [name, key] : meshes) {
     benchmark::RegisterBenchmark(("Orientation/" + name).c_str(), BM_Orientation, key)
         ->Unit(benchmark::kMillisecond)
         ->MinTime(0.2);
-    benchmark::RegisterBenchmark(("Mapping/patches/" + name).c_str(), BM_Mapping, key, tailor::MappingMode::kPatches)
+    benchmark::RegisterBenchmark(("Mapping/patches/" + name).c_str(), BM_Mapping, key, patches)
         ->Unit(benchmark::kMillisecond)
         ->MinTime(0.2);
-    benchmark::RegisterBenchmark(("Mapping/thesis/" + name).c_str(), BM_Mapping, key, tailor::MappingMode::kThesis)
+    benchmark::RegisterBenchmark(("Mapping/growth/" + name).c_str(), BM_Mapping, key, growth)
+        ->Unit(benchmark::kMillisecond)
+        ->MinTime(0.2);
+    benchmark::RegisterBenchmark(("Mapping/fewest-seams/" + name).c_str(), BM_Mapping, key, fewest_seams)
+        ->Unit(benchmark::kMillisecond)
+        ->MinTime(0.2);
+    benchmark::RegisterBenchmark(("Mapping/thesis/" + name).c_str(), BM_Mapping, key, thesis)
         ->Unit(benchmark::kMillisecond)
         ->MinTime(0.2);
   }

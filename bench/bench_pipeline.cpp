@@ -14,7 +14,10 @@
 
 namespace {
 
-void BM_EndToEndPlyToGlb(benchmark::State& state) {
+// close_cracks: the default; without it, the growth alone (`tailor map --no-crack-closing`).
+void BM_EndToEndPlyToGlb(benchmark::State& state, bool close_cracks) {
+  tailor::MappingOptions options;
+  options.close_cracks = close_cracks;
   const std::string& input = subdivided_horse_ply_path();
   const std::string output = (std::filesystem::temp_directory_path() / "tailor_bench_pipeline.glb").string();
   size_t faces = 0;
@@ -28,7 +31,7 @@ void BM_EndToEndPlyToGlb(benchmark::State& state) {
     tailor::FaceFrames frames;
     tailor::Atlas atlas;
     if (!tailor::compute_orientation(mesh, topology, {}, frames).is_ok() ||
-        !tailor::map_texture(mesh, topology, frames, {}, atlas).is_ok() ||
+        !tailor::map_texture(mesh, topology, frames, options, atlas).is_ok() ||
         !tailor::export_mesh(output, mesh, atlas, {}).is_ok()) {
       state.SkipWithError("pipeline failed");
       return;
@@ -39,6 +42,7 @@ void BM_EndToEndPlyToGlb(benchmark::State& state) {
   state.counters["faces"] = static_cast<double>(faces);
   set_faces_rate(state, faces);
 }
-BENCHMARK(BM_EndToEndPlyToGlb)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK_CAPTURE(BM_EndToEndPlyToGlb, default, true)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK_CAPTURE(BM_EndToEndPlyToGlb, no_crack_closing, false)->Unit(benchmark::kMillisecond)->Iterations(3);
 
 }  // namespace

@@ -12,9 +12,7 @@
 #include <limits>
 #include <memory>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
+#include "internal/simd.h"
 
 #include "internal/face_stretch.h"
 #include "internal/front_buckets.h"
@@ -55,7 +53,7 @@ struct VertexHint {
   float u, v;  // contiguous: read as one UV
 };
 
-#if defined(__SSE2__)
+#if TAILOR_SSE2
 // Two floats (a UV or a frame corner) into the low lanes.
 inline __m128 load_uv(const float* p) { return _mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p))); }
 #endif
@@ -218,7 +216,7 @@ class PatchMapper {
       const float c = std::cos(theta), sn = std::sin(theta);
       r = Rotation{r.c * c - r.s * sn, r.s * c + r.c * sn};
     }
-#if defined(__SSE2__)
+#if TAILOR_SSE2
     // Both predictions at once, lane by lane the operations of the scalar code below (same bits,
     // checked on 2e7 random cases; x - y is x + (-y) and a sum does not depend on operand order).
     const float* l = rec_[f].local;

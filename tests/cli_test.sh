@@ -51,6 +51,11 @@ cmp -s "$tmp/a.glb" "$tmp/b.glb" && ok || fail "two runs gave different .glb fil
 for ext in obj ply; do
   "$tailor" map "$mesh" -o "$tmp/c.$ext" --quiet && [[ -s $tmp/c.$ext ]] && ok || fail "map to .$ext failed"
 done
+# Crack closing is reported in the stats and can be switched off (then nothing is zipped).
+grep -Eq '"cracks_closed": [1-9][0-9]*' "$tmp/a.json" && ok || fail "stats: no cracks_closed > 0"
+"$tailor" map "$mesh" -o "$tmp/open.glb" --stats "$tmp/open.json" --no-crack-closing --quiet &&
+  grep -q '"cracks_closed": 0' "$tmp/open.json" && grep -q '"close_cracks": false' "$tmp/open.json" && ok ||
+  fail "--no-crack-closing: $(cat "$tmp/open.json")"
 
 # --- eval: metrics of our own output agree with map's (0 flipped), stability experiment runs ---
 "$tailor" eval "$tmp/a.glb" >"$tmp/eval.txt" 2>&1 && grep -Eq "5856 faces, .* 0 flipped" "$tmp/eval.txt" && ok ||
@@ -95,6 +100,7 @@ cp "$mesh" "$tmp/bad"$'\xff'".obj"
 
 # --- bad usage: exit 2 ---
 expect_error 2 "mode" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --mode fancy
+expect_error 2 "crack-rings" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --crack-rings 1
 expect_error 2 "output must end" -- "$tailor" map "$mesh" -o "$tmp/x.txt"
 expect_error 2 "" -- "$tailor" map "$mesh"
 expect_error 2 "" -- "$tailor" frobnicate

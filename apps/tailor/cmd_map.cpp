@@ -348,8 +348,9 @@ void register_map(CLI::App& app, Runner& run) {
                   "patches mode: leave the cracks (cuts inside a patch) open; 3-6x faster mapping, 30-50% more seam "
                   "length");
   group->add_option("--crack-rings", opt->crack_rings,
-                    "patches mode: largest region, in rings of faces, that zipping a crack may relax (2..64); "
-                    "more closes wider cracks and takes longer")
+                    "patches mode: effort of the crack closing, the largest region (rings of faces) a zip may "
+                    "relax (2..64); more closes wider cracks and takes longer. Fewest seams: --field-following 0 "
+                    "--crack-rings 32")
       ->check(CLI::Range(2u, 64u))
       ->capture_default_str();
   group->add_option("--threshold", opt->threshold, "thesis mode: initial error threshold in pixels")

@@ -84,8 +84,9 @@ struct MappingOptions {
   bool close_cracks = true;         //!< last, zip cracks (seams inside one patch) shut from their tips, spreading
                                     //!< each gap over the faces around it within max_stretch (ARAP relaxation):
                                     //!< 30-50% less seam length, mapping 3-6x slower (docs/mapping.md)
-  uint32_t crack_rings = 16;        //!< largest region a zip relaxes, in rings of faces around it (2..64): more
-                                    //!< closes wider gaps, costs more time
+  uint32_t crack_rings = 16;        //!< effort of the crack closing (2..64): the largest region a zip relaxes, in
+                                    //!< rings of faces around it (a first try takes crack_rings / 2 rings per unit
+                                    //!< of gap / edge length); more closes wider gaps and takes longer
   uint32_t min_patch_faces = 16;    //!< patches with fewer faces are absorbed into a neighbouring patch by rigid
                                     //!< unfolding (0 = keep all; isolated components stay whole)
   // kThesis -------------------------------------------------------------------------------------

@@ -7,9 +7,7 @@
 #include <cmath>
 #include <limits>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
+#include "simd.h"
 
 namespace tailor::internal {
 
@@ -49,7 +47,7 @@ inline StretchFrame stretch_frame(const float* local, float scale) {
 inline float stretch_error(const StretchFrame& s, const float* uv) {
   constexpr float kInf = std::numeric_limits<float>::infinity();
   if (!s.valid) return kInf;
-#if defined(__SSE2__)
+#if TAILOR_SSE2
   // The same operations as the scalar code below, four lanes at a time (IEEE operations round
   // each lane as the scalar ones do, and nothing is reordered, so the result has the same bits;
   // checked on 2e7 random triangles). The growth runs this ~1.5 times per face: 3% of its
