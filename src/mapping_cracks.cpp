@@ -25,6 +25,7 @@
 //   parameterization", SGP 2008 (ARAP local/global iterations; uniform weights here).
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <vector>
 
 #include "internal/simd.h"
@@ -291,20 +292,34 @@ class CrackCloser {
     wedge_stamp_.assign(3 * face_count, 0);
     wedge_local_.assign(3 * face_count, 0);
 
-    // Crack edges, each once (its half-edge in the face of lower id), in edge order; a zip queues
-    // the crack edges around the vertices it merged (they may end there now), first in first out.
-    std::vector<uint32_t> queue;
+    // Crack edges, each once (its half-edge in the face of lower id), nearest to the component's
+    // seed first (faces' distance in edge steps, then edge id); a zip queues the crack edges around
+    // the vertices it merged (they may end there now). Why this order: zips overlap along a crack
+    // and between neighbouring cracks, so each depends on those before it; with the seed's
+    // neighbourhood first, removing part of the mesh (far from the seed, as in the stability test)
+    // changes only zips processed after it, as the growth's hop rule does for the placements.
+    const std::vector<uint32_t> distance = seed_distances();
+    auto key = [&](uint32_t e) {
+      const uint32_t d = std::min(distance[e / 3], distance[opposite_[e] / 3]);
+      return (uint64_t{d} << 32) | e;
+    };
+    std::vector<uint64_t> heap;
     std::vector<uint8_t> queued(3 * face_count, 0);
     for (uint32_t e = 0; e < 3 * face_count; ++e) {
       if (e < opposite_[e] && is_crack(e)) {
-        queue.push_back(e);
+        heap.push_back(key(e));
         queued[e] = 1;
       }
     }
-    for (size_t head = 0; head < queue.size(); ++head) {
-      if (head % kProgressInterval == 0 && progress_ && !progress_(static_cast<float>(head) / static_cast<float>(queue.size())))
+    std::make_heap(heap.begin(), heap.end(), std::greater<>());
+    const size_t initial = heap.size();
+    for (size_t popped = 0; !heap.empty(); ++popped) {
+      if (popped % kProgressInterval == 0 && progress_ &&
+          !progress_(std::min(1.f, static_cast<float>(popped) / static_cast<float>(initial + 1))))
         return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
-      const uint32_t e = queue[head];
+      std::pop_heap(heap.begin(), heap.end(), std::greater<>());
+      const uint32_t e = static_cast<uint32_t>(heap.back());
+      heap.pop_back();
       queued[e] = 0;
       if (!is_crack(e)) continue;
       const int merged = zip(e);
@@ -320,7 +335,8 @@ class CrackCloser {
             const uint32_t canonical = std::min(h, o);
             if (queued[canonical] || !is_crack(canonical)) continue;
             queued[canonical] = 1;
-            queue.push_back(canonical);
+            heap.push_back(key(canonical));
+            std::push_heap(heap.begin(), heap.end(), std::greater<>());
           }
         }
       }
@@ -329,6 +345,27 @@ class CrackCloser {
   }
 
  private:
+  // Per face, its distance in edge steps from its component's seed face (breadth first).
+  std::vector<uint32_t> seed_distances() const {
+    const size_t face_count = in_.mesh.face_count();
+    std::vector<uint32_t> distance(face_count, kInvalid), fifo;
+    fifo.reserve(face_count);
+    for (const uint32_t seed : in_.component_seeds) {
+      distance[seed] = 0;
+      fifo.push_back(seed);
+    }
+    for (size_t head = 0; head < fifo.size(); ++head) {
+      const uint32_t f = fifo[head];
+      for (uint32_t k = 0; k < 3; ++k) {
+        const uint32_t o = opposite_[3 * f + k];
+        if (o == kInvalid || distance[o / 3] != kInvalid) continue;
+        distance[o / 3] = distance[f] + 1;
+        fifo.push_back(o / 3);
+      }
+    }
+    return distance;
+  }
+
   // === UV vertices ("wedges") ===================================================================
   // Corners around one mesh vertex that hold the same UV through a chain of faces form a wedge;
   // wedge_[c] is the id of corner c's wedge (one of its corners). Found by union-find across every

@@ -536,9 +536,10 @@ TEST(Stability, RemovingTenPercentKeepsMostOfTheMapping) {
   EXPECT_GE(report.within_1px_ratio, report.identical_ratio);
   // The growth order is local (hop rule), so almost everything is reproduced bit for bit
   // (measured: 99.1%; 84% with the thesis's global counter). Crack closing relaxes regions that
-  // overlap along a crack, so a crack passing near the removed part changes in the last bits
-  // along its length (measured: 92.2% bit-identical, 98.7% within 1 px, mean 0.05 px).
-  EXPECT_GT(report.identical_ratio, 0.9);
+  // overlap along a crack, so zips processed after one near the removed part change in the last
+  // bits (measured: 97.2% bit-identical, 98.8% within 1 px, mean 0.05 px; 92.2% when the zips
+  // went in edge order instead of nearest to the seed first).
+  EXPECT_GT(report.identical_ratio, 0.95);
   EXPECT_GT(report.within_1px_ratio, 0.97);
   EXPECT_LT(report.mean_difference_px, 1.0);
   // On the horse the hop rule keeps 99% of the corners bit-identical and the mean change under
@@ -554,9 +555,11 @@ TEST(Stability, RemovingTenPercentKeepsMostOfTheMapping) {
   ASSERT_TRUE(measure_stability(horse, {}, global_counter, counter).is_ok());
   EXPECT_GT(hops.identical_ratio, 0.97);
   EXPECT_LT(hops.mean_difference_px, 1.0);
-  // With crack closing (default): measured 91.1% bit-identical, 98.6% within 1 px, 0.53 px.
+  // With crack closing (default): measured 95.9% bit-identical, 99.2% within 1 px, 0.51 px (91.1%
+  // in edge order).
   ASSERT_TRUE(measure_stability(horse, {}, {}, closed).is_ok());
-  EXPECT_GT(closed.within_1px_ratio, 0.97);
+  EXPECT_GT(closed.identical_ratio, 0.94);
+  EXPECT_GT(closed.within_1px_ratio, 0.98);
   EXPECT_LT(closed.mean_difference_px, 1.0);
   EXPECT_LT(counter.identical_ratio, 0.9);
   EXPECT_GT(counter.mean_difference_px, 2.0 * hops.mean_difference_px);
