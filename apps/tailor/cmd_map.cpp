@@ -371,7 +371,10 @@ void register_map(CLI::App& app, Runner& run) {
       "  tailor tile gravel.png -o gravel_tile.png\n"
       "  tailor map bunny.ply --texture gravel_tile.png -o bunny.glb --stats bunny.json --preview bunny.png\n"
       "Prints one summary line: faces, patches, seam length, flipped faces, stretch, Sander L2/Linf,\n"
-      "median angle distortion, seam gap, and the time of each stage.");
+      "median angle distortion, seam gap, and the time of each stage.\n"
+      "Trade-offs: --no-crack-closing maps 3-8x faster and keeps more UVs bit-identical when parts of\n"
+      "the mesh change, with about twice the seam length; --field-following 0 --crack-rings 32 gives the\n"
+      "fewest seams (one patch per component) for stochastic textures whose direction does not matter.");
   cmd->callback([&run, opt] { run = [opt] { return run_map(*opt); }; });
 }
 
