@@ -185,15 +185,22 @@ TEST(Mapping, PureUnfoldingAndLooserBoundsStayValid) {
             ErrorCode::kInvalidArgument);
 }
 
+// Maps mesh `name` into `on` with default options and into `off` with `step` switched off; returns
+// the latter options.
+MappingOptions map_with_and_without(const char* name, bool MappingOptions::*step, Mapped& on, Mapped& off) {
+  on.mesh = load(name);
+  off.mesh = on.mesh;
+  MappingOptions options;
+  map_mesh(on, options);
+  options.*step = false;
+  map_mesh(off, options);
+  return options;
+}
+
 TEST(Mapping, SeamShorteningShortensSeamsWithinTheBound) {
   for (const char* name : {"horse.ply", "spot.obj"}) {
     Mapped shortened, kept;
-    shortened.mesh = load(name);
-    kept.mesh = shortened.mesh;
-    MappingOptions options;
-    map_mesh(shortened, options);
-    options.shorten_seams = false;
-    map_mesh(kept, options);
+    const MappingOptions options = map_with_and_without(name, &MappingOptions::shorten_seams, shortened, kept);
     EXPECT_GT(shortened.stats.faces_reseamed, 0u) << name;
     EXPECT_EQ(kept.stats.faces_reseamed, 0u) << name;
     expect_valid_patches_atlas(shortened, options, std::string(name) + " shortened");
@@ -230,12 +237,7 @@ bool is_seam_edge(const Mapped& m, uint32_t e) {
 TEST(Mapping, CrackClosingZipsCracksWithinTheBound) {
   for (const char* name : {"horse.ply", "spot.obj"}) {
     Mapped closed, open;
-    closed.mesh = load(name);
-    open.mesh = closed.mesh;
-    MappingOptions options;
-    map_mesh(closed, options);
-    options.close_cracks = false;
-    map_mesh(open, options);
+    const MappingOptions options = map_with_and_without(name, &MappingOptions::close_cracks, closed, open);
     EXPECT_GT(closed.stats.cracks_closed, 100u) << name;
     EXPECT_EQ(open.stats.cracks_closed, 0u) << name;
     expect_valid_patches_atlas(closed, options, std::string(name) + " cracks closed");
