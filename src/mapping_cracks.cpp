@@ -26,6 +26,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <vector>
 
 #include "internal/simd.h"
@@ -59,8 +60,13 @@ constexpr int kAbortAt = 5;
 // Without it the distortion peaks at the zipped vertex (uniform ARAP) and 40 % fewer zips pass.
 // A zipped face must also keep its area within 1/(1 + kAreaBound)..1 + kAreaBound of the
 // surface's: the cone a zip flattens is mostly area change, and unbounded it raised the thesis
-// stretch (the area ratio's variation) past 0.08 on spot.
+// stretch (the area ratio's variation) past 0.08 on spot. It widens in proportion to max_stretch
+// above the default 0.25 (at max_stretch 4 a fixed 0.2 let 0 zips through on spot).
 constexpr float kAreaBound = 0.2f;
+// A zip at a vertex with more corners than this would relax its whole fan, once per crack edge
+// there (O(valence^2): a fan of 40k faces took 48 s, one of 1e6 would never end); such vertices
+// keep their cracks. Scans have valences of 4-12.
+constexpr uint32_t kMaxZipValence = 64;
 
 // === Local step ===================================================================================
 // Per moving face, what the Gauss-Seidel step reads of it (kRecord floats, see fit_rotations).
@@ -282,6 +288,7 @@ class CrackCloser {
     scale_ = in_.options.scale;
     bound_ = in_.options.max_stretch;
     max_rings_ = static_cast<int>(std::max<uint32_t>(in_.options.crack_rings, kMinRings));
+    area_bound_ = kAreaBound * std::max(1.f, bound_ / 0.25f);
     seam_flags_ = in_.options.seam_faces.empty() ? nullptr : in_.options.seam_faces.data();
     build_wedges();
     build_vertex_corners();
@@ -314,7 +321,9 @@ class CrackCloser {
     std::make_heap(heap.begin(), heap.end(), std::greater<>());
     const size_t initial = heap.size();
     for (size_t popped = 0; !heap.empty(); ++popped) {
-      if (popped % kProgressInterval == 0 && progress_ &&
+      // Every 256 pops (kProgressInterval counts placements; a pop here costs up to two
+      // relaxations): the closing is most of the mapping's time, so it reports and can be cancelled.
+      if (popped % 256 == 0 && progress_ &&
           !progress_(std::min(1.f, static_cast<float>(popped) / static_cast<float>(initial + 1))))
         return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
       std::pop_heap(heap.begin(), heap.end(), std::greater<>());
@@ -411,8 +420,11 @@ class CrackCloser {
     for (uint32_t c = 0; c < corners; ++c) vertex_corners_[fill[indices_[c]]++] = c;
   }
 
+  // Corner c's UV (size_t arithmetic: 2c wraps in 32 bits beyond 2^31 corners).
+  const float* uv_of(uint32_t corner) const { return uv_ + 2 * size_t{corner}; }
+
   bool same_uv(uint32_t a, uint32_t b) const {
-    return uv_[2 * a] == uv_[2 * b] && uv_[2 * a + 1] == uv_[2 * b + 1];
+    return uv_of(a)[0] == uv_of(b)[0] && uv_of(a)[1] == uv_of(b)[1];
   }
 
   // The corners of half-edge e = 3f + k at its start A and end B, and the neighbour's at A and B.
@@ -442,14 +454,19 @@ class CrackCloser {
   // (0: nothing changed; merges_ then lists the merges).
   int zip(uint32_t e) {
     const EdgeCorners c = edge_corners(e);
-    const float edge = std::hypot(uv_[2 * c.fa] - uv_[2 * c.fb], uv_[2 * c.fa + 1] - uv_[2 * c.fb + 1]);
+    const float edge = std::hypot(uv_of(c.fa)[0] - uv_of(c.fb)[0], uv_of(c.fa)[1] - uv_of(c.fb)[1]);
     merges_.clear();
     changed_.clear();
     float gap_ratio = 0.f;
     for (const auto& [fc, gc] : {std::pair{c.fa, c.ga}, std::pair{c.fb, c.gb}}) {
       const uint32_t keep = wedge_[fc], drop = wedge_[gc];
       if (keep == drop) continue;
-      const float gap = std::hypot(uv_[2 * keep] - uv_[2 * drop], uv_[2 * keep + 1] - uv_[2 * drop + 1]);
+      const uint32_t v = indices_[fc];
+      if (vertex_start_[v + 1] - vertex_start_[v] > kMaxZipValence) {
+        undo_merges();
+        return 0;
+      }
+      const float gap = std::hypot(uv_of(keep)[0] - uv_of(drop)[0], uv_of(keep)[1] - uv_of(drop)[1]);
       if (!(gap <= kMaxGapRatio * edge)) {
         undo_merges();
         return 0;
@@ -475,7 +492,7 @@ class CrackCloser {
   // Returns false if either reaches into another patch (its UV is pinned there) or holds a corner
   // of a user seam face (a zip there could close a seam the user asked for): no zip.
   bool merge(uint32_t vertex, uint32_t keep, uint32_t drop) {
-    const Merge m{vertex, keep, drop, {0.5f * (uv_[2 * keep] + uv_[2 * drop]), 0.5f * (uv_[2 * keep + 1] + uv_[2 * drop + 1])}};
+    const Merge m{vertex, keep, drop, {0.5f * (uv_of(keep)[0] + uv_of(drop)[0]), 0.5f * (uv_of(keep)[1] + uv_of(drop)[1])}};
     const uint32_t patch = atlas_.patch[keep / 3];
     bool inside = true;
     for (uint32_t j = vertex_start_[vertex]; j < vertex_start_[vertex + 1]; ++j) {
@@ -520,7 +537,10 @@ class CrackCloser {
     }
     last_max_ = 0.f;
     collect_region(patch, rings);
-    if (!collect_moving()) return false;
+    if (!collect_moving()) {
+      last_max_ = std::numeric_limits<float>::infinity();  // a larger region holds the same face: no retry
+      return false;
+    }
     build_terms();
     const size_t moving = moving_.size(), free_count = free_wedge_.size();
     const uint32_t* const corner_pos = corner_pos_.data();
@@ -565,8 +585,8 @@ class CrackCloser {
       }
       const StretchFrame& frame = frame_[written];
       const float area_ratio = ((uv[2] - uv[0]) * (uv[5] - uv[1]) - (uv[4] - uv[0]) * (uv[3] - uv[1])) * frame.inv;
-      within = stretch_error(frame, uv) <= bound_ && area_ratio <= 1.f + kAreaBound &&
-               area_ratio * (1.f + kAreaBound) >= 1.f;
+      within = stretch_error(frame, uv) <= bound_ && area_ratio <= 1.f + area_bound_ &&
+               area_ratio * (1.f + area_bound_) >= 1.f;
     }
     if (within) return true;
     for (size_t i = 0; i < written; ++i) std::copy(saved + 6 * i, saved + 6 * i + 6, uv_ + 6 * size_t{moving_[i]});
@@ -737,6 +757,7 @@ class CrackCloser {
   const uint8_t* seam_flags_ = nullptr;
   float scale_ = 1.f, bound_ = 0.f;
   int max_rings_ = kMinRings;
+  float area_bound_ = kAreaBound;  // kAreaBound, widened in proportion above the default max_stretch
   float last_max_ = 0.f;
   std::vector<uint32_t> wedge_;       // per corner: its wedge id
   std::vector<uint32_t> wedge_size_;  // per wedge id: corners

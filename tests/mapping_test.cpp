@@ -484,6 +484,22 @@ TEST(Mapping, ProgressCanCancel) {
   EXPECT_EQ(s.code(), ErrorCode::kCancelled);
   EXPECT_EQ(calls, 1);
   EXPECT_TRUE(m.atlas.corner_uv.empty());
+  // The crack closing (most of the time) reports the last 80% and can be cancelled too: progress
+  // rises through it, and stopping half-way leaves the atlas empty.
+  std::vector<float> seen;
+  options.progress = [&seen](float done) {
+    seen.push_back(done);
+    return true;
+  };
+  ASSERT_TRUE(map_texture(m.mesh, m.topology, m.frames, options, m.atlas).is_ok());
+  ASSERT_GT(seen.size(), 10u);
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+  EXPECT_GT(seen.back(), 0.9f);
+  EXPECT_GT(std::count_if(seen.begin(), seen.end(), [](float d) { return d > 0.2f; }), 5);
+  options.progress = [](float done) { return done < 0.6f; };
+  EXPECT_EQ(map_texture(m.mesh, m.topology, m.frames, options, m.atlas).code(), ErrorCode::kCancelled);
+  EXPECT_TRUE(m.atlas.corner_uv.empty());
+  EXPECT_TRUE(m.atlas.patch.empty());
 }
 
 TEST(Mapping, RejectsBadOptionsAndMismatchedInputs) {

@@ -122,11 +122,15 @@ struct MappingStats {
 //! Maps the texture: fills atlas.corner_uv (#F*3 by 2, pixels), atlas.patch (#F) and
 //! atlas.patch_count; every face is placed and every UV is finite.
 //! Preconditions: topology = build_topology(mesh), frames = compute_orientation(mesh, topology, ...).
-//! Fails with kInvalidArgument on bad options (scale <= 0 or non-finite, max_stretch out of range,
-//! seam_faces of the wrong size), kInvalidMesh when frames/topology do not match the mesh,
-//! kCancelled when the progress callback returns false. Cost: O(F log front) time, O(F + V) memory,
-//! allocated once before the loop (the atlas's capacity is reused). Deterministic. Safe for any
-//! mesh that passed finalize_mesh (non-manifold and inconsistent edges act as boundaries).
+//! Fails with kInvalidArgument on bad options (scale <= 0 or non-finite, max_stretch,
+//! field_following, hop_age, crack_rings, max_seed_rotation_deg or factor_step out of range,
+//! seam_faces of the wrong size, a non-finite seed point), kInvalidMesh when frames/topology do not
+//! match the mesh, kCancelled when the progress callback returns false (the atlas is then empty).
+//! Cost: the growth O(F log front) time; the crack closing O(F) plus, per crack vertex tried, a
+//! relaxation of O(crack_rings^2) faces (in practice 3-8x the growth; vertices of valence > 64 are
+//! not zipped, so a huge fan cannot make it quadratic); O(F + V) memory, allocated before the loops
+//! (the atlas's capacity is reused). Deterministic, the same bits with or without SIMD. Safe for
+//! any mesh that passed finalize_mesh (non-manifold and inconsistent edges act as boundaries).
 Status map_texture(const Mesh& mesh, const Topology& topology, const FaceFrames& frames,
                    const MappingOptions& options, Atlas& atlas, MappingStats* stats = nullptr);
 
