@@ -12,8 +12,10 @@
 // vertex (the tip), then relaxes the free UVs of the faces within a few rings of it by local-global
 // ARAP iterations (per face the nearest rotation of its Jacobian, per UV vertex the mean of the
 // positions its faces predict); the UVs on the ring's edge stay fixed, so nothing outside changes.
-// It is kept only if every face it touched is within the bound, else undone: every face stays
-// within max_stretch, no face inverts, and each kept zip removes at least one seam edge.
+// It is kept only if every face it touched is within the bounds (max_stretch, and an area ratio
+// near 1), else undone: every face stays within max_stretch, no face inverts, and each kept zip
+// removes at least one seam edge. Zips go nearest to the component's seed first, so removing part
+// of a mesh changes only the zips after the first one it touches (stability, as the hop rule).
 //
 // Cost: the horse (97k faces) runs ~7,500 relaxations of ~70 moving faces and ~10 iterations each.
 // The local step (fit_rotations) takes four faces per instruction and the global step (sweep) u
