@@ -51,6 +51,10 @@ cmp -s "$tmp/a.glb" "$tmp/b.glb" && ok || fail "two runs gave different .glb fil
 for ext in obj ply; do
   "$tailor" map "$mesh" -o "$tmp/c.$ext" --quiet && [[ -s $tmp/c.$ext ]] && ok || fail "map to .$ext failed"
 done
+# --axis auto tries pca, x, y, z and keeps the least seam (a coordinate axis on this CAD part).
+"$tailor" map tests/data/meshes/adis16480.stl -o "$tmp/auto.glb" --axis auto --stats "$tmp/auto.json" >"$tmp/auto.txt" 2>&1 &&
+  grep -q "^axis auto: [xyz] (seams without crack closing: pca" "$tmp/auto.txt" &&
+  grep -Eq '"axis": "auto:[xyz]"' "$tmp/auto.json" && ok || fail "--axis auto: $(cat "$tmp/auto.txt")"
 # Crack closing is reported in the stats and can be switched off (then nothing is zipped).
 grep -Eq '"cracks_closed": [1-9][0-9]*' "$tmp/a.json" && ok || fail "stats: no cracks_closed > 0"
 "$tailor" map "$mesh" -o "$tmp/open.glb" --stats "$tmp/open.json" --no-crack-closing --quiet &&
