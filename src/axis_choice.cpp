@@ -34,6 +34,7 @@ Status choose_orientation_axis(const Mesh& mesh, const Topology& topology, const
                                const MappingOptions& mapping, AxisChoice& choice) {
   choice = AxisChoice{};
   MappingOptions growth = mapping;
+  growth.mode = MappingMode::kPatches;  // the thesis mode has one UV per vertex: no seams to rank by
   growth.close_cracks = false;
   growth.progress = nullptr;
   FaceFrames frames;

@@ -32,8 +32,9 @@ struct AxisChoice {
   std::array<double, kAxisCandidates> seam_ratio{};  //!< per candidate: seam length / edge length of the growth
 };
 
-//! Maps the mesh once per candidate axis with `mapping` minus the crack closing (the growth and seam
-//! shortening, which rank the axes as the full mapping does on CAD parts, at a fifth of its cost)
+//! Maps the mesh once per candidate axis with `mapping` in patches mode minus the crack closing (the
+//! growth and seam shortening, which rank the axes as the full mapping does on CAD parts, at a fifth
+//! of its cost; in thesis mode every candidate would score 0)
 //! and picks the axis leaving the least seam length. mapping.progress, if set, gets the share of
 //! candidates done; false cancels (kCancelled). Fails as compute_orientation / map_texture do.
 //! Cost: four orientations and growths, O(F log front). Deterministic.
