@@ -474,7 +474,7 @@ class CrackCloser {
         return 0;
       }
       gap_ratio = std::max(gap_ratio, gap / edge);
-      if (!merge(indices_[fc], keep, drop)) {
+      if (!merge(v, keep, drop)) {
         undo_merges();
         return 0;
       }

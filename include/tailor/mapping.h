@@ -83,7 +83,7 @@ struct MappingOptions {
                                     //!< 6-11% less seam length on the shared meshes, docs/mapping.md)
   bool close_cracks = true;         //!< last, zip cracks (seams inside one patch) shut from their tips, spreading
                                     //!< each gap over the faces around it within max_stretch (ARAP relaxation):
-                                    //!< 30-50% less seam length, mapping 3-6x slower (docs/mapping.md)
+                                    //!< 30-55% less seam length, mapping 3-8x slower (docs/mapping.md)
   uint32_t crack_rings = 16;        //!< effort of the crack closing (2..64): the largest region a zip relaxes, in
                                     //!< rings of faces around it (a first try takes crack_rings / 2 rings per unit
                                     //!< of gap / edge length); more closes wider gaps and takes longer
