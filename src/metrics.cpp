@@ -13,6 +13,9 @@
 #include <numbers>
 #include <string>
 
+#include "internal/huge_pages.h"
+#include "internal/parallel_chunks.h"
+
 namespace tailor {
 namespace {
 
@@ -66,15 +69,25 @@ double angle2(double ax, double ay, double bx, double by) {
   return std::atan2(std::abs(ax * by - ay * bx), ax * bx + ay * by);
 }
 
-// sum_k |angle_uv_k - angle_3d_k| in degrees.
+// sum_k |angle_uv_k - angle_3d_k| in degrees. A triangle's interior angles sum to pi, in 3D and in
+// UV alike, so two atan2 per triangle give the third (atan2 is most of the metrics' time); not
+// when a UV edge has zero length, where the angles at its ends are atan2(0, 0) = 0.
 double angle_distortion_deg(const Face& face) {
-  double sum = 0;
+  double a3[3], a2[3];
+  bool zero_uv_edge = false;
   for (int k = 0; k < 3; ++k) {
-    const int i = (k + 1) % 3, j = (k + 2) % 3;
-    const double a3 = angle3(sub(face.p[i], face.p[k]), sub(face.p[j], face.p[k]));
-    const double a2 = angle2(face.u[i] - face.u[k], face.v[i] - face.v[k], face.u[j] - face.u[k], face.v[j] - face.v[k]);
-    sum += std::abs(a2 - a3);
+    const int i = (k + 1) % 3;
+    zero_uv_edge = zero_uv_edge || (face.u[i] == face.u[k] && face.v[i] == face.v[k]);
   }
+  const int computed = zero_uv_edge ? 3 : 2;
+  for (int k = 0; k < computed; ++k) {
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    a3[k] = angle3(sub(face.p[i], face.p[k]), sub(face.p[j], face.p[k]));
+    a2[k] = angle2(face.u[i] - face.u[k], face.v[i] - face.v[k], face.u[j] - face.u[k], face.v[j] - face.v[k]);
+  }
+  double sum = std::abs(a2[0] - a3[0]) + std::abs(a2[1] - a3[1]);
+  // pi - a2[0] - a2[1] - (pi - a3[0] - a3[1])
+  sum += zero_uv_edge ? std::abs(a2[2] - a3[2]) : std::abs((a3[0] + a3[1]) - (a2[0] + a2[1]));
   return sum * (180.0 / std::numbers::pi);
 }
 
@@ -219,23 +232,53 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
   }
   metrics.faces = nf;
 
-  // Pass 1: areas, orientation votes per patch, patch sizes.
-  std::vector<uint32_t> patch_faces(nf, 0);
-  std::vector<int64_t> patch_vote(nf, 0);  // (# positive) - (# negative) UV-area faces
-  double sum_uv = 0, sum_3d = 0;
+  // The per-face and per-edge passes run on fixed chunks (internal/parallel_chunks.h), their
+  // partial sums added in chunk order: the figures do not depend on the thread count.
+  const size_t threads = internal::parallel_threads(nf, options.threads);
+  const size_t chunks = internal::chunk_count(nf);
+
+  // Pass 1: areas and the sign of each face's UV area (kDegenerate: skipped), then, in face order,
+  // orientation votes per patch and patch sizes.
+  constexpr int8_t kDegenerate = 2;
+  std::vector<int8_t> sign(nf);
+  struct AreaSums {
+    double uv = 0, surface = 0;
+    size_t kept = 0;  // non-degenerate faces
+  };
+  std::vector<AreaSums> area_sums(chunks);
+  internal::for_each_chunk(nf, threads, [&](size_t begin, size_t end, size_t chunk) {
+    AreaSums sums;
+    for (size_t f = begin; f < end; ++f) {
+      const Face face = load_face(mesh, corner_uv, f);
+      if (face.degenerate) {
+        sign[f] = kDegenerate;
+        continue;
+      }
+      sums.uv += std::abs(face.area_uv);
+      sums.surface += face.area3d;
+      ++sums.kept;
+      sign[f] = face.area_uv > 0 ? 1 : (face.area_uv < 0 ? -1 : 0);
+    }
+    area_sums[chunk] = sums;
+  });
+  uint32_t patch_end = 0;  // ids are < #F, but usually few: per-patch arrays sized by the largest
+  for (const uint32_t p : patch) patch_end = std::max(patch_end, p + 1);
+  std::vector<uint32_t> patch_faces(patch_end, 0);
+  std::vector<int64_t> patch_vote(patch_end, 0);  // (# positive) - (# negative) UV-area faces
   for (size_t f = 0; f < nf; ++f) {
     ++patch_faces[patch[f]];
-    const Face face = load_face(mesh, corner_uv, f);
-    if (face.degenerate) {
-      ++metrics.degenerate_faces;
-      continue;
-    }
-    sum_uv += std::abs(face.area_uv);
-    sum_3d += face.area3d;
-    if (face.area_uv > 0) ++patch_vote[patch[f]];
-    else if (face.area_uv < 0) --patch_vote[patch[f]];
+    if (sign[f] != kDegenerate) patch_vote[patch[f]] += sign[f];
   }
-  for (size_t p = 0; p < nf; ++p) {
+  double sum_uv = 0, sum_3d = 0;
+  std::vector<size_t> kept_before(chunks + 1, 0);  // non-degenerate faces in the chunks before
+  for (size_t c = 0; c < chunks; ++c) {
+    sum_uv += area_sums[c].uv;
+    sum_3d += area_sums[c].surface;
+    kept_before[c + 1] = kept_before[c] + area_sums[c].kept;
+  }
+  const size_t counted = kept_before[chunks];
+  metrics.degenerate_faces = nf - counted;
+  for (size_t p = 0; p < patch_end; ++p) {
     if (patch_faces[p] > 0) ++metrics.patches;
     if (patch_faces[p] == 1) ++metrics.single_face_patches;
   }
@@ -246,35 +289,52 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
   const double scale = sum_uv / sum_3d;  // R
   metrics.uv_scale = scale;
 
-  // Pass 2: per-face quantities.
-  std::vector<double> angles, ratios, areas;  // per non-degenerate face
-  angles.reserve(nf - metrics.degenerate_faces);
-  ratios.reserve(nf - metrics.degenerate_faces);
-  areas.reserve(nf - metrics.degenerate_faces);
-  double sum_r = 0;
-  size_t counted = 0;
-  double l2_num = 0, l2_den = 0, gamma_max = 0;
-  for (size_t f = 0; f < nf; ++f) {
-    const Face face = load_face(mesh, corner_uv, f);
-    if (face.degenerate) continue;
-    ++counted;
-    const double r = std::abs(face.area_uv) / face.area3d;
-    sum_r += r;
-    ratios.push_back(r);
-    areas.push_back(face.area3d);
-    angles.push_back(angle_distortion_deg(face));
-    // Ties (and empty votes) count as counter-clockwise, the orientation the mapping produces.
-    const bool majority_positive = patch_vote[patch[f]] >= 0;
-    if (face.area_uv == 0) {
-      ++metrics.flipped;
-      ++metrics.zero_uv_area_faces;
-      continue;  // infinite Sander stretch: excluded from L2 / Linf
+  // Pass 2: per-face quantities, per non-degenerate face in face order.
+  std::vector<double> angles, ratios, areas;
+  for (std::vector<double>* v : {&angles, &ratios, &areas}) {
+    internal::reserve_huge(*v, counted);  // fresh and large: huge pages (huge_pages.h)
+    v->resize(counted);
+  }
+  struct FaceSums {
+    double r = 0, l2_num = 0, l2_den = 0, gamma_max = 0;
+    size_t flipped = 0, zero_uv_area = 0;
+  };
+  std::vector<FaceSums> face_sums(chunks);
+  internal::for_each_chunk(nf, threads, [&](size_t begin, size_t end, size_t chunk) {
+    FaceSums sums;
+    size_t i = kept_before[chunk];
+    for (size_t f = begin; f < end; ++f) {
+      if (sign[f] == kDegenerate) continue;
+      const Face face = load_face(mesh, corner_uv, f);
+      const double r = std::abs(face.area_uv) / face.area3d;
+      sums.r += r;
+      ratios[i] = r;
+      areas[i] = face.area3d;
+      angles[i] = angle_distortion_deg(face);
+      ++i;
+      // Ties (and empty votes) count as counter-clockwise, the orientation the mapping produces.
+      const bool majority_positive = patch_vote[patch[f]] >= 0;
+      if (face.area_uv == 0) {
+        ++sums.flipped;
+        ++sums.zero_uv_area;
+        continue;  // infinite Sander stretch: excluded from L2 / Linf
+      }
+      if ((face.area_uv > 0) != majority_positive) ++sums.flipped;
+      double g = 0;
+      sums.l2_num += face.area3d * sander_stretch(face, g);
+      sums.l2_den += face.area3d;
+      sums.gamma_max = std::max(sums.gamma_max, g);
     }
-    if ((face.area_uv > 0) != majority_positive) ++metrics.flipped;
-    double g = 0;
-    l2_num += face.area3d * sander_stretch(face, g);
-    l2_den += face.area3d;
-    gamma_max = std::max(gamma_max, g);
+    face_sums[chunk] = sums;
+  });
+  double sum_r = 0, l2_num = 0, l2_den = 0, gamma_max = 0;
+  for (const FaceSums& sums : face_sums) {
+    sum_r += sums.r;
+    l2_num += sums.l2_num;
+    l2_den += sums.l2_den;
+    gamma_max = std::max(gamma_max, sums.gamma_max);
+    metrics.flipped += sums.flipped;
+    metrics.zero_uv_area_faces += sums.zero_uv_area;
   }
   const double mean_r = sum_r / static_cast<double>(counted);
   // Second pass over r for a numerically stable variance (both forms).
@@ -293,31 +353,51 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
   }
 
   // Seams: over distinct edges (a paired edge once, a boundary edge once).
+  struct SeamSums {
+    double total_length = 0, seam_length = 0, gap_weighted = 0, gap_plain = 0, invisible_length = 0;
+    size_t seam_edges = 0, invisible_count = 0;
+  };
+  const size_t corners = 3 * nf;
+  std::vector<SeamSums> seam_sums(internal::chunk_count(corners));
+  internal::for_each_chunk(corners, threads, [&](size_t begin, size_t end, size_t chunk) {
+    SeamSums sums;
+    for (size_t e = begin; e < end; ++e) {
+      const uint32_t o = topology.opposite[e];
+      if (o != kInvalid && o < e) continue;
+      const size_t f = e / 3, k = e % 3;
+      const double length =
+          norm(sub(position(mesh, mesh.indices[3 * f + (k + 1) % 3]), position(mesh, mesh.indices[3 * f + k])));
+      sums.total_length += length;
+      if (o == kInvalid) continue;
+      const EdgeSides s = edge_sides(e, o);
+      if (same_uv(corner_uv, s.fa, s.ga) && same_uv(corner_uv, s.fb, s.gb)) continue;
+      ++sums.seam_edges;
+      sums.seam_length += length;
+      const double w = options.texture_width_px, h = options.texture_height_px;
+      const double gap_a = toroidal_distance(double{corner_uv[2 * s.fa]} - corner_uv[2 * s.ga],
+                                             double{corner_uv[2 * s.fa + 1]} - corner_uv[2 * s.ga + 1], w, h);
+      const double gap_b = toroidal_distance(double{corner_uv[2 * s.fb]} - corner_uv[2 * s.gb],
+                                             double{corner_uv[2 * s.fb + 1]} - corner_uv[2 * s.gb + 1], w, h);
+      const double gap = 0.5 * (gap_a + gap_b);
+      sums.gap_weighted += length * gap;
+      sums.gap_plain += gap;
+      if (gap < 1.0) {
+        sums.invisible_length += length;
+        ++sums.invisible_count;
+      }
+    }
+    seam_sums[chunk] = sums;
+  });
   double total_length = 0, seam_length = 0, gap_weighted = 0, gap_plain = 0, invisible_length = 0;
   size_t invisible_count = 0;
-  for (size_t e = 0; e < 3 * nf; ++e) {
-    const uint32_t o = topology.opposite[e];
-    if (o != kInvalid && o < e) continue;
-    const size_t f = e / 3, k = e % 3;
-    const double length = norm(sub(position(mesh, mesh.indices[3 * f + (k + 1) % 3]), position(mesh, mesh.indices[3 * f + k])));
-    total_length += length;
-    if (o == kInvalid) continue;
-    const EdgeSides s = edge_sides(e, o);
-    if (same_uv(corner_uv, s.fa, s.ga) && same_uv(corner_uv, s.fb, s.gb)) continue;
-    ++metrics.seam_edges;
-    seam_length += length;
-    const double w = options.texture_width_px, h = options.texture_height_px;
-    const double gap_a = toroidal_distance(double{corner_uv[2 * s.fa]} - corner_uv[2 * s.ga],
-                                           double{corner_uv[2 * s.fa + 1]} - corner_uv[2 * s.ga + 1], w, h);
-    const double gap_b = toroidal_distance(double{corner_uv[2 * s.fb]} - corner_uv[2 * s.gb],
-                                           double{corner_uv[2 * s.fb + 1]} - corner_uv[2 * s.gb + 1], w, h);
-    const double gap = 0.5 * (gap_a + gap_b);
-    gap_weighted += length * gap;
-    gap_plain += gap;
-    if (gap < 1.0) {
-      invisible_length += length;
-      ++invisible_count;
-    }
+  for (const SeamSums& sums : seam_sums) {
+    total_length += sums.total_length;
+    seam_length += sums.seam_length;
+    gap_weighted += sums.gap_weighted;
+    gap_plain += sums.gap_plain;
+    invisible_length += sums.invisible_length;
+    invisible_count += sums.invisible_count;
+    metrics.seam_edges += sums.seam_edges;
   }
   if (total_length > 0) metrics.seam_length_ratio = seam_length / total_length;
   if (metrics.seam_edges == 0) {

@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "internal/huge_pages.h"
+#include "internal/parallel_chunks.h"
 
 namespace tailor {
 namespace {
@@ -49,8 +50,6 @@ Vec3 perpendicular(const Vec3& a) {
 // A face is degenerate when its doubled area is below this fraction of its squared longest edge
 // (or the edge itself vanishes): its normal is then numerically meaningless.
 constexpr double kDegenerateRatio = 1e-10;
-// Below this many faces per thread, starting threads costs more than it saves.
-constexpr size_t kFacesPerThread = 100000;
 
 inline Vec3 load(const float* v) { return {v[0], v[1], v[2]}; }
 inline void store(float* out, const Vec3& v) {
@@ -212,10 +211,7 @@ Status compute_orientation(const Mesh& mesh, const Topology& topology, const Ori
       if (options.smooth_passes == 0) write_corner_frame(f, p0, p1, p2);
     }
   };
-  const size_t threads = options.threads != 0 ? std::min<size_t>(options.threads, 64)
-                         : std::clamp<size_t>(std::min<size_t>(std::thread::hardware_concurrency(),
-                                                               face_count / kFacesPerThread),
-                                              1, 8);
+  const size_t threads = internal::parallel_threads(face_count, options.threads);
   std::vector<size_t> degenerate_count(threads, 0), fallback_count(threads, 0);
   if (threads == 1) {
     frame_faces(0, face_count, degenerate_count[0], fallback_count[0]);
@@ -265,30 +261,34 @@ Status compute_orientation(const Mesh& mesh, const Topology& topology, const Ori
   }
 
   // === Variation: sum of angles to the edge neighbours' orientations (the thesis's age) ===
-  // acos dominates this stage, so each interior edge's angle is computed once, by the face met
-  // first, and left at the opposite corner for the other face (the dot product is symmetric, so
-  // both faces see the same value as if each had computed it).
-  std::vector<double> angle_at_corner;
-  internal::reserve_huge(angle_at_corner, 3 * face_count);
-  angle_at_corner.resize(3 * face_count);
-  for (size_t f = 0; f < face_count; ++f) {
-    const Vec3 o = load(&frames.orientation[3 * f]);
-    double sum = 0;
-    for (uint32_t k = 0; k < 3; ++k) {
-      const uint32_t e = static_cast<uint32_t>(3 * f + k);
-      const uint32_t opposite = topology.opposite[e];
-      if (opposite == kInvalid) continue;
-      double angle;
-      if (opposite > e) {
-        angle = std::acos(std::clamp(dot(o, load(&frames.orientation[3 * (opposite / 3)])), -1.0, 1.0));
-        angle_at_corner[opposite] = angle;
-      } else {
-        angle = angle_at_corner[e];
+  // acos dominates this stage, so each interior edge's angle is computed once, at its half-edge
+  // of lower id, then each face adds its three in edge order (the same values in the same order
+  // as if each face had computed them). Both passes write only their own chunk's half-edges or
+  // faces: identical for any thread count.
+  std::vector<double> edge_angle;
+  internal::reserve_huge(edge_angle, 3 * face_count);
+  edge_angle.resize(3 * face_count);
+  const uint32_t* opposite = topology.opposite.data();
+  internal::for_each_chunk(face_count, threads, [&](size_t begin, size_t end, size_t) {
+    for (size_t f = begin; f < end; ++f) {
+      const Vec3 o = load(&frames.orientation[3 * f]);
+      for (size_t e = 3 * f; e < 3 * f + 3; ++e) {
+        if (opposite[e] == kInvalid || opposite[e] < e) continue;
+        const Vec3 other = load(&frames.orientation[3 * size_t{opposite[e] / 3}]);
+        edge_angle[e] = std::acos(std::clamp(dot(o, other), -1.0, 1.0));
       }
-      sum += angle;
     }
-    frames.variation[f] = static_cast<float>(sum);
-  }
+  });
+  internal::for_each_chunk(face_count, threads, [&](size_t begin, size_t end, size_t) {
+    for (size_t f = begin; f < end; ++f) {
+      double sum = 0;
+      for (size_t e = 3 * f; e < 3 * f + 3; ++e) {
+        if (opposite[e] == kInvalid) continue;
+        sum += edge_angle[std::min<size_t>(e, opposite[e])];
+      }
+      frames.variation[f] = static_cast<float>(sum);
+    }
+  });
 
   store(frames.axis.data(), axis);
   store(frames.axis2.data(), axis2);

@@ -108,6 +108,40 @@ TEST(Metrics, ShearHasKnownStretchAndAngles) {
 // (r = 400). Mean r 250, population std 150: stretch 0.6 (equal areas, so the weighted form too).
 // R = (50 + 200) / 1 = 250. Sander: T0 (a+c)/2 = 1/100, T1 1/400; L2 = sqrt(0.00625) * sqrt(250)
 // = 1.25; Linf = (1/10) * sqrt(250) = 1.5811.
+// A UV triangle with two corners on one point has the angles atan2(0, 0) = 0 (not a sum of pi):
+// distortion = the 3D angles' sum, 180 degrees; the untouched face has 0: median 90.
+TEST(Metrics, CollapsedUvEdgeCountsEveryAngle) {
+  const Mesh mesh = grid(1, 1);
+  auto uv = corner_uvs(mesh, [](float x, float y) { return std::pair{8 * x, 8 * y}; });
+  uv[2] = uv[0];  // lower face: corner 1 onto corner 0
+  uv[3] = uv[1];
+  const UvMetrics m = metrics_of(mesh, uv);
+  EXPECT_NEAR(m.distortion_deg, 90.0, 1e-9);
+}
+
+// The passes run on chunks of 32k elements summed in order: any thread count, the same bits.
+TEST(Metrics, ThreadCountDoesNotChangeAnyFigure) {
+  const Mesh mesh = grid(180, 120);  // 43,200 faces, 129,600 corners: several chunks
+  auto uv = corner_uvs(mesh, [](float x, float y) { return std::pair{7 * x + 0.01f * y * y, 6.5f * y + std::sin(x)}; });
+  for (size_t f = 0; f < mesh.face_count(); ++f)  // a cut at x = 90: seams, two patches
+    if (mesh.positions[3 * size_t{mesh.indices[3 * f]}] >= 90.f)
+      for (size_t k = 0; k < 3; ++k) uv[2 * (3 * f + k)] += 1000.f;
+  MetricsOptions one, three;
+  one.threads = 1;
+  three.threads = 3;
+  const UvMetrics a = metrics_of(mesh, uv, {}, one), b = metrics_of(mesh, uv, {}, three);
+  EXPECT_GT(a.seam_edges, 0u);
+  EXPECT_EQ(a.patches, 2u);
+  for (const auto& [x, y] : {std::pair{a.stretch, b.stretch}, {a.stretch_area_weighted, b.stretch_area_weighted},
+                             {a.distortion_deg, b.distortion_deg}, {a.l2_stretch, b.l2_stretch},
+                             {a.linf_stretch, b.linf_stretch}, {a.seam_length_ratio, b.seam_length_ratio},
+                             {a.seam_gap_px, b.seam_gap_px}, {a.seam_invisible_ratio, b.seam_invisible_ratio},
+                             {a.uv_scale, b.uv_scale}})
+    EXPECT_EQ(x, y);
+  EXPECT_EQ(a.flipped, b.flipped);
+  EXPECT_EQ(a.seam_edges, b.seam_edges);
+}
+
 TEST(Metrics, UnequalScalesGiveKnownStretch) {
   Mesh mesh;
   mesh.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};

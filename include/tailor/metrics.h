@@ -21,6 +21,8 @@ namespace tailor {
 struct MetricsOptions {
   float texture_width_px = 512;   //!< texture period along u in pixels (> 0); the seam gap is measured modulo it
   float texture_height_px = 512;  //!< texture period along v in pixels (> 0)
+  uint32_t threads = 0;           //!< threads (0 = one per 100k faces, at most the cores and 8); the
+                                  //!< figures are identical for any count
 };
 
 struct UvMetrics {
@@ -52,7 +54,8 @@ struct UvMetrics {
 //! Fails with kInvalidArgument when the array sizes do not match, a patch id is >= #F or the texture
 //! size is not positive (caller errors), and with kInvalidMesh when a UV is not finite, every face
 //! has zero 3D area or every non-degenerate face has zero UV area (bad data: no scale).
-//! Cost: O(F) time and memory (one sort-free pass plus a median by nth_element). Deterministic.
+//! Cost: O(F) time and memory (sort-free passes, on threads for large meshes, plus a median by
+//! nth_element). Deterministic, whatever the thread count.
 Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<const float> corner_uv,
                           std::span<const uint32_t> patch, const MetricsOptions& options, UvMetrics& metrics);
 

@@ -64,7 +64,10 @@ using HugeArray = std::unique_ptr<T[], FreeDeleter>;
 template <class T>
 HugeArray<T> huge_uninitialized(size_t n) {
   static_assert(std::is_trivially_default_constructible_v<T> && std::is_trivially_destructible_v<T>);
-  void* p = std::malloc(n == 0 ? sizeof(T) : n * sizeof(T));
+  const size_t bytes = n == 0 ? sizeof(T) : n * sizeof(T);
+  // Over-aligned types (cache-line records): aligned_alloc wants a multiple of the alignment,
+  // which sizeof(T) is.
+  void* p = alignof(T) > alignof(std::max_align_t) ? std::aligned_alloc(alignof(T), bytes) : std::malloc(bytes);
   if (p == nullptr) throw std::bad_alloc();
   advise_huge_pages(p, n * sizeof(T));
   return HugeArray<T>(static_cast<T*>(p));

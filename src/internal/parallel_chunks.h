@@ -1,0 +1,52 @@
+// Deterministic data parallelism for per-element passes whose results are summed: [0, n) is cut
+// into fixed chunks (their bounds do not depend on the thread count), each chunk's partial result
+// is kept apart, and the caller reduces them in chunk order. A floating-point sum is then the same
+// bit for bit on one thread or eight.
+#pragma once
+
+#include <algorithm>
+#include <atomic>
+#include <cstddef>
+#include <exception>
+#include <thread>
+#include <vector>
+
+namespace tailor::internal {
+
+//! Elements per chunk: large enough that a chunk's bookkeeping is noise, small enough that two
+//! threads get balanced work on a 100k-element input.
+inline constexpr size_t kParallelChunk = size_t{1} << 15;
+
+//! Threads worth starting for n elements: one per `per_thread` elements, at most the cores and 8,
+//! at least 1; `requested` > 0 overrides (at most 64).
+inline size_t parallel_threads(size_t n, size_t requested, size_t per_thread = 100000) {
+  if (requested != 0) return std::min<size_t>(requested, 64);
+  const size_t cores = std::max<size_t>(std::thread::hardware_concurrency(), 1);
+  return std::clamp<size_t>(std::min(cores, n / per_thread), 1, 8);
+}
+
+//! Number of chunks for n elements.
+inline size_t chunk_count(size_t n) { return (n + kParallelChunk - 1) / kParallelChunk; }
+
+//! Calls body(begin, end, chunk) for every chunk of [0, n), on up to `threads` threads (each takes
+//! the next chunk not yet taken; fewer when the system refuses a thread). body must only write
+//! state owned by its chunk or its elements.
+template <class Body>
+void for_each_chunk(size_t n, size_t threads, Body body) {
+  const size_t chunks = chunk_count(n);
+  threads = std::clamp<size_t>(threads, 1, std::max<size_t>(chunks, 1));
+  std::atomic<size_t> next{0};
+  auto run = [&] {
+    for (size_t c; (c = next.fetch_add(1)) < chunks;) body(c * kParallelChunk, std::min(n, (c + 1) * kParallelChunk), c);
+  };
+  std::vector<std::thread> workers;
+  try {
+    workers.reserve(threads - 1);
+    for (size_t t = 1; t < threads; ++t) workers.emplace_back(run);
+  } catch (const std::exception&) {  // no thread to be had: the calling thread does the rest
+  }
+  run();
+  for (std::thread& w : workers) w.join();
+}
+
+}  // namespace tailor::internal
