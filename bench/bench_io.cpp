@@ -1,5 +1,6 @@
-// Loading and adjacency benchmarks on the subdivided horse (1,551,456 faces, bench_meshes.h).
-// Targets: binary PLY >= 50 M faces/s for the whole load_mesh (read + parse + finalize_mesh).
+// Loading, adjacency and export benchmarks on the subdivided horse (1,551,456 faces, bench_meshes.h).
+// Targets: binary PLY >= 50 M faces/s for the whole load_mesh (read + parse + finalize_mesh); the
+// .glb export <= 100 ms (its share of the end-to-end 3 M faces/s, bench_pipeline.cpp).
 // Rates use wall-clock time (UseRealTime): finalize_mesh runs part of its work on a second thread.
 #include <benchmark/benchmark.h>
 
@@ -9,7 +10,10 @@
 #include <string>
 
 #include "bench_meshes.h"
+#include "tailor/export.h"
 #include "tailor/io.h"
+#include "tailor/mapping.h"
+#include "tailor/orientation.h"
 #include "tailor/topology.h"
 
 namespace {
@@ -47,6 +51,45 @@ void BM_Topology(benchmark::State& state) {
   set_faces_rate(state, mesh.face_count());
 }
 BENCHMARK(BM_Topology)->Unit(benchmark::kMillisecond)->MinTime(1.0)->UseRealTime();
+
+// The atlas of `tailor map --no-crack-closing` (seams on about 5% of the edges), mapped once.
+const tailor::Atlas& subdivided_horse_atlas() {
+  static const tailor::Atlas atlas = [] {
+    const tailor::Mesh& mesh = subdivided_horse();
+    const tailor::Topology topology = tailor::build_topology(mesh);
+    tailor::FaceFrames frames;
+    tailor::MappingOptions options;
+    options.close_cracks = false;
+    tailor::Atlas result;
+    if (!tailor::compute_orientation(mesh, topology, {}, frames).is_ok() ||
+        !tailor::map_texture(mesh, topology, frames, options, result).is_ok())
+      result = {};
+    return result;
+  }();
+  return atlas;
+}
+
+// export_mesh to .glb with normals and no texture: validation, vertex split, normals, the write.
+// The previous output is removed untimed: renaming over an existing 45 MB file costs ext4 another
+// ~30 ms (it flushes the new file first, auto_da_alloc), which is the file system's, not ours.
+void BM_ExportGlb(benchmark::State& state) {
+  const tailor::Mesh& mesh = subdivided_horse();
+  const tailor::Atlas& atlas = subdivided_horse_atlas();
+  const std::string output = (std::filesystem::temp_directory_path() / "tailor_bench_export.glb").string();
+  for (auto _ : state) {
+    state.PauseTiming();
+    std::remove(output.c_str());
+    state.ResumeTiming();
+    const tailor::Status s = tailor::export_mesh(output, mesh, atlas, {});
+    if (!s.is_ok()) {
+      state.SkipWithError(s.message().c_str());
+      return;
+    }
+  }
+  std::remove(output.c_str());
+  set_faces_rate(state, mesh.face_count());
+}
+BENCHMARK(BM_ExportGlb)->Unit(benchmark::kMillisecond)->MinTime(1.0)->UseRealTime();
 
 }  // namespace
 

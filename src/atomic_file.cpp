@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <utility>
 
 namespace tailor::internal {
 namespace {
@@ -42,28 +43,72 @@ Status FileBatch::commit() {
   return Status::ok();
 }
 
-Status write_file_atomic(const std::string& path, std::span<const char> bytes) {
-  const std::string tmp = path + ".tmp-" + std::to_string(static_cast<long>(getpid()));
-  std::FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f) return Status::error(ErrorCode::kIo, path, std::string("cannot create file: ") + std::strerror(errno));
-  const bool written = bytes.empty() || std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
-  const bool flushed = std::fflush(f) == 0;
-  const bool closed = std::fclose(f) == 0;
-  if (!written || !flushed || !closed) {
-    const int err = errno;
-    std::remove(tmp.c_str());
-    return Status::error(ErrorCode::kIo, path, std::string("cannot write file: ") + std::strerror(err));
+AtomicFileWriter::AtomicFileWriter(std::string path) : path_(std::move(path)) {}
+
+AtomicFileWriter::~AtomicFileWriter() {
+  if (file_) std::fclose(file_);
+  if (!temporary_.empty()) std::remove(temporary_.c_str());
+}
+
+Status AtomicFileWriter::open() {
+  if (file_ || !temporary_.empty()) return Status::error(ErrorCode::kIo, path_, "cannot create file: already open");
+  const std::string tmp = path_ + ".tmp-" + std::to_string(static_cast<long>(getpid()));
+  file_ = std::fopen(tmp.c_str(), "wb");
+  if (!file_) {
+    error_ = Status::error(ErrorCode::kIo, path_, std::string("cannot create file: ") + std::strerror(errno));
+    return error_;
   }
+  temporary_ = tmp;
+  return Status::ok();
+}
+
+Status AtomicFileWriter::fail(int err) {
+  if (file_) std::fclose(file_);
+  file_ = nullptr;
+  if (!temporary_.empty()) std::remove(temporary_.c_str());
+  temporary_.clear();
+  error_ = Status::error(ErrorCode::kIo, path_, std::string("cannot write file: ") + std::strerror(err));
+  return error_;
+}
+
+Status AtomicFileWriter::write(std::span<const char> bytes) {
+  if (!error_.is_ok()) return error_;
+  if (!file_) return fail(EBADF);
+  if (!bytes.empty() && std::fwrite(bytes.data(), 1, bytes.size(), file_) != bytes.size()) return fail(errno);
+  return Status::ok();
+}
+
+Status AtomicFileWriter::commit() {
+  if (!error_.is_ok()) return error_;
+  if (!file_) return fail(EBADF);
+  const bool flushed = std::fflush(file_) == 0;
+  const bool closed = std::fclose(file_) == 0;
+  file_ = nullptr;
+  if (!flushed || !closed) return fail(errno);
+  std::string tmp;
+  tmp.swap(temporary_);  // from here on the batch or the rename owns the temporary file
   if (active_batch) {
-    active_batch->add(tmp, path);
+    active_batch->add(tmp, path_);
     return Status::ok();
   }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+  if (std::rename(tmp.c_str(), path_.c_str()) != 0) {
     const int err = errno;
     std::remove(tmp.c_str());
-    return Status::error(ErrorCode::kIo, path, std::string("cannot rename temporary file: ") + std::strerror(err));
+    error_ = Status::error(ErrorCode::kIo, path_, std::string("cannot rename temporary file: ") + std::strerror(err));
+    return error_;
   }
   return Status::ok();
+}
+
+Status write_file_atomic(const std::string& path, std::span<const std::span<const char>> pieces) {
+  AtomicFileWriter file(path);
+  TAILOR_RETURN_IF_ERROR(file.open());
+  for (const std::span<const char> piece : pieces) TAILOR_RETURN_IF_ERROR(file.write(piece));
+  return file.commit();
+}
+
+Status write_file_atomic(const std::string& path, std::span<const char> bytes) {
+  return write_file_atomic(path, std::span<const std::span<const char>>(&bytes, 1));
 }
 
 Status read_file(const std::string& path, std::string& bytes) {

@@ -10,6 +10,8 @@
 #include <bit>
 #include <cstring>
 #include <limits>
+#include <span>
+#include <vector>
 
 #include "internal/atomic_file.h"
 #include "internal/export_writers.h"
@@ -37,14 +39,29 @@ void append_u32(std::string& out, uint32_t value) {
   out.append(bytes, 4);
 }
 
-template <typename T>
-void append_array(std::string& out, const T* data, size_t count) {
-  static_assert(std::endian::native == std::endian::little, "glb writer assumes a little-endian host");
-  out.append(reinterpret_cast<const char*>(data), count * sizeof(T));
-}
-
 void pad_to_4(std::string& out, char fill) {
   while (out.size() % 4 != 0) out.push_back(fill);
+}
+
+template <typename T>
+std::span<const char> bytes_of(const T* data, size_t count) {
+  static_assert(std::endian::native == std::endian::little, "glb writer assumes a little-endian host");
+  return {reinterpret_cast<const char*>(data), count * sizeof(T)};
+}
+
+// Streams `count` items of `floats_per_item` floats, each made by make(item, float* out), through
+// one small reusable buffer: the arrays gathered for the file are never held whole in memory.
+template <class Make>
+Status write_gathered(AtomicFileWriter& file, size_t count, size_t floats_per_item, Make&& make) {
+  constexpr size_t kChunkItems = 16384;
+  std::vector<float> chunk(kChunkItems * floats_per_item);
+  for (size_t begin = 0; begin < count; begin += kChunkItems) {
+    const size_t end = std::min(count, begin + kChunkItems);
+    float* out = chunk.data();
+    for (size_t i = begin; i < end; ++i, out += floats_per_item) make(i, out);
+    TAILOR_RETURN_IF_ERROR(file.write(bytes_of(chunk.data(), (end - begin) * floats_per_item)));
+  }
+  return Status::ok();
 }
 
 // Adds a buffer view over bin[offset, offset + length) and returns its index.
@@ -58,6 +75,7 @@ size_t add_view(nlohmann::json& views, size_t offset, size_t length, int target)
 }  // namespace
 
 Status write_glb(const std::string& path, const ExportData& data, const ExportOptions& options) {
+  const Mesh& mesh = *data.mesh;
   const SplitMesh& split = data.split;
   const size_t vertex_count = split.xref.size();
   const size_t index_count = split.indices.size();
@@ -68,54 +86,47 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
   if (!options.texture_path.empty())
     TAILOR_RETURN_IF_ERROR(read_texture_bytes(options.texture_path, texture_bytes, mime_type));
 
-  // glTF's v axis points down the image: TEXCOORD_0 = (s, -t), the usual (s, 1 - t) shifted by a
-  // whole repeat (invisible with REPEAT) but exact, so a round trip is bit-exact (see export.h).
-  std::vector<float> texcoords(2 * vertex_count);
-  for (size_t s = 0; s < vertex_count; ++s) {
-    texcoords[2 * s] = split.uvs[2 * s];
-    texcoords[2 * s + 1] = -split.uvs[2 * s + 1];
-  }
+  // Split positions are source positions through xref, in split order (the order matters for
+  // min/max: -0 and +0 compare equal, the first one seen is kept).
+  const float* positions = mesh.positions.data();
   float lo[3] = {std::numeric_limits<float>::max(), std::numeric_limits<float>::max(), std::numeric_limits<float>::max()};
   float hi[3] = {-lo[0], -lo[1], -lo[2]};
-  for (size_t s = 0; s < vertex_count; ++s)
+  for (size_t s = 0; s < vertex_count; ++s) {
+    const float* p = &positions[3 * size_t{split.xref[s]}];
     for (int i = 0; i < 3; ++i) {
-      lo[i] = std::min(lo[i], split.positions[3 * s + i]);
-      hi[i] = std::max(hi[i], split.positions[3 * s + i]);
+      lo[i] = std::min(lo[i], p[i]);
+      hi[i] = std::max(hi[i], p[i]);
     }
+  }
 
-  std::string bin;
+  // The BIN chunk's layout: positions, normals (optional), texcoords, indices, texture. Every block
+  // is a multiple of 4 bytes long, so each starts 4-byte aligned.
+  const bool normals = !data.normals.empty();
+  size_t bin_size = 0;
   nlohmann::json views = nlohmann::json::array(), accessors = nlohmann::json::array(), attributes;
-  // Every block is a multiple of 4 bytes long, so each starts 4-byte aligned.
   {
-    const size_t offset = bin.size();
-    append_array(bin, split.positions.data(), split.positions.size());
-    const size_t view = add_view(views, offset, bin.size() - offset, kArrayBuffer);
+    const size_t view = add_view(views, bin_size, 12 * vertex_count, kArrayBuffer);
+    bin_size += 12 * vertex_count;
     attributes["POSITION"] = accessors.size();
     accessors.push_back({{"bufferView", view}, {"componentType", kFloat}, {"count", vertex_count}, {"type", "VEC3"},
                          {"min", {lo[0], lo[1], lo[2]}}, {"max", {hi[0], hi[1], hi[2]}}});
   }
-  if (!data.normals.empty()) {
-    std::vector<float> normals(3 * vertex_count);
-    for (size_t s = 0; s < vertex_count; ++s)
-      std::memcpy(&normals[3 * s], &data.normals[3 * size_t{split.xref[s]}], 3 * sizeof(float));
-    const size_t offset = bin.size();
-    append_array(bin, normals.data(), normals.size());
-    const size_t view = add_view(views, offset, bin.size() - offset, kArrayBuffer);
+  if (normals) {
+    const size_t view = add_view(views, bin_size, 12 * vertex_count, kArrayBuffer);
+    bin_size += 12 * vertex_count;
     attributes["NORMAL"] = accessors.size();
     accessors.push_back({{"bufferView", view}, {"componentType", kFloat}, {"count", vertex_count}, {"type", "VEC3"}});
   }
   {
-    const size_t offset = bin.size();
-    append_array(bin, texcoords.data(), texcoords.size());
-    const size_t view = add_view(views, offset, bin.size() - offset, kArrayBuffer);
+    const size_t view = add_view(views, bin_size, 8 * vertex_count, kArrayBuffer);
+    bin_size += 8 * vertex_count;
     attributes["TEXCOORD_0"] = accessors.size();
     accessors.push_back({{"bufferView", view}, {"componentType", kFloat}, {"count", vertex_count}, {"type", "VEC2"}});
   }
   size_t indices_accessor = 0;
   {
-    const size_t offset = bin.size();
-    append_array(bin, split.indices.data(), index_count);
-    const size_t view = add_view(views, offset, bin.size() - offset, kElementArrayBuffer);
+    const size_t view = add_view(views, bin_size, 4 * index_count, kElementArrayBuffer);
+    bin_size += 4 * index_count;
     indices_accessor = accessors.size();
     accessors.push_back({{"bufferView", view}, {"componentType", kUnsignedInt}, {"count", index_count}, {"type", "SCALAR"}});
   }
@@ -130,13 +141,14 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
       {"meshes", {{{"primitives", {{{"attributes", attributes}, {"indices", indices_accessor}, {"material", 0},
                                     {"mode", kTriangles}}}}}}},
   };
+  size_t texture_padding = 0;
   if (!texture_bytes.empty()) {
-    if (texture_bytes.size() > std::numeric_limits<uint32_t>::max() - bin.size())
+    if (texture_bytes.size() > std::numeric_limits<uint32_t>::max() - bin_size)
       return Status::error(ErrorCode::kLimit, path, "texture too large for a .glb buffer");
-    const size_t offset = bin.size();
-    bin += texture_bytes;
-    const size_t view = add_view(views, offset, texture_bytes.size(), 0);
-    pad_to_4(bin, '\0');
+    const size_t view = add_view(views, bin_size, texture_bytes.size(), 0);
+    bin_size += texture_bytes.size();
+    texture_padding = (4 - bin_size % 4) % 4;
+    bin_size += texture_padding;
     gltf["images"] = {{{"bufferView", view}, {"mimeType", mime_type}}};
     gltf["samplers"] = {{{"magFilter", kLinear}, {"minFilter", kLinearMipmapLinear}, {"wrapS", kRepeat}, {"wrapT", kRepeat}}};
     gltf["textures"] = {{{"sampler", 0}, {"source", 0}}};
@@ -145,26 +157,53 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
   gltf["materials"].push_back({{"name", "tailor"}, {"pbrMetallicRoughness", pbr}});
   gltf["accessors"] = accessors;
   gltf["bufferViews"] = views;
-  gltf["buffers"] = {{{"byteLength", bin.size()}}};
+  gltf["buffers"] = {{{"byteLength", bin_size}}};
 
   // Strings may come from file names, which need not be UTF-8: replace, never throw.
   std::string json = gltf.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   pad_to_4(json, ' ');
-  const size_t total = 12 + 8 + json.size() + 8 + bin.size();
+  const size_t total = 12 + 8 + json.size() + 8 + bin_size;
   if (total > std::numeric_limits<uint32_t>::max())
     return Status::error(ErrorCode::kLimit, path, "output larger than the 4 GiB a .glb can hold");
-  std::string out;
-  out.reserve(total);
-  append_u32(out, kGlbMagic);
-  append_u32(out, 2);
-  append_u32(out, static_cast<uint32_t>(total));
-  append_u32(out, static_cast<uint32_t>(json.size()));
-  append_u32(out, kChunkJson);
-  out += json;
-  append_u32(out, static_cast<uint32_t>(bin.size()));
-  append_u32(out, kChunkBin);
-  out += bin;
-  return write_file_atomic(path, out);
+
+  // Header, JSON chunk and BIN chunk header in one small string; the rest goes straight from the
+  // split (indices, texture bytes) or through a small buffer (positions, normals, texcoords).
+  std::string head;
+  head.reserve(28 + json.size());
+  append_u32(head, kGlbMagic);
+  append_u32(head, 2);
+  append_u32(head, static_cast<uint32_t>(total));
+  append_u32(head, static_cast<uint32_t>(json.size()));
+  append_u32(head, kChunkJson);
+  head += json;
+  append_u32(head, static_cast<uint32_t>(bin_size));
+  append_u32(head, kChunkBin);
+
+  AtomicFileWriter file(path);
+  TAILOR_RETURN_IF_ERROR(file.open());
+  TAILOR_RETURN_IF_ERROR(file.write(head));
+  const uint32_t* xref = split.xref.data();
+  TAILOR_RETURN_IF_ERROR(write_gathered(file, vertex_count, 3, [&](size_t s, float* out) {
+    std::memcpy(out, &positions[3 * size_t{xref[s]}], 3 * sizeof(float));
+  }));
+  if (normals) {
+    const float* source = data.normals.data();
+    TAILOR_RETURN_IF_ERROR(write_gathered(file, vertex_count, 3, [&](size_t s, float* out) {
+      std::memcpy(out, &source[3 * size_t{xref[s]}], 3 * sizeof(float));
+    }));
+  }
+  // glTF's v axis points down the image: TEXCOORD_0 = (s, -t), the usual (s, 1 - t) shifted by a
+  // whole repeat (invisible with REPEAT) but exact, so a round trip is bit-exact (see export.h).
+  const float* uvs = split.uvs.data();
+  TAILOR_RETURN_IF_ERROR(write_gathered(file, vertex_count, 2, [&](size_t s, float* out) {
+    out[0] = uvs[2 * s];
+    out[1] = -uvs[2 * s + 1];
+  }));
+  TAILOR_RETURN_IF_ERROR(file.write(bytes_of(split.indices.data(), index_count)));
+  TAILOR_RETURN_IF_ERROR(file.write(texture_bytes));
+  static constexpr char kZeros[4] = {0, 0, 0, 0};
+  TAILOR_RETURN_IF_ERROR(file.write({kZeros, texture_padding}));
+  return file.commit();
 }
 
 }  // namespace tailor::internal

@@ -33,8 +33,19 @@ Status write_obj(const std::string& path, const ExportData& data, const ExportOp
     TAILOR_RETURN_IF_ERROR(write_file_atomic(mtl_path.string(), mtl));
   }
 
+  // The text goes out in pieces of about kFlushBytes through one reused string: the file is never
+  // held whole in memory.
+  AtomicFileWriter file(path);
+  TAILOR_RETURN_IF_ERROR(file.open());
+  constexpr size_t kFlushBytes = size_t{1} << 20;
   std::string out;
-  out.reserve(32 * mesh.positions.size() + 24 * split.uvs.size() + 40 * mesh.indices.size());
+  out.reserve(kFlushBytes + 4096);
+  auto flush_if_full = [&]() -> Status {
+    if (out.size() < kFlushBytes) return Status::ok();
+    Status s = file.write(out);
+    out.clear();
+    return s;
+  };
   out += "# written by tailor: ";
   out += std::to_string(mesh.vertex_count()) + " vertices, " + std::to_string(mesh.face_count()) + " faces\n";
   if (textured) out += "mtllib " + mtl_name + "\n";
@@ -46,6 +57,7 @@ Status write_obj(const std::string& path, const ExportData& data, const ExportOp
     out += ' ';
     append_float(out, mesh.positions[3 * v + 2]);
     out += '\n';
+    TAILOR_RETURN_IF_ERROR(flush_if_full());
   }
   for (size_t s = 0; s < split.xref.size(); ++s) {
     out += "vt ";
@@ -53,6 +65,7 @@ Status write_obj(const std::string& path, const ExportData& data, const ExportOp
     out += ' ';
     append_float(out, split.uvs[2 * s + 1]);
     out += '\n';
+    TAILOR_RETURN_IF_ERROR(flush_if_full());
   }
   const bool normals = !data.normals.empty();
   for (size_t v = 0; normals && v < mesh.vertex_count(); ++v) {
@@ -63,6 +76,7 @@ Status write_obj(const std::string& path, const ExportData& data, const ExportOp
     out += ' ';
     append_float(out, data.normals[3 * v + 2]);
     out += '\n';
+    TAILOR_RETURN_IF_ERROR(flush_if_full());
   }
   if (textured) out += "usemtl tailor\n";
   for (size_t f = 0; f < mesh.face_count(); ++f) {
@@ -79,8 +93,10 @@ Status write_obj(const std::string& path, const ExportData& data, const ExportOp
       }
     }
     out += '\n';
+    TAILOR_RETURN_IF_ERROR(flush_if_full());
   }
-  return write_file_atomic(path, out);
+  TAILOR_RETURN_IF_ERROR(file.write(out));
+  return file.commit();
 }
 
 }  // namespace tailor::internal

@@ -3,9 +3,11 @@
 // line names the texture the way MeshLab does. Vertices are split on UV, so the faces of
 // different patches do not share vertices in the file; tailor's readers of split files weld
 // identical positions back when they need the connectivity (weld_identical_positions).
+#include <algorithm>
 #include <bit>
 #include <cstring>
 #include <filesystem>
+#include <vector>
 
 #include "internal/atomic_file.h"
 #include "internal/export_writers.h"
@@ -33,20 +35,32 @@ Status write_ply(const std::string& path, const ExportData& data, const ExportOp
   out += "property float x\nproperty float y\nproperty float z\nproperty float s\nproperty float t\n";
   out += "element face " + std::to_string(face_count) + "\n";
   out += "property list uchar uint vertex_indices\nend_header\n";
-  const size_t header = out.size();
-  out.resize(header + vertex_count * 20 + face_count * 13);
-  char* p = out.data() + header;
-  for (size_t s = 0; s < vertex_count; ++s) {
-    std::memcpy(p, &split.positions[3 * s], 12);
-    std::memcpy(p + 12, &split.uvs[2 * s], 8);
-    p += 20;
+  // Streamed through one small buffer of whole records: the file is never held whole in memory.
+  AtomicFileWriter file(path);
+  TAILOR_RETURN_IF_ERROR(file.open());
+  TAILOR_RETURN_IF_ERROR(file.write(out));
+  constexpr size_t kChunkRecords = 16384;
+  std::vector<char> chunk(kChunkRecords * 20);
+  const float* positions = data.mesh->positions.data();
+  for (size_t begin = 0; begin < vertex_count; begin += kChunkRecords) {
+    const size_t end = std::min(vertex_count, begin + kChunkRecords);
+    char* p = chunk.data();
+    for (size_t s = begin; s < end; ++s, p += 20) {
+      std::memcpy(p, &positions[3 * size_t{split.xref[s]}], 12);
+      std::memcpy(p + 12, &split.uvs[2 * s], 8);
+    }
+    TAILOR_RETURN_IF_ERROR(file.write({chunk.data(), (end - begin) * 20}));
   }
-  for (size_t f = 0; f < face_count; ++f) {
-    *p = 3;
-    std::memcpy(p + 1, &split.indices[3 * f], 12);
-    p += 13;
+  for (size_t begin = 0; begin < face_count; begin += kChunkRecords) {
+    const size_t end = std::min(face_count, begin + kChunkRecords);
+    char* p = chunk.data();
+    for (size_t f = begin; f < end; ++f, p += 13) {
+      *p = 3;
+      std::memcpy(p + 1, &split.indices[3 * f], 12);
+    }
+    TAILOR_RETURN_IF_ERROR(file.write({chunk.data(), (end - begin) * 13}));
   }
-  return write_file_atomic(path, out);
+  return file.commit();
 }
 
 }  // namespace tailor::internal

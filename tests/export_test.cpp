@@ -3,15 +3,23 @@
 #include <nlohmann/json.hpp>
 #include <stb/stb_image.h>
 #include <stb/stb_image_write.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <bit>
+#include <csignal>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <map>
 #include <random>
 #include <string>
+#include <string_view>
+#include <tuple>
 
 #include "internal/atomic_file.h"
 #include "tailor/export.h"
@@ -177,6 +185,146 @@ TEST_F(ExportTest, SplitsVerticesOnUvAndWeldsThemBack) {
   EXPECT_EQ(welded.vertex_count(), 8u);
   for (size_t c = 0; c < cube_.indices.size(); ++c)
     EXPECT_EQ(std::memcmp(&welded.positions[3 * size_t{welded.indices[c]}], &cube_.positions[3 * size_t{cube_.indices[c]}], 12), 0);
+}
+
+// The split of a reference implementation: a std::map over (vertex, u bits, v bits), -0 as +0.
+void reference_split(const Mesh& mesh, const std::vector<float>& corner_uv, SplitMesh& out) {
+  out = SplitMesh{};
+  std::map<std::tuple<uint32_t, uint32_t, uint32_t>, uint32_t> ids;
+  for (size_t c = 0; c < mesh.indices.size(); ++c) {
+    const float u = corner_uv[2 * c] + 0.0f, w = corner_uv[2 * c + 1] + 0.0f;
+    const auto key = std::make_tuple(mesh.indices[c], std::bit_cast<uint32_t>(u), std::bit_cast<uint32_t>(w));
+    auto [it, added] = ids.emplace(key, static_cast<uint32_t>(out.xref.size()));
+    if (added) {
+      out.xref.push_back(mesh.indices[c]);
+      out.uvs.push_back(u);
+      out.uvs.push_back(w);
+      for (int i = 0; i < 3; ++i) out.positions.push_back(mesh.positions[3 * size_t{mesh.indices[c]} + i]);
+    }
+    out.indices.push_back(it->second);
+  }
+}
+
+void expect_same_split(const SplitMesh& a, const SplitMesh& b) {
+  EXPECT_EQ(a.xref, b.xref);
+  EXPECT_EQ(a.indices, b.indices);
+  ASSERT_EQ(a.uvs.size(), b.uvs.size());
+  EXPECT_EQ(std::memcmp(a.uvs.data(), b.uvs.data(), 4 * a.uvs.size()), 0);
+  ASSERT_EQ(a.positions.size(), b.positions.size());
+  EXPECT_EQ(std::memcmp(a.positions.data(), b.positions.data(), 4 * a.positions.size()), 0);
+}
+
+// A closed fan of n faces around vertex 0, rim vertex k at angle k; each face gives the centre its
+// own UV (n UVs at one vertex), the rim vertices keep one UV each.
+void make_fan(size_t n, Mesh& mesh, std::vector<float>& corner_uv) {
+  mesh = Mesh{};
+  corner_uv.clear();
+  mesh.positions = {0, 0, 1};
+  for (size_t k = 0; k < n; ++k) {
+    const double a = 2 * 3.14159265358979 * static_cast<double>(k) / static_cast<double>(n);
+    mesh.positions.insert(mesh.positions.end(), {static_cast<float>(std::cos(a)), static_cast<float>(std::sin(a)), 0});
+  }
+  for (size_t k = 0; k < n; ++k) {
+    const auto a = static_cast<uint32_t>(1 + k), b = static_cast<uint32_t>(1 + (k + 1) % n);
+    mesh.indices.insert(mesh.indices.end(), {0, a, b});
+    corner_uv.insert(corner_uv.end(), {0, static_cast<float>(k + 1), static_cast<float>(a), 0, static_cast<float>(b), 0});
+  }
+}
+
+TEST_F(ExportTest, SplitMatchesReferenceOnSeamsAndHugeFans) {
+  // Seam vertices with 1 to 4 UVs each, on a real mesh: UVs drawn from a few values per vertex.
+  Mesh mesh;
+  ASSERT_TRUE(load_mesh(kSpot, mesh).is_ok());
+  std::mt19937 rng(7);
+  std::vector<float> uv(2 * mesh.indices.size());
+  for (size_t c = 0; c < mesh.indices.size(); ++c) {
+    const uint32_t pick = rng() % 4;
+    uv[2 * c] = pick == 3 ? -0.0f : static_cast<float>(mesh.indices[c] % 5 + pick);  // -0 and +0 meet
+    uv[2 * c + 1] = pick == 3 ? 0.0f : 0.25f * static_cast<float>(pick);
+  }
+  SplitMesh got, want;
+  split_vertices(mesh, uv, got);
+  reference_split(mesh, uv, want);
+  EXPECT_GT(want.xref.size(), 2 * mesh.vertex_count());  // many vertices with several UVs
+  expect_same_split(got, want);
+
+  // A fan with 300 UVs at its centre: the chain walks exceed their budget and the split falls
+  // back to its hash table; the result is the same.
+  std::vector<float> fan_uv;
+  make_fan(300, mesh, fan_uv);
+  split_vertices(mesh, fan_uv, got);
+  reference_split(mesh, fan_uv, want);
+  EXPECT_EQ(got.xref.size(), 600u);  // 300 centre copies + 300 rim vertices
+  expect_same_split(got, want);
+  // And through export_mesh (scaled on the fly): the .ply holds the 600 split vertices.
+  Atlas atlas;
+  atlas.corner_uv = fan_uv;
+  atlas.patch.assign(mesh.face_count(), 0);
+  ExportOptions options;
+  options.texture_width = options.texture_height = 1;
+  ASSERT_TRUE(export_mesh(path("fan.ply"), mesh, atlas, options).is_ok());
+  EXPECT_NE(read_all(path("fan.ply")).find("element vertex 600\n"), std::string::npos);
+}
+
+TEST_F(ExportTest, NonFiniteUvIsReportedAtItsCorner) {
+  Atlas atlas = cube_atlas_;
+  atlas.corner_uv[2 * 7 + 1] = std::numeric_limits<float>::infinity();
+  atlas.corner_uv[2 * 9] = std::numeric_limits<float>::quiet_NaN();
+  for (const char* name : {"cube.glb", "cube.obj", "cube.ply"}) {
+    const Status s = export_mesh(path(name), cube_, atlas, ExportOptions{});
+    EXPECT_EQ(s.code(), ErrorCode::kInvalidArgument) << name;
+    EXPECT_EQ(s.what(), "UV is not finite");
+    EXPECT_EQ(s.where(), "corner 7");
+    EXPECT_FALSE(fs::exists(path(name)));
+  }
+}
+
+// A file size limit (RLIMIT_FSIZE) makes writes fail part-way: the streamed writers must then leave
+// the previous file as it was and no temporary file.
+TEST_F(ExportTest, WriteFailuresPartWayLeaveNoPartialFile) {
+  Mesh mesh;
+  ASSERT_TRUE(load_mesh(kSpot, mesh).is_ok());  // 5856 faces: every output is well over 64 KiB
+  Atlas atlas;
+  atlas.corner_uv = mesh.corner_uvs;
+  atlas.patch.assign(mesh.face_count(), 0);
+  ExportOptions options;
+  options.texture_path = kTexture;
+  const std::string names[] = {"m.glb", "m.obj", "m.ply", "raw.bin"};
+  for (const std::string& name : names) std::ofstream(path(name)) << "old\n";
+
+  struct rlimit old_limit;
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &old_limit), 0);
+  void (*old_handler)(int) = std::signal(SIGXFSZ, SIG_IGN);  // fail with EFBIG, do not kill
+  struct rlimit limit = old_limit;
+  limit.rlim_cur = 64 * 1024;
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &limit), 0);
+  Status statuses[4];
+  for (int i = 0; i < 3; ++i) statuses[i] = export_mesh(path(names[i]), mesh, atlas, options);
+  const std::string big(48 * 1024, 'x');
+  const std::span<const char> pieces[2] = {big, big};
+  statuses[3] = internal::write_file_atomic(path(names[3]), pieces);
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &old_limit), 0);
+  std::signal(SIGXFSZ, old_handler);
+
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(statuses[i].code(), ErrorCode::kIo) << names[i];
+    EXPECT_NE(statuses[i].what().find("cannot write file"), std::string::npos) << statuses[i].message();
+    EXPECT_EQ(read_all(path(names[i])), "old\n") << names[i];
+  }
+  EXPECT_EQ(temporaries(), 0u);
+
+  // Without the limit the gather write lands, pieces in order.
+  const std::span<const char> small[3] = {std::string_view("ab"), std::string_view(""), std::string_view("cde")};
+  ASSERT_TRUE(internal::write_file_atomic(path(names[3]), small).is_ok());
+  EXPECT_EQ(read_all(path(names[3])), "abcde");
+  // A writer dropped before its commit (an early return) leaves nothing either.
+  {
+    internal::AtomicFileWriter file(path("dropped.bin"));
+    ASSERT_TRUE(file.open().is_ok());
+    ASSERT_TRUE(file.write(big).is_ok());
+  }
+  EXPECT_FALSE(fs::exists(path("dropped.bin")));
+  EXPECT_EQ(temporaries(), 0u);
 }
 
 TEST_F(ExportTest, GlbRoundTripsAndValidates) {

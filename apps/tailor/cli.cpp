@@ -3,14 +3,53 @@
 
 #include "tailor/tiling.h"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <cmath>
+#include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <sstream>
 
 namespace tailor::cli {
+
+namespace {
+// The input being read, for the SIGBUS handler (which may only call async-signal-safe functions:
+// the message is assembled beforehand).
+char reading_message[4200];
+size_t reading_length = 0;
+volatile sig_atomic_t reading = 0;
+
+extern "C" void on_bus_error(int signal) {
+  if (!reading) {  // not an input read: keep the default action
+    std::signal(signal, SIG_DFL);
+    std::raise(signal);
+    return;
+  }
+  const ssize_t ignored = write(STDERR_FILENO, reading_message, reading_length);
+  (void)ignored;
+  _exit(kExitBadInput);
+}
+}  // namespace
+
+ReadingInput::ReadingInput(const std::string& path) {
+  const std::string message =
+      "tailor: error: " + path.substr(0, 4000) + ": the file changed while it was read (truncated by another program?)\n";
+  std::memcpy(reading_message, message.data(), message.size());
+  reading_length = message.size();
+  static const bool installed = [] {
+    struct sigaction action {};
+    action.sa_handler = on_bus_error;
+    sigemptyset(&action.sa_mask);
+    return sigaction(SIGBUS, &action, nullptr) == 0;
+  }();
+  (void)installed;
+  reading = 1;
+}
+
+ReadingInput::~ReadingInput() { reading = 0; }
 
 int report_error(const Status& status) {
   std::fprintf(stderr, "tailor: error: %s\n", status.message().c_str());

@@ -26,6 +26,18 @@ inline constexpr int kExitUsage = 2;     //!< bad command line
 //! Prints "tailor: error: <file>: <what> (<where>)" on stderr; returns the exit code for `status`.
 int report_error(const Status& status);
 
+//! While alive, a SIGBUS (what reading a mapped input raises once another program truncates the
+//! file) ends the process with "tailor: error: <path>: the file changed while it was read ..."
+//! and exit code 1 instead of a crash. Inputs are read before any output is written, so nothing is
+//! left behind. Outside such a scope SIGBUS keeps its default action (a crash to debug).
+class ReadingInput {
+ public:
+  explicit ReadingInput(const std::string& path);
+  ~ReadingInput();
+  ReadingInput(const ReadingInput&) = delete;
+  ReadingInput& operator=(const ReadingInput&) = delete;
+};
+
 //! Prints "tailor: warning: <text>" on stderr unless quiet.
 void warn(bool quiet, const std::string& text);
 

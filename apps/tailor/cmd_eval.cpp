@@ -33,7 +33,10 @@ constexpr int kDefaultTextureSize = 512;
 // --stability: the remove-a-ball experiment of thesis 2.6 on tailor's own mapping of the mesh.
 int run_stability(const EvalOptions& opt) {
   Mesh mesh;
-  if (Status s = load_mesh(opt.input, mesh); !s) return report_error(s);
+  {
+    const ReadingInput reading(opt.input);
+    if (Status s = load_mesh(opt.input, mesh); !s) return report_error(s);
+  }
   MappingOptions mapping;
   if (!opt.seed_point.empty()) {
     if (!parse_vec3(opt.seed_point, mapping.seed_point))
@@ -78,8 +81,11 @@ int run_eval(const EvalOptions& opt) {
   Image texture;
   const bool glb = mesh_format_from_path(opt.input) == MeshFormat::kGlb;
   // Only decode the embedded texture when its size is needed.
-  const Status status = glb ? read_glb_file(opt.input, mesh, opt.texture_size > 0 ? nullptr : &texture, &report)
-                            : load_mesh(opt.input, mesh, &report);
+  const Status status = [&] {
+    const ReadingInput reading(opt.input);
+    return glb ? read_glb_file(opt.input, mesh, opt.texture_size > 0 ? nullptr : &texture, &report)
+               : load_mesh(opt.input, mesh, &report);
+  }();
   if (!status) return report_error(status);
   if (mesh.corner_uvs.empty())
     return report_error(Status::error(ErrorCode::kInvalidMesh, opt.input,

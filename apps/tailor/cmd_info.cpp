@@ -20,7 +20,10 @@ struct InfoOptions {
 int run_info(const InfoOptions& opt) {
   Mesh mesh;
   LoadReport report;
-  const Status status = load_mesh(opt.input, mesh, &report);
+  const Status status = [&] {
+    const ReadingInput reading(opt.input);
+    return load_mesh(opt.input, mesh, &report);
+  }();
   if (!status) return report_error(status);
   const Topology topology = build_topology(mesh);
 

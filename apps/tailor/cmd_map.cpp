@@ -45,6 +45,7 @@ struct MapOptions {
   std::string seed_point;
   std::string seam_faces;
   bool stability = false;
+  uint32_t threads = 0;
   bool quiet = false;
 };
 
@@ -106,7 +107,9 @@ int run_map(const MapOptions& opt) {
     if (Status s = parse_axis(opt.axis, orientation_options); !s) return report_error(s);
   }
   orientation_options.smooth_passes = opt.smooth;
+  orientation_options.threads = opt.threads;
   MappingOptions mapping_options;
+  mapping_options.threads = opt.threads;
   if (opt.mode == "patches") mapping_options.mode = MappingMode::kPatches;
   else if (opt.mode == "thesis") mapping_options.mode = MappingMode::kThesis;
   else return report_error(usage_error("--mode must be patches or thesis, got '" + opt.mode + "'"));
@@ -147,7 +150,10 @@ int run_map(const MapOptions& opt) {
   // === Load, topology, orientation ===
   Mesh mesh;
   LoadReport load;
-  if (Status s = load_mesh(opt.input, mesh, &load); !s) return report_error(s);
+  {
+    const ReadingInput reading(opt.input);
+    if (Status s = load_mesh(opt.input, mesh, &load); !s) return report_error(s);
+  }
   if (load.degenerate_faces) warn(opt.quiet, opt.input + ": dropped " + std::to_string(load.degenerate_faces) + " degenerate faces");
   if (load.duplicate_faces) warn(opt.quiet, opt.input + ": dropped " + std::to_string(load.duplicate_faces) + " duplicate faces");
   std::vector<uint8_t> seam_faces;
@@ -204,6 +210,7 @@ int run_map(const MapOptions& opt) {
   MetricsOptions metrics_options;
   metrics_options.texture_width_px = static_cast<float>(tex_w);
   metrics_options.texture_height_px = static_cast<float>(tex_h);
+  metrics_options.threads = opt.threads;
   UvMetrics metrics;
   if (Status s = compute_uv_metrics(mesh, topology, atlas.corner_uv, atlas.patch, metrics_options, metrics); !s)
     return report_error(s.with_file(opt.input));
@@ -398,6 +405,11 @@ void register_map(CLI::App& app, Runner& run) {
                     "File of face indices (one per line) where seams should go (PLY 'seam' property also works)");
   cmd->add_flag("--stability", opt->stability,
                 "Also remove ~10% of the faces, re-map and report how much the remaining UVs moved");
+  cmd->add_option("--threads", opt->threads,
+                  "Threads for the orientation, the crack closing and the metrics (0 = one per core, up to 8, "
+                  "where the mesh is large enough); the output is the same for any count")
+      ->capture_default_str()
+      ->check(CLI::Range(0u, 64u));
   cmd->add_flag("-q,--quiet", opt->quiet, "Print nothing but errors");
   cmd->footer(
       "Example:\n"

@@ -58,9 +58,11 @@ int run_render(const RenderArgs& args) {
 
   Mesh mesh;
   Image texture;
-  Status status = mesh_format_from_path(args.input) == MeshFormat::kGlb
-                      ? read_glb_file(args.input, mesh, &texture)
-                      : load_mesh(args.input, mesh);
+  Status status = [&] {
+    const ReadingInput reading(args.input);
+    return mesh_format_from_path(args.input) == MeshFormat::kGlb ? read_glb_file(args.input, mesh, &texture)
+                                                                  : load_mesh(args.input, mesh);
+  }();
   if (!status) return report_error(status.with_file(args.input));
   if (!args.texture.empty()) {
     status = load_image(args.texture, texture);

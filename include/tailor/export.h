@@ -52,8 +52,9 @@ struct SplitMesh {
 
 //! Splits vertices on (vertex index, uv bits): corners with the same vertex and bit-identical UV
 //! (-0 and +0 are merged) share one split vertex; split vertices are numbered in order of first
-//! corner. corner_uv_repeats: #F*3 by 2 (any unit; copied as is). Cost: O(F) with one flat
-//! open-addressing hash, no per-element allocation. Deterministic.
+//! corner. corner_uv_repeats: #F*3 by 2 (any unit; copied as is). Cost: O(F): one chain of split
+//! vertices per source vertex, falling back to a flat hash table for huge fans; no per-element
+//! allocation. Deterministic.
 void split_vertices(const Mesh& mesh, std::span<const float> corner_uv_repeats, SplitMesh& out);
 
 //! The inverse, for readers of split files (.glb, .ply): merges vertices with bit-identical

@@ -2,6 +2,7 @@
 // to "<path>.tmp-<pid>" first, and only a complete, flushed file is renamed onto <path>.
 #pragma once
 
+#include <cstdio>
 #include <span>
 #include <string>
 #include <utility>
@@ -15,6 +16,42 @@ namespace tailor::internal {
 //! is left as it was. While a FileBatch is alive on this thread, the file is only staged (written
 //! to its temporary name) and lands when the batch commits.
 Status write_file_atomic(const std::string& path, std::span<const char> bytes);
+
+//! The same for a file made of several pieces, written in order (a gather write: the caller need
+//! not assemble the whole file in memory). Same temporary file, rename and FileBatch semantics.
+Status write_file_atomic(const std::string& path, std::span<const std::span<const char>> pieces);
+
+//! Writes one file atomically piece by piece, for writers that produce it in chunks:
+//!     AtomicFileWriter file(path);
+//!     TAILOR_RETURN_IF_ERROR(file.open());
+//!     file.write(header); file.write(chunk); ...      // errors are sticky, checked by commit()
+//!     return file.commit();
+//! open() creates "<path>.tmp-<pid>"; commit() flushes, closes and renames it onto `path` (or
+//! stages it in the active FileBatch, like write_file_atomic). When any step failed, or the writer
+//! is destroyed without a commit (an early return), the temporary file is removed and `path` is
+//! left as it was. Error messages are those of write_file_atomic. Not copyable; one thread.
+class AtomicFileWriter {
+ public:
+  explicit AtomicFileWriter(std::string path);
+  ~AtomicFileWriter();
+  AtomicFileWriter(const AtomicFileWriter&) = delete;
+  AtomicFileWriter& operator=(const AtomicFileWriter&) = delete;
+
+  //! Creates the temporary file. Fails with kIo ("cannot create file").
+  Status open();
+  //! Appends bytes. After the first failure it writes nothing more and returns that error (kIo).
+  Status write(std::span<const char> bytes);
+  //! Flushes, closes and renames (or stages). Fails with kIo; the temporary file is then removed.
+  Status commit();
+
+ private:
+  Status fail(int err);  // records the first write error, closes and removes the temporary file
+
+  std::string path_;
+  std::string temporary_;
+  std::FILE* file_ = nullptr;
+  Status error_;
+};
 
 //! Makes the outputs of one command land together. While it is alive on this thread (batches nest:
 //! the innermost one collects), write_file_atomic stages each file under its temporary name;

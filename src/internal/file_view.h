@@ -17,7 +17,8 @@ namespace tailor::internal {
 
 //! The bytes of one file, mapped or copied. Move-only; unmaps on destruction.
 //! Caveat of any mapping: if another process truncates the file while it is viewed, reading
-//! past the new end raises SIGBUS (content, however malformed, is safe: parsers get a span).
+//! past the new end raises SIGBUS (content, however malformed, is safe: parsers get a span). The
+//! tailor CLI turns that signal into a one-line error (apps/tailor/cli.h, ReadingInput).
 class FileView {
  public:
   FileView() = default;
