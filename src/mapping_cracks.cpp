@@ -15,7 +15,9 @@
 // It is kept only if every face it touched is within the bounds (max_stretch, and an area ratio
 // near 1), else undone: every face stays within max_stretch, no face inverts, and each kept zip
 // removes at least one seam edge. Zips go nearest to the component's seed first, so removing part
-// of a mesh changes only the zips after the first one it touches (stability, as the hop rule).
+// of a mesh changes only the zips after the first one it touches (stability, as the hop rule);
+// bands of seed distance far enough apart not to share a vertex are zipped on several threads,
+// with the same result for any thread count (close_cracks at the end).
 //
 // Cost: the horse (97k faces) runs ~7,500 relaxations of ~70 moving faces and ~10 iterations each.
 // The local step (fit_rotations) takes four faces per instruction and the global step (sweep) u
@@ -26,15 +28,20 @@
 //   L. Liu, L. Zhang, Y. Xu, C. Gotsman, S. J. Gortler, "A local/global approach to mesh
 //   parameterization", SGP 2008 (ARAP local/global iterations; uniform weights here).
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <memory>
+#include <system_error>
+#include <thread>
 #include <vector>
 
 #include "internal/simd.h"
 
 #include "internal/face_stretch.h"
 #include "internal/mapping_common.h"
+#include "internal/parallel_chunks.h"
 
 namespace tailor::internal {
 namespace {
@@ -69,6 +76,8 @@ constexpr float kAreaBound = 0.2f;
 // there (O(valence^2): a fan of 40k faces took 48 s, one of 1e6 would never end); such vertices
 // keep their cracks. Scans have valences of 4-12.
 constexpr uint32_t kMaxZipValence = 64;
+// Faces per closing worker: below this, starting threads costs more than it saves.
+constexpr size_t kFacesPerClosingThread = 10000;
 
 // === Local step ===================================================================================
 // Per moving face, what the Gauss-Seidel step reads of it (kRecord floats, see fit_rotations).
@@ -275,14 +284,44 @@ T* scratch(std::vector<T>& v, size_t n) {
   return v.data();
 }
 
+// What the workers share. Each worker processes one band of seed distance at a time and reads or
+// writes these only for the faces, corners and wedges of vertices near its band (see kZoneSteps
+// and close_cracks): bands processed at the same time are further apart than that, so they never
+// touch the same element.
+struct CrackShared {
+  std::vector<uint32_t> wedge;       // per corner: its wedge id
+  std::vector<uint32_t> wedge_size;  // per wedge id: corners
+  std::vector<uint32_t> vertex_start, vertex_corners;  // corners around each vertex (CSR)
+  std::vector<uint8_t> zero_area;    // per face: is_zero_area_frame (a moving face is in ~6 relaxations)
+  std::vector<uint32_t> face_stamp, wedge_stamp, wedge_local;  // per face / wedge id: relaxation marks
+  std::vector<uint8_t> queued;       // per half-edge: waiting in a band's queue or an outbox
+  std::vector<uint32_t> distance;    // per vertex: edges from the nearest seed face's corners
+  std::atomic<uint32_t> stamp{0};    // the last relaxation mark handed out (unique across workers)
+  std::atomic<uint64_t> popped{0};   // queue entries taken, all workers
+  std::atomic<bool> cancelled{false};
+};
+
+// A zip at a crack edge reads and writes only what belongs to vertices within crack_rings + 1
+// edges of the edge's own: the merged vertices' fans (1 edge), one more edge per ring, the faces
+// across the last ring (their corners' wedges and UVs), and the crack edges around the merged
+// vertices. A band is crack_rings + kZoneSteps wide, so bands three apart stay 2 edges clear.
+constexpr uint32_t kZoneSteps = 3;
+constexpr uint32_t kBandPhases = 3;
+
 class CrackCloser {
  public:
-  CrackCloser(const MappingInput& in, Atlas& atlas, const ProgressCallback& progress)
-      : in_(in), atlas_(atlas), progress_(progress) {}
-
-  Status run(uint64_t& zipped) {
-    zipped = 0;
-    const size_t face_count = in_.mesh.face_count();
+  CrackCloser(const MappingInput& in, Atlas& atlas, CrackShared& shared)
+      : in_(in),
+        atlas_(atlas),
+        shared_(shared),
+        wedge_(shared.wedge),
+        wedge_size_(shared.wedge_size),
+        vertex_start_(shared.vertex_start),
+        vertex_corners_(shared.vertex_corners),
+        zero_area_(shared.zero_area),
+        face_stamp_(shared.face_stamp),
+        wedge_stamp_(shared.wedge_stamp),
+        wedge_local_(shared.wedge_local) {
     opposite_ = in_.topology.opposite.data();
     indices_ = in_.mesh.indices.data();
     local_ = in_.frames.local.data();
@@ -292,42 +331,62 @@ class CrackCloser {
     max_rings_ = static_cast<int>(std::max<uint32_t>(in_.options.crack_rings, kMinRings));
     area_bound_ = kAreaBound * std::max(1.f, bound_ / 0.25f);
     seam_flags_ = in_.options.seam_faces.empty() ? nullptr : in_.options.seam_faces.data();
+  }
+
+  // Fills the shared state (once, before any worker runs).
+  void build_shared() {
+    const size_t face_count = in_.mesh.face_count();
     build_wedges();
     build_vertex_corners();
-    // A moving face is in ~6 relaxations on average (horse): test it once.
     zero_area_.resize(face_count);
     for (size_t f = 0; f < face_count; ++f) zero_area_[f] = is_zero_area_frame(local_ + 6 * f);
     face_stamp_.assign(face_count, 0);
     wedge_stamp_.assign(3 * face_count, 0);
     wedge_local_.assign(3 * face_count, 0);
+    shared_.queued.assign(3 * face_count, 0);
+    shared_.distance = seed_distances();
+  }
 
-    // Crack edges, each once (its half-edge in the face of lower id), nearest to the component's
-    // seed first (faces' distance in edge steps, then edge id); a zip queues the crack edges around
-    // the vertices it merged (they may end there now). Why this order: zips overlap along a crack
-    // and between neighbouring cracks, so each depends on those before it; with the seed's
-    // neighbourhood first, removing part of the mesh (far from the seed, as in the stability test)
-    // changes only zips processed after it, as the growth's hop rule does for the placements.
-    const std::vector<uint32_t> distance = seed_distances();
-    auto key = [&](uint32_t e) {
-      const uint32_t d = std::min(distance[e / 3], distance[opposite_[e] / 3]);
-      return (uint64_t{d} << 32) | e;
-    };
-    std::vector<uint64_t> heap;
-    std::vector<uint8_t> queued(3 * face_count, 0);
-    for (uint32_t e = 0; e < 3 * face_count; ++e) {
-      if (e < opposite_[e] && is_crack(e)) {
-        heap.push_back(key(e));
-        queued[e] = 1;
-      }
-    }
+  // Crack edges are processed nearest to the component's seed first (queue key: the distance of
+  // the edge's nearer vertex, then the edge id). Why this order: zips overlap along a crack and
+  // between neighbouring cracks, so each depends on those before it; with the seed's
+  // neighbourhood first, removing part of the mesh (far from the seed, as in the stability test)
+  // changes only zips processed after it, as the growth's hop rule does for the placements.
+  uint64_t key(uint32_t e) const {
+    const EdgeCorners c = edge_corners(e);
+    const uint32_t d = std::min(shared_.distance[indices_[c.fa]], shared_.distance[indices_[c.fb]]);
+    return (uint64_t{d} << 32) | e;
+  }
+
+  // A seam edge inside one patch, not next to a user seam face (those seams were asked for).
+  bool is_crack(uint32_t e) const {
+    const uint32_t o = opposite_[e];
+    if (o == kInvalid) return false;
+    const uint32_t f = e / 3, g = o / 3;
+    if (atlas_.patch[f] != atlas_.patch[g]) return false;
+    if (seam_flags_ && (seam_flags_[f] || seam_flags_[g])) return false;
+    const EdgeCorners c = edge_corners(e);
+    return wedge_[c.fa] != wedge_[c.ga] || wedge_[c.fb] != wedge_[c.gb];
+  }
+
+  // Zips the crack edges of one band (a min-heap of keys) until none is left; a zip queues the
+  // crack edges around the vertices it merged (they may end there now): into `heap` when they
+  // are of this band, else into `outbox` (their keys). `report`: this worker reports progress
+  // (every 256 pops, the share of `initial` popped by all workers) and may cancel.
+  void close_band(std::vector<uint64_t>& heap, uint32_t band, uint32_t band_steps, std::vector<uint64_t>& outbox,
+                  const ProgressCallback* report, size_t initial) {
     std::make_heap(heap.begin(), heap.end(), std::greater<>());
-    const size_t initial = heap.size();
-    for (size_t popped = 0; !heap.empty(); ++popped) {
+    uint8_t* const queued = shared_.queued.data();
+    while (!heap.empty()) {
+      if (shared_.cancelled.load(std::memory_order_relaxed)) return;
+      const uint64_t popped = shared_.popped.fetch_add(1, std::memory_order_relaxed);
       // Every 256 pops (kProgressInterval counts placements; a pop here costs up to two
       // relaxations): the closing is most of the mapping's time, so it reports and can be cancelled.
-      if (popped % 256 == 0 && progress_ &&
-          !progress_(std::min(1.f, static_cast<float>(popped) / static_cast<float>(initial + 1))))
-        return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
+      if (report && ++own_pops_ % 256 == 0 &&
+          !(*report)(std::min(1.f, static_cast<float>(popped) / static_cast<float>(initial + 1)))) {
+        shared_.cancelled.store(true, std::memory_order_relaxed);
+        return;
+      }
       std::pop_heap(heap.begin(), heap.end(), std::greater<>());
       const uint32_t e = static_cast<uint32_t>(heap.back());
       heap.pop_back();
@@ -335,7 +394,7 @@ class CrackCloser {
       if (!is_crack(e)) continue;
       const int merged = zip(e);
       if (merged == 0) continue;
-      zipped += static_cast<uint64_t>(merged);
+      zipped_ += static_cast<uint64_t>(merged);
       for (int m = 0; m < merged; ++m) {
         const uint32_t v = merges_[static_cast<size_t>(m)].vertex;
         for (uint32_t i = vertex_start_[v]; i < vertex_start_[v + 1]; ++i) {
@@ -346,33 +405,52 @@ class CrackCloser {
             const uint32_t canonical = std::min(h, o);
             if (queued[canonical] || !is_crack(canonical)) continue;
             queued[canonical] = 1;
-            heap.push_back(key(canonical));
-            std::push_heap(heap.begin(), heap.end(), std::greater<>());
+            const uint64_t k2 = key(canonical);
+            const uint32_t b = static_cast<uint32_t>(k2 >> 32) / band_steps;
+            if (b == band) {
+              heap.push_back(k2);
+              std::push_heap(heap.begin(), heap.end(), std::greater<>());
+            } else {
+              outbox.push_back(k2);
+            }
           }
         }
       }
     }
-    return Status::ok();
   }
 
+  uint64_t zipped() const { return zipped_; }
+
  private:
-  // Per face, its distance in edge steps from its component's seed face (breadth first).
+  // Per vertex, its distance in edges from the nearest corner of a seed face (in_.component_seeds;
+  // vertices no seed reaches start their own search at 0), breadth first.
   std::vector<uint32_t> seed_distances() const {
-    const size_t face_count = in_.mesh.face_count();
-    std::vector<uint32_t> distance(face_count, kInvalid), fifo;
-    fifo.reserve(face_count);
-    for (const uint32_t seed : in_.component_seeds) {
-      distance[seed] = 0;
-      fifo.push_back(seed);
-    }
-    for (size_t head = 0; head < fifo.size(); ++head) {
-      const uint32_t f = fifo[head];
-      for (uint32_t k = 0; k < 3; ++k) {
-        const uint32_t o = opposite_[3 * f + k];
-        if (o == kInvalid || distance[o / 3] != kInvalid) continue;
-        distance[o / 3] = distance[f] + 1;
-        fifo.push_back(o / 3);
+    const size_t vertex_count = in_.mesh.vertex_count();
+    std::vector<uint32_t> distance(vertex_count, kInvalid), fifo;
+    fifo.reserve(vertex_count);
+    auto reach = [&](uint32_t v, uint32_t d) {
+      if (distance[v] != kInvalid) return;
+      distance[v] = d;
+      fifo.push_back(v);
+    };
+    auto search = [&](size_t head) {
+      for (; head < fifo.size(); ++head) {
+        const uint32_t v = fifo[head], d = distance[v] + 1;
+        for (uint32_t i = vertex_start_[v]; i < vertex_start_[v + 1]; ++i) {
+          const uint32_t c = vertex_corners_[i], f = c / 3, k = c - 3 * f;
+          reach(indices_[3 * size_t{f} + static_cast<uint32_t>(kNext[k])], d);
+          reach(indices_[3 * size_t{f} + static_cast<uint32_t>(kPrev[k])], d);
+        }
       }
+    };
+    for (const uint32_t seed : in_.component_seeds)
+      for (size_t k = 0; k < 3; ++k) reach(indices_[3 * size_t{seed} + k], 0);
+    search(0);
+    for (uint32_t v = 0; v < vertex_count; ++v) {
+      if (distance[v] != kInvalid) continue;
+      const size_t head = fifo.size();
+      reach(v, 0);
+      search(head);
     }
     return distance;
   }
@@ -436,17 +514,6 @@ class CrackCloser {
   EdgeCorners edge_corners(uint32_t e) const {
     const uint32_t o = opposite_[e], f = e / 3, g = o / 3;
     return {e, 3 * f + static_cast<uint32_t>(kNext[e - 3 * f]), 3 * g + static_cast<uint32_t>(kNext[o - 3 * g]), o};
-  }
-
-  // A seam edge inside one patch, not next to a user seam face (those seams were asked for).
-  bool is_crack(uint32_t e) const {
-    const uint32_t o = opposite_[e];
-    if (o == kInvalid) return false;
-    const uint32_t f = e / 3, g = o / 3;
-    if (atlas_.patch[f] != atlas_.patch[g]) return false;
-    if (seam_flags_ && (seam_flags_[f] || seam_flags_[g])) return false;
-    const EdgeCorners c = edge_corners(e);
-    return wedge_[c.fa] != wedge_[c.ga] || wedge_[c.fb] != wedge_[c.gb];
   }
 
   // === Zips ======================================================================================
@@ -532,11 +599,8 @@ class CrackCloser {
   // moved face is within the bounds; else restores every UV it changed. last_max_: the largest
   // distortion / bound of the last iteration.
   bool relax(uint32_t patch, int rings) {
-    if (++stamp_ == 0) {  // wrapped: forget every mark
-      std::fill(face_stamp_.begin(), face_stamp_.end(), 0);
-      std::fill(wedge_stamp_.begin(), wedge_stamp_.end(), 0);
-      stamp_ = 1;
-    }
+    // A mark no other relaxation used, on any worker (close_cracks resets them before a wrap).
+    stamp_ = shared_.stamp.fetch_add(1, std::memory_order_relaxed) + 1;
     last_max_ = 0.f;
     collect_region(patch, rings);
     if (!collect_moving()) {
@@ -751,7 +815,7 @@ class CrackCloser {
 
   const MappingInput& in_;
   Atlas& atlas_;
-  const ProgressCallback& progress_;  // share of the queue done (it grows as zips queue more)
+  CrackShared& shared_;
   const uint32_t* opposite_ = nullptr;
   const uint32_t* indices_ = nullptr;
   const float* local_ = nullptr;
@@ -761,14 +825,19 @@ class CrackCloser {
   int max_rings_ = kMinRings;
   float area_bound_ = kAreaBound;  // kAreaBound, widened in proportion above the default max_stretch
   float last_max_ = 0.f;
-  std::vector<uint32_t> wedge_;       // per corner: its wedge id
-  std::vector<uint32_t> wedge_size_;  // per wedge id: corners
-  std::vector<uint32_t> vertex_start_, vertex_corners_;  // corners around each vertex (CSR)
-  std::vector<uint8_t> zero_area_;  // per face: is_zero_area_frame
+  uint64_t zipped_ = 0, own_pops_ = 0;
+  // The shared arrays (see CrackShared), by their names here.
+  std::vector<uint32_t>& wedge_;
+  std::vector<uint32_t>& wedge_size_;
+  std::vector<uint32_t>& vertex_start_;
+  std::vector<uint32_t>& vertex_corners_;
+  std::vector<uint8_t>& zero_area_;
+  std::vector<uint32_t>& face_stamp_;
+  std::vector<uint32_t>& wedge_stamp_;
+  std::vector<uint32_t>& wedge_local_;
   // Scratch of one relaxation, reused (no allocation per zip once warm; the per-face and
   // per-wedge buffers only grow, see scratch()).
   uint32_t stamp_ = 0;
-  std::vector<uint32_t> face_stamp_, wedge_stamp_, wedge_local_;  // per face / wedge id
   std::vector<uint32_t> region_, moving_;  // faces within the rings; those with a free corner
   std::vector<Change> changed_;
   std::vector<Merge> merges_;
@@ -789,9 +858,81 @@ class CrackCloser {
 
 }  // namespace
 
+// Threads: the crack edges are cut into bands of seed distance crack_rings + kZoneSteps wide. A
+// zip reaches only vertices within crack_rings + 1 edges of its own (kZoneSteps), so bands three
+// apart never touch the same vertex, face, corner or wedge: the bands 0, 3, 6... are zipped at
+// once (each in key order, largest first, each by the next free worker), then 1, 4, 7... and
+// 2, 5, 8..., and again while zips queue edges into bands already done. The result depends on the
+// bands only, not on which worker zipped which band nor on how many workers there were.
 Status close_cracks(const MappingInput& input, const ProgressCallback& progress, Atlas& atlas, uint64_t& zipped) {
-  CrackCloser closer(input, atlas, progress);
-  return closer.run(zipped);
+  zipped = 0;
+  const size_t face_count = input.mesh.face_count();
+  CrackShared shared;
+  const size_t threads = parallel_threads(face_count, input.options.threads, kFacesPerClosingThread);
+  std::vector<std::unique_ptr<CrackCloser>> workers;  // one allocation per worker, not per element
+  for (size_t t = 0; t < threads; ++t) workers.push_back(std::make_unique<CrackCloser>(input, atlas, shared));
+  CrackCloser& first = *workers[0];
+  first.build_shared();
+
+  const uint32_t band_steps = std::max<uint32_t>(input.options.crack_rings, kMinRings) + kZoneSteps;
+  const uint32_t* opposite = input.topology.opposite.data();
+  std::vector<std::vector<uint64_t>> heaps;
+  size_t initial = 0;
+  for (uint32_t e = 0; e < 3 * face_count; ++e) {
+    if (!(e < opposite[e] && first.is_crack(e))) continue;  // each crack edge once
+    const uint64_t key = first.key(e);
+    const uint32_t band = static_cast<uint32_t>(key >> 32) / band_steps;
+    if (band >= heaps.size()) heaps.resize(band + 1);
+    heaps[band].push_back(key);
+    shared.queued[e] = 1;
+    ++initial;
+  }
+  std::vector<std::vector<uint64_t>> outboxes(threads);
+  for (bool any = true; any;) {
+    any = false;
+    for (uint32_t parity = 0; parity < kBandPhases; ++parity) {
+      std::vector<uint32_t> bands;
+      for (uint32_t b = parity; b < heaps.size(); b += kBandPhases)
+        if (!heaps[b].empty()) bands.push_back(b);
+      if (bands.empty()) continue;
+      any = true;
+      if (shared.stamp.load() > (uint32_t{1} << 31)) {  // far from wrapping within one pass
+        std::fill(shared.face_stamp.begin(), shared.face_stamp.end(), 0);
+        std::fill(shared.wedge_stamp.begin(), shared.wedge_stamp.end(), 0);
+        shared.stamp.store(0);
+      }
+      // Largest first, each to the next free worker: the phase ends with its largest band.
+      std::stable_sort(bands.begin(), bands.end(),
+                       [&](uint32_t a, uint32_t b) { return heaps[a].size() > heaps[b].size(); });
+      const size_t used = std::min(threads, bands.size());
+      std::atomic<size_t> next_band{0};
+      auto work = [&](size_t w) {
+        for (size_t i; (i = next_band.fetch_add(1)) < bands.size();)
+          workers[w]->close_band(heaps[bands[i]], bands[i], band_steps, outboxes[w], w == 0 && progress ? &progress : nullptr,
+                                 initial);
+      };
+      std::vector<std::thread> helpers;
+      try {
+        for (size_t w = 1; w < used; ++w) helpers.emplace_back(work, w);
+      } catch (const std::system_error&) {  // no thread to be had: fewer workers, same result
+      }
+      work(0);
+      for (std::thread& h : helpers) h.join();
+      if (shared.cancelled.load()) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
+      // Edges queued into other bands: a heap's pops depend only on its set of (unique) keys.
+      for (std::vector<uint64_t>& outbox : outboxes) {
+        for (const uint64_t key : outbox) {
+          const uint32_t band = static_cast<uint32_t>(key >> 32) / band_steps;
+          if (band >= heaps.size()) heaps.resize(band + 1);
+          heaps[band].push_back(key);
+        }
+        outbox.clear();
+      }
+    }
+  }
+  for (const auto& worker : workers) zipped += worker->zipped();
+  if (progress && !progress(1.f)) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
+  return Status::ok();
 }
 
 }  // namespace tailor::internal

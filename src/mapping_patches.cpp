@@ -16,6 +16,7 @@
 
 #include "internal/face_stretch.h"
 #include "internal/front_buckets.h"
+#include "internal/huge_pages.h"
 #include "internal/mapping_common.h"
 
 namespace tailor::internal {
@@ -78,9 +79,12 @@ class PatchMapper {
     factor_step_ = in_.factor_step;
     relax_ = 1.f - in_.options.field_following;
 
+    // Fresh multi-megabyte arrays: on huge pages (see huge_pages.h).
+    reserve_huge(atlas_.corner_uv, 6 * face_count);
     atlas_.corner_uv.assign(6 * face_count, 0.f);
     uv_ = atlas_.corner_uv.data();
     fill_records();
+    reserve_huge(hint_, mesh.vertex_count());
     hint_.assign(mesh.vertex_count(), VertexHint{kInvalid, 0.f, 0.f});
     hop_age_ = in_.factor_step < 0 ? in_.options.hop_age : 0.f;
     // Not initialised: a face's entry is written when it is placed, and only placed faces' are read.
@@ -147,8 +151,10 @@ class PatchMapper {
   // cache line per face instead of one per array).
   void fill_records() {
     const size_t face_count = in_.mesh.face_count();
-    // Default-initialised (every field is written below): no extra pass over 64 bytes per face.
-    rec_.reset(new FaceRecord[face_count]);
+    // Uninitialised (every field is written below): no extra pass over 64 bytes per face; on huge
+    // pages (100 MB on 1.5 M faces: in 4 KiB pages, faulting it in was a third of the mapping's
+    // page faults).
+    rec_ = huge_uninitialized<FaceRecord>(face_count);
     const uint32_t* opposite = in_.topology.opposite.data();
     const uint32_t* indices = in_.mesh.indices.data();
     const float* local = in_.frames.local.data();
@@ -699,6 +705,7 @@ class PatchMapper {
     for (size_t p = 0; p < patch_size_.size(); ++p)
       if (patch_size_[p] > 0) remap[p] = next++;
     const size_t face_count = in_.mesh.face_count();
+    reserve_huge(atlas_.patch, face_count);
     atlas_.patch.resize(face_count);
     for (size_t f = 0; f < face_count; ++f) atlas_.patch[f] = remap[rec_[f].patch];
     atlas_.patch_count = next;
@@ -714,7 +721,7 @@ class PatchMapper {
   float hop_age_ = 0.f;  // age per hop from the component's seed; 0 = the global counter
   std::unique_ptr<uint32_t[]> hops_;  // per face: hops from its component's seed (hop_age_ > 0)
   float* uv_ = nullptr;
-  std::unique_ptr<FaceRecord[]> rec_;  // per face
+  HugeArray<FaceRecord> rec_;  // per face
   std::vector<VertexHint> hint_;  // per vertex: the UV its patch first gave it
   std::vector<Rotation> patch_rotation_;
   std::vector<uint32_t> patch_size_;

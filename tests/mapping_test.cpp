@@ -314,6 +314,25 @@ TEST(Mapping, IsDeterministic) {
   EXPECT_EQ(a.atlas.corner_uv, b.atlas.corner_uv);
 }
 
+// The crack closing zips bands of seed distance on several threads: the horse has a dozen bands,
+// and the atlas must not depend on how many workers shared them.
+TEST(Mapping, CrackClosingIsTheSameOnAnyThreadCount) {
+  Mapped one, many;
+  one.mesh = load("horse.ply");
+  many.mesh = one.mesh;
+  MappingOptions options;
+  options.threads = 1;
+  map_mesh(one, options);
+  EXPECT_GT(one.stats.cracks_closed, 1000u);
+  for (const uint32_t threads : {2u, 5u}) {
+    options.threads = threads;
+    map_mesh(many, options);
+    EXPECT_EQ(one.atlas.corner_uv, many.atlas.corner_uv) << threads << " threads";
+    EXPECT_EQ(one.atlas.patch, many.atlas.patch) << threads << " threads";
+    EXPECT_EQ(one.stats.cracks_closed, many.stats.cracks_closed);
+  }
+}
+
 TEST(Mapping, SeedPointChoosesTheFirstPatch) {
   Mapped m;
   m.mesh = load("spot.obj");

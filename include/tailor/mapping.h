@@ -87,6 +87,8 @@ struct MappingOptions {
   uint32_t crack_rings = 16;        //!< effort of the crack closing (2..64): the largest region a zip relaxes, in
                                     //!< rings of faces around it (a first try takes crack_rings / 2 rings per unit
                                     //!< of gap / edge length); more closes wider gaps and takes longer
+  uint32_t threads = 0;             //!< threads of the crack closing (0 = one per 10k faces, at most the cores
+                                    //!< and 8); the result is identical for any count (the growth is sequential)
   uint32_t min_patch_faces = 16;    //!< patches with fewer faces are absorbed into a neighbouring patch by rigid
                                     //!< unfolding (0 = keep all; isolated components stay whole)
   // kThesis -------------------------------------------------------------------------------------
