@@ -343,11 +343,20 @@ class CrackCloser {
     seam_flags_ = in_.options.seam_faces.empty() ? nullptr : in_.options.seam_faces.data();
   }
 
-  // Fills the shared state (once, before any worker runs).
-  void build_shared() {
+  // Fills the shared state (once, before any worker runs). With threads, the vertex distances
+  // (a breadth-first search that reads only the mesh and the vertex fans) are found on a second
+  // thread meanwhile.
+  void build_shared(size_t threads) {
     const size_t face_count = in_.mesh.face_count();
-    build_wedges();
     build_vertex_corners();
+    std::thread helper;
+    if (threads > 1) {
+      try {
+        helper = std::thread([this] { shared_.vertex_distance = vertex_seed_distances(); });
+      } catch (const std::system_error&) {  // no thread to be had: found below
+      }
+    }
+    build_wedges();
     fresh(zero_area_, face_count, uint8_t{0});
     for (size_t f = 0; f < face_count; ++f) zero_area_[f] = is_zero_area_frame(local_ + 6 * f);
     fresh(face_stamp_, face_count, 0u);
@@ -355,7 +364,8 @@ class CrackCloser {
     fresh(wedge_local_, 3 * face_count, 0u);
     fresh(shared_.queued, 3 * face_count, uint8_t{0});
     shared_.face_distance = face_seed_distances();
-    shared_.vertex_distance = vertex_seed_distances();
+    if (helper.joinable()) helper.join();
+    else shared_.vertex_distance = vertex_seed_distances();
   }
 
   // Crack edges are processed nearest to the component's seed first (queue key: the distance of
@@ -913,7 +923,7 @@ Status close_cracks(const MappingInput& input, const ProgressCallback& progress,
   std::vector<std::unique_ptr<CrackCloser>> workers;  // one allocation per worker, not per element
   for (size_t t = 0; t < threads; ++t) workers.push_back(std::make_unique<CrackCloser>(input, atlas, shared));
   CrackCloser& first = *workers[0];
-  first.build_shared();
+  first.build_shared(threads);
 
   const uint32_t band_steps = std::max<uint32_t>(input.options.crack_rings, kMinRings) + kZoneSteps;
   const uint32_t* opposite = input.topology.opposite.data();
