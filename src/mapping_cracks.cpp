@@ -14,10 +14,10 @@
 // positions its faces predict); the UVs on the ring's edge stay fixed, so nothing outside changes.
 // It is kept only if every face it touched is within the bounds (max_stretch, and an area ratio
 // near 1), else undone: every face stays within max_stretch, no face inverts, and each kept zip
-// removes at least one seam edge. Zips go nearest to the component's seed first, so removing part
-// of a mesh changes only the zips after the first one it touches (stability, as the hop rule);
-// bands of seed distance far enough apart not to share a vertex are zipped on several threads,
-// with the same result for any thread count (close_cracks at the end).
+// removes at least one seam edge. Zips go nearest to the component's seed first, band by band of
+// seed distance, so removing part of a mesh changes only zips near or after the first one it
+// touches (stability, as the hop rule); bands far enough apart not to share a vertex are zipped on
+// several threads, with the same result for any thread count (close_cracks at the end).
 //
 // Cost: the horse (97k faces) runs ~7,500 relaxations of ~70 moving faces and ~10 iterations each.
 // The local step (fit_rotations) takes four faces per instruction and the global step (sweep) u
@@ -29,10 +29,13 @@
 //   parameterization", SGP 2008 (ARAP local/global iterations; uniform weights here).
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
+#include <exception>
 #include <functional>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <system_error>
 #include <thread>
 #include <vector>
@@ -350,29 +353,46 @@ class CrackCloser {
     const size_t face_count = in_.mesh.face_count();
     build_vertex_corners();
     std::thread helper;
+    std::exception_ptr failure;  // out of memory on the helper: rethrown here
     if (threads > 1) {
       try {
-        helper = std::thread([this] { shared_.vertex_distance = vertex_seed_distances(); });
-      } catch (const std::system_error&) {  // no thread to be had: found below
+        helper = std::thread([this, &failure] {
+          try {
+            shared_.vertex_distance = vertex_seed_distances();
+          } catch (...) {
+            failure = std::current_exception();
+          }
+        });
+      } catch (...) {  // no thread to be had: found below
       }
     }
-    build_wedges();
-    fresh(zero_area_, face_count, uint8_t{0});
-    for (size_t f = 0; f < face_count; ++f) zero_area_[f] = is_zero_area_frame(local_ + 6 * f);
-    fresh(face_stamp_, face_count, 0u);
-    fresh(wedge_stamp_, 3 * face_count, 0u);
-    fresh(wedge_local_, 3 * face_count, 0u);
-    fresh(shared_.queued, 3 * face_count, uint8_t{0});
-    shared_.face_distance = face_seed_distances();
-    if (helper.joinable()) helper.join();
-    else shared_.vertex_distance = vertex_seed_distances();
+    try {
+      build_wedges();
+      fresh(zero_area_, face_count, uint8_t{0});
+      for (size_t f = 0; f < face_count; ++f) zero_area_[f] = is_zero_area_frame(local_ + 6 * f);
+      fresh(face_stamp_, face_count, 0u);
+      fresh(wedge_stamp_, 3 * face_count, 0u);
+      fresh(wedge_local_, 3 * face_count, 0u);
+      fresh(shared_.queued, 3 * face_count, uint8_t{0});
+      shared_.face_distance = face_seed_distances();
+    } catch (...) {
+      if (helper.joinable()) helper.join();
+      throw;
+    }
+    if (helper.joinable()) {
+      helper.join();
+      if (failure) std::rethrow_exception(failure);
+    } else {
+      shared_.vertex_distance = vertex_seed_distances();
+    }
   }
 
   // Crack edges are processed nearest to the component's seed first (queue key: the distance of
   // the edge's nearer face in edge steps, then the edge id). Why this order: zips overlap along a
   // crack and between neighbouring cracks, so each depends on those before it; with the seed's
   // neighbourhood first, removing part of the mesh (far from the seed, as in the stability test)
-  // changes only zips processed after it, as the growth's hop rule does for the placements. (The
+  // changes only zips processed after it (and, through the band schedule, up to two bands nearer:
+  // see close_cracks), as the growth's hop rule does for the placements. (The
   // vertex distance, coarser, leaves more ties to the edge ids, which a removal renumbers: it cut
   // the bit-identical share of the stability test from 88.8% to 72.5% on the bunny.)
   uint64_t key(uint32_t e) const {
@@ -947,7 +967,9 @@ Status close_cracks(const MappingInput& input, const ProgressCallback& progress,
         if (!heaps[b].empty()) bands.push_back(b);
       if (bands.empty()) continue;
       any = true;
-      if (shared.stamp.load() > (uint32_t{1} << 31)) {  // far from wrapping within one pass
+      // Relaxation marks are 32-bit: reset between phases once half are used (a phase would need
+      // 2^31 relaxations, ~10^10 faces, to wrap).
+      if (shared.stamp.load() > (uint32_t{1} << 31)) {
         std::fill(shared.face_stamp.begin(), shared.face_stamp.end(), 0);
         std::fill(shared.wedge_stamp.begin(), shared.wedge_stamp.end(), 0);
         shared.stamp.store(0);
@@ -956,19 +978,44 @@ Status close_cracks(const MappingInput& input, const ProgressCallback& progress,
       std::stable_sort(bands.begin(), bands.end(),
                        [&](uint32_t a, uint32_t b) { return heaps[a].size() > heaps[b].size(); });
       const size_t used = std::min(threads, bands.size());
-      std::atomic<size_t> next_band{0};
+      std::atomic<size_t> next_band{0}, helpers_done{0};
+      std::exception_ptr failure;  // the first exception of a helper (out of memory), rethrown here
+      std::mutex failure_mutex;
       auto work = [&](size_t w) {
-        for (size_t i; (i = next_band.fetch_add(1)) < bands.size();)
-          workers[w]->close_band(heaps[bands[i]], bands[i], band_steps, outboxes[w], w == 0 && progress ? &progress : nullptr,
-                                 initial);
+        try {
+          for (size_t i; (i = next_band.fetch_add(1)) < bands.size();)
+            workers[w]->close_band(heaps[bands[i]], bands[i], band_steps, outboxes[w],
+                                   w == 0 && progress ? &progress : nullptr, initial);
+        } catch (...) {
+          if (w == 0) throw;
+          const std::lock_guard<std::mutex> lock(failure_mutex);
+          if (!failure) failure = std::current_exception();
+          shared.cancelled.store(true);
+        }
+        if (w != 0) helpers_done.fetch_add(1);
       };
       std::vector<std::thread> helpers;
       try {
+        helpers.reserve(used - 1);
         for (size_t w = 1; w < used; ++w) helpers.emplace_back(work, w);
-      } catch (const std::system_error&) {  // no thread to be had: fewer workers, same result
+      } catch (...) {  // no thread to be had: fewer workers, same result
       }
-      work(0);
+      try {
+        work(0);
+      } catch (...) {
+        shared.cancelled.store(true);
+        for (std::thread& h : helpers) h.join();
+        throw;
+      }
+      // The calling thread, out of bands, keeps reporting (and may cancel) until the others finish.
+      while (helpers_done.load() < helpers.size()) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        if (progress && !shared.cancelled.load() &&
+            !progress(std::min(1.f, static_cast<float>(shared.popped.load()) / static_cast<float>(initial + 1))))
+          shared.cancelled.store(true);
+      }
       for (std::thread& h : helpers) h.join();
+      if (failure) std::rethrow_exception(failure);
       if (shared.cancelled.load()) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
       // Edges queued into other bands: a heap's pops depend only on its set of (unique) keys.
       for (std::vector<uint64_t>& outbox : outboxes) {

@@ -6,6 +6,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -23,9 +24,8 @@ size_t reading_length = 0;
 volatile sig_atomic_t reading = 0;
 
 extern "C" void on_bus_error(int signal) {
-  if (!reading) {  // not an input read: keep the default action
+  if (!reading) {  // not an input read: the default action, when the faulting access runs again
     std::signal(signal, SIG_DFL);
-    std::raise(signal);
     return;
   }
   const ssize_t ignored = write(STDERR_FILENO, reading_message, reading_length);
@@ -39,6 +39,7 @@ ReadingInput::ReadingInput(const std::string& path) {
       "tailor: error: " + path.substr(0, 4000) + ": the file changed while it was read (truncated by another program?)\n";
   std::memcpy(reading_message, message.data(), message.size());
   reading_length = message.size();
+  std::atomic_signal_fence(std::memory_order_seq_cst);  // the message is complete before the flag
   static const bool installed = [] {
     struct sigaction action {};
     action.sa_handler = on_bus_error;

@@ -29,7 +29,8 @@ int report_error(const Status& status);
 //! While alive, a SIGBUS (what reading a mapped input raises once another program truncates the
 //! file) ends the process with "tailor: error: <path>: the file changed while it was read ..."
 //! and exit code 1 instead of a crash. Inputs are read before any output is written, so nothing is
-//! left behind. Outside such a scope SIGBUS keeps its default action (a crash to debug).
+//! left behind. Outside such a scope SIGBUS keeps its default action (a crash to debug). Scopes do
+//! not nest (each wraps one load).
 class ReadingInput {
  public:
   explicit ReadingInput(const std::string& path);

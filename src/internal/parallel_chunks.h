@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cstddef>
 #include <exception>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -30,23 +31,33 @@ inline size_t chunk_count(size_t n) { return (n + kParallelChunk - 1) / kParalle
 
 //! Calls body(begin, end, chunk) for every chunk of [0, n), on up to `threads` threads (each takes
 //! the next chunk not yet taken; fewer when the system refuses a thread). body must only write
-//! state owned by its chunk or its elements.
+//! state owned by its chunk or its elements. An exception from body (any thread) is rethrown here
+//! once every thread has stopped.
 template <class Body>
 void for_each_chunk(size_t n, size_t threads, Body body) {
   const size_t chunks = chunk_count(n);
   threads = std::clamp<size_t>(threads, 1, std::max<size_t>(chunks, 1));
   std::atomic<size_t> next{0};
+  std::exception_ptr failure;  // the first exception of any thread, rethrown on the calling one
+  std::mutex failure_mutex;
   auto run = [&] {
-    for (size_t c; (c = next.fetch_add(1)) < chunks;) body(c * kParallelChunk, std::min(n, (c + 1) * kParallelChunk), c);
+    try {
+      for (size_t c; (c = next.fetch_add(1)) < chunks;) body(c * kParallelChunk, std::min(n, (c + 1) * kParallelChunk), c);
+    } catch (...) {
+      const std::lock_guard<std::mutex> lock(failure_mutex);
+      if (!failure) failure = std::current_exception();
+      next.store(chunks);  // the others stop after their current chunk
+    }
   };
   std::vector<std::thread> workers;
   try {
     workers.reserve(threads - 1);
     for (size_t t = 1; t < threads; ++t) workers.emplace_back(run);
-  } catch (const std::exception&) {  // no thread to be had: the calling thread does the rest
+  } catch (...) {  // no thread to be had: the calling thread does the rest
   }
   run();
   for (std::thread& w : workers) w.join();
+  if (failure) std::rethrow_exception(failure);
 }
 
 }  // namespace tailor::internal
