@@ -5,16 +5,15 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
-#include <exception>
 #include <filesystem>
 #include <limits>
-#include <thread>
 
 #include "internal/simd.h"
 
 #include "internal/atomic_file.h"
 #include "internal/export_writers.h"
 #include "internal/huge_pages.h"
+#include "internal/parallel_chunks.h"
 
 namespace tailor {
 namespace internal {
@@ -185,34 +184,11 @@ Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas
   internal::ExportData data;
   data.mesh = &mesh;
   const bool want_normals = options.normals && format != ExportFormat::kPly;
-  std::exception_ptr normals_error;
-  std::thread worker;
-  if (want_normals && nf >= kThreadedFaces) {
-    try {
-      worker = std::thread([&] {
-        try {
-          vertex_normals(mesh, data.normals);
-        } catch (...) {  // (out of memory) rethrown on the calling thread, as without a thread
-          normals_error = std::current_exception();
-        }
-      });
-    } catch (...) {  // no thread available: computed inline below
-    }
-  }
   const double su = 1.0 / options.texture_width, sv = 1.0 / options.texture_height;
   size_t bad_corner = internal::kNoBadCorner;
-  try {
-    bad_corner = internal::split_vertices_scaled(mesh, atlas.corner_uv, su, sv, data.split);
-  } catch (...) {
-    if (worker.joinable()) worker.join();
-    throw;
-  }
-  if (worker.joinable()) {
-    worker.join();
-    if (normals_error) std::rethrow_exception(normals_error);
-  } else if (want_normals && bad_corner == internal::kNoBadCorner) {
-    vertex_normals(mesh, data.normals);
-  }
+  internal::run_beside(
+      want_normals && nf >= kThreadedFaces, [&] { if (want_normals) vertex_normals(mesh, data.normals); },
+      [&] { bad_corner = internal::split_vertices_scaled(mesh, atlas.corner_uv, su, sv, data.split); });
   if (bad_corner != internal::kNoBadCorner)
     return Status::error(ErrorCode::kInvalidArgument, path, "UV is not finite", "corner " + std::to_string(bad_corner));
 

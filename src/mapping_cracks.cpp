@@ -352,39 +352,18 @@ class CrackCloser {
   void build_shared(size_t threads) {
     const size_t face_count = in_.mesh.face_count();
     build_vertex_corners();
-    std::thread helper;
-    std::exception_ptr failure;  // out of memory on the helper: rethrown here
-    if (threads > 1) {
-      try {
-        helper = std::thread([this, &failure] {
-          try {
-            shared_.vertex_distance = vertex_seed_distances();
-          } catch (...) {
-            failure = std::current_exception();
-          }
+    run_beside(
+        threads > 1, [this] { shared_.vertex_distance = vertex_seed_distances(); },
+        [&] {
+          build_wedges();
+          fresh(zero_area_, face_count, uint8_t{0});
+          for (size_t f = 0; f < face_count; ++f) zero_area_[f] = is_zero_area_frame(local_ + 6 * f);
+          fresh(face_stamp_, face_count, 0u);
+          fresh(wedge_stamp_, 3 * face_count, 0u);
+          fresh(wedge_local_, 3 * face_count, 0u);
+          fresh(shared_.queued, 3 * face_count, uint8_t{0});
+          shared_.face_distance = face_seed_distances();
         });
-      } catch (...) {  // no thread to be had: found below
-      }
-    }
-    try {
-      build_wedges();
-      fresh(zero_area_, face_count, uint8_t{0});
-      for (size_t f = 0; f < face_count; ++f) zero_area_[f] = is_zero_area_frame(local_ + 6 * f);
-      fresh(face_stamp_, face_count, 0u);
-      fresh(wedge_stamp_, 3 * face_count, 0u);
-      fresh(wedge_local_, 3 * face_count, 0u);
-      fresh(shared_.queued, 3 * face_count, uint8_t{0});
-      shared_.face_distance = face_seed_distances();
-    } catch (...) {
-      if (helper.joinable()) helper.join();
-      throw;
-    }
-    if (helper.joinable()) {
-      helper.join();
-      if (failure) std::rethrow_exception(failure);
-    } else {
-      shared_.vertex_distance = vertex_seed_distances();
-    }
   }
 
   // Crack edges are processed nearest to the component's seed first (queue key: the distance of

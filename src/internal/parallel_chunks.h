@@ -60,4 +60,34 @@ void for_each_chunk(size_t n, size_t threads, Body body) {
   if (failure) std::rethrow_exception(failure);
 }
 
+//! Runs beside() on a second thread while main() runs on the calling one, when `threaded` and a
+//! thread can be had; else main() then beside(). For two independent jobs (they must not write
+//! what the other reads). An exception from either is rethrown here once both have stopped.
+template <class Beside, class Main>
+void run_beside(bool threaded, Beside beside, Main main) {
+  std::exception_ptr failure;
+  std::thread helper;
+  if (threaded) {
+    try {
+      helper = std::thread([&] {
+        try {
+          beside();
+        } catch (...) {
+          failure = std::current_exception();
+        }
+      });
+    } catch (...) {  // no thread to be had: run inline below
+    }
+  }
+  try {
+    main();
+  } catch (...) {
+    if (helper.joinable()) helper.join();
+    throw;
+  }
+  if (!helper.joinable()) return beside();
+  helper.join();
+  if (failure) std::rethrow_exception(failure);
+}
+
 }  // namespace tailor::internal
