@@ -8,7 +8,7 @@ CMAKE_FLAGS ?=
 EXAMPLE_MESH := examples/spot.obj
 EXAMPLE_TEXTURE := examples/gravel.png
 
-.PHONY: all deps configure build test run bench fuzz clean
+.PHONY: all deps configure build test run bench fuzz tsan clean
 
 all: build
 
@@ -40,5 +40,10 @@ bench: build
 fuzz: deps
 	@bash scripts/fuzz.sh long
 
+# The threaded stages (crack closing, metrics, orientation) under ThreadSanitizer: their
+# thread-count tests, and the closing on real meshes with 4 threads.
+tsan: deps
+	@bash scripts/tsan.sh
+
 clean:
-	rm -rf $(BUILD_DIR) build-fuzz out
+	rm -rf $(BUILD_DIR) build-fuzz build-tsan out
