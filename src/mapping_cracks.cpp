@@ -371,9 +371,9 @@ class CrackCloser {
   // crack and between neighbouring cracks, so each depends on those before it; with the seed's
   // neighbourhood first, removing part of the mesh (far from the seed, as in the stability test)
   // changes only zips processed after it (and, through the band schedule, up to two bands nearer:
-  // see close_cracks), as the growth's hop rule does for the placements. (The
-  // vertex distance, coarser, leaves more ties to the edge ids, which a removal renumbers: it cut
-  // the bit-identical share of the stability test from 88.8% to 72.5% on the bunny.)
+  // see close_cracks), as the growth's hop rule does for the placements. (The vertex distance,
+  // coarser, leaves more ties to the edge ids, which a removal renumbers: it cut the bit-identical
+  // share of the stability test from 88.8% to 72.5% on the bunny.)
   uint64_t key(uint32_t e) const {
     const uint32_t d = std::min(shared_.face_distance[e / 3], shared_.face_distance[opposite_[e] / 3]);
     return (uint64_t{d} << 32) | e;

@@ -12,7 +12,6 @@
 #include <cmath>
 #include <functional>
 #include <string>
-#include <thread>
 
 #include "internal/huge_pages.h"
 #include "internal/parallel_chunks.h"
@@ -180,7 +179,7 @@ Status compute_orientation(const Mesh& mesh, const Topology& topology, const Ori
     frames.anchor[2 * f] = static_cast<float>(dot(p0, o));
     frames.anchor[2 * f + 1] = static_cast<float>(dot(p0, p));
   };
-  // Faces are independent here: large meshes are split into one contiguous range per thread
+  // Faces are independent here: they are cut into fixed chunks shared out among the threads
   // (each writes only its own faces; counters are summed after), so the result is the same
   // bit for bit whatever the thread count.
   auto frame_faces = [&](size_t begin, size_t end, size_t& degenerate_faces, size_t& fallback_faces) {
@@ -212,22 +211,14 @@ Status compute_orientation(const Mesh& mesh, const Topology& topology, const Ori
     }
   };
   const size_t threads = internal::parallel_threads(face_count, options.threads);
-  std::vector<size_t> degenerate_count(threads, 0), fallback_count(threads, 0);
-  if (threads == 1) {
-    frame_faces(0, face_count, degenerate_count[0], fallback_count[0]);
-  } else {
-    std::vector<std::thread> workers;
-    workers.reserve(threads - 1);
-    auto range = [&](size_t t) { return face_count * t / threads; };
-    for (size_t t = 1; t < threads; ++t)
-      workers.emplace_back(frame_faces, range(t), range(t + 1), std::ref(degenerate_count[t]),
-                           std::ref(fallback_count[t]));
-    frame_faces(0, range(1), degenerate_count[0], fallback_count[0]);
-    for (std::thread& w : workers) w.join();
-  }
-  for (size_t t = 0; t < threads; ++t) {
-    frames.degenerate_faces += static_cast<uint32_t>(degenerate_count[t]);
-    frames.fallback_faces += static_cast<uint32_t>(fallback_count[t]);
+  std::vector<size_t> degenerate_count(internal::chunk_count(face_count), 0),
+      fallback_count(internal::chunk_count(face_count), 0);
+  internal::for_each_chunk(face_count, threads, [&](size_t begin, size_t end, size_t chunk) {
+    frame_faces(begin, end, degenerate_count[chunk], fallback_count[chunk]);
+  });
+  for (size_t c = 0; c < degenerate_count.size(); ++c) {
+    frames.degenerate_faces += static_cast<uint32_t>(degenerate_count[c]);
+    frames.fallback_faces += static_cast<uint32_t>(fallback_count[c]);
   }
 
   // === Optional smoothing: Jacobi passes (double-buffered, so the result is order independent) ===
