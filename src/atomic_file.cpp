@@ -81,10 +81,11 @@ Status AtomicFileWriter::write(std::span<const char> bytes) {
 Status AtomicFileWriter::commit() {
   if (!error_.is_ok()) return error_;
   if (!file_) return fail(EBADF);
-  const bool flushed = std::fflush(file_) == 0;
-  const bool closed = std::fclose(file_) == 0;
+  // The first failure's errno: fclose sets its own (or none) after a failed fflush.
+  int write_error = std::fflush(file_) == 0 ? 0 : (errno != 0 ? errno : EIO);
+  if (std::fclose(file_) != 0 && write_error == 0) write_error = errno != 0 ? errno : EIO;
   file_ = nullptr;
-  if (!flushed || !closed) return fail(errno);
+  if (write_error != 0) return fail(write_error);
   std::string tmp;
   tmp.swap(temporary_);  // from here on the batch or the rename owns the temporary file
   if (active_batch) {

@@ -370,8 +370,9 @@ class CrackCloser {
   // the edge's nearer face in edge steps, then the edge id). Why this order: zips overlap along a
   // crack and between neighbouring cracks, so each depends on those before it; with the seed's
   // neighbourhood first, removing part of the mesh (far from the seed, as in the stability test)
-  // changes only zips processed after it (and, through the band schedule, up to two bands nearer:
-  // see close_cracks), as the growth's hop rule does for the placements. (The vertex distance,
+  // changes only zips processed after it (and zips beside the band boundaries that move where the
+  // removal lengthens the seed distances: see close_cracks), as the growth's hop rule does for the
+  // placements. (The vertex distance,
   // coarser, leaves more ties to the edge ids, which a removal renumbers: it cut the bit-identical
   // share of the stability test from 88.8% to 72.5% on the bunny.)
   uint64_t key(uint32_t e) const {
@@ -914,6 +915,13 @@ class CrackCloser {
 // once (each in key order, largest first, each by the next free worker), then 1, 4, 7... and
 // 2, 5, 8..., and again while zips queue edges into bands already done. The result depends on the
 // bands only, not on which worker zipped which band nor on how many workers there were.
+// Stability: where removing part of a mesh lengthens the seed distances (behind the hole), the
+// band boundaries move with them and the zips beside a boundary change order. That, not the
+// phase order, costs the stability test's bit-identical share 9 points on fertility and the bunny
+// (bands in seed order without phases lose the same; bands 2x / 4x wider lose 5 / 2 on the bunny,
+// with less parallelism). Cubes fixed in space (coloured modulo 3) kept the bunny's share but, run
+// colour by colour, lost 55 points on spot; and any Lipschitz bound in space comes from the
+// longest edge, an outlier on scans (the bunny would be one band). docs/mapping.md, section 2.
 Status close_cracks(const MappingInput& input, const ProgressCallback& progress, Atlas& atlas, uint64_t& zipped) {
   zipped = 0;
   const size_t face_count = input.mesh.face_count();
