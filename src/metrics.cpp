@@ -69,25 +69,38 @@ double angle2(double ax, double ay, double bx, double by) {
   return std::atan2(std::abs(ax * by - ay * bx), ax * bx + ay * by);
 }
 
-// sum_k |angle_uv_k - angle_3d_k| in degrees. A triangle's interior angles sum to pi, in 3D and in
-// UV alike, so two atan2 per triangle give the third (atan2 is most of the metrics' time); not
-// when a UV edge has zero length, where the angles at its ends are atan2(0, 0) = 0.
+// sum_k |angle_uv_k - angle_3d_k| in degrees. Each difference comes from one atan2 of the two
+// angles' sine and cosine products: angle_uv - angle_3d = atan2(c2 d3 - d2 c3, d2 d3 + c2 c3) for
+// angles atan2(c, d) in [0, pi], where the difference lies within (-pi, pi). A triangle's interior
+// angles sum to pi, in 3D and in UV alike, so the third corner's difference is minus the sum of the
+// other two: two atan2 per triangle (atan2 is most of the metrics' time). Not when a UV edge has
+// zero length, where the UV angles at its ends are atan2(0, 0) = 0: there, all six angles.
 double angle_distortion_deg(const Face& face) {
-  double a3[3], a2[3];
   bool zero_uv_edge = false;
   for (int k = 0; k < 3; ++k) {
     const int i = (k + 1) % 3;
     zero_uv_edge = zero_uv_edge || (face.u[i] == face.u[k] && face.v[i] == face.v[k]);
   }
-  const int computed = zero_uv_edge ? 3 : 2;
-  for (int k = 0; k < computed; ++k) {
-    const int i = (k + 1) % 3, j = (k + 2) % 3;
-    a3[k] = angle3(sub(face.p[i], face.p[k]), sub(face.p[j], face.p[k]));
-    a2[k] = angle2(face.u[i] - face.u[k], face.v[i] - face.v[k], face.u[j] - face.u[k], face.v[j] - face.v[k]);
+  double sum = 0.;
+  if (zero_uv_edge) {
+    for (int k = 0; k < 3; ++k) {
+      const int i = (k + 1) % 3, j = (k + 2) % 3;
+      sum += std::abs(angle2(face.u[i] - face.u[k], face.v[i] - face.v[k], face.u[j] - face.u[k], face.v[j] - face.v[k]) -
+                      angle3(sub(face.p[i], face.p[k]), sub(face.p[j], face.p[k])));
+    }
+  } else {
+    double difference[2];
+    for (int k = 0; k < 2; ++k) {
+      const int i = (k + 1) % 3, j = (k + 2) % 3;
+      const Vec3 a = sub(face.p[i], face.p[k]), b = sub(face.p[j], face.p[k]);
+      const double c3 = norm(cross(a, b)), d3 = dot(a, b);
+      const double ax = face.u[i] - face.u[k], ay = face.v[i] - face.v[k];
+      const double bx = face.u[j] - face.u[k], by = face.v[j] - face.v[k];
+      const double c2 = std::abs(ax * by - ay * bx), d2 = ax * bx + ay * by;
+      difference[k] = std::atan2(c2 * d3 - d2 * c3, d2 * d3 + c2 * c3);
+    }
+    sum = std::abs(difference[0]) + std::abs(difference[1]) + std::abs(difference[0] + difference[1]);
   }
-  double sum = std::abs(a2[0] - a3[0]) + std::abs(a2[1] - a3[1]);
-  // pi - a2[0] - a2[1] - (pi - a3[0] - a3[1])
-  sum += zero_uv_edge ? std::abs(a2[2] - a3[2]) : std::abs((a3[0] + a3[1]) - (a2[0] + a2[1]));
   return sum * (180.0 / std::numbers::pi);
 }
 
