@@ -25,7 +25,10 @@ const std::string& subdivided_horse_ply_path();
 //! subdivided_horse() as ascii OBJ (`v x y z` with %.9g, `f a b c`).
 const std::string& subdivided_horse_obj_path();
 
-//! Sets the "Mfaces/s" rate counter every benchmark reports: `faces` per iteration.
+//! Sets the "Mfaces/s" rate counter every benchmark reports: `faces` per iteration. A rate divides
+//! by the benchmark's time, which is the calling thread's CPU time unless the benchmark is
+//! registered with UseRealTime(): every benchmark of code that may start threads must be (without
+//! it, the threaded crack closing's rates came out 10-40 % too high).
 inline void set_faces_rate(benchmark::State& state, size_t faces) {
   state.counters["Mfaces/s"] = benchmark::Counter(
       static_cast<double>(state.iterations()) * static_cast<double>(faces) * 1e-6, benchmark::Counter::kIsRate);
