@@ -69,6 +69,11 @@ constexpr float kEscalateAbove = 1.5f;
 constexpr int kIterations = 12;
 constexpr float kSettledPx = 0.05f;
 constexpr int kAbortAt = 5;
+// Successive over-relaxation of the Gauss-Seidel sweep: each free UV moves 1.2x of the way to its
+// weighted mean. Within the same iterations more zips settle within the bound: mean seam length
+// over the 16 shared meshes 6.43 -> 6.34% (13 lower, 2 higher; bunny 4.04 -> 3.90%, spot 6.72 ->
+// 6.30%) for the same instructions; 1.3-1.4 gained little more, 1.6 raised the seams again.
+constexpr float kOverRelaxation = 1.2f;
 // Reweighting: a face's weight is multiplied by 1 + (distortion / bound)^2 after each iteration.
 // Without it the distortion peaks at the zipped vertex (uniform ARAP) and 40 % fewer zips pass.
 // A zipped face must also keep its area within 1/(1 + kAreaBound)..1 + kAreaBound of the
@@ -233,8 +238,9 @@ struct alignas(16) Term {
                 // of u and v read them as pairs)
 };
 
-// One Gauss-Seidel sweep: each free wedge (in order) moved to the weighted mean of the positions
-// its faces' other corners predict, from the records of fit_rotations. free_wedge: the free
+// One Gauss-Seidel sweep: each free wedge (in order) moved towards the weighted mean of the
+// positions its faces' other corners predict, from the records of fit_rotations (over-relaxed by
+// kOverRelaxation). free_wedge: the free
 // wedges' offsets in pos; term_end: the end of each one's terms. Returns the largest move
 // (|du| + |dv|, pixels).
 TAILOR_AVX_CLONES float sweep(size_t free_count, const uint32_t* free_wedge, const uint32_t* term_end,
@@ -272,7 +278,8 @@ TAILOR_AVX_CLONES float sweep(size_t free_count, const uint32_t* free_wedge, con
 #endif
     const float inv = 0.5f / sw;
     float* target = pos + free_wedge[k];
-    const float u = su * inv, v = sv * inv;
+    const float u = target[0] + kOverRelaxation * (su * inv - target[0]);
+    const float v = target[1] + kOverRelaxation * (sv * inv - target[1]);
     moved = std::max(moved, std::abs(u - target[0]) + std::abs(v - target[1]));
     target[0] = u;
     target[1] = v;
