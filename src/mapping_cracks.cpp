@@ -924,9 +924,9 @@ class CrackCloser {
 // bands only, not on which worker zipped which band nor on how many workers there were.
 // Stability: where removing part of a mesh lengthens the seed distances (behind the hole), the
 // band boundaries move with them and the zips beside a boundary change order. That, not the
-// phase order, costs the stability test's bit-identical share 9 points on fertility and the bunny
-// (bands in seed order without phases lose the same; bands 2x / 4x wider lose 5 / 2 on the bunny,
-// with less parallelism). Cubes fixed in space (coloured modulo 3) kept the bunny's share but, run
+// phase order, cost the stability test's bit-identical share 9 points on fertility and the bunny
+// (measured before the sweeps were over-relaxed; bands in seed order without phases lost the
+// same; bands 2x / 4x wider lost 5 / 2 on the bunny, with less parallelism). Cubes fixed in space (coloured modulo 3) kept the bunny's share but, run
 // colour by colour, lost 55 points on spot; and any Lipschitz bound in space comes from the
 // longest edge, an outlier on scans (the bunny would be one band). docs/mapping.md, section 2.
 Status close_cracks(const MappingInput& input, const ProgressCallback& progress, Atlas& atlas, uint64_t& zipped) {
