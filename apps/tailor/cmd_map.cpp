@@ -382,7 +382,7 @@ void register_map(CLI::App& app, Runner& run) {
   group->add_flag("--no-seam-shortening", opt->keep_seams,
                   "patches mode: keep the seams as the growth left them (no re-placing of faces along them)");
   group->add_flag("--no-crack-closing", opt->keep_cracks,
-                  "patches mode: leave the cracks (cuts inside a patch) open; 3-8x faster mapping, about twice the seam "
+                  "patches mode: leave the cracks (cuts inside a patch) open; 3-10x faster mapping, about twice the seam "
                   "length");
   group->add_option("--crack-rings", opt->crack_rings,
                     "patches mode: effort of the crack closing, the largest region (rings of faces) a zip may "
@@ -417,7 +417,7 @@ void register_map(CLI::App& app, Runner& run) {
       "  tailor map bunny.ply --texture gravel_tile.png -o bunny.glb --stats bunny.json --preview bunny.png\n"
       "Prints one summary line: faces, patches, seam length, flipped faces, stretch, Sander L2/Linf,\n"
       "median angle distortion, seam gap, and the time of each stage.\n"
-      "Trade-offs: --no-crack-closing maps 3-8x faster and keeps more UVs bit-identical when parts of\n"
+      "Trade-offs: --no-crack-closing maps 3-10x faster and keeps more UVs bit-identical when parts of\n"
       "the mesh change, with about twice the seam length; --field-following 0 --crack-rings 32 gives the\n"
       "fewest seams (one patch per component) for stochastic textures whose direction does not matter.");
   cmd->callback([&run, opt] { run = [opt] { return run_map(*opt); }; });

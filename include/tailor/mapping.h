@@ -83,7 +83,7 @@ struct MappingOptions {
                                     //!< 6-11% less seam length on the shared meshes, docs/mapping.md)
   bool close_cracks = true;         //!< last, zip cracks (seams inside one patch) shut from their tips, spreading
                                     //!< each gap over the faces around it within max_stretch (ARAP relaxation):
-                                    //!< 30-55% less seam length, mapping 3-8x slower (docs/mapping.md)
+                                    //!< 23-57% less seam length on scans, mapping 3-10x slower (docs/mapping.md)
   uint32_t crack_rings = 16;        //!< effort of the crack closing (2..64): the largest region a zip relaxes, in
                                     //!< rings of faces around it (a first try takes crack_rings / 2 rings per unit
                                     //!< of gap / edge length); more closes wider gaps and takes longer
@@ -129,7 +129,7 @@ struct MappingStats {
 //! seam_faces of the wrong size, a non-finite seed point), kInvalidMesh when frames/topology do not
 //! match the mesh, kCancelled when the progress callback returns false (the atlas is then empty).
 //! Cost: the growth O(F log front) time; the crack closing O(F) plus, per crack vertex tried, a
-//! relaxation of O(crack_rings^2) faces (in practice 3-8x the growth; vertices of valence > 64 are
+//! relaxation of O(crack_rings^2) faces (in practice 3-10x the growth; vertices of valence > 64 are
 //! not zipped, so a huge fan cannot make it quadratic); O(F + V) memory, allocated before the loops
 //! (the atlas's capacity is reused). Deterministic, the same bits with or without SIMD. Safe for
 //! any mesh that passed finalize_mesh (non-manifold and inconsistent edges act as boundaries).
