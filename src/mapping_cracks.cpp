@@ -240,9 +240,8 @@ struct alignas(16) Term {
 
 // One Gauss-Seidel sweep: each free wedge (in order) moved towards the weighted mean of the
 // positions its faces' other corners predict, from the records of fit_rotations (over-relaxed by
-// kOverRelaxation). free_wedge: the free
-// wedges' offsets in pos; term_end: the end of each one's terms. Returns the largest move
-// (|du| + |dv|, pixels).
+// kOverRelaxation). free_wedge: the free wedges' offsets in pos; term_end: the end of each one's
+// terms. Returns the largest move (|du| + |dv|, pixels).
 TAILOR_AVX_CLONES float sweep(size_t free_count, const uint32_t* free_wedge, const uint32_t* term_end,
                               const Term* terms, const float* record, float* pos) {
   float moved = 0.f;
@@ -379,9 +378,9 @@ class CrackCloser {
   // neighbourhood first, removing part of the mesh (far from the seed, as in the stability test)
   // changes only zips processed after it (and zips beside the band boundaries that move where the
   // removal lengthens the seed distances: see close_cracks), as the growth's hop rule does for the
-  // placements. (The vertex distance,
-  // coarser, leaves more ties to the edge ids, which a removal renumbers: it cut the bit-identical
-  // share of the stability test from 88.8% to 72.5% on the bunny.)
+  // placements. (The vertex distance, coarser, leaves more ties to the edge ids, which a removal
+  // renumbers: it cut the bit-identical share of the stability test from 88.8% to 72.5% on the
+  // bunny.)
   uint64_t key(uint32_t e) const {
     const uint32_t d = std::min(shared_.face_distance[e / 3], shared_.face_distance[opposite_[e] / 3]);
     return (uint64_t{d} << 32) | e;
@@ -926,9 +925,10 @@ class CrackCloser {
 // band boundaries move with them and the zips beside a boundary change order. That, not the
 // phase order, cost the stability test's bit-identical share 9 points on fertility and the bunny
 // (measured before the sweeps were over-relaxed; bands in seed order without phases lost the
-// same; bands 2x / 4x wider lost 5 / 2 on the bunny, with less parallelism). Cubes fixed in space (coloured modulo 3) kept the bunny's share but, run
-// colour by colour, lost 55 points on spot; and any Lipschitz bound in space comes from the
-// longest edge, an outlier on scans (the bunny would be one band). docs/mapping.md, section 2.
+// same; bands 2x / 4x wider lost 5 / 2 on the bunny, with less parallelism). Cubes fixed in space
+// (coloured modulo 3) kept the bunny's share but, run colour by colour, lost 55 points on spot;
+// and any Lipschitz bound in space comes from the longest edge, an outlier on scans (the bunny
+// would be one band). docs/mapping.md, section 2.
 Status close_cracks(const MappingInput& input, const ProgressCallback& progress, Atlas& atlas, uint64_t& zipped) {
   zipped = 0;
   const size_t face_count = input.mesh.face_count();

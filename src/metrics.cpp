@@ -85,8 +85,9 @@ double angle_distortion_deg(const Face& face) {
   if (zero_uv_edge) {
     for (int k = 0; k < 3; ++k) {
       const int i = (k + 1) % 3, j = (k + 2) % 3;
-      sum += std::abs(angle2(face.u[i] - face.u[k], face.v[i] - face.v[k], face.u[j] - face.u[k], face.v[j] - face.v[k]) -
-                      angle3(sub(face.p[i], face.p[k]), sub(face.p[j], face.p[k])));
+      const double uv =
+          angle2(face.u[i] - face.u[k], face.v[i] - face.v[k], face.u[j] - face.u[k], face.v[j] - face.v[k]);
+      sum += std::abs(uv - angle3(sub(face.p[i], face.p[k]), sub(face.p[j], face.p[k])));
     }
   } else {
     double difference[2];
