@@ -941,14 +941,16 @@ Status close_cracks(const MappingInput& input, const ProgressCallback& progress,
 
   const uint32_t band_steps = std::max<uint32_t>(input.options.crack_rings, kMinRings) + kZoneSteps;
   const uint32_t* opposite = input.topology.opposite.data();
-  std::vector<std::vector<uint64_t>> heaps;
+  std::vector<std::vector<uint64_t>> heaps;  // per band: keys (the edge in the low 32 bits)
+  auto add_to_band = [&](uint64_t key) {
+    const uint32_t band = first.band_of(static_cast<uint32_t>(key), band_steps);
+    if (band >= heaps.size()) heaps.resize(band + 1);
+    heaps[band].push_back(key);
+  };
   size_t initial = 0;
   for (uint32_t e = 0; e < 3 * face_count; ++e) {
     if (!(e < opposite[e] && first.is_crack(e))) continue;  // each crack edge once
-    const uint64_t key = first.key(e);
-    const uint32_t band = first.band_of(e, band_steps);
-    if (band >= heaps.size()) heaps.resize(band + 1);
-    heaps[band].push_back(key);
+    add_to_band(first.key(e));
     shared.queued[e] = 1;
     ++initial;
   }
@@ -1013,11 +1015,7 @@ Status close_cracks(const MappingInput& input, const ProgressCallback& progress,
       if (shared.cancelled.load()) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
       // Edges queued into other bands: a heap's pops depend only on its set of (unique) keys.
       for (std::vector<uint64_t>& outbox : outboxes) {
-        for (const uint64_t key : outbox) {
-          const uint32_t band = first.band_of(static_cast<uint32_t>(key), band_steps);
-          if (band >= heaps.size()) heaps.resize(band + 1);
-          heaps[band].push_back(key);
-        }
+        for (const uint64_t key : outbox) add_to_band(key);
         outbox.clear();
       }
     }
