@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "internal/atomic_file.h"
-#include "internal/flat_hash.h"
+#include "util/atomic_file.h"
+#include "util/flat_hash.h"
 #include "tailor/io.h"
 
 namespace {

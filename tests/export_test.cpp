@@ -21,7 +21,7 @@
 #include <string_view>
 #include <tuple>
 
-#include "internal/atomic_file.h"
+#include "util/atomic_file.h"
 #include "tailor/export.h"
 #include "tailor/gltf.h"
 #include "tailor/io.h"

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "internal/atomic_file.h"
+#include "util/atomic_file.h"
 #include "tailor/image.h"
 #include "tailor/image_ops.h"
 

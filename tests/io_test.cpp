@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "internal/atomic_file.h"
+#include "util/atomic_file.h"
 #include "tailor/io.h"
 
 namespace tailor {

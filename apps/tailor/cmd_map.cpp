@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.h"
-#include "internal/atomic_file.h"
+#include "util/atomic_file.h"
 #include "tailor/axis_choice.h"
 #include "tailor/export.h"
 #include "tailor/image.h"

@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.h"
-#include "internal/atomic_file.h"
+#include "util/atomic_file.h"
 #include "tailor/image.h"
 #include "tailor/tiling.h"
 

@@ -53,8 +53,9 @@ std::string extension_of(const std::string& path) {
   return ext;
 }
 
-//! The viewer's files: --web-root, else web/ next to or above the executable (build tree,
-//! install tree), else the source tree this binary was built from.
+//! The viewer's files: --web-root, else the installed share/tailor/web relative to the executable
+//! (any prefix: the tree can be moved), else the source tree this binary was built from (a build
+//! tree). web/ next to or above the executable is also tried, for a copied build.
 Status find_web_root(const std::string& given, std::string& root) {
   std::vector<std::string> candidates;
   if (!given.empty()) {
@@ -64,13 +65,11 @@ Status find_web_root(const std::string& given, std::string& root) {
     const ssize_t n = ::readlink("/proc/self/exe", exe.data(), exe.size() - 1);
     if (n > 0) {
       const std::string dir = dir_of(std::string(exe.data(), static_cast<size_t>(n)));
+      candidates.push_back(dir + "/" TAILOR_INSTALLED_DATA_DIR "/web");
       candidates.push_back(dir + "/web");
       candidates.push_back(dir + "/../web");
-      candidates.push_back(dir + "/../share/tailor/web");
     }
-#ifdef TAILOR_SOURCE_DIR
-    candidates.push_back(std::string(TAILOR_SOURCE_DIR) + "/web");
-#endif
+    candidates.push_back(TAILOR_SOURCE_WEB_DIR);
   }
   for (const std::string& dir : candidates) {
     if (!file_exists(dir + "/index.html")) continue;

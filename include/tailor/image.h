@@ -34,6 +34,10 @@ struct ImageF {
 //! Largest width or height accepted by the readers (absurd sizes are rejected before decoding).
 inline constexpr int kMaxImageSide = 16384;
 
+//! Checks that an Image is consistent: 1 <= width, height <= kMaxImageSide, 1 <= channels <= 4
+//! and pixels.size() == width * height * channels. Fails with kInvalidImage saying which.
+Status check_image(const Image& image);
+
 //! Reads PNG (8 or 16 bit; 16-bit is reduced to 8), JPEG, TGA or BMP with 1-4 channels.
 Status load_image(const std::string& path, Image& image);
 

@@ -1,18 +1,14 @@
-// tailor: small operations on the images of image.h (conversions, validation, resizing).
+// tailor: small operations on the images of image.h (conversions, resizing).
 //
 // All functions take the layout documented in image.h: row-major, top row first, `channels`
 // interleaved samples per pixel, sample (x, y, c) at index (y * width + x) * channels + c.
 // None of them prints, throws or keeps state; all are safe on untrusted Image structs once
-// check_image() accepted them.
+// check_image() (image.h) accepted them.
 #pragma once
 
 #include "tailor/image.h"
 
 namespace tailor {
-
-//! Checks that an Image is consistent: 1 <= width, height <= kMaxImageSide, 1 <= channels <= 4
-//! and pixels.size() == width * height * channels. Fails with kInvalidImage saying which.
-Status check_image(const Image& image);
 
 //! 8-bit -> float: every sample divided by 255 (so samples lie in [0, 1]). Same layout. Cost O(n).
 ImageF to_float(const Image& image);

@@ -121,6 +121,11 @@ struct MappingStats {
   double seconds = 0.0;             //!< wall time of map_texture
 };
 
+//! Seed face of every edge component: the face whose centroid is nearest to the seed point (the
+//! option, or the centre of the bounding box), components ordered by that distance (then id).
+std::vector<uint32_t> component_seed_faces(const Mesh& mesh, const Topology& topology, const FaceFrames& frames,
+                                           const MappingOptions& options);
+
 //! Maps the texture: fills atlas.corner_uv (#F*3 by 2, pixels), atlas.patch (#F) and
 //! atlas.patch_count; every face is placed and every UV is finite.
 //! Preconditions: topology = build_topology(mesh), frames = compute_orientation(mesh, topology, ...).

@@ -1,0 +1,204 @@
+// export_mesh: validation, vertex splitting and normals shared by the .glb, .obj and .ply writers.
+#include "tailor/export.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+
+#include "util/simd.h"
+
+#include "util/atomic_file.h"
+#include "export/writers.h"
+#include "util/huge_pages.h"
+#include "util/parallel_chunks.h"
+
+namespace tailor {
+namespace internal {
+
+Status read_texture_bytes(const std::string& path, std::string& bytes, std::string& mime_type) {
+  TAILOR_RETURN_IF_ERROR(read_file(path, bytes));
+  static constexpr unsigned char kPng[8] = {0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a};
+  static constexpr unsigned char kJpeg[3] = {0xff, 0xd8, 0xff};
+  if (bytes.size() >= sizeof kPng && std::memcmp(bytes.data(), kPng, sizeof kPng) == 0) {
+    mime_type = "image/png";
+  } else if (bytes.size() >= sizeof kJpeg && std::memcmp(bytes.data(), kJpeg, sizeof kJpeg) == 0) {
+    mime_type = "image/jpeg";
+  } else {
+    bytes.clear();
+    return Status::error(ErrorCode::kInvalidImage, path, "texture is neither PNG nor JPEG");
+  }
+  return Status::ok();
+}
+
+void append_float(std::string& out, float value) {
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  out.append(buffer, result.ptr);
+}
+
+// Path of `target` relative to `base_dir` when one exists, else `target` as given (absolute).
+std::string relative_path(const std::string& target, const std::filesystem::path& base_dir) {
+  std::error_code error;
+  const std::filesystem::path absolute_target = std::filesystem::absolute(target, error);
+  if (error) return target;
+  const std::filesystem::path absolute_base = std::filesystem::absolute(base_dir.empty() ? "." : base_dir, error);
+  if (error) return absolute_target.string();
+  const std::filesystem::path relative = absolute_target.lexically_normal().lexically_relative(absolute_base.lexically_normal());
+  return relative.empty() ? absolute_target.string() : relative.generic_string();
+}
+
+
+}  // namespace internal
+
+namespace {
+
+enum class ExportFormat { kUnknown, kGlb, kObj, kPly };
+
+ExportFormat export_format(const std::string& path) {
+  const size_t dot = path.find_last_of('.');
+  const size_t slash = path.find_last_of('/');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return ExportFormat::kUnknown;
+  std::string ext = path.substr(dot + 1);
+  for (char& c : ext) c = static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
+  if (ext == "glb") return ExportFormat::kGlb;
+  if (ext == "obj") return ExportFormat::kObj;
+  if (ext == "ply") return ExportFormat::kPly;
+  return ExportFormat::kUnknown;
+}
+
+// Area-weighted normals per source vertex (the unnormalised face normal is 2 * area * n), so that
+// shading stays smooth across UV seams. Isolated or degenerate vertices get +z.
+void vertex_normals(const Mesh& mesh, std::vector<float>& normals) {
+  const size_t nv = mesh.vertex_count();
+  // calloc'd: fresh pages come zeroed from the kernel, a vector would zero them again.
+  const internal::HugeArray<double> sum_array = internal::huge_zeroed<double>(3 * nv);
+  double* sum = sum_array.get();
+  const float* positions = mesh.positions.data();
+  const uint32_t* indices = mesh.indices.data();
+  for (size_t f = 0; f < mesh.face_count(); ++f) {
+    const uint32_t* t = &indices[3 * f];
+    const float* a = &positions[3 * size_t{t[0]}];
+    const float* b = &positions[3 * size_t{t[1]}];
+    const float* c = &positions[3 * size_t{t[2]}];
+#if TAILOR_SSE2
+    // The scalar code below with x and y in one register: the same IEEE operations in the same
+    // order per component, so the same bits, in about half the instructions.
+    auto load_xy = [](const float* p) { return _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)))); };
+    auto load_z = [](const float* p) { return _mm_cvtss_sd(_mm_setzero_pd(), _mm_load_ss(p + 2)); };
+    const __m128d a_xy = load_xy(a), a_z = load_z(a);
+    const __m128d e1_xy = _mm_sub_pd(load_xy(b), a_xy), e1_z = _mm_sub_sd(load_z(b), a_z);
+    const __m128d e2_xy = _mm_sub_pd(load_xy(c), a_xy), e2_z = _mm_sub_sd(load_z(c), a_z);
+    // (n0, n1) = (e1y, e1z) * (e2z, e2x) - (e1z, e1x) * (e2y, e2z); n2 = e1x * e2y - e1y * e2x.
+    const __m128d n_xy = _mm_sub_pd(_mm_mul_pd(_mm_shuffle_pd(e1_xy, e1_z, 1), _mm_shuffle_pd(e2_z, e2_xy, 0)),
+                                    _mm_mul_pd(_mm_shuffle_pd(e1_z, e1_xy, 0), _mm_shuffle_pd(e2_xy, e2_z, 1)));
+    const __m128d n_z = _mm_sub_sd(_mm_mul_sd(e1_xy, _mm_unpackhi_pd(e2_xy, e2_xy)),
+                                   _mm_mul_sd(_mm_unpackhi_pd(e1_xy, e1_xy), e2_xy));
+    for (int k = 0; k < 3; ++k) {  // one vertex at a time: a face may repeat a vertex
+      double* s = &sum[3 * size_t{t[k]}];
+      _mm_storeu_pd(s, _mm_add_pd(_mm_loadu_pd(s), n_xy));
+      _mm_store_sd(s + 2, _mm_add_sd(_mm_load_sd(s + 2), n_z));
+    }
+#else
+    const double e1[3] = {double{b[0]} - a[0], double{b[1]} - a[1], double{b[2]} - a[2]};
+    const double e2[3] = {double{c[0]} - a[0], double{c[1]} - a[1], double{c[2]} - a[2]};
+    const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+    for (int k = 0; k < 3; ++k)
+      for (int i = 0; i < 3; ++i) sum[3 * size_t{t[k]} + i] += n[i];
+#endif
+  }
+  internal::reserve_huge(normals, 3 * nv);
+  normals.resize(3 * nv);
+  for (size_t v = 0; v < nv; ++v) {
+    const double* n = &sum[3 * v];
+    const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (length > 0 && std::isfinite(length)) {
+      for (int i = 0; i < 3; ++i) normals[3 * v + i] = static_cast<float>(n[i] / length);
+    } else {
+      normals[3 * v] = 0;
+      normals[3 * v + 1] = 0;
+      normals[3 * v + 2] = 1;
+    }
+  }
+}
+
+// True when every corner's vertex index is < vertex_count().
+bool indices_in_range(const Mesh& mesh) {
+  const uint32_t* idx = mesh.indices.data();
+  const size_t n = mesh.indices.size();
+  const size_t nv = mesh.vertex_count();
+  if (nv == 0) return n == 0;
+  if (nv > std::numeric_limits<uint32_t>::max()) return true;
+  uint32_t largest = 0;
+  for (size_t c = 0; c < n; ++c) largest = std::max(largest, idx[c]);
+  return largest < nv;
+}
+
+// True when no coordinate is inf or NaN (all exponent bits set).
+bool positions_finite(const Mesh& mesh) {
+  const float* pos = mesh.positions.data();
+  const size_t n = mesh.positions.size();
+  uint32_t any = 0;
+  for (size_t i = 0; i < n; ++i) {
+    uint32_t bits;
+    std::memcpy(&bits, pos + i, 4);
+    any |= static_cast<uint32_t>((bits & 0x7f800000u) == 0x7f800000u);
+  }
+  return any == 0;
+}
+
+// Faces from which the normals get their own thread (below, starting it costs more than it saves).
+constexpr size_t kThreadedFaces = 100000;
+
+}  // namespace
+
+Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas, const ExportOptions& options) {
+  const ExportFormat format = export_format(path);
+  if (format == ExportFormat::kUnknown)
+    return Status::error(ErrorCode::kInvalidArgument, path, "unsupported output format (use .glb, .obj or .ply)");
+  const size_t nf = mesh.face_count();
+  if (nf == 0) return Status::error(ErrorCode::kInvalidArgument, path, "mesh has no face to export");
+  if (atlas.corner_uv.size() != 6 * nf)
+    return Status::error(ErrorCode::kInvalidArgument, path, "atlas does not match the mesh",
+                         std::to_string(atlas.corner_uv.size()) + " UV floats for " + std::to_string(nf) + " faces");
+  if (options.texture_width <= 0 || options.texture_height <= 0)
+    return Status::error(ErrorCode::kInvalidArgument, path, "texture size must be positive");
+  // Branch-free scans first (they vectorize); the exact culprit is looked for only on failure.
+  if (!indices_in_range(mesh)) {
+    for (size_t c = 0; c < mesh.indices.size(); ++c)
+      if (mesh.indices[c] >= mesh.vertex_count())
+        return Status::error(ErrorCode::kInvalidArgument, path, "vertex index out of range", "corner " + std::to_string(c));
+  }
+  if (!positions_finite(mesh)) {
+    for (size_t i = 0; i < mesh.positions.size(); ++i)
+      if (!std::isfinite(mesh.positions[i]))
+        return Status::error(ErrorCode::kInvalidArgument, path, "position is not finite", "vertex " + std::to_string(i / 3));
+  }
+
+  // Pixels -> texture repeats, OBJ convention (t up); the glTF writer flips t itself. Scaled on the
+  // fly inside the split (no array of repeats), which also finds the first non-finite UV.
+  // The normals need only the mesh: on large meshes a second thread computes them during the split
+  // (both results are the same whichever thread runs them).
+  internal::ExportData data;
+  data.mesh = &mesh;
+  const bool want_normals = options.normals && format != ExportFormat::kPly;
+  const double su = 1.0 / options.texture_width, sv = 1.0 / options.texture_height;
+  size_t bad_corner = internal::kNoBadCorner;
+  internal::run_beside(
+      want_normals && nf >= kThreadedFaces, [&] { if (want_normals) vertex_normals(mesh, data.normals); },
+      [&] { bad_corner = internal::split_vertices_scaled(mesh, atlas.corner_uv, su, sv, data.split); });
+  if (bad_corner != internal::kNoBadCorner)
+    return Status::error(ErrorCode::kInvalidArgument, path, "UV is not finite", "corner " + std::to_string(bad_corner));
+
+  switch (format) {
+    case ExportFormat::kGlb: return internal::write_glb(path, data, options);
+    case ExportFormat::kObj: return internal::write_obj(path, data, options);
+    case ExportFormat::kPly: return internal::write_ply(path, data, options);
+    case ExportFormat::kUnknown: break;
+  }
+  return Status::error(ErrorCode::kInvalidArgument, path, "unsupported output format");
+}
+
+}  // namespace tailor

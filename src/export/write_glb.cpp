@@ -1,0 +1,209 @@
+// Binary glTF 2.0 writer (.glb): one node, one mesh, one triangle primitive with POSITION (with
+// min/max), NORMAL (optional), TEXCOORD_0 and uint32 indices, one material whose base colour
+// texture is the given PNG/JPEG embedded byte for byte, sampled with REPEAT and trilinear
+// filtering. The JSON is built with nlohmann::json (keys sorted, so the output is deterministic)
+// rather than through tinygltf's writer, which would decode and re-encode the image.
+// Reference: the glTF 2.0 specification, sections 3.6 (buffers), 3.7 (geometry), 4.4 (GLB layout).
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <limits>
+#include <span>
+#include <vector>
+
+#include "util/atomic_file.h"
+#include "export/writers.h"
+
+namespace tailor::internal {
+namespace {
+
+// glTF enumerations (spec section 5).
+constexpr int kFloat = 5126;
+constexpr int kUnsignedInt = 5125;
+constexpr int kArrayBuffer = 34962;
+constexpr int kElementArrayBuffer = 34963;
+constexpr int kLinear = 9729;
+constexpr int kLinearMipmapLinear = 9987;
+constexpr int kRepeat = 10497;
+constexpr int kTriangles = 4;
+constexpr uint32_t kGlbMagic = 0x46546C67;  // "glTF"
+constexpr uint32_t kChunkJson = 0x4E4F534A;  // "JSON"
+constexpr uint32_t kChunkBin = 0x004E4942;   // "BIN\0"
+
+void append_u32(std::string& out, uint32_t value) {
+  static_assert(std::endian::native == std::endian::little, "glb writer assumes a little-endian host");
+  char bytes[4];
+  std::memcpy(bytes, &value, 4);
+  out.append(bytes, 4);
+}
+
+void pad_to_4(std::string& out, char fill) {
+  while (out.size() % 4 != 0) out.push_back(fill);
+}
+
+template <typename T>
+std::span<const char> bytes_of(const T* data, size_t count) {
+  static_assert(std::endian::native == std::endian::little, "glb writer assumes a little-endian host");
+  return {reinterpret_cast<const char*>(data), count * sizeof(T)};
+}
+
+// Streams `count` items of `floats_per_item` floats, each made by make(item, float* out), through
+// one small reusable buffer: the arrays gathered for the file are never held whole in memory.
+template <class Make>
+Status write_gathered(AtomicFileWriter& file, size_t count, size_t floats_per_item, Make&& make) {
+  constexpr size_t kChunkItems = 16384;
+  std::vector<float> chunk(kChunkItems * floats_per_item);
+  for (size_t begin = 0; begin < count; begin += kChunkItems) {
+    const size_t end = std::min(count, begin + kChunkItems);
+    float* out = chunk.data();
+    for (size_t i = begin; i < end; ++i, out += floats_per_item) make(i, out);
+    TAILOR_RETURN_IF_ERROR(file.write(bytes_of(chunk.data(), (end - begin) * floats_per_item)));
+  }
+  return Status::ok();
+}
+
+// Adds a buffer view over bin[offset, offset + length) and returns its index.
+size_t add_view(nlohmann::json& views, size_t offset, size_t length, int target) {
+  nlohmann::json view = {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", length}};
+  if (target != 0) view["target"] = target;
+  views.push_back(view);
+  return views.size() - 1;
+}
+
+}  // namespace
+
+Status write_glb(const std::string& path, const ExportData& data, const ExportOptions& options) {
+  const Mesh& mesh = *data.mesh;
+  const SplitMesh& split = data.split;
+  const size_t vertex_count = split.xref.size();
+  const size_t index_count = split.indices.size();
+  if (vertex_count > std::numeric_limits<uint32_t>::max() / 12 || index_count > std::numeric_limits<uint32_t>::max() / 4)
+    return Status::error(ErrorCode::kLimit, path, "mesh too large for a .glb buffer (4 GiB)");
+
+  std::string texture_bytes, mime_type;
+  if (!options.texture_path.empty())
+    TAILOR_RETURN_IF_ERROR(read_texture_bytes(options.texture_path, texture_bytes, mime_type));
+
+  // Split positions are source positions through xref, in split order (the order matters for
+  // min/max: -0 and +0 compare equal, the first one seen is kept).
+  const float* positions = mesh.positions.data();
+  float lo[3] = {std::numeric_limits<float>::max(), std::numeric_limits<float>::max(), std::numeric_limits<float>::max()};
+  float hi[3] = {-lo[0], -lo[1], -lo[2]};
+  for (size_t s = 0; s < vertex_count; ++s) {
+    const float* p = &positions[3 * size_t{split.xref[s]}];
+    for (int i = 0; i < 3; ++i) {
+      lo[i] = std::min(lo[i], p[i]);
+      hi[i] = std::max(hi[i], p[i]);
+    }
+  }
+
+  // The BIN chunk's layout: positions, normals (optional), texcoords, indices, texture. Every block
+  // is a multiple of 4 bytes long, so each starts 4-byte aligned.
+  const bool normals = !data.normals.empty();
+  size_t bin_size = 0;
+  nlohmann::json views = nlohmann::json::array(), accessors = nlohmann::json::array(), attributes;
+  {
+    const size_t view = add_view(views, bin_size, 12 * vertex_count, kArrayBuffer);
+    bin_size += 12 * vertex_count;
+    attributes["POSITION"] = accessors.size();
+    accessors.push_back({{"bufferView", view}, {"componentType", kFloat}, {"count", vertex_count}, {"type", "VEC3"},
+                         {"min", {lo[0], lo[1], lo[2]}}, {"max", {hi[0], hi[1], hi[2]}}});
+  }
+  if (normals) {
+    const size_t view = add_view(views, bin_size, 12 * vertex_count, kArrayBuffer);
+    bin_size += 12 * vertex_count;
+    attributes["NORMAL"] = accessors.size();
+    accessors.push_back({{"bufferView", view}, {"componentType", kFloat}, {"count", vertex_count}, {"type", "VEC3"}});
+  }
+  {
+    const size_t view = add_view(views, bin_size, 8 * vertex_count, kArrayBuffer);
+    bin_size += 8 * vertex_count;
+    attributes["TEXCOORD_0"] = accessors.size();
+    accessors.push_back({{"bufferView", view}, {"componentType", kFloat}, {"count", vertex_count}, {"type", "VEC2"}});
+  }
+  size_t indices_accessor = 0;
+  {
+    const size_t view = add_view(views, bin_size, 4 * index_count, kElementArrayBuffer);
+    bin_size += 4 * index_count;
+    indices_accessor = accessors.size();
+    accessors.push_back({{"bufferView", view}, {"componentType", kUnsignedInt}, {"count", index_count}, {"type", "SCALAR"}});
+  }
+
+  nlohmann::json pbr = {{"metallicFactor", 0.0}, {"roughnessFactor", 1.0}};
+  nlohmann::json gltf = {
+      {"asset", {{"version", "2.0"}, {"generator", "tailor"}}},
+      {"scene", 0},
+      {"scenes", {{{"nodes", {0}}}}},
+      {"nodes", {{{"mesh", 0}, {"name", "tailor"}}}},
+      {"materials", nlohmann::json::array()},
+      {"meshes", {{{"primitives", {{{"attributes", attributes}, {"indices", indices_accessor}, {"material", 0},
+                                    {"mode", kTriangles}}}}}}},
+  };
+  size_t texture_padding = 0;
+  if (!texture_bytes.empty()) {
+    if (texture_bytes.size() > std::numeric_limits<uint32_t>::max() - bin_size)
+      return Status::error(ErrorCode::kLimit, path, "texture too large for a .glb buffer");
+    const size_t view = add_view(views, bin_size, texture_bytes.size(), 0);
+    bin_size += texture_bytes.size();
+    texture_padding = (4 - bin_size % 4) % 4;
+    bin_size += texture_padding;
+    gltf["images"] = {{{"bufferView", view}, {"mimeType", mime_type}}};
+    gltf["samplers"] = {{{"magFilter", kLinear}, {"minFilter", kLinearMipmapLinear}, {"wrapS", kRepeat}, {"wrapT", kRepeat}}};
+    gltf["textures"] = {{{"sampler", 0}, {"source", 0}}};
+    pbr["baseColorTexture"] = {{"index", 0}};
+  }
+  gltf["materials"].push_back({{"name", "tailor"}, {"pbrMetallicRoughness", pbr}});
+  gltf["accessors"] = accessors;
+  gltf["bufferViews"] = views;
+  gltf["buffers"] = {{{"byteLength", bin_size}}};
+
+  // Strings may come from file names, which need not be UTF-8: replace, never throw.
+  std::string json = gltf.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  pad_to_4(json, ' ');
+  const size_t total = 12 + 8 + json.size() + 8 + bin_size;
+  if (total > std::numeric_limits<uint32_t>::max())
+    return Status::error(ErrorCode::kLimit, path, "output larger than the 4 GiB a .glb can hold");
+
+  // Header, JSON chunk and BIN chunk header in one small string; the rest goes straight from the
+  // split (indices, texture bytes) or through a small buffer (positions, normals, texcoords).
+  std::string head;
+  head.reserve(28 + json.size());
+  append_u32(head, kGlbMagic);
+  append_u32(head, 2);
+  append_u32(head, static_cast<uint32_t>(total));
+  append_u32(head, static_cast<uint32_t>(json.size()));
+  append_u32(head, kChunkJson);
+  head += json;
+  append_u32(head, static_cast<uint32_t>(bin_size));
+  append_u32(head, kChunkBin);
+
+  AtomicFileWriter file(path);
+  TAILOR_RETURN_IF_ERROR(file.open());
+  TAILOR_RETURN_IF_ERROR(file.write(head));
+  const uint32_t* xref = split.xref.data();
+  TAILOR_RETURN_IF_ERROR(write_gathered(file, vertex_count, 3, [&](size_t s, float* out) {
+    std::memcpy(out, &positions[3 * size_t{xref[s]}], 3 * sizeof(float));
+  }));
+  if (normals) {
+    const float* source = data.normals.data();
+    TAILOR_RETURN_IF_ERROR(write_gathered(file, vertex_count, 3, [&](size_t s, float* out) {
+      std::memcpy(out, &source[3 * size_t{xref[s]}], 3 * sizeof(float));
+    }));
+  }
+  // glTF's v axis points down the image: TEXCOORD_0 = (s, -t), the usual (s, 1 - t) shifted by a
+  // whole repeat (invisible with REPEAT) but exact, so a round trip is bit-exact (see export.h).
+  const float* uvs = split.uvs.data();
+  TAILOR_RETURN_IF_ERROR(write_gathered(file, vertex_count, 2, [&](size_t s, float* out) {
+    out[0] = uvs[2 * s];
+    out[1] = -uvs[2 * s + 1];
+  }));
+  TAILOR_RETURN_IF_ERROR(file.write(bytes_of(split.indices.data(), index_count)));
+  TAILOR_RETURN_IF_ERROR(file.write(texture_bytes));
+  static constexpr char kZeros[4] = {0, 0, 0, 0};
+  TAILOR_RETURN_IF_ERROR(file.write({kZeros, texture_padding}));
+  return file.commit();
+}
+
+}  // namespace tailor::internal

@@ -1,0 +1,102 @@
+// Wavefront OBJ writer: `v` per source vertex (so the reloaded mesh keeps its connectivity), `vt`
+// per split vertex (one per distinct (vertex, uv) pair, in texture repeats, t up), `vn` per source
+// vertex when normals are on, faces `f v/vt[/vn]` (1-based). With a texture, a <stem>.mtl next to
+// the .obj holds one material whose map_Kd is the texture path relative to the .obj's folder.
+// Numbers are written with std::to_chars (shortest text that reads back bit-exact).
+#include <filesystem>
+
+#include "util/atomic_file.h"
+#include "export/writers.h"
+
+namespace tailor::internal {
+namespace {
+
+void append_u32(std::string& out, uint32_t value) { out += std::to_string(value); }
+
+}  // namespace
+
+Status write_obj(const std::string& path, const ExportData& data, const ExportOptions& options) {
+  const Mesh& mesh = *data.mesh;
+  const SplitMesh& split = data.split;
+  const std::filesystem::path obj_path(path);
+  const bool textured = !options.texture_path.empty();
+  std::string mtl_name;
+
+  if (textured) {
+    std::string bytes, mime_type;  // fail early on a missing or non-image texture
+    TAILOR_RETURN_IF_ERROR(read_texture_bytes(options.texture_path, bytes, mime_type));
+    mtl_name = obj_path.stem().string() + ".mtl";
+    std::string mtl = "# written by tailor\nnewmtl tailor\nKa 1 1 1\nKd 1 1 1\nKs 0 0 0\nd 1\nillum 1\nmap_Kd ";
+    mtl += relative_path(options.texture_path, obj_path.parent_path());
+    mtl += "\n";
+    const std::filesystem::path mtl_path = obj_path.parent_path() / mtl_name;
+    TAILOR_RETURN_IF_ERROR(write_file_atomic(mtl_path.string(), mtl));
+  }
+
+  // The text goes out in pieces of about kFlushBytes through one reused string: the file is never
+  // held whole in memory.
+  AtomicFileWriter file(path);
+  TAILOR_RETURN_IF_ERROR(file.open());
+  constexpr size_t kFlushBytes = size_t{1} << 20;
+  std::string out;
+  out.reserve(kFlushBytes + 4096);
+  auto flush_if_full = [&]() -> Status {
+    if (out.size() < kFlushBytes) return Status::ok();
+    Status s = file.write(out);
+    out.clear();
+    return s;
+  };
+  out += "# written by tailor: ";
+  out += std::to_string(mesh.vertex_count()) + " vertices, " + std::to_string(mesh.face_count()) + " faces\n";
+  if (textured) out += "mtllib " + mtl_name + "\n";
+  for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+    out += "v ";
+    append_float(out, mesh.positions[3 * v]);
+    out += ' ';
+    append_float(out, mesh.positions[3 * v + 1]);
+    out += ' ';
+    append_float(out, mesh.positions[3 * v + 2]);
+    out += '\n';
+    TAILOR_RETURN_IF_ERROR(flush_if_full());
+  }
+  for (size_t s = 0; s < split.xref.size(); ++s) {
+    out += "vt ";
+    append_float(out, split.uvs[2 * s]);
+    out += ' ';
+    append_float(out, split.uvs[2 * s + 1]);
+    out += '\n';
+    TAILOR_RETURN_IF_ERROR(flush_if_full());
+  }
+  const bool normals = !data.normals.empty();
+  for (size_t v = 0; normals && v < mesh.vertex_count(); ++v) {
+    out += "vn ";
+    append_float(out, data.normals[3 * v]);
+    out += ' ';
+    append_float(out, data.normals[3 * v + 1]);
+    out += ' ';
+    append_float(out, data.normals[3 * v + 2]);
+    out += '\n';
+    TAILOR_RETURN_IF_ERROR(flush_if_full());
+  }
+  if (textured) out += "usemtl tailor\n";
+  for (size_t f = 0; f < mesh.face_count(); ++f) {
+    out += 'f';
+    for (int k = 0; k < 3; ++k) {
+      const size_t c = 3 * f + k;
+      out += ' ';
+      append_u32(out, mesh.indices[c] + 1);
+      out += '/';
+      append_u32(out, split.indices[c] + 1);
+      if (normals) {
+        out += '/';
+        append_u32(out, mesh.indices[c] + 1);
+      }
+    }
+    out += '\n';
+    TAILOR_RETURN_IF_ERROR(flush_if_full());
+  }
+  TAILOR_RETURN_IF_ERROR(file.write(out));
+  return file.commit();
+}
+
+}  // namespace tailor::internal

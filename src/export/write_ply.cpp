@@ -1,0 +1,66 @@
+// PLY writer: binary little endian, one vertex per split vertex with float x y z s t (texture
+// repeats, t up as in OBJ), faces as `list uchar uint vertex_indices`. A `comment TextureFile`
+// line names the texture the way MeshLab does. Vertices are split on UV, so the faces of
+// different patches do not share vertices in the file; tailor's readers of split files weld
+// identical positions back when they need the connectivity (weld_identical_positions).
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <filesystem>
+#include <vector>
+
+#include "util/atomic_file.h"
+#include "export/writers.h"
+
+namespace tailor::internal {
+
+Status write_ply(const std::string& path, const ExportData& data, const ExportOptions& options) {
+  static_assert(std::endian::native == std::endian::little, "ply writer assumes a little-endian host");
+  const SplitMesh& split = data.split;
+  const size_t vertex_count = split.xref.size();
+  const size_t face_count = split.indices.size() / 3;
+  if (!options.texture_path.empty()) {
+    std::string bytes, mime_type;  // fail on a missing or non-image texture like the other writers
+    TAILOR_RETURN_IF_ERROR(read_texture_bytes(options.texture_path, bytes, mime_type));
+  }
+
+  std::string out = "ply\nformat binary_little_endian 1.0\ncomment written by tailor\n";
+  if (!options.texture_path.empty()) {
+    std::string name = relative_path(options.texture_path, std::filesystem::path(path).parent_path());
+    for (char& c : name)
+      if (c == '\n' || c == '\r') c = ' ';
+    out += "comment TextureFile " + name + "\n";
+  }
+  out += "element vertex " + std::to_string(vertex_count) + "\n";
+  out += "property float x\nproperty float y\nproperty float z\nproperty float s\nproperty float t\n";
+  out += "element face " + std::to_string(face_count) + "\n";
+  out += "property list uchar uint vertex_indices\nend_header\n";
+  // Streamed through one small buffer of whole records: the file is never held whole in memory.
+  AtomicFileWriter file(path);
+  TAILOR_RETURN_IF_ERROR(file.open());
+  TAILOR_RETURN_IF_ERROR(file.write(out));
+  constexpr size_t kChunkRecords = 16384;
+  std::vector<char> chunk(kChunkRecords * 20);
+  const float* positions = data.mesh->positions.data();
+  for (size_t begin = 0; begin < vertex_count; begin += kChunkRecords) {
+    const size_t end = std::min(vertex_count, begin + kChunkRecords);
+    char* p = chunk.data();
+    for (size_t s = begin; s < end; ++s, p += 20) {
+      std::memcpy(p, &positions[3 * size_t{split.xref[s]}], 12);
+      std::memcpy(p + 12, &split.uvs[2 * s], 8);
+    }
+    TAILOR_RETURN_IF_ERROR(file.write({chunk.data(), (end - begin) * 20}));
+  }
+  for (size_t begin = 0; begin < face_count; begin += kChunkRecords) {
+    const size_t end = std::min(face_count, begin + kChunkRecords);
+    char* p = chunk.data();
+    for (size_t f = begin; f < end; ++f, p += 13) {
+      *p = 3;
+      std::memcpy(p + 1, &split.indices[3 * f], 12);
+    }
+    TAILOR_RETURN_IF_ERROR(file.write({chunk.data(), (end - begin) * 13}));
+  }
+  return file.commit();
+}
+
+}  // namespace tailor::internal

@@ -1,0 +1,42 @@
+// Per-format writers behind export_mesh (export.cpp). export.cpp validates the inputs, splits the
+// vertices and computes normals once; each writer only serialises and writes atomically.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "tailor/export.h"
+#include "tailor/mesh.h"
+#include "tailor/status.h"
+#include "surface/vertex_split.h"
+
+namespace tailor::internal {
+
+//! What every writer gets: the source mesh, its vertices split on UV with uvs in texture repeats
+//! (OBJ convention, t up: see export.h), and unit normals per SOURCE vertex (#V by 3, or empty).
+//! split.positions is left EMPTY: writers read mesh->positions[3 * split.xref[s]] as they stream,
+//! which saves an array of 12 bytes per split vertex.
+struct ExportData {
+  const Mesh* mesh = nullptr;
+  SplitMesh split;
+  std::vector<float> normals;
+};
+
+//! A texture file's bytes and MIME type ("image/png" or "image/jpeg", from the magic bytes).
+//! Fails with kIo (unreadable) or kInvalidImage (neither PNG nor JPEG).
+Status read_texture_bytes(const std::string& path, std::string& bytes, std::string& mime_type);
+
+//! Appends the shortest decimal text that reads back as exactly `value` (std::to_chars).
+void append_float(std::string& out, float value);
+
+//! Path of `target` relative to the folder `base_dir` (generic separators), or absolute when none exists.
+std::string relative_path(const std::string& target, const std::filesystem::path& base_dir);
+
+Status write_glb(const std::string& path, const ExportData& data, const ExportOptions& options);
+Status write_obj(const std::string& path, const ExportData& data, const ExportOptions& options);
+Status write_ply(const std::string& path, const ExportData& data, const ExportOptions& options);
+
+}  // namespace tailor::internal

@@ -1,0 +1,145 @@
+// Reading images (PNG, JPEG, TGA, BMP through stb_image) and writing PNG atomically
+// (stb_image_write to memory, then internal::write_file_atomic).
+//
+// Untrusted input: the header is inspected with stbi_info_from_memory and the size checked
+// against kMaxImageSide before anything is decoded, so a 100-byte file claiming 100000 x 100000
+// pixels is refused without allocating.
+#include <stb/stb_image.h>
+#include <stb/stb_image_write.h>
+
+#include <climits>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+#include "util/atomic_file.h"
+#include "tailor/image.h"
+
+namespace tailor {
+
+Status check_image(const Image& image) {
+  if (image.width < 1 || image.height < 1) return Status::error(ErrorCode::kInvalidImage, "", "image has no pixels");
+  if (image.width > kMaxImageSide || image.height > kMaxImageSide)
+    return Status::error(ErrorCode::kInvalidImage, "",
+                         "image too large (the limit is " + std::to_string(kMaxImageSide) + " px a side)");
+  if (image.channels < 1 || image.channels > 4)
+    return Status::error(ErrorCode::kInvalidImage, "", "image must have 1 to 4 channels");
+  const size_t expected = static_cast<size_t>(image.width) * image.height * image.channels;
+  if (image.pixels.size() != expected)
+    return Status::error(ErrorCode::kInvalidImage, "", "pixel buffer size does not match width x height x channels");
+  return Status::ok();
+}
+
+namespace {
+
+std::string size_text(long width, long height) { return std::to_string(width) + "x" + std::to_string(height); }
+
+uint32_t be16(const unsigned char* p) { return (uint32_t{p[0]} << 8) | p[1]; }
+uint32_t be32(const unsigned char* p) {
+  return (uint32_t{p[0]} << 24) | (uint32_t{p[1]} << 16) | (uint32_t{p[2]} << 8) | p[3];
+}
+
+//! The size a PNG, JPEG or BMP header claims, read directly: stb_image refuses (with a vague
+//! "unknown image type") headers whose size would overflow its own limits, and the user should
+//! rather hear "too large". Returns false when the header is not recognised.
+bool claimed_size(const std::string& bytes, long& width, long& height) {
+  const auto* p = reinterpret_cast<const unsigned char*>(bytes.data());
+  const size_t n = bytes.size();
+  if (n >= 24 && std::memcmp(p, "\x89PNG\r\n\x1a\n", 8) == 0 && std::memcmp(p + 12, "IHDR", 4) == 0) {
+    width = be32(p + 16);
+    height = be32(p + 20);
+    return true;
+  }
+  if (n >= 4 && p[0] == 0xFF && p[1] == 0xD8) {  // JPEG: walk the markers up to a start-of-frame
+    size_t i = 2;
+    while (i + 9 < n && p[i] == 0xFF) {
+      const unsigned marker = p[i + 1];
+      if (marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC) {
+        height = be16(p + i + 5);
+        width = be16(p + i + 7);
+        return true;
+      }
+      i += 2 + be16(p + i + 2);
+    }
+    return false;
+  }
+  if (n >= 26 && p[0] == 'B' && p[1] == 'M') {
+    auto le32 = [&](size_t o) {
+      return static_cast<int32_t>(uint32_t{p[o]} | (uint32_t{p[o + 1]} << 8) | (uint32_t{p[o + 2]} << 16) |
+                                  (uint32_t{p[o + 3]} << 24));
+    };
+    width = std::labs(le32(18));
+    height = std::labs(le32(22));
+    return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+Status load_image(const std::string& path, Image& image) {
+  image = Image{};
+  std::string bytes;
+  TAILOR_RETURN_IF_ERROR(internal::read_file(path, bytes));
+  if (bytes.empty()) return Status::error(ErrorCode::kInvalidImage, path, "empty file, not an image");
+  if (bytes.size() > static_cast<size_t>(INT_MAX))
+    return Status::error(ErrorCode::kInvalidImage, path, "file too large to be an image (over 2 GiB)");
+  const auto* data = reinterpret_cast<const stbi_uc*>(bytes.data());
+  const int length = static_cast<int>(bytes.size());
+
+  int width = 0, height = 0, channels = 0;
+  if (stbi_info_from_memory(data, length, &width, &height, &channels) == 0) {
+    long claimed_w = 0, claimed_h = 0;
+    if (claimed_size(bytes, claimed_w, claimed_h) && (claimed_w > kMaxImageSide || claimed_h > kMaxImageSide))
+      return Status::error(ErrorCode::kInvalidImage, path,
+                           "image too large (the limit is " + std::to_string(kMaxImageSide) + " px a side)",
+                           "header says " + size_text(claimed_w, claimed_h));
+    const char* reason = stbi_failure_reason();
+    return Status::error(ErrorCode::kInvalidImage, path, "not a readable PNG, JPEG, TGA or BMP image",
+                         std::string("header: ") + (reason ? reason : "unknown format"));
+  }
+  if (width <= 0 || height <= 0)
+    return Status::error(ErrorCode::kInvalidImage, path, "image has no pixels",
+                         "header says " + size_text(width, height));
+  if (width > kMaxImageSide || height > kMaxImageSide)
+    return Status::error(ErrorCode::kInvalidImage, path,
+                         "image too large (the limit is " + std::to_string(kMaxImageSide) + " px a side)",
+                         "header says " + size_text(width, height));
+  if (channels < 1 || channels > 4)
+    return Status::error(ErrorCode::kUnsupported, path, "unsupported channel count " + std::to_string(channels));
+
+  // 16-bit PNGs are reduced to 8 bits by stbi_load_from_memory itself.
+  int w = 0, h = 0, c = 0;
+  stbi_uc* pixels = stbi_load_from_memory(data, length, &w, &h, &c, 0);
+  if (pixels == nullptr) {
+    const char* reason = stbi_failure_reason();
+    return Status::error(ErrorCode::kInvalidImage, path, "truncated or corrupt image data",
+                         std::string("decoder: ") + (reason ? reason : "unknown error"));
+  }
+  if (w != width || h != height || c != channels) {
+    stbi_image_free(pixels);
+    return Status::error(ErrorCode::kInvalidImage, path, "image header and data disagree on the size");
+  }
+  image.width = w;
+  image.height = h;
+  image.channels = c;
+  image.pixels.assign(pixels, pixels + static_cast<size_t>(w) * h * c);
+  stbi_image_free(pixels);
+  return Status::ok();
+}
+
+Status write_png(const std::string& path, const Image& image) {
+  TAILOR_RETURN_IF_ERROR(check_image(image).with_file(path));
+  std::string encoded;
+  encoded.reserve(image.pixels.size() / 2 + 1024);
+  auto append = [](void* context, void* bytes, int size) {
+    static_cast<std::string*>(context)->append(static_cast<const char*>(bytes), static_cast<size_t>(size));
+  };
+  const int ok = stbi_write_png_to_func(append, &encoded, image.width, image.height, image.channels,
+                                        image.pixels.data(), image.width * image.channels);
+  if (ok == 0 || encoded.empty()) return Status::error(ErrorCode::kIo, path, "PNG encoding failed");
+  return internal::write_file_atomic(path, std::span<const char>(encoded.data(), encoded.size()));
+}
+
+}  // namespace tailor

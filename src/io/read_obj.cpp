@@ -1,0 +1,156 @@
+// Wavefront OBJ reader: `v`, `vt` and `f` statements (v, v/vt, v//vn, v/vt/vn corners, negative
+// indices relative to the current counts), polygons fan-triangulated, `\r\n` line ends, `#`
+// comments, backslash line continuation. `vn`, `o`, `g`, `s`, `usemtl`, `mtllib`, `l`, `p` and any
+// other statement are ignored; no .mtl file is ever opened.
+//
+// Hand-written instead of tinyobjloader (which Debian ships): tinyobjloader reports bad indices as
+// warnings without line numbers (or silently clamps them), stores per-shape index structs that we
+// would copy again, and its float parser is slower than fast_float. This reader is a single pass
+// over the bytes with exact float parsing (fast_float) and line-accurate errors.
+#include <string_view>
+#include <vector>
+
+#include "io/readers.h"
+#include "util/text_scan.h"
+
+namespace tailor::internal {
+namespace {
+
+// A positive index that refers past the elements defined so far (legal if defined later);
+// checked once the whole file is read.
+struct ForwardRef {
+  uint64_t index;  // 0-based
+  size_t line;
+};
+
+std::string out_of_range_text(const char* what, int64_t index, size_t count) {
+  return std::string(what) + " index " + std::to_string(index) + " out of range (mesh has " + std::to_string(count) +
+         (what[0] == 'f' ? " vertices)" : " texture coordinates)");
+}
+
+// Resolves a 1-based or negative OBJ index against the current count; returns false when it
+// cannot be valid (0, or negative past the start).
+bool resolve(int64_t raw, size_t count, uint64_t& out) {
+  if (raw > 0) {
+    out = static_cast<uint64_t>(raw - 1);
+    return out < kMaxVertices;
+  }
+  if (raw < 0 && static_cast<uint64_t>(-(raw + 1)) < count) {
+    out = count - static_cast<uint64_t>(-(raw + 1)) - 1;
+    return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report) {
+  report.format = "OBJ";
+  TextScanner s(data.data(), data.data() + data.size());
+  s.set_hash_comments(true);
+  s.set_line_continuation(true);
+
+  std::vector<float> texcoords;        // #VT by 2
+  std::vector<uint32_t> corner_vt;     // per triangle corner: vt index or kInvalid
+  std::vector<ForwardRef> forward_v, forward_vt;
+  std::vector<uint32_t> poly, poly_vt;
+  size_t corners_without_vt = 0;       // once nonzero, corner_vt is dropped and no longer filled
+
+  while (!s.at_end()) {
+    const std::string_view w = s.word();
+    if (w.empty()) {
+      s.next_line();
+      continue;
+    }
+    if (w == "v") {
+      float x, y, z;
+      if (!s.read_float(x) || !s.read_float(y) || !s.read_float(z)) {
+        return Status::error(ErrorCode::kParse, name, "bad vertex line (expected 3 numbers)", s.where());
+      }
+      mesh.positions.insert(mesh.positions.end(), {x, y, z});
+    } else if (w == "vt") {
+      float u, v = 0.0f;
+      if (!s.read_float(u)) return Status::error(ErrorCode::kParse, name, "bad texture coordinate line", s.where());
+      if (!s.at_line_end() && !s.read_float(v)) {
+        return Status::error(ErrorCode::kParse, name, "bad texture coordinate line", s.where());
+      }
+      texcoords.insert(texcoords.end(), {u, v});
+    } else if (w == "f") {
+      poly.clear();
+      poly_vt.clear();
+      const size_t nv = mesh.positions.size() / 3, nt = texcoords.size() / 2;
+      while (!s.at_line_end()) {
+        int64_t raw = 0;
+        uint64_t vi = 0, ti = kInvalid;
+        if (!s.read_int(raw, false)) return Status::error(ErrorCode::kParse, name, "bad face corner", s.where());
+        if (!resolve(raw, nv, vi)) {
+          return Status::error(ErrorCode::kInvalidMesh, name, out_of_range_text("face", raw, nv), s.where());
+        }
+        if (vi >= nv) forward_v.push_back({vi, s.line()});
+        if (s.consume('/')) {
+          if (s.at_token_end()) return Status::error(ErrorCode::kParse, name, "bad face corner", s.where());
+          if (*s.pos() != '/') {
+            if (!s.read_int(raw, false)) return Status::error(ErrorCode::kParse, name, "bad face corner", s.where());
+            if (!resolve(raw, nt, ti)) {
+              return Status::error(ErrorCode::kInvalidMesh, name, out_of_range_text("texture", raw, nt), s.where());
+            }
+            if (ti >= nt) forward_vt.push_back({ti, s.line()});
+          }
+          if (s.consume('/')) {
+            int64_t normal = 0;  // normals are not used; only the syntax is checked
+            if (!s.read_int(normal, false)) return Status::error(ErrorCode::kParse, name, "bad face corner", s.where());
+          }
+        }
+        if (!s.at_token_end()) return Status::error(ErrorCode::kParse, name, "bad face corner", s.where());
+        poly.push_back(static_cast<uint32_t>(vi));
+        poly_vt.push_back(static_cast<uint32_t>(ti));
+      }
+      const size_t n = poly.size();
+      if (n < 3) {
+        return Status::error(ErrorCode::kInvalidMesh, name, "face with " + std::to_string(n) + " vertices", s.where());
+      }
+      ++report.source_faces;
+      if (n > 3) ++report.polygons_triangulated;
+      for (size_t k = 1; k + 1 < n; ++k) mesh.indices.insert(mesh.indices.end(), {poly[0], poly[k], poly[k + 1]});
+      if (corners_without_vt == 0) {
+        for (uint32_t t : poly_vt) corners_without_vt += t == kInvalid;
+        if (corners_without_vt == 0) {
+          for (size_t k = 1; k + 1 < n; ++k) corner_vt.insert(corner_vt.end(), {poly_vt[0], poly_vt[k], poly_vt[k + 1]});
+        } else {
+          std::vector<uint32_t>().swap(corner_vt);  // no uvs after all: stop recording them
+        }
+      }
+      if (mesh.indices.size() / 3 > kMaxFaces) return Status::error(ErrorCode::kLimit, name, "too many faces", s.where());
+    }
+    // Every other statement (vn, o, g, s, usemtl, mtllib, l, p, unknown ones) is skipped.
+    s.next_line();
+  }
+
+  // Positive indices may refer to elements defined further down; check them now.
+  const size_t nv = mesh.positions.size() / 3, nt = texcoords.size() / 2;
+  for (const ForwardRef& r : forward_v) {
+    if (r.index >= nv) {
+      return Status::error(ErrorCode::kInvalidMesh, name,
+                           out_of_range_text("face", static_cast<int64_t>(r.index + 1), nv),
+                           "line " + std::to_string(r.line));
+    }
+  }
+  for (const ForwardRef& r : forward_vt) {
+    if (r.index >= nt) {
+      return Status::error(ErrorCode::kInvalidMesh, name,
+                           out_of_range_text("texture", static_cast<int64_t>(r.index + 1), nt),
+                           "line " + std::to_string(r.line));
+    }
+  }
+  // Corner uvs only when every corner has one: a partial set cannot be used as a mapping.
+  if (!mesh.indices.empty() && corners_without_vt == 0) {
+    mesh.corner_uvs.resize(2 * corner_vt.size());
+    for (size_t c = 0; c < corner_vt.size(); ++c) {
+      mesh.corner_uvs[2 * c] = texcoords[2 * corner_vt[c]];
+      mesh.corner_uvs[2 * c + 1] = texcoords[2 * corner_vt[c] + 1];
+    }
+  }
+  return Status::ok();
+}
+
+}  // namespace tailor::internal

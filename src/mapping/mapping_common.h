@@ -1,0 +1,68 @@
+// Shared pieces of the two mapping modes (mapping.cpp dispatches, mapping_patches.cpp and
+// mapping_thesis.cpp implement): the front key layout, the component seed order, the inputs.
+#pragma once
+
+#include <bit>
+#include <cstdint>
+#include <cstring>
+#include <vector>
+
+#include "tailor/atlas.h"
+#include "tailor/mapping.h"
+#include "tailor/mesh.h"
+#include "tailor/orientation.h"
+#include "tailor/topology.h"
+
+namespace tailor::internal {
+
+// === Front key =================================================================================
+// One uint64, smaller = sooner:
+//   bits 62-63  class: 0 waiting, 1 deferred (failed since its neighbourhood last changed),
+//               2 user seam face (processed after everything else of the component)
+//   bits 60-61  3 - placed edge neighbours (thesis queues 3, 2, 1, 0)
+//   bits 32-59  age: the top 28 bits of the float's bit pattern (non-negative floats order like
+//               their bits; dropping 3 mantissa bits keeps ~1e-6 relative precision)
+//   bits 0-31   face id (unique keys, ties broken by face id)
+enum FrontClass : uint64_t { kWaiting = 0, kDeferred = 1, kSeam = 2 };
+
+inline uint64_t front_key(uint64_t front_class, uint32_t placed_neighbours, float age, uint32_t face) {
+  const uint32_t rank = placed_neighbours >= 3 ? 0u : 3u - placed_neighbours;
+  uint32_t bits = std::bit_cast<uint32_t>(age > 0.f ? age : 0.f);  // also maps NaN to 0
+  bits = (bits >> 3) & 0x0FFFFFFFu;
+  return (front_class << 62) | (uint64_t{rank} << 60) | (uint64_t{bits} << 32) | face;
+}
+inline uint64_t front_class(uint64_t key) { return key >> 62; }
+inline uint64_t with_class(uint64_t key, uint64_t front_class) {
+  return (key & ~(uint64_t{3} << 62)) | (front_class << 62);
+}
+
+// === Inputs shared by both modes ===============================================================
+struct MappingInput {
+  const Mesh& mesh;
+  const Topology& topology;
+  const FaceFrames& frames;
+  const MappingOptions& options;
+  double factor_step;                   // resolved for the mode; < 0 in kPatches = the hop rule
+  std::vector<uint32_t> component_seeds;  // first face of each component, in processing order
+};
+
+Status map_patches(const MappingInput& input, Atlas& atlas, MappingStats& stats);
+//! Re-places faces on seams from their neighbours where that shortens the seams and keeps them
+//! within options.max_stretch (patches mode, after the growth); drops emptied patches. seam_mark:
+//! #F flags, 1 on every face with a seam edge (others may be 1 too), cleared on return. Returns the
+//! number of moves. Deterministic; O(F) once, then O(faces on seams) per pass, bounded passes.
+uint64_t shorten_seams(const MappingInput& input, std::vector<uint8_t>& seam_mark, Atlas& atlas);
+
+//! Zips cracks (seam edges between two faces of one patch) shut from their tips, relaxing the UVs
+//! around each zip (ARAP); a zip is kept only if every face it moved stays within
+//! options.max_stretch (patches mode, last step). zipped: the number of zipped vertices.
+//! progress (may be empty) gets the share done; false cancels (kCancelled, atlas half-zipped).
+//! Deterministic; O(F) setup, then O(rings^2) per crack vertex tried.
+Status close_cracks(const MappingInput& input, const ProgressCallback& progress, Atlas& atlas, uint64_t& zipped);
+
+Status map_thesis(const MappingInput& input, Atlas& atlas, MappingStats& stats);
+
+//! Progress reporting cadence (placed faces between callback calls).
+inline constexpr uint32_t kProgressInterval = 1u << 16;
+
+}  // namespace tailor::internal

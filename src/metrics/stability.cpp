@@ -1,0 +1,172 @@
+// Stability of the mapping under removal of part of the mesh (thesis 2.6, Table 2.1).
+//
+// This work is based on:
+//   V. Singh, A. M. Namboodiri, "Efficient texture mapping by homogeneous patch discovery",
+//   ICVGIP 2012 (thesis section 2.6).
+#include "tailor/stability.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <utility>
+
+#include "tailor/mapping.h"
+#include "tailor/topology.h"
+
+namespace tailor {
+namespace {
+
+void face_centroid(const Mesh& mesh, size_t f, double out[3]) {
+  for (int i = 0; i < 3; ++i) {
+    out[i] = (static_cast<double>(mesh.positions[3 * mesh.indices[3 * f] + i]) +
+              mesh.positions[3 * mesh.indices[3 * f + 1] + i] + mesh.positions[3 * mesh.indices[3 * f + 2] + i]) /
+             3.0;
+  }
+}
+
+double distance2(const double a[3], const double b[3]) {
+  return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]);
+}
+
+}  // namespace
+
+Status measure_stability(const Mesh& mesh, const OrientationOptions& orientation, const MappingOptions& mapping,
+                         StabilityReport& report, const StabilityOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  report = StabilityReport{};
+  const size_t face_count = mesh.face_count();
+  if (face_count < 10) return Status::error(ErrorCode::kInvalidMesh, "", "stability needs at least 10 faces");
+  if (!(options.remove_fraction > 0.f && options.remove_fraction <= 0.9f))
+    return Status::error(ErrorCode::kInvalidArgument, "", "remove fraction must be in (0, 0.9]");
+
+  // === Full mapping ===
+  // The frame (axis and unit-cube normalisation) is resolved once on the full mesh and then given
+  // explicitly to both runs, as a client that keeps them would: the cut mesh alone would have a
+  // different bounding box and principal axis, which would move every UV.
+  const Topology topology = build_topology(mesh);
+  FaceFrames frames;
+  TAILOR_RETURN_IF_ERROR(compute_orientation(mesh, topology, orientation, frames));
+  OrientationOptions fixed = orientation;
+  fixed.axis = AxisSource::kUser;
+  fixed.user_axis = frames.axis;
+  fixed.user_axis2 = frames.axis2;
+  fixed.fixed_origin = frames.origin;
+  fixed.fixed_unit_scale = frames.unit_scale;
+  TAILOR_RETURN_IF_ERROR(compute_orientation(mesh, topology, fixed, frames));
+  MappingOptions map_options = mapping;
+  map_options.progress = nullptr;
+  if (!map_options.use_seed_point) {
+    // Pin the default seed (nearest the bbox centre) so that the cut mesh starts at the same face.
+    const std::vector<uint32_t> seeds = component_seed_faces(mesh, topology, frames, map_options);
+    double c[3];
+    face_centroid(mesh, seeds.front(), c);
+    map_options.use_seed_point = true;
+    map_options.seed_point = {static_cast<float>(c[0]), static_cast<float>(c[1]), static_cast<float>(c[2])};
+  }
+  // === The ball: centred on the face farthest from the seed, holding remove_fraction of faces ===
+  const double seed[3] = {map_options.seed_point[0], map_options.seed_point[1], map_options.seed_point[2]};
+  size_t far_face = 0;
+  double far_d2 = -1;
+  std::vector<std::pair<double, uint32_t>> by_distance(face_count);
+  std::vector<double> to_seed(face_count);  // squared distance of each centroid to the seed point
+  for (size_t f = 0; f < face_count; ++f) {
+    double c[3];
+    face_centroid(mesh, f, c);
+    const double d2 = to_seed[f] = distance2(c, seed);
+    if (d2 > far_d2) {
+      far_d2 = d2;
+      far_face = f;
+    }
+  }
+  double centre[3];
+  face_centroid(mesh, far_face, centre);
+  for (size_t f = 0; f < face_count; ++f) {
+    double c[3];
+    face_centroid(mesh, f, c);
+    by_distance[f] = {distance2(c, centre), static_cast<uint32_t>(f)};
+  }
+  const size_t removed = std::clamp<size_t>(
+      static_cast<size_t>(std::lround(options.remove_fraction * static_cast<double>(face_count))), 1,
+      face_count - 1);
+  std::nth_element(by_distance.begin(), by_distance.begin() + static_cast<std::ptrdiff_t>(removed - 1),
+                   by_distance.end());
+  std::vector<uint8_t> gone(face_count, 0);
+  for (size_t i = 0; i < removed; ++i) gone[by_distance[i].second] = 1;
+  // On meshes whose face density varies a lot (CAD parts) the ball can reach the seed; both runs
+  // then start at the surviving face nearest to it, or the experiment would measure a new seed.
+  {
+    uint32_t nearest = kInvalid;
+    double nearest_d2 = 0;
+    for (size_t f = 0; f < face_count; ++f) {
+      if (gone[f] || (nearest != kInvalid && to_seed[f] >= nearest_d2)) continue;
+      nearest = static_cast<uint32_t>(f);
+      nearest_d2 = to_seed[f];
+    }
+    double c[3];
+    face_centroid(mesh, nearest, c);
+    map_options.seed_point = {static_cast<float>(c[0]), static_cast<float>(c[1]), static_cast<float>(c[2])};
+  }
+  Atlas full;
+  MappingStats full_stats;
+  TAILOR_RETURN_IF_ERROR(map_texture(mesh, topology, frames, map_options, full, &full_stats));
+
+  // === The cut mesh: same vertices (ids kept), surviving faces in their original order ===
+  Mesh cut;
+  cut.positions = mesh.positions;
+  std::vector<uint32_t> original;  // cut face -> full face
+  original.reserve(face_count - removed);
+  for (size_t f = 0; f < face_count; ++f) {
+    if (gone[f]) continue;
+    original.push_back(static_cast<uint32_t>(f));
+    cut.indices.insert(cut.indices.end(), mesh.indices.begin() + static_cast<std::ptrdiff_t>(3 * f),
+                       mesh.indices.begin() + static_cast<std::ptrdiff_t>(3 * f + 3));
+  }
+  std::vector<uint8_t> cut_seams;
+  if (!mapping.seam_faces.empty()) {
+    for (const uint32_t f : original) cut_seams.push_back(mapping.seam_faces[f]);
+    map_options.seam_faces = cut_seams;
+  }
+  const Topology cut_topology = build_topology(cut);
+  FaceFrames cut_frames;
+  TAILOR_RETURN_IF_ERROR(compute_orientation(cut, cut_topology, fixed, cut_frames));
+  Atlas cut_atlas;
+  MappingStats cut_stats;
+  TAILOR_RETURN_IF_ERROR(map_texture(cut, cut_topology, cut_frames, map_options, cut_atlas, &cut_stats));
+
+  // === Compare surviving corners ===
+  double sum = 0, worst = 0;
+  size_t identical = 0, close = 0;
+  std::vector<double> differences;
+  differences.reserve(3 * original.size());
+  for (size_t i = 0; i < original.size(); ++i) {
+    const float* a = &full.corner_uv[6 * original[i]];
+    const float* b = &cut_atlas.corner_uv[6 * i];
+    for (int k = 0; k < 3; ++k) {
+      const double du = static_cast<double>(a[2 * k]) - b[2 * k];
+      const double dv = static_cast<double>(a[2 * k + 1]) - b[2 * k + 1];
+      const double d = std::sqrt(du * du + dv * dv);
+      sum += d;
+      worst = std::max(worst, d);
+      differences.push_back(d);
+      identical += (a[2 * k] == b[2 * k] && a[2 * k + 1] == b[2 * k + 1]) ? 1 : 0;
+      close += d < 1.0 ? 1 : 0;
+    }
+  }
+  const size_t corners = 3 * original.size();
+  report.faces = face_count;
+  report.removed_faces = removed;
+  report.compared_corners = corners;
+  report.mean_difference_px = sum / static_cast<double>(corners);
+  report.max_difference_px = worst;
+  std::nth_element(differences.begin(), differences.begin() + static_cast<std::ptrdiff_t>(differences.size() / 2),
+                   differences.end());
+  report.median_difference_px = differences[differences.size() / 2];
+  report.identical_ratio = static_cast<double>(identical) / static_cast<double>(corners);
+  report.within_1px_ratio = static_cast<double>(close) / static_cast<double>(corners);
+  report.patches_full = full.patch_count;
+  report.patches_cut = cut_atlas.patch_count;
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return Status::ok();
+}
+
+}  // namespace tailor

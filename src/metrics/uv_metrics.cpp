@@ -1,0 +1,430 @@
+// UV map quality metrics (see include/tailor/metrics.h and docs/metrics.md).
+//
+// This work is based on:
+//   - Sai Yeshwanth Chaganti, "Efficient Texture Mapping by Homogeneous Patch Discovery", MS thesis,
+//     IIIT Hyderabad, ch. 4 (stretch as the spread of the area ratio, distortion as the median angle
+//     difference);
+//   - P. V. Sander, J. Snyder, S. J. Gortler, H. Hoppe, "Texture Mapping Progressive Meshes",
+//     SIGGRAPH 2001 (L2 and Linf stretch of the map from texture to surface).
+#include "tailor/metrics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include "util/huge_pages.h"
+#include "util/parallel_chunks.h"
+
+namespace tailor {
+namespace {
+
+// A triangle is degenerate when twice its area is below this fraction of its longest edge squared
+// (a needle whose height is 1e-12 of its length): its angles and ratios carry no information and
+// would otherwise divide by zero.
+constexpr double kDegenerateRelativeHeight = 1e-12;
+
+struct Vec3 {
+  double x, y, z;
+};
+
+Vec3 position(const Mesh& mesh, uint32_t v) {
+  const float* p = &mesh.positions[3 * size_t{v}];
+  return {p[0], p[1], p[2]};
+}
+Vec3 sub(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+double dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+Vec3 cross(Vec3 a, Vec3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+double norm(Vec3 a) { return std::sqrt(dot(a, a)); }
+
+// The corners of one face in 3D and in UV.
+struct Face {
+  Vec3 p[3];
+  double u[3], v[3];
+  double area3d = 0;     // A_f
+  double area_uv = 0;    // signed a_f (positive = counter-clockwise in UV)
+  bool degenerate = false;
+};
+
+Face load_face(const Mesh& mesh, std::span<const float> corner_uv, size_t f) {
+  Face face;
+  for (int k = 0; k < 3; ++k) {
+    face.p[k] = position(mesh, mesh.indices[3 * f + k]);
+    face.u[k] = corner_uv[2 * (3 * f + k)];
+    face.v[k] = corner_uv[2 * (3 * f + k) + 1];
+  }
+  const Vec3 e1 = sub(face.p[1], face.p[0]), e2 = sub(face.p[2], face.p[0]), e3 = sub(face.p[2], face.p[1]);
+  const double twice_area = norm(cross(e1, e2));
+  const double longest2 = std::max({dot(e1, e1), dot(e2, e2), dot(e3, e3)});
+  face.area3d = 0.5 * twice_area;
+  face.degenerate = !(twice_area > kDegenerateRelativeHeight * longest2);
+  face.area_uv = 0.5 * ((face.u[1] - face.u[0]) * (face.v[2] - face.v[0]) -
+                        (face.u[2] - face.u[0]) * (face.v[1] - face.v[0]));
+  return face;
+}
+
+// Unsigned angle between two vectors; atan2 stays finite (0) for zero vectors.
+double angle3(Vec3 a, Vec3 b) { return std::atan2(norm(cross(a, b)), dot(a, b)); }
+double angle2(double ax, double ay, double bx, double by) {
+  return std::atan2(std::abs(ax * by - ay * bx), ax * bx + ay * by);
+}
+
+// sum_k |angle_uv_k - angle_3d_k| in degrees. Each difference comes from one atan2 of the two
+// angles' sine and cosine products: angle_uv - angle_3d = atan2(c2 d3 - d2 c3, d2 d3 + c2 c3) for
+// angles atan2(c, d) in [0, pi], where the difference lies within (-pi, pi). A triangle's interior
+// angles sum to pi, in 3D and in UV alike, so the third corner's difference is minus the sum of the
+// other two: two atan2 per triangle (atan2 is most of the metrics' time). Not when a UV edge has
+// zero length, where the UV angles at its ends are atan2(0, 0) = 0: there, all six angles.
+double angle_distortion_deg(const Face& face) {
+  bool zero_uv_edge = false;
+  for (int k = 0; k < 3; ++k) {
+    const int i = (k + 1) % 3;
+    zero_uv_edge = zero_uv_edge || (face.u[i] == face.u[k] && face.v[i] == face.v[k]);
+  }
+  double sum = 0.;
+  if (zero_uv_edge) {
+    for (int k = 0; k < 3; ++k) {
+      const int i = (k + 1) % 3, j = (k + 2) % 3;
+      const double uv =
+          angle2(face.u[i] - face.u[k], face.v[i] - face.v[k], face.u[j] - face.u[k], face.v[j] - face.v[k]);
+      sum += std::abs(uv - angle3(sub(face.p[i], face.p[k]), sub(face.p[j], face.p[k])));
+    }
+  } else {
+    double difference[2];
+    for (int k = 0; k < 2; ++k) {
+      const int i = (k + 1) % 3, j = (k + 2) % 3;
+      const Vec3 a = sub(face.p[i], face.p[k]), b = sub(face.p[j], face.p[k]);
+      const double c3 = norm(cross(a, b)), d3 = dot(a, b);
+      const double ax = face.u[i] - face.u[k], ay = face.v[i] - face.v[k];
+      const double bx = face.u[j] - face.u[k], by = face.v[j] - face.v[k];
+      const double c2 = std::abs(ax * by - ay * bx), d2 = ax * bx + ay * by;
+      difference[k] = std::atan2(c2 * d3 - d2 * c3, d2 * d3 + c2 * c3);
+    }
+    sum = std::abs(difference[0]) + std::abs(difference[1]) + std::abs(difference[0] + difference[1]);
+  }
+  return sum * (180.0 / std::numbers::pi);
+}
+
+// Sander et al. 2001: Jacobian of the affine map (s, t) -> 3D of a face with non-zero UV area.
+// Returns (a + c) / 2 (the squared L2 stretch of the face) and sets G, the largest singular value.
+double sander_stretch(const Face& face, double& gamma_max) {
+  const double s1 = face.u[0], s2 = face.u[1], s3 = face.u[2];
+  const double t1 = face.v[0], t2 = face.v[1], t3 = face.v[2];
+  const double twice = 2.0 * face.area_uv;
+  const Vec3& q1 = face.p[0];
+  const Vec3& q2 = face.p[1];
+  const Vec3& q3 = face.p[2];
+  const Vec3 ss = {(q1.x * (t2 - t3) + q2.x * (t3 - t1) + q3.x * (t1 - t2)) / twice,
+                   (q1.y * (t2 - t3) + q2.y * (t3 - t1) + q3.y * (t1 - t2)) / twice,
+                   (q1.z * (t2 - t3) + q2.z * (t3 - t1) + q3.z * (t1 - t2)) / twice};
+  const Vec3 st = {(q1.x * (s3 - s2) + q2.x * (s1 - s3) + q3.x * (s2 - s1)) / twice,
+                   (q1.y * (s3 - s2) + q2.y * (s1 - s3) + q3.y * (s2 - s1)) / twice,
+                   (q1.z * (s3 - s2) + q2.z * (s1 - s3) + q3.z * (s2 - s1)) / twice};
+  const double a = dot(ss, ss), b = dot(ss, st), c = dot(st, st);
+  gamma_max = std::sqrt(0.5 * ((a + c) + std::sqrt((a - c) * (a - c) + 4 * b * b)));
+  return 0.5 * (a + c);
+}
+
+// Distance between two UV points on the torus of the texture period.
+double toroidal_distance(double du, double dv, double width, double height) {
+  du -= width * std::round(du / width);
+  dv -= height * std::round(dv / height);
+  return std::sqrt(du * du + dv * dv);
+}
+
+// Union-find with path halving; the root of a set is its lowest face (union links the larger root
+// under the smaller), so the labelling is deterministic.
+uint32_t find_root(std::vector<uint32_t>& parent, uint32_t x) {
+  while (parent[x] != x) {
+    parent[x] = parent[parent[x]];
+    x = parent[x];
+  }
+  return x;
+}
+
+bool same_uv(std::span<const float> uv, size_t c0, size_t c1) {
+  return uv[2 * c0] == uv[2 * c1] && uv[2 * c0 + 1] == uv[2 * c1 + 1];
+}
+
+// The corners on both sides of paired edge e (face f, edge k) and its opposite o (face g, edge j):
+// e runs a -> b in f, o runs b -> a in g.
+struct EdgeSides {
+  size_t fa, fb, ga, gb;
+};
+EdgeSides edge_sides(size_t e, size_t o) {
+  const size_t f = e / 3, k = e % 3, g = o / 3, j = o % 3;
+  return {3 * f + k, 3 * f + (k + 1) % 3, 3 * g + (j + 1) % 3, 3 * g + j};
+}
+
+double median(std::vector<double>& values) {
+  if (values.empty()) return 0;
+  const size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(mid), values.end());
+  const double upper = values[mid];
+  if (values.size() % 2 == 1) return upper;
+  const double lower = *std::max_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(mid));
+  return 0.5 * (lower + upper);
+}
+
+}  // namespace
+
+uint32_t derive_patches(const Mesh& mesh, const Topology& topology, std::span<const float> corner_uv,
+                        std::vector<uint32_t>& patch) {
+  const size_t nf = mesh.face_count();
+  std::vector<uint32_t> parent(nf);
+  for (size_t f = 0; f < nf; ++f) parent[f] = static_cast<uint32_t>(f);
+  for (size_t e = 0; e < 3 * nf; ++e) {
+    const uint32_t o = topology.opposite[e];
+    if (o == kInvalid || o < e) continue;
+    const EdgeSides s = edge_sides(e, o);
+    if (!same_uv(corner_uv, s.fa, s.ga) || !same_uv(corner_uv, s.fb, s.gb)) continue;
+    const uint32_t ra = find_root(parent, static_cast<uint32_t>(e / 3));
+    const uint32_t rb = find_root(parent, o / 3);
+    if (ra < rb) parent[rb] = ra;
+    else if (rb < ra) parent[ra] = rb;
+  }
+  patch.assign(nf, kInvalid);
+  uint32_t count = 0;
+  for (size_t f = 0; f < nf; ++f) {
+    const uint32_t root = find_root(parent, static_cast<uint32_t>(f));
+    // Roots are the lowest face of their set, so a root is labelled before any other member.
+    if (root == f) patch[f] = count++;
+    else patch[f] = patch[root];
+  }
+  return count;
+}
+
+void face_area_stretch(const Mesh& mesh, std::span<const float> corner_uv, std::vector<float>& ratio) {
+  const size_t nf = mesh.face_count();
+  ratio.assign(nf, 1.0f);
+  double sum_uv = 0, sum_3d = 0;
+  for (size_t f = 0; f < nf; ++f) {
+    const Face face = load_face(mesh, corner_uv, f);
+    if (face.degenerate) continue;
+    sum_uv += std::abs(face.area_uv);
+    sum_3d += face.area3d;
+  }
+  if (!(sum_uv > 0) || !(sum_3d > 0)) {
+    std::fill(ratio.begin(), ratio.end(), 0.0f);
+    return;
+  }
+  const double scale = sum_uv / sum_3d;
+  for (size_t f = 0; f < nf; ++f) {
+    const Face face = load_face(mesh, corner_uv, f);
+    if (face.degenerate) continue;
+    ratio[f] = static_cast<float>(std::abs(face.area_uv) / face.area3d / scale);
+  }
+}
+
+Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<const float> corner_uv,
+                          std::span<const uint32_t> patch_in, const MetricsOptions& options, UvMetrics& metrics) {
+  metrics = UvMetrics{};
+  const size_t nf = mesh.face_count();
+  if (corner_uv.size() != 6 * nf)
+    return Status::error(ErrorCode::kInvalidArgument, "", "corner UVs do not match the mesh",
+                         std::to_string(corner_uv.size()) + " floats for " + std::to_string(nf) + " faces");
+  if (topology.opposite.size() != 3 * nf)
+    return Status::error(ErrorCode::kInvalidArgument, "", "topology does not match the mesh");
+  if (!patch_in.empty() && patch_in.size() != nf)
+    return Status::error(ErrorCode::kInvalidArgument, "", "patch ids do not match the mesh",
+                         std::to_string(patch_in.size()) + " ids for " + std::to_string(nf) + " faces");
+  if (!(options.texture_width_px > 0) || !(options.texture_height_px > 0) ||
+      !std::isfinite(options.texture_width_px) || !std::isfinite(options.texture_height_px))
+    return Status::error(ErrorCode::kInvalidArgument, "", "texture size must be positive");
+  for (size_t i = 0; i < corner_uv.size(); ++i)
+    if (!std::isfinite(corner_uv[i]))
+      return Status::error(ErrorCode::kInvalidMesh, "", "UV is not finite", "corner " + std::to_string(i / 2));
+  for (size_t f = 0; f < patch_in.size(); ++f)
+    if (patch_in[f] >= nf)
+      return Status::error(ErrorCode::kInvalidArgument, "", "patch id out of range", "face " + std::to_string(f));
+
+  std::vector<uint32_t> derived;
+  std::span<const uint32_t> patch = patch_in;
+  if (patch.empty()) {
+    derive_patches(mesh, topology, corner_uv, derived);
+    patch = derived;
+  }
+  metrics.faces = nf;
+
+  // The per-face and per-edge passes run on fixed chunks (internal/parallel_chunks.h), their
+  // partial sums added in chunk order: the figures do not depend on the thread count.
+  const size_t threads = internal::parallel_threads(nf, options.threads);
+  const size_t chunks = internal::chunk_count(nf);
+
+  // Pass 1: areas and the sign of each face's UV area (kDegenerate: skipped), then, in face order,
+  // orientation votes per patch and patch sizes.
+  constexpr int8_t kDegenerate = 2;
+  std::vector<int8_t> sign(nf);
+  struct AreaSums {
+    double uv = 0, surface = 0;
+    size_t kept = 0;  // non-degenerate faces
+  };
+  std::vector<AreaSums> area_sums(chunks);
+  internal::for_each_chunk(nf, threads, [&](size_t begin, size_t end, size_t chunk) {
+    AreaSums sums;
+    for (size_t f = begin; f < end; ++f) {
+      const Face face = load_face(mesh, corner_uv, f);
+      if (face.degenerate) {
+        sign[f] = kDegenerate;
+        continue;
+      }
+      sums.uv += std::abs(face.area_uv);
+      sums.surface += face.area3d;
+      ++sums.kept;
+      sign[f] = face.area_uv > 0 ? 1 : (face.area_uv < 0 ? -1 : 0);
+    }
+    area_sums[chunk] = sums;
+  });
+  uint32_t patch_end = 0;  // ids are < #F, but usually few: per-patch arrays sized by the largest
+  for (const uint32_t p : patch) patch_end = std::max(patch_end, p + 1);
+  std::vector<uint32_t> patch_faces(patch_end, 0);
+  std::vector<int64_t> patch_vote(patch_end, 0);  // (# positive) - (# negative) UV-area faces
+  for (size_t f = 0; f < nf; ++f) {
+    ++patch_faces[patch[f]];
+    if (sign[f] != kDegenerate) patch_vote[patch[f]] += sign[f];
+  }
+  double sum_uv = 0, sum_3d = 0;
+  std::vector<size_t> kept_before(chunks + 1, 0);  // non-degenerate faces in the chunks before
+  for (size_t c = 0; c < chunks; ++c) {
+    sum_uv += area_sums[c].uv;
+    sum_3d += area_sums[c].surface;
+    kept_before[c + 1] = kept_before[c] + area_sums[c].kept;
+  }
+  const size_t counted = kept_before[chunks];
+  metrics.degenerate_faces = nf - counted;
+  for (size_t p = 0; p < patch_end; ++p) {
+    if (patch_faces[p] > 0) ++metrics.patches;
+    if (patch_faces[p] == 1) ++metrics.single_face_patches;
+  }
+  if (!(sum_3d > 0))
+    return Status::error(ErrorCode::kInvalidMesh, "", "every face has zero 3D area");
+  if (!(sum_uv > 0))
+    return Status::error(ErrorCode::kInvalidMesh, "", "every face has zero UV area");
+  const double scale = sum_uv / sum_3d;  // R
+  metrics.uv_scale = scale;
+
+  // Pass 2: per-face quantities, per non-degenerate face in face order.
+  std::vector<double> angles, ratios, areas;
+  for (std::vector<double>* v : {&angles, &ratios, &areas}) {
+    internal::reserve_huge(*v, counted);  // fresh and large: huge pages (huge_pages.h)
+    v->resize(counted);
+  }
+  struct FaceSums {
+    double r = 0, l2_num = 0, l2_den = 0, gamma_max = 0;
+    size_t flipped = 0, zero_uv_area = 0;
+  };
+  std::vector<FaceSums> face_sums(chunks);
+  internal::for_each_chunk(nf, threads, [&](size_t begin, size_t end, size_t chunk) {
+    FaceSums sums;
+    size_t i = kept_before[chunk];
+    for (size_t f = begin; f < end; ++f) {
+      if (sign[f] == kDegenerate) continue;
+      const Face face = load_face(mesh, corner_uv, f);
+      const double r = std::abs(face.area_uv) / face.area3d;
+      sums.r += r;
+      ratios[i] = r;
+      areas[i] = face.area3d;
+      angles[i] = angle_distortion_deg(face);
+      ++i;
+      // Ties (and empty votes) count as counter-clockwise, the orientation the mapping produces.
+      const bool majority_positive = patch_vote[patch[f]] >= 0;
+      if (face.area_uv == 0) {
+        ++sums.flipped;
+        ++sums.zero_uv_area;
+        continue;  // infinite Sander stretch: excluded from L2 / Linf
+      }
+      if ((face.area_uv > 0) != majority_positive) ++sums.flipped;
+      double g = 0;
+      sums.l2_num += face.area3d * sander_stretch(face, g);
+      sums.l2_den += face.area3d;
+      sums.gamma_max = std::max(sums.gamma_max, g);
+    }
+    face_sums[chunk] = sums;
+  });
+  double sum_r = 0, l2_num = 0, l2_den = 0, gamma_max = 0;
+  for (const FaceSums& sums : face_sums) {
+    sum_r += sums.r;
+    l2_num += sums.l2_num;
+    l2_den += sums.l2_den;
+    gamma_max = std::max(gamma_max, sums.gamma_max);
+    metrics.flipped += sums.flipped;
+    metrics.zero_uv_area_faces += sums.zero_uv_area;
+  }
+  const double mean_r = sum_r / static_cast<double>(counted);
+  // Second pass over r for a numerically stable variance (both forms).
+  double var_sum = 0, var_w_sum = 0;
+  for (size_t i = 0; i < ratios.size(); ++i) {
+    const double r = ratios[i];
+    var_sum += (r - mean_r) * (r - mean_r);
+    var_w_sum += areas[i] * (r - scale) * (r - scale);  // the area-weighted mean of r is R
+  }
+  metrics.stretch = mean_r > 0 ? std::sqrt(var_sum / static_cast<double>(counted)) / mean_r : 0;
+  metrics.stretch_area_weighted = std::sqrt(var_w_sum / sum_3d) / scale;
+  metrics.distortion_deg = median(angles);
+  if (l2_den > 0) {
+    metrics.l2_stretch = std::sqrt(l2_num / l2_den) * std::sqrt(scale);
+    metrics.linf_stretch = gamma_max * std::sqrt(scale);
+  }
+
+  // Seams: over distinct edges (a paired edge once, a boundary edge once).
+  struct SeamSums {
+    double total_length = 0, seam_length = 0, gap_weighted = 0, gap_plain = 0, invisible_length = 0;
+    size_t seam_edges = 0, invisible_count = 0;
+  };
+  const size_t corners = 3 * nf;
+  std::vector<SeamSums> seam_sums(internal::chunk_count(corners));
+  internal::for_each_chunk(corners, threads, [&](size_t begin, size_t end, size_t chunk) {
+    SeamSums sums;
+    for (size_t e = begin; e < end; ++e) {
+      const uint32_t o = topology.opposite[e];
+      if (o != kInvalid && o < e) continue;
+      const size_t f = e / 3, k = e % 3;
+      const double length =
+          norm(sub(position(mesh, mesh.indices[3 * f + (k + 1) % 3]), position(mesh, mesh.indices[3 * f + k])));
+      sums.total_length += length;
+      if (o == kInvalid) continue;
+      const EdgeSides s = edge_sides(e, o);
+      if (same_uv(corner_uv, s.fa, s.ga) && same_uv(corner_uv, s.fb, s.gb)) continue;
+      ++sums.seam_edges;
+      sums.seam_length += length;
+      const double w = options.texture_width_px, h = options.texture_height_px;
+      const double gap_a = toroidal_distance(double{corner_uv[2 * s.fa]} - corner_uv[2 * s.ga],
+                                             double{corner_uv[2 * s.fa + 1]} - corner_uv[2 * s.ga + 1], w, h);
+      const double gap_b = toroidal_distance(double{corner_uv[2 * s.fb]} - corner_uv[2 * s.gb],
+                                             double{corner_uv[2 * s.fb + 1]} - corner_uv[2 * s.gb + 1], w, h);
+      const double gap = 0.5 * (gap_a + gap_b);
+      sums.gap_weighted += length * gap;
+      sums.gap_plain += gap;
+      if (gap < 1.0) {
+        sums.invisible_length += length;
+        ++sums.invisible_count;
+      }
+    }
+    seam_sums[chunk] = sums;
+  });
+  double total_length = 0, seam_length = 0, gap_weighted = 0, gap_plain = 0, invisible_length = 0;
+  size_t invisible_count = 0;
+  for (const SeamSums& sums : seam_sums) {
+    total_length += sums.total_length;
+    seam_length += sums.seam_length;
+    gap_weighted += sums.gap_weighted;
+    gap_plain += sums.gap_plain;
+    invisible_length += sums.invisible_length;
+    invisible_count += sums.invisible_count;
+    metrics.seam_edges += sums.seam_edges;
+  }
+  if (total_length > 0) metrics.seam_length_ratio = seam_length / total_length;
+  if (metrics.seam_edges == 0) {
+    metrics.seam_invisible_ratio = 1.0;
+  } else if (seam_length > 0) {
+    metrics.seam_gap_px = gap_weighted / seam_length;
+    metrics.seam_invisible_ratio = invisible_length / seam_length;
+  } else {  // only zero-length seam edges: plain means
+    const double n = static_cast<double>(metrics.seam_edges);
+    metrics.seam_gap_px = gap_plain / n;
+    metrics.seam_invisible_ratio = static_cast<double>(invisible_count) / n;
+  }
+  return Status::ok();
+}
+
+}  // namespace tailor

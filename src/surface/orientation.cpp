@@ -1,0 +1,312 @@
+// Per-face frames and the orientation field (thesis 2.2: "the orientation vector of each triangle
+// is taken as the projection of the first principal vector onto the triangle").
+//
+// This work is based on:
+//   V. Singh, A. M. Namboodiri, "Efficient texture mapping by homogeneous patch discovery",
+//   ICVGIP 2012 (thesis chapter 2).
+#include "tailor/orientation.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <string>
+
+#include "util/huge_pages.h"
+#include "util/parallel_chunks.h"
+
+namespace tailor {
+namespace {
+
+struct Vec3 {
+  double x = 0, y = 0, z = 0;
+};
+inline Vec3 sub(const Vec3& a, const Vec3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline Vec3 add(const Vec3& a, const Vec3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline Vec3 mul(const Vec3& a, double s) { return {a.x * s, a.y * s, a.z * s}; }
+inline double dot(const Vec3& a, const Vec3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline Vec3 cross(const Vec3& a, const Vec3& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+inline double norm(const Vec3& a) { return std::sqrt(dot(a, a)); }
+
+// Sign convention for axes, so that the field does not depend on the eigen solver's sign choice:
+// the largest-magnitude component is positive.
+Vec3 canonical_sign(Vec3 a) {
+  const double ax = std::abs(a.x), ay = std::abs(a.y), az = std::abs(a.z);
+  const double c = (ax >= ay && ax >= az) ? a.x : (ay >= az ? a.y : a.z);
+  return c < 0 ? mul(a, -1.0) : a;
+}
+
+// Any unit vector perpendicular to a (unit).
+Vec3 perpendicular(const Vec3& a) {
+  const Vec3 helper = std::abs(a.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+  Vec3 p = cross(a, helper);
+  return mul(p, 1.0 / norm(p));
+}
+
+// A face is degenerate when its doubled area is below this fraction of its squared longest edge
+// (or the edge itself vanishes): its normal is then numerically meaningless.
+constexpr double kDegenerateRatio = 1e-10;
+
+inline Vec3 load(const float* v) { return {v[0], v[1], v[2]}; }
+inline void store(float* out, const Vec3& v) {
+  out[0] = static_cast<float>(v.x);
+  out[1] = static_cast<float>(v.y);
+  out[2] = static_cast<float>(v.z);
+}
+
+// Projects axis a into the plane of unit normal n; returns false when it nearly vanishes.
+bool project(const Vec3& a, const Vec3& n, double degenerate_cos, Vec3& o) {
+  const double an = dot(a, n);
+  if (std::abs(an) > degenerate_cos) return false;
+  o = sub(a, mul(n, an));
+  const double len = norm(o);
+  if (!(len > 1e-12)) return false;
+  o = mul(o, 1.0 / len);
+  return true;
+}
+
+}  // namespace
+
+Status compute_orientation(const Mesh& mesh, const Topology& topology, const OrientationOptions& options,
+                           FaceFrames& frames) {
+  const auto start = std::chrono::steady_clock::now();
+  frames = FaceFrames{};
+  const size_t face_count = mesh.face_count();
+  const size_t vertex_count = mesh.vertex_count();
+  if (face_count == 0) return Status::error(ErrorCode::kInvalidMesh, "", "mesh has no face");
+  if (topology.opposite.size() != 3 * face_count)
+    return Status::error(ErrorCode::kInvalidMesh, "", "topology does not match the mesh");
+  if (options.smooth_passes > 1000)
+    return Status::error(ErrorCode::kInvalidArgument, "", "smoothing passes must be at most 1000");
+  if (!(options.degenerate_cos >= 0.5f && options.degenerate_cos <= 1.f))
+    return Status::error(ErrorCode::kInvalidArgument, "", "degenerate_cos must be in [0.5, 1]");
+  if (!(options.fixed_unit_scale >= 0.f) || !std::isfinite(options.fixed_unit_scale))
+    return Status::error(ErrorCode::kInvalidArgument, "", "fixed unit scale must be finite and >= 0");
+  const float* pos = mesh.positions.data();
+  const uint32_t* idx = mesh.indices.data();
+
+  // === Normalisation into the unit cube, PCA over referenced vertices ===
+  std::vector<uint8_t> used(vertex_count, 0);
+  for (size_t c = 0; c < 3 * face_count; ++c) used[idx[c]] = 1;
+  Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY}, mean{};
+  size_t used_count = 0;
+  for (size_t v = 0; v < vertex_count; ++v) {
+    if (!used[v]) continue;
+    const Vec3 p = load(pos + 3 * v);
+    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+    mean = add(mean, p);
+    ++used_count;
+  }
+  mean = mul(mean, 1.0 / static_cast<double>(used_count));
+  double unit_scale = 1.0;
+  Vec3 origin = lo;
+  if (options.fixed_unit_scale > 0.f) {
+    unit_scale = options.fixed_unit_scale;
+    origin = {options.fixed_origin[0], options.fixed_origin[1], options.fixed_origin[2]};
+  } else {
+    const double longest = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+    unit_scale = longest > 0 ? 1.0 / longest : 1.0;
+  }
+
+  Vec3 axis, axis2;
+  if (options.axis == AxisSource::kUser) {
+    axis = {options.user_axis[0], options.user_axis[1], options.user_axis[2]};
+    const double len = norm(axis);
+    if (!(len > 0) || !std::isfinite(len))
+      return Status::error(ErrorCode::kInvalidArgument, "", "orientation axis must be non-zero and finite");
+    axis = mul(axis, 1.0 / len);
+    Vec3 second{options.user_axis2[0], options.user_axis2[1], options.user_axis2[2]};
+    // Keep only the part of the fallback perpendicular to the axis; derive one if nothing is left.
+    second = sub(second, mul(axis, dot(second, axis)));
+    const double len2 = norm(second);
+    axis2 = (len2 > 1e-6 && std::isfinite(len2)) ? mul(second, 1.0 / len2) : perpendicular(axis);
+  } else {
+    // Covariance in double about the mean: no catastrophic cancellation for offset meshes.
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (size_t v = 0; v < vertex_count; ++v) {
+      if (!used[v]) continue;
+      const Vec3 d = sub(load(pos + 3 * v), mean);
+      const Eigen::Vector3d e(d.x, d.y, d.z);
+      cov += e * e.transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(cov);
+    const Eigen::Matrix3d vecs = solver.eigenvectors();  // eigenvalues ascending
+    if (solver.info() != Eigen::Success || !vecs.allFinite()) {
+      axis = {1, 0, 0};
+      axis2 = {0, 1, 0};
+    } else {
+      axis = canonical_sign({vecs(0, 2), vecs(1, 2), vecs(2, 2)});
+      axis2 = canonical_sign({vecs(0, 1), vecs(1, 1), vecs(2, 1)});
+    }
+  }
+
+  // === Per-face normal, area, orientation ===
+  // ~76 bytes per face of fresh memory: on large meshes, faulting it in 4 KiB pages costs more than
+  // the arithmetic, so ask for huge pages first.
+  auto allocate = [](std::vector<float>& v, size_t n) {
+    internal::reserve_huge(v, n);
+    v.resize(n);
+  };
+  allocate(frames.normal, 3 * face_count);
+  allocate(frames.orientation, 3 * face_count);
+  allocate(frames.bitangent, 3 * face_count);
+  allocate(frames.area, face_count);
+  allocate(frames.local, 6 * face_count);
+  allocate(frames.variation, face_count);
+  allocate(frames.anchor, 2 * face_count);
+  const double degenerate_cos = options.degenerate_cos;
+  std::vector<uint8_t> degenerate(face_count, 0);
+  // Corner k of face f in normalised coordinates.
+  auto corner = [&](size_t f, int k) { return mul(sub(load(pos + 3 * idx[3 * f + k]), origin), unit_scale); };
+  // Bitangent, corners in the face frame and anchor, from the stored (float) normal and orientation.
+  auto write_corner_frame = [&](size_t f, const Vec3& p0, const Vec3& p1, const Vec3& p2) {
+    const Vec3 n = load(&frames.normal[3 * f]);
+    const Vec3 o = load(&frames.orientation[3 * f]);
+    const Vec3 p = cross(n, o);  // (o, p, n) right-handed: counter-clockwise stays counter-clockwise
+    store(&frames.bitangent[3 * f], p);
+    float* local = &frames.local[6 * f];
+    const Vec3 d1 = sub(p1, p0), d2 = sub(p2, p0);
+    local[0] = 0.f;
+    local[1] = 0.f;
+    local[2] = static_cast<float>(dot(d1, o));
+    local[3] = static_cast<float>(dot(d1, p));
+    local[4] = static_cast<float>(dot(d2, o));
+    local[5] = static_cast<float>(dot(d2, p));
+    frames.anchor[2 * f] = static_cast<float>(dot(p0, o));
+    frames.anchor[2 * f + 1] = static_cast<float>(dot(p0, p));
+  };
+  // Faces are independent here: they are cut into fixed chunks shared out among the threads
+  // (each writes only its own faces; counters are summed after), so the result is the same
+  // bit for bit whatever the thread count.
+  auto frame_faces = [&](size_t begin, size_t end, size_t& degenerate_faces, size_t& fallback_faces) {
+    for (size_t f = begin; f < end; ++f) {
+      const Vec3 p0 = corner(f, 0), p1 = corner(f, 1), p2 = corner(f, 2);
+      const Vec3 e1 = sub(p1, p0), e2 = sub(p2, p0);
+      Vec3 n = cross(e1, e2);
+      const double twice_area = norm(n);
+      const double longest2 = std::max({dot(e1, e1), dot(e2, e2), dot(sub(p2, p1), sub(p2, p1))});
+      Vec3 o;
+      if (!(twice_area > kDegenerateRatio * longest2) || !(longest2 > 0)) {
+        // Zero-area face: any orthonormal frame; o along its longest edge when there is one.
+        degenerate[f] = 1;
+        ++degenerate_faces;
+        n = perpendicular(axis);
+        if (!project(axis, n, degenerate_cos, o)) o = perpendicular(n);
+      } else {
+        n = mul(n, 1.0 / twice_area);
+        if (!project(axis, n, degenerate_cos, o)) {
+          ++fallback_faces;
+          if (!project(axis2, n, degenerate_cos, o)) o = perpendicular(n);
+        }
+      }
+      store(&frames.normal[3 * f], n);
+      store(&frames.orientation[3 * f], o);
+      frames.area[f] = static_cast<float>(0.5 * twice_area);
+      // Without smoothing the frame is final: finish the face while its corners are in cache.
+      if (options.smooth_passes == 0) write_corner_frame(f, p0, p1, p2);
+    }
+  };
+  const size_t threads = internal::parallel_threads(face_count, options.threads);
+  std::vector<size_t> degenerate_count(internal::chunk_count(face_count), 0),
+      fallback_count(internal::chunk_count(face_count), 0);
+  internal::for_each_chunk(face_count, threads, [&](size_t begin, size_t end, size_t chunk) {
+    frame_faces(begin, end, degenerate_count[chunk], fallback_count[chunk]);
+  });
+  for (size_t c = 0; c < degenerate_count.size(); ++c) {
+    frames.degenerate_faces += static_cast<uint32_t>(degenerate_count[c]);
+    frames.fallback_faces += static_cast<uint32_t>(fallback_count[c]);
+  }
+
+  // === Optional smoothing: Jacobi passes (double-buffered, so the result is order independent) ===
+  if (options.smooth_passes > 0) {
+    std::vector<float> next(frames.orientation.size());
+    for (uint32_t pass = 0; pass < options.smooth_passes; ++pass) {
+      for (size_t f = 0; f < face_count; ++f) {
+        Vec3 sum = load(&frames.orientation[3 * f]);
+        if (!degenerate[f]) {
+          for (int k = 0; k < 3; ++k) {
+            const uint32_t g = neighbour_face(topology, static_cast<uint32_t>(3 * f + k));
+            if (g == kInvalid || degenerate[g]) continue;
+            sum = add(sum, load(&frames.orientation[3 * g]));
+          }
+          Vec3 o;
+          // The sum of neighbours can cancel at a field singularity: keep the face's own value.
+          if (project(sum, load(&frames.normal[3 * f]), 1.0, o)) sum = o;
+          else sum = load(&frames.orientation[3 * f]);
+        }
+        store(&next[3 * f], sum);
+      }
+      frames.orientation.swap(next);
+    }
+  }
+
+  // === Bitangent, corner coordinates in the face frame, anchor (after smoothing) ===
+  if (options.smooth_passes > 0) {
+    for (size_t f = 0; f < face_count; ++f) {
+      write_corner_frame(f, corner(f, 0), corner(f, 1), corner(f, 2));
+    }
+  }
+
+  // === Variation: sum of angles to the edge neighbours' orientations (the thesis's age) ===
+  // acos dominates this stage, so each interior edge's angle is computed once, at its half-edge
+  // of lower id, then each face adds its three in edge order (the same values in the same order
+  // as if each face had computed them). Both passes write only their own chunk's half-edges or
+  // faces: identical for any thread count.
+  std::vector<double> edge_angle;
+  internal::reserve_huge(edge_angle, 3 * face_count);
+  edge_angle.resize(3 * face_count);
+  const uint32_t* opposite = topology.opposite.data();
+  internal::for_each_chunk(face_count, threads, [&](size_t begin, size_t end, size_t) {
+    for (size_t f = begin; f < end; ++f) {
+      const Vec3 o = load(&frames.orientation[3 * f]);
+      for (size_t e = 3 * f; e < 3 * f + 3; ++e) {
+        if (opposite[e] == kInvalid || opposite[e] < e) continue;
+        const Vec3 other = load(&frames.orientation[3 * size_t{opposite[e] / 3}]);
+        edge_angle[e] = std::acos(std::clamp(dot(o, other), -1.0, 1.0));
+      }
+    }
+  });
+  internal::for_each_chunk(face_count, threads, [&](size_t begin, size_t end, size_t) {
+    for (size_t f = begin; f < end; ++f) {
+      double sum = 0;
+      for (size_t e = 3 * f; e < 3 * f + 3; ++e) {
+        if (opposite[e] == kInvalid) continue;
+        sum += edge_angle[std::min<size_t>(e, opposite[e])];
+      }
+      frames.variation[f] = static_cast<float>(sum);
+    }
+  });
+
+  store(frames.axis.data(), axis);
+  store(frames.axis2.data(), axis2);
+  store(frames.origin.data(), origin);
+  store(frames.bbox_min.data(), lo);
+  store(frames.bbox_max.data(), hi);
+  frames.unit_scale = static_cast<float>(unit_scale);
+  frames.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return Status::ok();
+}
+
+double mean_neighbour_angle(const Topology& topology, const FaceFrames& frames) {
+  double sum = 0;
+  size_t count = 0;
+  const size_t corners = topology.opposite.size();
+  for (size_t e = 0; e < corners; ++e) {
+    const uint32_t o = topology.opposite[e];
+    if (o == kInvalid || o < e) continue;
+    const size_t f = e / 3, g = o / 3;
+    const float* a = &frames.orientation[3 * f];
+    const float* b = &frames.orientation[3 * g];
+    const double d = static_cast<double>(a[0]) * b[0] + static_cast<double>(a[1]) * b[1] +
+                     static_cast<double>(a[2]) * b[2];
+    sum += std::acos(std::clamp(d, -1.0, 1.0));
+    ++count;
+  }
+  return count ? sum / static_cast<double>(count) : 0.0;
+}
+
+}  // namespace tailor

@@ -1,0 +1,334 @@
+// Quality metrics of a self-tileable texture (see TileMetrics in tailor/tiling.h).
+//
+// This work is based on:
+//   C. Barnes, E. Shechtman, A. Finkelstein, D. B. Goldman, "PatchMatch: A Randomized Correspondence
+//   Algorithm for Structural Image Editing", SIGGRAPH 2009 (approximate nearest patches for the
+//   patch-coherence metric: random init, propagation, random search with halving radius).
+//
+// Patch coherence is evaluated on a fixed grid of tile patches (stride 1 up to 128 x 128, then the
+// smallest stride giving <= 16384 patches) so that a 512 px image costs ~0.1 s; the generator is
+// seeded with a constant, so the value is deterministic.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "texture/tiling_util.h"
+#include "tailor/image_ops.h"
+#include "tailor/tiling.h"
+
+namespace tailor {
+
+using internal::Plane;
+
+namespace {
+
+constexpr int kPatch = 7;
+constexpr int kMaxPatches = 16384;
+constexpr int kIterations = 6;
+constexpr int kSamplesPerRadius = 1;  // random samples per search radius
+constexpr int kBins = 64;
+
+double median_of(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const size_t mid = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
+  double m = v[mid];
+  if (v.size() % 2 == 0) m = 0.5 * (m + *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid)));
+  return m;
+}
+
+double ratio(double value, double median) {
+  if (median < 1e-9) return value < 1e-9 ? 1.0 : 1e9;
+  return value / median;
+}
+
+//! Mean absolute difference across each column boundary (x, x+1 mod W) and row boundary.
+void boundary_differences(const Plane& p, std::vector<double>& cols, std::vector<double>& rows) {
+  const int w = p.width, h = p.height, c = p.channels;
+  cols.assign(static_cast<size_t>(w), 0.0);
+  rows.assign(static_cast<size_t>(h), 0.0);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const float* a = p.at(x, y);
+      const float* right = p.at((x + 1) % w, y);
+      const float* down = p.at(x, (y + 1) % h);
+      double dx = 0.0, dy = 0.0;
+      for (int k = 0; k < c; ++k) {
+        dx += std::abs(a[k] - right[k]);
+        dy += std::abs(a[k] - down[k]);
+      }
+      cols[static_cast<size_t>(x)] += dx;
+      rows[static_cast<size_t>(y)] += dy;
+    }
+  }
+  for (double& v : cols) v /= static_cast<double>(h) * c;
+  for (double& v : rows) v /= static_cast<double>(w) * c;
+}
+
+struct SeamStats {
+  double wrap_x = 0.0, wrap_y = 0.0, worst_all = 0.0, worst_interior = 0.0;
+};
+
+SeamStats seam_stats(const Plane& p) {
+  std::vector<double> cols, rows;
+  boundary_differences(p, cols, rows);
+  const double mc = median_of(std::vector<double>(cols.begin(), cols.end() - 1));
+  const double mr = median_of(std::vector<double>(rows.begin(), rows.end() - 1));
+  SeamStats s;
+  s.wrap_x = ratio(cols.back(), mc);
+  s.wrap_y = ratio(rows.back(), mr);
+  for (size_t i = 0; i < cols.size(); ++i) {
+    const double r = ratio(cols[i], mc);
+    s.worst_all = std::max(s.worst_all, r);
+    if (i + 1 < cols.size()) s.worst_interior = std::max(s.worst_interior, r);
+  }
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const double r = ratio(rows[i], mr);
+    s.worst_all = std::max(s.worst_all, r);
+    if (i + 1 < rows.size()) s.worst_interior = std::max(s.worst_interior, r);
+  }
+  return s;
+}
+
+double gradient_energy(const Plane& p) {
+  const int w = p.width, h = p.height, c = p.channels;
+  double sum = 0.0;
+  for (int y = 0; y + 1 < h; ++y)
+    for (int x = 0; x + 1 < w; ++x) {
+      const float* a = p.at(x, y);
+      const float* right = p.at(x + 1, y);
+      const float* down = p.at(x, y + 1);
+      for (int k = 0; k < c; ++k) sum += std::abs(a[k] - right[k]) + std::abs(a[k] - down[k]);
+    }
+  return sum / (static_cast<double>(w - 1) * (h - 1) * c);
+}
+
+double histogram_l1(const Image& a, const Image& b) {
+  const int c = a.channels;
+  double total = 0.0;
+  for (int k = 0; k < c; ++k) {
+    std::vector<double> ha(kBins, 0.0), hb(kBins, 0.0);
+    for (size_t i = static_cast<size_t>(k); i < a.pixels.size(); i += static_cast<size_t>(c))
+      ha[a.pixels[i] >> 2] += 1.0;
+    for (size_t i = static_cast<size_t>(k); i < b.pixels.size(); i += static_cast<size_t>(c))
+      hb[b.pixels[i] >> 2] += 1.0;
+    const double na = static_cast<double>(a.pixels.size() / static_cast<size_t>(c));
+    const double nb = static_cast<double>(b.pixels.size() / static_cast<size_t>(c));
+    for (int i = 0; i < kBins; ++i)
+      total += std::abs(ha[static_cast<size_t>(i)] / na - hb[static_cast<size_t>(i)] / nb);
+  }
+  return total / c;
+}
+
+//! Mean over channels of the per-channel variance (8-bit units squared).
+double variance(const Plane& p) {
+  const int c = p.channels;
+  const double n = static_cast<double>(p.width) * p.height;
+  double total = 0.0;
+  for (int k = 0; k < c; ++k) {
+    double s = 0.0, s2 = 0.0;
+    for (size_t i = static_cast<size_t>(k); i < p.px.size(); i += static_cast<size_t>(c)) {
+      s += p.px[i];
+      s2 += static_cast<double>(p.px[i]) * p.px[i];
+    }
+    total += std::max(0.0, s2 / n - (s / n) * (s / n));
+  }
+  return total / c;
+}
+
+//! PatchMatch nearest-patch distances from a fixed grid of (toroidal) `source` patches to the
+//! patches of `target` (non-toroidal). Returns the mean per-sample squared distance.
+double mean_nearest_patch_distance(const Plane& source, const Plane& target) {
+  const int c = source.channels;
+  const int w = source.width, h = source.height;
+  // Toroidally padded copy of the source, so that a patch is a plain sub-rectangle.
+  const int pw = w + kPatch - 1, ph = h + kPatch - 1;
+  std::vector<float> padded(static_cast<size_t>(pw) * ph * c);
+  for (int y = 0; y < ph; ++y)
+    for (int x = 0; x < pw; ++x) {
+      const float* s = source.at(x % w, y % h);
+      std::copy(s, s + c, &padded[(static_cast<size_t>(y) * pw + x) * c]);
+    }
+  const int tx = target.width - kPatch + 1, ty = target.height - kPatch + 1;
+  int stride = 1;
+  while ((((w + stride - 1) / stride) * ((h + stride - 1) / stride)) > kMaxPatches) ++stride;
+  const int gx = (w + stride - 1) / stride, gy = (h + stride - 1) / stride;
+  // Grid origin: 0, unless the last patch of a row (column) would stop short of the wrap, which
+  // happens for strides above kPatch - 1 (images over ~900 px): the source's own wrap seam would
+  // never be sampled and an exemplar's toroidal coherence would read 0. Shift the grid so that
+  // the last patch straddles the wrap.
+  const int ox = std::max(0, w - (kPatch - 1) - (gx - 1) * stride);
+  const int oy = std::max(0, h - (kPatch - 1) - (gy - 1) * stride);
+  const size_t count = static_cast<size_t>(gx) * gy;
+
+  auto distance = [&](int sx, int sy, int u, int v, float bound) {
+    float sum = 0.0f;
+    for (int j = 0; j < kPatch; ++j) {
+      const float* a = &padded[(static_cast<size_t>(sy + j) * pw + sx) * c];
+      const float* b = target.at(u, v + j);
+      for (int i = 0; i < kPatch * c; ++i) {
+        const float d = a[i] - b[i];
+        sum += d * d;
+      }
+      if (sum >= bound) return sum;
+    }
+    return sum;
+  };
+
+  // Exact copies are found exactly: every target patch is hashed, and a source patch whose hash
+  // matches (and whose samples are verified equal) gets distance 0, the true minimum. PatchMatch
+  // then propagates these offsets to the patches around them.
+  auto hash_patch = [c](const float* first, size_t row_stride) {
+    uint64_t hv = 1469598103934665603ull;
+    for (int j = 0; j < kPatch; ++j) {
+      const float* row = first + static_cast<size_t>(j) * row_stride;
+      for (int i = 0; i < kPatch * c; ++i) {
+        hv ^= static_cast<uint64_t>(static_cast<int64_t>(std::lround(row[i] * 4.0f)));
+        hv *= 1099511628211ull;
+      }
+    }
+    return hv;
+  };
+  std::vector<std::pair<uint64_t, uint32_t>> table(static_cast<size_t>(tx) * ty);
+  for (int v = 0; v < ty; ++v)
+    for (int u = 0; u < tx; ++u)
+      table[static_cast<size_t>(v) * tx + u] = {hash_patch(target.at(u, v), static_cast<size_t>(target.width) * c),
+                                                static_cast<uint32_t>(v * tx + u)};
+  std::sort(table.begin(), table.end());
+
+  std::vector<int> nu(count), nv(count);
+  std::vector<float> cost(count);
+  internal::SplitMix64 rng(0x5EED5EEDull);
+  for (size_t i = 0; i < count; ++i) {
+    const int sx = ox + static_cast<int>(i % static_cast<size_t>(gx)) * stride;
+    const int sy = oy + static_cast<int>(i / static_cast<size_t>(gx)) * stride;
+    nu[i] = static_cast<int>(rng.below(static_cast<uint32_t>(tx)));
+    nv[i] = static_cast<int>(rng.below(static_cast<uint32_t>(ty)));
+    cost[i] = distance(sx, sy, nu[i], nv[i], std::numeric_limits<float>::max());
+    const uint64_t hv = hash_patch(&padded[(static_cast<size_t>(sy) * pw + sx) * c], static_cast<size_t>(pw) * c);
+    auto it = std::lower_bound(table.begin(), table.end(), std::make_pair(hv, uint32_t{0}));
+    for (int tries = 0; it != table.end() && it->first == hv && tries < 4; ++it, ++tries) {
+      const int u = static_cast<int>(it->second % static_cast<uint32_t>(tx));
+      const int v = static_cast<int>(it->second / static_cast<uint32_t>(tx));
+      if (distance(sx, sy, u, v, std::numeric_limits<float>::max()) == 0.0f) {
+        nu[i] = u;
+        nv[i] = v;
+        cost[i] = 0.0f;
+        break;
+      }
+    }
+  }
+  auto try_candidate = [&](size_t i, int sx, int sy, int u, int v) {
+    u = std::clamp(u, 0, tx - 1);
+    v = std::clamp(v, 0, ty - 1);
+    if (u == nu[i] && v == nv[i]) return;
+    const float d = distance(sx, sy, u, v, cost[i]);
+    if (d < cost[i]) {
+      cost[i] = d;
+      nu[i] = u;
+      nv[i] = v;
+    }
+  };
+  const int max_radius = std::max(target.width, target.height);
+  for (int iter = 0; iter < kIterations; ++iter) {
+    const bool forward = iter % 2 == 0;
+    const int step = forward ? 1 : -1;
+    for (size_t n = 0; n < count; ++n) {
+      const size_t i = forward ? n : count - 1 - n;
+      if (cost[i] == 0.0f) continue;  // already exact
+      const int ix = static_cast<int>(i % static_cast<size_t>(gx)), iy = static_cast<int>(i / static_cast<size_t>(gx));
+      const int sx = ox + ix * stride, sy = oy + iy * stride;
+      // Propagation from the previous neighbours in scan order.
+      const int px = ix - step, py = iy - step;
+      if (px >= 0 && px < gx) {
+        const size_t k = static_cast<size_t>(iy) * gx + px;
+        try_candidate(i, sx, sy, nu[k] + step * stride, nv[k]);
+      }
+      if (py >= 0 && py < gy) {
+        const size_t k = static_cast<size_t>(py) * gx + ix;
+        try_candidate(i, sx, sy, nu[k], nv[k] + step * stride);
+      }
+      // Random search around the current best with a halving radius.
+      for (int r = max_radius; r >= 1; r /= 2) {
+        for (int rep = 0; rep < kSamplesPerRadius; ++rep) {
+          const int du = static_cast<int>(rng.below(static_cast<uint32_t>(2 * r + 1))) - r;
+          const int dv = static_cast<int>(rng.below(static_cast<uint32_t>(2 * r + 1))) - r;
+          try_candidate(i, sx, sy, nu[i] + du, nv[i] + dv);
+        }
+      }
+    }
+  }
+  double total = 0.0;
+  for (float v : cost) total += v;
+  return total / (static_cast<double>(count) * kPatch * kPatch * c);
+}
+
+}  // namespace
+
+Status tile_metrics(const Image& tile_in, const Image* exemplar_in, TileMetrics& metrics) {
+  metrics = TileMetrics{};
+  TAILOR_RETURN_IF_ERROR(check_image(tile_in));
+  if (tile_in.width < 8 || tile_in.height < 8)
+    return Status::error(ErrorCode::kInvalidImage, "", "image too small to evaluate (at least 8 px a side)");
+  Image tile = tile_in;
+  Image exemplar;
+  if (exemplar_in) {
+    TAILOR_RETURN_IF_ERROR(check_image(*exemplar_in));
+    if (exemplar_in->width < 8 || exemplar_in->height < 8)
+      return Status::error(ErrorCode::kInvalidImage, "", "exemplar too small to evaluate (at least 8 px a side)");
+    exemplar = *exemplar_in;
+    if (exemplar.channels != tile.channels) {
+      tile = to_grey(tile);
+      exemplar = to_grey(exemplar);
+    }
+  }
+  const Plane tp = internal::to_plane(tile);
+  const SeamStats ts = seam_stats(tp);
+  metrics.wrap_ratio_x = ts.wrap_x;
+  metrics.wrap_ratio_y = ts.wrap_y;
+  metrics.worst_seam_ratio = ts.worst_all;
+  metrics.gradient_energy = gradient_energy(tp);
+  if (!exemplar_in) return Status::ok();
+
+  const Plane ep = internal::to_plane(exemplar);
+  const SeamStats es = seam_stats(ep);
+  metrics.has_exemplar = true;
+  metrics.exemplar_worst_seam_ratio = es.worst_interior;
+  metrics.exemplar_wrap_ratio_x = es.wrap_x;
+  metrics.exemplar_wrap_ratio_y = es.wrap_y;
+  metrics.histogram_l1 = histogram_l1(tile, exemplar);
+  const double eg = gradient_energy(ep);
+  metrics.gradient_ratio = ratio(metrics.gradient_energy, eg);
+  const double var = std::max(variance(ep), 1e-6);
+  if (ep.width >= kPatch && ep.height >= kPatch) {
+    metrics.patch_coherence = mean_nearest_patch_distance(tp, ep) / var;
+    metrics.exemplar_patch_coherence = mean_nearest_patch_distance(ep, ep) / var;
+  }
+  return Status::ok();
+}
+
+bool meets_tile_targets(const TileMetrics& m, std::string* failed) {
+  std::string out;
+  auto check = [&](bool ok, const char* what) {
+    if (!ok) out += (out.empty() ? "" : ", ") + std::string(what);
+  };
+  check(m.wrap_ratio_x >= 0.8 && m.wrap_ratio_x <= 1.2, "wrap ratio x outside [0.8, 1.2]");
+  check(m.wrap_ratio_y >= 0.8 && m.wrap_ratio_y <= 1.2, "wrap ratio y outside [0.8, 1.2]");
+  if (m.has_exemplar) {
+    check(m.worst_seam_ratio <= std::max(m.exemplar_worst_seam_ratio, 1.5),
+          "worst seam above the exemplar's (and 1.5)");
+    check(m.histogram_l1 <= 0.1, "histogram L1 above 0.1");
+    check(m.gradient_ratio >= 0.95, "gradient ratio below 0.95");
+    // No allowance: the estimator is deterministic (constant seed), and it can only overestimate
+    // the tile's figure (patches not copied verbatim are matched approximately).
+    check(m.patch_coherence <= m.exemplar_patch_coherence,
+          "patch coherence worse than the exemplar's");
+  } else {
+    check(m.worst_seam_ratio <= 1.5, "worst seam above 1.5");
+  }
+  if (failed) *failed = out;
+  return out.empty();
+}
+
+}  // namespace tailor
