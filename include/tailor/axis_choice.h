@@ -9,6 +9,7 @@
 #include <array>
 #include <cstdint>
 
+#include "tailor/api.h"
 #include "tailor/mapping.h"
 #include "tailor/mesh.h"
 #include "tailor/orientation.h"
@@ -22,10 +23,10 @@ enum class AxisCandidate : uint8_t { kPca, kX, kY, kZ };
 inline constexpr int kAxisCandidates = 4;
 
 //! Short name of a candidate: "pca", "x", "y", "z".
-const char* axis_candidate_name(AxisCandidate candidate);
+TAILOR_API const char* axis_candidate_name(AxisCandidate candidate);
 
 //! `base` with its axis set to `candidate` (kPca, or kUser with a unit coordinate axis).
-OrientationOptions orientation_for(AxisCandidate candidate, const OrientationOptions& base);
+TAILOR_API OrientationOptions orientation_for(AxisCandidate candidate, const OrientationOptions& base);
 
 struct AxisChoice {
   AxisCandidate best = AxisCandidate::kPca;  //!< the candidate with the least seam length
@@ -38,7 +39,7 @@ struct AxisChoice {
 //! and picks the axis leaving the least seam length. mapping.progress, if set, gets the share of
 //! candidates done; false cancels (kCancelled). Fails as compute_orientation / map_texture do.
 //! Cost: four orientations and growths, O(F log front). Deterministic.
-Status choose_orientation_axis(const Mesh& mesh, const Topology& topology, const OrientationOptions& base,
-                               const MappingOptions& mapping, AxisChoice& choice);
+TAILOR_API Status choose_orientation_axis(const Mesh& mesh, const Topology& topology, const OrientationOptions& base,
+                                          const MappingOptions& mapping, AxisChoice& choice);
 
 }  // namespace tailor

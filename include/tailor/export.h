@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "tailor/api.h"
 #include "tailor/atlas.h"
 #include "tailor/mesh.h"
 #include "tailor/status.h"
@@ -40,7 +41,8 @@ struct ExportOptions {
 //! Fails with kInvalidArgument on an unsupported extension, mismatched atlas size or a texture size
 //! <= 0; kInvalidImage when the texture is neither PNG nor JPEG; kIo when a file cannot be read or
 //! written. Cost: O(F) time, output-sized memory.
-Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas, const ExportOptions& options);
+TAILOR_API Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas,
+                              const ExportOptions& options);
 
 //! A mesh whose vertices are split so that each vertex has one UV.
 struct SplitMesh {
@@ -55,11 +57,11 @@ struct SplitMesh {
 //! corner. corner_uv_repeats: #F*3 by 2 (any unit; copied as is). Cost: O(F): one chain of split
 //! vertices per source vertex, falling back to a flat hash table for huge fans; no per-element
 //! allocation. Deterministic.
-void split_vertices(const Mesh& mesh, std::span<const float> corner_uv_repeats, SplitMesh& out);
+TAILOR_API void split_vertices(const Mesh& mesh, std::span<const float> corner_uv_repeats, SplitMesh& out);
 
 //! The inverse, for readers of split files (.glb, .ply): merges vertices with bit-identical
 //! positions (-0 and +0 merged), keeping the first one, and rewrites mesh.indices; corner UVs are
 //! per corner and stay as they are. Returns the number of vertices removed. Cost: O(V + F).
-size_t weld_identical_positions(Mesh& mesh);
+TAILOR_API size_t weld_identical_positions(Mesh& mesh);
 
 }  // namespace tailor

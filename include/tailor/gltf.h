@@ -19,6 +19,7 @@
 #include <span>
 #include <string>
 
+#include "tailor/api.h"
 #include "tailor/image.h"
 #include "tailor/mesh.h"
 #include "tailor/status.h"
@@ -30,10 +31,10 @@ namespace tailor {
 //! empty when there is none). report may be null. Fails with kIo, kParse (not a glb, bad chunk,
 //! bad accessor), kUnsupported (no triangle primitive, sparse accessors, non-float positions),
 //! kInvalidMesh, kInvalidImage (texture present but undecodable). Cost: O(file size).
-Status read_glb_file(const std::string& path, Mesh& mesh, Image* texture, LoadReport* report = nullptr);
+TAILOR_API Status read_glb_file(const std::string& path, Mesh& mesh, Image* texture, LoadReport* report = nullptr);
 
 //! Same from memory; `name` is used in error messages only.
-Status read_glb_memory(std::span<const char> data, const std::string& name, Mesh& mesh, Image* texture,
-                       LoadReport* report = nullptr);
+TAILOR_API Status read_glb_memory(std::span<const char> data, const std::string& name, Mesh& mesh, Image* texture,
+                                  LoadReport* report = nullptr);
 
 }  // namespace tailor

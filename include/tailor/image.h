@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "tailor/api.h"
 #include "tailor/status.h"
 
 namespace tailor {
@@ -36,12 +37,12 @@ inline constexpr int kMaxImageSide = 16384;
 
 //! Checks that an Image is consistent: 1 <= width, height <= kMaxImageSide, 1 <= channels <= 4
 //! and pixels.size() == width * height * channels. Fails with kInvalidImage saying which.
-Status check_image(const Image& image);
+TAILOR_API Status check_image(const Image& image);
 
 //! Reads PNG (8 or 16 bit; 16-bit is reduced to 8), JPEG, TGA or BMP with 1-4 channels.
-Status load_image(const std::string& path, Image& image);
+TAILOR_API Status load_image(const std::string& path, Image& image);
 
 //! Writes a PNG atomically (temporary file, then rename).
-Status write_png(const std::string& path, const Image& image);
+TAILOR_API Status write_png(const std::string& path, const Image& image);
 
 }  // namespace tailor

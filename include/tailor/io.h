@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "tailor/api.h"
 #include "tailor/mesh.h"
 #include "tailor/status.h"
 
@@ -22,25 +23,25 @@ namespace tailor {
 enum class MeshFormat { kUnknown, kPly, kObj, kOff, kStl, kGlb };
 
 //! Format from the file extension (case-insensitive): .ply .obj .off .stl .glb; kUnknown otherwise.
-MeshFormat mesh_format_from_path(const std::string& path);
+TAILOR_API MeshFormat mesh_format_from_path(const std::string& path);
 
 //! Reads a mesh file; the format comes from the extension, or from the content when the extension
 //! is unknown. Cost: one pass over the file, O(F + V) memory.
-Status load_mesh(const std::string& path, Mesh& mesh, LoadReport* report = nullptr);
+TAILOR_API Status load_mesh(const std::string& path, Mesh& mesh, LoadReport* report = nullptr);
 
 //! Parses a mesh held in memory (used by load_mesh, the fuzzers and the truncation tests).
 //! `name` is only used in error messages.
-Status read_mesh(std::span<const char> data, MeshFormat format, const std::string& name, Mesh& mesh,
-                 LoadReport* report = nullptr);
+TAILOR_API Status read_mesh(std::span<const char> data, MeshFormat format, const std::string& name, Mesh& mesh,
+                            LoadReport* report = nullptr);
 
 //! Reads a seam-face list: one 0-based face index per line ('#' comments and blank lines allowed),
 //! and sets seam_faces[f] = 1 for each (seam_faces is resized to face_count, zeros elsewhere).
 //! Face indices refer to the mesh as loaded (after finalize_mesh dropped degenerate faces).
 //! Fails with the line number on a malformed or out-of-range index.
-Status load_seam_faces(const std::string& path, size_t face_count, std::vector<uint8_t>& seam_faces);
+TAILOR_API Status load_seam_faces(const std::string& path, size_t face_count, std::vector<uint8_t>& seam_faces);
 
 //! Validation and repair shared by all readers (see top of file). Fails on non-finite positions,
 //! out-of-range indices, more than kMaxFaces faces, and meshes with no face left.
-Status finalize_mesh(const std::string& name, Mesh& mesh, LoadReport& report);
+TAILOR_API Status finalize_mesh(const std::string& name, Mesh& mesh, LoadReport& report);
 
 }  // namespace tailor

@@ -36,6 +36,7 @@
 #include <functional>
 #include <span>
 
+#include "tailor/api.h"
 #include "tailor/atlas.h"
 #include "tailor/mesh.h"
 #include "tailor/orientation.h"
@@ -123,8 +124,8 @@ struct MappingStats {
 
 //! Seed face of every edge component: the face whose centroid is nearest to the seed point (the
 //! option, or the centre of the bounding box), components ordered by that distance (then id).
-std::vector<uint32_t> component_seed_faces(const Mesh& mesh, const Topology& topology, const FaceFrames& frames,
-                                           const MappingOptions& options);
+TAILOR_API std::vector<uint32_t> component_seed_faces(const Mesh& mesh, const Topology& topology,
+                                                      const FaceFrames& frames, const MappingOptions& options);
 
 //! Maps the texture: fills atlas.corner_uv (#F*3 by 2, pixels), atlas.patch (#F) and
 //! atlas.patch_count; every face is placed and every UV is finite.
@@ -138,13 +139,13 @@ std::vector<uint32_t> component_seed_faces(const Mesh& mesh, const Topology& top
 //! not zipped, so a huge fan cannot make it quadratic); O(F + V) memory, allocated before the loops
 //! (the atlas's capacity is reused). Deterministic, the same bits with or without SIMD. Safe for
 //! any mesh that passed finalize_mesh (non-manifold and inconsistent edges act as boundaries).
-Status map_texture(const Mesh& mesh, const Topology& topology, const FaceFrames& frames,
-                   const MappingOptions& options, Atlas& atlas, MappingStats* stats = nullptr);
+TAILOR_API Status map_texture(const Mesh& mesh, const Topology& topology, const FaceFrames& frames,
+                              const MappingOptions& options, Atlas& atlas, MappingStats* stats = nullptr);
 
 //! Per-face check used by kPatches and by tests: singular values of the Jacobian of the map from
 //! the face's frame (corner positions `local`, 6 floats, normalised units, times `scale`) to the
 //! UV triangle `uv` (6 floats, pixels). Returns max(sigma_max - 1, 1/sigma_min - 1), or +inf when
 //! the UV triangle is inverted or degenerate, or the face's own triangle has no positive area. O(1).
-float face_stretch_error(std::span<const float, 6> local, float scale, std::span<const float, 6> uv);
+TAILOR_API float face_stretch_error(std::span<const float, 6> local, float scale, std::span<const float, 6> uv);
 
 }  // namespace tailor

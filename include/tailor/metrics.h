@@ -12,6 +12,7 @@
 #include <span>
 #include <vector>
 
+#include "tailor/api.h"
 #include "tailor/mesh.h"
 #include "tailor/status.h"
 #include "tailor/topology.h"
@@ -56,18 +57,19 @@ struct UvMetrics {
 //! has zero 3D area or every non-degenerate face has zero UV area (bad data: no scale).
 //! Cost: O(F) time and memory (sort-free passes, on threads for large meshes, plus a median by
 //! nth_element). Deterministic, whatever the thread count.
-Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<const float> corner_uv,
-                          std::span<const uint32_t> patch, const MetricsOptions& options, UvMetrics& metrics);
+TAILOR_API Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<const float> corner_uv,
+                                     std::span<const uint32_t> patch, const MetricsOptions& options,
+                                     UvMetrics& metrics);
 
 //! Patches = connected components of faces joined across paired edges whose two sides have
 //! bit-identical UVs at both endpoints. Fills patch (#F ids, numbered in order of lowest face) and
 //! returns the count. Precondition: corner_uv has #F*3*2 floats. Cost: O(F), union-find.
-uint32_t derive_patches(const Mesh& mesh, const Topology& topology, std::span<const float> corner_uv,
-                        std::vector<uint32_t>& patch);
+TAILOR_API uint32_t derive_patches(const Mesh& mesh, const Topology& topology, std::span<const float> corner_uv,
+                                   std::vector<uint32_t>& patch);
 
 //! Per-face area ratio (a_f / A_f) / R for heat maps: 1 = ideal, > 1 magnified, < 1 shrunk.
 //! Faces with zero 3D area get 1 (neutral); when R is 0 every face gets 0. ratio gets #F values.
 //! Precondition: corner_uv has #F*3*2 floats. Cost: O(F).
-void face_area_stretch(const Mesh& mesh, std::span<const float> corner_uv, std::vector<float>& ratio);
+TAILOR_API void face_area_stretch(const Mesh& mesh, std::span<const float> corner_uv, std::vector<float>& ratio);
 
 }  // namespace tailor

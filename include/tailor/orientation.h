@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "tailor/api.h"
 #include "tailor/mesh.h"
 #include "tailor/status.h"
 #include "tailor/topology.h"
@@ -76,11 +77,11 @@ struct FaceFrames {
 //! themselves. Fails with kInvalidArgument on a zero user axis or smooth_passes > 1000, and with
 //! kInvalidMesh on an empty mesh or a topology of the wrong size. Cost: O(V + F * (1 + passes)).
 //! Deterministic; safe for any mesh that passed finalize_mesh.
-Status compute_orientation(const Mesh& mesh, const Topology& topology, const OrientationOptions& options,
-                           FaceFrames& frames);
+TAILOR_API Status compute_orientation(const Mesh& mesh, const Topology& topology, const OrientationOptions& options,
+                                      FaceFrames& frames);
 
 //! Mean angle (radians) between the orientations of edge-adjacent faces (each interior edge once);
 //! a measure of field smoothness used by tests and benchmarks. O(F).
-double mean_neighbour_angle(const Topology& topology, const FaceFrames& frames);
+TAILOR_API double mean_neighbour_angle(const Topology& topology, const FaceFrames& frames);
 
 }  // namespace tailor

@@ -18,6 +18,7 @@
 #include <span>
 #include <string_view>
 
+#include "tailor/api.h"
 #include "tailor/image.h"
 #include "tailor/mesh.h"
 #include "tailor/status.h"
@@ -28,16 +29,16 @@ namespace tailor {
 enum class PreviewView { kTexture, kPatches, kDistortion, kChecker };
 
 //! Parses "texture", "patches", "distortion" or "checker"; returns false for anything else.
-bool preview_view_from_name(std::string_view name, PreviewView& view);
+TAILOR_API bool preview_view_from_name(std::string_view name, PreviewView& view);
 
 //! The lowercase name of a view ("texture", ...).
-const char* preview_view_name(PreviewView view);
+TAILOR_API const char* preview_view_name(PreviewView view);
 
 //! Which mesh axis points up in the picture (scans are often z-up; glTF is y-up).
 enum class UpAxis { kPosY, kPosZ, kPosX, kNegY, kNegZ, kNegX };
 
 //! Parses "y", "z", "x", "-y", "-z" or "-x" (also with a leading '+'); false for anything else.
-bool up_axis_from_name(std::string_view name, UpAxis& up);
+TAILOR_API bool up_axis_from_name(std::string_view name, UpAxis& up);
 
 struct RenderOptions {
   int width = 1024;                        //!< output width in pixels, 16..8192
@@ -68,7 +69,7 @@ struct RenderOptions {
 //! out-of-range indices, kUnsupported when no OpenGL context can be created (OSMesa missing or
 //! out of memory). Cost: O(F) to build vertex arrays plus the rasterisation; about a second for
 //! 1 M faces at 1024x768 on two cores. Never prints, never throws.
-Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::span<const uint32_t> patch,
-                      const Image* texture, const RenderOptions& options, Image& out);
+TAILOR_API Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::span<const uint32_t> patch,
+                                 const Image* texture, const RenderOptions& options, Image& out);
 
 }  // namespace tailor

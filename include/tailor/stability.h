@@ -10,6 +10,7 @@
 
 #include <cstdint>
 
+#include "tailor/api.h"
 #include "tailor/mapping.h"
 #include "tailor/mesh.h"
 #include "tailor/orientation.h"
@@ -40,7 +41,8 @@ struct StabilityReport {
 //! returned), or with kInvalidArgument when remove_fraction is out of range, or kInvalidMesh when
 //! the mesh has fewer than 10 faces. The progress callback in `mapping` is ignored.
 //! Cost: two orientation + mapping runs, O(F log F). Deterministic.
-Status measure_stability(const Mesh& mesh, const OrientationOptions& orientation, const MappingOptions& mapping,
-                         StabilityReport& report, const StabilityOptions& options = {});
+TAILOR_API Status measure_stability(const Mesh& mesh, const OrientationOptions& orientation,
+                                    const MappingOptions& mapping, StabilityReport& report,
+                                    const StabilityOptions& options = {});
 
 }  // namespace tailor

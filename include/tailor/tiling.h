@@ -45,6 +45,7 @@
 #include <string>
 #include <vector>
 
+#include "tailor/api.h"
 #include "tailor/image.h"
 #include "tailor/status.h"
 
@@ -89,32 +90,34 @@ struct TileReport {
 
 //! Toroidal shift by (width / 2, height / 2): out(x, y) = in((x + width/2) % width, (y + height/2) % height).
 //! The input's wrap seams end up on column width - width/2 and row height - height/2.
-Image swap_quadrants(const Image& image);
+TAILOR_API Image swap_quadrants(const Image& image);
 
 //! Makes `exemplar` self-tileable (see the top of this file). `tile` has the exemplar's channel count
 //! and size (or the period-fitted size). Fails with kInvalidImage for an inconsistent image or one
 //! smaller than 32 px a side, kInvalidArgument for options out of range, kCancelled when progress
 //! returned false. `report` may be null.
-Status make_tileable(const Image& exemplar, const TileOptions& options, Image& tile, TileReport* report = nullptr);
+TAILOR_API Status make_tileable(const Image& exemplar, const TileOptions& options, Image& tile,
+                                TileReport* report = nullptr);
 
 //! `count` tiles (1 to 64): tiles[0] is make_tileable's result, tiles[k] re-quilts everything but
 //! the outer TileReport::border px ring with 2 x 2 large blocks, seed (options.seed, k), a raster
 //! order that changes with k, and tiles[0]'s own source blocks excluded (so interiors differ).
 //! All tiles share that ring bit-exactly, so any of them can be placed next to any other.
 //! Cost: make_tileable plus 4 FFT block searches per extra tile.
-Status make_tile_variants(const Image& exemplar, const TileOptions& options, int count, std::vector<Image>& tiles,
-                          TileReport* report = nullptr);
+TAILOR_API Status make_tile_variants(const Image& exemplar, const TileOptions& options, int count,
+                                     std::vector<Image>& tiles, TileReport* report = nullptr);
 
 //! Texel period along x and y from the normalised (unbiased) autocorrelation of the luminance,
 //! computed by FFT: the first autocorrelation peak within lags [3, 2 size / 3] reaching 80 % of the
 //! highest one, refined to sub-pixel by a parabola. Noise-like textures give found = false.
 //! Cost O(N log N). Never fails (an invalid image gives an empty estimate).
-PeriodEstimate estimate_period(const Image& image);
+TAILOR_API PeriodEstimate estimate_period(const Image& image);
 
 //! Size holding a whole number of periods nearest (width, height): n = floor(size / period + 0.55)
 //! periods (ties go to the larger size: the thesis prefers adding texture to cutting it), at least
 //! one; axes without a period keep their size. Results are clamped to [32, kMaxImageSide].
-void period_fitted_size(const PeriodEstimate& period, int width, int height, int& fitted_width, int& fitted_height);
+TAILOR_API void period_fitted_size(const PeriodEstimate& period, int width, int height, int& fitted_width,
+                                   int& fitted_height);
 
 //! Quality of a tile (thesis ch. 4 and issue 4). Column boundary x is the pair (x, x+1 mod W);
 //! its "difference" is the mean absolute 8-bit difference across it over all rows and channels.
@@ -142,11 +145,11 @@ struct TileMetrics {
 //! al. 2009, constant seed, 6 iterations), so the value is an upper bound of the exact one, and
 //! deterministic. Cost: O(N) plus ~0.1 s per 512 px image. Fails with kInvalidImage for an
 //! inconsistent image or one smaller than 8 px a side. Safe for untrusted images.
-Status tile_metrics(const Image& tile, const Image* exemplar, TileMetrics& metrics);
+TAILOR_API Status tile_metrics(const Image& tile, const Image* exemplar, TileMetrics& metrics);
 
 //! The issue's quality targets: wrap ratios in [0.8, 1.2], worst seam <= max(exemplar's, 1.5),
 //! histogram L1 <= 0.1, gradient ratio >= 0.95, patch coherence <= the exemplar's toroidal one
 //! (no allowance). Returns true when all hold; `failed` lists the others.
-bool meets_tile_targets(const TileMetrics& metrics, std::string* failed = nullptr);
+TAILOR_API bool meets_tile_targets(const TileMetrics& metrics, std::string* failed = nullptr);
 
 }  // namespace tailor

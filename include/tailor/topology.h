@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "tailor/api.h"
 #include "tailor/mesh.h"
 
 namespace tailor {
@@ -31,7 +32,7 @@ struct Topology {
 
 //! Builds the opposite-edge table and components. O(F) time with a flat open-addressing hash of
 //! directed edges; no per-edge allocation. Precondition: mesh passed finalize_mesh (indices < #V).
-Topology build_topology(const Mesh& mesh);
+TAILOR_API Topology build_topology(const Mesh& mesh);
 
 //! The neighbour face across edge e, or kInvalid.
 inline uint32_t neighbour_face(const Topology& t, uint32_t e) {
