@@ -5,6 +5,7 @@
 #include <atomic>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -76,7 +77,10 @@ Status find_web_root(const std::string& given, std::string& root) {
     if (!file_exists(dir + "/node_modules/three/build/three.module.js")) {
       return Status::error(ErrorCode::kIo, dir, "three.js is not installed", "run 'npm install' in that folder");
     }
-    root = dir;
+    // Printed in the startup line: the absolute path, so that one can tell which copy is served.
+    std::error_code error;
+    const std::filesystem::path absolute = std::filesystem::canonical(dir, error);
+    root = error ? dir : absolute.string();
     return Status::ok();
   }
   return Status::error(ErrorCode::kIo, given.empty() ? "" : given, "web viewer files (index.html) not found",
@@ -171,7 +175,8 @@ int run_view(const ViewArgs& args) {
   ::sigaction(SIGTERM, &action, nullptr);
 
   // Always printed (also with --quiet): the URL is the point of the command, and scripts read it.
-  std::printf("tailor view: http://127.0.0.1:%d/  (%s; Ctrl-C to stop)\n", server.port(), base_name(args.input).c_str());
+  std::printf("tailor view: http://127.0.0.1:%d/  (%s, viewer in %s; Ctrl-C to stop)\n", server.port(),
+              base_name(args.input).c_str(), root.c_str());
   std::fflush(stdout);
   server.serve(g_stop);
   if (!args.quiet) std::fprintf(stderr, "tailor view: stopped\n");

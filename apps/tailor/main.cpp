@@ -5,6 +5,7 @@
 #include <new>
 
 #include "cli.h"
+#include "tailor/version.h"
 
 int main(int argc, char** argv) {
   using namespace tailor::cli;
@@ -12,6 +13,7 @@ int main(int argc, char** argv) {
                "and make texture images self-tileable so the mapping needs no atlas."};
   app.name("tailor");
   app.require_subcommand(1);
+  app.set_version_flag("--version", "tailor " TAILOR_VERSION_STRING, "Print the version and exit");
   app.footer(
       "Examples:\n"
       "  tailor map bunny.ply --texture bricks.png -o bunny.glb   # UVs + textured glTF\n"
@@ -34,6 +36,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr, "tailor: error: %s (run 'tailor --help')\n", e.what());
