@@ -7,8 +7,9 @@ JOBS ?= 2
 CMAKE_FLAGS ?=
 EXAMPLE_MESH := examples/spot.obj
 EXAMPLE_TEXTURE := examples/gravel.png
+PREFIX ?= /usr/local
 
-.PHONY: all deps configure build test run bench fuzz tsan clean
+.PHONY: all deps configure build test run install bench fuzz tsan clean
 
 all: build
 
@@ -33,6 +34,11 @@ run: build
 	@$(BUILD_DIR)/tailor map $(EXAMPLE_MESH) --texture out/gravel_tile.png -o out/example.glb \
 	   --stats out/example_stats.json --preview out/example_preview.png --preview-all
 	@echo "open it in a browser: $(BUILD_DIR)/tailor view out/example.glb"
+
+# The tailor command, its web viewer, and the C++ libraries with their headers, CMake package and
+# pkg-config file, under PREFIX (default /usr/local); DESTDIR=/stage prefixes every path (packaging).
+install: build
+	@DESTDIR="$(DESTDIR)" cmake --install $(BUILD_DIR) --prefix "$(PREFIX)"
 
 bench: build
 	@bash scripts/bench.sh $(BUILD_DIR)
