@@ -1,0 +1,216 @@
+#!/usr/bin/env bash
+# The installed tailor, as a user or a packager gets it, run by ctest from the repo root as
+#   bash tests/install_test.sh <build-dir>/tailor
+# 1. cmake --install of that build into a temporary prefix: the layout, and no installed text file
+#    naming the source or build tree;
+# 2. the installed `tailor` runs (--version, map);
+# 3. examples/consumer built against the prefix with find_package(tailor) and with pkg-config
+#    (static libraries): both run, write valid .glb files (node + glTF-Validator, skipped without
+#    node), byte-identical to the installed `tailor map`'s;
+# 4. the installed `tailor view` serves the installed share/tailor/web (it says so in its startup
+#    line): the page and every module it imports, following the imports from viewer.js, and no
+#    installed module goes unused;
+# 5. BUILD_SHARED_LIBS=ON: the three libraries alone (kept in <build-dir>/install-test-shared, so a
+#    rerun rebuilds only what changed), installed with `--component library`; the consumer built
+#    with find_package is dynamically linked to libtailor_core.so and gives the same .glb; a
+#    program calling the texture and render libraries links with pkg-config.
+set -uo pipefail
+tailor=${1:?usage: install_test.sh <build-dir>/tailor}
+build=$(cd "$(dirname "$tailor")" && pwd)
+repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$repo"
+
+tmp=$(mktemp -d)
+server_pid=""
+cleanup() {
+  if [[ -n $server_pid ]]; then
+    kill "$server_pid" 2>/dev/null
+    wait "$server_pid" 2>/dev/null
+  fi
+  rm -rf "$tmp"
+}
+trap cleanup EXIT
+passed=0
+failed=0
+ok() { passed=$((passed + 1)); }
+fail() { failed=$((failed + 1)); echo "FAIL: $*"; }
+# A step the rest depends on: report and stop.
+fatal() {
+  fail "$*"
+  echo "$passed passed, $failed failed"
+  exit 1
+}
+
+mesh=tests/data/meshes/horse.ply
+texture=examples/gravel.png
+prefix=$tmp/prefix
+version=$(sed -n 's/^#define TAILOR_VERSION_STRING "\(.*\)"$/\1/p' "$build/include/tailor/version.h")
+[[ -n $version ]] || fatal "no TAILOR_VERSION_STRING in $build/include/tailor/version.h"
+jobs=2
+
+# Validates a .glb with the Khronos validator when node is there.
+validate() {
+  if ! command -v node >/dev/null; then
+    echo "skipped: glTF validation of $(basename "$1") (node is missing)"
+    return
+  fi
+  node tests/tools/validate_gltf.mjs --strict "$1" >"$tmp/validate.txt" 2>&1 && ok ||
+    fail "$1 is not valid glTF: $(cat "$tmp/validate.txt")"
+}
+
+# --- 1. install into a temporary prefix ---
+cmake --install "$build" --prefix "$prefix" >"$tmp/install.log" 2>&1 || fatal "cmake --install failed: $(cat "$tmp/install.log")"
+for f in bin/tailor include/tailor/tailor.h include/tailor/api.h include/tailor/version.h \
+  lib/libtailor_core.a lib/libtailor_texture.a lib/libtailor_render.a \
+  lib/cmake/tailor/tailorConfig.cmake lib/cmake/tailor/tailorConfigVersion.cmake lib/cmake/tailor/tailorTargets.cmake \
+  lib/pkgconfig/tailor.pc share/tailor/web/index.html share/tailor/web/node_modules/three/build/three.module.js; do
+  [[ -f $prefix/$f ]] && ok || fail "not installed: $f"
+done
+[[ ! -e $prefix/include/tailor/version.h.in ]] && ok || fail "version.h.in was installed"
+# Text files only: the tailor binary keeps the source tree's web/ as its last fallback, for build trees.
+refs=$(grep -rIlF -e "$repo" -e "$build" "$prefix")
+[[ -z $refs ]] && ok || fail "installed files name the source or build tree: $refs"
+
+# --- 2. the installed command ---
+[[ $("$prefix/bin/tailor" --version) == "tailor $version" ]] && ok || fail "tailor --version: $("$prefix/bin/tailor" --version 2>&1)"
+"$prefix/bin/tailor" map "$mesh" --texture "$texture" -o "$tmp/reference.glb" --quiet && [[ -s $tmp/reference.glb ]] ||
+  fatal "the installed tailor map failed"
+ok
+
+# --- 3. examples/consumer with find_package and with pkg-config ---
+# run_consumer NAME BINARY: maps the test mesh, validates the .glb and compares it with tailor map's.
+run_consumer() {
+  local name=$1 binary=$2
+  if "$binary" "$mesh" "$tmp/$name.glb" "$texture" >"$tmp/$name.txt" 2>&1; then ok
+  else fail "$name: the consumer failed: $(cat "$tmp/$name.txt")"; return; fi
+  grep -q "faces in [0-9]* patches" "$tmp/$name.txt" && ok || fail "$name: unexpected output: $(cat "$tmp/$name.txt")"
+  validate "$tmp/$name.glb"
+  cmp -s "$tmp/$name.glb" "$tmp/reference.glb" && ok ||
+    fail "$name: the consumer's .glb differs from tailor map's (the same default options)"
+}
+if cmake -S examples/consumer -B "$tmp/consumer-cmake" -DCMAKE_PREFIX_PATH="$prefix" >"$tmp/cmake.log" 2>&1 &&
+  cmake --build "$tmp/consumer-cmake" -j "$jobs" >>"$tmp/cmake.log" 2>&1; then
+  ok
+  run_consumer consumer-cmake "$tmp/consumer-cmake/consumer"
+else
+  fail "examples/consumer does not build with find_package: $(tail -20 "$tmp/cmake.log")"
+fi
+export PKG_CONFIG_PATH=$prefix/lib/pkgconfig
+[[ $(pkg-config --modversion tailor 2>&1) == "$version" ]] && ok || fail "pkg-config --modversion tailor: $(pkg-config --modversion tailor 2>&1)"
+if g++ -std=c++20 -O2 examples/consumer/main.cpp $(pkg-config --cflags --libs --static tailor) \
+  -o "$tmp/consumer-pkg-config" >"$tmp/g++.log" 2>&1; then
+  ok
+  run_consumer consumer-pkg-config "$tmp/consumer-pkg-config"
+else
+  fail "examples/consumer does not build with pkg-config: $(tail -20 "$tmp/g++.log")"
+fi
+
+# --- 4. the installed tailor view serves the installed viewer ---
+"$prefix/bin/tailor" view "$tmp/reference.glb" >"$tmp/view.log" 2>&1 &
+server_pid=$!
+url=""
+for _ in $(seq 1 100); do
+  url=$(grep -o 'http://127\.0\.0\.1:[0-9]*/' "$tmp/view.log")
+  [[ -n $url ]] && break
+  kill -0 "$server_pid" 2>/dev/null || break
+  sleep 0.1
+done
+web=$(cd "$prefix/share/tailor/web" && pwd -P)
+if [[ -z $url ]]; then
+  fail "the installed tailor view printed no URL: $(cat "$tmp/view.log")"
+else
+  ok
+  grep -qF "viewer in $web;" "$tmp/view.log" && ok || fail "tailor view does not serve $web: $(cat "$tmp/view.log")"
+  fetch() { curl -sf --max-time 10 -o "$2" "$url${1#/}"; }
+  fetch / "$tmp/index.html" && cmp -s "$tmp/index.html" "$web/index.html" && ok || fail "GET / is not the installed index.html"
+  # Follow the imports from the page's module script, the importmap's way ('three' and 'three/addons/').
+  declare -A seen=()
+  queue=($(grep -o '<script type="module" src="[^"]*"' "$web/index.html" | sed 's/.*src="//; s/"$//'))
+  [[ ${#queue[@]} -gt 0 ]] && ok || fail "index.html has no module script"
+  while [[ ${#queue[@]} -gt 0 ]]; do
+    path=${queue[0]}
+    queue=("${queue[@]:1}")
+    [[ -n ${seen[$path]:-} ]] && continue
+    seen[$path]=1
+    if ! fetch "$path" "$tmp/module.js"; then
+      fail "GET $path (imported by the viewer) failed"
+      continue
+    fi
+    while read -r spec; do
+      case $spec in
+        three) target=/node_modules/three/build/three.module.js ;;
+        three/addons/*) target=/node_modules/three/examples/jsm/${spec#three/addons/} ;;
+        ./* | ../*)
+          target=${path%/*}/$spec
+          while [[ $target == */./* ]]; do target=${target/\/.\//\/}; done
+          while [[ $target =~ ^(.*)/[^/.][^/]*/\.\./(.*)$ ]]; do target=${BASH_REMATCH[1]}/${BASH_REMATCH[2]}; done ;;
+        *) fail "$path imports '$spec', which the page cannot resolve"; continue ;;
+      esac
+      queue+=("$target")
+    done < <(grep -E "^[[:space:]]*(import|export|\})[^'\"]*['\"][^'\"]+['\"];?[[:space:]]*$" "$tmp/module.js" |
+      grep -oE "(from|import)[[:space:]]+['\"][^'\"]+['\"]" | sed -E "s/^(from|import)[[:space:]]+['\"]//; s/['\"]$//")
+  done
+  installed=$(cd "$web" && find . -name '*.js' | sed 's/^\.//' | sort)
+  imported=$(printf '%s\n' "${!seen[@]}" | sort)
+  [[ $installed == "$imported" ]] && ok ||
+    fail "installed modules and imported ones differ: $(diff <(echo "$installed") <(echo "$imported") | grep '^[<>]' | tr '\n' ' ')"
+  echo "tailor view served the installed viewer: ${#seen[@]} modules"
+fi
+kill -INT "$server_pid" 2>/dev/null
+wait "$server_pid" 2>/dev/null
+server_pid=""
+
+# --- 5. shared libraries ---
+shared_build=$build/install-test-shared
+shared=$tmp/shared
+launcher=$(sed -n 's/^CMAKE_CXX_COMPILER_LAUNCHER:[A-Z]*=//p' "$build/CMakeCache.txt")
+compiler=$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' "$build/CMakeCache.txt")
+start=$SECONDS
+if cmake -S "$repo" -B "$shared_build" -DCMAKE_BUILD_TYPE=Release -DBUILD_SHARED_LIBS=ON \
+  -DTAILOR_BUILD_TESTS=OFF -DTAILOR_BUILD_BENCH=OFF -DCMAKE_CXX_COMPILER="$compiler" \
+  -DCMAKE_CXX_COMPILER_LAUNCHER="$launcher" >"$tmp/shared.log" 2>&1 &&
+  cmake --build "$shared_build" -j "$jobs" --target tailor_core tailor_texture tailor_render >>"$tmp/shared.log" 2>&1 &&
+  cmake --install "$shared_build" --component library --prefix "$shared" >>"$tmp/shared.log" 2>&1; then
+  ok
+  echo "shared libraries built and installed in $((SECONDS - start)) s"
+else
+  fatal "the shared libraries do not build or install: $(tail -20 "$tmp/shared.log")"
+fi
+for lib in core texture render; do
+  [[ -f $shared/lib/libtailor_$lib.so ]] && ok || fail "not installed: lib/libtailor_$lib.so"
+done
+[[ ! -e $shared/bin/tailor ]] && ok || fail "--component library installed the tailor command"
+if cmake -S examples/consumer -B "$tmp/consumer-shared" -DCMAKE_PREFIX_PATH="$shared" >"$tmp/cmake-shared.log" 2>&1 &&
+  cmake --build "$tmp/consumer-shared" -j "$jobs" >>"$tmp/cmake-shared.log" 2>&1; then
+  ok
+  ldd "$tmp/consumer-shared/consumer" | grep -q "libtailor_core\.so.* => $shared/lib/" && ok ||
+    fail "the consumer is not linked to $shared/lib/libtailor_core.so: $(ldd "$tmp/consumer-shared/consumer")"
+  run_consumer consumer-shared "$tmp/consumer-shared/consumer"
+else
+  fail "examples/consumer does not build with the shared libraries: $(tail -20 "$tmp/cmake-shared.log")"
+fi
+# The texture and render libraries export their API too (pkg-config, shared: no --static).
+cat >"$tmp/all_libs.cpp" <<'EOF'
+#include <cstdio>
+#include "tailor/tailor.h"
+int main() {
+  tailor::Image image{64, 32, 1, std::vector<uint8_t>(64 * 32, 7)};
+  const tailor::Image swapped = tailor::swap_quadrants(image);  // tailor::texture
+  tailor::PreviewView view;
+  const bool parsed = tailor::preview_view_from_name("patches", view);  // tailor::render
+  std::printf("%d %d %s\n", swapped.width, parsed, tailor::preview_view_name(view));
+  return tailor::check_image(swapped).is_ok() ? 0 : 1;  // tailor::core
+}
+EOF
+if PKG_CONFIG_PATH=$shared/lib/pkgconfig g++ -std=c++20 "$tmp/all_libs.cpp" \
+  $(PKG_CONFIG_PATH=$shared/lib/pkgconfig pkg-config --cflags --libs tailor) -Wl,-rpath,"$shared/lib" \
+  -o "$tmp/all_libs" >"$tmp/all_libs.log" 2>&1; then
+  [[ $("$tmp/all_libs") == "64 1 patches" ]] && ok || fail "the program using all three shared libraries: $("$tmp/all_libs" 2>&1)"
+  [[ $(ldd "$tmp/all_libs" | grep -c "libtailor_[a-z]*\.so.* => $shared/lib/") -eq 3 ]] && ok ||
+    fail "not linked to the three shared libraries: $(ldd "$tmp/all_libs")"
+else
+  fail "a program using all three shared libraries does not link: $(tail -20 "$tmp/all_libs.log")"
+fi
+
+echo "$passed passed, $failed failed"
+[[ $failed -eq 0 ]]
