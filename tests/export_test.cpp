@@ -4,13 +4,10 @@
 #include <stb/stb_image.h>
 #include <stb/stb_image_write.h>
 #include <sys/resource.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <bit>
 #include <csignal>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -30,10 +27,14 @@
 #include "tailor/metrics.h"
 #include "tailor/topology.h"
 
+#include "support/fixtures.h"
+
 namespace tailor {
 namespace {
 
 namespace fs = std::filesystem;
+using test::read_all;
+using test::run_command;
 
 const std::string kTexture = std::string(TAILOR_TEST_DATA) + "/textures/vistex-tile04-128.png";
 const std::string kSpot = std::string(TAILOR_TEST_DATA) + "/meshes/spot.obj";
@@ -68,10 +69,7 @@ void make_cube(Mesh& mesh, Atlas& atlas) {
 class ExportTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("tailor_export_test_" + std::to_string(getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = test::empty_temp_dir(::testing::UnitTest::GetInstance()->current_test_info()->name());
     make_cube(cube_, cube_atlas_);
   }
   void TearDown() override { fs::remove_all(dir_); }
@@ -87,24 +85,6 @@ class ExportTest : public ::testing::Test {
   Mesh cube_;
   Atlas cube_atlas_;
 };
-
-std::string read_all(const std::string& file) {
-  std::string bytes;
-  EXPECT_TRUE(internal::read_file(file, bytes).is_ok()) << file;
-  return bytes;
-}
-
-// Runs a shell command, returns its exit status and stdout+stderr.
-int run_command(const std::string& command, std::string& output) {
-  output.clear();
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  if (!pipe) return -1;
-  char buffer[4096];
-  size_t n = 0;
-  while ((n = fread(buffer, 1, sizeof buffer, pipe)) > 0) output.append(buffer, n);
-  const int status = pclose(pipe);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
 bool have_node() {
   std::string out;

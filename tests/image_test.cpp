@@ -2,7 +2,6 @@
 // 8 bits, and broken or hostile files give a clear error instead of a crash or a huge allocation.
 #include <gtest/gtest.h>
 #include <stb/stb_image_write.h>
-#include <unistd.h>
 
 #include <array>
 #include <cstdio>
@@ -16,6 +15,8 @@
 #include "tailor/image.h"
 #include "tailor/image_ops.h"
 
+#include "support/fixtures.h"
+
 // Compiled into libstb.so (C linkage) but declared only in stb_image_write's implementation part.
 extern "C" unsigned char* stbi_zlib_compress(unsigned char* data, int data_len, int* out_len, int quality);
 
@@ -24,11 +25,7 @@ namespace {
 
 const std::string kData = std::string(TAILOR_TEST_DATA) + "/textures/";
 
-std::string temp_path(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("tailor_image_test_" + std::to_string(getpid()));
-  std::filesystem::create_directories(dir);
-  return (dir / name).string();
-}
+using test::temp_path;
 
 void write_bytes(const std::string& path, const std::string& bytes) {
   std::ofstream f(path, std::ios::binary);

@@ -17,20 +17,16 @@
 #include "util/atomic_file.h"
 #include "tailor/io.h"
 
+#include "support/fixtures.h"
+
 namespace tailor {
 namespace {
 
-std::string mesh_path(const std::string& name) { return std::string(TAILOR_TEST_DATA) + "/meshes/" + name; }
+using test::load_test_mesh;
+using test::mesh_path;
 
 Status parse(const std::string& text, MeshFormat format, Mesh& mesh, LoadReport* report = nullptr) {
   return read_mesh(std::span<const char>(text.data(), text.size()), format, "test", mesh, report);
-}
-
-Mesh load_or_die(const std::string& name, LoadReport* report = nullptr) {
-  Mesh m;
-  const Status s = load_mesh(mesh_path(name), m, report);
-  EXPECT_TRUE(s.is_ok()) << s.message();
-  return m;
 }
 
 // Every index in range, every coordinate finite, side arrays in step: what finalize promises.
@@ -157,7 +153,7 @@ TEST(RealMeshes, LoadWithManifestCounts) {
   for (const Expected& e : cases) {
     SCOPED_TRACE(e.file);
     LoadReport r;
-    const Mesh m = load_or_die(e.file, &r);
+    const Mesh m = load_test_mesh(e.file, &r);
     expect_valid(m);
     EXPECT_EQ(m.face_count(), e.faces);
     EXPECT_EQ(m.vertex_count(), e.vertices);
@@ -175,7 +171,7 @@ TEST(RealMeshes, LoadWithManifestCounts) {
 
 TEST(RealMeshes, SpotHasCornerUvsAndStlCountsWelds) {
   LoadReport r;
-  const Mesh spot = load_or_die("spot.obj");
+  const Mesh spot = load_test_mesh("spot.obj");
   EXPECT_EQ(spot.corner_uvs.size(), 6u * 5856);
   // The first face is "f 739/1 735/2 736/3": its first corner carries the first vt of the file.
   std::string text;
@@ -187,7 +183,7 @@ TEST(RealMeshes, SpotHasCornerUvsAndStlCountsWelds) {
   EXPECT_EQ(spot.corner_uvs[0], u0);
   EXPECT_EQ(spot.corner_uvs[1], v0);
   EXPECT_EQ(spot.indices[0], 738u);
-  const Mesh stl = load_or_die("featuretype.stl", &r);
+  const Mesh stl = load_test_mesh("featuretype.stl", &r);
   EXPECT_EQ(r.welded_vertices, 3u * 3476 - 2010);
   EXPECT_TRUE(stl.corner_uvs.empty());
 }
@@ -199,7 +195,7 @@ TEST(RealMeshes, HorseFirstVertexMatchesFileBytes) {
   const size_t body = bytes.find("end_header\n") + 11;
   float x0;
   std::memcpy(&x0, bytes.data() + body, 4);
-  const Mesh m = load_or_die("horse.ply");
+  const Mesh m = load_test_mesh("horse.ply");
   EXPECT_EQ(m.positions[0], x0);
 }
 
@@ -208,7 +204,7 @@ TEST(RealMeshes, HorseFirstVertexMatchesFileBytes) {
 // ================================================================================================
 
 TEST(Ply, BigEndianMatchesLittleEndian) {
-  const Mesh horse = load_or_die("horse.ply");
+  const Mesh horse = load_test_mesh("horse.ply");
   Mesh le, be;
   LoadReport r;
   ASSERT_TRUE(parse(binary_ply(horse, false), MeshFormat::kPly, le).is_ok());
@@ -221,7 +217,7 @@ TEST(Ply, BigEndianMatchesLittleEndian) {
 }
 
 TEST(Ply, AsciiMatchesBinary) {
-  const Mesh small = first_faces(load_or_die("fandisk.off"), 300);
+  const Mesh small = first_faces(load_test_mesh("fandisk.off"), 300);
   Mesh a;
   LoadReport r;
   ASSERT_TRUE(parse(ascii_ply(small), MeshFormat::kPly, a, &r).is_ok());
@@ -530,7 +526,7 @@ TEST(Adversarial, LargeMeshRepairsMatchSmallMeshRepairs) {
   // Horse three times over (290,898 faces: large enough for finalize_mesh's second thread), the
   // copies rotated and reversed, plus degenerate faces: repairs must match the plain horse.
   LoadReport plain;
-  const Mesh horse = load_or_die("horse.ply", &plain);
+  const Mesh horse = load_test_mesh("horse.ply", &plain);
   Mesh big;
   big.positions = horse.positions;
   big.indices = horse.indices;
@@ -600,7 +596,7 @@ TEST(Errors, IndexOutOfRangeNamesLineOrFace) {
   s = parse("OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 3\n", MeshFormat::kOff, m);
   EXPECT_EQ(s.where(), "line 7");
 
-  const Mesh small = first_faces(load_or_die("fandisk.off"), 100);
+  const Mesh small = first_faces(load_test_mesh("fandisk.off"), 100);
   Mesh bad = small;
   bad.indices[3 * 57 + 1] = static_cast<uint32_t>(small.vertex_count()) + 5;
   s = parse(binary_ply(bad, false), MeshFormat::kPly, m);
@@ -791,8 +787,8 @@ void check_all_prefixes(const std::string& full, MeshFormat format) {
 }
 
 TEST(Truncation, EveryPrefixOfSmallFilesFailsCleanly) {
-  const Mesh fandisk = first_faces(load_or_die("fandisk.off"), 100);
-  const Mesh spot = first_faces(load_or_die("spot.obj"), 100);
+  const Mesh fandisk = first_faces(load_test_mesh("fandisk.off"), 100);
+  const Mesh spot = first_faces(load_test_mesh("spot.obj"), 100);
   ASSERT_EQ(spot.corner_uvs.size(), 600u);
   {
     SCOPED_TRACE("binary ply");
@@ -820,7 +816,7 @@ TEST(Truncation, EveryPrefixOfSmallFilesFailsCleanly) {
 }
 
 TEST(Truncation, ObjRoundTripKeepsCornerUvs) {
-  const Mesh spot = first_faces(load_or_die("spot.obj"), 100);
+  const Mesh spot = first_faces(load_test_mesh("spot.obj"), 100);
   Mesh m;
   ASSERT_TRUE(parse(obj_text(spot), MeshFormat::kObj, m).is_ok());
   EXPECT_EQ(m.positions, spot.positions);

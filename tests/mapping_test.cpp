@@ -16,8 +16,14 @@
 #include "tailor/stability.h"
 #include "tailor/topology.h"
 
+#include "support/fixtures.h"
+
 namespace tailor {
 namespace {
+
+using test::Diagonal;
+using test::grid;
+using test::load_test_mesh;
 
 struct Mapped {
   Mesh mesh;
@@ -27,32 +33,11 @@ struct Mapped {
   MappingStats stats;
 };
 
-Mesh load(const std::string& name) {
-  Mesh mesh;
-  const Status s = load_mesh(std::string(TAILOR_TEST_DATA) + "/meshes/" + name, mesh);
-  EXPECT_TRUE(s.is_ok()) << name << ": " << s.message();
-  return mesh;
-}
-
 void map_mesh(Mapped& m, const MappingOptions& options = {}) {
   m.topology = build_topology(m.mesh);
   ASSERT_TRUE(compute_orientation(m.mesh, m.topology, {}, m.frames).is_ok());
   const Status s = map_texture(m.mesh, m.topology, m.frames, options, m.atlas, &m.stats);
   ASSERT_TRUE(s.is_ok()) << s.message();
-}
-
-// A flat grid of n by n unit squares in the z = 0 plane.
-Mesh grid(int n) {
-  Mesh mesh;
-  for (int j = 0; j <= n; ++j)
-    for (int i = 0; i <= n; ++i) mesh.positions.insert(mesh.positions.end(), {float(i), float(j), 0.f});
-  auto id = [n](int i, int j) { return static_cast<uint32_t>(j * (n + 1) + i); };
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      mesh.indices.insert(mesh.indices.end(), {id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-      mesh.indices.insert(mesh.indices.end(), {id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-    }
-  return mesh;
 }
 
 // An open cylinder of radius 1 around y: m segments around, h rings of height 0.1.
@@ -157,7 +142,7 @@ TEST(Mapping, EveryTestMeshMapsCompletelyWithinTheBound) {
   const MappingOptions options;
   for (const std::string& name : names) {
     Mapped m;
-    m.mesh = load(name);
+    m.mesh = load_test_mesh(name);
     map_mesh(m, options);
     expect_valid_patches_atlas(m, options, name);
   }
@@ -165,7 +150,7 @@ TEST(Mapping, EveryTestMeshMapsCompletelyWithinTheBound) {
 
 TEST(Mapping, PureUnfoldingAndLooserBoundsStayValid) {
   Mapped follow, unfold;
-  follow.mesh = load("fertility.off");
+  follow.mesh = load_test_mesh("fertility.off");
   unfold.mesh = follow.mesh;
   map_mesh(follow);
   MappingOptions options;
@@ -189,7 +174,7 @@ TEST(Mapping, PureUnfoldingAndLooserBoundsStayValid) {
 // Maps mesh `name` into `on` with default options and into `off` with `step` switched off; returns
 // the latter options.
 MappingOptions map_with_and_without(const char* name, bool MappingOptions::*step, Mapped& on, Mapped& off) {
-  on.mesh = load(name);
+  on.mesh = load_test_mesh(name);
   off.mesh = on.mesh;
   MappingOptions options;
   map_mesh(on, options);
@@ -214,7 +199,7 @@ TEST(Mapping, SeamShorteningShortensSeamsWithinTheBound) {
   // Without absorption, patches are small and many: moving a face out of one must never cut it in
   // two (it did on the horse before the fan check: 3 patches split).
   Mapped small;
-  small.mesh = load("horse.ply");
+  small.mesh = load_test_mesh("horse.ply");
   MappingOptions keep_all;
   keep_all.min_patch_faces = 0;
   map_mesh(small, keep_all);
@@ -275,7 +260,7 @@ TEST(Mapping, CrackClosingZipsCracksWithinTheBound) {
 
 TEST(Mapping, FlatGridIsOnePatchWithoutSeamOrDistortion) {
   Mapped m;
-  m.mesh = grid(30);
+  m.mesh = grid(30, 30, Diagonal::kRising);
   map_mesh(m);
   const UvMetrics metrics = metrics_of(m);
   EXPECT_EQ(m.atlas.patch_count, 1u);
@@ -301,7 +286,7 @@ TEST(Mapping, CylinderIsCutAlongOneLine) {
 
 TEST(Mapping, IsDeterministic) {
   Mapped a, b;
-  a.mesh = load("fertility.off");
+  a.mesh = load_test_mesh("fertility.off");
   b.mesh = a.mesh;
   map_mesh(a);
   map_mesh(b);
@@ -318,7 +303,7 @@ TEST(Mapping, IsDeterministic) {
 // and the atlas must not depend on how many workers shared them.
 TEST(Mapping, CrackClosingIsTheSameOnAnyThreadCount) {
   Mapped one, many;
-  one.mesh = load("horse.ply");
+  one.mesh = load_test_mesh("horse.ply");
   many.mesh = one.mesh;
   MappingOptions options;
   options.threads = 1;
@@ -335,7 +320,7 @@ TEST(Mapping, CrackClosingIsTheSameOnAnyThreadCount) {
 
 TEST(Mapping, SeedPointChoosesTheFirstPatch) {
   Mapped m;
-  m.mesh = load("spot.obj");
+  m.mesh = load_test_mesh("spot.obj");
   // Centroid of face 1000: the nearest face to it is face 1000 itself.
   double c[3] = {0, 0, 0};
   for (int k = 0; k < 3; ++k)
@@ -353,7 +338,7 @@ TEST(Mapping, SeedPointChoosesTheFirstPatch) {
 
 TEST(Mapping, ThesisModeReproducesItsCounters) {
   Mapped m;
-  m.mesh = load("spot.obj");
+  m.mesh = load_test_mesh("spot.obj");
   MappingOptions options;
   options.mode = MappingMode::kThesis;
   map_mesh(m, options);
@@ -393,7 +378,7 @@ TEST(Mapping, ThesisModeReproducesItsCounters) {
 TEST(Mapping, ThesisModeInvertsFacesOnADenseMeshWherePatchesModeDoesNot) {
   // The measurement on horse (97k faces): 4,708 inverted faces, Sander L2 30.6.
   Mapped thesis, patches;
-  thesis.mesh = load("horse.ply");
+  thesis.mesh = load_test_mesh("horse.ply");
   patches.mesh = thesis.mesh;
   MappingOptions options;
   options.mode = MappingMode::kThesis;
@@ -427,7 +412,7 @@ size_t seam_edges_on(const Mapped& m, const std::vector<uint8_t>& marked) {
 
 TEST(Mapping, SeamFacesAttractTheSeams) {
   Mapped plain, constrained;
-  plain.mesh = load("spot.obj");
+  plain.mesh = load_test_mesh("spot.obj");
   constrained.mesh = plain.mesh;
   map_mesh(plain);
   // Mark a band of faces: centroids with x in the middle 10% of the bounding box.
@@ -489,7 +474,7 @@ TEST(Mapping, FaceStretchErrorMeasuresSingularValues) {
 
 TEST(Mapping, ProgressCanCancel) {
   Mapped m;
-  m.mesh = load("horse.ply");  // more faces than one progress interval
+  m.mesh = load_test_mesh("horse.ply");  // more faces than one progress interval
   m.topology = build_topology(m.mesh);
   ASSERT_TRUE(compute_orientation(m.mesh, m.topology, {}, m.frames).is_ok());
   MappingOptions options;
@@ -524,7 +509,7 @@ TEST(Mapping, ProgressCanCancel) {
 
 TEST(Mapping, RejectsBadOptionsAndMismatchedInputs) {
   Mapped m;
-  m.mesh = grid(3);
+  m.mesh = grid(3, 3, Diagonal::kRising);
   map_mesh(m);
   MappingOptions options;
   options.scale = 0.f;
@@ -555,7 +540,7 @@ TEST(Mapping, RejectsBadOptionsAndMismatchedInputs) {
 
 TEST(Mapping, SeveralComponentsEachGetTheirPatches) {
   Mapped m;
-  m.mesh = load("blobby-3cc.off");
+  m.mesh = load_test_mesh("blobby-3cc.off");
   map_mesh(m);
   EXPECT_EQ(m.stats.components, m.topology.edge_components);
   EXPECT_GE(m.atlas.patch_count, m.stats.components);
@@ -563,7 +548,7 @@ TEST(Mapping, SeveralComponentsEachGetTheirPatches) {
 
 TEST(AxisChoice, ACoordinateAxisHalvesTheCadPartsSeams) {
   Mapped m;
-  m.mesh = load("adis16480.stl");  // an axis-aligned CAD part; its principal axis runs diagonally
+  m.mesh = load_test_mesh("adis16480.stl");  // an axis-aligned CAD part; its principal axis runs diagonally
   m.topology = build_topology(m.mesh);
   AxisChoice choice;
   ASSERT_TRUE(choose_orientation_axis(m.mesh, m.topology, {}, {}, choice).is_ok());
@@ -590,7 +575,7 @@ TEST(AxisChoice, ACoordinateAxisHalvesTheCadPartsSeams) {
 }
 
 TEST(Stability, RemovingTenPercentKeepsMostOfTheMapping) {
-  const Mesh mesh = load("fandisk.off");
+  const Mesh mesh = load_test_mesh("fandisk.off");
   StabilityReport report;
   const Status s = measure_stability(mesh, {}, {}, report);
   ASSERT_TRUE(s.is_ok()) << s.message();
@@ -611,7 +596,7 @@ TEST(Stability, RemovingTenPercentKeepsMostOfTheMapping) {
   // On the horse the hop rule keeps 99% of the corners bit-identical and the mean change under
   // 1 px (measured 0.5 px); the global counter re-places whole regions (83%, 3.5 px). Compared
   // without crack closing, which would blur the difference (see above).
-  const Mesh horse = load("horse.ply");
+  const Mesh horse = load_test_mesh("horse.ply");
   StabilityReport hops, counter, closed;
   MappingOptions growth_only;
   growth_only.close_cracks = false;

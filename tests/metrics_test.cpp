@@ -8,27 +8,13 @@
 #include "tailor/metrics.h"
 #include "tailor/topology.h"
 
+#include "support/fixtures.h"
+
 namespace tailor {
 namespace {
 
-// A flat (z = 0) grid of nx by ny unit cells, two triangles per cell, all counter-clockwise seen
-// from +z: lower (i,j) (i+1,j) (i,j+1), upper (i+1,j) (i+1,j+1) (i,j+1). Vertex (i,j) = j*(nx+1)+i.
-Mesh grid(int nx, int ny) {
-  Mesh mesh;
-  for (int j = 0; j <= ny; ++j)
-    for (int i = 0; i <= nx; ++i) {
-      mesh.positions.push_back(static_cast<float>(i));
-      mesh.positions.push_back(static_cast<float>(j));
-      mesh.positions.push_back(0.0f);
-    }
-  const auto id = [nx](int i, int j) { return static_cast<uint32_t>(j * (nx + 1) + i); };
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      mesh.indices.insert(mesh.indices.end(), {id(i, j), id(i + 1, j), id(i, j + 1)});
-      mesh.indices.insert(mesh.indices.end(), {id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
-    }
-  return mesh;
-}
+using test::Diagonal;
+using test::grid;
 
 // Corner UVs (px) from a function of the vertex position.
 template <typename F>
@@ -53,7 +39,7 @@ UvMetrics metrics_of(const Mesh& mesh, const std::vector<float>& uv, const std::
 }
 
 TEST(Metrics, IdentityMapIsIdeal) {
-  const Mesh mesh = grid(3, 2);
+  const Mesh mesh = grid(3, 2, Diagonal::kFalling);
   const auto uv = corner_uvs(mesh, [](float x, float y) { return std::pair{x, y}; });
   const UvMetrics m = metrics_of(mesh, uv);
   EXPECT_EQ(m.faces, 12u);
@@ -72,7 +58,7 @@ TEST(Metrics, IdentityMapIsIdeal) {
 }
 
 TEST(Metrics, UniformScaleIsIdeal) {
-  const Mesh mesh = grid(3, 2);
+  const Mesh mesh = grid(3, 2, Diagonal::kFalling);
   // 800 px per unit, as the thesis's scale, and an offset: only R changes.
   const auto uv = corner_uvs(mesh, [](float x, float y) { return std::pair{800 * x + 13, 800 * y - 7}; });
   const UvMetrics m = metrics_of(mesh, uv);
@@ -92,7 +78,7 @@ TEST(Metrics, UniformScaleIsIdeal) {
 // has 45, 90, 45: distortion |45-90| + |90-45| + 0 = 90. Upper triangle (1,0) (1,1) (0,1):
 // 45, 90, 45 -> image (1,0) (2,1) (1,1): 45, 45, 90: also 90. Median 90.
 TEST(Metrics, ShearHasKnownStretchAndAngles) {
-  const Mesh mesh = grid(2, 2);
+  const Mesh mesh = grid(2, 2, Diagonal::kFalling);
   const auto uv = corner_uvs(mesh, [](float x, float y) { return std::pair{100 * (x + y), 100 * y}; });
   const UvMetrics m = metrics_of(mesh, uv);
   const double phi = (1 + std::sqrt(5.0)) / 2;
@@ -111,7 +97,7 @@ TEST(Metrics, ShearHasKnownStretchAndAngles) {
 // A UV triangle with two corners on one point has the angles atan2(0, 0) = 0 (not a sum of pi):
 // distortion = the 3D angles' sum, 180 degrees; the untouched face has 0: median 90.
 TEST(Metrics, CollapsedUvEdgeCountsEveryAngle) {
-  const Mesh mesh = grid(1, 1);
+  const Mesh mesh = grid(1, 1, Diagonal::kFalling);
   auto uv = corner_uvs(mesh, [](float x, float y) { return std::pair{8 * x, 8 * y}; });
   uv[2] = uv[0];  // lower face: corner 1 onto corner 0
   uv[3] = uv[1];
@@ -121,7 +107,7 @@ TEST(Metrics, CollapsedUvEdgeCountsEveryAngle) {
 
 // The passes run on chunks of 32k elements summed in order: any thread count, the same bits.
 TEST(Metrics, ThreadCountDoesNotChangeAnyFigure) {
-  const Mesh mesh = grid(180, 120);  // 43,200 faces, 129,600 corners: several chunks
+  const Mesh mesh = grid(180, 120, Diagonal::kFalling);  // 43,200 faces, 129,600 corners: several chunks
   auto uv = corner_uvs(mesh, [](float x, float y) { return std::pair{7 * x + 0.01f * y * y, 6.5f * y + std::sin(x)}; });
   for (size_t f = 0; f < mesh.face_count(); ++f)  // a cut at x = 90: seams, two patches
     if (mesh.positions[3 * size_t{mesh.indices[3 * f]}] >= 90.f)
@@ -168,7 +154,7 @@ TEST(Metrics, CountsFlippedFaceAgainstPatchMajority) {
   // 2x2 cells; moving the UV of corner vertex (2,2), used only by the last upper triangle
   // (2,1) (2,2) (1,2), to (0.5, 0.5) inverts that triangle: signed area 0.5 * ((0.5-2)(2-1) -
   // (1-2)(0.5-1)) = -1. UVs stay shared, so it is still one patch.
-  const Mesh mesh = grid(2, 2);
+  const Mesh mesh = grid(2, 2, Diagonal::kFalling);
   auto uv = corner_uvs(mesh, [](float x, float y) {
     return (x == 2 && y == 2) ? std::pair{0.5f, 0.5f} : std::pair{x, y};
   });
@@ -231,7 +217,7 @@ TEST(Metrics, SeamGapIsTheToroidalDistance) {
 
 TEST(Metrics, DerivesPatchesOfAMeshCutInTwo) {
   // 4x2 cells; the right half (x > 2, and x = 2 for faces of the right half) is shifted by 1000 px.
-  const Mesh mesh = grid(4, 2);
+  const Mesh mesh = grid(4, 2, Diagonal::kFalling);
   std::vector<float> uv(2 * mesh.indices.size());
   for (size_t f = 0; f < mesh.face_count(); ++f) {
     float cx = 0;
@@ -260,7 +246,7 @@ TEST(Metrics, DerivesPatchesOfAMeshCutInTwo) {
 }
 
 TEST(Metrics, DegenerateFacesAreSkippedWithoutNaN) {
-  Mesh mesh = grid(2, 1);
+  Mesh mesh = grid(2, 1, Diagonal::kFalling);
   // A zero-area face on three collinear vertices (0,0) (1,0) (2,0).
   mesh.indices.insert(mesh.indices.end(), {0, 1, 2});
   auto uv = corner_uvs(mesh, [](float x, float y) { return std::pair{5 * x, 5 * y}; });
@@ -282,7 +268,7 @@ TEST(Metrics, DegenerateFacesAreSkippedWithoutNaN) {
 }
 
 TEST(Metrics, RejectsBadInput) {
-  const Mesh mesh = grid(1, 1);
+  const Mesh mesh = grid(1, 1, Diagonal::kFalling);
   const Topology topology = build_topology(mesh);
   auto uv = corner_uvs(mesh, [](float x, float y) { return std::pair{x, y}; });
   UvMetrics m;

@@ -9,50 +9,13 @@
 #include "tailor/orientation.h"
 #include "tailor/topology.h"
 
+#include "support/fixtures.h"
+
 namespace tailor {
 namespace {
 
-// Closed axis-aligned box [0,sx]x[0,sy]x[0,sz], each side split into n by n quads (two
-// counter-clockwise triangles seen from outside). Vertices are not shared between sides, which is
-// enough for frames (topology then sees six open sheets).
-Mesh box(float sx, float sy, float sz, int n) {
-  Mesh mesh;
-  const float size[3] = {sx, sy, sz};
-  for (int axis = 0; axis < 3; ++axis) {
-    for (int side = 0; side < 2; ++side) {
-      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-      const uint32_t base = static_cast<uint32_t>(mesh.vertex_count());
-      for (int j = 0; j <= n; ++j)
-        for (int i = 0; i <= n; ++i) {
-          float p[3];
-          p[axis] = side ? size[axis] : 0.f;
-          p[u] = size[u] * static_cast<float>(i) / static_cast<float>(n);
-          p[v] = size[v] * static_cast<float>(j) / static_cast<float>(n);
-          mesh.positions.insert(mesh.positions.end(), p, p + 3);
-        }
-      auto id = [&](int i, int j) { return base + static_cast<uint32_t>(j * (n + 1) + i); };
-      for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i) {
-          // (u, v, axis) is right-handed: counter-clockwise in (u, v) faces +axis.
-          if (side) {
-            mesh.indices.insert(mesh.indices.end(), {id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-            mesh.indices.insert(mesh.indices.end(), {id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-          } else {
-            mesh.indices.insert(mesh.indices.end(), {id(i, j), id(i + 1, j + 1), id(i + 1, j)});
-            mesh.indices.insert(mesh.indices.end(), {id(i, j), id(i, j + 1), id(i + 1, j + 1)});
-          }
-        }
-    }
-  }
-  return mesh;
-}
-
-Mesh load(const std::string& name) {
-  Mesh mesh;
-  const Status s = load_mesh(std::string(TAILOR_TEST_DATA) + "/meshes/" + name, mesh);
-  EXPECT_TRUE(s.is_ok()) << s.message();
-  return mesh;
-}
+using test::box_sides;
+using test::load_test_mesh;
 
 double dot3(const float* a, const float* b) {
   return static_cast<double>(a[0]) * b[0] + static_cast<double>(a[1]) * b[1] + static_cast<double>(a[2]) * b[2];
@@ -66,7 +29,7 @@ FaceFrames frames_of(const Mesh& mesh, const OrientationOptions& options = {}) {
 }
 
 TEST(Orientation, PcaAxisOfElongatedBoxIsItsLongSide) {
-  const FaceFrames frames = frames_of(box(10.f, 1.f, 2.f, 4));
+  const FaceFrames frames = frames_of(box_sides(10.f, 1.f, 2.f, 4));
   EXPECT_GT(std::abs(frames.axis[0]), 0.999f);
   EXPECT_GT(std::abs(frames.axis2[2]), 0.999f);  // second longest side
   EXPECT_FLOAT_EQ(frames.unit_scale, 0.1f);      // 1 / longest side
@@ -74,7 +37,7 @@ TEST(Orientation, PcaAxisOfElongatedBoxIsItsLongSide) {
 }
 
 TEST(Orientation, FramesAreOrthonormalInTheFacePlaneAndRightHanded) {
-  const Mesh mesh = load("spot.obj");
+  const Mesh mesh = load_test_mesh("spot.obj");
   const FaceFrames frames = frames_of(mesh);
   ASSERT_EQ(frames.face_count(), mesh.face_count());
   for (size_t f = 0; f < mesh.face_count(); ++f) {
@@ -92,7 +55,7 @@ TEST(Orientation, FramesAreOrthonormalInTheFacePlaneAndRightHanded) {
 }
 
 TEST(Orientation, LocalCoordinatesKeepEdgeLengthsAndCounterClockwiseOrder) {
-  const Mesh mesh = load("fandisk.off");
+  const Mesh mesh = load_test_mesh("fandisk.off");
   const FaceFrames frames = frames_of(mesh);
   for (size_t f = 0; f < mesh.face_count(); ++f) {
     const float* l = &frames.local[6 * f];
@@ -113,7 +76,7 @@ TEST(Orientation, UserAxisIsProjectedAndFallsBackWhereNormal) {
   OrientationOptions options;
   options.axis = AxisSource::kUser;
   options.user_axis = {0.f, 2.f, 0.f};  // any length
-  const Mesh mesh = box(1.f, 1.f, 1.f, 2);
+  const Mesh mesh = box_sides(1.f, 1.f, 1.f, 2);
   const FaceFrames frames = frames_of(mesh, options);
   EXPECT_FLOAT_EQ(frames.axis[1], 1.f);
   uint32_t fallback = 0;
@@ -145,7 +108,7 @@ TEST(Orientation, ZeroAreaFacesGetAFiniteFrame) {
 }
 
 TEST(Orientation, SmoothingReducesTheMeanNeighbourAngle) {
-  const Mesh mesh = load("fertility.off");
+  const Mesh mesh = load_test_mesh("fertility.off");
   const Topology topology = build_topology(mesh);
   FaceFrames raw, smooth;
   ASSERT_TRUE(compute_orientation(mesh, topology, {}, raw).is_ok());
@@ -175,7 +138,7 @@ TEST(Orientation, VariationSumsNeighbourAngles) {
   OrientationOptions options;
   options.axis = AxisSource::kUser;
   options.user_axis = {1.f, 2.f, 3.f};
-  const FaceFrames frames = frames_of(box(1.f, 1.f, 1.f, 3), options);
+  const FaceFrames frames = frames_of(box_sides(1.f, 1.f, 1.f, 3), options);
   for (float v : frames.variation) EXPECT_LT(v, 3e-3f);
   // Two faces folded by 90 degrees along their shared edge, axis across the fold: o turns by
   // 90 degrees, so each face's variation is pi/2.
@@ -189,7 +152,7 @@ TEST(Orientation, VariationSumsNeighbourAngles) {
 }
 
 TEST(Orientation, ThreadCountDoesNotChangeTheFrames) {
-  const Mesh mesh = load("horse.ply");
+  const Mesh mesh = load_test_mesh("horse.ply");
   const Topology topology = build_topology(mesh);
   FaceFrames one, three;
   OrientationOptions options;
@@ -209,7 +172,7 @@ TEST(Orientation, ThreadCountDoesNotChangeTheFrames) {
 }
 
 TEST(Orientation, RejectsBadOptionsAndMismatchedTopology) {
-  const Mesh mesh = box(1.f, 1.f, 1.f, 1);
+  const Mesh mesh = box_sides(1.f, 1.f, 1.f, 1);
   const Topology topology = build_topology(mesh);
   FaceFrames frames;
   OrientationOptions options;
@@ -224,7 +187,7 @@ TEST(Orientation, RejectsBadOptionsAndMismatchedTopology) {
 }
 
 TEST(Orientation, IsDeterministic) {
-  const Mesh mesh = load("blobby-3cc.off");
+  const Mesh mesh = load_test_mesh("blobby-3cc.off");
   const FaceFrames a = frames_of(mesh);
   const FaceFrames b = frames_of(mesh);
   EXPECT_EQ(a.orientation, b.orientation);

@@ -13,8 +13,13 @@
 #include "tailor/io.h"
 #include "tailor/render.h"
 
+#include "support/fixtures.h"
+
 namespace tailor {
 namespace {
+
+using test::box;
+using test::load_test_mesh;
 
 const std::string kData = std::string(TAILOR_TEST_DATA) + "/";
 
@@ -26,7 +31,7 @@ struct Fixture {
 const Fixture& spot() {
   static const Fixture f = [] {
     Fixture x;
-    EXPECT_TRUE(load_mesh(kData + "meshes/spot.obj", x.mesh).is_ok());
+    x.mesh = load_test_mesh("spot.obj");
     EXPECT_TRUE(load_image(kData + "textures/vistex-tile04-128.png", x.texture).is_ok());
     return x;
   }();
@@ -265,16 +270,6 @@ TEST(RenderPreview, RejectsBadInput) {
   bad_texture.pixels.resize(5);
   EXPECT_EQ(render_preview(square, square.corner_uvs, {}, &bad_texture, small(PreviewView::kTexture), out).code(),
             ErrorCode::kInvalidImage);
-}
-
-// Closed box [0,sx] x [0,sy] x [0,sz], outward faces.
-Mesh box(float sx, float sy, float sz) {
-  Mesh m;
-  for (int i = 0; i < 8; ++i)
-    m.positions.insert(m.positions.end(), {(i & 1) ? sx : 0.f, (i & 2) ? sy : 0.f, (i & 4) ? sz : 0.f});
-  m.indices = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4,
-               2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
-  return m;
 }
 
 // Width and height of the box around the pixels that differ from the background.

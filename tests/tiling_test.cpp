@@ -1,16 +1,12 @@
 // Self-tileable textures (thesis chapter 3): quality targets on real exemplars, bit-exact borders,
 // determinism, variants, period detection, and the `tailor tile` / `tailor eval-tile` commands.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -20,22 +16,20 @@
 #include "tailor/image_ops.h"
 #include "tailor/tiling.h"
 
+#include "support/fixtures.h"
+
 namespace tailor {
 namespace {
 
 const std::string kData = std::string(TAILOR_TEST_DATA) + "/textures/";
+
+using test::temp_dir;
 
 Image load(const std::string& name) {
   Image im;
   const Status s = load_image(kData + name, im);
   EXPECT_TRUE(s.is_ok()) << s.message();
   return im;
-}
-
-std::string temp_dir() {
-  const auto dir = std::filesystem::temp_directory_path() / ("tailor_tiling_test_" + std::to_string(getpid()));
-  std::filesystem::create_directories(dir);
-  return dir.string();
 }
 
 const uint8_t* px(const Image& im, int x, int y) {
@@ -371,18 +365,8 @@ struct CliRun {
 };
 
 CliRun run_cli(const std::string& args) {
-  const std::string dir = temp_dir();
-  const std::string out = dir + "/stdout.txt", err = dir + "/stderr.txt";
-  const std::string cmd = std::string(TAILOR_BINARY) + " " + args + " >" + out + " 2>" + err;
   CliRun r;
-  const int status = std::system(cmd.c_str());
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream fo(out), fe(err);
-  std::stringstream so, se;
-  so << fo.rdbuf();
-  se << fe.rdbuf();
-  r.out = so.str();
-  r.err = se.str();
+  r.code = test::run_command(std::string(TAILOR_BINARY) + " " + args, r.out, &r.err);
   return r;
 }
 

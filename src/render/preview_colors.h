@@ -1,4 +1,4 @@
-// Colours and legend text of the preview pictures (render_preview.cpp): distinct patch colours,
+// Colours and legend text of the preview pictures (preview_scene.cpp): distinct patch colours,
 // the diverging heat map of the distortion view, and a tiny bitmap font stamped into the final
 // RGB image for the legend labels (text drawn on the CPU keeps the GL part free of font code).
 #pragma once

@@ -1,7 +1,7 @@
 // The `tailor map IN -o OUT.ply` pipeline with a scalar build of the mapping stage: CMake compiles
-// src/mapping*.cpp into this executable with TAILOR_NO_SIMD (src/internal/simd.h), so its symbols
-// take the place of the library's SIMD ones. tests/simd_test.sh compares its output with the
-// tailor binary's byte for byte: the SIMD paths must give the scalar paths' bits.
+// TAILOR_MAPPING_SOURCES (src/mapping/) into this executable with TAILOR_NO_SIMD (src/util/simd.h),
+// so its symbols take the place of the library's SIMD ones. tests/simd_test.sh compares its output
+// with the tailor binary's byte for byte: the SIMD paths must give the scalar paths' bits.
 // Usage: map_scalar IN OUT.ply [--field-following F] [--crack-rings N]
 #include <cstdio>
 #include <cstdlib>

@@ -1,0 +1,375 @@
+// Headless preview pictures with Mesa's off-screen OpenGL (OSMesa on llvmpipe).
+//
+// The mesh is drawn as unindexed triangles (UVs and colours live per corner) from vertex buffer
+// objects filled in batches, so memory stays bounded for any face count and no immediate mode is
+// used.
+//
+// What is drawn is prepared on the CPU by preview_scene.h (framing, colours, camera, vertex
+// arrays); this file holds everything that talks to GL: the context, the texture upload, the
+// buffers and draw calls, and render_preview, which runs the whole picture.
+#define GL_GLEXT_PROTOTYPES 1
+#include <GL/osmesa.h>
+#include <GL/gl.h>
+#include <GL/glext.h>
+
+#include <algorithm>
+#include <array>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "render/preview_scene.h"
+#include "tailor/export.h"
+#include "tailor/render.h"
+
+namespace tailor {
+
+// What is prepared on the CPU (preview_scene.h).
+using internal::Camera;
+using internal::check_inputs;
+using internal::checker_image;
+using internal::draw_legend_text;
+using internal::fill_face_colored_batch;
+using internal::Framing;
+using internal::half_size;
+using internal::kBackground;
+using internal::kCheckerDark;
+using internal::kCheckerLight;
+using internal::kNeutralDark;
+using internal::kNeutralLight;
+using internal::kSeamColor;
+using internal::legend_bar;
+using internal::legend_box;
+using internal::LegendBar;
+using internal::LegendBox;
+using internal::Mat4;
+using internal::orthographic;
+using internal::patch_keys;
+using internal::place_camera;
+using internal::prepare_scene;
+using internal::PreviewScene;
+using internal::resolve;
+using internal::Rgb;
+using internal::split_surface;
+using internal::SplitSurface;
+
+namespace {
+
+// Faces per vertex-buffer batch: 3 corners x (3+3 floats + 2 floats + 4 bytes) = 108 bytes a
+// face, so ~28 MB of arrays at a time, few enough draw calls that batching costs nothing.
+constexpr size_t kBatchFaces = size_t{1} << 18;
+// Largest render target side after supersampling (llvmpipe allows 16384; memory is the limit).
+constexpr int kMaxRenderSide = 8192;
+
+// === OSMesa context, created and destroyed per call =============================================
+
+class OffscreenContext {
+ public:
+  OffscreenContext() = default;
+  OffscreenContext(const OffscreenContext&) = delete;
+  OffscreenContext& operator=(const OffscreenContext&) = delete;
+  ~OffscreenContext() {
+    if (context_ != nullptr) OSMesaDestroyContext(context_);
+  }
+
+  bool create(int width, int height) {
+    context_ = OSMesaCreateContextExt(OSMESA_RGBA, 24, 0, 0, nullptr);
+    if (context_ == nullptr) return false;
+    buffer_.assign(static_cast<size_t>(width) * static_cast<size_t>(height) * 4, 0);
+    return OSMesaMakeCurrent(context_, buffer_.data(), GL_UNSIGNED_BYTE, width, height) == GL_TRUE;
+  }
+
+  //! RGBA, bottom row first (OSMesa's default).
+  const std::vector<uint8_t>& pixels() const { return buffer_; }
+
+ private:
+  OSMesaContext context_ = nullptr;
+  std::vector<uint8_t> buffer_;
+};
+
+// === Textures ====================================================================================
+
+//! Uploads a repeating, trilinearly filtered texture. The mipmap chain is built on the CPU:
+//! glGenerateMipmap would make llvmpipe compile a blit shader, which costs more than the filtering.
+void upload_texture(const Image& image) {
+  static constexpr std::array<GLenum, 4> kFormats = {GL_LUMINANCE, GL_LUMINANCE_ALPHA, GL_RGB, GL_RGBA};
+  const GLenum format = kFormats[static_cast<size_t>(image.channels - 1)];
+  GLuint id = 0;
+  glGenTextures(1, &id);
+  glBindTexture(GL_TEXTURE_2D, id);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  Image level_image;
+  const Image* current = &image;
+  for (GLint level = 0;; ++level) {
+    glTexImage2D(GL_TEXTURE_2D, level, static_cast<GLint>(format), current->width, current->height, 0, format,
+                 GL_UNSIGNED_BYTE, current->pixels.data());
+    if (current->width == 1 && current->height == 1) break;
+    level_image = half_size(*current);
+    current = &level_image;
+  }
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
+  glEnable(GL_TEXTURE_2D);
+}
+
+// === Drawing =====================================================================================
+
+//! Attribute pointers of one draw: positions and normals always, then either texture coordinates
+//! or RGBA colours. Buffers are bound to GL_ARRAY_BUFFER one after the other.
+struct VertexStreams {
+  std::span<const float> positions;  // xyz, centred on the framing sphere
+  std::span<const float> normals;    // xyz
+  std::span<const float> texcoords;  // st, or empty
+  std::span<const uint8_t> colors;   // rgba, or empty
+};
+
+void bind_streams(const VertexStreams& in, const std::array<GLuint, 4>& buffers) {
+  const auto upload = [](GLuint buffer, const void* data, size_t bytes) {
+    glBindBuffer(GL_ARRAY_BUFFER, buffer);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(bytes), data, GL_STREAM_DRAW);
+  };
+  glEnableClientState(GL_VERTEX_ARRAY);
+  upload(buffers[0], in.positions.data(), in.positions.size_bytes());
+  glVertexPointer(3, GL_FLOAT, 0, nullptr);
+  glEnableClientState(GL_NORMAL_ARRAY);
+  upload(buffers[1], in.normals.data(), in.normals.size_bytes());
+  glNormalPointer(GL_FLOAT, 0, nullptr);
+  if (!in.texcoords.empty()) {
+    glEnableClientState(GL_TEXTURE_COORD_ARRAY);
+    upload(buffers[2], in.texcoords.data(), in.texcoords.size_bytes());
+    glTexCoordPointer(2, GL_FLOAT, 0, nullptr);
+  }
+  if (!in.colors.empty()) {
+    glEnableClientState(GL_COLOR_ARRAY);
+    upload(buffers[3], in.colors.data(), in.colors.size_bytes());
+    glColorPointer(4, GL_UNSIGNED_BYTE, 0, nullptr);
+  }
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+}
+
+void unbind_streams() {
+  glDisableClientState(GL_VERTEX_ARRAY);
+  glDisableClientState(GL_NORMAL_ARRAY);
+  glDisableClientState(GL_TEXTURE_COORD_ARRAY);
+  glDisableClientState(GL_COLOR_ARRAY);
+}
+
+//! Indexed drawing of a mesh split so that every vertex carries one key (a UV, or a patch id):
+//! llvmpipe shades each split vertex about once instead of once per corner, which is most of the
+//! cost on large meshes. `key` is #F*3 by 2 floats; `key_is_uv` says whether it is a texture
+//! coordinate (else a patch id encoded as two exact floats, see draw_patch_surface).
+void draw_split_surface(const Mesh& mesh, std::span<const float> key, bool key_is_uv,
+                        std::span<const float> vertex_normal, const Framing& frame) {
+  const SplitSurface surface = split_surface(mesh, key, key_is_uv, vertex_normal, frame);
+  const SplitMesh& split = surface.split;
+  std::array<GLuint, 4> buffers{};
+  GLuint element_buffer = 0;
+  glGenBuffers(4, buffers.data());
+  glGenBuffers(1, &element_buffer);
+  bind_streams({surface.positions, surface.normals, surface.texcoords, surface.colors}, buffers);
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, element_buffer);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(split.indices.size() * sizeof(uint32_t)),
+               split.indices.data(), GL_STATIC_DRAW);
+  // Batches keep every count within GLsizei.
+  const size_t total = split.indices.size();
+  for (size_t start = 0; start < total; start += 3 * kBatchFaces) {
+    const size_t n = std::min(3 * kBatchFaces, total - start);
+    glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(n), GL_UNSIGNED_INT,
+                   reinterpret_cast<const void*>(start * sizeof(uint32_t)));
+  }
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, 0);
+  unbind_streams();
+  glDeleteBuffers(1, &element_buffer);
+  glDeleteBuffers(4, buffers.data());
+}
+
+//! Patch colours: vertices are split on (vertex, patch) so each patch keeps its own colour.
+void draw_patch_surface(const Mesh& mesh, std::span<const uint32_t> patch, std::span<const float> vertex_normal,
+                        const Framing& frame) {
+  const std::vector<float> key = patch_keys(mesh, patch);
+  draw_split_surface(mesh, key, false, vertex_normal, frame);
+}
+
+//! Per-face colours (distortion): unindexed triangles, filled and drawn in batches so memory stays
+//! bounded (108 bytes of arrays per face would otherwise be needed at once).
+void draw_face_colored_surface(const Mesh& mesh, const std::vector<Rgb>& face_colors,
+                               std::span<const float> vertex_normal, const Framing& frame) {
+  const size_t faces = mesh.face_count();
+  const size_t batch = std::min(faces, kBatchFaces);
+  std::vector<float> pos(9 * batch), nor(9 * batch);
+  std::vector<uint8_t> col(12 * batch);
+  std::array<GLuint, 4> buffers{};
+  glGenBuffers(4, buffers.data());
+  for (size_t start = 0; start < faces; start += batch) {
+    const size_t count = std::min(batch, faces - start);
+    fill_face_colored_batch(mesh, face_colors, vertex_normal, frame, start, count, pos, nor, col);
+    bind_streams({std::span<const float>(pos).first(9 * count), std::span<const float>(nor).first(9 * count), {},
+                  std::span<const uint8_t>(col).first(12 * count)},
+                 buffers);
+    glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(3 * count));
+  }
+  unbind_streams();
+  glDeleteBuffers(4, buffers.data());
+}
+
+void draw_lines(const std::vector<float>& lines, float width) {
+  if (lines.empty()) return;
+  GLuint buffer = 0;
+  glGenBuffers(1, &buffer);
+  glBindBuffer(GL_ARRAY_BUFFER, buffer);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(lines.size() * sizeof(float)), lines.data(), GL_STATIC_DRAW);
+  glEnableClientState(GL_VERTEX_ARRAY);
+  glVertexPointer(3, GL_FLOAT, 0, nullptr);
+  glLineWidth(width);
+  glColor3ub(kSeamColor[0], kSeamColor[1], kSeamColor[2]);
+  glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(lines.size() / 3));
+  glDisableClientState(GL_VERTEX_ARRAY);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+  glDeleteBuffers(1, &buffer);
+}
+
+//! The colour bar of the distortion view, drawn in render-target pixels (`scale` = supersampling).
+void draw_legend_bar(const LegendBox& box, int target_width, int target_height, int scale) {
+  const LegendBar bar = legend_bar(box, target_height, scale);
+  const std::vector<float>& xy = bar.xy;
+  const std::vector<uint8_t>& rgba = bar.rgba;
+  const size_t frame_vertices = bar.frame_vertices;
+  glMatrixMode(GL_PROJECTION);
+  const Mat4 ortho = orthographic(target_width, target_height);
+  glLoadMatrixf(ortho.data());
+  glMatrixMode(GL_MODELVIEW);
+  glLoadIdentity();
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_LIGHTING);
+  glDisable(GL_TEXTURE_2D);
+  glShadeModel(GL_SMOOTH);
+  glEnableClientState(GL_VERTEX_ARRAY);
+  glEnableClientState(GL_COLOR_ARRAY);
+  glVertexPointer(2, GL_FLOAT, 0, xy.data());
+  glColorPointer(4, GL_UNSIGNED_BYTE, 0, rgba.data());
+  glDrawArrays(GL_TRIANGLE_STRIP, 0, static_cast<GLsizei>(frame_vertices));
+  glDrawArrays(GL_TRIANGLE_STRIP, static_cast<GLint>(frame_vertices),
+               static_cast<GLsizei>(xy.size() / 2 - frame_vertices));
+  glDisableClientState(GL_COLOR_ARRAY);
+  glDisableClientState(GL_VERTEX_ARRAY);
+}
+
+}  // namespace
+
+Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::span<const uint32_t> patch,
+                      const Image* texture, const RenderOptions& options, Image& out) {
+  out = Image{};
+  TAILOR_RETURN_IF_ERROR(check_inputs(mesh, corner_uv, patch, texture, options));
+  try {
+    // Supersampling is reduced rather than refused when the target would get too large.
+    int scale = options.supersample;
+    while (scale > 1 && (options.width * scale > kMaxRenderSide || options.height * scale > kMaxRenderSide)) --scale;
+    const int target_width = options.width * scale;
+    const int target_height = options.height * scale;
+
+    PreviewScene scene;
+    prepare_scene(mesh, corner_uv, patch, options, scene);
+    const bool textured = options.view == PreviewView::kTexture || options.view == PreviewView::kChecker;
+
+    OffscreenContext context;
+    if (!context.create(target_width, target_height)) {
+      return Status::error(ErrorCode::kUnsupported, "", "cannot create an off-screen OpenGL context (OSMesa)");
+    }
+    GLint max_texture = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture);
+    const bool use_image = options.view == PreviewView::kTexture && texture != nullptr;
+    if (use_image && (texture->width > max_texture || texture->height > max_texture)) {
+      return Status::error(ErrorCode::kUnsupported, "", "texture larger than the renderer allows",
+                           std::to_string(max_texture) + " pixels a side");
+    }
+
+    // The distortion view keeps a band at the bottom for its legend, so the mesh never hides it.
+    const LegendBox box = legend_box(options.width, options.height);
+    const int band = options.view == PreviewView::kDistortion ? options.height - box.y + box.height : 0;
+    glViewport(0, band * scale, target_width, target_height - band * scale);
+    glClearColor(kBackground[0] / 255.0f, kBackground[1] / 255.0f, kBackground[2] / 255.0f, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LEQUAL);
+
+    const Camera camera = place_camera(scene.frame, options, band);
+    glMatrixMode(GL_PROJECTION);
+    glLoadMatrixf(camera.projection.data());
+
+    // Light fixed in eye space (up-left of the camera) before the view matrix is loaded.
+    glMatrixMode(GL_MODELVIEW);
+    glLoadIdentity();
+    const std::array<GLfloat, 4> light_dir = {-0.35f, 0.55f, 0.76f, 0.0f};
+    const std::array<GLfloat, 4> diffuse = {0.72f, 0.72f, 0.72f, 1.0f};
+    const std::array<GLfloat, 4> ambient = {0.0f, 0.0f, 0.0f, 1.0f};
+    const std::array<GLfloat, 4> scene_ambient = {0.36f, 0.36f, 0.36f, 1.0f};
+    glLightfv(GL_LIGHT0, GL_POSITION, light_dir.data());
+    glLightfv(GL_LIGHT0, GL_DIFFUSE, diffuse.data());
+    glLightfv(GL_LIGHT0, GL_AMBIENT, ambient.data());
+    glLightModelfv(GL_LIGHT_MODEL_AMBIENT, scene_ambient.data());
+    glLightModeli(GL_LIGHT_MODEL_TWO_SIDE, GL_TRUE);  // open meshes show their inside lit too
+    glEnable(GL_LIGHTING);
+    glEnable(GL_LIGHT0);
+    glEnable(GL_COLOR_MATERIAL);
+    glColorMaterial(GL_FRONT_AND_BACK, GL_AMBIENT_AND_DIFFUSE);
+    glShadeModel(GL_SMOOTH);
+    glLoadMatrixf(camera.view.data());
+    glMultMatrixf(camera.turn.data());
+
+    glColor4ub(255, 255, 255, 255);
+    if (textured) {
+      if (use_image) {
+        upload_texture(*texture);
+      } else {
+        const bool checker = options.view == PreviewView::kChecker;
+        upload_texture(checker ? checker_image(kCheckerDark, kCheckerLight) : checker_image(kNeutralDark, kNeutralLight));
+        // The generated image holds 2x2 squares.
+        glMatrixMode(GL_TEXTURE);
+        glLoadIdentity();
+        glScalef(options.checker_squares / 2.0f, options.checker_squares / 2.0f, 1.0f);
+        glMatrixMode(GL_MODELVIEW);
+      }
+    }
+    // Seams are drawn on top of the faces: push the faces back a little.
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(1.0f, 1.0f);
+
+    if (textured) {
+      draw_split_surface(mesh, corner_uv, true, scene.normals, scene.frame);
+    } else if (options.view == PreviewView::kPatches) {
+      draw_patch_surface(mesh, scene.patch_ids, scene.normals, scene.frame);
+    } else {
+      draw_face_colored_surface(mesh, scene.face_colors, scene.normals, scene.frame);
+    }
+    glDisable(GL_POLYGON_OFFSET_FILL);
+    glDisable(GL_LIGHTING);
+    glDisable(GL_TEXTURE_2D);
+    draw_lines(scene.lines, 1.25f * static_cast<float>(scale));
+
+    glViewport(0, 0, target_width, target_height);
+    if (options.view == PreviewView::kDistortion) draw_legend_bar(box, target_width, target_height, scale);
+    glFinish();
+    if (glGetError() == GL_OUT_OF_MEMORY) {
+      return Status::error(ErrorCode::kUnsupported, "", "the renderer ran out of memory");
+    }
+
+    out.width = options.width;
+    out.height = options.height;
+    out.channels = 3;
+    out.pixels.assign(static_cast<size_t>(out.width) * static_cast<size_t>(out.height) * 3, 0);
+    resolve(context.pixels(), target_width, scale, out);
+    if (options.view == PreviewView::kDistortion) draw_legend_text(box, options.distortion_range, out);
+    return Status::ok();
+  } catch (const std::bad_alloc&) {
+    out = Image{};
+    return Status::error(ErrorCode::kLimit, "", "out of memory while rendering the preview");
+  } catch (const std::exception& e) {
+    out = Image{};
+    return Status::error(ErrorCode::kUnsupported, "", std::string("rendering failed: ") + e.what());
+  }
+}
+
+}  // namespace tailor
