@@ -37,17 +37,17 @@ int run_stability(const EvalOptions& opt) {
     const ReadingInput reading(opt.input);
     if (Status s = load_mesh(opt.input, mesh); !s) return report_error(s);
   }
-  MappingOptions mapping;
+  MapTextureOptions mapping;
   if (!opt.seed_point.empty()) {
-    if (!parse_vec3(opt.seed_point, mapping.seed_point))
+    if (!parse_vec3(opt.seed_point, mapping.mapping.seed_point))
       return report_error(Status::error(ErrorCode::kInvalidArgument, "",
                                         "--seed-point must be three numbers X,Y,Z, got '" + opt.seed_point + "'"));
-    mapping.use_seed_point = true;
+    mapping.mapping.use_seed_point = true;
   }
   StabilityOptions options;
   options.remove_fraction = opt.remove_fraction;
   StabilityReport r;
-  if (Status s = measure_stability(mesh, OrientationOptions{}, mapping, r, options); !s)
+  if (Status s = measure_stability(mesh, mapping, r, options); !s)
     return report_error(s.with_file(opt.input));
   if (opt.json) {
     nlohmann::json j;

@@ -167,19 +167,24 @@ int run_map(const MapOptions& opt) {
   if (topology.nonmanifold_edges || topology.inconsistent_edges)
     warn(opt.quiet, opt.input + ": " + std::to_string(topology.nonmanifold_edges) + " non-manifold and " +
                         std::to_string(topology.inconsistent_edges) + " inconsistently oriented edges treated as boundary");
+  MapTextureOptions options;
+  options.orientation = orientation_options;
+  options.mapping = mapping_options;
+  options.metrics.texture_width_px = static_cast<float>(tex_w);
+  options.metrics.texture_height_px = static_cast<float>(tex_h);
+  options.metrics.threads = opt.threads;
   std::string axis_used = opt.axis;
   double axis_seconds = 0;
   if (auto_axis) {
     const auto axis_start = std::chrono::steady_clock::now();
     Progress choosing("choosing axis", opt.quiet);
-    MappingOptions trial = mapping_options;
-    trial.progress = [&choosing](float f) { return choosing.update(f); };
+    options.mapping.progress = [&choosing](float f) { return choosing.update(f); };
     AxisChoice choice;
-    if (Status s = choose_orientation_axis(mesh, topology, orientation_options, trial, choice); !s)
+    if (Status s = choose_orientation_axis(mesh, topology, options, choice); !s)
       return report_error(s.with_file(opt.input));
     choosing.done();
     axis_seconds = seconds_since(axis_start);
-    orientation_options = orientation_for(choice.best, orientation_options);
+    options.orientation = orientation_for(choice.best, options.orientation);
     axis_used = std::string("auto:") + axis_candidate_name(choice.best);
     if (!opt.quiet) {
       std::string line = "axis auto: " + std::string(axis_candidate_name(choice.best)) + " (seams without crack closing:";
@@ -192,37 +197,22 @@ int run_map(const MapOptions& opt) {
       std::fprintf(stderr, "%s)\n", line.c_str());
     }
   }
-  FaceFrames frames;
-  if (Status s = compute_orientation(mesh, topology, orientation_options, frames); !s)
-    return report_error(s.with_file(opt.input));
-
-  // === Mapping ===
+  // === Orientation, mapping, metrics ===
   Progress progress("mapping", opt.quiet);
-  mapping_options.progress = [&progress](float f) { return progress.update(f); };
-  Atlas atlas;
-  MappingStats stats;
-  if (Status s = map_texture(mesh, topology, frames, mapping_options, atlas, &stats); !s)
-    return report_error(s.with_file(opt.input));
+  options.mapping.progress = [&progress](float f) { return progress.update(f); };
+  TextureMap map;
+  if (Status s = map_texture(mesh, topology, options, map); !s) return report_error(s.with_file(opt.input));
   progress.done();
-
-  // === Metrics ===
-  const auto metrics_start = std::chrono::steady_clock::now();
-  MetricsOptions metrics_options;
-  metrics_options.texture_width_px = static_cast<float>(tex_w);
-  metrics_options.texture_height_px = static_cast<float>(tex_h);
-  metrics_options.threads = opt.threads;
-  UvMetrics metrics;
-  if (Status s = compute_uv_metrics(mesh, topology, atlas.corner_uv, atlas.patch, metrics_options, metrics); !s)
-    return report_error(s.with_file(opt.input));
-  const double metrics_seconds = seconds_since(metrics_start);
+  const FaceFrames& frames = map.frames;
+  const Atlas& atlas = map.atlas;
+  const MappingStats& stats = map.stats;
+  const UvMetrics& metrics = map.metrics;
+  const double metrics_seconds = metrics.seconds;
 
   // === Stability (optional: two more mappings) ===
   StabilityReport stability;
   if (opt.stability) {
-    MappingOptions quiet_mapping = mapping_options;
-    quiet_mapping.progress = nullptr;
-    if (Status s = measure_stability(mesh, orientation_options, quiet_mapping, stability); !s)
-      return report_error(s.with_file(opt.input));
+    if (Status s = measure_stability(mesh, options, stability); !s) return report_error(s.with_file(opt.input));
   }
 
   // === Previews, rendered before anything is written ===
