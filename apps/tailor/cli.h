@@ -13,10 +13,6 @@
 
 #include "tailor/status.h"
 
-namespace tailor {
-struct TileMetrics;
-}
-
 namespace tailor::cli {
 
 inline constexpr int kExitOk = 0;
@@ -60,11 +56,6 @@ Status check_outputs(const std::vector<OutputPath>& outputs, const std::vector<s
 
 //! Parses "X,Y,Z" into three finite floats; false when the text is anything else.
 bool parse_vec3(const std::string& text, std::array<float, 3>& v);
-
-//! The JSON fields of tile metrics shared by `tile` and `eval-tile`: wrap ratios and worst seam;
-//! with an exemplar also its ratios, histogram L1, gradient ratio and patch coherences; then
-//! targets_met (and targets_failed when some are not).
-nlohmann::json tile_metrics_json(const TileMetrics& m, bool with_exemplar);
 
 //! A progress bar on stderr, drawn only when stderr is a terminal and not quiet, and only once the
 //! work has run for more than ~1 s. update() is cheap enough to call per percent of work.

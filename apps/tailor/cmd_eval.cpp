@@ -4,14 +4,13 @@
 #include <cstdio>
 #include <memory>
 
-#include <nlohmann/json.hpp>
-
 #include "cli.h"
 #include "tailor/export.h"
 #include "tailor/gltf.h"
 #include "tailor/io.h"
 #include "tailor/mapping.h"
 #include "tailor/metrics.h"
+#include "tailor/report.h"
 #include "tailor/stability.h"
 #include "tailor/topology.h"
 
@@ -49,27 +48,8 @@ int run_stability(const EvalOptions& opt) {
   StabilityReport r;
   if (Status s = measure_stability(mesh, mapping, r, options); !s)
     return report_error(s.with_file(opt.input));
-  if (opt.json) {
-    nlohmann::json j;
-    j["file"] = opt.input;
-    j["faces"] = r.faces;
-    j["removed_faces"] = r.removed_faces;
-    j["compared_corners"] = r.compared_corners;
-    j["mean_difference_px"] = r.mean_difference_px;
-    j["max_difference_px"] = r.max_difference_px;
-    j["identical_ratio"] = r.identical_ratio;
-    j["within_1px_ratio"] = r.within_1px_ratio;
-    j["patches_full"] = r.patches_full;
-    j["patches_cut"] = r.patches_cut;
-    j["seconds"] = r.seconds;
-    std::printf("%s\n", json_text(j).c_str());
-  } else if (!opt.quiet) {
-    std::printf("%s: stability: removed %zu of %zu faces, surviving corners moved %.3f px on average (max %.2f px), "
-                "%.1f%% bit-identical, %.1f%% within 1 px; patches %u -> %u (%.0f ms)\n",
-                opt.input.c_str(), r.removed_faces, r.faces, r.mean_difference_px, r.max_difference_px,
-                100.0 * r.identical_ratio, 100.0 * r.within_1px_ratio, r.patches_full, r.patches_cut,
-                r.seconds * 1e3);
-  }
+  if (opt.json) std::fputs(stability_report_json(opt.input, r).c_str(), stdout);
+  else if (!opt.quiet) std::fputs(stability_summary(opt.input, r).c_str(), stdout);
   return kExitOk;
 }
 
@@ -123,44 +103,19 @@ int run_eval(const EvalOptions& opt) {
   if (m.zero_uv_area_faces > 0)
     warn(opt.quiet || opt.json, std::to_string(m.zero_uv_area_faces) + " faces with zero UV area (counted as flipped)");
 
-  if (opt.json) {
-    nlohmann::json j;
-    j["file"] = opt.input;
-    j["format"] = report.format;
-    j["vertices"] = mesh.vertex_count();
-    j["faces"] = m.faces;
-    j["welded_vertices"] = glb ? report.welded_vertices : welded;
-    j["texture_width"] = width;
-    j["texture_height"] = height;
-    j["texture_size_from"] = size_source;
-    j["patches"] = m.patches;
-    j["single_face_patches"] = m.single_face_patches;
-    j["degenerate_faces"] = m.degenerate_faces;
-    j["stretch"] = m.stretch;
-    j["stretch_area_weighted"] = m.stretch_area_weighted;
-    j["distortion_deg"] = m.distortion_deg;
-    j["l2_stretch"] = m.l2_stretch;
-    j["linf_stretch"] = m.linf_stretch;
-    j["flipped"] = m.flipped;
-    j["zero_uv_area_faces"] = m.zero_uv_area_faces;
-    j["seam_edges"] = m.seam_edges;
-    j["seam_length_ratio"] = m.seam_length_ratio;
-    j["seam_gap_px"] = m.seam_gap_px;
-    j["seam_invisible_ratio"] = m.seam_invisible_ratio;
-    j["uv_scale_px2_per_unit2"] = m.uv_scale;
-    j["boundary_edges"] = topology.boundary_edges;
-    j["nonmanifold_edges"] = topology.nonmanifold_edges;
-    j["seconds"] = seconds;
-    std::printf("%s\n", json_text(j).c_str());
-    return kExitOk;
-  }
-  std::printf(
-      "%s: %zu faces, %u patches (%zu single-face), seams %.2f%% of edge length (%zu edges), %zu flipped, "
-      "stretch %.4f (area-weighted %.4f), L2 %.4f, Linf %.4f, distortion %.2f deg (median), "
-      "seam gap %.2f px, %.1f%% invisible (texture %dx%d px, %s)\n",
-      opt.input.c_str(), m.faces, m.patches, m.single_face_patches, 100.0 * m.seam_length_ratio, m.seam_edges,
-      m.flipped, m.stretch, m.stretch_area_weighted, m.l2_stretch, m.linf_stretch, m.distortion_deg, m.seam_gap_px,
-      100.0 * m.seam_invisible_ratio, width, height, size_source);
+  EvalRun run;
+  run.file = opt.input;
+  run.format = report.format;
+  run.vertices = mesh.vertex_count();
+  run.welded_vertices = glb ? report.welded_vertices : welded;
+  run.texture_width = width;
+  run.texture_height = height;
+  run.texture_size_from = size_source;
+  run.metrics = m;
+  run.boundary_edges = topology.boundary_edges;
+  run.nonmanifold_edges = topology.nonmanifold_edges;
+  run.seconds = seconds;
+  std::fputs((opt.json ? eval_report_json(run) : eval_summary(run)).c_str(), stdout);
   return kExitOk;
 }
 

@@ -3,8 +3,6 @@
 #include <cstdio>
 #include <filesystem>
 
-#include <nlohmann/json.hpp>
-
 #include "cli.h"
 #include "util/atomic_file.h"
 #include "tailor/axis_choice.h"
@@ -15,6 +13,7 @@
 #include "tailor/metrics.h"
 #include "tailor/orientation.h"
 #include "tailor/render.h"
+#include "tailor/report.h"
 #include "tailor/stability.h"
 #include "tailor/topology.h"
 
@@ -70,8 +69,6 @@ std::string sibling_path(const std::string& path, const std::string& suffix) {
   const std::filesystem::path p(path);
   return (p.parent_path() / (p.stem().string() + "_" + suffix + p.extension().string())).string();
 }
-
-double ms(double seconds) { return seconds * 1e3; }
 
 // The preview pictures to write: the texture view, plus the other views with --preview-all.
 std::vector<std::pair<PreviewView, std::string>> preview_paths(const MapOptions& opt) {
@@ -173,8 +170,16 @@ int run_map(const MapOptions& opt) {
   options.metrics.texture_width_px = static_cast<float>(tex_w);
   options.metrics.texture_height_px = static_cast<float>(tex_h);
   options.metrics.threads = opt.threads;
-  std::string axis_used = opt.axis;
-  double axis_seconds = 0;
+  MapRun run;  // the report: what was asked, then what each step found
+  run.input = opt.input;
+  run.output = opt.output;
+  run.texture = opt.texture;
+  run.texture_width = tex_w;
+  run.texture_height = tex_h;
+  run.axis = opt.axis;
+  run.axis_auto = auto_axis;
+  run.seed_point = opt.seed_point;
+  run.seam_faces = opt.seam_faces;
   if (auto_axis) {
     const auto axis_start = std::chrono::steady_clock::now();
     Progress choosing("choosing axis", opt.quiet);
@@ -183,9 +188,9 @@ int run_map(const MapOptions& opt) {
     if (Status s = choose_orientation_axis(mesh, topology, options, choice); !s)
       return report_error(s.with_file(opt.input));
     choosing.done();
-    axis_seconds = seconds_since(axis_start);
+    run.axis_choice_seconds = seconds_since(axis_start);
     options.orientation = orientation_for(choice.best, options.orientation);
-    axis_used = std::string("auto:") + axis_candidate_name(choice.best);
+    run.axis = std::string("auto:") + axis_candidate_name(choice.best);
     if (!opt.quiet) {
       std::string line = "axis auto: " + std::string(axis_candidate_name(choice.best)) + " (seams without crack closing:";
       for (int i = 0; i < kAxisCandidates; ++i) {
@@ -203,21 +208,19 @@ int run_map(const MapOptions& opt) {
   TextureMap map;
   if (Status s = map_texture(mesh, topology, options, map); !s) return report_error(s.with_file(opt.input));
   progress.done();
-  const FaceFrames& frames = map.frames;
   const Atlas& atlas = map.atlas;
-  const MappingStats& stats = map.stats;
-  const UvMetrics& metrics = map.metrics;
-  const double metrics_seconds = metrics.seconds;
+  run.options = options;
+  add_map_results(mesh, load, topology, map, run);
 
   // === Stability (optional: two more mappings) ===
-  StabilityReport stability;
   if (opt.stability) {
+    StabilityReport stability;
     if (Status s = measure_stability(mesh, options, stability); !s) return report_error(s.with_file(opt.input));
+    run.stability = stability;
   }
 
   // === Previews, rendered before anything is written ===
   std::vector<std::pair<std::string, Image>> pictures;
-  double preview_seconds = 0;
   if (!opt.preview.empty()) {
     const auto preview_start = std::chrono::steady_clock::now();
     std::vector<float> uv_repeats(atlas.corner_uv.size());
@@ -236,7 +239,7 @@ int run_map(const MapOptions& opt) {
         return report_error(s.with_file(path));
       pictures.emplace_back(path, std::move(picture));
     }
-    preview_seconds = seconds_since(preview_start);
+    run.preview_seconds = seconds_since(preview_start);
   }
 
   // === Export, then the pictures, then the report (every output was checked up front) ===
@@ -248,81 +251,22 @@ int run_map(const MapOptions& opt) {
   export_options.texture_width = tex_w;
   export_options.texture_height = tex_h;
   if (Status s = export_mesh(opt.output, mesh, atlas, export_options); !s) return report_error(s);
-  const double export_seconds = seconds_since(export_start);
-  std::vector<std::string> previews;
+  run.export_seconds = seconds_since(export_start);
   for (const auto& [path, picture] : pictures) {
     if (Status s = write_png(path, picture); !s) return report_error(s);
-    previews.push_back(path);
+    run.previews.push_back(path);
   }
 
-  const double total_seconds = seconds_since(start);
+  run.total_seconds = seconds_since(start);
 
   // === Report ===
   if (!opt.stats.empty()) {
-    nlohmann::json j;
-    j["input"] = opt.input;
-    j["output"] = opt.output;
-    j["texture"] = opt.texture;
-    j["texture_size"] = {tex_w, tex_h};
-    j["options"] = {{"mode", opt.mode}, {"scale", opt.scale}, {"threshold_px", opt.threshold},
-                    {"max_stretch", opt.max_stretch},
-                    {"field_following", opt.field_following}, {"min_patch_faces", opt.min_patch_faces},
-                    {"shorten_seams", !opt.keep_seams}, {"close_cracks", !opt.keep_cracks}, {"crack_rings", opt.crack_rings}, {"hop_age", opt.hop_age},
-                    {"axis", axis_used}, {"smooth", opt.smooth}, {"seed_point", opt.seed_point},
-                    {"seam_faces", opt.seam_faces}};
-    j["mesh"] = {{"format", load.format}, {"vertices", mesh.vertex_count()}, {"faces", mesh.face_count()},
-                 {"components", topology.vertex_components}, {"boundary_edges", topology.boundary_edges},
-                 {"nonmanifold_edges", topology.nonmanifold_edges},
-                 {"inconsistent_edges", topology.inconsistent_edges},
-                 {"degenerate_faces_dropped", load.degenerate_faces},
-                 {"duplicate_faces_dropped", load.duplicate_faces},
-                 {"unreferenced_vertices", load.unreferenced_vertices}};
-    j["mapping"] = {{"patches", stats.patches}, {"patches_before_absorb", stats.patches_before_absorb},
-                    {"deferrals", stats.deferrals}, {"threshold_raises", stats.threshold_raises},
-                    {"final_threshold_px", stats.final_threshold_px}, {"max_error_px", stats.max_error_px},
-                    {"max_stretch_accepted", stats.max_stretch_accepted},
-                    {"faces_three_textured", stats.faces_three_textured},
-                    {"faces_unfolded", stats.faces_unfolded}, {"faces_rigid", stats.faces_rigid},
-                    {"faces_reseamed", stats.faces_reseamed}, {"cracks_closed", stats.cracks_closed},
-                    {"faces_seam", stats.faces_seam}, {"inverted_accepted", stats.inverted_accepted}};
-    j["metrics"] = {{"patches", metrics.patches}, {"single_face_patches", metrics.single_face_patches},
-                    {"stretch", metrics.stretch}, {"stretch_area_weighted", metrics.stretch_area_weighted},
-                    {"distortion_deg", metrics.distortion_deg}, {"l2_stretch", metrics.l2_stretch},
-                    {"linf_stretch", metrics.linf_stretch}, {"flipped", metrics.flipped},
-                    {"seam_edges", metrics.seam_edges}, {"seam_length_ratio", metrics.seam_length_ratio},
-                    {"seam_gap_px", metrics.seam_gap_px}, {"seam_invisible_ratio", metrics.seam_invisible_ratio},
-                    {"uv_scale", metrics.uv_scale}};
-    if (opt.stability)
-      j["stability"] = {{"removed_faces", stability.removed_faces}, {"compared_corners", stability.compared_corners},
-                        {"mean_difference_px", stability.mean_difference_px},
-                        {"max_difference_px", stability.max_difference_px},
-                        {"identical_ratio", stability.identical_ratio},
-                        {"within_1px_ratio", stability.within_1px_ratio}};
-    j["time_ms"] = {{"load", ms(load.load_seconds)}, {"topology", ms(topology.build_seconds)},
-                    {"axis_choice", ms(axis_seconds)}, {"orientation", ms(frames.seconds)}, {"mapping", ms(stats.seconds)},
-                    {"metrics", ms(metrics_seconds)}, {"export", ms(export_seconds)},
-                    {"preview", ms(preview_seconds)}, {"total", ms(total_seconds)}};
-    j["previews"] = previews;
-    const std::string text = json_text(j) + "\n";
-    if (Status s = internal::write_file_atomic(opt.stats, text); !s) return report_error(s);
+    if (Status s = internal::write_file_atomic(opt.stats, map_report_json(run)); !s) return report_error(s);
   }
   if (Status s = batch.commit(); !s) return report_error(s);
   if (!opt.quiet) {
-    std::printf(
-        "%s: %zu faces, %u patches, seams %.2f%% of edge length, %zu flipped, stretch %.3f, L2 %.3f, "
-        "Linf %.2f, median angle %.2f deg, seam gap %.1f px (%.0f%% invisible) | load %.1f ms, topology %.1f, "
-        "%sorientation %.1f, mapping %.1f, export %.1f ms -> %s\n",
-        opt.input.c_str(), mesh.face_count(), metrics.patches, 100.0 * metrics.seam_length_ratio, metrics.flipped,
-        metrics.stretch, metrics.l2_stretch, metrics.linf_stretch, metrics.distortion_deg, metrics.seam_gap_px,
-        100.0 * metrics.seam_invisible_ratio, ms(load.load_seconds), ms(topology.build_seconds),
-        auto_axis ? ("axis choice " + std::to_string(static_cast<long>(ms(axis_seconds))) + ", ").c_str() : "",
-        ms(frames.seconds), ms(stats.seconds), ms(export_seconds), opt.output.c_str());
-    if (opt.stability)
-      std::printf("stability: removed %zu faces, surviving corners moved %.3f px on average (max %.2f px), "
-                  "%.1f%% bit-identical, %.1f%% within 1 px\n",
-                  stability.removed_faces, stability.mean_difference_px, stability.max_difference_px,
-                  100.0 * stability.identical_ratio, 100.0 * stability.within_1px_ratio);
-    for (const std::string& p : previews) std::printf("preview: %s\n", p.c_str());
+    std::fputs(map_summary(run).c_str(), stdout);
+    for (const std::string& p : run.previews) std::printf("preview: %s\n", p.c_str());
     if (!opt.stats.empty()) std::printf("stats: %s\n", opt.stats.c_str());
   }
   return kExitOk;
