@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "tailor/option_doc.h"
 #include "tailor/status.h"
 
 namespace tailor::cli {
@@ -53,6 +54,19 @@ struct OutputPath {
 //! two outputs share a path, and no output overwrites one of `inputs` (empty entries ignored).
 //! Fails with kInvalidArgument (exit 2), so a refused run writes nothing.
 Status check_outputs(const std::vector<OutputPath>& outputs, const std::vector<std::string>& inputs);
+
+//! Adds the option `doc` names (flag and help from the library's table, tailor/option_doc.h), bound
+//! to `field`; the default shown is the field's value now: its options struct's default, or for a
+//! text option, that default's name.
+template <class T>
+CLI::Option* add_documented(CLI::App* app, const OptionDoc& doc, T& field) {
+  return app->add_option(std::string(doc.flag), field, std::string(doc.help))->capture_default_str();
+}
+
+//! Adds the switch `doc` names ("--no-..."), which turns `field` (on by default) off.
+inline CLI::Option* add_off_switch(CLI::App* app, const OptionDoc& doc, bool& field) {
+  return app->add_flag_callback(std::string(doc.flag), [&field] { field = false; }, std::string(doc.help));
+}
 
 //! Parses "X,Y,Z" into three finite floats; false when the text is anything else.
 bool parse_vec3(const std::string& text, std::array<float, 3>& v);

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <string>
 
 #include "cli.h"
 #include "tailor/export.h"
@@ -19,15 +20,13 @@ namespace {
 
 struct EvalOptions {
   std::string input;
-  int texture_size = 0;  // 0 = not given: the embedded image size for .glb, else 512
+  int texture_size = 0;  // 0 = not given: the embedded image size for .glb, else MetricsOptions' default
   bool json = false;
   bool quiet = false;
   bool stability = false;
   std::string seed_point;
-  float remove_fraction = 0.1f;
+  StabilityOptions stability_options;
 };
-
-constexpr int kDefaultTextureSize = 512;
 
 // --stability: the remove-a-ball experiment of thesis 2.6 on tailor's own mapping of the mesh.
 int run_stability(const EvalOptions& opt) {
@@ -43,10 +42,8 @@ int run_stability(const EvalOptions& opt) {
                                         "--seed-point must be three numbers X,Y,Z, got '" + opt.seed_point + "'"));
     mapping.mapping.use_seed_point = true;
   }
-  StabilityOptions options;
-  options.remove_fraction = opt.remove_fraction;
   StabilityReport r;
-  if (Status s = measure_stability(mesh, mapping, r, options); !s)
+  if (Status s = measure_stability(mesh, mapping, r, opt.stability_options); !s)
     return report_error(s.with_file(opt.input));
   if (opt.json) std::fputs(stability_report_json(opt.input, r).c_str(), stdout);
   else if (!opt.quiet) std::fputs(stability_summary(opt.input, r).c_str(), stdout);
@@ -74,7 +71,8 @@ int run_eval(const EvalOptions& opt) {
   // so that seams are edges between faces again (corner UVs are unaffected).
   const size_t welded = glb ? 0 : weld_identical_positions(mesh);
 
-  int width = kDefaultTextureSize, height = kDefaultTextureSize;
+  int width = static_cast<int>(MetricsOptions{}.texture_width_px);
+  int height = static_cast<int>(MetricsOptions{}.texture_height_px);
   const char* size_source = "default";
   if (opt.texture_size > 0) {
     width = height = opt.texture_size;
@@ -127,17 +125,18 @@ void register_eval(CLI::App& app, Runner& run) {
   cmd->add_option("mesh", opt->input, "UV-mapped mesh: .obj (vt), .ply (s,t) or .glb (TEXCOORD_0); any mesh with --stability")->required();
   cmd->add_option("--texture-size", opt->texture_size,
                   "Texture size in pixels (UVs are in repeats; this gives pixels). Default: the embedded "
-                  "texture's size for .glb, else 512")
+                  "texture's size for .glb, else " +
+                      std::to_string(static_cast<int>(MetricsOptions{}.texture_width_px)))
       ->check(CLI::Range(1, 1 << 16));
   cmd->add_flag("--json", opt->json, "Print the full report as a JSON object");
   cmd->add_flag("-q,--quiet", opt->quiet, "Print nothing but the result and errors");
   cmd->add_flag("--stability", opt->stability,
                 "Instead: map the mesh with tailor (default options), remove the faces in a ball holding "
                 "~10% of them, re-map, and report how far the surviving UVs moved (thesis 2.6)");
-  cmd->add_option("--seed-point", opt->seed_point, "With --stability: X,Y,Z where both mappings start");
-  cmd->add_option("--remove-fraction", opt->remove_fraction, "With --stability: share of faces removed")
-      ->check(CLI::Range(0.01f, 0.9f))
-      ->capture_default_str();
+  cmd->add_option("--seed-point", opt->seed_point,
+                  "With --stability: " + std::string(option_doc(kMappingOptionDocs, "seed_point").help));
+  add_documented(cmd, option_doc(kStabilityOptionDocs, "remove_fraction"), opt->stability_options.remove_fraction)
+      ->check(CLI::Range(0.01f, 0.9f));
   cmd->footer(
       "Metrics (docs/metrics.md): patches, seams (share of edge length), flipped faces, stretch\n"
       "(coefficient of variation of UV/3D area ratio, 0 ideal), L2/Linf stretch (Sander 2001, 1 ideal),\n"

@@ -21,11 +21,8 @@ struct TileCliOptions {
   std::string input;
   std::string output;
   std::string json;
-  int block = 32;
-  int overlap = 0;
-  uint64_t seed = 1;
+  TileOptions options;  // bound to --block, --overlap, --seed, --fit-period (defaults: TileOptions')
   int variants = 1;
-  bool fit_period = false;
   bool quiet = false;
 };
 
@@ -53,11 +50,7 @@ int run_tile(const TileCliOptions& opt) {
   Image exemplar;
   if (Status s = load_image(opt.input, exemplar); !s) return report_error(s);
 
-  TileOptions options;
-  options.block = opt.block;
-  options.overlap = opt.overlap;
-  options.seed = opt.seed;
-  options.fit_period = opt.fit_period;
+  TileOptions options = opt.options;
   Progress progress("tile", opt.quiet);
   options.progress = [&progress](double f) { return progress.update(f); };
 
@@ -118,14 +111,16 @@ void register_tile(CLI::App& app, Runner& run) {
   cmd->add_option("input", opt->input, "Texture image (.png .jpg .tga .bmp, 8-bit or 16-bit PNG)")->required();
   cmd->add_option("-o,--output", opt->output, "Output .png (with --variants: NAME_0.png ... and NAME.json)")
       ->required();
-  cmd->add_option("--block", opt->block, "Quilting block size in px")->default_val(32)->check(CLI::Range(8, 256));
-  cmd->add_option("--overlap", opt->overlap, "Block overlap in px (default block/4)")->check(CLI::Range(1, 127));
-  cmd->add_option("--seed", opt->seed, "Seed of the random block choice (same seed, same output)")->default_val(1);
+  TileOptions& options = opt->options;
+  add_documented(cmd, option_doc(kTileOptionDocs, "block"), options.block)->check(CLI::Range(8, 256));
+  const OptionDoc& overlap = option_doc(kTileOptionDocs, "overlap");  // its default, 0, stands for block/4
+  cmd->add_option(std::string(overlap.flag), options.overlap, std::string(overlap.help))->check(CLI::Range(1, 127));
+  add_documented(cmd, option_doc(kTileOptionDocs, "seed"), options.seed);
   cmd->add_option("--variants", opt->variants, "Number of tiles with identical borders, different interiors")
-      ->default_val(1)
+      ->capture_default_str()
       ->check(CLI::Range(1, 64));
-  cmd->add_flag("--fit-period", opt->fit_period,
-                "Crop or extend to a whole number of texel periods (regular patterns)");
+  const OptionDoc& fit_period = option_doc(kTileOptionDocs, "fit_period");
+  cmd->add_flag(std::string(fit_period.flag), options.fit_period, std::string(fit_period.help));
   cmd->add_option("--json", opt->json, "Write the metrics and settings as JSON to this file");
   cmd->add_flag("-q,--quiet", opt->quiet, "Print nothing but errors");
   cmd->footer(
@@ -135,9 +130,10 @@ void register_tile(CLI::App& app, Runner& run) {
       "  tailor eval-tile bricks_tile.png bricks.jpg                     # check the result");
   cmd->callback([&run, opt] {
     run = [opt] {
-      if (opt->overlap != 0 && opt->overlap > opt->block / 2 - 1)
+      const TileOptions& o = opt->options;
+      if (o.overlap != 0 && o.overlap > o.block / 2 - 1)
         return report_error(Status::error(ErrorCode::kInvalidArgument, "", "--overlap must be at most block/2 - 1",
-                                          "block " + std::to_string(opt->block)));
+                                          "block " + std::to_string(o.block)));
       return run_tile(*opt);
     };
   });

@@ -44,6 +44,7 @@
 #include "tailor/atlas.h"
 #include "tailor/mesh.h"
 #include "tailor/metrics.h"
+#include "tailor/option_doc.h"
 #include "tailor/orientation.h"
 #include "tailor/status.h"
 #include "tailor/topology.h"
@@ -103,6 +104,39 @@ struct MappingOptions {
   // Both ------------------------------------------------------------------------------------------
   std::span<const uint8_t> seam_faces;  //!< empty, or #F flags: 1 = user-marked seam face (deferred to the end)
   ProgressCallback progress;        //!< optional; see ProgressCallback
+};
+
+//! Flags and help of the MappingOptions a user sets (option_doc.h): the tailor CLI shows these, with
+//! the defaults of a default-constructed MappingOptions.
+inline constexpr OptionDoc kMappingOptionDocs[] = {
+    {"mode", "--mode",
+     "patches: per-corner UVs, bounded per-face stretch, no inverted face; thesis: the thesis as written, one UV "
+     "per vertex (reference)"},
+    {"scale", "--scale", "Texture pixels per unit of the mesh normalised into the unit cube"},
+    {"max_stretch", "--max-stretch", "patches mode: per-face singular values must stay within [1/(1+x), 1+x]"},
+    {"field_following", "--field-following",
+     "patches mode: 1 = texture direction follows the orientation field (thesis), 0 = faces are unfolded rigidly "
+     "(fewer seams, direction drifts); values between blend"},
+    {"min_patch_faces", "--min-patch-faces",
+     "patches mode: smaller patches are absorbed into a neighbour (0 keeps all)"},
+    {"hop_age", "--hop-age",
+     "patches mode: growth-order age per face of path from the seed, radians (0..1); keeps the order local so "
+     "removing part of a mesh changes little elsewhere; 0 = the thesis's global counter"},
+    {"shorten_seams", "--no-seam-shortening",
+     "patches mode: seam shortening re-places faces along the seams after the growth where that shortens them; "
+     "off, the seams stay as the growth left them"},
+    {"close_cracks", "--no-crack-closing",
+     "patches mode: crack closing zips the cracks (cuts inside a patch) shut, last; off, the mapping is 3-10x "
+     "faster with about twice the seam length"},
+    {"crack_rings", "--crack-rings",
+     "patches mode: effort of the crack closing, the largest region (rings of faces) a zip may relax (2..64); "
+     "more closes wider cracks and takes longer. Fewest seams: --field-following 0 --crack-rings 32"},
+    {"threshold_px", "--threshold", "thesis mode: initial error threshold in pixels"},
+    {"seed_point", "--seed-point",
+     "X,Y,Z: start at the face nearest this point (same point = stable results when parts of the mesh are "
+     "removed)"},
+    {"seam_faces", "--seam-faces",
+     "File of face indices (one per line) where seams should go (PLY 'seam' property also works)"},
 };
 
 struct MappingStats {

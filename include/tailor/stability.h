@@ -12,6 +12,7 @@
 
 #include "tailor/mapping.h"
 #include "tailor/mesh.h"
+#include "tailor/option_doc.h"
 #include "tailor/orientation.h"
 #include "tailor/status.h"
 
@@ -19,6 +20,11 @@ namespace tailor {
 
 struct StabilityOptions {
   float remove_fraction = 0.1f;  //!< share of faces removed, (0, 0.9]
+};
+
+//! Flags and help of the StabilityOptions (option_doc.h).
+inline constexpr OptionDoc kStabilityOptionDocs[] = {
+    {"remove_fraction", "--remove-fraction", "With --stability: share of the faces removed"},
 };
 
 struct StabilityReport {
