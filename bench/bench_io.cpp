@@ -13,7 +13,6 @@
 #include "tailor/export.h"
 #include "tailor/io.h"
 #include "tailor/mapping.h"
-#include "tailor/orientation.h"
 #include "tailor/topology.h"
 
 namespace {
@@ -57,14 +56,12 @@ const tailor::Atlas& subdivided_horse_atlas() {
   static const tailor::Atlas atlas = [] {
     const tailor::Mesh& mesh = subdivided_horse();
     const tailor::Topology topology = tailor::build_topology(mesh);
-    tailor::FaceFrames frames;
-    tailor::MappingOptions options;
-    options.close_cracks = false;
-    tailor::Atlas result;
-    if (!tailor::compute_orientation(mesh, topology, {}, frames).is_ok() ||
-        !tailor::map_texture(mesh, topology, frames, options, result).is_ok())
-      result = {};
-    return result;
+    tailor::MapTextureOptions options;
+    options.mapping.close_cracks = false;
+    options.measure = false;
+    tailor::TextureMap result;
+    if (!tailor::map_texture(mesh, topology, options, result).is_ok()) result = {};
+    return result.atlas;
   }();
   return atlas;
 }

@@ -9,15 +9,15 @@
 #include "tailor/export.h"
 #include "tailor/io.h"
 #include "tailor/mapping.h"
-#include "tailor/orientation.h"
 #include "tailor/topology.h"
 
 namespace {
 
 // close_cracks: the default; without it, the growth alone (`tailor map --no-crack-closing`).
 void BM_EndToEndPlyToGlb(benchmark::State& state, bool close_cracks) {
-  tailor::MappingOptions options;
-  options.close_cracks = close_cracks;
+  tailor::MapTextureOptions options;
+  options.mapping.close_cracks = close_cracks;
+  options.measure = false;
   const std::string& input = subdivided_horse_ply_path();
   const std::string output = (std::filesystem::temp_directory_path() / "tailor_bench_pipeline.glb").string();
   size_t faces = 0;
@@ -28,11 +28,9 @@ void BM_EndToEndPlyToGlb(benchmark::State& state, bool close_cracks) {
       return;
     }
     const tailor::Topology topology = tailor::build_topology(mesh);
-    tailor::FaceFrames frames;
-    tailor::Atlas atlas;
-    if (!tailor::compute_orientation(mesh, topology, {}, frames).is_ok() ||
-        !tailor::map_texture(mesh, topology, frames, options, atlas).is_ok() ||
-        !tailor::export_mesh(output, mesh, atlas, {}).is_ok()) {
+    tailor::TextureMap map;
+    if (!tailor::map_texture(mesh, topology, options, map).is_ok() ||
+        !tailor::export_mesh(output, mesh, map.atlas, {}).is_ok()) {
       state.SkipWithError("pipeline failed");
       return;
     }

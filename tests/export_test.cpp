@@ -492,13 +492,11 @@ TEST_F(ExportTest, MappedMeshExportsUpright) {
   Mesh mesh;
   ASSERT_TRUE(load_mesh(std::string(TAILOR_TEST_DATA) + "/meshes/fandisk.off", mesh).is_ok());
   const Topology topology = build_topology(mesh);
-  FaceFrames frames;
-  ASSERT_TRUE(compute_orientation(mesh, topology, OrientationOptions{}, frames).is_ok());
-  Atlas atlas;
-  const Status mapped = map_texture(mesh, topology, frames, MappingOptions{}, atlas);
+  TextureMap map;
+  const Status mapped = map_texture(mesh, topology, MapTextureOptions{}, map);
   ASSERT_TRUE(mapped.is_ok()) << mapped.message();
-  UvMetrics before;
-  ASSERT_TRUE(compute_uv_metrics(mesh, topology, atlas.corner_uv, atlas.patch, {}, before).is_ok());
+  const Atlas& atlas = map.atlas;
+  const UvMetrics& before = map.metrics;
 
   ExportOptions options;
   options.texture_path = kTexture;

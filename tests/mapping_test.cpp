@@ -33,10 +33,22 @@ struct Mapped {
   MappingStats stats;
 };
 
+// map_texture with these mapping options (default orientation, no metrics) on m.mesh and m.topology.
+Status map_into(Mapped& m, const MappingOptions& options) {
+  MapTextureOptions all;
+  all.mapping = options;
+  all.measure = false;
+  TextureMap map;
+  const Status s = map_texture(m.mesh, m.topology, all, map);
+  m.frames = std::move(map.frames);
+  m.atlas = std::move(map.atlas);
+  m.stats = map.stats;
+  return s;
+}
+
 void map_mesh(Mapped& m, const MappingOptions& options = {}) {
   m.topology = build_topology(m.mesh);
-  ASSERT_TRUE(compute_orientation(m.mesh, m.topology, {}, m.frames).is_ok());
-  const Status s = map_texture(m.mesh, m.topology, m.frames, options, m.atlas, &m.stats);
+  const Status s = map_into(m, options);
   ASSERT_TRUE(s.is_ok()) << s.message();
 }
 
@@ -167,8 +179,7 @@ TEST(Mapping, PureUnfoldingAndLooserBoundsStayValid) {
   expect_valid_patches_atlas(loose, options, "fertility.off max_stretch 0.5");
   EXPECT_GT(loose.stats.max_stretch_accepted, 0.25f);
   options.field_following = 2.f;
-  EXPECT_EQ(map_texture(loose.mesh, loose.topology, loose.frames, options, loose.atlas).code(),
-            ErrorCode::kInvalidArgument);
+  EXPECT_EQ(map_into(loose, options).code(), ErrorCode::kInvalidArgument);
 }
 
 // Maps mesh `name` into `on` with default options and into `off` with `step` switched off; returns
@@ -476,7 +487,6 @@ TEST(Mapping, ProgressCanCancel) {
   Mapped m;
   m.mesh = load_test_mesh("horse.ply");  // more faces than one progress interval
   m.topology = build_topology(m.mesh);
-  ASSERT_TRUE(compute_orientation(m.mesh, m.topology, {}, m.frames).is_ok());
   MappingOptions options;
   int calls = 0;
   options.progress = [&calls](float done) {
@@ -485,7 +495,7 @@ TEST(Mapping, ProgressCanCancel) {
     ++calls;
     return false;
   };
-  const Status s = map_texture(m.mesh, m.topology, m.frames, options, m.atlas, &m.stats);
+  const Status s = map_into(m, options);
   EXPECT_EQ(s.code(), ErrorCode::kCancelled);
   EXPECT_EQ(calls, 1);
   EXPECT_TRUE(m.atlas.corner_uv.empty());
@@ -496,13 +506,13 @@ TEST(Mapping, ProgressCanCancel) {
     seen.push_back(done);
     return true;
   };
-  ASSERT_TRUE(map_texture(m.mesh, m.topology, m.frames, options, m.atlas).is_ok());
+  ASSERT_TRUE(map_into(m, options).is_ok());
   ASSERT_GT(seen.size(), 10u);
   EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
   EXPECT_GT(seen.back(), 0.9f);
   EXPECT_GT(std::count_if(seen.begin(), seen.end(), [](float d) { return d > 0.2f; }), 5);
   options.progress = [](float done) { return done < 0.6f; };
-  EXPECT_EQ(map_texture(m.mesh, m.topology, m.frames, options, m.atlas).code(), ErrorCode::kCancelled);
+  EXPECT_EQ(map_into(m, options).code(), ErrorCode::kCancelled);
   EXPECT_TRUE(m.atlas.corner_uv.empty());
   EXPECT_TRUE(m.atlas.patch.empty());
 }
@@ -513,29 +523,29 @@ TEST(Mapping, RejectsBadOptionsAndMismatchedInputs) {
   map_mesh(m);
   MappingOptions options;
   options.scale = 0.f;
-  EXPECT_EQ(map_texture(m.mesh, m.topology, m.frames, options, m.atlas).code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(map_into(m, options).code(), ErrorCode::kInvalidArgument);
   options = {};
   options.scale = std::numeric_limits<float>::quiet_NaN();
-  EXPECT_EQ(map_texture(m.mesh, m.topology, m.frames, options, m.atlas).code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(map_into(m, options).code(), ErrorCode::kInvalidArgument);
   options = {};
   options.max_stretch = 0.f;
-  EXPECT_EQ(map_texture(m.mesh, m.topology, m.frames, options, m.atlas).code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(map_into(m, options).code(), ErrorCode::kInvalidArgument);
   options = {};
   options.hop_age = -0.5f;
-  EXPECT_EQ(map_texture(m.mesh, m.topology, m.frames, options, m.atlas).code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(map_into(m, options).code(), ErrorCode::kInvalidArgument);
   options.hop_age = std::numeric_limits<float>::quiet_NaN();
-  EXPECT_EQ(map_texture(m.mesh, m.topology, m.frames, options, m.atlas).code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(map_into(m, options).code(), ErrorCode::kInvalidArgument);
   options = {};
   options.crack_rings = 1;
-  EXPECT_EQ(map_texture(m.mesh, m.topology, m.frames, options, m.atlas).code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(map_into(m, options).code(), ErrorCode::kInvalidArgument);
   options.crack_rings = 65;
-  EXPECT_EQ(map_texture(m.mesh, m.topology, m.frames, options, m.atlas).code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(map_into(m, options).code(), ErrorCode::kInvalidArgument);
   options = {};
   const std::vector<uint8_t> wrong_size(3, 1);
   options.seam_faces = wrong_size;
-  EXPECT_EQ(map_texture(m.mesh, m.topology, m.frames, options, m.atlas).code(), ErrorCode::kInvalidArgument);
-  EXPECT_EQ(map_texture(m.mesh, m.topology, FaceFrames{}, {}, m.atlas).code(), ErrorCode::kInvalidMesh);
-  EXPECT_EQ(map_texture(m.mesh, Topology{}, m.frames, {}, m.atlas).code(), ErrorCode::kInvalidMesh);
+  EXPECT_EQ(map_into(m, options).code(), ErrorCode::kInvalidArgument);
+  TextureMap map;
+  EXPECT_EQ(map_texture(m.mesh, Topology{}, {}, map).code(), ErrorCode::kInvalidMesh);
 }
 
 TEST(Mapping, SeveralComponentsEachGetTheirPatches) {
@@ -551,7 +561,7 @@ TEST(AxisChoice, ACoordinateAxisHalvesTheCadPartsSeams) {
   m.mesh = load_test_mesh("adis16480.stl");  // an axis-aligned CAD part; its principal axis runs diagonally
   m.topology = build_topology(m.mesh);
   AxisChoice choice;
-  ASSERT_TRUE(choose_orientation_axis(m.mesh, m.topology, {}, {}, choice).is_ok());
+  ASSERT_TRUE(choose_orientation_axis(m.mesh, m.topology, {}, choice).is_ok());
   // Measured: pca 13.4%, x 4.4%, y 4.0%, z 7.0% of edge length.
   EXPECT_NE(choice.best, AxisCandidate::kPca);
   const double best = choice.seam_ratio[static_cast<size_t>(choice.best)];
@@ -562,22 +572,23 @@ TEST(AxisChoice, ACoordinateAxisHalvesTheCadPartsSeams) {
   const OrientationOptions chosen = orientation_for(choice.best, {});
   EXPECT_EQ(chosen.axis, AxisSource::kUser);
   EXPECT_EQ(chosen.user_axis, (std::array<float, 3>{0.f, 1.f, 0.f}));
-  ASSERT_TRUE(compute_orientation(m.mesh, m.topology, chosen, m.frames).is_ok());
-  MappingOptions growth;
-  growth.close_cracks = false;
-  ASSERT_TRUE(map_texture(m.mesh, m.topology, m.frames, growth, m.atlas).is_ok());
-  EXPECT_DOUBLE_EQ(metrics_of(m).seam_length_ratio, best);
+  MapTextureOptions growth;
+  growth.orientation = chosen;
+  growth.mapping.close_cracks = false;
+  TextureMap map;
+  ASSERT_TRUE(map_texture(m.mesh, m.topology, growth, map).is_ok());
+  EXPECT_DOUBLE_EQ(map.metrics.seam_length_ratio, best);
   EXPECT_EQ(orientation_for(AxisCandidate::kPca, chosen).axis, AxisSource::kPca);
   // Cancelling through the progress callback.
-  MappingOptions cancel;
-  cancel.progress = [](float done) { return done < 0.5f; };
-  EXPECT_EQ(choose_orientation_axis(m.mesh, m.topology, {}, cancel, choice).code(), ErrorCode::kCancelled);
+  MapTextureOptions cancel;
+  cancel.mapping.progress = [](float done) { return done < 0.5f; };
+  EXPECT_EQ(choose_orientation_axis(m.mesh, m.topology, cancel, choice).code(), ErrorCode::kCancelled);
 }
 
 TEST(Stability, RemovingTenPercentKeepsMostOfTheMapping) {
   const Mesh mesh = load_test_mesh("fandisk.off");
   StabilityReport report;
-  const Status s = measure_stability(mesh, {}, {}, report);
+  const Status s = measure_stability(mesh, {}, report);
   ASSERT_TRUE(s.is_ok()) << s.message();
   EXPECT_EQ(report.faces, mesh.face_count());
   EXPECT_NEAR(static_cast<double>(report.removed_faces), 0.1 * static_cast<double>(mesh.face_count()), 1.0);
@@ -598,17 +609,17 @@ TEST(Stability, RemovingTenPercentKeepsMostOfTheMapping) {
   // without crack closing, which would blur the difference (see above).
   const Mesh horse = load_test_mesh("horse.ply");
   StabilityReport hops, counter, closed;
-  MappingOptions growth_only;
-  growth_only.close_cracks = false;
-  ASSERT_TRUE(measure_stability(horse, {}, growth_only, hops).is_ok());
-  MappingOptions global_counter = growth_only;
-  global_counter.hop_age = 0.f;
-  ASSERT_TRUE(measure_stability(horse, {}, global_counter, counter).is_ok());
+  MapTextureOptions growth_only;
+  growth_only.mapping.close_cracks = false;
+  ASSERT_TRUE(measure_stability(horse, growth_only, hops).is_ok());
+  MapTextureOptions global_counter = growth_only;
+  global_counter.mapping.hop_age = 0.f;
+  ASSERT_TRUE(measure_stability(horse, global_counter, counter).is_ok());
   EXPECT_GT(hops.identical_ratio, 0.97);
   EXPECT_LT(hops.mean_difference_px, 1.0);
   // With crack closing (default): measured 95.9% bit-identical, 99.2% within 1 px, 0.51 px (91.1%
   // in edge order).
-  ASSERT_TRUE(measure_stability(horse, {}, {}, closed).is_ok());
+  ASSERT_TRUE(measure_stability(horse, {}, closed).is_ok());
   EXPECT_GT(closed.identical_ratio, 0.94);
   EXPECT_GT(closed.within_1px_ratio, 0.98);
   EXPECT_LT(closed.mean_difference_px, 1.0);
@@ -616,7 +627,7 @@ TEST(Stability, RemovingTenPercentKeepsMostOfTheMapping) {
   EXPECT_GT(counter.mean_difference_px, 2.0 * hops.mean_difference_px);
   StabilityOptions bad;
   bad.remove_fraction = 0.f;
-  EXPECT_EQ(measure_stability(mesh, {}, {}, report, bad).code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(measure_stability(mesh, {}, report, bad).code(), ErrorCode::kInvalidArgument);
 }
 
 }  // namespace

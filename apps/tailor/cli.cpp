@@ -1,8 +1,6 @@
 // Error lines, warnings and the progress bar of the tailor CLI.
 #include "cli.h"
 
-#include "tailor/tiling.h"
-
 #include <signal.h>
 #include <unistd.h>
 
@@ -127,26 +125,6 @@ void Progress::done() {
     std::fflush(stderr);
     drawn_ = false;
   }
-}
-
-nlohmann::json tile_metrics_json(const TileMetrics& m, bool with_exemplar) {
-  nlohmann::json j;
-  j["wrap_ratio_x"] = m.wrap_ratio_x;
-  j["wrap_ratio_y"] = m.wrap_ratio_y;
-  j["worst_seam_ratio"] = m.worst_seam_ratio;
-  if (with_exemplar) {
-    j["exemplar_worst_seam_ratio"] = m.exemplar_worst_seam_ratio;
-    j["exemplar_wrap_ratio_x"] = m.exemplar_wrap_ratio_x;
-    j["exemplar_wrap_ratio_y"] = m.exemplar_wrap_ratio_y;
-    j["histogram_l1"] = m.histogram_l1;
-    j["gradient_ratio"] = m.gradient_ratio;
-    j["patch_coherence"] = m.patch_coherence;
-    j["exemplar_patch_coherence"] = m.exemplar_patch_coherence;
-  }
-  std::string failed;
-  j["targets_met"] = meets_tile_targets(m, &failed);
-  if (!failed.empty()) j["targets_failed"] = failed;
-  return j;
 }
 
 }  // namespace tailor::cli

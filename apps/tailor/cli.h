@@ -11,11 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "tailor/option_doc.h"
 #include "tailor/status.h"
-
-namespace tailor {
-struct TileMetrics;
-}
 
 namespace tailor::cli {
 
@@ -58,13 +55,21 @@ struct OutputPath {
 //! Fails with kInvalidArgument (exit 2), so a refused run writes nothing.
 Status check_outputs(const std::vector<OutputPath>& outputs, const std::vector<std::string>& inputs);
 
+//! Adds the option `doc` names (flag and help from the library's table, tailor/option_doc.h), bound
+//! to `field`; the default shown is the field's value now: its options struct's default, or for a
+//! text option, that default's name.
+template <class T>
+CLI::Option* add_documented(CLI::App* app, const OptionDoc& doc, T& field) {
+  return app->add_option(std::string(doc.flag), field, std::string(doc.help))->capture_default_str();
+}
+
+//! Adds the switch `doc` names ("--no-..."), which turns `field` (on by default) off.
+inline CLI::Option* add_off_switch(CLI::App* app, const OptionDoc& doc, bool& field) {
+  return app->add_flag_callback(std::string(doc.flag), [&field] { field = false; }, std::string(doc.help));
+}
+
 //! Parses "X,Y,Z" into three finite floats; false when the text is anything else.
 bool parse_vec3(const std::string& text, std::array<float, 3>& v);
-
-//! The JSON fields of tile metrics shared by `tile` and `eval-tile`: wrap ratios and worst seam;
-//! with an exemplar also its ratios, histogram L1, gradient ratio and patch coherences; then
-//! targets_met (and targets_failed when some are not).
-nlohmann::json tile_metrics_json(const TileMetrics& m, bool with_exemplar);
 
 //! A progress bar on stderr, drawn only when stderr is a terminal and not quiet, and only once the
 //! work has run for more than ~1 s. update() is cheap enough to call per percent of work.

@@ -3,8 +3,7 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
-
-#include <nlohmann/json.hpp>
+#include <string>
 
 #include "cli.h"
 #include "tailor/export.h"
@@ -12,6 +11,7 @@
 #include "tailor/io.h"
 #include "tailor/mapping.h"
 #include "tailor/metrics.h"
+#include "tailor/report.h"
 #include "tailor/stability.h"
 #include "tailor/topology.h"
 
@@ -20,15 +20,13 @@ namespace {
 
 struct EvalOptions {
   std::string input;
-  int texture_size = 0;  // 0 = not given: the embedded image size for .glb, else 512
+  int texture_size = 0;  // 0 = not given: the embedded image size for .glb, else MetricsOptions' default
   bool json = false;
   bool quiet = false;
   bool stability = false;
   std::string seed_point;
-  float remove_fraction = 0.1f;
+  StabilityOptions stability_options;
 };
-
-constexpr int kDefaultTextureSize = 512;
 
 // --stability: the remove-a-ball experiment of thesis 2.6 on tailor's own mapping of the mesh.
 int run_stability(const EvalOptions& opt) {
@@ -37,39 +35,18 @@ int run_stability(const EvalOptions& opt) {
     const ReadingInput reading(opt.input);
     if (Status s = load_mesh(opt.input, mesh); !s) return report_error(s);
   }
-  MappingOptions mapping;
+  MapTextureOptions mapping;
   if (!opt.seed_point.empty()) {
-    if (!parse_vec3(opt.seed_point, mapping.seed_point))
+    if (!parse_vec3(opt.seed_point, mapping.mapping.seed_point))
       return report_error(Status::error(ErrorCode::kInvalidArgument, "",
                                         "--seed-point must be three numbers X,Y,Z, got '" + opt.seed_point + "'"));
-    mapping.use_seed_point = true;
+    mapping.mapping.use_seed_point = true;
   }
-  StabilityOptions options;
-  options.remove_fraction = opt.remove_fraction;
   StabilityReport r;
-  if (Status s = measure_stability(mesh, OrientationOptions{}, mapping, r, options); !s)
+  if (Status s = measure_stability(mesh, mapping, r, opt.stability_options); !s)
     return report_error(s.with_file(opt.input));
-  if (opt.json) {
-    nlohmann::json j;
-    j["file"] = opt.input;
-    j["faces"] = r.faces;
-    j["removed_faces"] = r.removed_faces;
-    j["compared_corners"] = r.compared_corners;
-    j["mean_difference_px"] = r.mean_difference_px;
-    j["max_difference_px"] = r.max_difference_px;
-    j["identical_ratio"] = r.identical_ratio;
-    j["within_1px_ratio"] = r.within_1px_ratio;
-    j["patches_full"] = r.patches_full;
-    j["patches_cut"] = r.patches_cut;
-    j["seconds"] = r.seconds;
-    std::printf("%s\n", json_text(j).c_str());
-  } else if (!opt.quiet) {
-    std::printf("%s: stability: removed %zu of %zu faces, surviving corners moved %.3f px on average (max %.2f px), "
-                "%.1f%% bit-identical, %.1f%% within 1 px; patches %u -> %u (%.0f ms)\n",
-                opt.input.c_str(), r.removed_faces, r.faces, r.mean_difference_px, r.max_difference_px,
-                100.0 * r.identical_ratio, 100.0 * r.within_1px_ratio, r.patches_full, r.patches_cut,
-                r.seconds * 1e3);
-  }
+  if (opt.json) std::fputs(stability_report_json(opt.input, r).c_str(), stdout);
+  else if (!opt.quiet) std::fputs(stability_summary(opt.input, r).c_str(), stdout);
   return kExitOk;
 }
 
@@ -94,7 +71,8 @@ int run_eval(const EvalOptions& opt) {
   // so that seams are edges between faces again (corner UVs are unaffected).
   const size_t welded = glb ? 0 : weld_identical_positions(mesh);
 
-  int width = kDefaultTextureSize, height = kDefaultTextureSize;
+  int width = static_cast<int>(MetricsOptions{}.texture_width_px);
+  int height = static_cast<int>(MetricsOptions{}.texture_height_px);
   const char* size_source = "default";
   if (opt.texture_size > 0) {
     width = height = opt.texture_size;
@@ -123,44 +101,19 @@ int run_eval(const EvalOptions& opt) {
   if (m.zero_uv_area_faces > 0)
     warn(opt.quiet || opt.json, std::to_string(m.zero_uv_area_faces) + " faces with zero UV area (counted as flipped)");
 
-  if (opt.json) {
-    nlohmann::json j;
-    j["file"] = opt.input;
-    j["format"] = report.format;
-    j["vertices"] = mesh.vertex_count();
-    j["faces"] = m.faces;
-    j["welded_vertices"] = glb ? report.welded_vertices : welded;
-    j["texture_width"] = width;
-    j["texture_height"] = height;
-    j["texture_size_from"] = size_source;
-    j["patches"] = m.patches;
-    j["single_face_patches"] = m.single_face_patches;
-    j["degenerate_faces"] = m.degenerate_faces;
-    j["stretch"] = m.stretch;
-    j["stretch_area_weighted"] = m.stretch_area_weighted;
-    j["distortion_deg"] = m.distortion_deg;
-    j["l2_stretch"] = m.l2_stretch;
-    j["linf_stretch"] = m.linf_stretch;
-    j["flipped"] = m.flipped;
-    j["zero_uv_area_faces"] = m.zero_uv_area_faces;
-    j["seam_edges"] = m.seam_edges;
-    j["seam_length_ratio"] = m.seam_length_ratio;
-    j["seam_gap_px"] = m.seam_gap_px;
-    j["seam_invisible_ratio"] = m.seam_invisible_ratio;
-    j["uv_scale_px2_per_unit2"] = m.uv_scale;
-    j["boundary_edges"] = topology.boundary_edges;
-    j["nonmanifold_edges"] = topology.nonmanifold_edges;
-    j["seconds"] = seconds;
-    std::printf("%s\n", json_text(j).c_str());
-    return kExitOk;
-  }
-  std::printf(
-      "%s: %zu faces, %u patches (%zu single-face), seams %.2f%% of edge length (%zu edges), %zu flipped, "
-      "stretch %.4f (area-weighted %.4f), L2 %.4f, Linf %.4f, distortion %.2f deg (median), "
-      "seam gap %.2f px, %.1f%% invisible (texture %dx%d px, %s)\n",
-      opt.input.c_str(), m.faces, m.patches, m.single_face_patches, 100.0 * m.seam_length_ratio, m.seam_edges,
-      m.flipped, m.stretch, m.stretch_area_weighted, m.l2_stretch, m.linf_stretch, m.distortion_deg, m.seam_gap_px,
-      100.0 * m.seam_invisible_ratio, width, height, size_source);
+  EvalRun run;
+  run.file = opt.input;
+  run.format = report.format;
+  run.vertices = mesh.vertex_count();
+  run.welded_vertices = glb ? report.welded_vertices : welded;
+  run.texture_width = width;
+  run.texture_height = height;
+  run.texture_size_from = size_source;
+  run.metrics = m;
+  run.boundary_edges = topology.boundary_edges;
+  run.nonmanifold_edges = topology.nonmanifold_edges;
+  run.seconds = seconds;
+  std::fputs((opt.json ? eval_report_json(run) : eval_summary(run)).c_str(), stdout);
   return kExitOk;
 }
 
@@ -172,17 +125,18 @@ void register_eval(CLI::App& app, Runner& run) {
   cmd->add_option("mesh", opt->input, "UV-mapped mesh: .obj (vt), .ply (s,t) or .glb (TEXCOORD_0); any mesh with --stability")->required();
   cmd->add_option("--texture-size", opt->texture_size,
                   "Texture size in pixels (UVs are in repeats; this gives pixels). Default: the embedded "
-                  "texture's size for .glb, else 512")
+                  "texture's size for .glb, else " +
+                      std::to_string(static_cast<int>(MetricsOptions{}.texture_width_px)))
       ->check(CLI::Range(1, 1 << 16));
   cmd->add_flag("--json", opt->json, "Print the full report as a JSON object");
   cmd->add_flag("-q,--quiet", opt->quiet, "Print nothing but the result and errors");
   cmd->add_flag("--stability", opt->stability,
                 "Instead: map the mesh with tailor (default options), remove the faces in a ball holding "
                 "~10% of them, re-map, and report how far the surviving UVs moved (thesis 2.6)");
-  cmd->add_option("--seed-point", opt->seed_point, "With --stability: X,Y,Z where both mappings start");
-  cmd->add_option("--remove-fraction", opt->remove_fraction, "With --stability: share of faces removed")
-      ->check(CLI::Range(0.01f, 0.9f))
-      ->capture_default_str();
+  cmd->add_option("--seed-point", opt->seed_point,
+                  "With --stability: " + std::string(option_doc(kMappingOptionDocs, "seed_point").help));
+  add_documented(cmd, option_doc(kStabilityOptionDocs, "remove_fraction"), opt->stability_options.remove_fraction)
+      ->check(CLI::Range(0.01f, 0.9f));
   cmd->footer(
       "Metrics (docs/metrics.md): patches, seams (share of edge length), flipped faces, stretch\n"
       "(coefficient of variation of UV/3D area ratio, 0 ideal), L2/Linf stretch (Sander 2001, 1 ideal),\n"

@@ -4,10 +4,9 @@
 #include <memory>
 #include <string>
 
-#include <nlohmann/json.hpp>
-
 #include "cli.h"
 #include "tailor/image.h"
+#include "tailor/report.h"
 #include "tailor/tiling.h"
 
 namespace tailor::cli {
@@ -26,22 +25,19 @@ int run_eval_tile(const EvalTileOptions& opt) {
   const bool with_exemplar = !opt.exemplar.empty();
   if (with_exemplar)
     if (Status s = load_image(opt.exemplar, exemplar); !s) return report_error(s);
-  TileMetrics m;
-  if (Status s = tile_metrics(tile, with_exemplar ? &exemplar : nullptr, m); !s) {
+  TileQuality quality;
+  quality.file = opt.tile;
+  const TileMetrics& m = quality.metrics;
+  if (Status s = tile_metrics(tile, with_exemplar ? &exemplar : nullptr, quality.metrics); !s) {
     // Name the image the complaint is about ("exemplar ..." messages concern the exemplar).
     const bool about_exemplar = with_exemplar && s.what().rfind("exemplar", 0) == 0;
     return report_error(s.with_file(about_exemplar ? opt.exemplar : opt.tile));
   }
-  std::string failed;
-  const bool met = meets_tile_targets(m, &failed);
+  quality.targets_met = meets_tile_targets(m, &quality.targets_failed);
+  const bool met = quality.targets_met;
+  const std::string& failed = quality.targets_failed;
   if (opt.json) {
-    nlohmann::json j = tile_metrics_json(m, with_exemplar);
-    j["file"] = opt.tile;
-    j["width"] = tile.width;
-    j["height"] = tile.height;
-    j["gradient_energy"] = m.gradient_energy;
-    if (with_exemplar) j["exemplar"] = opt.exemplar;
-    std::printf("%s\n", json_text(j).c_str());
+    std::fputs(eval_tile_report_json(quality, tile.width, tile.height, opt.exemplar).c_str(), stdout);
     return kExitOk;
   }
   if (opt.quiet) {

@@ -14,16 +14,16 @@
 namespace tailor::cli {
 namespace {
 
+// The command line: --yaw, --pitch and --checker are bound to `options` (defaults: RenderOptions');
+// the options given as text default to the names of RenderOptions' defaults.
 struct RenderArgs {
   std::string input;
   std::string output;
   std::string texture;
-  std::string view = "texture";
-  std::string size = "1024x768";
-  std::string up = "y";
-  float yaw = RenderOptions{}.yaw_degrees;
-  float pitch = RenderOptions{}.pitch_degrees;
-  float checker = RenderOptions{}.checker_squares;
+  RenderOptions options;
+  std::string view = preview_view_name(RenderOptions{}.view);
+  std::string size = std::to_string(RenderOptions{}.width) + "x" + std::to_string(RenderOptions{}.height);
+  std::string up = up_axis_name(RenderOptions{}.up);
   bool quiet = false;
 };
 
@@ -39,7 +39,7 @@ bool parse_size(const std::string& text, int& width, int& height) {
 
 int run_render(const RenderArgs& args) {
   const auto start = std::chrono::steady_clock::now();
-  RenderOptions options;
+  RenderOptions options = args.options;
   if (!preview_view_from_name(args.view, options.view)) {
     return report_error(Status::error(ErrorCode::kInvalidArgument, "", "unknown view '" + args.view + "'",
                                       "use texture, patches, distortion or checker"));
@@ -52,9 +52,6 @@ int run_render(const RenderArgs& args) {
     return report_error(Status::error(ErrorCode::kInvalidArgument, "", "bad --up '" + args.up + "'",
                                       "use x, y, z, -x, -y or -z"));
   }
-  options.yaw_degrees = args.yaw;
-  options.pitch_degrees = args.pitch;
-  options.checker_squares = args.checker;
 
   Mesh mesh;
   Image texture;
@@ -95,16 +92,14 @@ void register_render(CLI::App& app, Runner& run) {
   auto args = std::make_shared<RenderArgs>();
   cmd->add_option("mesh", args->input, "UV-mapped mesh: .glb (texture embedded) or .obj/.ply with UVs")->required();
   cmd->add_option("-o,--output", args->output, "PNG picture to write")->required();
-  cmd->add_option("--view", args->view,
-                  "texture (default), patches (a colour per patch, seams drawn), distortion (area-stretch "
-                  "heat map with legend) or checker")
+  add_documented(cmd, option_doc(kRenderOptionDocs, "view"), args->view)
       ->check(CLI::IsMember({"texture", "patches", "distortion", "checker"}));
-  cmd->add_option("--size", args->size, "picture size WIDTHxHEIGHT (default 1024x768)");
+  add_documented(cmd, option_doc(kRenderOptionDocs, "width"), args->size);
   cmd->add_option("--texture", args->texture, "texture image to use instead of the one in the .glb");
-  cmd->add_option("--up", args->up, "mesh axis that points up in the picture: y (default, glTF), z (most scans), x, -x, -y, -z");
-  cmd->add_option("--yaw", args->yaw, "camera azimuth in degrees around the up axis (default 35)");
-  cmd->add_option("--pitch", args->pitch, "camera elevation in degrees (default 25)");
-  cmd->add_option("--checker", args->checker, "checker squares per texture repeat (default 8)");
+  add_documented(cmd, option_doc(kRenderOptionDocs, "up"), args->up);
+  add_documented(cmd, option_doc(kRenderOptionDocs, "yaw_degrees"), args->options.yaw_degrees);
+  add_documented(cmd, option_doc(kRenderOptionDocs, "pitch_degrees"), args->options.pitch_degrees);
+  add_documented(cmd, option_doc(kRenderOptionDocs, "checker_squares"), args->options.checker_squares);
   cmd->add_flag("-q,--quiet", args->quiet, "print nothing but errors");
   cmd->footer(
       "Examples:\n"

@@ -4,7 +4,7 @@
 // Usage: consumer IN.ply|obj|off|stl|glb OUT.glb [TEXTURE.png]
 #include <cstdio>
 
-#include "tailor/tailor.h"  // the whole API; or only io.h topology.h orientation.h mapping.h export.h
+#include "tailor/tailor.h"  // the whole API; or only io.h topology.h mapping.h export.h
 
 // Every call that can fail returns a tailor::Status; message() says what and where.
 static int fail(const tailor::Status& status) {
@@ -21,12 +21,12 @@ int main(int argc, char** argv) {
   if (tailor::Status s = tailor::load_mesh(argv[1], mesh); !s) return fail(s);
   const tailor::Topology topology = tailor::build_topology(mesh);  // which faces share an edge
 
-  // {} below: the default options, as `tailor map` uses them.
-  tailor::FaceFrames frames;  // per-face frames and the orientation field the texture follows
-  if (tailor::Status s = tailor::compute_orientation(mesh, topology, {}, frames); !s) return fail(s);
-
-  tailor::Atlas atlas;  // the result: a UV per face corner, in texture pixels, and a patch per face
-  if (tailor::Status s = tailor::map_texture(mesh, topology, frames, {}, atlas); !s) return fail(s);
+  // The pipeline: orientation field, growth, seam shortening, crack closing and metrics, with the
+  // default options of every stage (as `tailor map` uses them).
+  tailor::TextureMap map;  // per-face frames, the atlas (a UV per face corner, in texture pixels,
+                           // and a patch per face), what each stage did, and the quality metrics
+  if (tailor::Status s = tailor::map_texture(mesh, topology, {}, map); !s) return fail(s);
+  const tailor::Atlas& atlas = map.atlas;
 
   tailor::ExportOptions output;  // the texture to embed and its size (pixels per texture repeat)
   if (argc > 3) {

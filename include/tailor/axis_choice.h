@@ -33,13 +33,14 @@ struct AxisChoice {
   std::array<double, kAxisCandidates> seam_ratio{};  //!< per candidate: seam length / edge length of the growth
 };
 
-//! Maps the mesh once per candidate axis with `mapping` in patches mode minus the crack closing (the
-//! growth and seam shortening, which rank the axes as the full mapping does on CAD parts, at a fifth
-//! of its cost; in thesis mode every candidate would score 0)
-//! and picks the axis leaving the least seam length. mapping.progress, if set, gets the share of
-//! candidates done; false cancels (kCancelled). Fails as compute_orientation / map_texture do.
-//! Cost: four orientations and growths, O(F log front). Deterministic.
-TAILOR_API Status choose_orientation_axis(const Mesh& mesh, const Topology& topology, const OrientationOptions& base,
-                                          const MappingOptions& mapping, AxisChoice& choice);
+//! Maps the mesh once per candidate axis (orientation_for(candidate, options.orientation)) with
+//! map_texture in patches mode minus the crack closing (the growth and seam shortening, which rank
+//! the axes as the full mapping does on CAD parts, at a fifth of its cost; in thesis mode every
+//! candidate would score 0) and picks the axis leaving the least seam length.
+//! options.mapping.progress, if set, gets the share of candidates done; false cancels
+//! (kCancelled). Fails as map_texture does. Cost: four orientations, growths and metrics,
+//! O(F log front). Deterministic.
+TAILOR_API Status choose_orientation_axis(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options,
+                               AxisChoice& choice);
 
 }  // namespace tailor

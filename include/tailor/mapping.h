@@ -1,5 +1,9 @@
 // tailor: texture mapping by homogeneous patch discovery (thesis chapter 2, DESIGN.md section 4).
 //
+// map_texture runs the whole pipeline, one stage per module: 1. the orientation field
+// (orientation.h), 2. the growth described below, 3. seam shortening, 4. crack closing (both in
+// patches mode), 5. the metrics of the result (metrics.h).
+//
 // A greedy front grows over the mesh face by face. Faces waiting on the front are keyed by
 // (number of placed edge neighbours, most first; then age = variation + hop_age times the face's
 // path length from its component's seed, least first), so the texture spreads through regions where the orientation field is homogeneous and
@@ -35,10 +39,13 @@
 #include <cstdint>
 #include <functional>
 #include <span>
+#include <string_view>
 
 #include "tailor/api.h"
 #include "tailor/atlas.h"
 #include "tailor/mesh.h"
+#include "tailor/metrics.h"
+#include "tailor/option_doc.h"
 #include "tailor/orientation.h"
 #include "tailor/status.h"
 #include "tailor/topology.h"
@@ -100,6 +107,39 @@ struct MappingOptions {
   ProgressCallback progress;        //!< optional; see ProgressCallback
 };
 
+//! Flags and help of the MappingOptions a user sets (option_doc.h): the tailor CLI shows these, with
+//! the defaults of a default-constructed MappingOptions.
+inline constexpr OptionDoc kMappingOptionDocs[] = {
+    {"mode", "--mode",
+     "patches: per-corner UVs, bounded per-face stretch, no inverted face; thesis: the thesis as written, one UV "
+     "per vertex (reference)"},
+    {"scale", "--scale", "Texture pixels per unit of the mesh normalised into the unit cube"},
+    {"max_stretch", "--max-stretch", "patches mode: per-face singular values must stay within [1/(1+x), 1+x]"},
+    {"field_following", "--field-following",
+     "patches mode: 1 = texture direction follows the orientation field (thesis), 0 = faces are unfolded rigidly "
+     "(fewer seams, direction drifts); values between blend"},
+    {"min_patch_faces", "--min-patch-faces",
+     "patches mode: smaller patches are absorbed into a neighbour (0 keeps all)"},
+    {"hop_age", "--hop-age",
+     "patches mode: growth-order age per face of path from the seed, radians (0..1); keeps the order local so "
+     "removing part of a mesh changes little elsewhere; 0 = the thesis's global counter"},
+    {"shorten_seams", "--no-seam-shortening",
+     "patches mode: seam shortening re-places faces along the seams after the growth where that shortens them; "
+     "off, the seams stay as the growth left them"},
+    {"close_cracks", "--no-crack-closing",
+     "patches mode: crack closing zips the cracks (cuts inside a patch) shut, last; off, the mapping is 3-10x "
+     "faster with about twice the seam length"},
+    {"crack_rings", "--crack-rings",
+     "patches mode: effort of the crack closing, the largest region (rings of faces) a zip may relax (2..64); "
+     "more closes wider cracks and takes longer. Fewest seams: --field-following 0 --crack-rings 32"},
+    {"threshold_px", "--threshold", "thesis mode: initial error threshold in pixels"},
+    {"seed_point", "--seed-point",
+     "X,Y,Z: start at the face nearest this point (same point = stable results when parts of the mesh are "
+     "removed)"},
+    {"seam_faces", "--seam-faces",
+     "File of face indices (one per line) where seams should go (PLY 'seam' property also works)"},
+};
+
 struct MappingStats {
   uint32_t patches = 0;             //!< patches in the atlas (after absorption)
   uint32_t patches_before_absorb = 0;  //!< patches grown before tiny ones were absorbed (kPatches)
@@ -119,7 +159,7 @@ struct MappingStats {
   uint64_t cracks_closed = 0;       //!< kPatches: crack vertices zipped shut (one UV where there were two)
   uint64_t faces_seam = 0;          //!< faces flagged in seam_faces
   uint64_t inverted_accepted = 0;   //!< kThesis: faces accepted with a non-positive UV area (always 0 in kPatches)
-  double seconds = 0.0;             //!< wall time of map_texture
+  double seconds = 0.0;             //!< wall time of the growth, seam shortening and crack closing (steps 2-4)
 };
 
 //! Seed face of every edge component: the face whose centroid is nearest to the seed point (the
@@ -127,20 +167,46 @@ struct MappingStats {
 TAILOR_API std::vector<uint32_t> component_seed_faces(const Mesh& mesh, const Topology& topology,
                                                       const FaceFrames& frames, const MappingOptions& options);
 
-//! Maps the texture: fills atlas.corner_uv (#F*3 by 2, pixels), atlas.patch (#F) and
-//! atlas.patch_count; every face is placed and every UV is finite.
-//! Preconditions: topology = build_topology(mesh), frames = compute_orientation(mesh, topology, ...).
-//! Fails with kInvalidArgument on bad options (scale <= 0 or non-finite, max_stretch,
-//! field_following, hop_age, crack_rings, max_seed_rotation_deg or factor_step out of range,
-//! seam_faces of the wrong size, a non-finite seed point), kInvalidMesh when frames/topology do not
-//! match the mesh, kCancelled when the progress callback returns false (the atlas is then empty).
-//! Cost: the growth O(F log front) time; the crack closing O(F) plus, per crack vertex tried, a
-//! relaxation of O(crack_rings^2) faces (in practice 3-10x the growth; vertices of valence > 64 are
-//! not zipped, so a huge fan cannot make it quadratic); O(F + V) memory, allocated before the loops
-//! (the atlas's capacity is reused). Deterministic, the same bits with or without SIMD. Safe for
-//! any mesh that passed finalize_mesh (non-manifold and inconsistent edges act as boundaries).
-TAILOR_API Status map_texture(const Mesh& mesh, const Topology& topology, const FaceFrames& frames,
-                              const MappingOptions& options, Atlas& atlas, MappingStats* stats = nullptr);
+//! The options of the whole pipeline, one struct per stage (each with its defaults).
+struct MapTextureOptions {
+  OrientationOptions orientation;  //!< step 1, the orientation field
+  MappingOptions mapping;          //!< steps 2-4: growth, seam shortening, crack closing (and the progress)
+  MetricsOptions metrics;          //!< step 5 (the texture size, for the seam gap)
+  bool measure = true;             //!< false skips step 5 (TextureMap::metrics stays empty)
+};
+
+//! What map_texture computes, stage by stage.
+struct TextureMap {
+  FaceFrames frames;   //!< step 1: per-face frames and the orientation field (frames.seconds: its time)
+  Atlas atlas;         //!< steps 2-4: per-corner UVs in pixels and patch ids
+  MappingStats stats;  //!< steps 2-4: what they did (stats.seconds: their time)
+  UvMetrics metrics;   //!< step 5: quality of the atlas (metrics.seconds: its time)
+};
+
+//! Maps the texture, as `tailor map` does: 1. the orientation field (compute_orientation),
+//! 2. the growth (patches mode: the patch-discovery front; thesis mode: the reference algorithm),
+//! 3. seam shortening and 4. crack closing (patches mode, each unless switched off), 5. the
+//! metrics of the result (compute_uv_metrics, unless options.measure is false).
+//! Fills map.atlas: corner_uv (#F*3 by 2, pixels), patch (#F) and patch_count; every face is
+//! placed and every UV is finite. Precondition: topology = build_topology(mesh).
+//! Fails as compute_orientation does, then with kInvalidArgument on bad mapping options (scale <= 0
+//! or non-finite, max_stretch, field_following, hop_age, crack_rings, max_seed_rotation_deg or
+//! factor_step out of range, seam_faces of the wrong size, a non-finite seed point), kInvalidMesh
+//! when the topology does not match the mesh, kCancelled when the progress callback returns false
+//! (the atlas is then empty), and as compute_uv_metrics does.
+//! Cost: the orientation and the metrics O(F); the growth O(F log front) time; the crack closing
+//! O(F) plus, per crack vertex tried, a relaxation of O(crack_rings^2) faces (in practice 3-10x
+//! the growth; vertices of valence > 64 are not zipped, so a huge fan cannot make it quadratic);
+//! O(F + V) memory, allocated before the loops (the capacity of `map` is reused). Deterministic,
+//! the same bits with or without SIMD and for any thread count. Safe for any mesh that passed
+//! finalize_mesh (non-manifold and inconsistent edges act as boundaries).
+TAILOR_API Status map_texture(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options, TextureMap& map);
+
+//! The name of a mode, "patches" or "thesis" (CLI --mode).
+TAILOR_API const char* mapping_mode_name(MappingMode mode);
+
+//! Parses "patches" or "thesis"; false for anything else.
+TAILOR_API bool mapping_mode_from_name(std::string_view name, MappingMode& mode);
 
 //! Per-face check used by kPatches and by tests: singular values of the Jacobian of the map from
 //! the face's frame (corner positions `local`, 6 floats, normalised units, times `scale`) to the

@@ -46,6 +46,7 @@ struct UvMetrics {
                                      //!< modulo the texture size) between the two sides, averaged over both endpoints
   double seam_invisible_ratio = 0;   //!< share of seam length whose gap is < 1 px (1 when there is no seam)
   double uv_scale = 0;               //!< R: sum of UV areas / sum of 3D areas (px^2 per unit^2)
+  double seconds = 0;                //!< wall time of compute_uv_metrics
 };
 
 //! Computes all metrics of a per-corner UV map.

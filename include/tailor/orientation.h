@@ -21,6 +21,7 @@
 
 #include "tailor/api.h"
 #include "tailor/mesh.h"
+#include "tailor/option_doc.h"
 #include "tailor/status.h"
 #include "tailor/topology.h"
 
@@ -46,6 +47,14 @@ struct OrientationOptions {
   float fixed_unit_scale = 0.f;                //!< > 0: normalised = (x - origin) * this; 0 = 1 / longest bbox side
   uint32_t threads = 0;                        //!< threads for the per-face frames (0 = one per 100k faces, at most
                                                //!< the cores and 8); the result is identical for any count
+};
+
+//! Flags and help of the OrientationOptions a user sets (option_doc.h).
+inline constexpr OptionDoc kOrientationOptionDocs[] = {
+    {"axis", "--axis",
+     "Orientation field: pca, x, y, z, X,Y,Z, or auto (maps with each of pca, x, y, z first and keeps the one "
+     "with the least seam: halves the seams of CAD parts, 4 growths more time)"},
+    {"smooth_passes", "--smooth", "Orientation smoothing passes over face neighbours"},
 };
 
 //! Per-face frames. Shapes: #F by 3 arrays are packed xyz per face.

@@ -21,6 +21,7 @@
 #include "tailor/api.h"
 #include "tailor/image.h"
 #include "tailor/mesh.h"
+#include "tailor/option_doc.h"
 #include "tailor/status.h"
 
 namespace tailor {
@@ -40,6 +41,19 @@ enum class UpAxis { kPosY, kPosZ, kPosX, kNegY, kNegZ, kNegX };
 //! Parses "y", "z", "x", "-y", "-z" or "-x" (also with a leading '+'); false for anything else.
 TAILOR_API bool up_axis_from_name(std::string_view name, UpAxis& up);
 
+//! The name of an up axis, as up_axis_from_name reads it: "y", "z", "x", "-y", "-z" or "-x".
+inline const char* up_axis_name(UpAxis up) {
+  switch (up) {
+    case UpAxis::kPosY: return "y";
+    case UpAxis::kPosZ: return "z";
+    case UpAxis::kPosX: return "x";
+    case UpAxis::kNegY: return "-y";
+    case UpAxis::kNegZ: return "-z";
+    case UpAxis::kNegX: return "-x";
+  }
+  return "y";
+}
+
 struct RenderOptions {
   int width = 1024;                        //!< output width in pixels, 16..8192
   int height = 768;                        //!< output height in pixels, 16..8192
@@ -52,6 +66,19 @@ struct RenderOptions {
   float distortion_range = 2.0f;           //!< kDistortion: |log2(r_f / R)| mapped to full colour, > 0 (2 = 4x)
   bool draw_seams = true;                  //!< kPatches: draw seam edges as lines
   int supersample = 2;                     //!< render at this multiple of the size and box-filter down, 1..4
+};
+
+//! Flags and help of the RenderOptions a user sets (option_doc.h); `tailor map` names --up
+//! --preview-up.
+inline constexpr OptionDoc kRenderOptionDocs[] = {
+    {"view", "--view",
+     "texture, patches (a colour per patch, seams drawn), distortion (area-stretch heat map with legend) or "
+     "checker"},
+    {"width", "--size", "picture size WIDTHxHEIGHT"},
+    {"up", "--up", "mesh axis that points up in the picture: y (glTF), z (most scans), x, -x, -y, -z"},
+    {"yaw_degrees", "--yaw", "camera azimuth in degrees around the up axis"},
+    {"pitch_degrees", "--pitch", "camera elevation in degrees"},
+    {"checker_squares", "--checker", "checker squares per texture repeat"},
 };
 
 //! Renders a preview picture of `mesh`.

@@ -13,6 +13,7 @@
 #include "tailor/api.h"
 #include "tailor/mapping.h"
 #include "tailor/mesh.h"
+#include "tailor/option_doc.h"
 #include "tailor/orientation.h"
 #include "tailor/status.h"
 
@@ -20,6 +21,11 @@ namespace tailor {
 
 struct StabilityOptions {
   float remove_fraction = 0.1f;  //!< share of faces removed, (0, 0.9]
+};
+
+//! Flags and help of the StabilityOptions (option_doc.h).
+inline constexpr OptionDoc kStabilityOptionDocs[] = {
+    {"remove_fraction", "--remove-fraction", "With --stability: share of the faces removed"},
 };
 
 struct StabilityReport {
@@ -37,12 +43,12 @@ struct StabilityReport {
   double seconds = 0;             //!< wall time
 };
 
-//! Runs the experiment above. Fails like compute_orientation / map_texture (their Status is
-//! returned), or with kInvalidArgument when remove_fraction is out of range, or kInvalidMesh when
-//! the mesh has fewer than 10 faces. The progress callback in `mapping` is ignored.
-//! Cost: two orientation + mapping runs, O(F log F). Deterministic.
-TAILOR_API Status measure_stability(const Mesh& mesh, const OrientationOptions& orientation,
-                                    const MappingOptions& mapping, StabilityReport& report,
-                                    const StabilityOptions& options = {});
+//! Runs the experiment above, both mappings by map_texture with `options` (its axis and, when
+//! given, seed point resolved on the full mesh; options.mapping.progress and options.measure are
+//! ignored: no metrics are computed). Fails like map_texture (its Status is returned), or with
+//! kInvalidArgument when remove_fraction is out of range, or kInvalidMesh when the mesh has fewer
+//! than 10 faces. Cost: two orientation + mapping runs, O(F log F). Deterministic.
+TAILOR_API Status measure_stability(const Mesh& mesh, const MapTextureOptions& options, StabilityReport& report,
+                         const StabilityOptions& stability = {});
 
 }  // namespace tailor

@@ -47,6 +47,7 @@
 
 #include "tailor/api.h"
 #include "tailor/image.h"
+#include "tailor/option_doc.h"
 #include "tailor/status.h"
 
 namespace tailor {
@@ -62,6 +63,14 @@ struct TileOptions {
   double tolerance = 0.1;   //!< candidate blocks have SSD <= best * (1 + tolerance), [0, 1]
   bool fit_period = false;  //!< crop/extend to a whole number of texel periods first (thesis 3.1)
   TileProgress progress;    //!< optional progress callback (may be empty)
+};
+
+//! Flags and help of the TileOptions a user sets (option_doc.h).
+inline constexpr OptionDoc kTileOptionDocs[] = {
+    {"block", "--block", "Quilting block size in px"},
+    {"overlap", "--overlap", "Block overlap in px (when not given: block/4)"},
+    {"seed", "--seed", "Seed of the random block choice (same seed, same output)"},
+    {"fit_period", "--fit-period", "Crop or extend to a whole number of texel periods (regular patterns)"},
 };
 
 //! Texel period found by autocorrelation (thesis 3.1), per axis.

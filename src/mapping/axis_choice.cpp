@@ -1,9 +1,7 @@
-// Orientation axis by trial (tailor/axis_choice.h): one growth per candidate axis, ranked by the
-// seam length compute_uv_metrics measures.
+// Orientation axis by trial (tailor/axis_choice.h): one map_texture per candidate axis (growth and
+// seam shortening), ranked by the seam length its metrics measure.
 #include "tailor/axis_choice.h"
 
-#include "tailor/atlas.h"
-#include "tailor/metrics.h"
 
 namespace tailor {
 
@@ -30,27 +28,26 @@ OrientationOptions orientation_for(AxisCandidate candidate, const OrientationOpt
   return options;
 }
 
-Status choose_orientation_axis(const Mesh& mesh, const Topology& topology, const OrientationOptions& base,
-                               const MappingOptions& mapping, AxisChoice& choice) {
+Status choose_orientation_axis(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options,
+                               AxisChoice& choice) {
   choice = AxisChoice{};
-  MappingOptions growth = mapping;
-  growth.mode = MappingMode::kPatches;  // the thesis mode has one UV per vertex: no seams to rank by
-  growth.close_cracks = false;
-  growth.progress = nullptr;
-  FaceFrames frames;
-  Atlas atlas;
-  UvMetrics metrics;
+  const ProgressCallback& progress = options.mapping.progress;
+  MapTextureOptions trial = options;
+  trial.mapping.mode = MappingMode::kPatches;  // the thesis mode has one UV per vertex: no seams to rank by
+  trial.mapping.close_cracks = false;
+  trial.mapping.progress = nullptr;
+  trial.measure = true;
+  TextureMap map;
   for (int i = 0; i < kAxisCandidates; ++i) {
-    if (mapping.progress && !mapping.progress(static_cast<float>(i) / kAxisCandidates))
+    if (progress && !progress(static_cast<float>(i) / kAxisCandidates))
       return Status::error(ErrorCode::kCancelled, "", "axis choice cancelled");
     const AxisCandidate candidate = static_cast<AxisCandidate>(i);
-    TAILOR_RETURN_IF_ERROR(compute_orientation(mesh, topology, orientation_for(candidate, base), frames));
-    TAILOR_RETURN_IF_ERROR(map_texture(mesh, topology, frames, growth, atlas));
-    TAILOR_RETURN_IF_ERROR(compute_uv_metrics(mesh, topology, atlas.corner_uv, atlas.patch, {}, metrics));
-    choice.seam_ratio[static_cast<size_t>(i)] = metrics.seam_length_ratio;
-    if (metrics.seam_length_ratio < choice.seam_ratio[static_cast<size_t>(choice.best)]) choice.best = candidate;
+    trial.orientation = orientation_for(candidate, options.orientation);
+    TAILOR_RETURN_IF_ERROR(map_texture(mesh, topology, trial, map));
+    choice.seam_ratio[static_cast<size_t>(i)] = map.metrics.seam_length_ratio;
+    if (map.metrics.seam_length_ratio < choice.seam_ratio[static_cast<size_t>(choice.best)]) choice.best = candidate;
   }
-  if (mapping.progress && !mapping.progress(1.f)) return Status::error(ErrorCode::kCancelled, "", "axis choice cancelled");
+  if (progress && !progress(1.f)) return Status::error(ErrorCode::kCancelled, "", "axis choice cancelled");
   return Status::ok();
 }
 

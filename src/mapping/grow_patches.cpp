@@ -736,12 +736,10 @@ class PatchMapper {
 
 }  // namespace
 
-Status map_patches(const MappingInput& input, Atlas& atlas, MappingStats& stats) {
-  std::vector<uint8_t> seam_mark(input.mesh.face_count(), 0);
-  PatchMapper mapper(input, atlas, stats, seam_mark);
-  TAILOR_RETURN_IF_ERROR(mapper.run());
-  if (input.options.shorten_seams) stats.faces_reseamed = shorten_seams(input, seam_mark, atlas);
-  return Status::ok();
+Status grow_patches(const MappingInput& input, Atlas& atlas, MappingStats& stats, std::vector<uint8_t>& on_seam) {
+  on_seam.assign(input.mesh.face_count(), 0);
+  PatchMapper mapper(input, atlas, stats, on_seam);
+  return mapper.run();
 }
 
 }  // namespace tailor::internal

@@ -1,5 +1,8 @@
-// Texture mapping entry point: validates the inputs, orders the components' seeds and dispatches
-// to the patches mode (mapping_patches.cpp) or the thesis reference (mapping_thesis.cpp).
+// Texture mapping entry point: map_texture runs the pipeline, one stage per module, in order:
+// the orientation field (surface/orientation.cpp), the growth (grow_patches.cpp, or the thesis
+// reference in thesis_mode.cpp), seam shortening (shorten_seams.cpp), crack closing
+// (close_cracks.cpp), the metrics (metrics/uv_metrics.cpp). Here: the checks of the options and
+// the components' seed order.
 //
 // This work is based on:
 //   V. Singh, A. M. Namboodiri, "Efficient texture mapping by homogeneous patch discovery",
@@ -68,17 +71,11 @@ std::vector<uint32_t> component_seed_faces(const Mesh& mesh, const Topology& top
   return seeds;
 }
 
-namespace internal {
+namespace {
 
-}  // namespace internal
-
-Status map_texture(const Mesh& mesh, const Topology& topology, const FaceFrames& frames,
-                   const MappingOptions& options, Atlas& atlas, MappingStats* stats) {
-  const auto start = std::chrono::steady_clock::now();
-  // Cleared, not freed: a caller mapping again reuses the memory (no page faults on 37 MB).
-  atlas.corner_uv.clear();
-  atlas.patch.clear();
-  atlas.patch_count = 0;
+// Checks what steps 2-4 are given (the frames come from step 1), before any of them runs.
+Status check_mapping_inputs(const Mesh& mesh, const Topology& topology, const FaceFrames& frames,
+                            const MappingOptions& options) {
   const size_t face_count = mesh.face_count();
   if (face_count == 0) return Status::error(ErrorCode::kInvalidMesh, "", "mesh has no face");
   if (topology.opposite.size() != 3 * face_count || topology.face_component.size() != face_count)
@@ -108,39 +105,86 @@ Status map_texture(const Mesh& mesh, const Topology& topology, const FaceFrames&
   if (options.use_seed_point && !(std::isfinite(options.seed_point[0]) && std::isfinite(options.seed_point[1]) &&
                                   std::isfinite(options.seed_point[2])))
     return Status::error(ErrorCode::kInvalidArgument, "", "seed point must be finite");
+  return Status::ok();
+}
 
+// The growth's age per placed face: the option, or the mode's default (see MappingOptions::factor_step).
+double factor_step_for(const MappingOptions& options, size_t face_count) {
   const bool thesis = options.mode == MappingMode::kThesis;
-  double factor_step = options.factor_step;
   // Patches mode: negative = the hop rule (hop_age); with hop_age 0, the global counter at 1e-4.
-  if (factor_step < 0 && (thesis || options.hop_age == 0.f)) factor_step = thesis ? 1.0 / static_cast<double>(face_count) : 1e-4;
+  if (options.factor_step < 0 && (thesis || options.hop_age == 0.f))
+    return thesis ? 1.0 / static_cast<double>(face_count) : 1e-4;
+  return options.factor_step;
+}
+
+// Cleared, not freed: a caller mapping again reuses the memory (no page faults on 37 MB).
+void clear_atlas(Atlas& atlas) {
+  atlas.corner_uv.clear();
+  atlas.patch.clear();
+  atlas.patch_count = 0;
+}
+
+}  // namespace
+
+const char* mapping_mode_name(MappingMode mode) { return mode == MappingMode::kThesis ? "thesis" : "patches"; }
+
+bool mapping_mode_from_name(std::string_view name, MappingMode& mode) {
+  if (name == "patches") mode = MappingMode::kPatches;
+  else if (name == "thesis") mode = MappingMode::kThesis;
+  else return false;
+  return true;
+}
+
+Status map_texture(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options, TextureMap& map) {
+  clear_atlas(map.atlas);
+  map.stats = MappingStats{};
+  map.metrics = UvMetrics{};
+  const MappingOptions& mapping = options.mapping;
+
+  // === 1. Orientation field: per-face frames, the field and its variation (surface/orientation.cpp) ===
+  TAILOR_RETURN_IF_ERROR(compute_orientation(mesh, topology, options.orientation, map.frames));
+
+  const auto start = std::chrono::steady_clock::now();
+  TAILOR_RETURN_IF_ERROR(check_mapping_inputs(mesh, topology, map.frames, mapping));
+  const bool thesis = mapping.mode == MappingMode::kThesis;
+  const bool close_cracks = !thesis && mapping.close_cracks;
   // With crack closing the growth reports the first part of the progress, the closing the rest
   // (measured: the closing takes 70-90% of the mapping time).
-  const bool close_cracks = !thesis && options.close_cracks;
   constexpr float kGrowthShare = 0.2f;
-  MappingOptions growth_options = options;
-  if (close_cracks && options.progress)
-    growth_options.progress = [&options](float done) { return options.progress(kGrowthShare * done); };
-  internal::MappingInput input{mesh, topology, frames, growth_options, factor_step,
-                               component_seed_faces(mesh, topology, frames, options)};
-  MappingStats local_stats;
-  local_stats.components = static_cast<uint32_t>(input.component_seeds.size());
-  Status status = thesis ? internal::map_thesis(input, atlas, local_stats)
-                         : internal::map_patches(input, atlas, local_stats);
-  if (status.is_ok() && close_cracks) {
-    ProgressCallback closing_progress;
-    if (options.progress)
-      closing_progress = [&options](float done) { return options.progress(kGrowthShare + (1.f - kGrowthShare) * done); };
-    status = internal::close_cracks(input, closing_progress, atlas, local_stats.cracks_closed);
-  }
+  MappingOptions growth_options = mapping;
+  if (close_cracks && mapping.progress)
+    growth_options.progress = [&mapping](float done) { return mapping.progress(kGrowthShare * done); };
+  ProgressCallback closing_progress;
+  if (close_cracks && mapping.progress)
+    closing_progress = [&mapping](float done) { return mapping.progress(kGrowthShare + (1.f - kGrowthShare) * done); };
+  const internal::MappingInput input{mesh, topology, map.frames, growth_options,
+                                     factor_step_for(mapping, mesh.face_count()),
+                                     component_seed_faces(mesh, topology, map.frames, mapping)};
+  MappingStats& stats = map.stats;
+  stats.components = static_cast<uint32_t>(input.component_seeds.size());
+
+  // === 2. Growth: the patch-discovery front (mapping/grow_patches.cpp), or the thesis's (thesis_mode.cpp) ===
+  std::vector<uint8_t> on_seam;  // per face: placed on a seam by the growth (where step 3 looks)
+  Status status = thesis ? internal::map_thesis(input, map.atlas, stats)
+                         : internal::grow_patches(input, map.atlas, stats, on_seam);
+  // === 3. Seam shortening (mapping/shorten_seams.cpp) ===
+  if (status.is_ok() && !thesis && mapping.shorten_seams)
+    stats.faces_reseamed = internal::shorten_seams(input, on_seam, map.atlas);
+  // === 4. Crack closing (mapping/close_cracks.cpp) ===
+  if (status.is_ok() && close_cracks)
+    status = internal::close_cracks(input, closing_progress, map.atlas, stats.cracks_closed);
   if (!status.is_ok()) {
-    atlas.corner_uv.clear();
-    atlas.patch.clear();
-    atlas.patch_count = 0;
+    clear_atlas(map.atlas);
+    map.stats = MappingStats{};
     return status;
   }
-  local_stats.patches = atlas.patch_count;
-  local_stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (stats) *stats = local_stats;
+  stats.patches = map.atlas.patch_count;
+  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  // === 5. Metrics of the result (metrics/uv_metrics.cpp) ===
+  if (options.measure)
+    TAILOR_RETURN_IF_ERROR(compute_uv_metrics(mesh, topology, map.atlas.corner_uv, map.atlas.patch, options.metrics,
+                                              map.metrics));
   return Status::ok();
 }
 

@@ -1,5 +1,6 @@
-// Shared pieces of the two mapping modes (mapping.cpp dispatches, mapping_patches.cpp and
-// mapping_thesis.cpp implement): the front key layout, the component seed order, the inputs.
+// Shared pieces of the mapping stages (map_texture.cpp runs them in order; grow_patches.cpp,
+// shorten_seams.cpp, close_cracks.cpp and thesis_mode.cpp implement them): the front key layout,
+// the inputs, the stage functions.
 #pragma once
 
 #include <bit>
@@ -46,16 +47,19 @@ struct MappingInput {
   std::vector<uint32_t> component_seeds;  // first face of each component, in processing order
 };
 
-Status map_patches(const MappingInput& input, Atlas& atlas, MappingStats& stats);
+//! The growth of the patches mode (step 2 of map_texture): the patch-discovery front, then the
+//! absorption of small patches. on_seam gets #F flags, 1 on every face placed with a seam edge
+//! (and some of their neighbours): where shorten_seams looks.
+Status grow_patches(const MappingInput& input, Atlas& atlas, MappingStats& stats, std::vector<uint8_t>& on_seam);
 //! Re-places faces on seams from their neighbours where that shortens the seams and keeps them
-//! within options.max_stretch (patches mode, after the growth); drops emptied patches. seam_mark:
+//! within options.max_stretch (patches mode, step 3, after the growth); drops emptied patches. seam_mark:
 //! #F flags, 1 on every face with a seam edge (others may be 1 too), cleared on return. Returns the
 //! number of moves. Deterministic; O(F) once, then O(faces on seams) per pass, bounded passes.
 uint64_t shorten_seams(const MappingInput& input, std::vector<uint8_t>& seam_mark, Atlas& atlas);
 
 //! Zips cracks (seam edges between two faces of one patch) shut from their tips, relaxing the UVs
 //! around each zip (ARAP); a zip is kept only if every face it moved stays within
-//! options.max_stretch (patches mode, last step). zipped: the number of zipped vertices.
+//! options.max_stretch (patches mode, step 4). zipped: the number of zipped vertices.
 //! progress (may be empty) gets the share done; false cancels (kCancelled, atlas half-zipped).
 //! Deterministic; O(F) setup, then O(rings^2) per crack vertex tried.
 Status close_cracks(const MappingInput& input, const ProgressCallback& progress, Atlas& atlas, uint64_t& zipped);

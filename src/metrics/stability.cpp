@@ -30,13 +30,13 @@ double distance2(const double a[3], const double b[3]) {
 
 }  // namespace
 
-Status measure_stability(const Mesh& mesh, const OrientationOptions& orientation, const MappingOptions& mapping,
-                         StabilityReport& report, const StabilityOptions& options) {
+Status measure_stability(const Mesh& mesh, const MapTextureOptions& options, StabilityReport& report,
+                         const StabilityOptions& stability) {
   const auto start = std::chrono::steady_clock::now();
   report = StabilityReport{};
   const size_t face_count = mesh.face_count();
   if (face_count < 10) return Status::error(ErrorCode::kInvalidMesh, "", "stability needs at least 10 faces");
-  if (!(options.remove_fraction > 0.f && options.remove_fraction <= 0.9f))
+  if (!(stability.remove_fraction > 0.f && stability.remove_fraction <= 0.9f))
     return Status::error(ErrorCode::kInvalidArgument, "", "remove fraction must be in (0, 0.9]");
 
   // === Full mapping ===
@@ -45,16 +45,17 @@ Status measure_stability(const Mesh& mesh, const OrientationOptions& orientation
   // different bounding box and principal axis, which would move every UV.
   const Topology topology = build_topology(mesh);
   FaceFrames frames;
-  TAILOR_RETURN_IF_ERROR(compute_orientation(mesh, topology, orientation, frames));
-  OrientationOptions fixed = orientation;
+  TAILOR_RETURN_IF_ERROR(compute_orientation(mesh, topology, options.orientation, frames));
+  MapTextureOptions run = options;  // both runs: fixed frame and seed, no progress, no metrics
+  OrientationOptions& fixed = run.orientation;
   fixed.axis = AxisSource::kUser;
   fixed.user_axis = frames.axis;
   fixed.user_axis2 = frames.axis2;
   fixed.fixed_origin = frames.origin;
   fixed.fixed_unit_scale = frames.unit_scale;
-  TAILOR_RETURN_IF_ERROR(compute_orientation(mesh, topology, fixed, frames));
-  MappingOptions map_options = mapping;
+  MappingOptions& map_options = run.mapping;
   map_options.progress = nullptr;
+  run.measure = false;
   if (!map_options.use_seed_point) {
     // Pin the default seed (nearest the bbox centre) so that the cut mesh starts at the same face.
     const std::vector<uint32_t> seeds = component_seed_faces(mesh, topology, frames, map_options);
@@ -86,7 +87,7 @@ Status measure_stability(const Mesh& mesh, const OrientationOptions& orientation
     by_distance[f] = {distance2(c, centre), static_cast<uint32_t>(f)};
   }
   const size_t removed = std::clamp<size_t>(
-      static_cast<size_t>(std::lround(options.remove_fraction * static_cast<double>(face_count))), 1,
+      static_cast<size_t>(std::lround(stability.remove_fraction * static_cast<double>(face_count))), 1,
       face_count - 1);
   std::nth_element(by_distance.begin(), by_distance.begin() + static_cast<std::ptrdiff_t>(removed - 1),
                    by_distance.end());
@@ -106,9 +107,9 @@ Status measure_stability(const Mesh& mesh, const OrientationOptions& orientation
     face_centroid(mesh, nearest, c);
     map_options.seed_point = {static_cast<float>(c[0]), static_cast<float>(c[1]), static_cast<float>(c[2])};
   }
-  Atlas full;
-  MappingStats full_stats;
-  TAILOR_RETURN_IF_ERROR(map_texture(mesh, topology, frames, map_options, full, &full_stats));
+  TextureMap full_map;
+  TAILOR_RETURN_IF_ERROR(map_texture(mesh, topology, run, full_map));
+  const Atlas& full = full_map.atlas;
 
   // === The cut mesh: same vertices (ids kept), surviving faces in their original order ===
   Mesh cut;
@@ -122,16 +123,14 @@ Status measure_stability(const Mesh& mesh, const OrientationOptions& orientation
                        mesh.indices.begin() + static_cast<std::ptrdiff_t>(3 * f + 3));
   }
   std::vector<uint8_t> cut_seams;
-  if (!mapping.seam_faces.empty()) {
-    for (const uint32_t f : original) cut_seams.push_back(mapping.seam_faces[f]);
+  if (!options.mapping.seam_faces.empty()) {
+    for (const uint32_t f : original) cut_seams.push_back(options.mapping.seam_faces[f]);
     map_options.seam_faces = cut_seams;
   }
   const Topology cut_topology = build_topology(cut);
-  FaceFrames cut_frames;
-  TAILOR_RETURN_IF_ERROR(compute_orientation(cut, cut_topology, fixed, cut_frames));
-  Atlas cut_atlas;
-  MappingStats cut_stats;
-  TAILOR_RETURN_IF_ERROR(map_texture(cut, cut_topology, cut_frames, map_options, cut_atlas, &cut_stats));
+  TextureMap cut_map;
+  TAILOR_RETURN_IF_ERROR(map_texture(cut, cut_topology, run, cut_map));
+  const Atlas& cut_atlas = cut_map.atlas;
 
   // === Compare surviving corners ===
   double sum = 0, worst = 0;

@@ -9,6 +9,7 @@
 #include "tailor/metrics.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -218,6 +219,7 @@ void face_area_stretch(const Mesh& mesh, std::span<const float> corner_uv, std::
 
 Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<const float> corner_uv,
                           std::span<const uint32_t> patch_in, const MetricsOptions& options, UvMetrics& metrics) {
+  const auto start = std::chrono::steady_clock::now();
   metrics = UvMetrics{};
   const size_t nf = mesh.face_count();
   if (corner_uv.size() != 6 * nf)
@@ -424,6 +426,7 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
     metrics.seam_gap_px = gap_plain / n;
     metrics.seam_invisible_ratio = static_cast<double>(invisible_count) / n;
   }
+  metrics.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return Status::ok();
 }
 

@@ -10,7 +10,6 @@
 #include "tailor/export.h"
 #include "tailor/io.h"
 #include "tailor/mapping.h"
-#include "tailor/orientation.h"
 #include "tailor/topology.h"
 
 int main(int argc, char** argv) {
@@ -18,11 +17,13 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: map_scalar IN OUT.ply [--field-following F] [--crack-rings N]\n");
     return 2;
   }
-  tailor::MappingOptions options;
+  tailor::MapTextureOptions options;
+  options.measure = false;
   for (int i = 3; i + 1 < argc; i += 2) {
     const std::string flag = argv[i];
-    if (flag == "--field-following") options.field_following = std::strtof(argv[i + 1], nullptr);
-    else if (flag == "--crack-rings") options.crack_rings = static_cast<uint32_t>(std::strtoul(argv[i + 1], nullptr, 10));
+    if (flag == "--field-following") options.mapping.field_following = std::strtof(argv[i + 1], nullptr);
+    else if (flag == "--crack-rings")
+      options.mapping.crack_rings = static_cast<uint32_t>(std::strtoul(argv[i + 1], nullptr, 10));
     else {
       std::fprintf(stderr, "map_scalar: unknown option %s\n", argv[i]);
       return 2;
@@ -31,11 +32,9 @@ int main(int argc, char** argv) {
   tailor::Mesh mesh;
   tailor::Status s = tailor::load_mesh(argv[1], mesh);
   const tailor::Topology topology = tailor::build_topology(mesh);
-  tailor::FaceFrames frames;
-  tailor::Atlas atlas;
-  if (s.is_ok()) s = tailor::compute_orientation(mesh, topology, {}, frames);
-  if (s.is_ok()) s = tailor::map_texture(mesh, topology, frames, options, atlas);
-  if (s.is_ok()) s = tailor::export_mesh(argv[2], mesh, atlas, {});
+  tailor::TextureMap map;
+  if (s.is_ok()) s = tailor::map_texture(mesh, topology, options, map);
+  if (s.is_ok()) s = tailor::export_mesh(argv[2], mesh, map.atlas, {});
   if (!s.is_ok()) {
     std::fprintf(stderr, "map_scalar: %s\n", s.message().c_str());
     return 1;

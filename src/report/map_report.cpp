@@ -1,0 +1,100 @@
+// The report of `tailor map` (tailor/report.h): the --stats JSON and the summary lines.
+#include "tailor/report.h"
+
+#include "report/report_text.h"
+
+namespace tailor {
+
+using internal::format_text;
+using internal::ms;
+
+void add_map_results(const Mesh& mesh, const LoadReport& load, const Topology& topology, const TextureMap& map,
+                     MapRun& run) {
+  run.load = load;
+  run.vertices = mesh.vertex_count();
+  run.faces = mesh.face_count();
+  run.components = topology.vertex_components;
+  run.boundary_edges = topology.boundary_edges;
+  run.nonmanifold_edges = topology.nonmanifold_edges;
+  run.inconsistent_edges = topology.inconsistent_edges;
+  run.topology_seconds = topology.build_seconds;
+  run.orientation_seconds = map.frames.seconds;
+  run.mapping = map.stats;
+  run.metrics = map.metrics;
+}
+
+std::string map_report_json(const MapRun& run) {
+  const MappingOptions& mapping = run.options.mapping;
+  const MappingStats& stats = run.mapping;
+  const UvMetrics& metrics = run.metrics;
+  nlohmann::json j;
+  j["input"] = run.input;
+  j["output"] = run.output;
+  j["texture"] = run.texture;
+  j["texture_size"] = {run.texture_width, run.texture_height};
+  j["options"] = {{"mode", mapping_mode_name(mapping.mode)}, {"scale", mapping.scale},
+                  {"threshold_px", mapping.threshold_px}, {"max_stretch", mapping.max_stretch},
+                  {"field_following", mapping.field_following}, {"min_patch_faces", mapping.min_patch_faces},
+                  {"shorten_seams", mapping.shorten_seams}, {"close_cracks", mapping.close_cracks},
+                  {"crack_rings", mapping.crack_rings}, {"hop_age", mapping.hop_age}, {"axis", run.axis},
+                  {"smooth", run.options.orientation.smooth_passes}, {"seed_point", run.seed_point},
+                  {"seam_faces", run.seam_faces}};
+  j["mesh"] = {{"format", run.load.format}, {"vertices", run.vertices}, {"faces", run.faces},
+               {"components", run.components}, {"boundary_edges", run.boundary_edges},
+               {"nonmanifold_edges", run.nonmanifold_edges}, {"inconsistent_edges", run.inconsistent_edges},
+               {"degenerate_faces_dropped", run.load.degenerate_faces},
+               {"duplicate_faces_dropped", run.load.duplicate_faces},
+               {"unreferenced_vertices", run.load.unreferenced_vertices}};
+  j["mapping"] = {{"patches", stats.patches}, {"patches_before_absorb", stats.patches_before_absorb},
+                  {"deferrals", stats.deferrals}, {"threshold_raises", stats.threshold_raises},
+                  {"final_threshold_px", stats.final_threshold_px}, {"max_error_px", stats.max_error_px},
+                  {"max_stretch_accepted", stats.max_stretch_accepted},
+                  {"faces_three_textured", stats.faces_three_textured}, {"faces_unfolded", stats.faces_unfolded},
+                  {"faces_rigid", stats.faces_rigid}, {"faces_reseamed", stats.faces_reseamed},
+                  {"cracks_closed", stats.cracks_closed}, {"faces_seam", stats.faces_seam},
+                  {"inverted_accepted", stats.inverted_accepted}};
+  j["metrics"] = {{"patches", metrics.patches}, {"single_face_patches", metrics.single_face_patches},
+                  {"stretch", metrics.stretch}, {"stretch_area_weighted", metrics.stretch_area_weighted},
+                  {"distortion_deg", metrics.distortion_deg}, {"l2_stretch", metrics.l2_stretch},
+                  {"linf_stretch", metrics.linf_stretch}, {"flipped", metrics.flipped},
+                  {"seam_edges", metrics.seam_edges}, {"seam_length_ratio", metrics.seam_length_ratio},
+                  {"seam_gap_px", metrics.seam_gap_px}, {"seam_invisible_ratio", metrics.seam_invisible_ratio},
+                  {"uv_scale", metrics.uv_scale}};
+  if (run.stability) {
+    const StabilityReport& s = *run.stability;
+    j["stability"] = {{"removed_faces", s.removed_faces}, {"compared_corners", s.compared_corners},
+                      {"mean_difference_px", s.mean_difference_px}, {"max_difference_px", s.max_difference_px},
+                      {"identical_ratio", s.identical_ratio}, {"within_1px_ratio", s.within_1px_ratio}};
+  }
+  j["time_ms"] = {{"load", ms(run.load.load_seconds)}, {"topology", ms(run.topology_seconds)},
+                  {"axis_choice", ms(run.axis_choice_seconds)}, {"orientation", ms(run.orientation_seconds)},
+                  {"mapping", ms(stats.seconds)}, {"metrics", ms(metrics.seconds)},
+                  {"export", ms(run.export_seconds)}, {"preview", ms(run.preview_seconds)},
+                  {"total", ms(run.total_seconds)}};
+  j["previews"] = run.previews;
+  return internal::json_text(j);
+}
+
+std::string map_summary(const MapRun& run) {
+  const UvMetrics& m = run.metrics;
+  const std::string axis_choice =
+      run.axis_auto ? "axis choice " + std::to_string(static_cast<long>(ms(run.axis_choice_seconds))) + ", " : "";
+  std::string text = format_text(
+      "%s: %zu faces, %u patches, seams %.2f%% of edge length, %zu flipped, stretch %.3f, L2 %.3f, "
+      "Linf %.2f, median angle %.2f deg, seam gap %.1f px (%.0f%% invisible) | load %.1f ms, topology %.1f, "
+      "%sorientation %.1f, mapping %.1f, export %.1f ms -> %s\n",
+      run.input.c_str(), run.faces, m.patches, 100.0 * m.seam_length_ratio, m.flipped, m.stretch, m.l2_stretch,
+      m.linf_stretch, m.distortion_deg, m.seam_gap_px, 100.0 * m.seam_invisible_ratio, ms(run.load.load_seconds),
+      ms(run.topology_seconds), axis_choice.c_str(), ms(run.orientation_seconds), ms(run.mapping.seconds),
+      ms(run.export_seconds), run.output.c_str());
+  if (run.stability) {
+    const StabilityReport& s = *run.stability;
+    text += format_text("stability: removed %zu faces, surviving corners moved %.3f px on average (max %.2f px), "
+                        "%.1f%% bit-identical, %.1f%% within 1 px\n",
+                        s.removed_faces, s.mean_difference_px, s.max_difference_px, 100.0 * s.identical_ratio,
+                        100.0 * s.within_1px_ratio);
+  }
+  return text;
+}
+
+}  // namespace tailor
