@@ -147,6 +147,10 @@ int run_eval(const EvalOptions& opt) {
     j["seam_length_ratio"] = m.seam_length_ratio;
     j["seam_gap_px"] = m.seam_gap_px;
     j["seam_invisible_ratio"] = m.seam_invisible_ratio;
+    j["visible_seam_ratio"] = m.visible_seam_ratio;
+    j["visible_off_sharp_ratio"] = m.visible_off_sharp_ratio;
+    j["visible_dangling_ends"] = m.visible_dangling_ends;
+    j["visible_branch_points"] = m.visible_branch_points;
     j["uv_scale_px2_per_unit2"] = m.uv_scale;
     j["boundary_edges"] = topology.boundary_edges;
     j["nonmanifold_edges"] = topology.nonmanifold_edges;
