@@ -215,6 +215,104 @@ TEST(Metrics, SeamGapIsTheToroidalDistance) {
   EXPECT_EQ(m.seam_invisible_ratio, 1.0);
 }
 
+// The lattice gap takes one whole-repeat offset for both ends of an edge, and the larger end.
+TEST(Metrics, SeamGapUsesOneLatticeOffsetForBothEnds) {
+  const MetricsOptions options;  // 512 x 512 px
+  const float fa[2] = {0, 0}, fb[2] = {10, 0};
+  // g's side shifted by (512, 0) at a and (512.6, 0) at b: k = (512, 0), gap 0.6 px: invisible.
+  const float ga[2] = {-512, 0}, gb[2] = {10 - 512.6f, 0};
+  EXPECT_NEAR(seam_gap_px(fa, fb, ga, gb, options), 0.6, 1e-4);
+  // Offsets (300, 0) and (-212, 0) are each 212 px from the lattice, but no single offset fits
+  // both ends: k = round(44 / 512) = 0, gap max(300, 212) = 300.
+  const float ga2[2] = {-300, 0}, gb2[2] = {10 + 212, 0};
+  EXPECT_NEAR(seam_gap_px(fa, fb, ga2, gb2, options), 300.0, 1e-4);
+}
+
+// g's side turned by a quarter turn and shifted by whole repeats: a seam under any texture, but
+// invisible under a 4-fold symmetric one.
+TEST(Metrics, QuarterTurnIsInvisibleOnlyWithFourfoldSymmetry) {
+  Mesh mesh;
+  mesh.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+  mesh.indices = {0, 1, 2, 1, 3, 2};
+  const float s = 100;
+  // Face 0 identity; face 1 rotated by +90 degrees ((u, v) -> (-v, u)) then shifted by (1024, 512).
+  const auto turned = [&](float x, float y) { return std::pair{-y * s + 1024, x * s + 512}; };
+  std::vector<float> uv = {0, 0, s, 0, 0, s};
+  for (const auto& [x, y] : {std::pair{1.f, 0.f}, std::pair{1.f, 1.f}, std::pair{0.f, 1.f}}) {
+    const auto [u, v] = turned(x, y);
+    uv.push_back(u);
+    uv.push_back(v);
+  }
+  UvMetrics m = metrics_of(mesh, uv);
+  EXPECT_EQ(m.seam_edges, 1u);
+  EXPECT_EQ(m.seam_invisible_ratio, 0.0);
+  EXPECT_GT(m.visible_seam_ratio, 0.0);
+  MetricsOptions four;
+  four.symmetry = 4;
+  m = metrics_of(mesh, uv, {}, four);
+  EXPECT_EQ(m.seam_edges, 1u);
+  EXPECT_EQ(m.seam_invisible_ratio, 1.0);
+  EXPECT_EQ(m.visible_seam_ratio, 0.0);
+
+  four.texture_height_px = 256;  // quarter turns need a square texture
+  UvMetrics unused;
+  EXPECT_EQ(compute_uv_metrics(mesh, build_topology(mesh), uv, {}, four, unused).code(), ErrorCode::kInvalidArgument);
+}
+
+// A cut from the border into a 4x4 grid along y = 2, stopping at the interior vertex (2, 2), then
+// a second cut down from (1, 2) to the border: the first cut's tip is a dangling end, (1, 2) a
+// branch point; vertices on the border are not counted. All cut edges are visible (30 px gap).
+TEST(Metrics, CountsDanglingEndsAndBranchPointsOfVisibleSeams) {
+  const Mesh mesh = grid(4, 4, Diagonal::kFalling);
+  std::vector<float> uv = corner_uvs(mesh, [](float x, float y) { return std::pair{100 * x, 100 * y}; });
+  const auto move_corners = [&](auto&& face_selected, auto&& vertex_selected, float du, float dv) {
+    for (size_t c = 0; c < mesh.indices.size(); ++c) {
+      const size_t f = c / 3;
+      float cx = 0, cy = 0;
+      for (int k = 0; k < 3; ++k) {
+        cx += mesh.positions[3 * size_t{mesh.indices[3 * f + k]}] / 3;
+        cy += mesh.positions[3 * size_t{mesh.indices[3 * f + k]} + 1] / 3;
+      }
+      const float* p = &mesh.positions[3 * size_t{mesh.indices[c]}];
+      if (face_selected(cx, cy) && vertex_selected(p[0], p[1])) {
+        uv[2 * c] += du;
+        uv[2 * c + 1] += dv;
+      }
+    }
+  };
+  // Horizontal cut: faces above y = 2 move their corners on y = 2 with x < 2 up by 30 px.
+  move_corners([](float, float cy) { return cy > 2; }, [](float x, float y) { return y == 2 && x < 2; }, 0, 30);
+  UvMetrics m = metrics_of(mesh, uv);
+  EXPECT_EQ(m.visible_dangling_ends, 1u);  // (2, 2); (0, 2) is on the border
+  EXPECT_EQ(m.visible_branch_points, 0u);
+  EXPECT_NEAR(m.visible_seam_ratio, m.seam_length_ratio, 1e-12);
+  EXPECT_EQ(m.visible_off_sharp_ratio, m.visible_seam_ratio);  // flat: no sharp edge
+
+  // Vertical cut below (1, 2): faces left of x = 1 (and below y = 2) move their corners on x = 1
+  // with y < 2 left by 30 px. (1, 2) now has three visible seam edges.
+  move_corners([](float cx, float cy) { return cx < 1 && cy < 2; }, [](float x, float y) { return x == 1 && y < 2; },
+               -30, 0);
+  m = metrics_of(mesh, uv);
+  EXPECT_EQ(m.visible_dangling_ends, 1u);
+  EXPECT_EQ(m.visible_branch_points, 1u);
+}
+
+// Visible seams on a sharp edge (a fold of 90 degrees) are not counted as off sharp edges.
+TEST(Metrics, VisibleSeamsOnSharpEdgesAreNotOffSharp) {
+  Mesh mesh;  // two triangles folded by 90 degrees along the edge (0,0,0)-(0,1,0)
+  mesh.positions = {0, 0, 0, 0, 1, 0, 1, 0, 0, 0, 0, 1};
+  mesh.indices = {0, 2, 1, 0, 1, 3};
+  const std::vector<float> uv = {0, 0, 100, 0, 0, 100, 40, 0, 40, 100, -60, 0};
+  MetricsOptions options;
+  UvMetrics m = metrics_of(mesh, uv, {}, options);
+  EXPECT_EQ(m.seam_edges, 1u);
+  EXPECT_GT(m.visible_seam_ratio, 0.0);
+  EXPECT_EQ(m.visible_off_sharp_ratio, 0.0);
+  options.sharp_angle_deg = 95;  // now the fold is not sharp
+  m = metrics_of(mesh, uv, {}, options);
+  EXPECT_EQ(m.visible_off_sharp_ratio, m.visible_seam_ratio);
+}
+
 TEST(Metrics, DerivesPatchesOfAMeshCutInTwo) {
   // 4x2 cells; the right half (x > 2, and x = 2 for faces of the right half) is shifted by 1000 px.
   const Mesh mesh = grid(4, 2, Diagonal::kFalling);

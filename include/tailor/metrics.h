@@ -22,6 +22,11 @@ namespace tailor {
 struct MetricsOptions {
   float texture_width_px = 512;   //!< texture period along u in pixels (> 0); the seam gap is measured modulo it
   float texture_height_px = 512;  //!< texture period along v in pixels (> 0)
+  uint32_t symmetry = 1;          //!< 1, or 4 for a tile that looks the same turned by 90 degrees (up to a
+                                  //!< shift; needs a square texture): a seam whose sides differ by a quarter
+                                  //!< turn and a whole number of repeats is then invisible too
+  float invisible_gap_px = 1.f;   //!< a seam edge whose lattice gap is below this is invisible (> 0)
+  float sharp_angle_deg = 30.f;   //!< an edge is sharp when its faces' normals differ by more than this
   uint32_t threads = 0;           //!< threads (0 = one per 100k faces, at most the cores and 8); the
                                   //!< figures are identical for any count
 };
@@ -42,9 +47,15 @@ struct UvMetrics {
                                      //!< excluded from l2/linf where their stretch is infinite)
   size_t seam_edges = 0;             //!< paired edges whose two faces disagree on the UV of a shared vertex
   double seam_length_ratio = 0;      //!< 3D length of seam edges / 3D length of all distinct edges
-  double seam_gap_px = 0;            //!< 3D-length-weighted mean over seam edges of the toroidal UV distance (px,
-                                     //!< modulo the texture size) between the two sides, averaged over both endpoints
-  double seam_invisible_ratio = 0;   //!< share of seam length whose gap is < 1 px (1 when there is no seam)
+  double seam_gap_px = 0;            //!< 3D-length-weighted mean over seam edges of their lattice gap (px; see
+                                     //!< seam_gap_px() below)
+  double seam_invisible_ratio = 0;   //!< share of seam length whose lattice gap is < invisible_gap_px: the
+                                     //!< texture continues across it (1 when there is no seam)
+  double visible_seam_ratio = 0;     //!< 3D length of visible seam edges / 3D length of all distinct edges
+  double visible_off_sharp_ratio = 0;  //!< the same for visible seam edges that are not sharp (dihedral angle
+                                     //!< <= sharp_angle_deg): visible seams the geometry does not hide
+  size_t visible_dangling_ends = 0;  //!< interior vertices with exactly 1 visible seam edge (a cut that stops)
+  size_t visible_branch_points = 0;  //!< interior vertices with 3 or more visible seam edges
   double uv_scale = 0;               //!< R: sum of UV areas / sum of 3D areas (px^2 per unit^2)
   double seconds = 0;                //!< wall time of compute_uv_metrics
 };
@@ -61,6 +72,21 @@ struct UvMetrics {
 TAILOR_API Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<const float> corner_uv,
                                      std::span<const uint32_t> patch, const MetricsOptions& options,
                                      UvMetrics& metrics);
+
+//! Lattice gap of a seam edge, in pixels: with the edge's ends a and b seen from its two faces f
+//! and g (uv_fa, uv_fb, uv_ga, uv_gb: 2 floats each, pixels), d_a = uv_f(a) - uv_g(a) and
+//! d_b = uv_f(b) - uv_g(b); k = the texture period (width, height) times round((d_a + d_b) / 2 /
+//! period) per component; gap = max(|d_a - k|, |d_b - k|). Under a texture repeating with that period
+//! the texture continues across the edge when the gap is below a pixel. With options.symmetry 4 the
+//! smallest gap over g's UVs turned by 0, 90, 180 and 270 degrees. O(1).
+double seam_gap_px(const float* uv_fa, const float* uv_fb, const float* uv_ga, const float* uv_gb,
+                   const MetricsOptions& options);
+
+//! Seam class of every edge e (#F*3, both sides of a pair alike): 0 no seam (boundary, or the two
+//! sides have identical UVs), 1 invisible seam (lattice gap < options.invisible_gap_px), 2 visible.
+//! For the seam views. Preconditions as compute_uv_metrics. Cost O(F).
+void classify_seam_edges(const Mesh& mesh, const Topology& topology, std::span<const float> corner_uv,
+                         const MetricsOptions& options, std::vector<uint8_t>& seam_class);
 
 //! Patches = connected components of faces joined across paired edges whose two sides have
 //! bit-identical UVs at both endpoints. Fills patch (#F ids, numbered in order of lowest face) and

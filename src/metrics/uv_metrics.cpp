@@ -126,11 +126,25 @@ double sander_stretch(const Face& face, double& gamma_max) {
   return 0.5 * (a + c);
 }
 
-// Distance between two UV points on the torus of the texture period.
-double toroidal_distance(double du, double dv, double width, double height) {
-  du -= width * std::round(du / width);
-  dv -= height * std::round(dv / height);
-  return std::sqrt(du * du + dv * dv);
+// Lattice gap for one rotation of g's side: `rot` quarter turns counter-clockwise (pixels).
+double lattice_gap(const float* fa, const float* fb, const float* ga, const float* gb, int rot, double w, double h) {
+  const auto turned = [rot](const float* uv, double& u, double& v) {
+    const double x = uv[0], y = uv[1];
+    switch (rot) {
+      case 0: u = x, v = y; break;
+      case 1: u = -y, v = x; break;
+      case 2: u = -x, v = -y; break;
+      default: u = y, v = -x; break;
+    }
+  };
+  double gau, gav, gbu, gbv;
+  turned(ga, gau, gav);
+  turned(gb, gbu, gbv);
+  const double dau = fa[0] - gau, dav = fa[1] - gav, dbu = fb[0] - gbu, dbv = fb[1] - gbv;
+  const double ku = w * std::round(0.5 * (dau + dbu) / w), kv = h * std::round(0.5 * (dav + dbv) / h);
+  const double ga2 = (dau - ku) * (dau - ku) + (dav - kv) * (dav - kv);
+  const double gb2 = (dbu - ku) * (dbu - ku) + (dbv - kv) * (dbv - kv);
+  return std::sqrt(std::max(ga2, gb2));
 }
 
 // Union-find with path halving; the root of a set is its lowest face (union links the larger root
@@ -195,6 +209,30 @@ uint32_t derive_patches(const Mesh& mesh, const Topology& topology, std::span<co
   return count;
 }
 
+double seam_gap_px(const float* uv_fa, const float* uv_fb, const float* uv_ga, const float* uv_gb,
+                   const MetricsOptions& options) {
+  const double w = options.texture_width_px, h = options.texture_height_px;
+  double gap = lattice_gap(uv_fa, uv_fb, uv_ga, uv_gb, 0, w, h);
+  if (options.symmetry == 4)
+    for (int rot = 1; rot < 4; ++rot) gap = std::min(gap, lattice_gap(uv_fa, uv_fb, uv_ga, uv_gb, rot, w, h));
+  return gap;
+}
+
+void classify_seam_edges(const Mesh& mesh, const Topology& topology, std::span<const float> corner_uv,
+                         const MetricsOptions& options, std::vector<uint8_t>& seam_class) {
+  const size_t edges = 3 * mesh.face_count();
+  seam_class.assign(edges, 0);
+  const float* uv = corner_uv.data();
+  for (size_t e = 0; e < edges; ++e) {
+    const uint32_t o = topology.opposite[e];
+    if (o == kInvalid || o < e) continue;
+    const EdgeSides s = edge_sides(e, o);
+    if (same_uv(corner_uv, s.fa, s.ga) && same_uv(corner_uv, s.fb, s.gb)) continue;
+    const double gap = seam_gap_px(uv + 2 * s.fa, uv + 2 * s.fb, uv + 2 * s.ga, uv + 2 * s.gb, options);
+    seam_class[e] = seam_class[o] = gap < options.invisible_gap_px ? 1 : 2;
+  }
+}
+
 void face_area_stretch(const Mesh& mesh, std::span<const float> corner_uv, std::vector<float>& ratio) {
   const size_t nf = mesh.face_count();
   ratio.assign(nf, 1.0f);
@@ -233,6 +271,12 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
   if (!(options.texture_width_px > 0) || !(options.texture_height_px > 0) ||
       !std::isfinite(options.texture_width_px) || !std::isfinite(options.texture_height_px))
     return Status::error(ErrorCode::kInvalidArgument, "", "texture size must be positive");
+  if (options.symmetry != 1 && options.symmetry != 4)
+    return Status::error(ErrorCode::kInvalidArgument, "", "symmetry must be 1 or 4");
+  if (options.symmetry == 4 && options.texture_width_px != options.texture_height_px)
+    return Status::error(ErrorCode::kInvalidArgument, "", "symmetry 4 needs a square texture");
+  if (!(options.invisible_gap_px > 0) || !(options.sharp_angle_deg >= 0) || !(options.sharp_angle_deg <= 180))
+    return Status::error(ErrorCode::kInvalidArgument, "", "invisible gap or sharp angle out of range");
   for (size_t i = 0; i < corner_uv.size(); ++i)
     if (!std::isfinite(corner_uv[i]))
       return Status::error(ErrorCode::kInvalidMesh, "", "UV is not finite", "corner " + std::to_string(i / 2));
@@ -368,12 +412,16 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
     metrics.linf_stretch = gamma_max * std::sqrt(scale);
   }
 
-  // Seams: over distinct edges (a paired edge once, a boundary edge once).
+  // Seams: over distinct edges (a paired edge once, a boundary edge once). Visible seam edges are
+  // marked on their lower edge id for the vertex pass below.
   struct SeamSums {
     double total_length = 0, seam_length = 0, gap_weighted = 0, gap_plain = 0, invisible_length = 0;
+    double visible_length = 0, visible_off_sharp = 0;
     size_t seam_edges = 0, invisible_count = 0;
   };
   const size_t corners = 3 * nf;
+  const double sharp_cos = std::cos(options.sharp_angle_deg * (std::numbers::pi / 180.0));
+  std::vector<uint8_t> visible(corners, 0);
   std::vector<SeamSums> seam_sums(internal::chunk_count(corners));
   internal::for_each_chunk(corners, threads, [&](size_t begin, size_t end, size_t chunk) {
     SeamSums sums;
@@ -389,22 +437,28 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
       if (same_uv(corner_uv, s.fa, s.ga) && same_uv(corner_uv, s.fb, s.gb)) continue;
       ++sums.seam_edges;
       sums.seam_length += length;
-      const double w = options.texture_width_px, h = options.texture_height_px;
-      const double gap_a = toroidal_distance(double{corner_uv[2 * s.fa]} - corner_uv[2 * s.ga],
-                                             double{corner_uv[2 * s.fa + 1]} - corner_uv[2 * s.ga + 1], w, h);
-      const double gap_b = toroidal_distance(double{corner_uv[2 * s.fb]} - corner_uv[2 * s.gb],
-                                             double{corner_uv[2 * s.fb + 1]} - corner_uv[2 * s.gb + 1], w, h);
-      const double gap = 0.5 * (gap_a + gap_b);
+      const float* uv = corner_uv.data();
+      const double gap = seam_gap_px(uv + 2 * s.fa, uv + 2 * s.fb, uv + 2 * s.ga, uv + 2 * s.gb, options);
       sums.gap_weighted += length * gap;
       sums.gap_plain += gap;
-      if (gap < 1.0) {
+      if (gap < options.invisible_gap_px) {
         sums.invisible_length += length;
         ++sums.invisible_count;
+        continue;
       }
+      visible[e] = 1;
+      sums.visible_length += length;
+      const Face face_f = load_face(mesh, corner_uv, f), face_g = load_face(mesh, corner_uv, o / 3);
+      const Vec3 nf3 = cross(sub(face_f.p[1], face_f.p[0]), sub(face_f.p[2], face_f.p[0]));
+      const Vec3 ng3 = cross(sub(face_g.p[1], face_g.p[0]), sub(face_g.p[2], face_g.p[0]));
+      const double nn = norm(nf3) * norm(ng3);
+      const bool sharp = nn > 0 && dot(nf3, ng3) < sharp_cos * nn;
+      if (!sharp) sums.visible_off_sharp += length;
     }
     seam_sums[chunk] = sums;
   });
   double total_length = 0, seam_length = 0, gap_weighted = 0, gap_plain = 0, invisible_length = 0;
+  double visible_length = 0, visible_off_sharp = 0;
   size_t invisible_count = 0;
   for (const SeamSums& sums : seam_sums) {
     total_length += sums.total_length;
@@ -412,10 +466,16 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
     gap_weighted += sums.gap_weighted;
     gap_plain += sums.gap_plain;
     invisible_length += sums.invisible_length;
+    visible_length += sums.visible_length;
+    visible_off_sharp += sums.visible_off_sharp;
     invisible_count += sums.invisible_count;
     metrics.seam_edges += sums.seam_edges;
   }
-  if (total_length > 0) metrics.seam_length_ratio = seam_length / total_length;
+  if (total_length > 0) {
+    metrics.seam_length_ratio = seam_length / total_length;
+    metrics.visible_seam_ratio = visible_length / total_length;
+    metrics.visible_off_sharp_ratio = visible_off_sharp / total_length;
+  }
   if (metrics.seam_edges == 0) {
     metrics.seam_invisible_ratio = 1.0;
   } else if (seam_length > 0) {
@@ -425,6 +485,25 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
     const double n = static_cast<double>(metrics.seam_edges);
     metrics.seam_gap_px = gap_plain / n;
     metrics.seam_invisible_ratio = static_cast<double>(invisible_count) / n;
+  }
+
+  // Ends and branches of the visible seams: visible edges per vertex, at interior vertices (no
+  // boundary edge around them). Sequential: two byte-sized counters per vertex.
+  const size_t nv = mesh.vertex_count();
+  std::vector<uint8_t> visible_at(nv, 0), on_boundary(nv, 0);
+  for (size_t e = 0; e < corners; ++e) {
+    const uint32_t a = mesh.indices[e], b = mesh.indices[3 * (e / 3) + (e % 3 + 1) % 3];
+    if (topology.opposite[e] == kInvalid) {
+      on_boundary[a] = on_boundary[b] = 1;
+    } else if (visible[e]) {
+      visible_at[a] = static_cast<uint8_t>(std::min(visible_at[a] + 1, 255));
+      visible_at[b] = static_cast<uint8_t>(std::min(visible_at[b] + 1, 255));
+    }
+  }
+  for (size_t v = 0; v < nv; ++v) {
+    if (on_boundary[v]) continue;
+    if (visible_at[v] == 1) ++metrics.visible_dangling_ends;
+    if (visible_at[v] >= 3) ++metrics.visible_branch_points;
   }
   metrics.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return Status::ok();

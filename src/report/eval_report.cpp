@@ -33,6 +33,10 @@ std::string eval_report_json(const EvalRun& run) {
   j["seam_length_ratio"] = m.seam_length_ratio;
   j["seam_gap_px"] = m.seam_gap_px;
   j["seam_invisible_ratio"] = m.seam_invisible_ratio;
+  j["visible_seam_ratio"] = m.visible_seam_ratio;
+  j["visible_off_sharp_ratio"] = m.visible_off_sharp_ratio;
+  j["visible_dangling_ends"] = m.visible_dangling_ends;
+  j["visible_branch_points"] = m.visible_branch_points;
   j["uv_scale_px2_per_unit2"] = m.uv_scale;
   j["boundary_edges"] = run.boundary_edges;
   j["nonmanifold_edges"] = run.nonmanifold_edges;
@@ -45,10 +49,13 @@ std::string eval_summary(const EvalRun& run) {
   return format_text(
       "%s: %zu faces, %u patches (%zu single-face), seams %.2f%% of edge length (%zu edges), %zu flipped, "
       "stretch %.4f (area-weighted %.4f), L2 %.4f, Linf %.4f, distortion %.2f deg (median), "
-      "seam gap %.2f px, %.1f%% invisible (texture %dx%d px, %s)\n",
+      "seam gap %.2f px, %.1f%% invisible, visible seams %.2f%% of edge length (%.2f%% off sharp edges, "
+      "%zu dangling ends, %zu branch points) (texture %dx%d px, %s)\n",
       run.file.c_str(), m.faces, m.patches, m.single_face_patches, 100.0 * m.seam_length_ratio, m.seam_edges,
       m.flipped, m.stretch, m.stretch_area_weighted, m.l2_stretch, m.linf_stretch, m.distortion_deg, m.seam_gap_px,
-      100.0 * m.seam_invisible_ratio, run.texture_width, run.texture_height, run.texture_size_from.c_str());
+      100.0 * m.seam_invisible_ratio, 100.0 * m.visible_seam_ratio, 100.0 * m.visible_off_sharp_ratio,
+      m.visible_dangling_ends, m.visible_branch_points, run.texture_width, run.texture_height,
+      run.texture_size_from.c_str());
 }
 
 std::string stability_report_json(const std::string& file, const StabilityReport& r) {

@@ -59,7 +59,10 @@ std::string map_report_json(const MapRun& run) {
                   {"linf_stretch", metrics.linf_stretch}, {"flipped", metrics.flipped},
                   {"seam_edges", metrics.seam_edges}, {"seam_length_ratio", metrics.seam_length_ratio},
                   {"seam_gap_px", metrics.seam_gap_px}, {"seam_invisible_ratio", metrics.seam_invisible_ratio},
-                  {"uv_scale", metrics.uv_scale}};
+                  {"visible_seam_ratio", metrics.visible_seam_ratio},
+                  {"visible_off_sharp_ratio", metrics.visible_off_sharp_ratio},
+                  {"visible_dangling_ends", metrics.visible_dangling_ends},
+                  {"visible_branch_points", metrics.visible_branch_points}, {"uv_scale", metrics.uv_scale}};
   if (run.stability) {
     const StabilityReport& s = *run.stability;
     j["stability"] = {{"removed_faces", s.removed_faces}, {"compared_corners", s.compared_corners},
@@ -81,10 +84,11 @@ std::string map_summary(const MapRun& run) {
       run.axis_auto ? "axis choice " + std::to_string(static_cast<long>(ms(run.axis_choice_seconds))) + ", " : "";
   std::string text = format_text(
       "%s: %zu faces, %u patches, seams %.2f%% of edge length, %zu flipped, stretch %.3f, L2 %.3f, "
-      "Linf %.2f, median angle %.2f deg, seam gap %.1f px (%.0f%% invisible) | load %.1f ms, topology %.1f, "
+      "Linf %.2f, median angle %.2f deg, visible seams %.2f%% (%.0f%% of seam length invisible, %zu dangling ends) | load %.1f ms, topology %.1f, "
       "%sorientation %.1f, mapping %.1f, export %.1f ms -> %s\n",
       run.input.c_str(), run.faces, m.patches, 100.0 * m.seam_length_ratio, m.flipped, m.stretch, m.l2_stretch,
-      m.linf_stretch, m.distortion_deg, m.seam_gap_px, 100.0 * m.seam_invisible_ratio, ms(run.load.load_seconds),
+      m.linf_stretch, m.distortion_deg, 100.0 * m.visible_seam_ratio, 100.0 * m.seam_invisible_ratio,
+      m.visible_dangling_ends, ms(run.load.load_seconds),
       ms(run.topology_seconds), axis_choice.c_str(), ms(run.orientation_seconds), ms(run.mapping.seconds),
       ms(run.export_seconds), run.output.c_str());
   if (run.stability) {
