@@ -1,14 +1,18 @@
 #!/usr/bin/env bash
 # End-to-end test of `tailor view` and `tailor render`, run by ctest from the repo root as
 #   bash tests/viewer_test.sh <tailor-binary>
-# 0. unit-tests the viewer's mesh analysis (web/mesh_data.js) in node;
+# 0. unit-tests the viewer's mesh analysis (web/mesh_data.js) in node, with the seam figures of a
+#    mapped horse against `tailor eval --json`;
 # 1. makes a .glb with `tailor map` from the bundled example;
 # 2. `tailor render`: every view writes a PNG, bad input gives one error line and exit 1;
 # 3. `tailor view`: serves on 127.0.0.1, answers GET, refuses path traversal and POST;
 # 4. a real browser (headless Chromium + playwright-core) opens the viewer, waits for the first
-#    frame, checks for console errors, a non-blank canvas and that the views change the picture;
-# 5. the same with tile variants from `tailor tile --variants 3`;
-# 6. Ctrl-C (SIGINT) stops the server with exit status 0.
+#    frame, checks for console errors, a non-blank canvas, that the views change the picture, red
+#    seam lines in the seams view and the viewer's seam figures against `tailor eval --json`;
+# 5. a stalled client holds up neither other requests nor Ctrl-C;
+# 6. Ctrl-C (SIGINT) stops the server with exit status 0;
+# 7. the browser test with tile variants from `tailor tile --variants 3`;
+# 8. the seams view of a mapped horse (128 px texture): red and green seam lines, eval's figures.
 # Never skips: a missing Chromium or node_modules is a failure.
 set -euo pipefail
 
@@ -25,7 +29,7 @@ for pkg in three playwright-core; do
   [ -d "web/node_modules/$pkg" ] || fail "web/node_modules/$pkg is missing (run 'npm install' in web/)"
 done
 
-timeout 60 node web/test/mesh_data_test.mjs || fail "web/mesh_data.js unit test failed"
+timeout 60 node web/test/mesh_data_test.mjs "$tailor" || fail "web/mesh_data.js unit test failed"
 
 tmp="$(mktemp -d)"
 server_pid=""
@@ -96,15 +100,16 @@ size="$(curl -s --max-time 10 "${url}files/model.glb" | wc -c)"
 [ "$(status_of -X POST "${url}")" = 405 ] || fail "POST is not refused"
 
 # --- 4. the browser ---------------------------------------------------------------------------------
-timeout 120 node web/test/viewer_browser_test.mjs "$url" || fail "browser test failed"
+timeout 60 "$tailor" eval "$tmp/spot.glb" --json -q >"$tmp/spot_eval.json" || fail "tailor eval of the test .glb failed"
+timeout 120 node web/test/viewer_browser_test.mjs "$url" --eval "$tmp/spot_eval.json" || fail "browser test failed"
 
-# --- 6. a client that never finishes its request holds up neither others nor Ctrl-C -----------------
+# --- 5. a client that never finishes its request holds up neither others nor Ctrl-C -----------------
 port="${url#http://127.0.0.1:}"; port="${port%/}"
 exec 3<>"/dev/tcp/127.0.0.1/$port"
 printf 'GET / HTTP/1.1\r\nHost: x' >&3
 [ "$(curl -s -o /dev/null -w '%{http_code}' --max-time 2 "$url")" = 200 ] || fail "a stalled client blocked other requests"
 
-# --- 7. Ctrl-C stops the server cleanly and promptly, the stalled client still connected ---------------
+# --- 6. Ctrl-C stops the server cleanly and promptly, the stalled client still connected ---------------
 kill -INT "$server_pid"
 set +e
 timeout 3 tail --pid="$server_pid" -f /dev/null || fail "tailor view took more than 3 s to stop after SIGINT"
@@ -114,12 +119,21 @@ set -e
 server_pid=""
 [ "$rc" -eq 0 ] || fail "tailor view exited $rc after SIGINT, expected 0"
 
-# --- 8. tile variants (a small exemplar keeps `tailor tile` fast) ------------------------------------
+# --- 7. tile variants (a small exemplar keeps `tailor tile` fast) ------------------------------------
 timeout 60 "$tailor" tile tests/data/textures/vistex-tile04-128.png --variants 3 -o "$tmp/tile.png" -q \
   || fail "tailor tile --variants 3 failed"
 [ -s "$tmp/tile.json" ] || fail "tailor tile wrote no variants .json"
 start_server "$tmp/spot.glb" --texture "$tmp/tile.json"
 timeout 120 node web/test/viewer_browser_test.mjs "$url" --variants || fail "browser test with tile variants failed"
+stop_server
+
+# --- 8. the seams view on a mesh with invisible seams too (the horse: ~3% of its seam length) ------
+timeout 60 "$tailor" map tests/data/meshes/horse.ply --texture tests/data/textures/vistex-tile04-128.png -o "$tmp/horse.glb" -q \
+  || fail "tailor map could not make the horse .glb"
+timeout 60 "$tailor" eval "$tmp/horse.glb" --json -q >"$tmp/horse_eval.json" || fail "tailor eval of the horse .glb failed"
+start_server "$tmp/horse.glb"
+timeout 120 node web/test/viewer_browser_test.mjs "$url" --eval "$tmp/horse_eval.json" --expect-invisible \
+  || fail "browser test of the seams view (horse) failed"
 stop_server
 
 echo "PASS: tailor render and tailor view (browser) work"

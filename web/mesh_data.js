@@ -4,11 +4,17 @@
 //              mesh exactly when their UVs agree along it: the components are the UV patches
 //              (the definition of `derive_patches` in metrics.h).
 //   seams    - edges used by exactly one face of the split mesh: patch borders, cuts and mesh borders.
+//   seam classes - the edges of the mesh welded by position, classified as `tailor eval` does
+//              (seam_gap_px in include/tailor/metrics.h): no seam, invisible seam (the texture
+//              continues across it: the two sides differ by whole repeats, to within a pixel),
+//              visible seam, or border (one face, more than two, or two running it the same way);
+//              with the length sums behind eval's visible_seam_ratio and seam_invisible_ratio.
 //   stretch  - log2 of (UV area / 3D area) divided by the mesh-wide ratio sum(a) / sum(A), the
 //              per-face area stretch of `tailor eval` (0 = ideal, +1 = twice the texture area).
 // The result is an unindexed BufferGeometry (three corners per face, each with the face's
 // values), so the shader can colour faces flat and draw edges from barycentric coordinates.
-// Everything runs over typed arrays with flat hash tables: about a second per million faces.
+// Everything runs over typed arrays (edges grouped by a counting sort, vertices welded by a flat
+// hash): about half a second per million faces in node.
 import * as THREE from 'three';
 
 /** Union-find root with path halving over an Int32Array of parents. */
@@ -20,6 +26,70 @@ function findRoot(parent, x) {
   return x;
 }
 
+// Lists longer than this (a vertex with a huge fan of faces) are matched by sorting, not by pairs.
+const kLinearMatchLimit = 32;
+
+/**
+ * The uses of each undirected edge, linked in rings: ring[e] = the next directed edge (e = 3f + k,
+ * corner k -> k+1) with the same two vertices, ring[e] === e for an edge used once. Vertices are
+ * index values, or weld[index value] when weld is given (ids < vertexCount). The uses are grouped by
+ * their lower vertex (a counting sort, as build_topology in C++: sequential passes that keep a
+ * scan's vertex order in cache, where a hash of 3F keys scatters), then matched by higher vertex.
+ */
+export function edgeRings(index, weld, vertexCount) {
+  const edges = index.length;
+  const vertexOf = (e) => (weld ? weld[index[e]] : index[e]);
+  const offset = new Uint32Array(vertexCount + 1);
+  for (let e = 0; e < edges; ++e) {
+    const u = vertexOf(e);
+    const w = vertexOf(e % 3 === 2 ? e - 2 : e + 1);
+    offset[(u < w ? u : w) + 1] += 1;
+  }
+  for (let v = 0; v < vertexCount; ++v) offset[v + 1] += offset[v];
+  const listEdge = new Uint32Array(edges);
+  const listHigh = new Int32Array(edges);  // -1 once linked
+  {
+    const cursor = offset.slice(0, vertexCount);
+    for (let e = 0; e < edges; ++e) {
+      const u = vertexOf(e);
+      const w = vertexOf(e % 3 === 2 ? e - 2 : e + 1);
+      const at = cursor[u < w ? u : w]++;
+      listEdge[at] = e;
+      listHigh[at] = u < w ? w : u;
+    }
+  }
+  const ring = new Int32Array(edges);
+  for (let v = 0; v < vertexCount; ++v) {
+    const begin = offset[v];
+    const end = offset[v + 1];
+    if (end - begin > kLinearMatchLimit) {
+      const order = new Uint32Array(end - begin);
+      for (let k = 0; k < order.length; ++k) order[k] = begin + k;
+      order.sort((x, y) => listHigh[x] - listHigh[y] || x - y);
+      for (let k = 0; k < order.length;) {
+        let m = k + 1;
+        while (m < order.length && listHigh[order[m]] === listHigh[order[k]]) ++m;
+        for (let r = k; r < m; ++r) ring[listEdge[order[r]]] = listEdge[order[r + 1 < m ? r + 1 : k]];
+        k = m;
+      }
+      continue;
+    }
+    for (let i = begin; i < end; ++i) {
+      const high = listHigh[i];
+      if (high < 0) continue;
+      let last = i;
+      for (let j = i + 1; j < end; ++j) {
+        if (listHigh[j] !== high) continue;
+        listHigh[j] = -1;
+        ring[listEdge[last]] = listEdge[j];
+        last = j;
+      }
+      ring[listEdge[last]] = listEdge[i];
+    }
+  }
+  return ring;
+}
+
 /**
  * Edge pairing of the split mesh. For each directed edge e = 3f + k (corner k -> k+1): seam[e] = 1
  * when no other face uses the same two vertex indices (a patch or mesh border), and patch ids:
@@ -28,39 +98,23 @@ function findRoot(parent, x) {
 export function edgesAndPatches(index) {
   const edges = index.length;
   const faces = edges / 3;
-  let size = 16;
-  while (size < 2 * edges) size *= 2;
-  const mask = size - 1;
-  const keyA = new Uint32Array(size);
-  const keyB = new Uint32Array(size);
-  const firstFace = new Int32Array(size).fill(-1);
-  const uses = new Uint32Array(size);
-  const slotOf = new Uint32Array(edges);
+  let vertexCount = 0;
+  for (let e = 0; e < edges; ++e) if (index[e] >= vertexCount) vertexCount = index[e] + 1;
+  const ring = edgeRings(index, null, vertexCount);
   const parent = new Int32Array(faces);
   for (let f = 0; f < faces; ++f) parent[f] = f;
-  for (let e = 0; e < edges; ++e) {
-    const f = (e / 3) | 0;
-    const u = index[e];
-    const w = index[3 * f + ((e % 3) + 1) % 3];
-    const a = Math.min(u, w);
-    const b = Math.max(u, w);
-    let slot = (Math.imul(a, 0x9e3779b1) ^ Math.imul(b, 0x85ebca6b)) >>> 0;
-    slot = (slot ^ (slot >>> 15)) & mask;
-    while (firstFace[slot] >= 0 && (keyA[slot] !== a || keyB[slot] !== b)) slot = (slot + 1) & mask;
-    if (firstFace[slot] < 0) {
-      firstFace[slot] = f;
-      keyA[slot] = a;
-      keyB[slot] = b;
-    } else {
-      const r1 = findRoot(parent, firstFace[slot]);
-      const r2 = findRoot(parent, f);
-      if (r1 !== r2) parent[Math.max(r1, r2)] = Math.min(r1, r2);
-    }
-    uses[slot] += 1;
-    slotOf[e] = slot;
-  }
   const seam = new Uint8Array(edges);
-  for (let e = 0; e < edges; ++e) seam[e] = uses[slotOf[e]] === 1 ? 1 : 0;
+  for (let e = 0; e < edges; ++e) {
+    const o = ring[e];
+    if (o === e) {
+      seam[e] = 1;
+      continue;
+    }
+    if (o < e) continue;  // each link once (a ring of two is linked both ways)
+    const r1 = findRoot(parent, (e / 3) | 0);
+    const r2 = findRoot(parent, (o / 3) | 0);
+    if (r1 !== r2) parent[Math.max(r1, r2)] = Math.min(r1, r2);
+  }
   const label = new Int32Array(faces).fill(-1);
   const patch = new Uint32Array(faces);
   let count = 0;
@@ -70,6 +124,146 @@ export function edgesAndPatches(index) {
     patch[f] = label[root];
   }
   return { seam, patch, count };
+}
+
+/** Edge classes of seamClasses(): no seam, invisible seam, visible seam, border (unpaired edge). */
+export const kSeamNone = 0;
+export const kSeamInvisible = 1;
+export const kSeamVisible = 2;
+export const kSeamBorder = 3;
+
+/** Texture size `tailor eval` assumes when the file embeds no image. */
+export const kDefaultTextureSize = 512;
+
+/**
+ * Welds vertices by exact position (the bits of the three floats, as weld_identical_positions in
+ * C++: -0 and +0 differ): weld[v] = the first vertex with v's position. Flat hash, O(V).
+ */
+export function weldByPosition(position) {
+  const count = position.length / 3;
+  const bits = new Uint32Array(position.buffer, position.byteOffset, 3 * count);
+  let size = 16;
+  while (size < 2 * count) size *= 2;
+  const mask = size - 1;
+  const table = new Int32Array(size).fill(-1);
+  const weld = new Uint32Array(count);
+  for (let v = 0; v < count; ++v) {
+    const x = bits[3 * v], y = bits[3 * v + 1], z = bits[3 * v + 2];
+    let h = Math.imul(x, 0x9e3779b1) ^ Math.imul(y ^ (x >>> 16), 0x85ebca6b) ^ Math.imul(z ^ (y >>> 13), 0xc2b2ae35);
+    h ^= h >>> 15;
+    h = Math.imul(h, 0x2c1b3c6d);
+    let slot = (h ^ (h >>> 12)) & mask;
+    let id = -1;
+    for (let w = table[slot]; w >= 0; w = table[slot]) {
+      if (bits[3 * w] === x && bits[3 * w + 1] === y && bits[3 * w + 2] === z) {
+        id = w;
+        break;
+      }
+      slot = (slot + 1) & mask;
+    }
+    if (id < 0) {
+      table[slot] = v;
+      id = v;
+    }
+    weld[v] = id;
+  }
+  return weld;
+}
+
+/** std::round: halves away from zero (Math.round rounds -0.5 up), so u and -u give mirrored gaps. */
+function roundHalfAway(x) {
+  return x < 0 ? -Math.round(-x) : Math.round(x);
+}
+
+/**
+ * Seam classes of the mesh welded by position, as `tailor eval` computes them (uv_metrics.cpp).
+ * index: corners (3 per face) into the split mesh; position: 3 floats per vertex; uv: 2 floats per
+ * vertex in texture repeats, or null; width, height: the texture size in pixels.
+ * An undirected edge of the welded mesh used by exactly two faces running it in opposite directions
+ * is paired; every other use is a border. A paired edge is a seam when its faces disagree on the UV
+ * of an end; its lattice gap (pixels) is max over the ends a, b of |d - k|, with d = uv_f - uv_g
+ * and k = the whole repeats nearest to (d_a + d_b) / 2; below 1 px the seam is invisible.
+ * Returns { seamClass: Uint8Array(3F) per directed edge e = 3f + k (corner k -> k+1), both sides
+ * of a pair alike; totalLength: 3D length of the distinct edges (a pair once, each border use
+ * once); seamLength, invisibleLength, visibleLength; seamEdges, invisibleEdges: counts }.
+ * Typed arrays only: O(F).
+ */
+export function seamClasses(index, position, uv, width = kDefaultTextureSize, height = kDefaultTextureSize) {
+  const edges = index.length;
+  const weld = weldByPosition(position);
+  // UVs in pixels rounded to float, as eval's corner_uv (identical UVs stay identical).
+  let uvPx = null;
+  if (uv) {
+    uvPx = new Float32Array(uv.length);
+    for (let v = 0; v < uv.length; v += 2) {
+      uvPx[v] = uv[v] * width;
+      uvPx[v + 1] = uv[v + 1] * height;
+    }
+  }
+  // A pair candidate: e's undirected edge has exactly two uses (a ring of two).
+  const ring = edgeRings(index, weld, weld.length);
+
+  const seamClass = new Uint8Array(edges);
+  let totalLength = 0, seamLength = 0, invisibleLength = 0, visibleLength = 0;
+  let seamEdges = 0, invisibleEdges = 0;
+  for (let e = 0; e < edges; ++e) {
+    const next = ring[e];
+    let o = next !== e && ring[next] === e ? next : -1;
+    const eNext = e % 3 === 2 ? e - 2 : e + 1;
+    if (o >= 0) {
+      // Paired only when the two faces run the edge in opposite directions (consistent
+      // orientation); an edge whose ends weld into one vertex has no direction (never paired).
+      const oNext = o % 3 === 2 ? o - 2 : o + 1;
+      const start = weld[index[e]];
+      if (start !== weld[index[oNext]] || start === weld[index[eNext]]) o = -1;
+      else if (o < e) continue;  // the pair was handled at its lower edge
+    }
+    const pa = 3 * index[e], pb = 3 * index[eNext];
+    const dx = position[pb] - position[pa], dy = position[pb + 1] - position[pa + 1], dz = position[pb + 2] - position[pa + 2];
+    const length = Math.sqrt(dx * dx + dy * dy + dz * dz);
+    totalLength += length;
+    if (o < 0) {
+      seamClass[e] = kSeamBorder;
+      continue;
+    }
+    if (!uvPx) continue;
+    // e runs a -> b in face f, o runs b -> a in face g.
+    const fa = 2 * index[e], fb = 2 * index[eNext];
+    const ga = 2 * index[o % 3 === 2 ? o - 2 : o + 1], gb = 2 * index[o];
+    if (uvPx[fa] === uvPx[ga] && uvPx[fa + 1] === uvPx[ga + 1] && uvPx[fb] === uvPx[gb] && uvPx[fb + 1] === uvPx[gb + 1]) continue;
+    const dau = uvPx[fa] - uvPx[ga], dav = uvPx[fa + 1] - uvPx[ga + 1];
+    const dbu = uvPx[fb] - uvPx[gb], dbv = uvPx[fb + 1] - uvPx[gb + 1];
+    const ku = width * roundHalfAway((0.5 * (dau + dbu)) / width);
+    const kv = height * roundHalfAway((0.5 * (dav + dbv)) / height);
+    const gapA = (dau - ku) * (dau - ku) + (dav - kv) * (dav - kv);
+    const gapB = (dbu - ku) * (dbu - ku) + (dbv - kv) * (dbv - kv);
+    const gap = Math.sqrt(Math.max(gapA, gapB));
+    seamEdges += 1;
+    seamLength += length;
+    if (gap < 1) {
+      seamClass[e] = seamClass[o] = kSeamInvisible;
+      invisibleLength += length;
+      invisibleEdges += 1;
+    } else {
+      seamClass[e] = seamClass[o] = kSeamVisible;
+      visibleLength += length;
+    }
+  }
+  return { seamClass, totalLength, seamLength, invisibleLength, visibleLength, seamEdges, invisibleEdges };
+}
+
+/**
+ * eval's two seam figures from summed seamClasses() results: visibleSeamRatio = visible seam
+ * length / length of all edges; seamInvisibleRatio = invisible share of seam length (1 with no
+ * seam; the share of seam edges when every seam edge has zero length).
+ */
+export function seamRatios(s) {
+  const visibleSeamRatio = s.totalLength > 0 ? s.visibleLength / s.totalLength : 0;
+  let seamInvisibleRatio = 1;
+  if (s.seamEdges > 0) {
+    seamInvisibleRatio = s.seamLength > 0 ? s.invisibleLength / s.seamLength : s.invisibleEdges / s.seamEdges;
+  }
+  return { visibleSeamRatio, seamInvisibleRatio };
 }
 
 /** log2((a_f / A_f) / R) per face; 0 for faces with no 3D area, -16 for collapsed UV faces. */
@@ -133,9 +327,11 @@ function floatArray(attribute) {
 
 /**
  * Builds the viewer geometry from an (indexed or not) BufferGeometry with position, optional
- * normal and uv. Returns { geometry, faces, patches, seamEdges, hasUv }.
+ * normal and uv; textureWidth, textureHeight: the embedded texture's size in pixels (eval's default
+ * 512 without one), for the seam classes. Returns { geometry, faces, patches, seamEdges, hasUv,
+ * seams } with seams = seamClasses()'s sums (no per-edge array).
  */
-export function buildSurface(source) {
+export function buildSurface(source, { textureWidth = kDefaultTextureSize, textureHeight = kDefaultTextureSize } = {}) {
   const position = floatArray(source.getAttribute('position'));
   const vertexCount = source.getAttribute('position').count;
   let index = source.index ? source.index.array : null;
@@ -150,6 +346,7 @@ export function buildSurface(source) {
   const faces = index.length / 3;
   const { seam, patch, count } = edgesAndPatches(index);
   const stretch = faceStretch(index, position, uv);
+  const { seamClass, ...seams } = seamClasses(index, position, uv, textureWidth, textureHeight);
 
   const n = 3 * faces;
   const outPos = new Float32Array(3 * n);
@@ -157,6 +354,7 @@ export function buildSurface(source) {
   const outUv = new Float32Array(2 * n);
   const outBary = new Uint8Array(3 * n);
   const outSeam = new Uint8Array(3 * n);
+  const outSeamClass = new Uint8Array(3 * n);
   const outPatch = new Uint8Array(3 * n);
   const outStretch = new Float32Array(n);
   const palette = new Uint8Array(3 * count);
@@ -185,6 +383,8 @@ export function buildSurface(source) {
       outBary[3 * corner + k] = 255;
       // Component m of `seam` flags the edge opposite corner m, i.e. edge (m+1) -> (m+2).
       for (let m = 0; m < 3; ++m) outSeam[3 * corner + m] = seam[3 * f + ((m + 1) % 3)] * 255;
+      // The same layout for the seam classes of the welded mesh (0..3, not normalized).
+      for (let m = 0; m < 3; ++m) outSeamClass[3 * corner + m] = seamClass[3 * f + ((m + 1) % 3)];
       outPatch[3 * corner] = palette[color];
       outPatch[3 * corner + 1] = palette[color + 1];
       outPatch[3 * corner + 2] = palette[color + 2];
@@ -198,9 +398,10 @@ export function buildSurface(source) {
   geometry.setAttribute('uv', new THREE.BufferAttribute(outUv, 2));
   geometry.setAttribute('bary', new THREE.BufferAttribute(outBary, 3, true));
   geometry.setAttribute('seam', new THREE.BufferAttribute(outSeam, 3, true));
+  geometry.setAttribute('seamClass', new THREE.BufferAttribute(outSeamClass, 3));
   geometry.setAttribute('patchColor', new THREE.BufferAttribute(outPatch, 3, true));
   geometry.setAttribute('stretch', new THREE.BufferAttribute(outStretch, 1));
   geometry.computeBoundingSphere();
   geometry.computeBoundingBox();
-  return { geometry, faces, patches: count, seamEdges: seamCount, hasUv: !!uv };
+  return { geometry, faces, patches: count, seamEdges: seamCount, hasUv: !!uv, seams };
 }

@@ -1,4 +1,4 @@
-// The viewer's one shader: texture / patches / distortion / checker views, texture scale and
+// The viewer's one shader: texture / patches / distortion / checker / seams views, texture scale and
 // rotation, wireframe and seam lines from barycentric coordinates (no extra geometry), and tile
 // variants: when K variants of a self-tileable texture exist (`tailor tile --variants K`, all with
 // identical borders), every tile cell of the UV plane picks one variant from a seeded random grid,
@@ -9,7 +9,12 @@
 import * as THREE from 'three';
 
 export const kMaxVariants = 8;
-export const kViews = ['texture', 'patches', 'distortion', 'checker'];
+export const kViews = ['texture', 'patches', 'distortion', 'checker', 'seams'];
+
+// Line colours of the seams view (display values, unlit): visible seams, invisible seams (the
+// texture continues across them), mesh borders.
+export const kSeamColors = { visible: [0.86, 0.08, 0.08], invisible: [0.05, 0.62, 0.16], border: [0.35, 0.35, 0.38] };
+const glslColor = (c) => `vec3(${c.map((x) => x.toFixed(3)).join(', ')})`;
 
 // What the vertex shader hands to the fragment shader (both must declare the same).
 const varyings = /* glsl */ `
@@ -17,6 +22,7 @@ varying vec3 vNormal;
 varying vec2 vUv;
 varying vec3 vBary;
 varying vec3 vSeam;
+varying vec3 vSeamClass;
 varying vec3 vPatch;
 varying float vStretch;
 `;
@@ -24,6 +30,7 @@ varying float vStretch;
 const vertexShader = /* glsl */ `
 attribute vec3 bary;
 attribute vec3 seam;
+attribute vec3 seamClass;
 attribute vec3 patchColor;
 attribute float stretch;
 ${varyings}
@@ -32,6 +39,7 @@ void main() {
   vUv = uv;
   vBary = bary;
   vSeam = seam;
+  vSeamClass = seamClass;
   vPatch = patchColor;
   vStretch = stretch;
   gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0);
@@ -104,6 +112,11 @@ float edgeLine(vec3 flags, float width) {
   return 1.0 - min(min(e.x, e.y), e.z);
 }
 
+// Flags (per opposite corner) of the edges of seam class c (mesh_data.js: 1 invisible, 2 visible, 3 border).
+vec3 seamFlags(float c) {
+  return vec3(equal(floor(vSeamClass + 0.5), vec3(c)));
+}
+
 void main() {
   vec3 n = normalize(vNormal);
   if (!gl_FrontFacing) n = -n;
@@ -121,12 +134,20 @@ void main() {
     base = vPatch;
   } else if (mode == 2) {
     base = coolWarm(vStretch / distortionRange);
-  } else {
+  } else if (mode == 3) {
     base = mix(vec3(35.0, 35.0, 40.0) / 255.0, vec3(240.0 / 255.0), checker(uv * checkerSquares));
+  } else {
+    base = vec3(0.84);  // seams: a light neutral surface under the coloured lines
   }
   vec3 color = min(base * light, vec3(1.0));
   if (wireframe) color = mix(color, vec3(0.08), 0.75 * edgeLine(vec3(1.0), 1.5));
   if (mode == 1 && showSeams) color = mix(color, vec3(0.08, 0.08, 0.11), edgeLine(vSeam, 2.0));
+  if (mode == 4) {
+    // Each side of an edge draws its half, so a seam line is about twice this width on screen.
+    color = mix(color, ${glslColor(kSeamColors.border)}, edgeLine(seamFlags(3.0), 1.2));
+    color = mix(color, ${glslColor(kSeamColors.invisible)}, edgeLine(seamFlags(1.0), 2.0));
+    color = mix(color, ${glslColor(kSeamColors.visible)}, edgeLine(seamFlags(2.0), 2.0));
+  }
   gl_FragColor = vec4(color, 1.0);
 }
 `;

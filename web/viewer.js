@@ -1,12 +1,13 @@
 // tailor's web viewer: loads the .glb served by `tailor view` (see /config.json), shows it with
-// orbit controls and a panel (view, texture scale and rotation, wireframe, tile variants).
+// orbit controls and a panel (view, texture scale and rotation, wireframe, tile variants). The
+// seams view draws the seams `tailor eval` calls visible in red, the invisible ones in green.
 // Frames are drawn only when something changed, so a 1 M face mesh costs nothing while idle.
 // A small test hook (window.tailorViewer) lets the browser test switch views and read pixels.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
-import { buildSurface } from './mesh_data.js';
-import { createSurfaceMaterial, updateSurfaceMaterial, kMaxVariants, kViews } from './surface_material.js';
+import { buildSurface, seamRatios, kDefaultTextureSize } from './mesh_data.js';
+import { createSurfaceMaterial, updateSurfaceMaterial, kMaxVariants, kViews, kSeamColors } from './surface_material.js';
 
 const state = {
   view: 'texture',
@@ -20,7 +21,12 @@ const state = {
   distortionRange: 2,
 };
 const textures = { map: null, variants: [], blank: null };
-const stats = { faces: 0, patches: 0, seamEdges: 0, loadSeconds: 0, analysisSeconds: 0 };
+const stats = {
+  faces: 0, patches: 0, seamEdges: 0, loadSeconds: 0, analysisSeconds: 0,
+  // Seam lengths of the welded mesh (mesh_data.js seamClasses) and eval's ratios from them.
+  seams: { totalLength: 0, seamLength: 0, invisibleLength: 0, visibleLength: 0, seamEdges: 0, invisibleEdges: 0 },
+  visibleSeamRatio: 0, seamInvisibleRatio: 1,
+};
 let frames = 0;
 let dirty = true;
 let ready = false;
@@ -82,6 +88,7 @@ function loadTexture(url) {
 function applyState() {
   updateSurfaceMaterial(material, state, textures);
   document.getElementById('legend').style.display = state.view === 'distortion' ? 'block' : 'none';
+  document.getElementById('seam-legend').style.display = state.view === 'seams' ? 'block' : 'none';
   dirty = true;
 }
 
@@ -119,8 +126,13 @@ async function load() {
   let hasUv = false;
   for (const mesh of meshes) {
     if (!textures.map && mesh.material && mesh.material.map) textures.map = prepareTexture(mesh.material.map);
+    // UVs are in repeats of the embedded texture: its size turns them into pixels for the seam
+    // gaps, as `tailor eval` does (512 without one).
+    const image = (mesh.material && mesh.material.map ? mesh.material.map : textures.map)?.image;
+    const textureWidth = image && image.width > 0 ? image.width : kDefaultTextureSize;
+    const textureHeight = image && image.height > 0 ? image.height : kDefaultTextureSize;
     const analysisStart = performance.now();
-    const surface = buildSurface(mesh.geometry);
+    const surface = buildSurface(mesh.geometry, { textureWidth, textureHeight });
     stats.analysisSeconds += (performance.now() - analysisStart) / 1000;
     mesh.geometry.dispose();
     mesh.geometry = surface.geometry;
@@ -128,6 +140,7 @@ async function load() {
     stats.faces += surface.faces;
     stats.patches += surface.patches;
     stats.seamEdges += surface.seamEdges;
+    for (const key of Object.keys(stats.seams)) stats.seams[key] += surface.seams[key];
     hasUv = hasUv || surface.hasUv;
   }
   // UVs are texture pixels / the embedded texture's size: a replacement texture of another size
@@ -152,13 +165,21 @@ async function load() {
   scene.add(gltf.scene);
   frameCamera(gltf.scene);
   stats.loadSeconds = (performance.now() - start) / 1000;
+  Object.assign(stats, seamRatios(stats.seams));
+  const percent = (x) => `${(100 * x).toFixed(2)}%`;
   document.getElementById('info').textContent =
     `${stats.faces.toLocaleString('en')} faces, ${stats.patches.toLocaleString('en')} patches, ` +
+    (hasUv ? `visible seams ${percent(stats.visibleSeamRatio)} of edge length, ` +
+      `${percent(stats.seamInvisibleRatio)} of seam length invisible; ` : '') +
     `loaded in ${stats.loadSeconds.toFixed(2)} s (patches, seams, stretch: ${stats.analysisSeconds.toFixed(2)} s)`;
   applyState();
 }
 
 function bindPanel() {
+  for (const swatch of document.querySelectorAll('#seam-legend .swatch')) {
+    const c = kSeamColors[swatch.dataset.seam];
+    swatch.style.background = `rgb(${c.map((x) => Math.round(255 * x)).join(',')})`;
+  }
   for (const input of document.querySelectorAll('input[name=view]')) {
     input.addEventListener('change', () => setView(input.value));
   }
@@ -216,8 +237,9 @@ function animate() {
 }
 
 /**
- * Renders now and returns the luminance mean and variance of the canvas plus a 100x75 RGB
- * thumbnail (box means, 22500 values) to compare pictures.
+ * Renders now and returns the luminance mean and variance of the canvas, a 100x75 RGB thumbnail
+ * (box means, 22500 values) to compare pictures, and the number of pixels close to the seams
+ * view's red and green line colours (seamPixels.visible, seamPixels.invisible).
  */
 function pixelStats() {
   renderer.render(scene, camera);
@@ -232,6 +254,8 @@ function pixelStats() {
   const counts = new Float64Array(tw * th);
   let sum = 0;
   let sum2 = 0;
+  const near = (i, c) => Math.abs(px[i] - 255 * c[0]) < 40 && Math.abs(px[i + 1] - 255 * c[1]) < 40 && Math.abs(px[i + 2] - 255 * c[2]) < 40;
+  const seamPixels = { visible: 0, invisible: 0 };
   for (let y = 0; y < h; ++y) {
     const ty = Math.min(th - 1, Math.floor((th * y) / h));
     for (let x = 0; x < w; ++x) {
@@ -239,6 +263,8 @@ function pixelStats() {
       const l = 0.299 * px[i] + 0.587 * px[i + 1] + 0.114 * px[i + 2];
       sum += l;
       sum2 += l * l;
+      if (near(i, kSeamColors.visible)) seamPixels.visible += 1;
+      else if (near(i, kSeamColors.invisible)) seamPixels.invisible += 1;
       const cell = ty * tw + Math.min(tw - 1, Math.floor((tw * x) / w));
       for (let c = 0; c < 3; ++c) thumb[3 * cell + c] += px[i + c];
       counts[cell] += 1;
@@ -247,13 +273,13 @@ function pixelStats() {
   const n = w * h;
   const mean = sum / n;
   const grid = Array.from(thumb, (v, k) => v / counts[Math.floor(k / 3)]);
-  return { width: w, height: h, mean, variance: sum2 / n - mean * mean, grid };
+  return { width: w, height: h, mean, variance: sum2 / n - mean * mean, grid, seamPixels };
 }
 
 window.tailorViewer = {
   get ready() { return ready; },
   get frames() { return frames; },
-  get stats() { return { ...stats }; },
+  get stats() { return { ...stats, seams: { ...stats.seams } }; },
   get state() { return { ...state }; },
   setView,
   pixelStats,

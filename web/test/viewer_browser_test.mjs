@@ -3,8 +3,13 @@
 //   - no console errors and no uncaught page errors;
 //   - the canvas is not blank (luminance variance);
 //   - the patches, distortion and checker views change the picture (clicked in the panel);
-//   - with --variants: the variant controls are shown and toggling them changes the picture.
-// Usage: node web/test/viewer_browser_test.mjs URL [--variants] [--screenshots DIR]
+//   - with --variants: the variant controls are shown and toggling them changes the picture;
+//   - the seams view (key 5, the radio button, the test hook): red lines for visible seams (and
+//     with --expect-invisible green ones for invisible seams) and the seam legend;
+//   - with --eval FILE (the output of `tailor eval MODEL --json`): the viewer's visible seam share
+//     of edge length and invisible share of seam length agree with eval's figures.
+// Usage: node web/test/viewer_browser_test.mjs URL [--variants] [--expect-invisible] [--eval FILE]
+//        [--screenshots DIR]
 // Exits 0 on success, 1 with a FAIL line otherwise.
 import { chromium } from 'playwright-core';
 import fs from 'node:fs';
@@ -13,6 +18,9 @@ import path from 'node:path';
 
 const url = process.argv[2];
 const expectVariants = process.argv.includes('--variants');
+const expectInvisible = process.argv.includes('--expect-invisible');
+const evalIndex = process.argv.indexOf('--eval');
+const evaluation = evalIndex > 0 ? JSON.parse(fs.readFileSync(process.argv[evalIndex + 1], 'utf8')) : null;
 // --screenshots DIR: also save a PNG of each view there (for looking at, not for judging).
 const shotIndex = process.argv.indexOf('--screenshots');
 const shotDir = shotIndex > 0 ? process.argv[shotIndex + 1] : null;
@@ -31,6 +39,11 @@ const kArgs = [
 const kFrameTimeoutMs = 60000;
 const kMinVariance = 50;   // luminance variance of a textured mesh on a plain background is in the hundreds
 const kMinChange = 8;      // mean absolute difference (0..255) of the 100x75 RGB thumbnails, over the model
+// Pixels of a seam line colour the seams view must show beyond the texture view's: red lines are
+// thousands of pixels on the test models, green ones (short invisible seams) a few dozen on the horse.
+const kMinVisibleSeamPixels = 100;
+const kMinInvisibleSeamPixels = 10;
+const kRatioTolerance = 1e-6;  // viewer's seam figures against eval's (the same definition, in doubles)
 
 function fail(message) {
   console.log(`FAIL: ${message}`);
@@ -100,6 +113,50 @@ try {
   const wire = await page.evaluate(() => window.tailorViewer.pixelStats());
   if (!(signatureDistance(texture, wire) > 1)) fail('the wireframe toggle did not change the picture');
   await page.click('#wireframe');
+
+  // The seams view: key 5, then the radio button and the hook agree.
+  await page.keyboard.press('5');
+  const seamsState = await page.evaluate(() => ({
+    view: window.tailorViewer.state.view,
+    radio: document.querySelector('input[name=view][value=seams]').checked,
+    legend: getComputedStyle(document.getElementById('seam-legend')).display !== 'none',
+  }));
+  if (seamsState.view !== 'seams' || !seamsState.radio) fail(`key 5 did not switch to the seams view (${JSON.stringify(seamsState)})`);
+  if (!seamsState.legend) fail('the seam legend is not shown in the seams view');
+  const seams = await page.evaluate(() => window.tailorViewer.pixelStats());
+  if (shotDir) await page.screenshot({ path: path.join(shotDir, 'viewer_seams.png') });
+  const seamChange = signatureDistance(texture, seams);
+  console.log(`seams view: variance ${seams.variance.toFixed(1)}, change from texture ${seamChange.toFixed(1)}, ` +
+    `red pixels ${seams.seamPixels.visible} (texture view ${texture.seamPixels.visible}), ` +
+    `green ${seams.seamPixels.invisible} (texture view ${texture.seamPixels.invisible})`);
+  if (!(seamChange > kMinChange)) fail('switching to the seams view did not change the picture');
+  if (!(seams.seamPixels.visible > texture.seamPixels.visible + kMinVisibleSeamPixels)) fail('no red (visible seam) lines in the seams view');
+  if (expectInvisible && !(seams.seamPixels.invisible > texture.seamPixels.invisible + kMinInvisibleSeamPixels)) {
+    fail('no green (invisible seam) lines in the seams view');
+  }
+  await page.click('input[name=view][value=texture]');
+  const viaRadio = await page.evaluate(async () => {
+    document.querySelector('input[name=view][value=seams]').click();
+    const a = window.tailorViewer.state.view;
+    window.tailorViewer.setView('texture');
+    const b = window.tailorViewer.state.view;
+    window.tailorViewer.setView('seams');
+    return [a, b, window.tailorViewer.state.view];
+  });
+  if (viaRadio.join() !== 'seams,texture,seams') fail(`the seams radio button / hook did not switch views: ${viaRadio}`);
+  const seamsAgain = await page.evaluate(() => window.tailorViewer.pixelStats());
+  if (signatureDistance(seams, seamsAgain) > 0.5) fail('the seams view drawn twice differs');
+  await page.click('input[name=view][value=texture]');
+
+  if (evaluation) {
+    const stats = await page.evaluate(() => window.tailorViewer.stats);
+    console.log(`seam figures: visible ${stats.visibleSeamRatio} (eval ${evaluation.visible_seam_ratio}), ` +
+      `invisible ${stats.seamInvisibleRatio} (eval ${evaluation.seam_invisible_ratio}), seam edges ${stats.seams.seamEdges} (eval ${evaluation.seam_edges})`);
+    if (!(Math.abs(stats.visibleSeamRatio - evaluation.visible_seam_ratio) < kRatioTolerance)) fail('visible seam ratio differs from tailor eval');
+    if (!(Math.abs(stats.seamInvisibleRatio - evaluation.seam_invisible_ratio) < kRatioTolerance)) fail('invisible seam ratio differs from tailor eval');
+    if (stats.seams.seamEdges !== evaluation.seam_edges) fail('seam edge count differs from tailor eval');
+    if (!info.text.includes('visible seams')) fail(`the stats line has no seam figures: ${info.text}`);
+  }
 
   if (expectVariants) {
     const visible = await page.isVisible('#variant-controls');
