@@ -4,6 +4,8 @@
 
 #include <utility>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -95,7 +97,7 @@ TEST(RenderPreview, EveryViewHasTheRequestedSizeAndIsNotBlank) {
   const Fixture& f = spot();
   ASSERT_FALSE(f.mesh.corner_uvs.empty());
   for (const PreviewView view : {PreviewView::kTexture, PreviewView::kPatches, PreviewView::kDistortion,
-                                 PreviewView::kChecker}) {
+                                 PreviewView::kChecker, PreviewView::kSeams}) {
     SCOPED_TRACE(preview_view_name(view));
     const Image img = render_ok(f.mesh, &f.texture, small(view));
     EXPECT_EQ(img.width, 320);
@@ -315,9 +317,109 @@ TEST(RenderPreview, UpAxisStandsAZUpPillarUpright) {
   EXPECT_FALSE(up_axis_from_name("", parsed));
 }
 
+// Planar UVs from the mesh's x and y: `repeats` texture repeats across its bounding box; faces whose
+// centroid lies right of the box's middle get `shift` (repeats) added, which cuts the mesh there.
+std::vector<float> planar_uvs(const Mesh& mesh, float repeats, float shift_u, float shift_v) {
+  float lo[2] = {1e30f, 1e30f}, hi[2] = {-1e30f, -1e30f};
+  for (size_t v = 0; v < mesh.vertex_count(); ++v)
+    for (size_t k = 0; k < 2; ++k) {
+      lo[k] = std::min(lo[k], mesh.positions[3 * v + k]);
+      hi[k] = std::max(hi[k], mesh.positions[3 * v + k]);
+    }
+  const float size = std::max(hi[0] - lo[0], hi[1] - lo[1]), middle = 0.5f * (lo[0] + hi[0]);
+  std::vector<float> uv(2 * mesh.indices.size());
+  for (size_t f = 0; f < mesh.face_count(); ++f) {
+    float cx = 0;
+    for (size_t k = 0; k < 3; ++k) cx += mesh.positions[3 * size_t{mesh.indices[3 * f + k]}] / 3;
+    for (size_t k = 0; k < 3; ++k) {
+      const float* p = &mesh.positions[3 * size_t{mesh.indices[3 * f + k]}];
+      uv[6 * f + 2 * k] = (p[0] - lo[0]) / size * repeats + (cx > middle ? shift_u : 0.0f);
+      uv[6 * f + 2 * k + 1] = (p[1] - lo[1]) / size * repeats + (cx > middle ? shift_v : 0.0f);
+    }
+  }
+  return uv;
+}
+
+Image render_uv(const Mesh& mesh, std::span<const float> uv, const Image* texture, const RenderOptions& options) {
+  Image out;
+  const Status s = render_preview(mesh, uv, {}, texture, options, out);
+  EXPECT_TRUE(s.is_ok()) << s.message();
+  return out;
+}
+
+// Pixels of one colour (within 40 per channel).
+std::vector<uint8_t> pixels_near(const Image& img, const std::array<int, 3>& rgb) {
+  std::vector<uint8_t> mask(static_cast<size_t>(img.width) * static_cast<size_t>(img.height), 0);
+  for (size_t i = 0; i < mask.size(); ++i) {
+    bool near = true;
+    for (size_t c = 0; c < 3; ++c) near = near && std::abs(int{img.pixels[3 * i + c]} - rgb[c]) <= 40;
+    mask[i] = near ? 1 : 0;
+  }
+  return mask;
+}
+
+size_t count(const std::vector<uint8_t>& mask) { return static_cast<size_t>(std::count(mask.begin(), mask.end(), 1)); }
+
+// Mean luminance gradient (central differences) over the masked pixels.
+double mean_gradient(const Image& img, const std::vector<uint8_t>& mask) {
+  const auto lum = [&](int x, int y) {
+    const uint8_t* p = &img.pixels[3 * (static_cast<size_t>(y) * static_cast<size_t>(img.width) + static_cast<size_t>(x))];
+    return 0.299 * p[0] + 0.587 * p[1] + 0.114 * p[2];
+  };
+  double sum = 0;
+  size_t n = 0;
+  for (int y = 1; y + 1 < img.height; ++y)
+    for (int x = 1; x + 1 < img.width; ++x) {
+      if (!mask[static_cast<size_t>(y) * static_cast<size_t>(img.width) + static_cast<size_t>(x)]) continue;
+      sum += std::abs(lum(x + 1, y) - lum(x - 1, y)) + std::abs(lum(x, y + 1) - lum(x, y - 1));
+      ++n;
+    }
+  return n > 0 ? sum / static_cast<double>(n) : 0.0;
+}
+
+// Issue 14's proof in pixels, on a shared mesh with the gravel tile: spot cut in two with the
+// right half's UVs shifted by whole repeats (an invisible seam, green in the seams view) renders
+// exactly as the uncut mesh; shifted by a fraction of a repeat (a visible seam, red) the texture
+// jumps across the cut: the luminance gradient along the seam's pixels rises well above the
+// uncut rendering's there.
+TEST(RenderPreview, InvisibleSeamsDoNotJumpInPixelsAndVisibleOnesDo) {
+  const Mesh mesh = load_test_mesh("spot.obj");
+  Image gravel;
+  ASSERT_TRUE(load_image(kData + "textures/gravel-gray-512.png", gravel).is_ok());
+  // 0.4 repeats across the mesh: each texel covers a few pixels, so neighbouring pixels of a
+  // continuous texture are alike and a cut shows.
+  const std::vector<float> uncut = planar_uvs(mesh, 0.4f, 0, 0);
+  const std::vector<float> whole = planar_uvs(mesh, 0.4f, 1, -2);
+  const std::vector<float> fraction = planar_uvs(mesh, 0.4f, 0.37f, 0.21f);
+  RenderOptions seams = small(PreviewView::kSeams);
+  seams.width = 640;
+  seams.height = 480;
+  const auto green = [](const Image& img) { return pixels_near(img, {20, 170, 60}); };
+  const auto red = [](const Image& img) { return pixels_near(img, {225, 30, 30}); };
+  const Image seams_whole = render_uv(mesh, whole, &gravel, seams);
+  const Image seams_fraction = render_uv(mesh, fraction, &gravel, seams);
+  EXPECT_GT(count(green(seams_whole)), 100u);
+  EXPECT_EQ(count(red(seams_whole)), 0u);
+  const std::vector<uint8_t> cut = red(seams_fraction);
+  EXPECT_GT(count(cut), 100u);
+  EXPECT_EQ(count(green(seams_fraction)), 0u);
+
+  RenderOptions texture = seams;
+  texture.view = PreviewView::kTexture;
+  const Image a = render_uv(mesh, uncut, &gravel, texture);
+  const Image b = render_uv(mesh, whole, &gravel, texture);
+  const Image c = render_uv(mesh, fraction, &gravel, texture);
+  EXPECT_LT(mean_abs_difference(a, b), 0.05);  // the invisible cut renders as no cut at all
+  EXPECT_GT(mean_abs_difference(a, c), 1.0);   // the shifted half shows other texels
+  const double along_uncut = mean_gradient(a, cut), along_whole = mean_gradient(b, cut);
+  const double along_fraction = mean_gradient(c, cut);
+  EXPECT_NEAR(along_whole, along_uncut, 0.05 * along_uncut + 0.1);
+  EXPECT_GT(along_fraction, 1.5 * along_uncut) << along_fraction << " vs " << along_uncut;
+}
+
 TEST(RenderPreview, ViewNamesRoundTrip) {
   for (const PreviewView view : {PreviewView::kTexture, PreviewView::kPatches, PreviewView::kDistortion,
-                                 PreviewView::kChecker}) {
+                                 PreviewView::kChecker, PreviewView::kSeams}) {
     PreviewView parsed = PreviewView::kTexture;
     ASSERT_TRUE(preview_view_from_name(preview_view_name(view), parsed));
     EXPECT_EQ(parsed, view);

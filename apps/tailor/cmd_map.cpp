@@ -82,7 +82,7 @@ std::vector<std::pair<PreviewView, std::string>> preview_paths(const MapArgs& op
   if (opt.preview.empty()) return views;
   views.emplace_back(PreviewView::kTexture, opt.preview);
   if (opt.preview_all) {
-    for (PreviewView v : {PreviewView::kPatches, PreviewView::kDistortion, PreviewView::kChecker})
+    for (PreviewView v : {PreviewView::kPatches, PreviewView::kDistortion, PreviewView::kChecker, PreviewView::kSeams})
       views.emplace_back(v, sibling_path(opt.preview, preview_view_name(v)));
   }
   return views;
@@ -223,6 +223,7 @@ int run_map(const MapArgs& opt) {
       RenderOptions render_options;
       render_options.view = view;
       render_options.up = preview_up;
+      render_options.seam_texture_px = texture.empty() ? opt.texture_size : 0;
       Image picture;
       if (Status s = render_preview(mesh, uv_repeats, atlas.patch, texture.empty() ? nullptr : &texture,
                                     render_options, picture);
@@ -281,7 +282,8 @@ void register_map(CLI::App& app, Runner& run) {
   cmd->add_option("--stats", opt->stats, "Write a JSON report (mesh, mapping counters, metrics, timings)");
   cmd->add_option("--preview", opt->preview, "Render a 3/4 view of the textured mesh to this PNG");
   cmd->add_flag("--preview-all", opt->preview_all,
-                "With --preview, also write <name>_patches.png, <name>_distortion.png and <name>_checker.png");
+                "With --preview, also write <name>_patches.png, <name>_distortion.png, <name>_checker.png and "
+                "<name>_seams.png");
   cmd->add_option("--preview-up", opt->preview_up, std::string(option_doc(kRenderOptionDocs, "up").help))
       ->capture_default_str();
   auto* group = cmd->add_option_group("Mapping");

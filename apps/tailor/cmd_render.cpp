@@ -42,7 +42,7 @@ int run_render(const RenderArgs& args) {
   RenderOptions options = args.options;
   if (!preview_view_from_name(args.view, options.view)) {
     return report_error(Status::error(ErrorCode::kInvalidArgument, "", "unknown view '" + args.view + "'",
-                                      "use texture, patches, distortion or checker"));
+                                      "use texture, patches, distortion, checker or seams"));
   }
   if (!parse_size(args.size, options.width, options.height)) {
     return report_error(Status::error(ErrorCode::kInvalidArgument, "", "bad --size '" + args.size + "'",
@@ -93,7 +93,7 @@ void register_render(CLI::App& app, Runner& run) {
   cmd->add_option("mesh", args->input, "UV-mapped mesh: .glb (texture embedded) or .obj/.ply with UVs")->required();
   cmd->add_option("-o,--output", args->output, "PNG picture to write")->required();
   add_documented(cmd, option_doc(kRenderOptionDocs, "view"), args->view)
-      ->check(CLI::IsMember({"texture", "patches", "distortion", "checker"}));
+      ->check(CLI::IsMember({"texture", "patches", "distortion", "checker", "seams"}));
   add_documented(cmd, option_doc(kRenderOptionDocs, "width"), args->size);
   cmd->add_option("--texture", args->texture, "texture image to use instead of the one in the .glb");
   add_documented(cmd, option_doc(kRenderOptionDocs, "up"), args->up);

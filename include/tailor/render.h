@@ -27,7 +27,13 @@
 namespace tailor {
 
 //! What the preview colours the surface with (see the top of this file).
-enum class PreviewView { kTexture, kPatches, kDistortion, kChecker };
+enum class PreviewView {
+  kTexture,     //!< the texture (or a neutral checker)
+  kPatches,     //!< a colour per patch, seams drawn
+  kDistortion,  //!< area-stretch heat map with a legend
+  kChecker,     //!< a black and white checker per texture repeat
+  kSeams,       //!< grey surface; visible seams red, invisible ones green (seam_gap_px in metrics.h)
+};
 
 //! Parses "texture", "patches", "distortion" or "checker"; returns false for anything else.
 TAILOR_API bool preview_view_from_name(std::string_view name, PreviewView& view);
@@ -65,6 +71,10 @@ struct RenderOptions {
   float checker_squares = 8.0f;            //!< kChecker (and the fallback texture): squares per texture repeat, > 0
   float distortion_range = 2.0f;           //!< kDistortion: |log2(r_f / R)| mapped to full colour, > 0 (2 = 4x)
   bool draw_seams = true;                  //!< kPatches: draw seam edges as lines
+  int seam_texture_px = 0;                 //!< kSeams: texture size in pixels a seam's gap is measured in (a
+                                           //!< gap under 1 px is invisible); 0 = the texture's width and
+                                           //!< height, or 512 without a texture
+  uint32_t seam_symmetry = 1;              //!< kSeams: 4 = a quarter turn across a seam is invisible too
   int supersample = 2;                     //!< render at this multiple of the size and box-filter down, 1..4
 };
 
@@ -72,8 +82,8 @@ struct RenderOptions {
 //! --preview-up.
 inline constexpr OptionDoc kRenderOptionDocs[] = {
     {"view", "--view",
-     "texture, patches (a colour per patch, seams drawn), distortion (area-stretch heat map with legend) or "
-     "checker"},
+     "texture, patches (a colour per patch, seams drawn), distortion (area-stretch heat map with legend), "
+     "checker, or seams (visible seams red, invisible ones green: where the texture continues across the cut)"},
     {"width", "--size", "picture size WIDTHxHEIGHT"},
     {"up", "--up", "mesh axis that points up in the picture: y (glTF), z (most scans), x, -x, -y, -z"},
     {"yaw_degrees", "--yaw", "camera azimuth in degrees around the up axis"},

@@ -215,7 +215,7 @@ void draw_face_colored_surface(const Mesh& mesh, const std::vector<Rgb>& face_co
   glDeleteBuffers(4, buffers.data());
 }
 
-void draw_lines(const std::vector<float>& lines, float width) {
+void draw_lines(const std::vector<float>& lines, float width, const internal::Rgb& color) {
   if (lines.empty()) return;
   GLuint buffer = 0;
   glGenBuffers(1, &buffer);
@@ -224,7 +224,7 @@ void draw_lines(const std::vector<float>& lines, float width) {
   glEnableClientState(GL_VERTEX_ARRAY);
   glVertexPointer(3, GL_FLOAT, 0, nullptr);
   glLineWidth(width);
-  glColor3ub(kSeamColor[0], kSeamColor[1], kSeamColor[2]);
+  glColor3ub(color[0], color[1], color[2]);
   glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(lines.size() / 3));
   glDisableClientState(GL_VERTEX_ARRAY);
   glBindBuffer(GL_ARRAY_BUFFER, 0);
@@ -271,6 +271,10 @@ Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::s
     const int target_height = options.height * scale;
 
     PreviewScene scene;
+    if (texture != nullptr && !texture->empty()) {
+      scene.texture_width = texture->width;
+      scene.texture_height = texture->height;
+    }
     prepare_scene(mesh, corner_uv, patch, options, scene);
     const bool textured = options.view == PreviewView::kTexture || options.view == PreviewView::kChecker;
 
@@ -347,7 +351,12 @@ Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::s
     glDisable(GL_POLYGON_OFFSET_FILL);
     glDisable(GL_LIGHTING);
     glDisable(GL_TEXTURE_2D);
-    draw_lines(scene.lines, 1.25f * static_cast<float>(scale));
+    if (options.view == PreviewView::kSeams) {
+      draw_lines(scene.invisible_lines, 2.0f * static_cast<float>(scale), internal::kInvisibleSeamColor);
+      draw_lines(scene.lines, 2.0f * static_cast<float>(scale), internal::kVisibleSeamColor);
+    } else {
+      draw_lines(scene.lines, 1.25f * static_cast<float>(scale), kSeamColor);
+    }
 
     glViewport(0, 0, target_width, target_height);
     if (options.view == PreviewView::kDistortion) draw_legend_bar(box, target_width, target_height, scale);

@@ -167,6 +167,35 @@ std::vector<float> seam_lines(const Mesh& mesh, const Topology& topology, std::s
   return lines;
 }
 
+// Visible and invisible seam edges (classify_seam_edges on the UVs in pixels of the texture size)
+// as two line sets.
+void seam_class_lines(const Mesh& mesh, const Topology& topology, std::span<const float> uv_repeats,
+                      const RenderOptions& options, PreviewScene& scene) {
+  const float w = static_cast<float>(options.seam_texture_px > 0 ? options.seam_texture_px : scene.texture_width);
+  const float h = static_cast<float>(options.seam_texture_px > 0 ? options.seam_texture_px : scene.texture_height);
+  std::vector<float> uv_px(uv_repeats.size());
+  for (size_t c = 0; c < uv_px.size(); c += 2) {
+    uv_px[c] = uv_repeats[c] * w;
+    uv_px[c + 1] = uv_repeats[c + 1] * h;
+  }
+  MetricsOptions metrics;
+  metrics.texture_width_px = w;
+  metrics.texture_height_px = h;
+  metrics.symmetry = options.seam_symmetry == 4 && w == h ? 4 : 1;
+  std::vector<uint8_t> seam_class;
+  classify_seam_edges(mesh, topology, uv_px, metrics, seam_class);
+  for (size_t e = 0; e < seam_class.size(); ++e) {
+    const uint32_t o = topology.opposite[e];
+    if (seam_class[e] == 0 || o < e) continue;
+    std::vector<float>& lines = seam_class[e] == 2 ? scene.lines : scene.invisible_lines;
+    const size_t f = e / 3;
+    for (const size_t corner : {3 * f + e % 3, 3 * f + (e % 3 + 1) % 3}) {
+      const float* p = &mesh.positions[3 * size_t{mesh.indices[corner]}];
+      for (size_t k = 0; k < 3; ++k) lines.push_back(static_cast<float>(p[k] - scene.frame.center[k]));
+    }
+  }
+}
+
 // === Per-face colours ============================================================================
 
 std::vector<Rgb> distortion_colors(const Mesh& mesh, std::span<const float> uv, float range) {
@@ -199,6 +228,9 @@ void prepare_scene(const Mesh& mesh, std::span<const float> corner_uv, std::span
     if (options.draw_seams) scene.lines = seam_lines(mesh, topology, corner_uv, scene.patch_ids, scene.frame);
   } else if (options.view == PreviewView::kDistortion) {
     scene.face_colors = distortion_colors(mesh, corner_uv, options.distortion_range);
+  } else if (options.view == PreviewView::kSeams) {
+    scene.face_colors.assign(mesh.face_count(), internal::kSeamsSurface);
+    seam_class_lines(mesh, build_topology(mesh), corner_uv, options, scene);
   }
 }
 
@@ -476,7 +508,8 @@ void resolve(const std::vector<uint8_t>& rgba, int target_width, int scale, Imag
 }  // namespace internal
 
 bool preview_view_from_name(std::string_view name, PreviewView& view) {
-  for (const PreviewView v : {PreviewView::kTexture, PreviewView::kPatches, PreviewView::kDistortion, PreviewView::kChecker}) {
+  for (const PreviewView v : {PreviewView::kTexture, PreviewView::kPatches, PreviewView::kDistortion,
+                              PreviewView::kChecker, PreviewView::kSeams}) {
     if (name == preview_view_name(v)) {
       view = v;
       return true;
@@ -505,6 +538,7 @@ const char* preview_view_name(PreviewView view) {
     case PreviewView::kPatches: return "patches";
     case PreviewView::kDistortion: return "distortion";
     case PreviewView::kChecker: return "checker";
+    case PreviewView::kSeams: return "seams";
   }
   return "texture";
 }

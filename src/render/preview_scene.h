@@ -29,6 +29,9 @@ namespace tailor::internal {
 
 inline constexpr Rgb kBackground = {236, 238, 242};
 inline constexpr Rgb kSeamColor = {20, 20, 28};
+inline constexpr Rgb kVisibleSeamColor = {225, 30, 30};    // seams view: the texture breaks here
+inline constexpr Rgb kInvisibleSeamColor = {20, 170, 60};  // seams view: a cut the texture continues across
+inline constexpr Rgb kSeamsSurface = {200, 200, 200};
 inline constexpr Rgb kLegendInk = {30, 30, 36};
 // Checker tiles: light/dark grey for the neutral stand-in texture, near black/white for the checker view.
 inline constexpr Rgb kNeutralDark = {150, 150, 150};
@@ -74,7 +77,10 @@ struct PreviewScene {
   Framing frame;
   std::vector<float> normals;
   std::vector<Rgb> face_colors;
-  std::vector<float> lines;
+  std::vector<float> lines;            // seam lines (kPatches), visible seams (kSeams)
+  std::vector<float> invisible_lines;  // kSeams: invisible seams
+  int texture_width = 512;             // kSeams: the texture's size, when one is given
+  int texture_height = 512;
   std::vector<uint32_t> derived;
   std::span<const uint32_t> patch_ids;
 };
