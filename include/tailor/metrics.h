@@ -79,13 +79,13 @@ TAILOR_API Status compute_uv_metrics(const Mesh& mesh, const Topology& topology,
 //! period) per component; gap = max(|d_a - k|, |d_b - k|). Under a texture repeating with that period
 //! the texture continues across the edge when the gap is below a pixel. With options.symmetry 4 the
 //! smallest gap over g's UVs turned by 0, 90, 180 and 270 degrees. O(1).
-double seam_gap_px(const float* uv_fa, const float* uv_fb, const float* uv_ga, const float* uv_gb,
+TAILOR_API double seam_gap_px(const float* uv_fa, const float* uv_fb, const float* uv_ga, const float* uv_gb,
                    const MetricsOptions& options);
 
 //! Seam class of every edge e (#F*3, both sides of a pair alike): 0 no seam (boundary, or the two
 //! sides have identical UVs), 1 invisible seam (lattice gap < options.invisible_gap_px), 2 visible.
 //! For the seam views. Preconditions as compute_uv_metrics. Cost O(F).
-void classify_seam_edges(const Mesh& mesh, const Topology& topology, std::span<const float> corner_uv,
+TAILOR_API void classify_seam_edges(const Mesh& mesh, const Topology& topology, std::span<const float> corner_uv,
                          const MetricsOptions& options, std::vector<uint8_t>& seam_class);
 
 //! Patches = connected components of faces joined across paired edges whose two sides have
