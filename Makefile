@@ -24,6 +24,7 @@ build: configure
 
 # Unit, integration, CLI and browser tests (ctest runs them all), then short fuzz runs.
 test: build
+	@bash scripts/check_format.sh
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
 	@bash scripts/fuzz.sh short
 
@@ -50,6 +51,10 @@ fuzz: deps
 # thread-count tests, and the closing on real meshes with 4 threads.
 tsan: deps
 	@bash scripts/tsan.sh
+
+# Rewrite the C++ sources as .clang-format says (make test fails on unformatted files).
+format: deps
+	@bash scripts/check_format.sh --fix
 
 clean:
 	rm -rf $(BUILD_DIR) build-fuzz build-tsan out
