@@ -103,6 +103,9 @@ void BM_Mapping(benchmark::State& state, const std::string& key, const tailor::M
   state.counters["single"] = static_cast<double>(m.single_face_patches);
   state.counters["seam%"] = 100.0 * m.seam_length_ratio;
   state.counters["gap_px"] = m.seam_gap_px;
+  state.counters["visible%"] = 100.0 * m.visible_seam_ratio;  // issue 14: seams the texture breaks at
+  state.counters["invisible%"] = 100.0 * m.seam_invisible_ratio;  // share of seam length on the lattice
+  state.counters["dangling"] = static_cast<double>(m.visible_dangling_ends);
   state.counters["flipped"] = static_cast<double>(m.flipped);
   state.counters["stretch"] = m.stretch;
   state.counters["angle_deg"] = m.distortion_deg;
@@ -111,8 +114,8 @@ void BM_Mapping(benchmark::State& state, const std::string& key, const tailor::M
   if (options.mode == tailor::MappingMode::kThesis) state.counters["thr_px"] = stats.final_threshold_px;
 }
 
-// Registers one orientation and four mapping benchmarks per mesh at static initialisation:
-// patches mode (default options), its growth alone (no crack closing), the fewest-seams setting
+// Registers one orientation and five mapping benchmarks per mesh at static initialisation:
+// patches mode (default options and ten times the texture scale), its growth alone (no crack closing), the fewest-seams setting
 // (pure unfolding, crack closing at 32 rings), thesis mode.
 [[maybe_unused]] const bool registered = [] {
   std::vector<std::pair<std::string, std::string>> meshes = {{"horse_x16", "horse_x16"}};
@@ -125,7 +128,8 @@ void BM_Mapping(benchmark::State& state, const std::string& key, const tailor::M
   }
   std::sort(files.begin(), files.end());
   for (const auto& f : files) meshes.emplace_back(f.stem().string(), f.string());
-  tailor::MappingOptions patches, growth, fewest_seams, thesis;
+  tailor::MappingOptions patches, patches_x10, growth, fewest_seams, thesis;
+  patches_x10.scale = 10 * patches.scale;  // `--scale 8000`: the texture repeats ~15 times across a mesh
   growth.close_cracks = false;
   fewest_seams.field_following = 0.f;  // `--field-following 0 --crack-rings 32`
   fewest_seams.crack_rings = 32;
@@ -136,6 +140,10 @@ void BM_Mapping(benchmark::State& state, const std::string& key, const tailor::M
         ->MinTime(0.2)
         ->UseRealTime();
     benchmark::RegisterBenchmark(("Mapping/patches/" + name).c_str(), BM_Mapping, key, patches)
+        ->Unit(benchmark::kMillisecond)
+        ->MinTime(0.2)
+        ->UseManualTime();
+    benchmark::RegisterBenchmark(("Mapping/patches-x10/" + name).c_str(), BM_Mapping, key, patches_x10)
         ->Unit(benchmark::kMillisecond)
         ->MinTime(0.2)
         ->UseManualTime();
