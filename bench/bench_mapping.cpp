@@ -124,6 +124,7 @@ void BM_Mapping(benchmark::State& state, const std::string& key, const tailor::M
   for (const auto& f : files) meshes.emplace_back(f.stem().string(), f.string());
   tailor::MappingOptions patches, growth, fewest_seams, thesis;
   growth.close_cracks = false;
+  growth.relax_iterations = 0;
   fewest_seams.field_following = 0.f;  // `--field-following 0 --crack-rings 32`
   fewest_seams.crack_rings = 32;
   thesis.mode = tailor::MappingMode::kThesis;

@@ -39,6 +39,7 @@ struct MapOptions {
   bool keep_seams = false;
   bool keep_cracks = false;
   uint32_t crack_rings = 16;
+  uint32_t relax_iterations = 10;
   float hop_age = 0.02f;
   std::string axis = "pca";
   uint32_t smooth = 0;
@@ -121,6 +122,7 @@ int run_map(const MapOptions& opt) {
   mapping_options.shorten_seams = !opt.keep_seams;
   mapping_options.close_cracks = !opt.keep_cracks;
   mapping_options.crack_rings = opt.crack_rings;
+  mapping_options.relax_iterations = opt.relax_iterations;
   mapping_options.hop_age = opt.hop_age;
   if (!opt.seed_point.empty()) {
     if (!parse_vec3(opt.seed_point, mapping_options.seed_point))
@@ -278,6 +280,7 @@ int run_map(const MapOptions& opt) {
                     {"max_stretch", opt.max_stretch},
                     {"field_following", opt.field_following}, {"min_patch_faces", opt.min_patch_faces},
                     {"shorten_seams", !opt.keep_seams}, {"close_cracks", !opt.keep_cracks}, {"crack_rings", opt.crack_rings}, {"hop_age", opt.hop_age},
+                    {"relax_iterations", opt.relax_iterations},
                     {"axis", axis_used}, {"smooth", opt.smooth}, {"seed_point", opt.seed_point},
                     {"seam_faces", opt.seam_faces}};
     j["mesh"] = {{"format", load.format}, {"vertices", mesh.vertex_count()}, {"faces", mesh.face_count()},
@@ -294,6 +297,7 @@ int run_map(const MapOptions& opt) {
                     {"faces_three_textured", stats.faces_three_textured},
                     {"faces_unfolded", stats.faces_unfolded}, {"faces_rigid", stats.faces_rigid},
                     {"faces_reseamed", stats.faces_reseamed}, {"cracks_closed", stats.cracks_closed},
+                    {"relax_moves", stats.relax_moves},
                     {"faces_seam", stats.faces_seam}, {"inverted_accepted", stats.inverted_accepted}};
     j["metrics"] = {{"patches", metrics.patches}, {"single_face_patches", metrics.single_face_patches},
                     {"stretch", metrics.stretch}, {"stretch_area_weighted", metrics.stretch_area_weighted},
@@ -389,6 +393,11 @@ void register_map(CLI::App& app, Runner& run) {
                     "relax (2..64); more closes wider cracks and takes longer. Fewest seams: --field-following 0 "
                     "--crack-rings 32")
       ->check(CLI::Range(2u, 64u))
+      ->capture_default_str();
+  group->add_option("--relax-iterations", opt->relax_iterations,
+                    "patches mode: last, local/global ARAP iterations over the UV vertices (0 = off, ..1000): less "
+                    "angle distortion within --max-stretch; patches and seams stay, invisible seams stay invisible")
+      ->check(CLI::Range(0u, 1000u))
       ->capture_default_str();
   group->add_option("--threshold", opt->threshold, "thesis mode: initial error threshold in pixels")
       ->capture_default_str();

@@ -36,6 +36,7 @@ Status choose_orientation_axis(const Mesh& mesh, const Topology& topology, const
   MappingOptions growth = mapping;
   growth.mode = MappingMode::kPatches;  // the thesis mode has one UV per vertex: no seams to rank by
   growth.close_cracks = false;
+  growth.relax_iterations = 0;  // moves no seam
   growth.progress = nullptr;
   FaceFrames frames;
   Atlas atlas;

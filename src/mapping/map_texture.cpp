@@ -101,6 +101,8 @@ Status map_texture(const Mesh& mesh, const Topology& topology, const FaceFrames&
     return Status::error(ErrorCode::kInvalidArgument, "", "hop age must be in [0, 1] radians");
   if (options.crack_rings < 2 || options.crack_rings > 64)
     return Status::error(ErrorCode::kInvalidArgument, "", "crack rings must be in [2, 64]");
+  if (options.relax_iterations > 1000)
+    return Status::error(ErrorCode::kInvalidArgument, "", "relax iterations must be at most 1000");
   if (!std::isfinite(options.factor_step) || options.factor_step > 1.0)
     return Status::error(ErrorCode::kInvalidArgument, "", "factor step must be finite and at most 1");
   if (!options.seam_faces.empty() && options.seam_faces.size() != face_count)
@@ -132,6 +134,8 @@ Status map_texture(const Mesh& mesh, const Topology& topology, const FaceFrames&
       closing_progress = [&options](float done) { return options.progress(kGrowthShare + (1.f - kGrowthShare) * done); };
     status = internal::close_cracks(input, closing_progress, atlas, local_stats.cracks_closed);
   }
+  if (status.is_ok() && !thesis && options.relax_iterations > 0)
+    status = internal::relax_patches(input, atlas, local_stats.relax_moves);
   if (!status.is_ok()) {
     atlas.corner_uv.clear();
     atlas.patch.clear();
