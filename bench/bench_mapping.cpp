@@ -131,6 +131,7 @@ void BM_Mapping(benchmark::State& state, const std::string& key, const tailor::M
   tailor::MappingOptions patches, patches_x10, growth, fewest_seams, thesis;
   patches_x10.scale = 10 * patches.scale;  // `--scale 8000`: the texture repeats ~15 times across a mesh
   growth.close_cracks = false;
+  growth.relax_iterations = 0;
   fewest_seams.field_following = 0.f;  // `--field-following 0 --crack-rings 32`
   fewest_seams.crack_rings = 32;
   thesis.mode = tailor::MappingMode::kThesis;

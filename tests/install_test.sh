@@ -183,8 +183,11 @@ done
 if cmake -S examples/consumer -B "$tmp/consumer-shared" -DCMAKE_PREFIX_PATH="$shared" >"$tmp/cmake-shared.log" 2>&1 &&
   cmake --build "$tmp/consumer-shared" -j "$jobs" >>"$tmp/cmake-shared.log" 2>&1; then
   ok
-  ldd "$tmp/consumer-shared/consumer" | grep -q "libtailor_core\.so.* => $shared/lib/" && ok ||
-    fail "the consumer is not linked to $shared/lib/libtailor_core.so: $(ldd "$tmp/consumer-shared/consumer")"
+  # ldd's output is read whole first: with pipefail, grep -q stopping early would make ldd fail
+  # with SIGPIPE now and then.
+  linked=$(ldd "$tmp/consumer-shared/consumer")
+  grep -q "libtailor_core\.so.* => $shared/lib/" <<<"$linked" && ok ||
+    fail "the consumer is not linked to $shared/lib/libtailor_core.so: $linked"
   run_consumer consumer-shared "$tmp/consumer-shared/consumer"
 else
   fail "examples/consumer does not build with the shared libraries: $(tail -20 "$tmp/cmake-shared.log")"

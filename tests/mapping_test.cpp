@@ -184,10 +184,10 @@ TEST(Mapping, PureUnfoldingAndLooserBoundsStayValid) {
 
 // Maps mesh `name` into `on` with default options and into `off` with `step` switched off; returns
 // the latter options.
-MappingOptions map_with_and_without(const char* name, bool MappingOptions::*step, Mapped& on, Mapped& off) {
+MappingOptions map_with_and_without(const char* name, bool MappingOptions::*step, Mapped& on, Mapped& off,
+                                    MappingOptions options = {}) {
   on.mesh = load_test_mesh(name);
   off.mesh = on.mesh;
-  MappingOptions options;
   map_mesh(on, options);
   options.*step = false;
   map_mesh(off, options);
@@ -234,7 +234,10 @@ bool is_seam_edge(const Mapped& m, uint32_t e) {
 TEST(Mapping, CrackClosingZipsCracksWithinTheBound) {
   for (const char* name : {"horse.ply", "spot.obj"}) {
     Mapped closed, open;
-    const MappingOptions options = map_with_and_without(name, &MappingOptions::close_cracks, closed, open);
+    MappingOptions no_relaxation;  // the faces a zip moved, alone (the relaxation moves nearly all)
+    no_relaxation.relax_iterations = 0;
+    const MappingOptions options =
+        map_with_and_without(name, &MappingOptions::close_cracks, closed, open, no_relaxation);
     EXPECT_GT(closed.stats.cracks_closed, 100u) << name;
     EXPECT_EQ(open.stats.cracks_closed, 0u) << name;
     expect_valid_patches_atlas(closed, options, std::string(name) + " cracks closed");
@@ -329,6 +332,72 @@ TEST(Mapping, CrackClosingIsTheSameOnAnyThreadCount) {
   }
 }
 
+// The relaxation (relax_iterations, the last step) lowers the angle distortion, keeps every face it
+// moves within the bound and the patches and seam edges as they were, leaves both sides of every
+// seam that is less than a pixel wide where they were (invisible seams stay invisible), and gives
+// the same atlas on any number of threads.
+TEST(Mapping, RelaxationLowersAngleDistortion) {
+  Mapped before, one, four;
+  before.mesh = load_test_mesh("horse.ply");
+  one.mesh = before.mesh;
+  four.mesh = before.mesh;
+  MappingOptions options;
+  options.relax_iterations = 0;
+  map_mesh(before, options);
+  EXPECT_EQ(before.stats.relax_moves, 0u);
+  options = {};
+  options.threads = 1;
+  map_mesh(one, options);
+  options.threads = 4;
+  map_mesh(four, options);
+  EXPECT_EQ(one.atlas.corner_uv, four.atlas.corner_uv);
+  EXPECT_EQ(one.stats.relax_moves, four.stats.relax_moves);
+  EXPECT_GT(one.stats.relax_moves, 100000u);
+  expect_valid_patches_atlas(one, options, "horse relaxed");
+  EXPECT_EQ(one.atlas.patch, before.atlas.patch);
+  const size_t face_count = one.mesh.face_count();
+  size_t moved = 0;
+  for (size_t f = 0; f < face_count; ++f) {
+    const float* uv = &one.atlas.corner_uv[6 * f];
+    if (std::equal(uv, uv + 6, &before.atlas.corner_uv[6 * f])) continue;
+    ++moved;
+    ASSERT_FALSE(is_degenerate(one.frames, f)) << "face " << f;
+    EXPECT_LE(face_stretch_error(std::span<const float, 6>(&one.frames.local[6 * f], 6), options.scale,
+                                 std::span<const float, 6>(uv, 6)),
+              options.max_stretch)
+        << "face " << f;
+  }
+  EXPECT_GT(moved, face_count / 2);
+  size_t seams = 0, narrow = 0;
+  for (uint32_t e = 0; e < one.topology.opposite.size(); ++e) {
+    const bool seam = is_seam_edge(before, e);
+    EXPECT_EQ(is_seam_edge(one, e), seam) << "edge " << e;
+    if (!seam || one.topology.opposite[e] < e) continue;
+    ++seams;
+    const uint32_t o = one.topology.opposite[e];
+    const uint32_t corners[4] = {e, 3 * (e / 3) + (e % 3 + 1) % 3, o, 3 * (o / 3) + (o % 3 + 1) % 3};
+    const float* uv = before.atlas.corner_uv.data();
+    const auto gap = [uv](uint32_t a, uint32_t b) { return std::hypot(uv[2 * a] - uv[2 * b], uv[2 * a + 1] - uv[2 * b + 1]); };
+    if (!(gap(corners[0], corners[3]) < 1.f && gap(corners[1], corners[2]) < 1.f)) continue;
+    ++narrow;
+    for (const uint32_t c : corners) {
+      EXPECT_EQ(one.atlas.corner_uv[2 * c], uv[2 * c]) << "edge " << e;
+      EXPECT_EQ(one.atlas.corner_uv[2 * c + 1], uv[2 * c + 1]) << "edge " << e;
+    }
+  }
+  EXPECT_GT(seams, 1000u);
+  EXPECT_GT(narrow, 10u);
+  // Measured: 6.52 -> 1.73 degrees (median over faces of the sum of |UV angle - 3D angle|), Sander
+  // L2 1.0045 -> 1.0028, thesis stretch 0.064 -> 0.056.
+  const UvMetrics unrelaxed = metrics_of(before), relaxed = metrics_of(one);
+  EXPECT_LT(relaxed.distortion_deg, 0.5 * unrelaxed.distortion_deg);
+  EXPECT_LT(relaxed.distortion_deg, 3.0);
+  EXPECT_EQ(relaxed.flipped, 0u);
+  EXPECT_EQ(relaxed.seam_edges, unrelaxed.seam_edges);
+  EXPECT_LT(relaxed.l2_stretch, unrelaxed.l2_stretch);
+  EXPECT_LT(relaxed.stretch, unrelaxed.stretch);
+}
+
 TEST(Mapping, SeedPointChoosesTheFirstPatch) {
   Mapped m;
   m.mesh = load_test_mesh("spot.obj");
@@ -338,6 +407,7 @@ TEST(Mapping, SeedPointChoosesTheFirstPatch) {
     for (int i = 0; i < 3; ++i) c[i] += m.mesh.positions[3 * m.mesh.indices[3 * 1000 + k] + i] / 3.0;
   MappingOptions options;
   options.min_patch_faces = 0;  // keep the seed's own patch even if small
+  options.relax_iterations = 0;  // which would move the seed's corners
   options.use_seed_point = true;
   options.seed_point = {float(c[0]), float(c[1]), float(c[2])};
   map_mesh(m, options);
@@ -541,6 +611,9 @@ TEST(Mapping, RejectsBadOptionsAndMismatchedInputs) {
   options.crack_rings = 65;
   EXPECT_EQ(map_into(m, options).code(), ErrorCode::kInvalidArgument);
   options = {};
+  options.relax_iterations = 1001;
+  EXPECT_EQ(map_into(m, options).code(), ErrorCode::kInvalidArgument);
+  options = {};
   const std::vector<uint8_t> wrong_size(3, 1);
   options.seam_faces = wrong_size;
   EXPECT_EQ(map_into(m, options).code(), ErrorCode::kInvalidArgument);
@@ -599,9 +672,10 @@ TEST(Stability, RemovingTenPercentKeepsMostOfTheMapping) {
   // The growth order is local (hop rule), so almost everything is reproduced bit for bit
   // (measured: 99.1%; 84% with the thesis's global counter). Crack closing relaxes regions that
   // overlap along a crack, so zips processed after one near the removed part change in the last
-  // bits (measured: 97.2% bit-identical, 98.8% within 1 px, mean 0.05 px; 92.2% when the zips
-  // went in edge order instead of nearest to the seed first).
-  EXPECT_GT(report.identical_ratio, 0.95);
+  // bits (measured: 97.7% bit-identical, 99.0% within 1 px, mean 0.04 px; 92.2% when the zips
+  // went in edge order instead of nearest to the seed first). The final relaxation spreads any
+  // change over the rings its iterations reach: 77.3% bit-identical, 98.8% within 1 px, 0.07 px.
+  EXPECT_GT(report.identical_ratio, 0.7);
   EXPECT_GT(report.within_1px_ratio, 0.97);
   EXPECT_LT(report.mean_difference_px, 1.0);
   // On the horse the hop rule keeps 99% of the corners bit-identical and the mean change under
@@ -611,16 +685,17 @@ TEST(Stability, RemovingTenPercentKeepsMostOfTheMapping) {
   StabilityReport hops, counter, closed;
   MapTextureOptions growth_only;
   growth_only.mapping.close_cracks = false;
+  growth_only.mapping.relax_iterations = 0;
   ASSERT_TRUE(measure_stability(horse, growth_only, hops).is_ok());
   MapTextureOptions global_counter = growth_only;
   global_counter.mapping.hop_age = 0.f;
   ASSERT_TRUE(measure_stability(horse, global_counter, counter).is_ok());
   EXPECT_GT(hops.identical_ratio, 0.97);
   EXPECT_LT(hops.mean_difference_px, 1.0);
-  // With crack closing (default): measured 95.9% bit-identical, 99.2% within 1 px, 0.51 px (91.1%
-  // in edge order).
+  // With crack closing and relaxation (default): measured 90.8% bit-identical, 99.3% within 1 px,
+  // 0.51 px (without the relaxation 95.7%, 99.2%, 0.51 px; 91.1% with zips in edge order).
   ASSERT_TRUE(measure_stability(horse, {}, closed).is_ok());
-  EXPECT_GT(closed.identical_ratio, 0.94);
+  EXPECT_GT(closed.identical_ratio, 0.85);
   EXPECT_GT(closed.within_1px_ratio, 0.98);
   EXPECT_LT(closed.mean_difference_px, 1.0);
   EXPECT_LT(counter.identical_ratio, 0.9);

@@ -297,6 +297,8 @@ void register_map(CLI::App& app, Runner& run) {
   add_off_switch(group, option_doc(kMappingOptionDocs, "close_cracks"), mapping.close_cracks);
   add_documented(group, option_doc(kMappingOptionDocs, "crack_rings"), mapping.crack_rings)
       ->check(CLI::Range(2u, 64u));
+  add_documented(group, option_doc(kMappingOptionDocs, "relax_iterations"), mapping.relax_iterations)
+      ->check(CLI::Range(0u, 1000u));
   add_documented(group, option_doc(kMappingOptionDocs, "threshold_px"), mapping.threshold_px);
   add_documented(group, option_doc(kOrientationOptionDocs, "axis"), opt->axis);
   add_documented(group, option_doc(kOrientationOptionDocs, "smooth_passes"), orientation.smooth_passes);

@@ -35,6 +35,7 @@ Status choose_orientation_axis(const Mesh& mesh, const Topology& topology, const
   MapTextureOptions trial = options;
   trial.mapping.mode = MappingMode::kPatches;  // the thesis mode has one UV per vertex: no seams to rank by
   trial.mapping.close_cracks = false;
+  trial.mapping.relax_iterations = 0;  // moves no seam
   trial.mapping.progress = nullptr;
   trial.measure = true;
   TextureMap map;

@@ -98,6 +98,8 @@ Status check_mapping_inputs(const Mesh& mesh, const Topology& topology, const Fa
     return Status::error(ErrorCode::kInvalidArgument, "", "hop age must be in [0, 1] radians");
   if (options.crack_rings < 2 || options.crack_rings > 64)
     return Status::error(ErrorCode::kInvalidArgument, "", "crack rings must be in [2, 64]");
+  if (options.relax_iterations > 1000)
+    return Status::error(ErrorCode::kInvalidArgument, "", "relax iterations must be at most 1000");
   if (!std::isfinite(options.factor_step) || options.factor_step > 1.0)
     return Status::error(ErrorCode::kInvalidArgument, "", "factor step must be finite and at most 1");
   if (!options.seam_faces.empty() && options.seam_faces.size() != face_count)
@@ -173,6 +175,9 @@ Status map_texture(const Mesh& mesh, const Topology& topology, const MapTextureO
   // === 4. Crack closing (mapping/close_cracks.cpp) ===
   if (status.is_ok() && close_cracks)
     status = internal::close_cracks(input, closing_progress, map.atlas, stats.cracks_closed);
+  // === 5. Relaxation of the angle distortion (mapping/relax_patches.cpp) ===
+  if (status.is_ok() && !thesis && mapping.relax_iterations > 0)
+    status = internal::relax_patches(input, map.atlas, stats.relax_moves);
   if (!status.is_ok()) {
     clear_atlas(map.atlas);
     map.stats = MappingStats{};
@@ -181,7 +186,7 @@ Status map_texture(const Mesh& mesh, const Topology& topology, const MapTextureO
   stats.patches = map.atlas.patch_count;
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
-  // === 5. Metrics of the result (metrics/uv_metrics.cpp) ===
+  // === 6. Metrics of the result (metrics/uv_metrics.cpp) ===
   if (options.measure)
     TAILOR_RETURN_IF_ERROR(compute_uv_metrics(mesh, topology, map.atlas.corner_uv, map.atlas.patch, options.metrics,
                                               map.metrics));

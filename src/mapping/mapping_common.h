@@ -64,6 +64,12 @@ uint64_t shorten_seams(const MappingInput& input, std::vector<uint8_t>& seam_mar
 //! Deterministic; O(F) setup, then O(rings^2) per crack vertex tried.
 Status close_cracks(const MappingInput& input, const ProgressCallback& progress, Atlas& atlas, uint64_t& zipped);
 
+//! Relaxes the UVs by options.relax_iterations local/global ARAP iterations (patches mode, last
+//! step): every UV vertex moves except both sides of a seam less than a pixel wide and the corners
+//! of zero-area faces, and only where the faces around it stay within options.max_stretch. moves:
+//! the accepted UV vertex moves. The same result for any thread count; O(F) per iteration.
+Status relax_patches(const MappingInput& input, Atlas& atlas, uint64_t& moves);
+
 Status map_thesis(const MappingInput& input, Atlas& atlas, MappingStats& stats);
 
 //! Progress reporting cadence (placed faces between callback calls).

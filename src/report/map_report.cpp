@@ -36,7 +36,8 @@ std::string map_report_json(const MapRun& run) {
                   {"threshold_px", mapping.threshold_px}, {"max_stretch", mapping.max_stretch},
                   {"field_following", mapping.field_following}, {"min_patch_faces", mapping.min_patch_faces},
                   {"shorten_seams", mapping.shorten_seams}, {"close_cracks", mapping.close_cracks},
-                  {"crack_rings", mapping.crack_rings}, {"hop_age", mapping.hop_age}, {"axis", run.axis},
+                  {"crack_rings", mapping.crack_rings}, {"relax_iterations", mapping.relax_iterations},
+                  {"hop_age", mapping.hop_age}, {"axis", run.axis},
                   {"smooth", run.options.orientation.smooth_passes}, {"seed_point", run.seed_point},
                   {"seam_faces", run.seam_faces}};
   j["mesh"] = {{"format", run.load.format}, {"vertices", run.vertices}, {"faces", run.faces},
@@ -51,7 +52,7 @@ std::string map_report_json(const MapRun& run) {
                   {"max_stretch_accepted", stats.max_stretch_accepted},
                   {"faces_three_textured", stats.faces_three_textured}, {"faces_unfolded", stats.faces_unfolded},
                   {"faces_rigid", stats.faces_rigid}, {"faces_reseamed", stats.faces_reseamed},
-                  {"cracks_closed", stats.cracks_closed}, {"faces_seam", stats.faces_seam},
+                  {"cracks_closed", stats.cracks_closed}, {"relax_moves", stats.relax_moves}, {"faces_seam", stats.faces_seam},
                   {"inverted_accepted", stats.inverted_accepted}};
   j["metrics"] = {{"patches", metrics.patches}, {"single_face_patches", metrics.single_face_patches},
                   {"stretch", metrics.stretch}, {"stretch_area_weighted", metrics.stretch_area_weighted},
