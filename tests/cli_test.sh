@@ -132,6 +132,18 @@ expect_error 2 "crack-rings" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --crack-ri
 expect_error 2 "output must end" -- "$tailor" map "$mesh" -o "$tmp/x.txt"
 expect_error 2 "" -- "$tailor" map "$mesh"
 expect_error 2 "" -- "$tailor" frobnicate
+# --symmetry 4 (experimental): the same bytes for any thread count, the metrics count quarter turns
+# (in the report and in eval); it needs a square texture (a 64x48 render here) and eval takes 1 or 4.
+"$tailor" map "$mesh" --texture "$texture" -o "$tmp/s4a.glb" --symmetry 4 --threads 1 --stats "$tmp/s4.json" -q &&
+  "$tailor" map "$mesh" --texture "$texture" -o "$tmp/s4b.glb" --symmetry 4 --threads 4 -q &&
+  cmp -s "$tmp/s4a.glb" "$tmp/s4b.glb" && grep -q '"symmetry": 4' "$tmp/s4.json" && ok ||
+  fail "map --symmetry 4: differs between 1 and 4 threads, or no symmetry in the stats"
+"$tailor" eval "$tmp/s4a.glb" --symmetry 4 >"$tmp/eval4.txt" 2>&1 && grep -Eq " 0 flipped, .*symmetry 4\)$" "$tmp/eval4.txt" &&
+  ok || fail "eval --symmetry 4: $(cat "$tmp/eval4.txt")"
+"$tailor" render "$mesh" --size 64x48 -o "$tmp/wide.png" -q || fail "render of a 64x48 picture failed"
+expect_error 2 "symmetry 4 needs a square texture, got 64x48" -- "$tailor" map "$mesh" --texture "$tmp/wide.png" -o "$tmp/x.glb" --symmetry 4
+[[ ! -e $tmp/x.glb ]] && ok || fail "map --symmetry 4 with a non-square texture wrote its output"
+expect_error 2 "symmetry" -- "$tailor" eval "$tmp/a.glb" --symmetry 3
 ls "$tmp"/*.tmp-* >/dev/null 2>&1 && fail "temporary files left behind" || ok
 
 echo "$passed passed, $failed failed"

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "tailor/mapping.h"
+#include "tailor/metrics.h"
 #include "tailor/orientation.h"
 #include "tailor/render.h"
 #include "tailor/stability.h"
@@ -48,7 +49,7 @@ TEST(Options, TheTablesNameEachFieldOnce) {
   for (const std::span<const OptionDoc> docs :
        {std::span<const OptionDoc>(kMappingOptionDocs), std::span<const OptionDoc>(kOrientationOptionDocs),
         std::span<const OptionDoc>(kStabilityOptionDocs), std::span<const OptionDoc>(kTileOptionDocs),
-        std::span<const OptionDoc>(kRenderOptionDocs)}) {
+        std::span<const OptionDoc>(kRenderOptionDocs), std::span<const OptionDoc>(kMetricsOptionDocs)}) {
     for (size_t i = 0; i < docs.size(); ++i) {
       EXPECT_FALSE(docs[i].help.empty()) << docs[i].field;
       EXPECT_EQ(docs[i].flag.substr(0, 2), "--") << docs[i].field;
@@ -71,6 +72,7 @@ TEST(Options, MapHelpShowsTheTablesAndTheStructsDefaults) {
   EXPECT_TRUE(shows(help, "--min-patch-faces UINT", m.min_patch_faces));
   EXPECT_TRUE(shows(help, "]", m.crack_rings));  // after the range check
   EXPECT_TRUE(shows(help, "--threshold FLOAT", m.threshold_px));
+  EXPECT_TRUE(shows(help, "--symmetry UINT:{1,4}", m.symmetry));
   EXPECT_TRUE(shows(help, "--smooth UINT", OrientationOptions{}.smooth_passes));
   EXPECT_TRUE(shows(help, "--preview-up TEXT", up_axis_name(RenderOptions{}.up)));
 }
@@ -88,6 +90,8 @@ TEST(Options, TileRenderAndEvalHelpShowTheTablesAndTheStructsDefaults) {
   EXPECT_TRUE(shows(render, "}", preview_view_name(r.view)));
   const std::string eval = help_of("eval");
   expect_documented(eval, kStabilityOptionDocs, "eval");
+  expect_documented(eval, kMetricsOptionDocs, "eval");
+  EXPECT_TRUE(shows(eval, "--symmetry UINT:{1,4}", MetricsOptions{}.symmetry));
   EXPECT_TRUE(shows(eval, "]", StabilityOptions{}.remove_fraction));
 }
 

@@ -42,6 +42,7 @@ TEST(Report, MapJsonHoldsTheOptionsAndResults) {
   EXPECT_EQ(j["options"]["crack_rings"], defaults.crack_rings);
   EXPECT_EQ(j["options"]["close_cracks"], true);
   EXPECT_EQ(j["options"]["axis"], "pca");
+  EXPECT_EQ(j["options"]["symmetry"], defaults.symmetry);
   EXPECT_EQ(j["mesh"]["faces"], 12);
   EXPECT_EQ(j["metrics"]["patches"], 2);
   EXPECT_DOUBLE_EQ(j["time_ms"]["mapping"].get<double>(), 2.0);
@@ -78,7 +79,7 @@ TEST(Report, FileNamesThatAreNotUtf8DoNotBreakTheJson) {
   const nlohmann::json j = nlohmann::json::parse(eval_report_json(run));
   EXPECT_EQ(j["file"], "bad\xef\xbf\xbd.obj");
   EXPECT_TRUE(j.contains("visible_seam_ratio") && j.contains("visible_dangling_ends"));
-  EXPECT_EQ(j.size(), 30u);
+  EXPECT_EQ(j.size(), 31u);
   EXPECT_EQ(eval_summary(run).find("bad\xff.obj: 0 faces"), 0u);
   const nlohmann::json s = nlohmann::json::parse(stability_report_json(run.file, StabilityReport{}));
   EXPECT_EQ(keys(s), (std::vector<std::string>{"compared_corners", "faces", "file", "identical_ratio",

@@ -25,6 +25,7 @@ struct EvalOptions {
   bool quiet = false;
   bool stability = false;
   std::string seed_point;
+  uint32_t symmetry = MetricsOptions{}.symmetry;
   StabilityOptions stability_options;
 };
 
@@ -82,6 +83,10 @@ int run_eval(const EvalOptions& opt) {
     height = texture.height;
     size_source = "embedded texture";
   }
+  if (opt.symmetry == 4 && width != height)
+    return report_error(Status::error(ErrorCode::kInvalidArgument, "",
+                                      "--symmetry 4 needs a square texture, got " + std::to_string(width) + "x" +
+                                          std::to_string(height)));
 
   // Texture repeats -> pixels.
   std::vector<float> uv_px(mesh.corner_uvs.size());
@@ -91,7 +96,8 @@ int run_eval(const EvalOptions& opt) {
   }
   const Topology topology = build_topology(mesh);
   UvMetrics m;
-  const MetricsOptions options{static_cast<float>(width), static_cast<float>(height)};
+  MetricsOptions options{static_cast<float>(width), static_cast<float>(height)};
+  options.symmetry = opt.symmetry;
   const Status metrics_status = compute_uv_metrics(mesh, topology, uv_px, {}, options, m);
   if (!metrics_status) return report_error(metrics_status.with_file(opt.input));
   const double seconds = seconds_since(start);
@@ -109,6 +115,7 @@ int run_eval(const EvalOptions& opt) {
   run.texture_width = width;
   run.texture_height = height;
   run.texture_size_from = size_source;
+  run.symmetry = opt.symmetry;
   run.metrics = m;
   run.boundary_edges = topology.boundary_edges;
   run.nonmanifold_edges = topology.nonmanifold_edges;
@@ -128,6 +135,7 @@ void register_eval(CLI::App& app, Runner& run) {
                   "texture's size for .glb, else " +
                       std::to_string(static_cast<int>(MetricsOptions{}.texture_width_px)))
       ->check(CLI::Range(1, 1 << 16));
+  add_documented(cmd, option_doc(kMetricsOptionDocs, "symmetry"), opt->symmetry)->check(CLI::IsMember({1u, 4u}));
   cmd->add_flag("--json", opt->json, "Print the full report as a JSON object");
   cmd->add_flag("-q,--quiet", opt->quiet, "Print nothing but the result and errors");
   cmd->add_flag("--stability", opt->stability,
@@ -142,6 +150,7 @@ void register_eval(CLI::App& app, Runner& run) {
       "(coefficient of variation of UV/3D area ratio, 0 ideal), L2/Linf stretch (Sander 2001, 1 ideal),\n"
       "median angle distortion, seam gap (px, modulo the texture) and share of invisible seams.\n"
       "Example:\n  tailor eval bunny.glb\n  tailor eval spot.obj --texture-size 1024 --json\n"
+      "  tailor eval bunny_grid.glb --symmetry 4   (a map made with tailor map --symmetry 4)\n"
       "  tailor eval bunny.ply --stability --seed-point 0,0.1,0\n");
   cmd->callback([&run, opt] { run = [opt] { return run_eval(*opt); }; });
 }

@@ -112,6 +112,8 @@ int run_map(const MapArgs& opt) {
   MappingOptions& mapping = options.mapping;
   if (!mapping_mode_from_name(opt.mode, mapping.mode))
     return report_error(usage_error("--mode must be patches or thesis, got '" + opt.mode + "'"));
+  if (mapping.symmetry == 4 && mapping.mode != MappingMode::kPatches)
+    return report_error(usage_error("--symmetry 4 needs --mode patches"));
   if (!opt.seed_point.empty()) {
     if (!parse_vec3(opt.seed_point, mapping.seed_point))
       return report_error(usage_error("--seed-point must be three numbers X,Y,Z, got '" + opt.seed_point + "'"));
@@ -138,6 +140,12 @@ int run_map(const MapArgs& opt) {
   }
   const int tex_w = texture.empty() ? opt.texture_size : texture.width;
   const int tex_h = texture.empty() ? opt.texture_size : texture.height;
+  // Symmetry 4: the lattice is the texture's square period; the metrics count quarter turns as invisible.
+  if (mapping.symmetry == 4 && tex_w != tex_h)
+    return report_error(usage_error("--symmetry 4 needs a square texture, got " + std::to_string(tex_w) + "x" +
+                                    std::to_string(tex_h)));
+  mapping.texture_period_px = static_cast<float>(tex_w);
+  options.metrics.symmetry = mapping.symmetry;
 
   // === Load, topology, orientation ===
   Mesh mesh;
@@ -224,6 +232,7 @@ int run_map(const MapArgs& opt) {
       render_options.view = view;
       render_options.up = preview_up;
       render_options.seam_texture_px = texture.empty() ? opt.texture_size : 0;
+      render_options.seam_symmetry = mapping.symmetry;
       Image picture;
       if (Status s = render_preview(mesh, uv_repeats, atlas.patch, texture.empty() ? nullptr : &texture,
                                     render_options, picture);
@@ -304,6 +313,8 @@ void register_map(CLI::App& app, Runner& run) {
   add_documented(group, option_doc(kOrientationOptionDocs, "smooth_passes"), orientation.smooth_passes);
   add_documented(group, option_doc(kMappingOptionDocs, "seed_point"), opt->seed_point);
   add_documented(group, option_doc(kMappingOptionDocs, "seam_faces"), opt->seam_faces);
+  add_documented(group, option_doc(kMappingOptionDocs, "symmetry"), mapping.symmetry)
+      ->check(CLI::IsMember({1u, 4u}));
   cmd->add_flag("--stability", opt->stability,
                 "Also remove ~10% of the faces, re-map and report how much the remaining UVs moved");
   cmd->add_option("--threads", mapping.threads,

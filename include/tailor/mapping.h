@@ -99,11 +99,18 @@ struct MappingOptions {
                                     //!< 1000): median angle distortion 6.5 -> 1.9 degrees on the shared meshes for
                                     //!< ~20% more mapping time; patches and seam edges unchanged, invisible seams
                                     //!< (< 1 px) untouched, every moved face within max_stretch (docs/mapping.md)
-  uint32_t threads = 0;             //!< threads of the crack closing and the relaxation (0 = one per 10k / 20k
+  uint32_t threads = 0;             //!< threads of the crack closing, the relaxation and symmetry 4's fields (0 = one per 10k / 20k
                                     //!< faces, at most the cores and 8); the result is identical for any count
                                     //!< (the growth is sequential)
   uint32_t min_patch_faces = 16;    //!< patches with fewer faces are absorbed into a neighbouring patch by rigid
                                     //!< unfolding (0 = keep all; isolated components stay whole)
+  uint32_t symmetry = 1;            //!< 1: the growth above; 4 (experimental): an integer-grid map in place of
+                                    //!< the growth, seam shortening and crack closing, for a square tile that
+                                    //!< looks the same turned by 90 degrees (4-RoSy and lattice position fields;
+                                    //!< seams that are quarter turns plus whole repeats are invisible, but today
+                                    //!< most seam length is not: docs/mapping.md). Measure it with
+                                    //!< MetricsOptions::symmetry 4 too
+  float texture_period_px = 512.f;  //!< symmetry 4: the texture's size in pixels (square), the lattice period
   // kThesis -------------------------------------------------------------------------------------
   float threshold_px = 25.f;        //!< initial absolute error threshold, pixels (thesis: 25 at scale 800)
   float threshold_step_px = 10.f;   //!< added when every waiting face exceeds the threshold (thesis: 10)
@@ -147,6 +154,10 @@ inline constexpr OptionDoc kMappingOptionDocs[] = {
      "removed)"},
     {"seam_faces", "--seam-faces",
      "File of face indices (one per line) where seams should go (PLY 'seam' property also works)"},
+    {"symmetry", "--symmetry",
+     "1: patch discovery; 4, experimental: an integer-grid map for a square tile that looks the same turned by "
+     "90 degrees (needs a square texture), whose seams are meant to be quarter turns plus whole repeats, "
+     "invisible under such a tile; today most seams stay visible, see docs/mapping.md"},
 };
 
 struct MappingStats {
@@ -196,12 +207,14 @@ struct TextureMap {
 //! Maps the texture, as `tailor map` does: 1. the orientation field (compute_orientation),
 //! 2. the growth (patches mode: the patch-discovery front; thesis mode: the reference algorithm),
 //! 3. seam shortening and 4. crack closing (patches mode, each unless switched off), 5. the
-//! metrics of the result (compute_uv_metrics, unless options.measure is false).
+//! metrics of the result (compute_uv_metrics, unless options.measure is false). With
+//! mapping.symmetry 4 the integer-grid map (experimental) takes the place of steps 2-4.
 //! Fills map.atlas: corner_uv (#F*3 by 2, pixels), patch (#F) and patch_count; every face is
 //! placed and every UV is finite. Precondition: topology = build_topology(mesh).
 //! Fails as compute_orientation does, then with kInvalidArgument on bad mapping options (scale <= 0
 //! or non-finite, max_stretch, field_following, hop_age, crack_rings, max_seed_rotation_deg or
-//! factor_step out of range, seam_faces of the wrong size, a non-finite seed point), kInvalidMesh
+//! factor_step out of range, seam_faces of the wrong size, a non-finite seed point, symmetry not 1
+//! or 4, symmetry 4 outside the patches mode or with texture_period_px < 1), kInvalidMesh
 //! when the topology does not match the mesh, kCancelled when the progress callback returns false
 //! (the atlas is then empty), and as compute_uv_metrics does.
 //! Cost: the orientation and the metrics O(F); the growth O(F log front) time; the crack closing

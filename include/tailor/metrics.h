@@ -14,6 +14,7 @@
 
 #include "tailor/api.h"
 #include "tailor/mesh.h"
+#include "tailor/option_doc.h"
 #include "tailor/status.h"
 #include "tailor/topology.h"
 
@@ -29,6 +30,13 @@ struct MetricsOptions {
   float sharp_angle_deg = 30.f;   //!< an edge is sharp when its faces' normals differ by more than this
   uint32_t threads = 0;           //!< threads (0 = one per 100k faces, at most the cores and 8); the
                                   //!< figures are identical for any count
+};
+
+//! Flags and help of the MetricsOptions a user sets (option_doc.h): `tailor eval` shows these.
+inline constexpr OptionDoc kMetricsOptionDocs[] = {
+    {"symmetry", "--symmetry",
+     "1, or 4 for a square tile that looks the same turned by 90 degrees: seams whose sides differ by a quarter "
+     "turn plus whole repeats count as invisible too (needs a square texture)"},
 };
 
 struct UvMetrics {

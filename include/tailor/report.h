@@ -83,6 +83,7 @@ struct EvalRun {
   int texture_width = 0;          //!< texture size the UVs were measured in (px per repeat)
   int texture_height = 0;
   std::string texture_size_from;  //!< "option", "embedded texture" or "default"
+  uint32_t symmetry = 1;          //!< MetricsOptions::symmetry the metrics were measured with
   UvMetrics metrics;
   size_t boundary_edges = 0;      //!< Topology::boundary_edges
   size_t nonmanifold_edges = 0;   //!< Topology::nonmanifold_edges

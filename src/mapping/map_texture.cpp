@@ -1,8 +1,9 @@
 // Texture mapping entry point: map_texture runs the pipeline, one stage per module, in order:
 // the orientation field (surface/orientation.cpp), the growth (grow_patches.cpp, or the thesis
 // reference in thesis_mode.cpp), seam shortening (shorten_seams.cpp), crack closing
-// (close_cracks.cpp), the metrics (metrics/uv_metrics.cpp). Here: the checks of the options and
-// the components' seed order.
+// (close_cracks.cpp), the metrics (metrics/uv_metrics.cpp); with symmetry 4 the integer-grid map
+// (grid_map.cpp) takes the place of the growth, seam shortening and crack closing. Here: the
+// checks of the options and the components' seed order.
 //
 // This work is based on:
 //   V. Singh, A. M. Namboodiri, "Efficient texture mapping by homogeneous patch discovery",
@@ -15,6 +16,7 @@
 #include <limits>
 
 #include "mapping/face_stretch.h"
+#include "mapping/grid_map.h"
 #include "mapping/mapping_common.h"
 
 namespace tailor {
@@ -107,6 +109,12 @@ Status check_mapping_inputs(const Mesh& mesh, const Topology& topology, const Fa
   if (options.use_seed_point && !(std::isfinite(options.seed_point[0]) && std::isfinite(options.seed_point[1]) &&
                                   std::isfinite(options.seed_point[2])))
     return Status::error(ErrorCode::kInvalidArgument, "", "seed point must be finite");
+  if (options.symmetry != 1 && options.symmetry != 4)
+    return Status::error(ErrorCode::kInvalidArgument, "", "symmetry must be 1 or 4");
+  if (options.symmetry == 4 && (options.mode != MappingMode::kPatches || !(options.texture_period_px >= 1.f) ||
+                                !std::isfinite(options.texture_period_px)))
+    return Status::error(ErrorCode::kInvalidArgument, "",
+                         "symmetry 4 needs the patches mode and a texture period >= 1 px");
   return Status::ok();
 }
 
@@ -149,7 +157,9 @@ Status map_texture(const Mesh& mesh, const Topology& topology, const MapTextureO
   const auto start = std::chrono::steady_clock::now();
   TAILOR_RETURN_IF_ERROR(check_mapping_inputs(mesh, topology, map.frames, mapping));
   const bool thesis = mapping.mode == MappingMode::kThesis;
-  const bool close_cracks = !thesis && mapping.close_cracks;
+  const bool grid = mapping.symmetry == 4;          // the integer-grid map replaces steps 2-4
+  const bool patches = !thesis && !grid;            // steps 3 and 4 follow the patches mode's growth
+  const bool close_cracks = patches && mapping.close_cracks;
   // With crack closing the growth reports the first part of the progress, the closing the rest
   // (measured: the closing takes 70-90% of the mapping time).
   constexpr float kGrowthShare = 0.2f;
@@ -165,18 +175,20 @@ Status map_texture(const Mesh& mesh, const Topology& topology, const MapTextureO
   MappingStats& stats = map.stats;
   stats.components = static_cast<uint32_t>(input.component_seeds.size());
 
-  // === 2. Growth: the patch-discovery front (mapping/grow_patches.cpp), or the thesis's (thesis_mode.cpp) ===
+  // === 2. Growth: the patch-discovery front (mapping/grow_patches.cpp), or the thesis's (thesis_mode.cpp);
+  //        with symmetry 4 the integer-grid map instead, in place of steps 2-4 (mapping/grid_map.cpp) ===
   std::vector<uint8_t> on_seam;  // per face: placed on a seam by the growth (where step 3 looks)
-  Status status = thesis ? internal::map_thesis(input, map.atlas, stats)
-                         : internal::grow_patches(input, map.atlas, stats, on_seam);
+  Status status = grid     ? internal::map_grid(input, map.atlas, stats)
+                  : thesis ? internal::map_thesis(input, map.atlas, stats)
+                           : internal::grow_patches(input, map.atlas, stats, on_seam);
   // === 3. Seam shortening (mapping/shorten_seams.cpp) ===
-  if (status.is_ok() && !thesis && mapping.shorten_seams)
+  if (status.is_ok() && patches && mapping.shorten_seams)
     stats.faces_reseamed = internal::shorten_seams(input, on_seam, map.atlas);
   // === 4. Crack closing (mapping/close_cracks.cpp) ===
   if (status.is_ok() && close_cracks)
     status = internal::close_cracks(input, closing_progress, map.atlas, stats.cracks_closed);
   // === 5. Relaxation of the angle distortion (mapping/relax_patches.cpp) ===
-  if (status.is_ok() && !thesis && mapping.relax_iterations > 0)
+  if (status.is_ok() && patches && mapping.relax_iterations > 0)
     status = internal::relax_patches(input, map.atlas, stats.relax_moves);
   if (!status.is_ok()) {
     clear_atlas(map.atlas);

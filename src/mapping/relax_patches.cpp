@@ -9,7 +9,8 @@
 //
 // What moves: the UV vertices ("wedges": the corners of one vertex joined by faces that agree on
 // their UV, across patches too, so a seamless edge stays seamless) except the two sides of an
-// invisible seam (a seam edge whose sides are less than kInvisibleGapPx apart at both ends: both
+// invisible seam (a seam edge whose sides are less than kInvisibleGapPx apart at both ends, or
+// whose lattice gap at the texture period is: both
 // ends' wedges stay where they are, so the seam stays invisible) and the corners of zero-area faces.
 // The two sides of a visible seam move independently: the seam stays a seam, its gap changes.
 // Patches, seam edges and invisible seams are exactly as before.
@@ -51,6 +52,7 @@
 
 #include "mapping/face_stretch.h"
 #include "mapping/mapping_common.h"
+#include "tailor/metrics.h"
 #include "util/huge_pages.h"
 #include "util/parallel_chunks.h"
 
@@ -100,7 +102,9 @@ class Relaxer {
         scale_(in.options.scale),
         bound_(in.options.max_stretch),
         high_(1.f + bound_),
-        low_(1.f / (1.f + bound_)) {}
+        low_(1.f / (1.f + bound_)) {
+    lattice_.texture_width_px = lattice_.texture_height_px = in.options.texture_period_px;
+  }
 
   // Wedges, the free ones' colours and terms, per face its frame.
   void build() {
@@ -140,7 +144,10 @@ class Relaxer {
       if (o == kInvalid || o < e) continue;
       const Sides s = sides(e, o);
       if (root[s.fa] == root[s.ga] && root[s.fb] == root[s.gb]) continue;  // seamless
-      if (!(gap(s.fa, s.ga) < kInvisibleGapPx && gap(s.fb, s.gb) < kInvisibleGapPx)) continue;
+      const bool narrow = gap(s.fa, s.ga) < kInvisibleGapPx && gap(s.fb, s.gb) < kInvisibleGapPx;
+      if (!narrow && !(seam_gap_px(&uv_[2 * size_t{s.fa}], &uv_[2 * size_t{s.fb}], &uv_[2 * size_t{s.ga}],
+                                   &uv_[2 * size_t{s.gb}], lattice_) < kInvisibleGapPx))
+        continue;
       for (const uint32_t c : {s.fa, s.fb, s.ga, s.gb}) id[root[c]] = kInvalid;
     }
     for (size_t f = 0; f < face_count; ++f)
@@ -418,6 +425,7 @@ class Relaxer {
 
   const MappingInput& in_;
   float* const uv_;
+  MetricsOptions lattice_;  // the texture period, for the lattice gap of seams (metrics.h)
   const float scale_, bound_;
   const float high_, low_;  // the singular values' bounds
   uint32_t free_count_ = 0;

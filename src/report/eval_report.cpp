@@ -19,6 +19,7 @@ std::string eval_report_json(const EvalRun& run) {
   j["texture_width"] = run.texture_width;
   j["texture_height"] = run.texture_height;
   j["texture_size_from"] = run.texture_size_from;
+  j["symmetry"] = run.symmetry;
   j["patches"] = m.patches;
   j["single_face_patches"] = m.single_face_patches;
   j["degenerate_faces"] = m.degenerate_faces;
@@ -50,12 +51,12 @@ std::string eval_summary(const EvalRun& run) {
       "%s: %zu faces, %u patches (%zu single-face), seams %.2f%% of edge length (%zu edges), %zu flipped, "
       "stretch %.4f (area-weighted %.4f), L2 %.4f, Linf %.4f, distortion %.2f deg (median), "
       "seam gap %.2f px, %.1f%% invisible, visible seams %.2f%% of edge length (%.2f%% off sharp edges, "
-      "%zu dangling ends, %zu branch points) (texture %dx%d px, %s)\n",
+      "%zu dangling ends, %zu branch points) (texture %dx%d px, %s%s)\n",
       run.file.c_str(), m.faces, m.patches, m.single_face_patches, 100.0 * m.seam_length_ratio, m.seam_edges,
       m.flipped, m.stretch, m.stretch_area_weighted, m.l2_stretch, m.linf_stretch, m.distortion_deg, m.seam_gap_px,
       100.0 * m.seam_invisible_ratio, 100.0 * m.visible_seam_ratio, 100.0 * m.visible_off_sharp_ratio,
       m.visible_dangling_ends, m.visible_branch_points, run.texture_width, run.texture_height,
-      run.texture_size_from.c_str());
+      run.texture_size_from.c_str(), run.symmetry == 4 ? ", symmetry 4" : "");
 }
 
 std::string stability_report_json(const std::string& file, const StabilityReport& r) {

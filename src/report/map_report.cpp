@@ -39,7 +39,7 @@ std::string map_report_json(const MapRun& run) {
                   {"crack_rings", mapping.crack_rings}, {"relax_iterations", mapping.relax_iterations},
                   {"hop_age", mapping.hop_age}, {"axis", run.axis},
                   {"smooth", run.options.orientation.smooth_passes}, {"seed_point", run.seed_point},
-                  {"seam_faces", run.seam_faces}};
+                  {"seam_faces", run.seam_faces}, {"symmetry", mapping.symmetry}};
   j["mesh"] = {{"format", run.load.format}, {"vertices", run.vertices}, {"faces", run.faces},
                {"components", run.components}, {"boundary_edges", run.boundary_edges},
                {"nonmanifold_edges", run.nonmanifold_edges}, {"inconsistent_edges", run.inconsistent_edges},
@@ -85,11 +85,11 @@ std::string map_summary(const MapRun& run) {
       run.axis_auto ? "axis choice " + std::to_string(static_cast<long>(ms(run.axis_choice_seconds))) + ", " : "";
   std::string text = format_text(
       "%s: %zu faces, %u patches, seams %.2f%% of edge length, %zu flipped, stretch %.3f, L2 %.3f, "
-      "Linf %.2f, median angle %.2f deg, visible seams %.2f%% (%.0f%% of seam length invisible, %zu dangling ends) | load %.1f ms, topology %.1f, "
+      "Linf %.2f, median angle %.2f deg, visible seams %.2f%% (%.0f%% of seam length invisible%s, %zu dangling ends) | load %.1f ms, topology %.1f, "
       "%sorientation %.1f, mapping %.1f, export %.1f ms -> %s\n",
       run.input.c_str(), run.faces, m.patches, 100.0 * m.seam_length_ratio, m.flipped, m.stretch, m.l2_stretch,
       m.linf_stretch, m.distortion_deg, 100.0 * m.visible_seam_ratio, 100.0 * m.seam_invisible_ratio,
-      m.visible_dangling_ends, ms(run.load.load_seconds),
+      run.options.metrics.symmetry == 4 ? " up to quarter turns" : "", m.visible_dangling_ends, ms(run.load.load_seconds),
       ms(run.topology_seconds), axis_choice.c_str(), ms(run.orientation_seconds), ms(run.mapping.seconds),
       ms(run.export_seconds), run.output.c_str());
   if (run.stability) {

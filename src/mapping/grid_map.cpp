@@ -1,0 +1,216 @@
+// Integer-grid mapping (symmetry 4): extraction of per-corner UVs from the fields (grid_map.h).
+#include "mapping/grid_map.h"
+
+#include <cmath>
+#include <limits>
+
+#include "mapping/face_stretch.h"
+#include "surface/rosy_field.h"
+#include "util/parallel_chunks.h"
+
+namespace tailor::internal {
+namespace {
+
+//! Places face g from its placed neighbour across g's edge `k` (corners k, k+1 take the
+//! neighbour's UVs at those vertices: ua, ub), the third corner by the similarity that maps g's
+//! edge onto (ua, ub). rigid: the face keeps its shape at `scale`, centred on the edge's middle
+//! (then the edge itself is a seam). Writes 6 floats in g's corner order; returns the stretch error.
+float unfold(const float* local, float scale, uint32_t k, const float* ua, const float* ub, bool rigid, float* uv) {
+  const uint32_t ia = k, ib = (k + 1) % 3, ic = (k + 2) % 3;
+  const float lx = local[2 * ib] - local[2 * ia], ly = local[2 * ib + 1] - local[2 * ia + 1];
+  const float cx = local[2 * ic] - local[2 * ia], cy = local[2 * ic + 1] - local[2 * ia + 1];
+  const float ex = ub[0] - ua[0], ey = ub[1] - ua[1];
+  const float l2 = lx * lx + ly * ly;
+  float zx = scale, zy = 0.f;  // degenerate edge: the face's own frame
+  if (l2 > 0.f) {
+    zx = (ex * lx + ey * ly) / l2;  // z = E / L (complex)
+    zy = (ey * lx - ex * ly) / l2;
+  }
+  float ax = ua[0], ay = ua[1];
+  if (rigid) {
+    const float zl = std::sqrt(zx * zx + zy * zy);
+    if (zl > 0.f) {
+      zx *= scale / zl;
+      zy *= scale / zl;
+    } else {
+      zx = scale;
+      zy = 0.f;
+    }
+    const float mx = 0.5f * (ua[0] + ub[0]), my = 0.5f * (ua[1] + ub[1]);
+    ax = mx - 0.5f * (zx * lx - zy * ly);
+    ay = my - 0.5f * (zx * ly + zy * lx);
+  }
+  uv[2 * ia] = ax;
+  uv[2 * ia + 1] = ay;
+  uv[2 * ib] = rigid ? ax + zx * lx - zy * ly : ub[0];
+  uv[2 * ib + 1] = rigid ? ay + zx * ly + zy * lx : ub[1];
+  uv[2 * ic] = ax + zx * cx - zy * cy;
+  uv[2 * ic + 1] = ay + zx * cy + zy * cx;
+  return stretch_error(stretch_frame(local, scale), uv);
+}
+
+}  // namespace
+
+Status map_grid(const MappingInput& input, Atlas& atlas, MappingStats& stats) {
+  const Mesh& mesh = input.mesh;
+  const Topology& topology = input.topology;
+  const FaceFrames& frames = input.frames;
+  const MappingOptions& options = input.options;
+  const size_t nf = mesh.face_count();
+  const uint32_t* idx = mesh.indices.data();
+  const float scale = options.scale, period = options.texture_period_px;
+
+  RosyFieldOptions field_options;
+  field_options.scale = scale;
+  field_options.period = period;
+  field_options.threads = options.threads;
+  RosyField field;
+  compute_rosy_field(mesh, topology, frames, field_options, field);
+  if (options.progress && !options.progress(0.8f)) return Status::error(ErrorCode::kCancelled, "", "cancelled");
+
+  // Per face: the lattice maps of its corners into corner 0's chart, whether they close around
+  // the face (no singularity) and whether the chart triangle is within the bound.
+  std::vector<LatticeMap> corner_map(3 * nf);
+  std::vector<uint8_t> good(nf, 0);
+  atlas.corner_uv.resize(6 * nf);
+  atlas.patch.assign(nf, kInvalid);
+  float* uv = atlas.corner_uv.data();
+  const size_t threads = parallel_threads(nf, options.threads);
+  for_each_chunk(nf, threads, [&](size_t begin, size_t end, size_t) {
+    for (size_t f = begin; f < end; ++f) {
+      const uint32_t a = idx[3 * f], b = idx[3 * f + 1], c = idx[3 * f + 2];
+      const LatticeMap mb = lattice_map(field, a, b), mc = lattice_map(field, a, c);
+      corner_map[3 * f] = LatticeMap{};
+      corner_map[3 * f + 1] = mb;
+      corner_map[3 * f + 2] = mc;
+      const bool flat = compose(mb, lattice_map(field, b, c)) == mc;
+      if (!flat) continue;
+      float chart[6];
+      for (size_t k = 0; k < 3; ++k) apply(corner_map[3 * f + k], period, &field.uv[2 * idx[3 * f + k]], chart + 2 * k);
+      const float* local = &frames.local[6 * f];
+      good[f] = is_zero_area_frame(local) || stretch_error(stretch_frame(local, scale), chart) <= options.max_stretch;
+    }
+  });
+
+  // Patches: breadth-first over good faces, chaining the lattice maps so that a face reached
+  // across an edge copies that edge's UVs exactly.
+  std::vector<LatticeMap> face_map(nf);
+  std::vector<uint32_t> queue;
+  queue.reserve(nf);
+  uint32_t patches = 0;
+  uint64_t good_faces = 0;
+  auto grow = [&](uint32_t seed) {
+    if (!good[seed] || atlas.patch[seed] != kInvalid) return;
+    atlas.patch[seed] = patches;
+    face_map[seed] = LatticeMap{};
+    queue.assign(1, seed);
+    for (size_t head = 0; head < queue.size(); ++head) {
+      const uint32_t f = queue[head];
+      for (uint32_t k = 0; k < 3; ++k) {
+        const uint32_t o = topology.opposite[3 * f + k];
+        if (o == kInvalid) continue;
+        const uint32_t g = o / 3;
+        if (!good[g] || atlas.patch[g] != kInvalid) continue;
+        // Vertex idx[3f + k] is g's corner (o % 3 + 1) % 3 (the opposite edge runs backwards).
+        const uint32_t j = (o % 3 + 1) % 3;
+        face_map[g] = compose(compose(face_map[f], corner_map[3 * f + k]), inverse(corner_map[3 * g + j]));
+        atlas.patch[g] = patches;
+        queue.push_back(g);
+      }
+    }
+    good_faces += queue.size();
+    ++patches;
+  };
+  for (const uint32_t seed : input.component_seeds) grow(seed);
+  for (uint32_t f = 0; f < nf; ++f) grow(f);
+  for_each_chunk(nf, threads, [&](size_t begin, size_t end, size_t) {
+    for (size_t f = begin; f < end; ++f) {
+      if (!good[f]) continue;
+      for (size_t k = 0; k < 3; ++k)
+        apply(compose(face_map[f], corner_map[3 * f + k]), period, &field.uv[2 * idx[3 * f + k]], uv + 6 * f + 2 * k);
+    }
+  });
+
+  // The rest (singular or over-stretched faces): unfolded from placed neighbours, nearest first.
+  std::vector<uint8_t> placed(good);
+  queue.clear();
+  auto push_neighbours = [&](uint32_t f) {
+    for (uint32_t k = 0; k < 3; ++k) {
+      const uint32_t o = topology.opposite[3 * f + k];
+      if (o != kInvalid && !placed[o / 3]) queue.push_back(o / 3);
+    }
+  };
+  for (uint32_t f = 0; f < nf; ++f)
+    if (placed[f]) continue;
+    else
+      for (uint32_t k = 0; k < 3; ++k) {
+        const uint32_t o = topology.opposite[3 * f + k];
+        if (o != kInvalid && placed[o / 3]) {
+          queue.push_back(f);
+          break;
+        }
+      }
+  uint64_t unfolded = 0, rigid = 0;
+  uint32_t next_unplaced = 0;
+  size_t head = 0;
+  while (true) {
+    if (head == queue.size()) {
+      // A component without any placed face: its first face sits at its anchor, in its frame.
+      while (next_unplaced < nf && placed[next_unplaced]) ++next_unplaced;
+      if (next_unplaced == nf) break;
+      const uint32_t f = next_unplaced;
+      const float* local = &frames.local[6 * f];
+      for (size_t k = 0; k < 3; ++k) {
+        uv[6 * f + 2 * k] = scale * (frames.anchor[2 * f] + local[2 * k]);
+        uv[6 * f + 2 * k + 1] = scale * (frames.anchor[2 * f + 1] + local[2 * k + 1]);
+      }
+      placed[f] = 1;
+      atlas.patch[f] = patches++;
+      ++rigid;
+      push_neighbours(f);
+      continue;
+    }
+    const uint32_t f = queue[head++];
+    if (placed[f]) continue;
+    const float* local = &frames.local[6 * f];
+    float best_uv[6], trial[6];
+    float best = std::numeric_limits<float>::infinity();
+    uint32_t best_k = kInvalid;
+    for (uint32_t k = 0; k < 3; ++k) {
+      const uint32_t o = topology.opposite[3 * f + k];
+      if (o == kInvalid || !placed[o / 3]) continue;
+      const uint32_t g = o / 3;
+      // f's corner k is g's corner (o % 3 + 1) % 3; f's corner k + 1 is g's corner o % 3.
+      const float* ua = uv + 6 * g + 2 * ((o % 3 + 1) % 3);
+      const float* ub = uv + 6 * g + 2 * (o % 3);
+      float err = unfold(local, scale, k, ua, ub, false, trial);
+      if (is_zero_area_frame(local)) err = 0.f;
+      if (err < best || best_k == kInvalid) {
+        best = err;
+        best_k = k;
+        std::copy(trial, trial + 6, best_uv);
+      }
+    }
+    const uint32_t o = topology.opposite[3 * f + best_k];
+    if (!(best <= options.max_stretch)) {
+      const uint32_t g = o / 3;
+      unfold(local, scale, best_k, uv + 6 * g + 2 * ((o % 3 + 1) % 3), uv + 6 * g + 2 * (o % 3), true, best_uv);
+      ++rigid;
+    } else {
+      ++unfolded;
+    }
+    std::copy(best_uv, best_uv + 6, uv + 6 * f);
+    placed[f] = 1;
+    atlas.patch[f] = atlas.patch[o / 3];
+    push_neighbours(f);
+  }
+  atlas.patch_count = patches;
+  stats.patches_before_absorb = patches;
+  stats.faces_unfolded = good_faces + unfolded;
+  stats.faces_rigid = rigid;
+  stats.faces_cut = nf - good_faces;
+  if (options.progress && !options.progress(1.f)) return Status::error(ErrorCode::kCancelled, "", "cancelled");
+  return Status::ok();
+}
+
+}  // namespace tailor::internal

@@ -1,0 +1,106 @@
+// A 4-RoSy orientation field and a lattice position field per vertex (issue 14: integer-grid
+// maps), after Instant Meshes (Jakob, Tarini, Panozzo, Sorkine-Hornung 2015): both fields are
+// smoothed by local Jacobi iterations on a multi-resolution hierarchy of the vertex graph, coarse
+// to fine, so the result does not depend on the thread count.
+//
+// Per vertex v: a unit normal n_v, a unit tangent q_v (the field's u direction; the field is
+// defined up to quarter turns about n_v) and a lattice coordinate U_v in pixels, in the frame
+// (q_v, n_v x q_v), modulo the lattice period T (the texture size): U_v is where v lies in the
+// repeating texture. Between the charts of two neighbouring vertices there is a lattice map
+// (quarter turns plus whole repeats; lattice_map below), found by matching the two fields.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "tailor/mesh.h"
+#include "tailor/orientation.h"
+#include "tailor/topology.h"
+
+namespace tailor::internal {
+
+struct RosyFieldOptions {
+  float scale = 800.f;             //!< pixels per normalised unit
+  float period = 512.f;            //!< lattice period in pixels (the square texture's size)
+  float sharp_angle_deg = 30.f;    //!< edges whose faces' normals differ by more are features the field follows
+  uint32_t orientation_iterations = 40;  //!< Jacobi iterations per level (the coarsest gets 4x)
+  uint32_t position_iterations = 100;    //!< Jacobi iterations per level (the coarsest gets 4x)
+  float robust = 0.04f;            //!< position smoothing weighs an edge by 1 / (1 + |r|^2 / (robust |d|^2)), r its
+                                   //!< residual, d its offset: edges far off are left as cuts (0 = least squares)
+  uint32_t threads = 0;            //!< 0 = one per 100k vertices, at most the cores and 8; same result for any count
+};
+
+//! The fields on the mesh's vertices; all arrays per vertex, normalised mesh units.
+struct RosyField {
+  std::vector<float> position;  //!< #V by 3: normalised position
+  std::vector<float> normal;    //!< #V by 3: unit vertex normal (area weighted)
+  std::vector<float> q;         //!< #V by 3: unit tangent, the field's u axis (mod quarter turns)
+  std::vector<float> uv;        //!< #V by 2: lattice coordinate in [0, period)^2, pixels
+  std::vector<uint8_t> sharp;   //!< #V: 1 where the field is tied to a feature edge
+  float scale = 800.f;
+  float period = 512.f;
+  uint32_t levels = 0;          //!< levels of the hierarchy used
+};
+
+//! Computes both fields. Preconditions as map_texture. Cost: O(V) per iteration, a geometric sum
+//! over levels; O(V + F) memory.
+void compute_rosy_field(const Mesh& mesh, const Topology& topology, const FaceFrames& frames,
+                        const RosyFieldOptions& options, RosyField& field);
+
+//! A lattice map x -> rot_r(x) + period * t, with rot_1(a, b) = (b, -a) (a quarter turn) and t
+//! integer. Compositions and inverses are exact on the integers.
+struct LatticeMap {
+  int r = 0;
+  int tx = 0, ty = 0;
+  bool operator==(const LatticeMap&) const = default;
+};
+
+inline void rotate_int(int r, int a, int b, int& x, int& y) {
+  switch (r & 3) {
+    case 0: x = a; y = b; break;
+    case 1: x = b; y = -a; break;
+    case 2: x = -a; y = -b; break;
+    default: x = -b; y = a; break;
+  }
+}
+inline void rotate_float(int r, float a, float b, float& x, float& y) {
+  switch (r & 3) {
+    case 0: x = a; y = b; break;
+    case 1: x = b; y = -a; break;
+    case 2: x = -a; y = -b; break;
+    default: x = -b; y = a; break;
+  }
+}
+//! (a o b)(x) = a(b(x)).
+inline LatticeMap compose(const LatticeMap& a, const LatticeMap& b) {
+  LatticeMap c;
+  c.r = (a.r + b.r) & 3;
+  int x, y;
+  rotate_int(a.r, b.tx, b.ty, x, y);
+  c.tx = x + a.tx;
+  c.ty = y + a.ty;
+  return c;
+}
+inline LatticeMap inverse(const LatticeMap& a) {
+  LatticeMap c;
+  c.r = (4 - a.r) & 3;
+  int x, y;
+  rotate_int(c.r, a.tx, a.ty, x, y);
+  c.tx = -x;
+  c.ty = -y;
+  return c;
+}
+inline void apply(const LatticeMap& m, float period, const float* in, float* out) {
+  float x, y;
+  rotate_float(m.r, in[0], in[1], x, y);
+  out[0] = x + period * static_cast<float>(m.tx);
+  out[1] = y + period * static_cast<float>(m.ty);
+}
+
+//! The lattice map from vertex w's chart to vertex v's chart (v, w neighbours), computed in the
+//! canonical direction (lower id first) and inverted otherwise, so that lattice_map(v, w) is
+//! exactly inverse(lattice_map(w, v)).
+LatticeMap lattice_map(const RosyField& field, uint32_t v, uint32_t w);
+
+}  // namespace tailor::internal
