@@ -121,6 +121,10 @@ expect_error 2 "scale" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --scale 1e-30
 expect_error 2 "share" -- "$tailor" tile "$texture" -o "$tmp/v.png" --variants 2 --json "$tmp/v.json"
 expect_error 2 "does not exist" -- "$tailor" tile "$texture" -o "$tmp/missing/t.png"
 [[ ! -e $tmp/v_0.png ]] && ok || fail "tile wrote variants although the run was refused"
+expect_error 2 "symmetry" -- "$tailor" tile "$texture" -o "$tmp/q.png" --symmetry 4 --variants 2
+expect_error 2 "symmetry" -- "$tailor" tile "$texture" -o "$tmp/q.png" --symmetry 4 --fit-period
+expect_error 2 "symmetry" -- "$tailor" tile "$texture" -o "$tmp/q.png" --symmetry 3
+[[ ! -e $tmp/q.png && ! -e $tmp/q_0.png ]] && ok || fail "tile --symmetry 4 wrote a tile although the run was refused"
 # File names need not be UTF-8: JSON output must not abort on them.
 cp "$mesh" "$tmp/bad"$'\xff'".obj"
 "$tailor" info "$tmp/bad"$'\xff'".obj" --json >"$tmp/badname.json" 2>&1 && grep -q '"faces": 5856' "$tmp/badname.json" && ok ||

@@ -358,6 +358,114 @@ TEST(Period, PhotosOfRegularPatternsAndNoise) {
 // ------------------------------------------------------------------------------------------------
 // The command line, as a user runs it.
 
+// ------------------------------------------------------------------------------------------------
+// --symmetry 4 (issue 14): a tile also unchanged by a quarter turn.
+
+TileOptions quarter_turn_options() {
+  TileOptions o;
+  o.symmetry = 4;
+  return o;
+}
+
+// rot90(tile)(x, y) = tile(y, N - 1 - x) equals tile((x + N/2) % N, y), sample for sample.
+TEST(QuarterTurn, InvarianceIsExactOnEveryExemplar) {
+  for (const char* file : kExemplars) {
+    SCOPED_TRACE(file);
+    const Image ex = load(file);
+    Image tile;
+    TileReport report;
+    ASSERT_TRUE(make_tileable(ex, quarter_turn_options(), tile, &report).is_ok());
+    const int n = tile.width;
+    ASSERT_EQ(tile.height, n);
+    EXPECT_EQ(n, std::min(ex.width, ex.height) / 4 * 4);
+    EXPECT_EQ(tile.channels, ex.channels);
+    size_t differing = 0;
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x)
+        if (!same_pixel(tile, y, n - 1 - x, tile, (x + n / 2) % n, y)) ++differing;
+    EXPECT_EQ(differing, 0u);
+    int sx = -1, sy = -1;
+    EXPECT_EQ(quarter_turn_difference(tile, &sx, &sy), 0);
+    EXPECT_EQ(sx, n / 2);
+    EXPECT_EQ(sy, 0);
+    EXPECT_EQ(report.quarter_turn_difference, 0);
+    EXPECT_EQ(report.symmetry, 4);
+  }
+  // A plain tile is not quarter-turn symmetric, and a non-square image has no figure.
+  const Image sand = load("vistex-sand05-128.png");
+  Image plain;
+  ASSERT_TRUE(make_tileable(sand, TileOptions{}, plain).is_ok());
+  EXPECT_GT(quarter_turn_difference(plain), 50);
+  EXPECT_EQ(quarter_turn_difference(stripes(64, 40, 8)), -1);
+}
+
+// Four of the five targets hold on the stochastic shared photos; patch coherence (measured, like
+// the exemplar's baseline, against the exemplar's four quarter turns) is 2.2-2.3 x the
+// exemplar's: the known shortfall of this version (docs/tiling.md), bounded here so that it
+// cannot get worse unnoticed.
+TEST(QuarterTurn, TargetsOnGravelAndSand) {
+  for (const char* file : {"gravel-gray-512.png", "vistex-sand05-128.png"}) {
+    SCOPED_TRACE(file);
+    const Image ex = load(file);
+    Image tile;
+    ASSERT_TRUE(make_tileable(ex, quarter_turn_options(), tile).is_ok());
+    TileMetrics m;
+    ASSERT_TRUE(tile_metrics(tile, &ex, m).is_ok());
+    EXPECT_EQ(m.quarter_turn_difference, 0);
+    EXPECT_TRUE(m.coherence_with_turns);
+    EXPECT_GE(m.wrap_ratio_x, 0.8);
+    EXPECT_LE(m.wrap_ratio_x, 1.2);
+    EXPECT_GE(m.wrap_ratio_y, 0.8);
+    EXPECT_LE(m.wrap_ratio_y, 1.2);
+    EXPECT_LE(m.worst_seam_ratio, std::max(m.exemplar_worst_seam_ratio, 1.5));
+    EXPECT_LE(m.histogram_l1, 0.1);
+    EXPECT_GE(m.gradient_ratio, 0.95);
+    EXPECT_LE(m.patch_coherence, 2.5 * m.exemplar_patch_coherence);
+  }
+}
+
+TEST(QuarterTurn, DeterministicAndDirectionalTexturesWarn) {
+  const Image gravel = load("gravel-gray-512.png");
+  Image a, b;
+  TileReport report;
+  ASSERT_TRUE(make_tileable(gravel, quarter_turn_options(), a, &report).is_ok());
+  ASSERT_TRUE(make_tileable(gravel, quarter_turn_options(), b).is_ok());
+  EXPECT_EQ(a.pixels, b.pixels);
+  EXPECT_TRUE(report.warnings.empty());
+  EXPECT_LT(report.anisotropy, 0.1);
+  TileOptions other = quarter_turn_options();
+  other.seed = 2;
+  ASSERT_TRUE(make_tileable(gravel, other, b).is_ok());
+  EXPECT_NE(a.pixels, b.pixels);
+
+  ASSERT_TRUE(make_tileable(load("brick-gray-512.png"), quarter_turn_options(), a, &report).is_ok());
+  EXPECT_GT(report.anisotropy, 0.5);
+  ASSERT_FALSE(report.warnings.empty());
+  EXPECT_NE(report.warnings[0].find("directional"), std::string::npos) << report.warnings[0];
+  EXPECT_GT(orientation_anisotropy(stripes(64, 64, 8)), 0.99);
+  EXPECT_LT(orientation_anisotropy(checkers(64, 64, 8)), 0.01);
+
+  // Non-square exemplar: cropped (with a warning) to its centred square, side a multiple of 4.
+  ASSERT_TRUE(make_tileable(stripes(150, 90, 10), quarter_turn_options(), a, &report).is_ok());
+  EXPECT_EQ(a.width, 88);
+  EXPECT_EQ(a.height, 88);
+  EXPECT_EQ(quarter_turn_difference(a), 0);
+}
+
+TEST(QuarterTurn, VariantsFitPeriodAndOtherOrdersAreErrors) {
+  const Image sand = load("vistex-sand05-128.png");
+  std::vector<Image> tiles;
+  EXPECT_EQ(make_tile_variants(sand, quarter_turn_options(), 2, tiles).code(), ErrorCode::kInvalidArgument);
+  TileOptions o = quarter_turn_options();
+  o.fit_period = true;
+  Image tile;
+  EXPECT_EQ(make_tileable(sand, o, tile).code(), ErrorCode::kInvalidArgument);
+  o = TileOptions{};
+  o.symmetry = 3;
+  EXPECT_EQ(make_tileable(sand, o, tile).code(), ErrorCode::kInvalidArgument);
+  EXPECT_TRUE(make_tile_variants(sand, quarter_turn_options(), 1, tiles).is_ok());
+}
+
 struct CliRun {
   int code = 0;
   std::string out;
@@ -417,6 +525,39 @@ TEST(TileCli, VariantsWriteNumberedFilesAndAJson) {
   ASSERT_EQ(j["files"].size(), 3u);
   EXPECT_EQ(j["files"][2], "sand_2.png");
   EXPECT_GE(j["border_px"].get<int>(), 1);
+}
+
+TEST(TileCli, SymmetryFourReportsTheQuarterTurnAndRefusesVariants) {
+  const std::string dir = temp_dir();
+  const std::string out = dir + "/sand_q.png", json = dir + "/sand_q.json";
+  const CliRun r = run_cli("tile " + kData + "vistex-sand05-128.png -o " + out + " --symmetry 4 --json " + json);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("quarter-turn symmetric (exact)"), std::string::npos) << r.out;
+  std::ifstream jf(json);
+  const nlohmann::json j = nlohmann::json::parse(jf, nullptr, false);
+  ASSERT_FALSE(j.is_discarded());
+  EXPECT_EQ(j["symmetry"], 4);
+  EXPECT_EQ(j["quarter_turn_difference"], 0);
+  EXPECT_EQ(j["quarter_turn_exact"], true);
+  EXPECT_EQ(j["tiles"][0]["quarter_turn_symmetric"], true);
+  const CliRun e = run_cli("eval-tile " + out + " " + kData + "vistex-sand05-128.png");
+  ASSERT_EQ(e.code, 0) << e.err;
+  EXPECT_NE(e.out.find("quarter turn            max difference 0 after the best shift (64, 0)"), std::string::npos)
+      << e.out;
+  const CliRun plain = run_cli("eval-tile " + kData + "vistex-sand05-128.png --json");
+  const nlohmann::json m = nlohmann::json::parse(plain.out, nullptr, false);
+  ASSERT_FALSE(m.is_discarded()) << plain.out;
+  EXPECT_GT(m["quarter_turn_difference"].get<int>(), 0);
+  EXPECT_EQ(m["quarter_turn_symmetric"], false);
+
+  for (const std::string& bad : {std::string("--variants 2"), std::string("--fit-period"), std::string("--symmetry 2")}) {
+    const std::string args = bad == "--symmetry 2" ? bad : "--symmetry 4 " + bad;
+    const CliRun u = run_cli("tile " + kData + "vistex-sand05-128.png -o " + dir + "/u.png " + args);
+    EXPECT_EQ(u.code, 2) << args << ": " << u.err;
+    EXPECT_EQ(std::count(u.err.begin(), u.err.end(), '\n'), 1) << u.err;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir + "/u.png"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/u_0.png"));
 }
 
 TEST(TileCli, BadInputGivesOneErrorLineAndExitCode) {

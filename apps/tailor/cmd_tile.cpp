@@ -121,12 +121,14 @@ void register_tile(CLI::App& app, Runner& run) {
       ->check(CLI::Range(1, 64));
   const OptionDoc& fit_period = option_doc(kTileOptionDocs, "fit_period");
   cmd->add_flag(std::string(fit_period.flag), options.fit_period, std::string(fit_period.help));
+  add_documented(cmd, option_doc(kTileOptionDocs, "symmetry"), options.symmetry)->check(CLI::IsMember({1, 4}));
   cmd->add_option("--json", opt->json, "Write the metrics and settings as JSON to this file");
   cmd->add_flag("-q,--quiet", opt->quiet, "Print nothing but errors");
   cmd->footer(
       "Examples:\n"
       "  tailor tile bricks.jpg -o bricks_tile.png\n"
       "  tailor tile bricks.jpg -o bricks.png --fit-period --variants 4   # bricks_0..3.png + bricks.json\n"
+      "  tailor tile gravel.png -o gravel_tile.png --symmetry 4         # also unchanged by a quarter turn\n"
       "  tailor eval-tile bricks_tile.png bricks.jpg                     # check the result");
   cmd->callback([&run, opt] {
     run = [opt] {
@@ -134,6 +136,12 @@ void register_tile(CLI::App& app, Runner& run) {
       if (o.overlap != 0 && o.overlap > o.block / 2 - 1)
         return report_error(Status::error(ErrorCode::kInvalidArgument, "", "--overlap must be at most block/2 - 1",
                                           "block " + std::to_string(o.block)));
+      if (o.symmetry == 4 && opt->variants > 1)
+        return report_error(Status::error(ErrorCode::kInvalidArgument, "",
+                                          "--symmetry 4 makes one tile: --variants cannot be used with it"));
+      if (o.symmetry == 4 && o.fit_period)
+        return report_error(
+            Status::error(ErrorCode::kInvalidArgument, "", "--symmetry 4 cannot be combined with --fit-period"));
       return run_tile(*opt);
     };
   });

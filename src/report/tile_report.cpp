@@ -36,6 +36,12 @@ nlohmann::json quality_json(const TileQuality& tile) {
     j["patch_coherence"] = m.patch_coherence;
     j["exemplar_patch_coherence"] = m.exemplar_patch_coherence;
   }
+  j["quarter_turn_difference"] = m.quarter_turn_difference;
+  if (m.quarter_turn_difference >= 0) {
+    j["quarter_turn_symmetric"] = m.quarter_turn_difference == 0;
+    j["quarter_turn_shift"] = {m.quarter_turn_shift_x, m.quarter_turn_shift_y};
+  }
+  if (m.has_exemplar) j["coherence_with_turns"] = m.coherence_with_turns;
   j["targets_met"] = tile.targets_met;
   if (!tile.targets_failed.empty()) j["targets_failed"] = tile.targets_failed;
   return j;
@@ -78,6 +84,13 @@ std::string tile_report_json(const TileRun& run) {
   j["blocks"] = report.blocks;
   j["seconds"] = run.seconds;
   if (run.options.fit_period) j["period"] = period_json(report.period);
+  j["symmetry"] = report.symmetry;
+  if (report.symmetry == 4) {
+    // The check of the tile as written: rot90(tile) against the tile, 0 = exact.
+    j["anisotropy"] = report.anisotropy;
+    j["quarter_turn_difference"] = report.quarter_turn_difference;
+    j["quarter_turn_exact"] = report.quarter_turn_difference == 0;
+  }
   j["warnings"] = report.warnings;
   nlohmann::json list = nlohmann::json::array();
   for (const TileQuality& tile : run.tiles) {
@@ -114,11 +127,15 @@ std::string tile_summary(const TileRun& run) {
   const std::string verdict = run.worst.targets_met ? "targets met" : "targets NOT met: " + run.worst.targets_failed;
   return internal::format_text(
       "%s %dx%d -> %s %dx%d: wrap %.2f x %.2f y, worst seam %.2f (exemplar %.2f), hist L1 %.3f, "
-      "gradient %.2f, coherence %.3f (exemplar %.3f), %s, %.2f s\n",
+      "gradient %.2f, coherence %.3f (exemplar %.3f%s), %s%s, %.2f s\n",
       run.input.c_str(), run.input_width, run.input_height, run.output.c_str(), run.report.width, run.report.height,
       worst.wrap_ratio_x, worst.wrap_ratio_y, worst.worst_seam_ratio, worst.exemplar_worst_seam_ratio,
       worst.histogram_l1, worst.gradient_ratio, worst.patch_coherence, worst.exemplar_patch_coherence,
-      verdict.c_str(), run.seconds);
+      worst.coherence_with_turns ? ", both with quarter turns" : "", verdict.c_str(),
+      run.report.symmetry != 4                 ? ""
+      : run.report.quarter_turn_difference == 0 ? ", quarter-turn symmetric (exact)"
+                                               : ", quarter turn NOT exact",
+      run.seconds);
 }
 
 std::string eval_tile_report_json(const TileQuality& tile, int width, int height, const std::string& exemplar) {

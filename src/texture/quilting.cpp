@@ -145,6 +145,25 @@ void Quilter::place(int bx, int by, int bw, int bh, const Exclusion& exclusion) 
         const float* e = ex_.at(px + x, py + y);
         std::copy(e, e + channels, canvas_.at(cx, cy));
         if (source_) (*source_)[ci] = (py + y) * ex_.width + px + x;
+        if (turns_) {
+          // The three images under r(x, y) = (N - 1 - y, x); the source turns with them:
+          // turns[k + 1](S - 1 - sy, sx) = turns[k](sx, sy) for the S x S exemplar.
+          const int n = canvas_.width, s = ex_.width;
+          const int32_t plane = s * s;
+          int rx = cx, ry = cy;
+          int32_t src = (py + y) * ex_.width + px + x;
+          for (int turn = 1; turn < 4; ++turn) {
+            const int nx2 = n - 1 - ry;
+            ry = rx;
+            rx = nx2;
+            const int32_t k = src / plane, sx = src % plane % s, sy = src % plane / s;
+            src = ((k + 1) % 4) * plane + sx * s + (s - 1 - sy);
+            const size_t ri = static_cast<size_t>(ry) * n + rx;
+            std::copy(e, e + channels, canvas_.at(rx, ry));
+            if (source_) (*source_)[ri] = src;
+            known_[ri] = 1;
+          }
+        }
       }
       known_[ci] = 1;
     }
@@ -386,16 +405,20 @@ double Quilter::patch_cost(int bx, int by, int px, int py, double factor_a, doub
       int n_tried = 0;
       float best = std::numeric_limits<float>::max();
       for (const auto& probe : kProbe) {
-        const int32_t s = region_src_[static_cast<size_t>(j + probe[1]) * rw + i + probe[0]];
+        int32_t s = region_src_[static_cast<size_t>(j + probe[1]) * rw + i + probe[0]];
+        // Quarter-turn mode: the source names a pixel of one of the exemplar's turns.
+        const int32_t turn = turns_ ? s / (ew * eh) : 0;
+        if (turns_) s %= ew * eh;
+        const Plane& plane = turns_ ? (*turns_)[static_cast<size_t>(turn)] : ex_;
         const int ox = std::clamp(s % ew - probe[0], 0, ew - kP);
         const int oy = std::clamp(s / ew - probe[1], 0, eh - kP);
-        const int32_t origin = oy * ew + ox;
+        const int32_t origin = turn * ew * eh + oy * ew + ox;
         if (std::find(tried, tried + n_tried, origin) != tried + n_tried) continue;
         tried[n_tried++] = origin;
         float sum = 0.0f;
         for (int b = 0; b < kP && sum < best; ++b) {
           const float* t = &region_val_[(static_cast<size_t>(j + b) * rw + i) * channels];
-          const float* e = ex_.at(ox, oy + b);
+          const float* e = plane.at(ox, oy + b);
           for (int a = 0; a < kP * channels; ++a) {
             const float d = t[a] - e[a];
             sum += d * d;

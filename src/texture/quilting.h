@@ -72,6 +72,14 @@ class Quilter {
   //! original content is the old seam and whose pixels are, or will be, replaced anyway.
   void set_profile(const Plane* original, int axes, int skip_first = 0, int skip_count = 0);
 
+  //! Quarter-turn mode (TileOptions::symmetry 4): the canvas is square (N x N) and kept unchanged
+  //! by r(x, y) = (N - 1 - y, x): every pixel a block writes is also written at its three images
+  //! under r. turns[k] is the (square) exemplar turned k times the same way (turns[0] = the
+  //! exemplar); a source index is then k * (exemplar pixels) + the pixel's index in turns[k], so
+  //! the patch cost sees rotated copies as copies. The caller keeps blocks from overlapping their
+  //! own images.
+  void set_quarter_turns(const std::vector<Plane>* turns) { turns_ = turns; }
+
  private:
   //! candidates_ = the positions within the SSD tolerance of the best (raster order), excluded
   //! ones left out (unless all are excluded); fewer than min_candidates_ -> the min_candidates_
@@ -141,6 +149,7 @@ class Quilter {
   int profile_axes_ = 0;
   int skip_first_ = 0, skip_count_ = 0;
   std::vector<uint8_t> strong_rows_, strong_cols_;
+  const std::vector<Plane>* turns_ = nullptr;
 };
 
 }  // namespace tailor::internal

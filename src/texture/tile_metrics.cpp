@@ -138,8 +138,36 @@ double variance(const Plane& p) {
 }
 
 //! PatchMatch nearest-patch distances from a fixed grid of (toroidal) `source` patches to the
-//! patches of `target` (non-toroidal). Returns the mean per-sample squared distance.
-double mean_nearest_patch_distance(const Plane& source, const Plane& target) {
+//! patches of `target` (non-toroidal): `cost` gets each grid patch's squared distance (summed over
+//! its samples).
+void nearest_patch_costs(const Plane& source, const Plane& target, std::vector<float>& cost);
+
+//! The mean per-sample squared distance of nearest_patch_costs; with `turns`, the nearest over
+//! the target and its three quarter turns.
+double mean_nearest_patch_distance(const Plane& source, const Plane& target, bool turns = false) {
+  std::vector<float> cost, other;
+  nearest_patch_costs(source, target, cost);
+  if (turns) {
+    Plane turned = target;
+    for (int k = 1; k < 4; ++k) {
+      const Plane prev = turned;
+      turned.width = prev.height;
+      turned.height = prev.width;
+      for (int y = 0; y < prev.height; ++y)
+        for (int x = 0; x < prev.width; ++x) {
+          const float* v = prev.at(x, y);
+          std::copy(v, v + prev.channels, turned.at(prev.height - 1 - y, x));
+        }
+      nearest_patch_costs(source, turned, other);
+      for (size_t i = 0; i < cost.size(); ++i) cost[i] = std::min(cost[i], other[i]);
+    }
+  }
+  double total = 0.0;
+  for (float v : cost) total += v;
+  return total / (static_cast<double>(cost.size()) * kPatch * kPatch * source.channels);
+}
+
+void nearest_patch_costs(const Plane& source, const Plane& target, std::vector<float>& cost) {
   const int c = source.channels;
   const int w = source.width, h = source.height;
   // Toroidally padded copy of the source, so that a patch is a plain sub-rectangle.
@@ -198,7 +226,7 @@ double mean_nearest_patch_distance(const Plane& source, const Plane& target) {
   std::sort(table.begin(), table.end());
 
   std::vector<int> nu(count), nv(count);
-  std::vector<float> cost(count);
+  cost.assign(count, 0.0f);
   internal::SplitMix64 rng(0x5EED5EEDull);
   for (size_t i = 0; i < count; ++i) {
     const int sx = ox + static_cast<int>(i % static_cast<size_t>(gx)) * stride;
@@ -259,12 +287,53 @@ double mean_nearest_patch_distance(const Plane& source, const Plane& target) {
       }
     }
   }
-  double total = 0.0;
-  for (float v : cost) total += v;
-  return total / (static_cast<double>(count) * kPatch * kPatch * c);
 }
 
 }  // namespace
+
+int quarter_turn_difference(const Image& tile, int* shift_x, int* shift_y) {
+  if (!check_image(tile).is_ok() || tile.width != tile.height) return -1;
+  const int n = tile.width, c = tile.channels;
+  int best = -1, best_sx = 0, best_sy = 0;
+  for (int sy : {0, n / 2})
+    for (int sx : {0, n / 2}) {
+      // rot90(tile)(x, y) = tile(y, n - 1 - x) (the inverse of r in Quilter::set_quarter_turns),
+      // against tile((x + sx) % n, (y + sy) % n).
+      int worst = 0;
+      for (int y = 0; y < n && (best < 0 || worst < best); ++y)
+        for (int x = 0; x < n; ++x) {
+          const uint8_t* a = &tile.pixels[(static_cast<size_t>(n - 1 - x) * n + y) * c];
+          const uint8_t* b = &tile.pixels[(static_cast<size_t>((y + sy) % n) * n + (x + sx) % n) * c];
+          for (int k = 0; k < c; ++k) worst = std::max(worst, std::abs(static_cast<int>(a[k]) - static_cast<int>(b[k])));
+        }
+      if (best < 0 || worst < best) {
+        best = worst;
+        best_sx = sx;
+        best_sy = sy;
+      }
+    }
+  if (shift_x) *shift_x = best_sx;
+  if (shift_y) *shift_y = best_sy;
+  return best;
+}
+
+double orientation_anisotropy(const Image& image) {
+  if (!check_image(image).is_ok() || image.width < 3 || image.height < 3) return 0.0;
+  const Image grey = image.channels == 1 ? image : to_grey(image);
+  const int w = grey.width, h = grey.height;
+  auto at = [&](int x, int y) { return static_cast<double>(grey.pixels[static_cast<size_t>(y) * w + x]); };
+  double jxx = 0.0, jyy = 0.0, jxy = 0.0;
+  for (int y = 1; y + 1 < h; ++y)
+    for (int x = 1; x + 1 < w; ++x) {
+      const double gx = at(x + 1, y) - at(x - 1, y), gy = at(x, y + 1) - at(x, y - 1);
+      jxx += gx * gx;
+      jyy += gy * gy;
+      jxy += gx * gy;
+    }
+  const double trace = jxx + jyy;
+  if (trace <= 0.0) return 0.0;
+  return std::sqrt((jxx - jyy) * (jxx - jyy) + 4.0 * jxy * jxy) / trace;
+}
 
 Status tile_metrics(const Image& tile_in, const Image* exemplar_in, TileMetrics& metrics) {
   metrics = TileMetrics{};
@@ -283,6 +352,8 @@ Status tile_metrics(const Image& tile_in, const Image* exemplar_in, TileMetrics&
       exemplar = to_grey(exemplar);
     }
   }
+  metrics.quarter_turn_difference =
+      quarter_turn_difference(tile, &metrics.quarter_turn_shift_x, &metrics.quarter_turn_shift_y);
   const Plane tp = internal::to_plane(tile);
   const SeamStats ts = seam_stats(tp);
   metrics.wrap_ratio_x = ts.wrap_x;
@@ -302,8 +373,11 @@ Status tile_metrics(const Image& tile_in, const Image* exemplar_in, TileMetrics&
   metrics.gradient_ratio = ratio(metrics.gradient_energy, eg);
   const double var = std::max(variance(ep), 1e-6);
   if (ep.width >= kPatch && ep.height >= kPatch) {
-    metrics.patch_coherence = mean_nearest_patch_distance(tp, ep) / var;
-    metrics.exemplar_patch_coherence = mean_nearest_patch_distance(ep, ep) / var;
+    // A quarter-turn tile holds every patch in four orientations: compare with all four.
+    const bool turns = metrics.quarter_turn_difference == 0;
+    metrics.coherence_with_turns = turns;
+    metrics.patch_coherence = mean_nearest_patch_distance(tp, ep, turns) / var;
+    metrics.exemplar_patch_coherence = mean_nearest_patch_distance(ep, ep, turns) / var;
   }
   return Status::ok();
 }

@@ -45,6 +45,34 @@ constexpr int kMinCandidates = 8;       // a tolerance set smaller than this is 
 constexpr int kProfileCandidates = 16;  // the same where the straight-boundary profile is checked
 constexpr int kAttemptPixels = 320 * 320;  // best of (this / pixels) attempts, at most kMaxAttempts
 constexpr int kMaxAttempts = 4;
+constexpr double kDirectional = 0.5;   // symmetry 4 warns above this orientation_anisotropy()
+
+//! Square image cut out of `in`.
+Image crop(const Image& in, int x0, int y0, int w, int h) {
+  Image out;
+  out.width = w;
+  out.height = h;
+  out.channels = in.channels;
+  out.pixels.resize(static_cast<size_t>(w) * h * in.channels);
+  for (int y = 0; y < h; ++y) {
+    const uint8_t* s = &in.pixels[(static_cast<size_t>(y0 + y) * in.width + x0) * in.channels];
+    std::copy(s, s + static_cast<size_t>(w) * in.channels, &out.pixels[static_cast<size_t>(y) * w * in.channels]);
+  }
+  return out;
+}
+
+//! The plane turned once the way of Quilter::set_quarter_turns: out(S - 1 - y, x) = in(x, y).
+Plane turn_plane(const Plane& in) {
+  Plane out = in;
+  out.width = in.height;
+  out.height = in.width;
+  for (int y = 0; y < in.height; ++y)
+    for (int x = 0; x < in.width; ++x) {
+      const float* v = in.at(x, y);
+      std::copy(v, v + in.channels, out.at(in.height - 1 - y, x));
+    }
+  return out;
+}
 
 //! Start positions of `count` blocks of side b evenly covering [start, start + length).
 std::vector<int> chain_positions(int start, int length, int b, int overlap) {
@@ -64,6 +92,7 @@ struct Setup {
   int shift_y = 0;
   int fold_x = 0;  // px added by fit_period extension: its fold seam lies fold_x px before the wrap
   int fold_y = 0;
+  int symmetry = 1;  // 4: quarter-turn tile (exemplar cropped to its centred square, even side)
 };
 
 void choose_shift(const Plane& ex, int& shift_x, int& shift_y);
@@ -109,7 +138,29 @@ Status prepare(const Image& input, const TileOptions& options, Setup& setup, Til
     return Status::error(ErrorCode::kInvalidImage, "",
                          "image too small to make tileable (at least " + std::to_string(kMinTileSide) + " px a side)",
                          std::to_string(input.width) + "x" + std::to_string(input.height));
+  if (options.symmetry != 1 && options.symmetry != 4)
+    return Status::error(ErrorCode::kInvalidArgument, "", "symmetry must be 1 or 4",
+                         "got " + std::to_string(options.symmetry));
+  if (options.symmetry == 4 && options.fit_period)
+    return Status::error(ErrorCode::kInvalidArgument, "", "--symmetry 4 cannot be combined with --fit-period",
+                         "a quarter-turn tile is square; a period fitted along x and y would not survive the turn");
   Image work = input;
+  report.symmetry = options.symmetry;
+  setup.symmetry = options.symmetry;
+  if (options.symmetry == 4) {
+    // Square of even side: the quarter turn about the centre maps the pixel grid onto itself.
+    report.anisotropy = orientation_anisotropy(input);
+    if (report.anisotropy > kDirectional)
+      report.warnings.push_back("directional texture (orientation anisotropy " +
+                                std::to_string(report.anisotropy).substr(0, 4) +
+                                " > 0.5): a quarter-turn tile shows it turned by 90 degrees in three of its quadrants");
+    const int side = std::min(input.width, input.height) & ~3;
+    if (side != input.width || side != input.height) {
+      report.warnings.push_back("cropped to the centred " + std::to_string(side) + "x" + std::to_string(side) +
+                                " square for --symmetry 4");
+      work = crop(input, (input.width - side) / 2, (input.height - side) / 2, side, side);
+    }
+  }
   if (options.fit_period) {
     report.period = estimate_period(input);
     int w = input.width, h = input.height;
@@ -137,7 +188,7 @@ Status prepare(const Image& input, const TileOptions& options, Setup& setup, Til
   setup.fold_y = std::clamp(work.height - input.height, 0, work.height / 4);
   setup.block = block;
   setup.overlap = overlap;
-  choose_shift(setup.exemplar, setup.shift_x, setup.shift_y);
+  if (setup.symmetry == 1) choose_shift(setup.exemplar, setup.shift_x, setup.shift_y);
   report.shift_x = setup.shift_x;
   report.shift_y = setup.shift_y;
   report.block = block;
@@ -312,6 +363,149 @@ Status quilt_cross(const Setup& setup, const TileOptions& options, const CrossPl
   return Status::ok();
 }
 
+//! Quarter-turn tile (symmetry 4) on the square N x N exemplar, M = N / 2: the canvas starts as a
+//! pinwheel of the exemplar's centred M x M square Q (Q in the top-left quadrant, its images under
+//! r(x, y) = (N - 1 - y, x) in the others), so it is unchanged by r and has seams on the lines
+//! x, y = M (the centre '+') and x, y = 0 (the wrap '+'). Zones of `margin` px around them are
+//! unknown and quilted with the arm blocks of quilt_cross, each block written into its four
+//! places (Quilter::set_quarter_turns). Up to the turn, there are two seams: segment A (x = M,
+//! y in [0, M): between the 2-fold point (M, 0) and the centre) and segment B (x = 0, y in [0, M):
+//! between the corner and the 2-fold point (0, M)); the centre and the corner, where a block
+//! would overlap its own images, get one quarter block each (its images are the other three
+//! quarters). The result is made exact by rebuilding it from its top-left quadrant.
+Status quilt_pinwheel(const Setup& setup, const TileOptions& options, const CrossPlan& plan, SsdSearch& search,
+                      const std::vector<Plane>& turns, Plane& canvas, int& placed, double& cut_cost) {
+  const Plane& ex = setup.exemplar;
+  const int n = ex.width, m = n / 2, c = ex.channels;
+  const int b = std::max(8, setup.block / kArmDivisor);
+  const int ov = std::clamp(setup.overlap / kArmDivisor, 1, b / 2 - 1);
+  const int margin = b - 2 * ov;                   // unknown zone across each line
+  const int half = margin / 2;                     // the zone is [line - half, line - half + margin)
+  const int arm = margin + 2 * ov;                 // block extent across a line
+  // A chain block must not reach its own quarter-turn image near a 4-fold point: the chains stop
+  // `reach` px before it and a quarter block of side `quarter` (>= reach + ov) fills the rest.
+  const int reach = half + 2 * ov;
+  const int quarter = std::max(b, reach + ov);
+  if (quarter > m / 2) return Status::error(ErrorCode::kInvalidArgument, "", "block too large for --symmetry 4");
+  canvas = ex;
+  std::vector<int32_t> source(static_cast<size_t>(n) * n, -1);
+  std::vector<uint8_t> known(static_cast<size_t>(n) * n, 1), locked(static_cast<size_t>(n) * n, 0);
+  const int32_t plane = n * n;
+  // Q = exemplar [qx, qx + m) x [qy, qy + m): of 3 x 3 places, the one whose 64-bin histogram
+  // (all channels) is nearest the exemplar's (a non-stationary photo: its centre alone can be
+  // lighter or darker than the whole).
+  auto histogram = [&](int x0, int y0, int size) {
+    std::vector<double> h(static_cast<size_t>(64 * c), 0.0);
+    for (int y = y0; y < y0 + size; ++y)
+      for (int x = x0; x < x0 + size; ++x)
+        for (int k = 0; k < c; ++k)
+          h[static_cast<size_t>(k * 64 + std::clamp(static_cast<int>(ex.at(x, y)[k]), 0, 255) / 4)] +=
+              1.0 / (static_cast<double>(size) * size);
+    return h;
+  };
+  const std::vector<double> whole = histogram(0, 0, n);
+  int qx = (n - m) / 2, qy = (n - m) / 2;
+  double best_l1 = std::numeric_limits<double>::max();
+  for (int j = 0; j <= 2; ++j)
+    for (int i = 0; i <= 2; ++i) {
+      const int x0 = i * (n - m) / 2, y0 = j * (n - m) / 2;
+      const std::vector<double> h = histogram(x0, y0, m);
+      double l1 = 0.0;
+      for (size_t k = 0; k < h.size(); ++k) l1 += std::abs(h[k] - whole[k]);
+      if (l1 < best_l1 - 1e-12) {
+        best_l1 = l1;
+        qx = x0;
+        qy = y0;
+      }
+    }
+  for (int y = 0; y < m; ++y)
+    for (int x = 0; x < m; ++x) {
+      int rx = x, ry = y;
+      int32_t src = (qy + y) * n + qx + x;
+      const float* e = ex.at(qx + x, qy + y);
+      for (int turn = 0; turn < 4; ++turn) {
+        std::copy(e, e + c, canvas.at(rx, ry));
+        source[static_cast<size_t>(ry) * n + rx] = src;
+        const int nx2 = n - 1 - ry;
+        ry = rx;
+        rx = nx2;
+        const int32_t k = src / plane, sx = src % plane % n, sy = src % plane / n;
+        src = ((k + 1) % 4) * plane + sx * n + (n - 1 - sy);
+      }
+    }
+  auto in_zone = [&](int v) { return Plane::mod(v - (m - half), n) < margin || Plane::mod(v + half, n) < margin; };
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x)
+      if (in_zone(x) || in_zone(y)) {
+        known[static_cast<size_t>(y) * n + x] = 0;
+        source[static_cast<size_t>(y) * n + x] = -1;
+      }
+  SplitMix64 rng(mix_seed(options.seed, plan.stream));
+  Quilter quilter(ex, search, canvas, known, locked, ov, options.tolerance, rng, &source, kCandidatePool,
+                  plan.gradient_penalty);
+  quilter.set_quarter_turns(&turns);
+  quilter.set_min_candidates(plan.min_candidates);
+  // The 2-fold point (M, 0) gets a block of 2 quarter x 2 quarter, so chain A starts below it.
+  const int a0 = quarter - ov;
+  const std::vector<int> chain_a = chain_positions(a0, m - reach + ov - a0, b, ov);
+  const std::vector<int> chain_b = chain_positions(reach - ov, m - half + ov - (reach - ov), b, ov);
+  const double total = static_cast<double>(chain_a.size() + chain_b.size() + 3);
+  double done = 0.0;
+  auto tick = [&]() -> bool {
+    done += 1.0;
+    return !options.progress || options.progress(done / total);
+  };
+  const Exclusion none;
+  // A: down segment x = M from the 2-fold point (M, 0) (its half-turn image fills y < 0) to the centre.
+  for (int y : chain_a) {
+    quilter.place(m - half - ov, y, arm, std::min(b, m - reach + ov - y), none);
+    if (!tick()) return Status::error(ErrorCode::kCancelled, "", "cancelled");
+  }
+  // B: down segment x = 0 from the corner to the centre line (filled by A's images by now).
+  for (int y : chain_b) {
+    quilter.place(-half - ov, y, arm, std::min(b, m - half + ov - y), none);
+    if (!tick()) return Status::error(ErrorCode::kCancelled, "", "cancelled");
+  }
+  // The rotation centres, where a block would overlap its own images: a block that writes only
+  // one wedge between diagonals (the rest of it is locked; its images fill the other wedges), so
+  // that the unrepaired seams between the images run along diagonals, spread over many columns
+  // and rows, not along the wrap or centre lines that the seam metrics measure. (dx2, dy2): twice
+  // the pixel centre's offset from the rotation centre.
+  auto place_wedge = [&](int cx, int cy, int bx, int by, int bw, int bh, auto inside) {
+    for (int y = by; y < by + bh; ++y)
+      for (int x = bx; x < bx + bw; ++x)
+        if (!inside(2 * (x - cx) + 1, 2 * (y - cy) + 1))
+          locked[static_cast<size_t>(Plane::mod(y, n)) * n + Plane::mod(x, n)] = 1;
+    quilter.place(bx, by, bw, bh, none);
+    std::fill(locked.begin(), locked.end(), uint8_t{0});
+  };
+  // 4-fold: the upper wedge (dx in [dy, -dy)); its quarter turns are the right, lower, left ones.
+  auto upper_wedge = [](int dx2, int dy2) { return dy2 < 0 && dx2 >= dy2 && dx2 < -dy2; };
+  // 2-fold: the half below the anti-diagonal through the point (its half turn is the other half).
+  auto lower_half = [](int dx2, int dy2) { return dx2 + dy2 < 0 || (dx2 + dy2 == 0 && dx2 < 0); };
+  place_wedge(m, 0, m - quarter, -quarter, 2 * quarter, 2 * quarter, lower_half);
+  if (!tick()) return Status::error(ErrorCode::kCancelled, "", "cancelled");
+  place_wedge(m, m, m - quarter, m - quarter, 2 * quarter, quarter, upper_wedge);
+  if (!tick()) return Status::error(ErrorCode::kCancelled, "", "cancelled");
+  place_wedge(0, 0, -quarter, -quarter, 2 * quarter, quarter, upper_wedge);
+  tick();
+  // Exact: every quadrant from the top-left one.
+  for (int y = 0; y < m; ++y)
+    for (int x = 0; x < m; ++x) {
+      const float* e = canvas.at(x, y);
+      int rx = x, ry = y;
+      for (int turn = 1; turn < 4; ++turn) {
+        const int nx2 = n - 1 - ry;
+        ry = rx;
+        rx = nx2;
+        std::copy(e, e + c, canvas.at(rx, ry));
+      }
+    }
+  placed += quilter.placed();
+  cut_cost = quilter.cut_cost();
+  return Status::ok();
+}
+
 }  // namespace
 
 Image swap_quadrants(const Image& image) {
@@ -339,6 +533,9 @@ Status make_tile_variants(const Image& exemplar, const TileOptions& options, int
   if (count < 1 || count > 64)
     return Status::error(ErrorCode::kInvalidArgument, "", "variant count must be in [1, 64]",
                          "got " + std::to_string(count));
+  if (options.symmetry == 4 && count > 1)
+    return Status::error(ErrorCode::kInvalidArgument, "", "--symmetry 4 makes one tile: --variants cannot be used with it",
+                         "variants re-quilt the interior freely, which would break the quarter-turn symmetry");
   TileReport local;
   TileReport& rep = report ? *report : local;
   rep = TileReport{};
@@ -369,7 +566,12 @@ Status make_tile_variants(const Image& exemplar, const TileOptions& options, int
     const double exemplar_worst = worst_seam_ratio(internal::to_plane(exemplar), false);
     const double target = std::max(exemplar_worst, kSeamFloor);
     std::vector<CrossPlan> plans;
-    if (exemplar_worst > kStrongEdge) {
+    std::vector<Plane> turns;
+    if (setup.symmetry == 4) {
+      turns.push_back(ex);
+      for (int k = 1; k < 4; ++k) turns.push_back(turn_plane(turns.back()));
+    }
+    if (exemplar_worst > kStrongEdge && setup.symmetry == 1) {
       plans.push_back({0, kSmoothPenalty, 0, 1, 2});
       plans.push_back({0, kSmoothPenalty, 0, 0, 2});
     } else {
@@ -381,7 +583,7 @@ Status make_tile_variants(const Image& exemplar, const TileOptions& options, int
     int base_blocks = 0;
     double base_worst = 0.0, base_cost = 0.0;
     bool base_meets = false;
-    const size_t retry_plan = exemplar_worst > kStrongEdge ? 1 : plans.size() - 1;
+    const size_t retry_plan = exemplar_worst > kStrongEdge && setup.symmetry == 1 ? 1 : plans.size() - 1;
     for (size_t i = 0; i < plans.size(); ++i) {
       // Later plans of strong-edge exemplars, and the smooth-penalty retry, run only if needed.
       if (i >= retry_plan && base_meets) break;
@@ -391,7 +593,10 @@ Status make_tile_variants(const Image& exemplar, const TileOptions& options, int
       Plane canvas;
       int blocks = 0;
       double cost = 0.0;
-      TAILOR_RETURN_IF_ERROR(quilt_cross(setup, plan_options, plans[i], search, canvas, blocks, cost));
+      if (setup.symmetry == 4)
+        TAILOR_RETURN_IF_ERROR(quilt_pinwheel(setup, plan_options, plans[i], search, turns, canvas, blocks, cost));
+      else
+        TAILOR_RETURN_IF_ERROR(quilt_cross(setup, plan_options, plans[i], search, canvas, blocks, cost));
       const double worst = worst_seam_ratio(canvas, true);
       const bool meets = worst <= target * kSeamHeadroom;
       // Meeting the seam target first, then the lower cut cost (or, both missing, the lower worst seam).
@@ -406,7 +611,25 @@ Status make_tile_variants(const Image& exemplar, const TileOptions& options, int
       }
     }
     rep.blocks += base_blocks;
+    if (setup.symmetry == 4) {
+      // The pinwheel's quadrant lines hold the repaired strips and the unrepaired seams through
+      // the rotation centres; shifted by N/4 they lie inside the tile and the wrap runs through
+      // quadrant interiors (exemplar columns and rows). rot90(tile) == tile shifted by (N/2, 0).
+      const Plane pinwheel = base;
+      const int q = w / 4;
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+          const float* v = pinwheel.at((x + q) % w, (y + q) % h);
+          std::copy(v, v + ex.channels, base.at(x, y));
+        }
+      rep.shift_x = rep.shift_y = q;
+    }
     tiles.push_back(plane_to_image(base));
+    if (setup.symmetry == 4) {
+      rep.border = 0;
+      rep.quarter_turn_difference = quarter_turn_difference(tiles[0]);
+      return Status::ok();
+    }
 
     // Variants: re-quilt everything inside a ring of `border` px, in a raster order that changes
     // with the variant; the ring and the cut band (overlap px) inside it are known context.
