@@ -103,7 +103,7 @@ void BM_Mapping(benchmark::State& state, const std::string& key, const tailor::M
   state.counters["single"] = static_cast<double>(m.single_face_patches);
   state.counters["seam%"] = 100.0 * m.seam_length_ratio;
   state.counters["gap_px"] = m.seam_gap_px;
-  state.counters["visible%"] = 100.0 * m.visible_seam_ratio;  // issue 14: seams the texture breaks at
+  state.counters["visible%"] = 100.0 * m.visible_seam_ratio;      // issue 14: seams the texture breaks at
   state.counters["invisible%"] = 100.0 * m.seam_invisible_ratio;  // share of seam length on the lattice
   state.counters["dangling"] = static_cast<double>(m.visible_dangling_ends);
   state.counters["flipped"] = static_cast<double>(m.flipped);
@@ -115,8 +115,8 @@ void BM_Mapping(benchmark::State& state, const std::string& key, const tailor::M
 }
 
 // Registers one orientation and five mapping benchmarks per mesh at static initialisation:
-// patches mode (default options and ten times the texture scale), its growth alone (no crack closing), the fewest-seams setting
-// (pure unfolding, crack closing at 32 rings), thesis mode.
+// patches mode (default options and ten times the texture scale), its growth alone (no crack closing), the fewest-seams
+// setting (pure unfolding, crack closing at 32 rings), thesis mode.
 [[maybe_unused]] const bool registered = [] {
   std::vector<std::pair<std::string, std::string>> meshes = {{"horse_x16", "horse_x16"}};
   const std::filesystem::path dir = std::filesystem::path(TAILOR_SHARED_DATA) / "meshes";

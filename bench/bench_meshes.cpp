@@ -11,16 +11,15 @@
 #include <string>
 #include <vector>
 
+#include "tailor/io.h"
 #include "util/atomic_file.h"
 #include "util/flat_hash.h"
-#include "tailor/io.h"
 
 namespace {
 
 using tailor::Mesh;
 using tailor::Status;
 namespace internal = tailor::internal;
-
 
 [[noreturn]] void die(const std::string& what) {
   std::fprintf(stderr, "bench: %s\n", what.c_str());

@@ -9,7 +9,7 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   tailor::Mesh mesh;
   tailor::Image image;
-  (void)tailor::read_glb_memory(std::span<const char>(reinterpret_cast<const char*>(data), size), "fuzz.glb",
-                                mesh, &image);
+  (void)tailor::read_glb_memory(std::span<const char>(reinterpret_cast<const char*>(data), size), "fuzz.glb", mesh,
+                                &image);
   return 0;
 }

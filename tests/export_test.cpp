@@ -1,33 +1,33 @@
 // Export (.glb / .obj / .ply), vertex splitting, the glb reader and `tailor eval`.
+#include "tailor/export.h"
+
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 #include <stb/stb_image.h>
 #include <stb/stb_image_write.h>
 #include <sys/resource.h>
 
 #include <bit>
-#include <csignal>
 #include <cmath>
+#include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <string>
 #include <string_view>
 #include <tuple>
 
-#include "util/atomic_file.h"
-#include "tailor/export.h"
+#include "support/fixtures.h"
 #include "tailor/gltf.h"
 #include "tailor/io.h"
 #include "tailor/mapping.h"
-#include "tailor/orientation.h"
 #include "tailor/metrics.h"
+#include "tailor/orientation.h"
 #include "tailor/topology.h"
-
-#include "support/fixtures.h"
+#include "util/atomic_file.h"
 
 namespace tailor {
 namespace {
@@ -95,7 +95,8 @@ bool have_node() {
 void expect_valid_gltf(const std::string& file) {
   if (!have_node()) GTEST_SKIP() << "node not installed: glTF validation skipped";
   std::string out;
-  const int rc = run_command(std::string("node ") + TAILOR_SOURCE_DIR + "/tests/tools/validate_gltf.mjs --strict '" + file + "'", out);
+  const int rc = run_command(
+      std::string("node ") + TAILOR_SOURCE_DIR + "/tests/tools/validate_gltf.mjs --strict '" + file + "'", out);
   EXPECT_EQ(rc, 0) << out;
   EXPECT_NE(out.find("errors 0 warnings 0"), std::string::npos) << out;
 }
@@ -164,7 +165,9 @@ TEST_F(ExportTest, SplitsVerticesOnUvAndWeldsThemBack) {
   EXPECT_EQ(weld_identical_positions(welded), 16u);
   EXPECT_EQ(welded.vertex_count(), 8u);
   for (size_t c = 0; c < cube_.indices.size(); ++c)
-    EXPECT_EQ(std::memcmp(&welded.positions[3 * size_t{welded.indices[c]}], &cube_.positions[3 * size_t{cube_.indices[c]}], 12), 0);
+    EXPECT_EQ(std::memcmp(&welded.positions[3 * size_t{welded.indices[c]}],
+                          &cube_.positions[3 * size_t{cube_.indices[c]}], 12),
+              0);
 }
 
 // The split of a reference implementation: a std::map over (vertex, u bits, v bits), -0 as +0.
@@ -207,7 +210,8 @@ void make_fan(size_t n, Mesh& mesh, std::vector<float>& corner_uv) {
   for (size_t k = 0; k < n; ++k) {
     const auto a = static_cast<uint32_t>(1 + k), b = static_cast<uint32_t>(1 + (k + 1) % n);
     mesh.indices.insert(mesh.indices.end(), {0, a, b});
-    corner_uv.insert(corner_uv.end(), {0, static_cast<float>(k + 1), static_cast<float>(a), 0, static_cast<float>(b), 0});
+    corner_uv.insert(corner_uv.end(),
+                     {0, static_cast<float>(k + 1), static_cast<float>(a), 0, static_cast<float>(b), 0});
   }
 }
 
@@ -327,7 +331,9 @@ TEST_F(ExportTest, GlbRoundTripsAndValidates) {
   for (size_t c = 0; c < 36; ++c) {
     EXPECT_EQ(back.corner_uvs[2 * c], cube_atlas_.corner_uv[2 * c] / 128.0f);
     EXPECT_EQ(back.corner_uvs[2 * c + 1], cube_atlas_.corner_uv[2 * c + 1] / 128.0f);
-    EXPECT_EQ(std::memcmp(&back.positions[3 * size_t{back.indices[c]}], &cube_.positions[3 * size_t{cube_.indices[c]}], 12), 0);
+    EXPECT_EQ(
+        std::memcmp(&back.positions[3 * size_t{back.indices[c]}], &cube_.positions[3 * size_t{cube_.indices[c]}], 12),
+        0);
   }
   // The embedded texture decodes to the file's pixels.
   int w = 0, h = 0, n = 0;
@@ -630,7 +636,8 @@ TEST_F(ExportTest, EvalCommandReportsMetrics) {
   EXPECT_GT(j["seam_gap_px"].get<double>(), 1.0);
 
   // OBJ: UVs in repeats times --texture-size.
-  ASSERT_EQ(run_command(std::string(TAILOR_BINARY) + " eval --json --texture-size 128 " + path("cube.obj"), out), 0) << out;
+  ASSERT_EQ(run_command(std::string(TAILOR_BINARY) + " eval --json --texture-size 128 " + path("cube.obj"), out), 0)
+      << out;
   nlohmann::json k = nlohmann::json::parse(out);
   EXPECT_EQ(k["patches"], 6);
   EXPECT_NEAR(k["seam_gap_px"].get<double>(), j["seam_gap_px"].get<double>(), 1e-3);
@@ -640,7 +647,8 @@ TEST_F(ExportTest, EvalCommandReportsMetrics) {
 
   // PLY (split vertices): eval welds them, so the 12 seams come back.
   ASSERT_TRUE(export_mesh(path("cube.ply"), cube_, cube_atlas_, options).is_ok());
-  ASSERT_EQ(run_command(std::string(TAILOR_BINARY) + " eval --json --texture-size 128 " + path("cube.ply"), out), 0) << out;
+  ASSERT_EQ(run_command(std::string(TAILOR_BINARY) + " eval --json --texture-size 128 " + path("cube.ply"), out), 0)
+      << out;
   k = nlohmann::json::parse(out);
   EXPECT_EQ(k["seam_edges"], 12);
   EXPECT_EQ(k["welded_vertices"], 16);

@@ -1,5 +1,7 @@
 // Image I/O: every supported format reads back what was written, 16-bit PNGs are reduced to
 // 8 bits, and broken or hostile files give a clear error instead of a crash or a huge allocation.
+#include "tailor/image.h"
+
 #include <gtest/gtest.h>
 #include <stb/stb_image_write.h>
 
@@ -11,11 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "util/atomic_file.h"
-#include "tailor/image.h"
-#include "tailor/image_ops.h"
-
 #include "support/fixtures.h"
+#include "tailor/image_ops.h"
+#include "util/atomic_file.h"
 
 // Compiled into libstb.so (C linkage) but declared only in stb_image_write's implementation part.
 extern "C" unsigned char* stbi_zlib_compress(unsigned char* data, int data_len, int* out_len, int quality);

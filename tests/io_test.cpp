@@ -1,6 +1,8 @@
 // Tests for the mesh readers (PLY, OBJ, OFF, STL) and finalize_mesh: exact counts on real meshes
 // (numbers from /work/shared/data/meshes/MANIFEST.md), hand-built adversarial files, error
 // messages that name the right line / element, and every prefix of small files failing cleanly.
+#include "tailor/io.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -14,10 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "util/atomic_file.h"
-#include "tailor/io.h"
-
 #include "support/fixtures.h"
+#include "util/atomic_file.h"
 
 namespace tailor {
 namespace {
@@ -80,7 +80,8 @@ std::string ascii_ply(const Mesh& m) {
                   std::to_string(m.face_count()) + "\nproperty list uchar int vertex_indices\nend_header\n";
   char buf[128];
   for (size_t v = 0; v < m.vertex_count(); ++v) {
-    std::snprintf(buf, sizeof buf, "%.9g %.9g %.9g\n", m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]);
+    std::snprintf(buf, sizeof buf, "%.9g %.9g %.9g\n", m.positions[3 * v], m.positions[3 * v + 1],
+                  m.positions[3 * v + 2]);
     s += buf;
   }
   for (size_t f = 0; f < m.face_count(); ++f) {
@@ -95,7 +96,8 @@ std::string obj_text(const Mesh& m) {
   std::string s = "# written by io_test\nmtllib missing.mtl\no part\n";
   char buf[128];
   for (size_t v = 0; v < m.vertex_count(); ++v) {
-    std::snprintf(buf, sizeof buf, "v %.9g %.9g %.9g\n", m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]);
+    std::snprintf(buf, sizeof buf, "v %.9g %.9g %.9g\n", m.positions[3 * v], m.positions[3 * v + 1],
+                  m.positions[3 * v + 2]);
     s += buf;
   }
   for (size_t c = 0; c < m.corner_uvs.size() / 2; ++c) {
@@ -104,10 +106,11 @@ std::string obj_text(const Mesh& m) {
   }
   for (size_t f = 0; f < m.face_count(); ++f) {
     if (m.corner_uvs.empty()) {
-      std::snprintf(buf, sizeof buf, "f %u %u %u\n", m.indices[3 * f] + 1, m.indices[3 * f + 1] + 1, m.indices[3 * f + 2] + 1);
+      std::snprintf(buf, sizeof buf, "f %u %u %u\n", m.indices[3 * f] + 1, m.indices[3 * f + 1] + 1,
+                    m.indices[3 * f + 2] + 1);
     } else {
-      std::snprintf(buf, sizeof buf, "f %u/%zu %u/%zu %u/%zu\n", m.indices[3 * f] + 1, 3 * f + 1, m.indices[3 * f + 1] + 1,
-                    3 * f + 2, m.indices[3 * f + 2] + 1, 3 * f + 3);
+      std::snprintf(buf, sizeof buf, "f %u/%zu %u/%zu %u/%zu\n", m.indices[3 * f] + 1, 3 * f + 1,
+                    m.indices[3 * f + 1] + 1, 3 * f + 2, m.indices[3 * f + 2] + 1, 3 * f + 3);
     }
     s += buf;
   }
@@ -126,7 +129,8 @@ Mesh first_faces(const Mesh& m, size_t n) {
     }
     out.indices.push_back(map[v]);
   }
-  if (!m.corner_uvs.empty()) out.corner_uvs.assign(m.corner_uvs.begin(), m.corner_uvs.begin() + static_cast<std::ptrdiff_t>(6 * n));
+  if (!m.corner_uvs.empty())
+    out.corner_uvs.assign(m.corner_uvs.begin(), m.corner_uvs.begin() + static_cast<std::ptrdiff_t>(6 * n));
   return out;
 }
 
@@ -240,7 +244,8 @@ std::string shuffled_binary(bool big, const std::string& count_type, const std::
   std::string s = std::string("ply\nformat ") + (big ? "binary_big_endian" : "binary_little_endian") +
                   " 1.0\nelement vertex 4\nproperty float nx\nproperty float z\nproperty uchar red\n"
                   "property double x\nproperty list uchar float junk\nproperty float y\n"
-                  "element face 2\nproperty uchar flags\nproperty list " + count_type + " " + index_type +
+                  "element face 2\nproperty uchar flags\nproperty list " +
+                  count_type + " " + index_type +
                   " vertex_index\nproperty list int short extra\n"
                   "element trailer 1\nproperty list ushort uchar name\nend_header\n";
   const float xy[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
@@ -256,13 +261,19 @@ std::string shuffled_binary(bool big, const std::string& count_type, const std::
   const uint32_t faces[2][3] = {{0, 1, 2}, {0, 2, 3}};
   for (int f = 0; f < 2; ++f) {
     put(s, uint8_t{1}, big);
-    if (count_type == "uchar") put(s, uint8_t{3}, big);
-    else if (count_type == "ushort") put(s, uint16_t{3}, big);
-    else put(s, int32_t{3}, big);
+    if (count_type == "uchar")
+      put(s, uint8_t{3}, big);
+    else if (count_type == "ushort")
+      put(s, uint16_t{3}, big);
+    else
+      put(s, int32_t{3}, big);
     for (uint32_t i : faces[f]) {
-      if (index_type == "uchar") put(s, static_cast<uint8_t>(i), big);
-      else if (index_type == "ushort") put(s, static_cast<uint16_t>(i), big);
-      else put(s, i, big);
+      if (index_type == "uchar")
+        put(s, static_cast<uint8_t>(i), big);
+      else if (index_type == "ushort")
+        put(s, static_cast<uint16_t>(i), big);
+      else
+        put(s, i, big);
     }
     put(s, int32_t{2}, big);
     put(s, int16_t{-5}, big);
@@ -618,9 +629,10 @@ TEST(Errors, FaceWithTwoVertices) {
   EXPECT_EQ(s.where(), "line 4");
   s = parse("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n", MeshFormat::kOff, m);
   EXPECT_EQ(s.what(), "face with 2 vertices");
-  s = parse("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-            "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n",
-            MeshFormat::kPly, m);
+  s = parse(
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n",
+      MeshFormat::kPly, m);
   EXPECT_EQ(s.what(), "face with 2 vertices");
   EXPECT_EQ(s.where(), "line 13");
 }
@@ -635,9 +647,10 @@ TEST(Errors, HugeHeaderCountsFailBeforeAllocating) {
   EXPECT_EQ(st.code(), ErrorCode::kParse);
   EXPECT_NE(st.what().find("4000000000"), std::string::npos) << st.what();
   // Overflowing products and counts beyond 64 bits.
-  st = parse("ply\nformat ascii 1.0\nelement vertex 18446744073709551615\nproperty float x\nproperty float y\n"
-             "property float z\nend_header\n0 0 0\n",
-             MeshFormat::kPly, m);
+  st = parse(
+      "ply\nformat ascii 1.0\nelement vertex 18446744073709551615\nproperty float x\nproperty float y\n"
+      "property float z\nend_header\n0 0 0\n",
+      MeshFormat::kPly, m);
   EXPECT_EQ(st.code(), ErrorCode::kParse);
   st = parse("ply\nformat ascii 1.0\nelement vertex 99999999999999999999999\nend_header\n", MeshFormat::kPly, m);
   EXPECT_EQ(st.code(), ErrorCode::kParse);
@@ -648,10 +661,11 @@ TEST(Errors, HugeHeaderCountsFailBeforeAllocating) {
   std::memcpy(&stl[80], &n, 4);
   EXPECT_EQ(parse(stl, MeshFormat::kStl, m).code(), ErrorCode::kParse);
   // A list count far larger than the file.
-  st = parse("ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-             "property float z\nelement face 1\nproperty list uint int vertex_indices\nend_header\n" +
-                 std::string(36, '\0') + std::string("\xff\xff\xff\x7f", 4),
-             MeshFormat::kPly, m);
+  st = parse(
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uint int vertex_indices\nend_header\n" +
+          std::string(36, '\0') + std::string("\xff\xff\xff\x7f", 4),
+      MeshFormat::kPly, m);
   EXPECT_EQ(st.code(), ErrorCode::kParse);
   EXPECT_EQ(st.where(), "face 0");
 }

@@ -1,4 +1,6 @@
 // Texture mapping by patch discovery (tailor/mapping.h) and its stability (tailor/stability.h).
+#include "tailor/mapping.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -9,15 +11,13 @@
 #include <string>
 #include <vector>
 
+#include "support/fixtures.h"
 #include "tailor/axis_choice.h"
 #include "tailor/io.h"
-#include "tailor/mapping.h"
 #include "tailor/metrics.h"
 #include "tailor/orientation.h"
 #include "tailor/stability.h"
 #include "tailor/topology.h"
-
-#include "support/fixtures.h"
 
 namespace tailor {
 namespace {
@@ -59,8 +59,8 @@ Mesh cylinder(int m, int h) {
   const double pi = std::acos(-1.0);
   for (int j = 0; j <= h; ++j)
     for (int i = 0; i < m; ++i)
-      mesh.positions.insert(mesh.positions.end(), {float(std::cos(2 * pi * i / m)), 0.1f * float(j),
-                                                   float(std::sin(2 * pi * i / m))});
+      mesh.positions.insert(mesh.positions.end(),
+                            {float(std::cos(2 * pi * i / m)), 0.1f * float(j), float(std::sin(2 * pi * i / m))});
   auto id = [m](int i, int j) { return static_cast<uint32_t>(j * m + (i % m)); };
   for (int j = 0; j < h; ++j)
     for (int i = 0; i < m; ++i) {
@@ -378,7 +378,9 @@ TEST(Mapping, RelaxationLowersAngleDistortion) {
     const uint32_t o = one.topology.opposite[e];
     const uint32_t corners[4] = {e, 3 * (e / 3) + (e % 3 + 1) % 3, o, 3 * (o / 3) + (o % 3 + 1) % 3};
     const float* uv = before.atlas.corner_uv.data();
-    const auto gap = [uv](uint32_t a, uint32_t b) { return std::hypot(uv[2 * a] - uv[2 * b], uv[2 * a + 1] - uv[2 * b + 1]); };
+    const auto gap = [uv](uint32_t a, uint32_t b) {
+      return std::hypot(uv[2 * a] - uv[2 * b], uv[2 * a + 1] - uv[2 * b + 1]);
+    };
     if (!(gap(corners[0], corners[3]) < 1.f && gap(corners[1], corners[2]) < 1.f)) continue;
     ++narrow;
     for (const uint32_t c : corners) {
@@ -407,7 +409,7 @@ TEST(Mapping, SeedPointChoosesTheFirstPatch) {
   for (int k = 0; k < 3; ++k)
     for (int i = 0; i < 3; ++i) c[i] += m.mesh.positions[3 * m.mesh.indices[3 * 1000 + k] + i] / 3.0;
   MappingOptions options;
-  options.min_patch_faces = 0;  // keep the seed's own patch even if small
+  options.min_patch_faces = 0;   // keep the seed's own patch even if small
   options.relax_iterations = 0;  // which would move the seed's corners
   options.use_seed_point = true;
   options.seed_point = {float(c[0]), float(c[1]), float(c[2])};

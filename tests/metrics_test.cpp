@@ -1,14 +1,14 @@
 // Metrics on hand-computed cases (docs/metrics.md has the definitions).
+#include "tailor/metrics.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
 #include <vector>
 
-#include "tailor/metrics.h"
-#include "tailor/topology.h"
-
 #include "support/fixtures.h"
+#include "tailor/topology.h"
 
 namespace tailor {
 namespace {
@@ -118,10 +118,14 @@ TEST(Metrics, ThreadCountDoesNotChangeAnyFigure) {
   const UvMetrics a = metrics_of(mesh, uv, {}, one), b = metrics_of(mesh, uv, {}, three);
   EXPECT_GT(a.seam_edges, 0u);
   EXPECT_EQ(a.patches, 2u);
-  for (const auto& [x, y] : {std::pair{a.stretch, b.stretch}, {a.stretch_area_weighted, b.stretch_area_weighted},
-                             {a.distortion_deg, b.distortion_deg}, {a.l2_stretch, b.l2_stretch},
-                             {a.linf_stretch, b.linf_stretch}, {a.seam_length_ratio, b.seam_length_ratio},
-                             {a.seam_gap_px, b.seam_gap_px}, {a.seam_invisible_ratio, b.seam_invisible_ratio},
+  for (const auto& [x, y] : {std::pair{a.stretch, b.stretch},
+                             {a.stretch_area_weighted, b.stretch_area_weighted},
+                             {a.distortion_deg, b.distortion_deg},
+                             {a.l2_stretch, b.l2_stretch},
+                             {a.linf_stretch, b.linf_stretch},
+                             {a.seam_length_ratio, b.seam_length_ratio},
+                             {a.seam_gap_px, b.seam_gap_px},
+                             {a.seam_invisible_ratio, b.seam_invisible_ratio},
                              {a.uv_scale, b.uv_scale}})
     EXPECT_EQ(x, y);
   EXPECT_EQ(a.flipped, b.flipped);
@@ -132,8 +136,8 @@ TEST(Metrics, UnequalScalesGiveKnownStretch) {
   Mesh mesh;
   mesh.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
   mesh.indices = {0, 1, 2, 1, 3, 2};
-  const std::vector<float> uv = {0, 0, 10, 0, 0, 10,           // T0
-                                 100, 0, 100, 20, 80, 20};     // T1: 20 px per unit, shifted
+  const std::vector<float> uv = {0,   0, 10,  0,  0,  10,   // T0
+                                 100, 0, 100, 20, 80, 20};  // T1: 20 px per unit, shifted
   const UvMetrics m = metrics_of(mesh, uv);
   EXPECT_NEAR(m.stretch, 0.6, 1e-9);
   EXPECT_NEAR(m.stretch_area_weighted, 0.6, 1e-9);
@@ -332,8 +336,10 @@ TEST(Metrics, DerivesPatchesOfAMeshCutInTwo) {
   EXPECT_EQ(derive_patches(mesh, topology, uv, patch), 2u);
   ASSERT_EQ(patch.size(), mesh.face_count());
   for (size_t f = 0; f < mesh.face_count(); ++f) {
-    const float cx = (mesh.positions[3 * size_t{mesh.indices[3 * f]}] + mesh.positions[3 * size_t{mesh.indices[3 * f + 1]}] +
-                      mesh.positions[3 * size_t{mesh.indices[3 * f + 2]}]) / 3;
+    const float cx =
+        (mesh.positions[3 * size_t{mesh.indices[3 * f]}] + mesh.positions[3 * size_t{mesh.indices[3 * f + 1]}] +
+         mesh.positions[3 * size_t{mesh.indices[3 * f + 2]}]) /
+        3;
     EXPECT_EQ(patch[f], cx > 2 ? 1u : 0u) << "face " << f;  // numbered in order of lowest face
   }
   const UvMetrics m = metrics_of(mesh, uv);

@@ -1,15 +1,15 @@
 // Orientation field and face frames (tailor/orientation.h).
+#include "tailor/orientation.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
 #include <vector>
 
-#include "tailor/io.h"
-#include "tailor/orientation.h"
-#include "tailor/topology.h"
-
 #include "support/fixtures.h"
+#include "tailor/io.h"
+#include "tailor/topology.h"
 
 namespace tailor {
 namespace {
@@ -62,8 +62,9 @@ TEST(Orientation, LocalCoordinatesKeepEdgeLengthsAndCounterClockwiseOrder) {
     for (int k = 1; k < 3; ++k) {
       const float* a = &mesh.positions[3 * mesh.indices[3 * f]];
       const float* b = &mesh.positions[3 * mesh.indices[3 * f + k]];
-      const double d3 = std::sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) +
-                                  (b[2] - a[2]) * (b[2] - a[2])) * frames.unit_scale;
+      const double d3 =
+          std::sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) + (b[2] - a[2]) * (b[2] - a[2])) *
+          frames.unit_scale;
       ASSERT_NEAR(std::hypot(l[2 * k], l[2 * k + 1]), d3, 1e-5 + 1e-4 * d3);
     }
     const double twice_area = static_cast<double>(l[2]) * l[5] - static_cast<double>(l[3]) * l[4];

@@ -1,21 +1,20 @@
 // Tests of the headless preview renderer (render.h): picture size, non-blank content, views that
 // differ from each other, texture orientation, determinism and input validation.
-#include <gtest/gtest.h>
+#include "tailor/render.h"
 
-#include <utility>
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "support/fixtures.h"
 #include "tailor/image.h"
 #include "tailor/io.h"
-#include "tailor/render.h"
-
-#include "support/fixtures.h"
 
 namespace tailor {
 namespace {
@@ -281,7 +280,8 @@ std::pair<int, int> covered_extent(const Image& img) {
     for (int x = 0; x < img.width; ++x) {
       const uint8_t* p = pixel(img, x, y);
       if (std::abs(int{p[0]} - int{img.pixels[0]}) + std::abs(int{p[1]} - int{img.pixels[1]}) +
-              std::abs(int{p[2]} - int{img.pixels[2]}) <= 12)
+              std::abs(int{p[2]} - int{img.pixels[2]}) <=
+          12)
         continue;
       x0 = std::min(x0, x);
       x1 = std::max(x1, x);
@@ -363,7 +363,8 @@ size_t count(const std::vector<uint8_t>& mask) { return static_cast<size_t>(std:
 // Mean luminance gradient (central differences) over the masked pixels.
 double mean_gradient(const Image& img, const std::vector<uint8_t>& mask) {
   const auto lum = [&](int x, int y) {
-    const uint8_t* p = &img.pixels[3 * (static_cast<size_t>(y) * static_cast<size_t>(img.width) + static_cast<size_t>(x))];
+    const uint8_t* p =
+        &img.pixels[3 * (static_cast<size_t>(y) * static_cast<size_t>(img.width) + static_cast<size_t>(x))];
     return 0.299 * p[0] + 0.587 * p[1] + 0.114 * p[2];
   };
   double sum = 0;

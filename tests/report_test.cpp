@@ -1,13 +1,13 @@
 // The reports of map, eval and tile (tailor/report.h): the JSON keys and values the CLI writes, and
 // the summary lines it prints.
+#include "tailor/report.h"
+
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include "tailor/report.h"
 
 namespace tailor {
 namespace {
@@ -83,8 +83,8 @@ TEST(Report, FileNamesThatAreNotUtf8DoNotBreakTheJson) {
   EXPECT_EQ(eval_summary(run).find("bad\xff.obj: 0 faces"), 0u);
   const nlohmann::json s = nlohmann::json::parse(stability_report_json(run.file, StabilityReport{}));
   EXPECT_EQ(keys(s), (std::vector<std::string>{"compared_corners", "faces", "file", "identical_ratio",
-                                               "max_difference_px", "mean_difference_px", "patches_cut",
-                                               "patches_full", "removed_faces", "seconds", "within_1px_ratio"}));
+                                               "max_difference_px", "mean_difference_px", "patches_cut", "patches_full",
+                                               "removed_faces", "seconds", "within_1px_ratio"}));
 }
 
 TEST(Report, TileReportsTheWorstVariant) {

@@ -1,5 +1,7 @@
 // Self-tileable textures (thesis chapter 3): quality targets on real exemplars, bit-exact borders,
 // determinism, variants, period detection, and the `tailor tile` / `tailor eval-tile` commands.
+#include "tailor/tiling.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -7,16 +9,13 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
+#include "support/fixtures.h"
 #include "tailor/image.h"
 #include "tailor/image_ops.h"
-#include "tailor/tiling.h"
-
-#include "support/fixtures.h"
 
 namespace tailor {
 namespace {
@@ -124,8 +123,8 @@ TEST(TileTargets, MeetsQualityTargetsForOtherSeedsOnTheHardestExemplars) {
 }
 
 const char* const kExemplars[] = {
-    "brick-gray-512.png",      "grass-gray-512.png",    "gravel-gray-512.png",   "vistex-fabric02-128.png",
-    "vistex-tile04-128.png",   "vistex-sand05-128.png", "vistex-bark11-128.png", "water-caustics-300.jpg",
+    "brick-gray-512.png",    "grass-gray-512.png",    "gravel-gray-512.png",   "vistex-fabric02-128.png",
+    "vistex-tile04-128.png", "vistex-sand05-128.png", "vistex-bark11-128.png", "water-caustics-300.jpg",
 };
 
 INSTANTIATE_TEST_SUITE_P(Exemplars, TileTargets, ::testing::ValuesIn(kExemplars),
@@ -550,7 +549,8 @@ TEST(TileCli, SymmetryFourReportsTheQuarterTurnAndRefusesVariants) {
   EXPECT_GT(m["quarter_turn_difference"].get<int>(), 0);
   EXPECT_EQ(m["quarter_turn_symmetric"], false);
 
-  for (const std::string& bad : {std::string("--variants 2"), std::string("--fit-period"), std::string("--symmetry 2")}) {
+  for (const std::string& bad :
+       {std::string("--variants 2"), std::string("--fit-period"), std::string("--symmetry 2")}) {
     const std::string args = bad == "--symmetry 2" ? bad : "--symmetry 4 " + bad;
     const CliRun u = run_cli("tile " + kData + "vistex-sand05-128.png -o " + dir + "/u.png " + args);
     EXPECT_EQ(u.code, 2) << args << ": " << u.err;

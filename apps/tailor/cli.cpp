@@ -33,8 +33,8 @@ extern "C" void on_bus_error(int signal) {
 }  // namespace
 
 ReadingInput::ReadingInput(const std::string& path) {
-  const std::string message =
-      "tailor: error: " + path.substr(0, 4000) + ": the file changed while it was read (truncated by another program?)\n";
+  const std::string message = "tailor: error: " + path.substr(0, 4000) +
+                              ": the file changed while it was read (truncated by another program?)\n";
   std::memcpy(reading_message, message.data(), message.size());
   reading_length = message.size();
   std::atomic_signal_fence(std::memory_order_seq_cst);  // the message is complete before the flag
@@ -77,8 +77,7 @@ Status check_outputs(const std::vector<OutputPath>& outputs, const std::vector<s
                            "directory of the output (" + option + ") does not exist");
     for (const std::string& in : inputs) {
       if (!in.empty() && key(in) == key(path))
-        return Status::error(ErrorCode::kInvalidArgument, path,
-                             "output (" + option + ") would overwrite an input");
+        return Status::error(ErrorCode::kInvalidArgument, path, "output (" + option + ") would overwrite an input");
     }
     for (size_t j = 0; j < i; ++j) {
       if (key(outputs[j].path) == key(path))
@@ -98,7 +97,8 @@ bool parse_vec3(const std::string& text, std::array<float, 3>& v) {
 }
 
 Progress::Progress(std::string label, bool quiet)
-    : label_(std::move(label)), enabled_(!quiet && isatty(STDERR_FILENO) == 1),
+    : label_(std::move(label)),
+      enabled_(!quiet && isatty(STDERR_FILENO) == 1),
       start_(std::chrono::steady_clock::now()) {}
 
 Progress::~Progress() { done(); }
@@ -112,8 +112,8 @@ bool Progress::update(double fraction) {
   last_percent_ = percent;
   constexpr int kWidth = 30;
   const int filled = percent * kWidth / 100;
-  std::fprintf(stderr, "\r%s [%.*s%*s] %3d%%", label_.c_str(), filled, "==============================",
-               kWidth - filled, "", percent);
+  std::fprintf(stderr, "\r%s [%.*s%*s] %3d%%", label_.c_str(), filled,
+               "==============================", kWidth - filled, "", percent);
   std::fflush(stderr);
   drawn_ = true;
   return true;

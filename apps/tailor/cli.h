@@ -3,11 +3,10 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
-
 #include <array>
 #include <chrono>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -65,7 +64,8 @@ CLI::Option* add_documented(CLI::App* app, const OptionDoc& doc, T& field) {
 
 //! Adds the switch `doc` names ("--no-..."), which turns `field` (on by default) off.
 inline CLI::Option* add_off_switch(CLI::App* app, const OptionDoc& doc, bool& field) {
-  return app->add_flag_callback(std::string(doc.flag), [&field] { field = false; }, std::string(doc.help));
+  return app->add_flag_callback(
+      std::string(doc.flag), [&field] { field = false; }, std::string(doc.help));
 }
 
 //! Parses "X,Y,Z" into three finite floats; false when the text is anything else.

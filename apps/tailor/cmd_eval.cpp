@@ -46,8 +46,10 @@ int run_stability(const EvalOptions& opt) {
   StabilityReport r;
   if (Status s = measure_stability(mesh, mapping, r, opt.stability_options); !s)
     return report_error(s.with_file(opt.input));
-  if (opt.json) std::fputs(stability_report_json(opt.input, r).c_str(), stdout);
-  else if (!opt.quiet) std::fputs(stability_summary(opt.input, r).c_str(), stdout);
+  if (opt.json)
+    std::fputs(stability_report_json(opt.input, r).c_str(), stdout);
+  else if (!opt.quiet)
+    std::fputs(stability_summary(opt.input, r).c_str(), stdout);
   return kExitOk;
 }
 
@@ -66,8 +68,9 @@ int run_eval(const EvalOptions& opt) {
   }();
   if (!status) return report_error(status);
   if (mesh.corner_uvs.empty())
-    return report_error(Status::error(ErrorCode::kInvalidMesh, opt.input,
-                                      "mesh has no texture coordinates to evaluate (OBJ vt, PLY s/t or glTF TEXCOORD_0)"));
+    return report_error(
+        Status::error(ErrorCode::kInvalidMesh, opt.input,
+                      "mesh has no texture coordinates to evaluate (OBJ vt, PLY s/t or glTF TEXCOORD_0)"));
   // glb readers weld split vertices themselves; PLY files written after splitting need it here
   // so that seams are edges between faces again (corner UVs are unaffected).
   const size_t welded = glb ? 0 : weld_identical_positions(mesh);
@@ -84,9 +87,9 @@ int run_eval(const EvalOptions& opt) {
     size_source = "embedded texture";
   }
   if (opt.symmetry == 4 && width != height)
-    return report_error(Status::error(ErrorCode::kInvalidArgument, "",
-                                      "--symmetry 4 needs a square texture, got " + std::to_string(width) + "x" +
-                                          std::to_string(height)));
+    return report_error(Status::error(
+        ErrorCode::kInvalidArgument, "",
+        "--symmetry 4 needs a square texture, got " + std::to_string(width) + "x" + std::to_string(height)));
 
   // Texture repeats -> pixels.
   std::vector<float> uv_px(mesh.corner_uvs.size());
@@ -103,7 +106,8 @@ int run_eval(const EvalOptions& opt) {
   const double seconds = seconds_since(start);
 
   if (m.degenerate_faces > 0)
-    warn(opt.quiet || opt.json, std::to_string(m.degenerate_faces) + " faces with zero 3D area skipped by the per-face metrics");
+    warn(opt.quiet || opt.json,
+         std::to_string(m.degenerate_faces) + " faces with zero 3D area skipped by the per-face metrics");
   if (m.zero_uv_area_faces > 0)
     warn(opt.quiet || opt.json, std::to_string(m.zero_uv_area_faces) + " faces with zero UV area (counted as flipped)");
 
@@ -129,7 +133,9 @@ int run_eval(const EvalOptions& opt) {
 void register_eval(CLI::App& app, Runner& run) {
   auto opt = std::make_shared<EvalOptions>();
   auto* cmd = app.add_subcommand("eval", "Print UV quality metrics of a UV-mapped mesh (.obj .ply .glb)");
-  cmd->add_option("mesh", opt->input, "UV-mapped mesh: .obj (vt), .ply (s,t) or .glb (TEXCOORD_0); any mesh with --stability")->required();
+  cmd->add_option("mesh", opt->input,
+                  "UV-mapped mesh: .obj (vt), .ply (s,t) or .glb (TEXCOORD_0); any mesh with --stability")
+      ->required();
   cmd->add_option("--texture-size", opt->texture_size,
                   "Texture size in pixels (UVs are in repeats; this gives pixels). Default: the embedded "
                   "texture's size for .glb, else " +

@@ -63,10 +63,11 @@ int run_eval_tile(const EvalTileOptions& opt) {
   if (m.quarter_turn_difference < 0)
     std::printf("  quarter turn            not square\n");
   else
-    std::printf("  quarter turn            max difference %d after the best shift (%d, %d)   (0 = unchanged by a quarter "
-                "turn%s)\n",
-                m.quarter_turn_difference, m.quarter_turn_shift_x, m.quarter_turn_shift_y,
-                m.coherence_with_turns ? "; coherence measured against the exemplar's four turns" : "");
+    std::printf(
+        "  quarter turn            max difference %d after the best shift (%d, %d)   (0 = unchanged by a quarter "
+        "turn%s)\n",
+        m.quarter_turn_difference, m.quarter_turn_shift_x, m.quarter_turn_shift_y,
+        m.coherence_with_turns ? "; coherence measured against the exemplar's four turns" : "");
   std::printf("  targets                 %s\n", met ? "met" : ("NOT met: " + failed).c_str());
   return kExitOk;
 }

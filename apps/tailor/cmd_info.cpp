@@ -1,7 +1,6 @@
 // tailor info: what a mesh file holds (counts, topology, repairs, bounding box, timings).
 #include <cstdio>
 #include <limits>
-
 #include <nlohmann/json.hpp>
 
 #include "cli.h"
@@ -79,16 +78,14 @@ int run_info(const InfoOptions& opt) {
   std::printf("  edges                  %zu\n", topology.edges);
   std::printf("  boundary edges         %zu\n", topology.boundary_edges);
   std::printf("  non-manifold edges     %zu\n", topology.nonmanifold_edges);
-  std::printf("  inconsistent edges     %zu (shared by two faces running the same way)\n",
-              topology.inconsistent_edges);
+  std::printf("  inconsistent edges     %zu (shared by two faces running the same way)\n", topology.inconsistent_edges);
   std::printf("  degenerate faces       %zu (dropped)\n", report.degenerate_faces);
   std::printf("  duplicate faces        %zu (dropped)\n", report.duplicate_faces);
   std::printf("  zero-area faces        %zu (kept)\n", report.zero_area_faces);
   std::printf("  unreferenced vertices  %zu (kept)\n", report.unreferenced_vertices);
   if (report.welded_vertices) std::printf("  welded corners         %zu\n", report.welded_vertices);
   std::printf("  texture coordinates    %s\n", mesh.corner_uvs.empty() ? "no" : "yes");
-  std::printf("  bounding box           [%g, %g, %g] - [%g, %g, %g]\n", lo[0], lo[1], lo[2], hi[0], hi[1],
-              hi[2]);
+  std::printf("  bounding box           [%g, %g, %g] - [%g, %g, %g]\n", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
   std::printf("  time                   load %.1f ms, topology %.1f ms\n", report.load_seconds * 1e3,
               topology.build_seconds * 1e3);
   return kExitOk;

@@ -6,7 +6,6 @@
 #include <filesystem>
 
 #include "cli.h"
-#include "util/atomic_file.h"
 #include "tailor/axis_choice.h"
 #include "tailor/export.h"
 #include "tailor/image.h"
@@ -18,6 +17,7 @@
 #include "tailor/report.h"
 #include "tailor/stability.h"
 #include "tailor/topology.h"
+#include "util/atomic_file.h"
 
 namespace tailor::cli {
 namespace {
@@ -62,9 +62,12 @@ Status parse_axis(const std::string& text, OrientationOptions& o) {
     return Status::ok();
   }
   o.axis = AxisSource::kUser;
-  if (text == "x") o.user_axis = {1, 0, 0};
-  else if (text == "y") o.user_axis = {0, 1, 0};
-  else if (text == "z") o.user_axis = {0, 0, 1};
+  if (text == "x")
+    o.user_axis = {1, 0, 0};
+  else if (text == "y")
+    o.user_axis = {0, 1, 0};
+  else if (text == "z")
+    o.user_axis = {0, 0, 1};
   else if (!parse_vec3(text, o.user_axis))
     return usage_error("--axis must be pca, x, y, z or three numbers X,Y,Z, got '" + text + "'");
   return Status::ok();
@@ -130,8 +133,7 @@ int run_map(const MapArgs& opt) {
     return report_error(usage_error("--hop-age must be between 0 and 1 radians"));
   // --threads is one count for every stage that has threads.
   options.orientation.threads = options.metrics.threads = mapping.threads;
-  if (Status s = check_outputs(output_paths(opt), {opt.input, opt.texture, opt.seam_faces}); !s)
-    return report_error(s);
+  if (Status s = check_outputs(output_paths(opt), {opt.input, opt.texture, opt.seam_faces}); !s) return report_error(s);
 
   // === Texture (read first: a bad texture should fail before minutes of work) ===
   Image texture;
@@ -142,8 +144,8 @@ int run_map(const MapArgs& opt) {
   const int tex_h = texture.empty() ? opt.texture_size : texture.height;
   // Symmetry 4: the lattice is the texture's square period; the metrics count quarter turns as invisible.
   if (mapping.symmetry == 4 && tex_w != tex_h)
-    return report_error(usage_error("--symmetry 4 needs a square texture, got " + std::to_string(tex_w) + "x" +
-                                    std::to_string(tex_h)));
+    return report_error(
+        usage_error("--symmetry 4 needs a square texture, got " + std::to_string(tex_w) + "x" + std::to_string(tex_h)));
   mapping.texture_period_px = static_cast<float>(tex_w);
   options.metrics.symmetry = mapping.symmetry;
 
@@ -154,8 +156,10 @@ int run_map(const MapArgs& opt) {
     const ReadingInput reading(opt.input);
     if (Status s = load_mesh(opt.input, mesh, &load); !s) return report_error(s);
   }
-  if (load.degenerate_faces) warn(opt.quiet, opt.input + ": dropped " + std::to_string(load.degenerate_faces) + " degenerate faces");
-  if (load.duplicate_faces) warn(opt.quiet, opt.input + ": dropped " + std::to_string(load.duplicate_faces) + " duplicate faces");
+  if (load.degenerate_faces)
+    warn(opt.quiet, opt.input + ": dropped " + std::to_string(load.degenerate_faces) + " degenerate faces");
+  if (load.duplicate_faces)
+    warn(opt.quiet, opt.input + ": dropped " + std::to_string(load.duplicate_faces) + " duplicate faces");
   std::vector<uint8_t> seam_faces;
   if (!opt.seam_faces.empty()) {
     if (Status s = load_seam_faces(opt.seam_faces, mesh.face_count(), seam_faces); !s) return report_error(s);
@@ -166,7 +170,8 @@ int run_map(const MapArgs& opt) {
   const Topology topology = build_topology(mesh);
   if (topology.nonmanifold_edges || topology.inconsistent_edges)
     warn(opt.quiet, opt.input + ": " + std::to_string(topology.nonmanifold_edges) + " non-manifold and " +
-                        std::to_string(topology.inconsistent_edges) + " inconsistently oriented edges treated as boundary");
+                        std::to_string(topology.inconsistent_edges) +
+                        " inconsistently oriented edges treated as boundary");
   options.metrics.texture_width_px = static_cast<float>(tex_w);
   options.metrics.texture_height_px = static_cast<float>(tex_h);
   MapRun run;  // the report: what was asked, then what each step found
@@ -191,7 +196,8 @@ int run_map(const MapArgs& opt) {
     options.orientation = orientation_for(choice.best, options.orientation);
     run.axis = std::string("auto:") + axis_candidate_name(choice.best);
     if (!opt.quiet) {
-      std::string line = "axis auto: " + std::string(axis_candidate_name(choice.best)) + " (seams without crack closing:";
+      std::string line =
+          "axis auto: " + std::string(axis_candidate_name(choice.best)) + " (seams without crack closing:";
       for (int i = 0; i < kAxisCandidates; ++i) {
         char item[32];
         std::snprintf(item, sizeof item, " %s %.2f%%", axis_candidate_name(static_cast<AxisCandidate>(i)),
@@ -234,8 +240,8 @@ int run_map(const MapArgs& opt) {
       render_options.seam_texture_px = texture.empty() ? opt.texture_size : 0;
       render_options.seam_symmetry = mapping.symmetry;
       Image picture;
-      if (Status s = render_preview(mesh, uv_repeats, atlas.patch, texture.empty() ? nullptr : &texture,
-                                    render_options, picture);
+      if (Status s = render_preview(mesh, uv_repeats, atlas.patch, texture.empty() ? nullptr : &texture, render_options,
+                                    picture);
           !s)
         return report_error(s.with_file(path));
       pictures.emplace_back(path, std::move(picture));
@@ -279,13 +285,13 @@ void register_map(CLI::App& app, Runner& run) {
   auto opt = std::make_shared<MapArgs>();
   MappingOptions& mapping = opt->options.mapping;
   OrientationOptions& orientation = opt->options.orientation;
-  auto* cmd = app.add_subcommand(
-      "map", "Compute texture coordinates by homogeneous patch discovery and write a textured mesh");
+  auto* cmd =
+      app.add_subcommand("map", "Compute texture coordinates by homogeneous patch discovery and write a textured mesh");
   cmd->add_option("mesh", opt->input, "Input mesh (.ply .obj .off .stl)")->required();
   cmd->add_option("-o,--output", opt->output, "Output mesh: .glb (texture embedded), .obj (+ .mtl) or .ply")
       ->required();
   cmd->add_option("-t,--texture", opt->texture,
-                   "Texture image (PNG/JPEG), ideally self-tileable (see 'tailor tile'); sets the texture size");
+                  "Texture image (PNG/JPEG), ideally self-tileable (see 'tailor tile'); sets the texture size");
   cmd->add_option("--texture-size", opt->texture_size, "Texture size in pixels when no --texture is given")
       ->capture_default_str();
   cmd->add_option("--stats", opt->stats, "Write a JSON report (mesh, mapping counters, metrics, timings)");
@@ -304,8 +310,7 @@ void register_map(CLI::App& app, Runner& run) {
   add_documented(group, option_doc(kMappingOptionDocs, "hop_age"), mapping.hop_age);
   add_off_switch(group, option_doc(kMappingOptionDocs, "shorten_seams"), mapping.shorten_seams);
   add_off_switch(group, option_doc(kMappingOptionDocs, "close_cracks"), mapping.close_cracks);
-  add_documented(group, option_doc(kMappingOptionDocs, "crack_rings"), mapping.crack_rings)
-      ->check(CLI::Range(2u, 64u));
+  add_documented(group, option_doc(kMappingOptionDocs, "crack_rings"), mapping.crack_rings)->check(CLI::Range(2u, 64u));
   add_documented(group, option_doc(kMappingOptionDocs, "relax_iterations"), mapping.relax_iterations)
       ->check(CLI::Range(0u, 1000u));
   add_documented(group, option_doc(kMappingOptionDocs, "threshold_px"), mapping.threshold_px);
@@ -313,8 +318,7 @@ void register_map(CLI::App& app, Runner& run) {
   add_documented(group, option_doc(kOrientationOptionDocs, "smooth_passes"), orientation.smooth_passes);
   add_documented(group, option_doc(kMappingOptionDocs, "seed_point"), opt->seed_point);
   add_documented(group, option_doc(kMappingOptionDocs, "seam_faces"), opt->seam_faces);
-  add_documented(group, option_doc(kMappingOptionDocs, "symmetry"), mapping.symmetry)
-      ->check(CLI::IsMember({1u, 4u}));
+  add_documented(group, option_doc(kMappingOptionDocs, "symmetry"), mapping.symmetry)->check(CLI::IsMember({1u, 4u}));
   cmd->add_flag("--stability", opt->stability,
                 "Also remove ~10% of the faces, re-map and report how much the remaining UVs moved");
   cmd->add_option("--threads", mapping.threads,

@@ -49,8 +49,8 @@ int run_render(const RenderArgs& args) {
                                       "expected WIDTHxHEIGHT, e.g. 1024x768"));
   }
   if (!up_axis_from_name(args.up, options.up)) {
-    return report_error(Status::error(ErrorCode::kInvalidArgument, "", "bad --up '" + args.up + "'",
-                                      "use x, y, z, -x, -y or -z"));
+    return report_error(
+        Status::error(ErrorCode::kInvalidArgument, "", "bad --up '" + args.up + "'", "use x, y, z, -x, -y or -z"));
   }
 
   Mesh mesh;
@@ -58,7 +58,7 @@ int run_render(const RenderArgs& args) {
   Status status = [&] {
     const ReadingInput reading(args.input);
     return mesh_format_from_path(args.input) == MeshFormat::kGlb ? read_glb_file(args.input, mesh, &texture)
-                                                                  : load_mesh(args.input, mesh);
+                                                                 : load_mesh(args.input, mesh);
   }();
   if (!status) return report_error(status.with_file(args.input));
   if (!args.texture.empty()) {

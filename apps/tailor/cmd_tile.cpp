@@ -9,10 +9,10 @@
 #include <vector>
 
 #include "cli.h"
-#include "util/atomic_file.h"
 #include "tailor/image.h"
 #include "tailor/report.h"
 #include "tailor/tiling.h"
+#include "util/atomic_file.h"
 
 namespace tailor::cli {
 namespace {

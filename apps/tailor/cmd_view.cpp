@@ -99,7 +99,8 @@ Status check_glb(const std::string& path) {
     return Status::error(ErrorCode::kParse, path, "not a binary glTF file", "shorter than its 12-byte header");
   }
   const auto u32 = [&](size_t at) {
-    return uint32_t{head[at]} | uint32_t{head[at + 1]} << 8 | uint32_t{head[at + 2]} << 16 | uint32_t{head[at + 3]} << 24;
+    return uint32_t{head[at]} | uint32_t{head[at + 1]} << 8 | uint32_t{head[at + 2]} << 16 |
+           uint32_t{head[at + 3]} << 24;
   };
   if (u32(0) != 0x46546C67u) return Status::error(ErrorCode::kParse, path, "not a binary glTF file", "bad magic");
   if (u32(4) != 2) return Status::error(ErrorCode::kUnsupported, path, "only glTF 2.0 is supported", "version field");

@@ -25,10 +25,10 @@ namespace {
 
 constexpr size_t kMaxHeaderBytes = 16 * 1024;  // a GET from a browser is well under 2 KB
 constexpr int kPollMillis = 200;               // how often the server and its workers look at the stop flag
-constexpr int kHeaderSeconds = 10;   // a client must send its whole request within this (slow or silent ones
-                                     // are dropped: a per-recv timeout would let a trickle hold a worker forever)
-constexpr int kStallSeconds = 30;    // a client that accepts no byte of the answer for this long is dropped
-constexpr size_t kMaxWorkers = 64;   // connections served at once; more get 503
+constexpr int kHeaderSeconds = 10;             // a client must send its whole request within this (slow or silent ones
+                                    // are dropped: a per-recv timeout would let a trickle hold a worker forever)
+constexpr int kStallSeconds = 30;   // a client that accepts no byte of the answer for this long is dropped
+constexpr size_t kMaxWorkers = 64;  // connections served at once; more get 503
 
 using Clock = std::chrono::steady_clock;
 
@@ -144,7 +144,8 @@ Status StaticServer::start(const std::string& web_root, std::vector<Route> route
   routes_ = std::move(routes);
 
   listen_fd_ = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  if (listen_fd_ < 0) return Status::error(ErrorCode::kIo, "", std::string("cannot open a socket: ") + std::strerror(errno));
+  if (listen_fd_ < 0)
+    return Status::error(ErrorCode::kIo, "", std::string("cannot open a socket: ") + std::strerror(errno));
   const int yes = 1;
   ::setsockopt(listen_fd_, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
   sockaddr_in addr{};

@@ -9,8 +9,9 @@
 
 int main(int argc, char** argv) {
   using namespace tailor::cli;
-  CLI::App app{"tailor: texture-map large triangle meshes at millions of faces per second,\n"
-               "and make texture images self-tileable so the mapping needs no atlas."};
+  CLI::App app{
+      "tailor: texture-map large triangle meshes at millions of faces per second,\n"
+      "and make texture images self-tileable so the mapping needs no atlas."};
   app.name("tailor");
   app.require_subcommand(1);
   app.set_version_flag("--version", "tailor " TAILOR_VERSION_STRING, "Print the version and exit");

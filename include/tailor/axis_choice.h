@@ -29,7 +29,7 @@ TAILOR_API const char* axis_candidate_name(AxisCandidate candidate);
 TAILOR_API OrientationOptions orientation_for(AxisCandidate candidate, const OrientationOptions& base);
 
 struct AxisChoice {
-  AxisCandidate best = AxisCandidate::kPca;  //!< the candidate with the least seam length
+  AxisCandidate best = AxisCandidate::kPca;          //!< the candidate with the least seam length
   std::array<double, kAxisCandidates> seam_ratio{};  //!< per candidate: seam length / edge length of the growth
 };
 
@@ -41,6 +41,6 @@ struct AxisChoice {
 //! (kCancelled). Fails as map_texture does. Cost: four orientations, growths and metrics,
 //! O(F log front). Deterministic.
 TAILOR_API Status choose_orientation_axis(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options,
-                               AxisChoice& choice);
+                                          AxisChoice& choice);
 
 }  // namespace tailor

@@ -6,8 +6,8 @@
 //
 // A greedy front grows over the mesh face by face. Faces waiting on the front are keyed by
 // (number of placed edge neighbours, most first; then age = variation + hop_age times the face's
-// path length from its component's seed, least first), so the texture spreads through regions where the orientation field is homogeneous and
-// stops at faces where it varies (geometric edges, field singularities): those become seams.
+// path length from its component's seed, least first), so the texture spreads through regions where the orientation
+// field is homogeneous and stops at faces where it varies (geometric edges, field singularities): those become seams.
 // A face is placed by unfolding it across an edge from a placed neighbour's corner UVs: the two
 // shared corners are copied and the third comes from a second placed neighbour, from the UV the
 // patch already gave that vertex, or is the mean of the two predictions a + scale*frame(C - A)
@@ -63,45 +63,46 @@ using ProgressCallback = std::function<bool(float)>;
 
 struct MappingOptions {
   MappingMode mode = MappingMode::kPatches;  //!< algorithm (CLI --mode patches|thesis)
-  float scale = 800.f;              //!< texture pixels per unit of the mesh normalised into the unit cube (> 0)
-  bool use_seed_point = false;      //!< true: first face = the face whose centroid is nearest to seed_point
+  float scale = 800.f;          //!< texture pixels per unit of the mesh normalised into the unit cube (> 0)
+  bool use_seed_point = false;  //!< true: first face = the face whose centroid is nearest to seed_point
   std::array<float, 3> seed_point{0.f, 0.f, 0.f};  //!< mesh coordinates (not normalised); default rule when
-                                    //!< unused: the face nearest to the centre of the bounding box
-  double factor_step = -1.0;        //!< age added per placed face, a global counter (radians); < 0 = mode default:
-                                    //!< 1/#F in kThesis (as the thesis), the hop rule below in kPatches (1e-4
-                                    //!< per face when hop_age is 0); >= 0 in kPatches: this counter, no hops
-  float hop_age = 0.02f;            //!< kPatches: age added per face of path from the component's seed (radians,
-                                    //!< 0..1; 0 = use the global counter). Local, so removing part of a mesh
-                                    //!< leaves the growth order elsewhere unchanged (stability); larger values
-                                    //!< grow rounder patches (more seam), smaller follow the field's variation
+                                                   //!< unused: the face nearest to the centre of the bounding box
+  double factor_step = -1.0;  //!< age added per placed face, a global counter (radians); < 0 = mode default:
+                              //!< 1/#F in kThesis (as the thesis), the hop rule below in kPatches (1e-4
+                              //!< per face when hop_age is 0); >= 0 in kPatches: this counter, no hops
+  float hop_age = 0.02f;      //!< kPatches: age added per face of path from the component's seed (radians,
+                              //!< 0..1; 0 = use the global counter). Local, so removing part of a mesh
+                              //!< leaves the growth order elsewhere unchanged (stability); larger values
+                              //!< grow rounder patches (more seam), smaller follow the field's variation
   // kPatches ------------------------------------------------------------------------------------
-  float max_stretch = 0.25f;        //!< per-face bound: singular values of the face->UV Jacobian (in units of
-                                    //!< `scale`) must lie in [1/(1+x), 1+x]; 0.01..4. 0.25 keeps every face
-                                    //!< within 25% of its length in any direction (so Sander Linf <= ~1.25)
-                                    //!< and the thesis stretch under 0.08 on the shared meshes; larger values
-                                    //!< give fewer seams and more distortion (docs/mapping.md)
+  float max_stretch = 0.25f;           //!< per-face bound: singular values of the face->UV Jacobian (in units of
+                                       //!< `scale`) must lie in [1/(1+x), 1+x]; 0.01..4. 0.25 keeps every face
+                                       //!< within 25% of its length in any direction (so Sander Linf <= ~1.25)
+                                       //!< and the thesis stretch under 0.08 on the shared meshes; larger values
+                                       //!< give fewer seams and more distortion (docs/mapping.md)
   float max_seed_rotation_deg = 45.f;  //!< a new patch is rotated (at most this much) so that it continues its
-                                    //!< neighbour's texture across the seed edge; beyond, it follows the field
-                                    //!< and only the seed edge's first vertex matches (0..180)
-  float field_following = 1.f;      //!< 1: every face's texture direction follows the orientation field (thesis);
-                                    //!< 0: pure unfolding, the direction is set by the patch seed and drifts with
-                                    //!< the surface (fewer seams, less distortion, see docs/mapping.md); 0..1
-  bool shorten_seams = true;        //!< after the growth, re-place faces on seams from their neighbours where
-                                    //!< that shortens the seams within the bound (jagged cuts lose their teeth:
-                                    //!< 6-11% less seam length on the shared meshes, docs/mapping.md)
-  bool close_cracks = true;         //!< last, zip cracks (seams inside one patch) shut from their tips, spreading
-                                    //!< each gap over the faces around it within max_stretch (ARAP relaxation):
-                                    //!< 23-57% less seam length on scans, mapping 3-10x slower (docs/mapping.md)
-  uint32_t crack_rings = 16;        //!< effort of the crack closing (2..64): the largest region a zip relaxes, in
-                                    //!< rings of faces around it (a first try takes crack_rings / 2 rings per unit
-                                    //!< of gap / edge length); more closes wider gaps and takes longer
-  uint32_t relax_iterations = 10;   //!< last, local/global ARAP iterations over the UV vertices (0 = off, at most
-                                    //!< 1000): median angle distortion 6.5 -> 1.9 degrees on the shared meshes for
-                                    //!< ~20% more mapping time; patches and seam edges unchanged, invisible seams
-                                    //!< (< 1 px) untouched, every moved face within max_stretch (docs/mapping.md)
-  uint32_t threads = 0;             //!< threads of the crack closing, the relaxation and symmetry 4's fields (0 = one per 10k / 20k
-                                    //!< faces, at most the cores and 8); the result is identical for any count
-                                    //!< (the growth is sequential)
+                                       //!< neighbour's texture across the seed edge; beyond, it follows the field
+                                       //!< and only the seed edge's first vertex matches (0..180)
+  float field_following = 1.f;         //!< 1: every face's texture direction follows the orientation field (thesis);
+                                       //!< 0: pure unfolding, the direction is set by the patch seed and drifts with
+                                       //!< the surface (fewer seams, less distortion, see docs/mapping.md); 0..1
+  bool shorten_seams = true;           //!< after the growth, re-place faces on seams from their neighbours where
+                                       //!< that shortens the seams within the bound (jagged cuts lose their teeth:
+                                       //!< 6-11% less seam length on the shared meshes, docs/mapping.md)
+  bool close_cracks = true;            //!< last, zip cracks (seams inside one patch) shut from their tips, spreading
+                                       //!< each gap over the faces around it within max_stretch (ARAP relaxation):
+                                       //!< 23-57% less seam length on scans, mapping 3-10x slower (docs/mapping.md)
+  uint32_t crack_rings = 16;           //!< effort of the crack closing (2..64): the largest region a zip relaxes, in
+                                       //!< rings of faces around it (a first try takes crack_rings / 2 rings per unit
+                                       //!< of gap / edge length); more closes wider gaps and takes longer
+  uint32_t relax_iterations = 10;      //!< last, local/global ARAP iterations over the UV vertices (0 = off, at most
+                                       //!< 1000): median angle distortion 6.5 -> 1.9 degrees on the shared meshes for
+                                       //!< ~20% more mapping time; patches and seam edges unchanged, invisible seams
+                                       //!< (< 1 px) untouched, every moved face within max_stretch (docs/mapping.md)
+  uint32_t threads =
+      0;  //!< threads of the crack closing, the relaxation and symmetry 4's fields (0 = one per 10k / 20k
+          //!< faces, at most the cores and 8); the result is identical for any count
+          //!< (the growth is sequential)
   uint32_t min_patch_faces = 16;    //!< patches with fewer faces are absorbed into a neighbouring patch by rigid
                                     //!< unfolding (0 = keep all; isolated components stay whole)
   uint32_t symmetry = 1;            //!< 1: the growth above; 4 (experimental): an integer-grid map in place of
@@ -112,11 +113,11 @@ struct MappingOptions {
                                     //!< MetricsOptions::symmetry 4 too
   float texture_period_px = 512.f;  //!< symmetry 4: the texture's size in pixels (square), the lattice period
   // kThesis -------------------------------------------------------------------------------------
-  float threshold_px = 25.f;        //!< initial absolute error threshold, pixels (thesis: 25 at scale 800)
-  float threshold_step_px = 10.f;   //!< added when every waiting face exceeds the threshold (thesis: 10)
+  float threshold_px = 25.f;       //!< initial absolute error threshold, pixels (thesis: 25 at scale 800)
+  float threshold_step_px = 10.f;  //!< added when every waiting face exceeds the threshold (thesis: 10)
   // Both ------------------------------------------------------------------------------------------
   std::span<const uint8_t> seam_faces;  //!< empty, or #F flags: 1 = user-marked seam face (deferred to the end)
-  ProgressCallback progress;        //!< optional; see ProgressCallback
+  ProgressCallback progress;            //!< optional; see ProgressCallback
 };
 
 //! Flags and help of the MappingOptions a user sets (option_doc.h): the tailor CLI shows these, with
@@ -161,26 +162,26 @@ inline constexpr OptionDoc kMappingOptionDocs[] = {
 };
 
 struct MappingStats {
-  uint32_t patches = 0;             //!< patches in the atlas (after absorption)
+  uint32_t patches = 0;                //!< patches in the atlas (after absorption)
   uint32_t patches_before_absorb = 0;  //!< patches grown before tiny ones were absorbed (kPatches)
-  uint32_t components = 0;          //!< connected components (each has at least one patch)
-  uint64_t deferrals = 0;           //!< pops that failed the bound and were put back
-  uint32_t threshold_raises = 0;    //!< kThesis: times the threshold was raised
-  float final_threshold_px = 0.f;   //!< kThesis: threshold at the end
-  float max_error_px = 0.f;         //!< largest accepted |c_A - c_B| (two-prediction disagreement), pixels
-  float max_stretch_accepted = 0.f; //!< kPatches: largest accepted max(sigma_max - 1, 1/sigma_min - 1)
-  uint64_t faces_three_textured = 0;//!< faces accepted with all three corners already known (thesis fig. 2.4)
-  uint64_t faces_unfolded = 0;      //!< faces placed from one or two known corners
-  uint64_t faces_rigid = 0;         //!< kPatches: faces placed rigidly (patch seeds, absorbed faces)
-  uint64_t faces_cut = 0;           //!< kPatches: faces joined across one edge while disagreeing with another
-                                    //!< placed neighbour of their patch (each leaves at least one cut edge)
-  uint64_t faces_reseamed = 0;      //!< kPatches: re-placements after the growth that shortened the seams (a face
-                                    //!< can move more than once)
-  uint64_t cracks_closed = 0;       //!< kPatches: crack vertices zipped shut (one UV where there were two)
-  uint64_t relax_moves = 0;         //!< kPatches: UV vertex moves the relaxation kept (relax_iterations)
-  uint64_t faces_seam = 0;          //!< faces flagged in seam_faces
-  uint64_t inverted_accepted = 0;   //!< kThesis: faces accepted with a non-positive UV area (always 0 in kPatches)
-  double seconds = 0.0;             //!< wall time of the growth, seam shortening and crack closing (steps 2-4)
+  uint32_t components = 0;             //!< connected components (each has at least one patch)
+  uint64_t deferrals = 0;              //!< pops that failed the bound and were put back
+  uint32_t threshold_raises = 0;       //!< kThesis: times the threshold was raised
+  float final_threshold_px = 0.f;      //!< kThesis: threshold at the end
+  float max_error_px = 0.f;            //!< largest accepted |c_A - c_B| (two-prediction disagreement), pixels
+  float max_stretch_accepted = 0.f;    //!< kPatches: largest accepted max(sigma_max - 1, 1/sigma_min - 1)
+  uint64_t faces_three_textured = 0;   //!< faces accepted with all three corners already known (thesis fig. 2.4)
+  uint64_t faces_unfolded = 0;         //!< faces placed from one or two known corners
+  uint64_t faces_rigid = 0;            //!< kPatches: faces placed rigidly (patch seeds, absorbed faces)
+  uint64_t faces_cut = 0;              //!< kPatches: faces joined across one edge while disagreeing with another
+                                       //!< placed neighbour of their patch (each leaves at least one cut edge)
+  uint64_t faces_reseamed = 0;         //!< kPatches: re-placements after the growth that shortened the seams (a face
+                                       //!< can move more than once)
+  uint64_t cracks_closed = 0;          //!< kPatches: crack vertices zipped shut (one UV where there were two)
+  uint64_t relax_moves = 0;            //!< kPatches: UV vertex moves the relaxation kept (relax_iterations)
+  uint64_t faces_seam = 0;             //!< faces flagged in seam_faces
+  uint64_t inverted_accepted = 0;      //!< kThesis: faces accepted with a non-positive UV area (always 0 in kPatches)
+  double seconds = 0.0;                //!< wall time of the growth, seam shortening and crack closing (steps 2-4)
 };
 
 //! Seed face of every edge component: the face whose centroid is nearest to the seed point (the
@@ -223,7 +224,8 @@ struct TextureMap {
 //! O(F + V) memory, allocated before the loops (the capacity of `map` is reused). Deterministic,
 //! the same bits with or without SIMD and for any thread count. Safe for any mesh that passed
 //! finalize_mesh (non-manifold and inconsistent edges act as boundaries).
-TAILOR_API Status map_texture(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options, TextureMap& map);
+TAILOR_API Status map_texture(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options,
+                              TextureMap& map);
 
 //! The name of a mode, "patches" or "thesis" (CLI --mode).
 TAILOR_API const char* mapping_mode_name(MappingMode mode);

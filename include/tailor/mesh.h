@@ -24,11 +24,11 @@ inline constexpr size_t kMaxVertices = (size_t{1} << 31) - 1;
 //! A triangle mesh.
 //! Corner c = 3f + k is corner k of face f; indices[c] is its vertex.
 struct Mesh {
-  std::vector<float> positions;    //!< #V by 3, xyz packed; finite after loading
-  std::vector<uint32_t> indices;   //!< #F by 3, counter-clockwise; every index < #V after loading
-  std::vector<float> corner_uvs;   //!< empty, or #F*3 by 2: texture coordinates from the file, per corner,
-                                   //!< in texture repeats (1.0 = one texture width), v up as in OBJ/glTF-flipped
-  std::vector<uint8_t> seam_faces; //!< empty, or #F flags: 1 = user-marked seam face (PLY `seam` property)
+  std::vector<float> positions;     //!< #V by 3, xyz packed; finite after loading
+  std::vector<uint32_t> indices;    //!< #F by 3, counter-clockwise; every index < #V after loading
+  std::vector<float> corner_uvs;    //!< empty, or #F*3 by 2: texture coordinates from the file, per corner,
+                                    //!< in texture repeats (1.0 = one texture width), v up as in OBJ/glTF-flipped
+  std::vector<uint8_t> seam_faces;  //!< empty, or #F flags: 1 = user-marked seam face (PLY `seam` property)
 
   size_t vertex_count() const { return positions.size() / 3; }
   size_t face_count() const { return indices.size() / 3; }
@@ -37,15 +37,15 @@ struct Mesh {
 
 //! What a reader saw and repaired. Repairs are counted, never silent.
 struct LoadReport {
-  std::string format;                 //!< e.g. "PLY binary_little_endian", "OBJ", "OFF", "STL binary"
+  std::string format;  //!< e.g. "PLY binary_little_endian", "OBJ", "OFF", "STL binary"
   size_t file_bytes = 0;
-  size_t source_faces = 0;            //!< faces/polygons/strip triangles as stored in the file
-  size_t polygons_triangulated = 0;   //!< source polygons with more than 3 vertices (fan-triangulated)
-  size_t degenerate_faces = 0;        //!< triangles with a repeated vertex index: dropped
-  size_t duplicate_faces = 0;         //!< triangles with the same vertex set as an earlier one: dropped
-  size_t zero_area_faces = 0;         //!< distinct vertices but zero area: kept
-  size_t unreferenced_vertices = 0;   //!< vertices no face uses: kept, so vertex ids match the file
-  size_t welded_vertices = 0;         //!< STL: corners merged into shared vertices (bit-identical positions)
+  size_t source_faces = 0;           //!< faces/polygons/strip triangles as stored in the file
+  size_t polygons_triangulated = 0;  //!< source polygons with more than 3 vertices (fan-triangulated)
+  size_t degenerate_faces = 0;       //!< triangles with a repeated vertex index: dropped
+  size_t duplicate_faces = 0;        //!< triangles with the same vertex set as an earlier one: dropped
+  size_t zero_area_faces = 0;        //!< distinct vertices but zero area: kept
+  size_t unreferenced_vertices = 0;  //!< vertices no face uses: kept, so vertex ids match the file
+  size_t welded_vertices = 0;        //!< STL: corners merged into shared vertices (bit-identical positions)
   double load_seconds = 0.0;
 };
 

@@ -40,32 +40,32 @@ inline constexpr OptionDoc kMetricsOptionDocs[] = {
 };
 
 struct UvMetrics {
-  size_t faces = 0;                  //!< faces in the mesh (degenerate included)
-  uint32_t patches = 0;              //!< distinct patch ids (given, or derived from UV connectivity)
-  size_t single_face_patches = 0;    //!< patches holding exactly one face
-  size_t degenerate_faces = 0;       //!< faces with zero 3D area, skipped by the per-face metrics
-  double stretch = 0;                //!< thesis ch.4: coefficient of variation of r_f = a_f / A_f (population std / mean); 0 ideal
-  double stretch_area_weighted = 0;  //!< same, mean and variance weighted by A_f; 0 ideal
-  double distortion_deg = 0;         //!< median over faces of sum_k |angle_uv_k - angle_3d_k|, degrees; 0 ideal
-  double l2_stretch = 0;             //!< Sander et al. 2001 L2 stretch times sqrt(R); 1 ideal, >= 1
-  double linf_stretch = 0;           //!< Sander et al. 2001 max singular value over faces times sqrt(R); 1 ideal
-  size_t flipped = 0;                //!< faces whose signed UV area has the opposite sign to the majority of their
-                                     //!< patch (zero-area UV faces count as flipped; degenerate 3D faces are skipped)
-  size_t zero_uv_area_faces = 0;     //!< non-degenerate faces with zero UV area (included in `flipped`,
-                                     //!< excluded from l2/linf where their stretch is infinite)
-  size_t seam_edges = 0;             //!< paired edges whose two faces disagree on the UV of a shared vertex
-  double seam_length_ratio = 0;      //!< 3D length of seam edges / 3D length of all distinct edges
-  double seam_gap_px = 0;            //!< 3D-length-weighted mean over seam edges of their lattice gap (px; see
-                                     //!< seam_gap_px() below)
-  double seam_invisible_ratio = 0;   //!< share of seam length whose lattice gap is < invisible_gap_px: the
-                                     //!< texture continues across it (1 when there is no seam)
-  double visible_seam_ratio = 0;     //!< 3D length of visible seam edges / 3D length of all distinct edges
+  size_t faces = 0;                //!< faces in the mesh (degenerate included)
+  uint32_t patches = 0;            //!< distinct patch ids (given, or derived from UV connectivity)
+  size_t single_face_patches = 0;  //!< patches holding exactly one face
+  size_t degenerate_faces = 0;     //!< faces with zero 3D area, skipped by the per-face metrics
+  double stretch = 0;  //!< thesis ch.4: coefficient of variation of r_f = a_f / A_f (population std / mean); 0 ideal
+  double stretch_area_weighted = 0;    //!< same, mean and variance weighted by A_f; 0 ideal
+  double distortion_deg = 0;           //!< median over faces of sum_k |angle_uv_k - angle_3d_k|, degrees; 0 ideal
+  double l2_stretch = 0;               //!< Sander et al. 2001 L2 stretch times sqrt(R); 1 ideal, >= 1
+  double linf_stretch = 0;             //!< Sander et al. 2001 max singular value over faces times sqrt(R); 1 ideal
+  size_t flipped = 0;                  //!< faces whose signed UV area has the opposite sign to the majority of their
+                                       //!< patch (zero-area UV faces count as flipped; degenerate 3D faces are skipped)
+  size_t zero_uv_area_faces = 0;       //!< non-degenerate faces with zero UV area (included in `flipped`,
+                                       //!< excluded from l2/linf where their stretch is infinite)
+  size_t seam_edges = 0;               //!< paired edges whose two faces disagree on the UV of a shared vertex
+  double seam_length_ratio = 0;        //!< 3D length of seam edges / 3D length of all distinct edges
+  double seam_gap_px = 0;              //!< 3D-length-weighted mean over seam edges of their lattice gap (px; see
+                                       //!< seam_gap_px() below)
+  double seam_invisible_ratio = 0;     //!< share of seam length whose lattice gap is < invisible_gap_px: the
+                                       //!< texture continues across it (1 when there is no seam)
+  double visible_seam_ratio = 0;       //!< 3D length of visible seam edges / 3D length of all distinct edges
   double visible_off_sharp_ratio = 0;  //!< the same for visible seam edges that are not sharp (dihedral angle
-                                     //!< <= sharp_angle_deg): visible seams the geometry does not hide
-  size_t visible_dangling_ends = 0;  //!< interior vertices with exactly 1 visible seam edge (a cut that stops)
-  size_t visible_branch_points = 0;  //!< interior vertices with 3 or more visible seam edges
-  double uv_scale = 0;               //!< R: sum of UV areas / sum of 3D areas (px^2 per unit^2)
-  double seconds = 0;                //!< wall time of compute_uv_metrics
+                                       //!< <= sharp_angle_deg): visible seams the geometry does not hide
+  size_t visible_dangling_ends = 0;    //!< interior vertices with exactly 1 visible seam edge (a cut that stops)
+  size_t visible_branch_points = 0;    //!< interior vertices with 3 or more visible seam edges
+  double uv_scale = 0;                 //!< R: sum of UV areas / sum of 3D areas (px^2 per unit^2)
+  double seconds = 0;                  //!< wall time of compute_uv_metrics
 };
 
 //! Computes all metrics of a per-corner UV map.
@@ -88,13 +88,13 @@ TAILOR_API Status compute_uv_metrics(const Mesh& mesh, const Topology& topology,
 //! the texture continues across the edge when the gap is below a pixel. With options.symmetry 4 the
 //! smallest gap over g's UVs turned by 0, 90, 180 and 270 degrees. O(1).
 TAILOR_API double seam_gap_px(const float* uv_fa, const float* uv_fb, const float* uv_ga, const float* uv_gb,
-                   const MetricsOptions& options);
+                              const MetricsOptions& options);
 
 //! Seam class of every edge e (#F*3, both sides of a pair alike): 0 no seam (boundary, or the two
 //! sides have identical UVs), 1 invisible seam (lattice gap < options.invisible_gap_px), 2 visible.
 //! For the seam views. Preconditions as compute_uv_metrics. Cost O(F).
 TAILOR_API void classify_seam_edges(const Mesh& mesh, const Topology& topology, std::span<const float> corner_uv,
-                         const MetricsOptions& options, std::vector<uint8_t>& seam_class);
+                                    const MetricsOptions& options, std::vector<uint8_t>& seam_class);
 
 //! Patches = connected components of faces joined across paired edges whose two sides have
 //! bit-identical UVs at both endpoints. Fills patch (#F ids, numbered in order of lowest face) and

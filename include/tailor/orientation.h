@@ -34,19 +34,19 @@ enum class AxisSource {
 };
 
 struct OrientationOptions {
-  AxisSource axis = AxisSource::kPca;          //!< source of the global axis projected on each face
-  std::array<float, 3> user_axis{0.f, 1.f, 0.f};  //!< kUser: axis, any non-zero length (normalised inside)
-  std::array<float, 3> user_axis2{0.f, 0.f, 0.f}; //!< kUser: fallback axis where user_axis is ~normal
-                                                  //!< to a face; zero = pick one perpendicular to user_axis
-  uint32_t smooth_passes = 0;                  //!< passes of neighbour averaging of o (0 = off, 0..1000)
-  float degenerate_cos = 0.995f;               //!< |axis . n| above this counts as "axis normal to face"
-                                               //!< and the second axis is projected instead (0.5..1)
+  AxisSource axis = AxisSource::kPca;              //!< source of the global axis projected on each face
+  std::array<float, 3> user_axis{0.f, 1.f, 0.f};   //!< kUser: axis, any non-zero length (normalised inside)
+  std::array<float, 3> user_axis2{0.f, 0.f, 0.f};  //!< kUser: fallback axis where user_axis is ~normal
+                                                   //!< to a face; zero = pick one perpendicular to user_axis
+  uint32_t smooth_passes = 0;                      //!< passes of neighbour averaging of o (0 = off, 0..1000)
+  float degenerate_cos = 0.995f;                   //!< |axis . n| above this counts as "axis normal to face"
+                                                   //!< and the second axis is projected instead (0.5..1)
   // Normalisation into the unit cube. Leave fixed_unit_scale at 0 to derive it from the mesh's
   // bounding box; stability runs pass the full mesh's values so a cut mesh keeps the same frame.
   std::array<float, 3> fixed_origin{0.f, 0.f, 0.f};  //!< with fixed_unit_scale > 0: bbox minimum, mesh units
-  float fixed_unit_scale = 0.f;                //!< > 0: normalised = (x - origin) * this; 0 = 1 / longest bbox side
-  uint32_t threads = 0;                        //!< threads for the per-face frames (0 = one per 100k faces, at most
-                                               //!< the cores and 8); the result is identical for any count
+  float fixed_unit_scale = 0.f;  //!< > 0: normalised = (x - origin) * this; 0 = 1 / longest bbox side
+  uint32_t threads = 0;          //!< threads for the per-face frames (0 = one per 100k faces, at most
+                                 //!< the cores and 8); the result is identical for any count
 };
 
 //! Flags and help of the OrientationOptions a user sets (option_doc.h).
@@ -72,10 +72,10 @@ struct FaceFrames {
   std::array<float, 3> axis2{};    //!< the fallback axis used (unit)
   std::array<float, 3> origin{};   //!< normalisation: normalised = (x - origin) * unit_scale
   std::array<float, 3> bbox_min{}, bbox_max{};  //!< bounding box of the referenced vertices (mesh coordinates)
-  float unit_scale = 1.f;          //!< 1 / longest bbox side (or OrientationOptions::fixed_unit_scale)
-  uint32_t degenerate_faces = 0;   //!< zero-area faces given an arbitrary valid frame
-  uint32_t fallback_faces = 0;     //!< faces where the second axis was projected
-  double seconds = 0.0;            //!< wall time of compute_orientation
+  float unit_scale = 1.f;                       //!< 1 / longest bbox side (or OrientationOptions::fixed_unit_scale)
+  uint32_t degenerate_faces = 0;                //!< zero-area faces given an arbitrary valid frame
+  uint32_t fallback_faces = 0;                  //!< faces where the second axis was projected
+  double seconds = 0.0;                         //!< wall time of compute_orientation
 
   size_t face_count() const { return area.size(); }
 };

@@ -61,21 +61,21 @@ inline const char* up_axis_name(UpAxis up) {
 }
 
 struct RenderOptions {
-  int width = 1024;                        //!< output width in pixels, 16..8192
-  int height = 768;                        //!< output height in pixels, 16..8192
+  int width = 1024;                          //!< output width in pixels, 16..8192
+  int height = 768;                          //!< output height in pixels, 16..8192
   PreviewView view = PreviewView::kTexture;  //!< what the surface shows
-  UpAxis up = UpAxis::kPosY;               //!< mesh axis shown pointing up (the mesh is turned, not the light)
-  float yaw_degrees = 35.0f;               //!< camera azimuth around the up axis (for +y: from +z towards +x)
-  float pitch_degrees = 25.0f;             //!< camera elevation above the horizontal plane, -89..89
-  float fov_degrees = 35.0f;               //!< vertical field of view, 5..120
-  float checker_squares = 8.0f;            //!< kChecker (and the fallback texture): squares per texture repeat, > 0
-  float distortion_range = 2.0f;           //!< kDistortion: |log2(r_f / R)| mapped to full colour, > 0 (2 = 4x)
-  bool draw_seams = true;                  //!< kPatches: draw seam edges as lines
-  int seam_texture_px = 0;                 //!< kSeams: texture size in pixels a seam's gap is measured in (a
-                                           //!< gap under 1 px is invisible); 0 = the texture's width and
-                                           //!< height, or 512 without a texture
-  uint32_t seam_symmetry = 1;              //!< kSeams: 4 = a quarter turn across a seam is invisible too
-  int supersample = 2;                     //!< render at this multiple of the size and box-filter down, 1..4
+  UpAxis up = UpAxis::kPosY;                 //!< mesh axis shown pointing up (the mesh is turned, not the light)
+  float yaw_degrees = 35.0f;                 //!< camera azimuth around the up axis (for +y: from +z towards +x)
+  float pitch_degrees = 25.0f;               //!< camera elevation above the horizontal plane, -89..89
+  float fov_degrees = 35.0f;                 //!< vertical field of view, 5..120
+  float checker_squares = 8.0f;              //!< kChecker (and the fallback texture): squares per texture repeat, > 0
+  float distortion_range = 2.0f;             //!< kDistortion: |log2(r_f / R)| mapped to full colour, > 0 (2 = 4x)
+  bool draw_seams = true;                    //!< kPatches: draw seam edges as lines
+  int seam_texture_px = 0;                   //!< kSeams: texture size in pixels a seam's gap is measured in (a
+                                             //!< gap under 1 px is invisible); 0 = the texture's width and
+                                             //!< height, or 512 without a texture
+  uint32_t seam_symmetry = 1;                //!< kSeams: 4 = a quarter turn across a seam is invisible too
+  int supersample = 2;                       //!< render at this multiple of the size and box-filter down, 1..4
 };
 
 //! Flags and help of the RenderOptions a user sets (option_doc.h); `tailor map` names --up

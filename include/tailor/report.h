@@ -29,10 +29,10 @@ namespace tailor {
 //! One run of `tailor map`: what was asked, what each stage found, how long each took.
 struct MapRun {
   // What was asked
-  std::string input;          //!< mesh file
-  std::string output;         //!< mesh file written
-  std::string texture;        //!< texture file, empty when none
-  int texture_width = 0;      //!< texture size the UVs are in (px per repeat)
+  std::string input;      //!< mesh file
+  std::string output;     //!< mesh file written
+  std::string texture;    //!< texture file, empty when none
+  int texture_width = 0;  //!< texture size the UVs are in (px per repeat)
   int texture_height = 0;
   MapTextureOptions options;  //!< as map_texture ran them (after --axis auto: the chosen axis)
   std::string axis;           //!< the axis as asked ("pca", "x", "0,1,0"...), or "auto:<chosen>"
@@ -40,15 +40,15 @@ struct MapRun {
   std::string seed_point;     //!< the seed point as asked ("X,Y,Z"), empty when none
   std::string seam_faces;     //!< seam-face file, empty when none
   // What the stages found (add_map_results fills these from the library's results)
-  LoadReport load;            //!< what the reader saw and repaired, its time
+  LoadReport load;  //!< what the reader saw and repaired, its time
   size_t vertices = 0;
   size_t faces = 0;
-  uint32_t components = 0;    //!< Topology::vertex_components
+  uint32_t components = 0;  //!< Topology::vertex_components
   size_t boundary_edges = 0;
   size_t nonmanifold_edges = 0;
   size_t inconsistent_edges = 0;
-  MappingStats mapping;       //!< map_texture's counters and time
-  UvMetrics metrics;          //!< map_texture's metrics and time
+  MappingStats mapping;                      //!< map_texture's counters and time
+  UvMetrics metrics;                         //!< map_texture's metrics and time
   std::optional<StabilityReport> stability;  //!< measure_stability, when it ran (--stability)
   std::vector<std::string> previews;         //!< preview pictures written
   // Wall times of the other steps, seconds
@@ -57,12 +57,12 @@ struct MapRun {
   double orientation_seconds = 0;
   double export_seconds = 0;
   double preview_seconds = 0;
-  double total_seconds = 0;   //!< the whole command
+  double total_seconds = 0;  //!< the whole command
 };
 
 //! Fills the fields of `run` that come from the loaded mesh, its topology and map_texture's result.
-TAILOR_API void add_map_results(const Mesh& mesh, const LoadReport& load, const Topology& topology, const TextureMap& map,
-                     MapRun& run);
+TAILOR_API void add_map_results(const Mesh& mesh, const LoadReport& load, const Topology& topology,
+                                const TextureMap& map, MapRun& run);
 
 //! The JSON report of `tailor map --stats`: input, output, texture, texture_size, options, mesh,
 //! mapping (MappingStats), metrics (UvMetrics), stability (when run), time_ms, previews.
@@ -76,18 +76,18 @@ TAILOR_API std::string map_summary(const MapRun& run);
 
 //! One run of `tailor eval` on a UV-mapped mesh.
 struct EvalRun {
-  std::string file;               //!< mesh file
-  std::string format;             //!< LoadReport::format
+  std::string file;    //!< mesh file
+  std::string format;  //!< LoadReport::format
   size_t vertices = 0;
-  size_t welded_vertices = 0;     //!< vertices merged to find the seams again (split files)
-  int texture_width = 0;          //!< texture size the UVs were measured in (px per repeat)
+  size_t welded_vertices = 0;  //!< vertices merged to find the seams again (split files)
+  int texture_width = 0;       //!< texture size the UVs were measured in (px per repeat)
   int texture_height = 0;
   std::string texture_size_from;  //!< "option", "embedded texture" or "default"
   uint32_t symmetry = 1;          //!< MetricsOptions::symmetry the metrics were measured with
   UvMetrics metrics;
-  size_t boundary_edges = 0;      //!< Topology::boundary_edges
-  size_t nonmanifold_edges = 0;   //!< Topology::nonmanifold_edges
-  double seconds = 0;             //!< the whole command
+  size_t boundary_edges = 0;     //!< Topology::boundary_edges
+  size_t nonmanifold_edges = 0;  //!< Topology::nonmanifold_edges
+  double seconds = 0;            //!< the whole command
 };
 
 //! The JSON of `tailor eval --json`: the metrics flat, with the file, sizes and edge counts.
@@ -115,17 +115,17 @@ struct TileQuality {
 
 //! One run of `tailor tile`.
 struct TileRun {
-  std::string input;           //!< exemplar file
+  std::string input;  //!< exemplar file
   int input_width = 0;
   int input_height = 0;
   int input_channels = 0;
-  std::string output;          //!< the output as the summary names it: the file, or NAME_{0..k}.png
-  TileOptions options;         //!< as asked (seed, fit_period; block and overlap as used are in `report`)
-  int variants = 1;            //!< tiles made (make_tile_variants' count)
-  TileReport report;           //!< make_tile_variants' report
-  double seconds = 0;          //!< time of make_tile_variants
+  std::string output;              //!< the output as the summary names it: the file, or NAME_{0..k}.png
+  TileOptions options;             //!< as asked (seed, fit_period; block and overlap as used are in `report`)
+  int variants = 1;                //!< tiles made (make_tile_variants' count)
+  TileReport report;               //!< make_tile_variants' report
+  double seconds = 0;              //!< time of make_tile_variants
   std::vector<TileQuality> tiles;  //!< one per variant (file always; metrics when measured)
-  TileQuality worst;           //!< worst_tile_metrics over the tiles, with its own verdict (no file)
+  TileQuality worst;               //!< worst_tile_metrics over the tiles, with its own verdict (no file)
 };
 
 //! Each metric's worst value over the tiles: wrap ratios farthest from 1, the largest worst seam,
@@ -146,6 +146,7 @@ TAILOR_API std::string tile_summary(const TileRun& run);
 
 //! The JSON of `tailor eval-tile --json`: `tile`'s metrics and verdict, its size, and the exemplar
 //! (empty when there is none).
-TAILOR_API std::string eval_tile_report_json(const TileQuality& tile, int width, int height, const std::string& exemplar);
+TAILOR_API std::string eval_tile_report_json(const TileQuality& tile, int width, int height,
+                                             const std::string& exemplar);
 
 }  // namespace tailor

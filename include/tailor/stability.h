@@ -29,18 +29,18 @@ inline constexpr OptionDoc kStabilityOptionDocs[] = {
 };
 
 struct StabilityReport {
-  size_t faces = 0;               //!< faces of the full mesh
-  size_t removed_faces = 0;       //!< faces removed (inside the ball)
-  size_t compared_corners = 0;    //!< corners of surviving faces
-  double mean_difference_px = 0;  //!< mean |uv_full - uv_cut| over surviving corners, pixels
-  double max_difference_px = 0;   //!< largest such difference, pixels
+  size_t faces = 0;                 //!< faces of the full mesh
+  size_t removed_faces = 0;         //!< faces removed (inside the ball)
+  size_t compared_corners = 0;      //!< corners of surviving faces
+  double mean_difference_px = 0;    //!< mean |uv_full - uv_cut| over surviving corners, pixels
+  double max_difference_px = 0;     //!< largest such difference, pixels
   double median_difference_px = 0;  //!< median of the differences, pixels (robust to the few regions that a
-                                  //!< changed growth order re-places whole)
-  double identical_ratio = 0;     //!< share of surviving corners with bit-identical UVs
-  double within_1px_ratio = 0;    //!< share of surviving corners that moved less than 1 px
-  uint32_t patches_full = 0;      //!< patches of the full mapping
-  uint32_t patches_cut = 0;       //!< patches of the cut mapping
-  double seconds = 0;             //!< wall time
+                                    //!< changed growth order re-places whole)
+  double identical_ratio = 0;       //!< share of surviving corners with bit-identical UVs
+  double within_1px_ratio = 0;      //!< share of surviving corners that moved less than 1 px
+  uint32_t patches_full = 0;        //!< patches of the full mapping
+  uint32_t patches_cut = 0;         //!< patches of the cut mapping
+  double seconds = 0;               //!< wall time
 };
 
 //! Runs the experiment above, both mappings by map_texture with `options` (its axis and, when
@@ -49,6 +49,6 @@ struct StabilityReport {
 //! kInvalidArgument when remove_fraction is out of range, or kInvalidMesh when the mesh has fewer
 //! than 10 faces. Cost: two orientation + mapping runs, O(F log F). Deterministic.
 TAILOR_API Status measure_stability(const Mesh& mesh, const MapTextureOptions& options, StabilityReport& report,
-                         const StabilityOptions& stability = {});
+                                    const StabilityOptions& stability = {});
 
 }  // namespace tailor

@@ -75,9 +75,9 @@ class Status {
 };
 
 //! Propagates a failed Status to the caller.
-#define TAILOR_RETURN_IF_ERROR(expr)          \
-  do {                                        \
-    ::tailor::Status tailor_status_ = (expr); \
+#define TAILOR_RETURN_IF_ERROR(expr)                    \
+  do {                                                  \
+    ::tailor::Status tailor_status_ = (expr);           \
     if (!tailor_status_.is_ok()) return tailor_status_; \
   } while (0)
 

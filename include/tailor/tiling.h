@@ -67,7 +67,7 @@ using TileProgress = std::function<bool(double)>;
 
 struct TileOptions {
   int block = 32;   //!< quilting block side in px, [8, 256]; shrunk to min(W, H) / 4 (with a warning) for small images;
-                   //!< the '+' is repaired with blocks of max(8, block / 2), variants with large blocks
+                    //!< the '+' is repaired with blocks of max(8, block / 2), variants with large blocks
   int overlap = 0;  //!< overlap of neighbouring blocks in px, [1, block / 2 - 1]; 0 = block / 4
   uint64_t seed = 1;        //!< seeds the random choice among near-best blocks; same seed -> same tile
   double tolerance = 0.1;   //!< candidate blocks have SSD <= best * (1 + tolerance), [0, 1]
@@ -103,13 +103,13 @@ struct PeriodEstimate {
 struct TileReport {
   int width = 0;  //!< output size (differs from the input only with fit_period)
   int height = 0;
-  int block = 0;                      //!< block side actually used (px)
-  int overlap = 0;                    //!< overlap actually used (px)
-  int border = 0;                     //!< width of the outer ring that is bit-identical across variants (px)
-  int shift_x = 0;                    //!< toroidal shift used: tile(x, y) = input((x + shift_x) % W, (y + shift_y) % H)
-  int shift_y = 0;                    //!<   outside the repaired strips (about W/2, H/2; see make_tileable); 0 with symmetry 4
-  int symmetry = 1;                   //!< TileOptions::symmetry as used
-  double anisotropy = 0.0;            //!< symmetry 4: orientation_anisotropy() of the exemplar (> 0.5 warns)
+  int block = 0;            //!< block side actually used (px)
+  int overlap = 0;          //!< overlap actually used (px)
+  int border = 0;           //!< width of the outer ring that is bit-identical across variants (px)
+  int shift_x = 0;          //!< toroidal shift used: tile(x, y) = input((x + shift_x) % W, (y + shift_y) % H)
+  int shift_y = 0;          //!<   outside the repaired strips (about W/2, H/2; see make_tileable); 0 with symmetry 4
+  int symmetry = 1;         //!< TileOptions::symmetry as used
+  double anisotropy = 0.0;  //!< symmetry 4: orientation_anisotropy() of the exemplar (> 0.5 warns)
   int quarter_turn_difference = -1;   //!< symmetry 4: quarter_turn_difference() of the tile (0: exact)
   int blocks = 0;                     //!< quilting blocks placed (all variants)
   PeriodEstimate period;              //!< filled when fit_period was asked for
@@ -179,8 +179,9 @@ struct TileMetrics {
   double patch_coherence = 0.0;  //!< mean over 7x7 tile patches (read toroidally) of the per-sample squared distance
                                  //!< to the nearest exemplar patch, over the exemplar's variance (0 = all copied)
   double exemplar_patch_coherence = 0.0;  //!< the same for the exemplar itself read toroidally (baseline)
-  int quarter_turn_difference = -1;  //!< quarter_turn_difference() of the tile (0: unchanged by a quarter turn; -1 not square)
-  int quarter_turn_shift_x = 0;      //!< the shift it found (0 or N/2)
+  int quarter_turn_difference =
+      -1;  //!< quarter_turn_difference() of the tile (0: unchanged by a quarter turn; -1 not square)
+  int quarter_turn_shift_x = 0;  //!< the shift it found (0 or N/2)
   int quarter_turn_shift_y = 0;
   bool coherence_with_turns = false;  //!< both coherences were measured against the exemplar and its three
                                       //!< quarter turns (done when quarter_turn_difference == 0: such a tile
@@ -195,8 +196,8 @@ struct TileMetrics {
 //! al. 2009, constant seed, 6 iterations), so the value is an upper bound of the exact one, and
 //! deterministic. A tile exactly unchanged by a quarter turn (quarter_turn_difference 0) is compared
 //! with the exemplar in its four quarter turns (the nearest patch over the four), and so is the
-//! exemplar's own baseline. Cost: O(N) plus ~0.1 s per 512 px image (4 x for such a tile). Fails with kInvalidImage for an
-//! inconsistent image or one smaller than 8 px a side. Safe for untrusted images.
+//! exemplar's own baseline. Cost: O(N) plus ~0.1 s per 512 px image (4 x for such a tile). Fails with kInvalidImage for
+//! an inconsistent image or one smaller than 8 px a side. Safe for untrusted images.
 TAILOR_API Status tile_metrics(const Image& tile, const Image* exemplar, TileMetrics& metrics);
 
 //! The quality targets: wrap ratios in [0.8, 1.2], worst seam <= max(exemplar's, 1.5),

@@ -1,6 +1,4 @@
 // export_mesh: validation, vertex splitting and normals shared by the .glb, .obj and .ply writers.
-#include "tailor/export.h"
-
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -8,12 +6,12 @@
 #include <filesystem>
 #include <limits>
 
-#include "util/simd.h"
-
-#include "util/atomic_file.h"
 #include "export/writers.h"
+#include "tailor/export.h"
+#include "util/atomic_file.h"
 #include "util/huge_pages.h"
 #include "util/parallel_chunks.h"
+#include "util/simd.h"
 
 namespace tailor {
 namespace internal {
@@ -46,10 +44,10 @@ std::string relative_path(const std::string& target, const std::filesystem::path
   if (error) return target;
   const std::filesystem::path absolute_base = std::filesystem::absolute(base_dir.empty() ? "." : base_dir, error);
   if (error) return absolute_target.string();
-  const std::filesystem::path relative = absolute_target.lexically_normal().lexically_relative(absolute_base.lexically_normal());
+  const std::filesystem::path relative =
+      absolute_target.lexically_normal().lexically_relative(absolute_base.lexically_normal());
   return relative.empty() ? absolute_target.string() : relative.generic_string();
 }
-
 
 }  // namespace internal
 
@@ -86,7 +84,9 @@ void vertex_normals(const Mesh& mesh, std::vector<float>& normals) {
 #if TAILOR_SSE2
     // The scalar code below with x and y in one register: the same IEEE operations in the same
     // order per component, so the same bits, in about half the instructions.
-    auto load_xy = [](const float* p) { return _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)))); };
+    auto load_xy = [](const float* p) {
+      return _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p))));
+    };
     auto load_z = [](const float* p) { return _mm_cvtss_sd(_mm_setzero_pd(), _mm_load_ss(p + 2)); };
     const __m128d a_xy = load_xy(a), a_z = load_z(a);
     const __m128d e1_xy = _mm_sub_pd(load_xy(b), a_xy), e1_z = _mm_sub_sd(load_z(b), a_z);
@@ -94,8 +94,8 @@ void vertex_normals(const Mesh& mesh, std::vector<float>& normals) {
     // (n0, n1) = (e1y, e1z) * (e2z, e2x) - (e1z, e1x) * (e2y, e2z); n2 = e1x * e2y - e1y * e2x.
     const __m128d n_xy = _mm_sub_pd(_mm_mul_pd(_mm_shuffle_pd(e1_xy, e1_z, 1), _mm_shuffle_pd(e2_z, e2_xy, 0)),
                                     _mm_mul_pd(_mm_shuffle_pd(e1_z, e1_xy, 0), _mm_shuffle_pd(e2_xy, e2_z, 1)));
-    const __m128d n_z = _mm_sub_sd(_mm_mul_sd(e1_xy, _mm_unpackhi_pd(e2_xy, e2_xy)),
-                                   _mm_mul_sd(_mm_unpackhi_pd(e1_xy, e1_xy), e2_xy));
+    const __m128d n_z =
+        _mm_sub_sd(_mm_mul_sd(e1_xy, _mm_unpackhi_pd(e2_xy, e2_xy)), _mm_mul_sd(_mm_unpackhi_pd(e1_xy, e1_xy), e2_xy));
     for (int k = 0; k < 3; ++k) {  // one vertex at a time: a face may repeat a vertex
       double* s = &sum[3 * size_t{t[k]}];
       _mm_storeu_pd(s, _mm_add_pd(_mm_loadu_pd(s), n_xy));
@@ -169,12 +169,14 @@ Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas
   if (!indices_in_range(mesh)) {
     for (size_t c = 0; c < mesh.indices.size(); ++c)
       if (mesh.indices[c] >= mesh.vertex_count())
-        return Status::error(ErrorCode::kInvalidArgument, path, "vertex index out of range", "corner " + std::to_string(c));
+        return Status::error(ErrorCode::kInvalidArgument, path, "vertex index out of range",
+                             "corner " + std::to_string(c));
   }
   if (!positions_finite(mesh)) {
     for (size_t i = 0; i < mesh.positions.size(); ++i)
       if (!std::isfinite(mesh.positions[i]))
-        return Status::error(ErrorCode::kInvalidArgument, path, "position is not finite", "vertex " + std::to_string(i / 3));
+        return Status::error(ErrorCode::kInvalidArgument, path, "position is not finite",
+                             "vertex " + std::to_string(i / 3));
   }
 
   // Pixels -> texture repeats, OBJ convention (t up); the glTF writer flips t itself. Scaled on the
@@ -187,7 +189,10 @@ Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas
   const double su = 1.0 / options.texture_width, sv = 1.0 / options.texture_height;
   size_t bad_corner = internal::kNoBadCorner;
   internal::run_beside(
-      want_normals && nf >= kThreadedFaces, [&] { if (want_normals) vertex_normals(mesh, data.normals); },
+      want_normals && nf >= kThreadedFaces,
+      [&] {
+        if (want_normals) vertex_normals(mesh, data.normals);
+      },
       [&] { bad_corner = internal::split_vertices_scaled(mesh, atlas.corner_uv, su, sv, data.split); });
   if (bad_corner != internal::kNoBadCorner)
     return Status::error(ErrorCode::kInvalidArgument, path, "UV is not finite", "corner " + std::to_string(bad_corner));

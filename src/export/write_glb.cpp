@@ -4,17 +4,16 @@
 // filtering. The JSON is built with nlohmann::json (keys sorted, so the output is deterministic)
 // rather than through tinygltf's writer, which would decode and re-encode the image.
 // Reference: the glTF 2.0 specification, sections 3.6 (buffers), 3.7 (geometry), 4.4 (GLB layout).
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 #include <bit>
 #include <cstring>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <span>
 #include <vector>
 
-#include "util/atomic_file.h"
 #include "export/writers.h"
+#include "util/atomic_file.h"
 
 namespace tailor::internal {
 namespace {
@@ -28,7 +27,7 @@ constexpr int kLinear = 9729;
 constexpr int kLinearMipmapLinear = 9987;
 constexpr int kRepeat = 10497;
 constexpr int kTriangles = 4;
-constexpr uint32_t kGlbMagic = 0x46546C67;  // "glTF"
+constexpr uint32_t kGlbMagic = 0x46546C67;   // "glTF"
 constexpr uint32_t kChunkJson = 0x4E4F534A;  // "JSON"
 constexpr uint32_t kChunkBin = 0x004E4942;   // "BIN\0"
 
@@ -79,7 +78,8 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
   const SplitMesh& split = data.split;
   const size_t vertex_count = split.xref.size();
   const size_t index_count = split.indices.size();
-  if (vertex_count > std::numeric_limits<uint32_t>::max() / 12 || index_count > std::numeric_limits<uint32_t>::max() / 4)
+  if (vertex_count > std::numeric_limits<uint32_t>::max() / 12 ||
+      index_count > std::numeric_limits<uint32_t>::max() / 4)
     return Status::error(ErrorCode::kLimit, path, "mesh too large for a .glb buffer (4 GiB)");
 
   std::string texture_bytes, mime_type;
@@ -89,7 +89,8 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
   // Split positions are source positions through xref, in split order (the order matters for
   // min/max: -0 and +0 compare equal, the first one seen is kept).
   const float* positions = mesh.positions.data();
-  float lo[3] = {std::numeric_limits<float>::max(), std::numeric_limits<float>::max(), std::numeric_limits<float>::max()};
+  float lo[3] = {std::numeric_limits<float>::max(), std::numeric_limits<float>::max(),
+                 std::numeric_limits<float>::max()};
   float hi[3] = {-lo[0], -lo[1], -lo[2]};
   for (size_t s = 0; s < vertex_count; ++s) {
     const float* p = &positions[3 * size_t{split.xref[s]}];
@@ -108,8 +109,12 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
     const size_t view = add_view(views, bin_size, 12 * vertex_count, kArrayBuffer);
     bin_size += 12 * vertex_count;
     attributes["POSITION"] = accessors.size();
-    accessors.push_back({{"bufferView", view}, {"componentType", kFloat}, {"count", vertex_count}, {"type", "VEC3"},
-                         {"min", {lo[0], lo[1], lo[2]}}, {"max", {hi[0], hi[1], hi[2]}}});
+    accessors.push_back({{"bufferView", view},
+                         {"componentType", kFloat},
+                         {"count", vertex_count},
+                         {"type", "VEC3"},
+                         {"min", {lo[0], lo[1], lo[2]}},
+                         {"max", {hi[0], hi[1], hi[2]}}});
   }
   if (normals) {
     const size_t view = add_view(views, bin_size, 12 * vertex_count, kArrayBuffer);
@@ -128,7 +133,8 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
     const size_t view = add_view(views, bin_size, 4 * index_count, kElementArrayBuffer);
     bin_size += 4 * index_count;
     indices_accessor = accessors.size();
-    accessors.push_back({{"bufferView", view}, {"componentType", kUnsignedInt}, {"count", index_count}, {"type", "SCALAR"}});
+    accessors.push_back(
+        {{"bufferView", view}, {"componentType", kUnsignedInt}, {"count", index_count}, {"type", "SCALAR"}});
   }
 
   nlohmann::json pbr = {{"metallicFactor", 0.0}, {"roughnessFactor", 1.0}};
@@ -138,8 +144,9 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
       {"scenes", {{{"nodes", {0}}}}},
       {"nodes", {{{"mesh", 0}, {"name", "tailor"}}}},
       {"materials", nlohmann::json::array()},
-      {"meshes", {{{"primitives", {{{"attributes", attributes}, {"indices", indices_accessor}, {"material", 0},
-                                    {"mode", kTriangles}}}}}}},
+      {"meshes",
+       {{{"primitives",
+          {{{"attributes", attributes}, {"indices", indices_accessor}, {"material", 0}, {"mode", kTriangles}}}}}}},
   };
   size_t texture_padding = 0;
   if (!texture_bytes.empty()) {
@@ -150,7 +157,8 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
     texture_padding = (4 - bin_size % 4) % 4;
     bin_size += texture_padding;
     gltf["images"] = {{{"bufferView", view}, {"mimeType", mime_type}}};
-    gltf["samplers"] = {{{"magFilter", kLinear}, {"minFilter", kLinearMipmapLinear}, {"wrapS", kRepeat}, {"wrapT", kRepeat}}};
+    gltf["samplers"] = {
+        {{"magFilter", kLinear}, {"minFilter", kLinearMipmapLinear}, {"wrapS", kRepeat}, {"wrapT", kRepeat}}};
     gltf["textures"] = {{{"sampler", 0}, {"source", 0}}};
     pbr["baseColorTexture"] = {{"index", 0}};
   }

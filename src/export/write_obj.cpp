@@ -5,8 +5,8 @@
 // Numbers are written with std::to_chars (shortest text that reads back bit-exact).
 #include <filesystem>
 
-#include "util/atomic_file.h"
 #include "export/writers.h"
+#include "util/atomic_file.h"
 
 namespace tailor::internal {
 namespace {

@@ -9,8 +9,8 @@
 #include <filesystem>
 #include <vector>
 
-#include "util/atomic_file.h"
 #include "export/writers.h"
+#include "util/atomic_file.h"
 
 namespace tailor::internal {
 

@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "surface/vertex_split.h"
 #include "tailor/export.h"
 #include "tailor/mesh.h"
 #include "tailor/status.h"
-#include "surface/vertex_split.h"
 
 namespace tailor::internal {
 

@@ -13,8 +13,8 @@
 #include <cstring>
 #include <string>
 
-#include "util/atomic_file.h"
 #include "tailor/image.h"
+#include "util/atomic_file.h"
 
 namespace tailor {
 

@@ -6,7 +6,6 @@
 // Here every index is range-checked and every accessor is checked against its buffer view and
 // the BIN chunk before a byte is read; only the BIN chunk is ever used (no URI is opened).
 // Reference: glTF 2.0 specification, sections 3.6 (buffers, accessors), 3.7 (meshes), 4.4 (GLB).
-#include <nlohmann/json.hpp>
 #include <stb/stb_image.h>
 
 #include <algorithm>
@@ -15,19 +14,20 @@
 #include <cmath>
 #include <cstring>
 #include <new>
+#include <nlohmann/json.hpp>
 
-#include "util/atomic_file.h"
 #include "io/readers.h"
 #include "tailor/export.h"
 #include "tailor/gltf.h"
 #include "tailor/io.h"
+#include "util/atomic_file.h"
 
 namespace tailor {
 namespace {
 
 using Json = nlohmann::json;
 
-constexpr uint32_t kGlbMagic = 0x46546C67;  // "glTF"
+constexpr uint32_t kGlbMagic = 0x46546C67;   // "glTF"
 constexpr uint32_t kChunkJson = 0x4E4F534A;  // "JSON"
 constexpr uint32_t kChunkBin = 0x004E4942;   // "BIN\0"
 constexpr int kByte = 5120, kUnsignedByte = 5121, kShort = 5122, kUnsignedShort = 5123, kUnsignedInt = 5125,
@@ -46,7 +46,8 @@ Status parse_error(const std::string& name, const std::string& what, const std::
 bool get_uint(const Json& object, const char* key, uint64_t& out) {
   if (!object.is_object()) return false;
   const auto it = object.find(key);
-  if (it == object.end() || !it->is_number_integer() || (it->is_number_integer() && !it->is_number_unsigned() && it->get<int64_t>() < 0))
+  if (it == object.end() || !it->is_number_integer() ||
+      (it->is_number_integer() && !it->is_number_unsigned() && it->get<int64_t>() < 0))
     return false;
   out = it->get<uint64_t>();
   return true;
@@ -69,7 +70,8 @@ Status split_glb(std::span<const char> data, const std::string& name, Glb& glb) 
   const auto* bytes = reinterpret_cast<const unsigned char*>(data.data());
   if (data.size() < 20 || load_u32(bytes) != kGlbMagic) return parse_error(name, "not a binary glTF file (bad magic)");
   if (load_u32(bytes + 4) != 2)
-    return Status::error(ErrorCode::kUnsupported, name, "unsupported glTF container version " + std::to_string(load_u32(bytes + 4)));
+    return Status::error(ErrorCode::kUnsupported, name,
+                         "unsupported glTF container version " + std::to_string(load_u32(bytes + 4)));
   const size_t total = load_u32(bytes + 8);
   if (total > data.size() || total < 20) return parse_error(name, "glb length field does not match the file", "byte 8");
   const size_t json_length = load_u32(bytes + 12);
@@ -150,7 +152,8 @@ Status accessor_view(const Json& doc, const Glb& glb, uint64_t index, const std:
   const std::string where = "accessor " + std::to_string(index);
   const Json* accessor = get_element(doc, "accessors", index);
   if (!accessor) return parse_error(name, "missing accessor", where);
-  if (accessor->contains("sparse")) return Status::error(ErrorCode::kUnsupported, name, "sparse accessors are not supported", where);
+  if (accessor->contains("sparse"))
+    return Status::error(ErrorCode::kUnsupported, name, "sparse accessors are not supported", where);
   uint64_t view_index = 0, offset = 0, count = 0, component_type = 0;
   if (!get_uint(*accessor, "bufferView", view_index))
     return Status::error(ErrorCode::kUnsupported, name, "accessor without buffer view", where);
@@ -254,7 +257,8 @@ void find_texture(const Json& doc, const Glb& glb, uint64_t material, std::span<
 
 Status decode_texture(std::span<const unsigned char> bytes, const std::string& name, Image& image) {
   image = Image{};
-  if (bytes.size() > size_t{INT_MAX}) return Status::error(ErrorCode::kInvalidImage, name, "embedded texture too large");
+  if (bytes.size() > size_t{INT_MAX})
+    return Status::error(ErrorCode::kInvalidImage, name, "embedded texture too large");
   const int length = static_cast<int>(bytes.size());
   int width = 0, height = 0, channels = 0;
   if (!stbi_info_from_memory(bytes.data(), length, &width, &height, &channels))
@@ -281,7 +285,8 @@ Status parse_glb(std::span<const char> data, const std::string& name, Mesh& mesh
   const Json doc = Json::parse(glb.json.begin(), glb.json.end(), nullptr, /*allow_exceptions=*/false);
   if (doc.is_discarded() || !doc.is_object()) return parse_error(name, "JSON chunk is not a valid JSON object");
   const auto meshes = doc.find("meshes");
-  if (meshes == doc.end() || !meshes->is_array()) return Status::error(ErrorCode::kUnsupported, name, "no mesh in the file");
+  if (meshes == doc.end() || !meshes->is_array())
+    return Status::error(ErrorCode::kUnsupported, name, "no mesh in the file");
 
   // Output size is bounded by a multiple of the input, so repeated references to one large
   // accessor cannot blow up memory.
@@ -312,8 +317,9 @@ Status parse_glb(std::span<const char> data, const std::string& name, Mesh& mesh
       const bool has_uv = get_uint(*attributes, "TEXCOORD_0", uv_index);
       if (has_uv) {
         TAILOR_RETURN_IF_ERROR(accessor_view(doc, glb, uv_index, name, uvs));
-        const bool ok_type = uvs.component_type == kFloat ||
-                             ((uvs.component_type == kUnsignedByte || uvs.component_type == kUnsignedShort) && uvs.normalized);
+        const bool ok_type =
+            uvs.component_type == kFloat ||
+            ((uvs.component_type == kUnsignedByte || uvs.component_type == kUnsignedShort) && uvs.normalized);
         if (!ok_type || uvs.components != 2)
           return Status::error(ErrorCode::kUnsupported, name, "TEXCOORD_0 must be float or normalized VEC2", where);
         if (uvs.count != positions.count) return parse_error(name, "TEXCOORD_0 and POSITION counts differ", where);
@@ -343,7 +349,8 @@ Status parse_glb(std::span<const char> data, const std::string& name, Mesh& mesh
       for (size_t i = 0; i < corner_count; ++i) {
         const size_t local = indexed ? read_index(indices, i) : i;
         if (local >= positions.count)
-          return Status::error(ErrorCode::kInvalidMesh, name, "index out of range", where + " index " + std::to_string(i));
+          return Status::error(ErrorCode::kInvalidMesh, name, "index out of range",
+                               where + " index " + std::to_string(i));
         mesh.indices[first_corner + i] = static_cast<uint32_t>(base + local);
       }
       // UVs per corner, OBJ convention up to a whole repeat (t = -v_gltf, see export.h).
@@ -365,7 +372,8 @@ Status parse_glb(std::span<const char> data, const std::string& name, Mesh& mesh
       }
     }
   }
-  if (triangle_primitives == 0) return Status::error(ErrorCode::kUnsupported, name, "no triangle primitive in the file");
+  if (triangle_primitives == 0)
+    return Status::error(ErrorCode::kUnsupported, name, "no triangle primitive in the file");
   // All or nothing: UVs are only meaningful when every primitive has them.
   if (with_uv != triangle_primitives) mesh.corner_uvs.clear();
   // glTF splits vertices on UV seams; weld them so that seams are edges between faces again.

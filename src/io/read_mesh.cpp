@@ -11,10 +11,10 @@
 #include <utility>
 #include <vector>
 
-#include "util/file_view.h"
-#include "util/huge_pages.h"
 #include "io/readers.h"
 #include "tailor/io.h"
+#include "util/file_view.h"
+#include "util/huge_pages.h"
 
 namespace tailor {
 namespace {
@@ -128,9 +128,7 @@ size_t mark_duplicates_by_buckets(const std::vector<uint32_t>& indices, uint8_t*
   const size_t nf = indices.size() / 3;
   uint32_t nv = 0;
   for (uint32_t i : indices) nv = std::max(nv, i + 1);
-  auto lowest = [&](size_t f) {
-    return std::min(indices[3 * f], std::min(indices[3 * f + 1], indices[3 * f + 2]));
-  };
+  auto lowest = [&](size_t f) { return std::min(indices[3 * f], std::min(indices[3 * f + 1], indices[3 * f + 2])); };
   // Faces the chains already dropped stay dropped (their twin is kept); the others compete here.
   std::vector<uint32_t> start(size_t{nv} + 1, 0);
   for (size_t f = 0; f < nf; ++f) {
@@ -346,8 +344,10 @@ Status finalize_mesh(const std::string& name, Mesh& mesh, LoadReport& report) {
   chains.reset();
   next.reset();
   const size_t main_zeros = geometry(used_main.get());
-  if (worker.joinable()) worker.join();
-  else worker_job();
+  if (worker.joinable())
+    worker.join();
+  else
+    worker_job();
   zero_area += main_zeros;
   size_t unreferenced = 0;
   for (size_t v = 0; v < nv; ++v) unreferenced += (used_main[v] | used_worker[v]) == 0;
@@ -371,10 +371,10 @@ Status finalize_mesh(const std::string& name, Mesh& mesh, LoadReport& report) {
   if (max_index >= nv) {
     for (size_t c = 0; c < 3 * nf; ++c) {
       if (idx[c] >= nv) {
-        return Status::error(ErrorCode::kInvalidMesh, name,
-                             "face index " + std::to_string(idx[c]) + " out of range (mesh has " +
-                                 std::to_string(nv) + " vertices)",
-                             "face " + std::to_string(c / 3));
+        return Status::error(
+            ErrorCode::kInvalidMesh, name,
+            "face index " + std::to_string(idx[c]) + " out of range (mesh has " + std::to_string(nv) + " vertices)",
+            "face " + std::to_string(c / 3));
       }
     }
   }

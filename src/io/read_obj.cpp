@@ -50,11 +50,11 @@ Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh,
   s.set_hash_comments(true);
   s.set_line_continuation(true);
 
-  std::vector<float> texcoords;        // #VT by 2
-  std::vector<uint32_t> corner_vt;     // per triangle corner: vt index or kInvalid
+  std::vector<float> texcoords;     // #VT by 2
+  std::vector<uint32_t> corner_vt;  // per triangle corner: vt index or kInvalid
   std::vector<ForwardRef> forward_v, forward_vt;
   std::vector<uint32_t> poly, poly_vt;
-  size_t corners_without_vt = 0;       // once nonzero, corner_vt is dropped and no longer filled
+  size_t corners_without_vt = 0;  // once nonzero, corner_vt is dropped and no longer filled
 
   while (!s.at_end()) {
     const std::string_view w = s.word();
@@ -115,12 +115,14 @@ Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh,
       if (corners_without_vt == 0) {
         for (uint32_t t : poly_vt) corners_without_vt += t == kInvalid;
         if (corners_without_vt == 0) {
-          for (size_t k = 1; k + 1 < n; ++k) corner_vt.insert(corner_vt.end(), {poly_vt[0], poly_vt[k], poly_vt[k + 1]});
+          for (size_t k = 1; k + 1 < n; ++k)
+            corner_vt.insert(corner_vt.end(), {poly_vt[0], poly_vt[k], poly_vt[k + 1]});
         } else {
           std::vector<uint32_t>().swap(corner_vt);  // no uvs after all: stop recording them
         }
       }
-      if (mesh.indices.size() / 3 > kMaxFaces) return Status::error(ErrorCode::kLimit, name, "too many faces", s.where());
+      if (mesh.indices.size() / 3 > kMaxFaces)
+        return Status::error(ErrorCode::kLimit, name, "too many faces", s.where());
     }
     // Every other statement (vn, o, g, s, usemtl, mtllib, l, p, unknown ones) is skipped.
     s.next_line();

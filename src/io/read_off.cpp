@@ -5,8 +5,8 @@
 #include <string_view>
 #include <vector>
 
-#include "util/huge_pages.h"
 #include "io/readers.h"
+#include "util/huge_pages.h"
 #include "util/text_scan.h"
 
 namespace tailor::internal {
@@ -41,7 +41,8 @@ Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh,
       prefix.remove_prefix(1);
       dimension_follows = true;
     }
-    if (!prefix.empty()) return Status::error(ErrorCode::kParse, name, "unknown OFF keyword '" + std::string(kw) + "'", s.where());
+    if (!prefix.empty())
+      return Status::error(ErrorCode::kParse, name, "unknown OFF keyword '" + std::string(kw) + "'", s.where());
     report.format = kw == "OFF" ? "OFF" : "OFF (" + std::string(kw) + ")";
     if (s.peek() == 'B') {
       return Status::error(ErrorCode::kUnsupported, name, "binary OFF files are not supported", s.where());
@@ -54,15 +55,19 @@ Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh,
   if (dimension_follows) {
     uint64_t dim = 0;
     if (!s.read_uint(dim)) return Status::error(ErrorCode::kParse, name, "bad OFF dimension", s.where());
-    if (dim != 3) return Status::error(ErrorCode::kUnsupported, name, "OFF dimension " + std::to_string(dim) + " is not 3", s.where());
+    if (dim != 3)
+      return Status::error(ErrorCode::kUnsupported, name, "OFF dimension " + std::to_string(dim) + " is not 3",
+                           s.where());
     s.skip_space();
   }
 
   // === Counts ===================================================================================
   uint64_t nv = 0, nf = 0, ne = 0;
-  if (!s.read_uint(nv)) return Status::error(ErrorCode::kParse, name, "bad OFF header (expected vertex count)", s.where());
+  if (!s.read_uint(nv))
+    return Status::error(ErrorCode::kParse, name, "bad OFF header (expected vertex count)", s.where());
   s.skip_space();
-  if (!s.read_uint(nf)) return Status::error(ErrorCode::kParse, name, "bad OFF header (expected face count)", s.where());
+  if (!s.read_uint(nf))
+    return Status::error(ErrorCode::kParse, name, "bad OFF header (expected face count)", s.where());
   if (!s.at_line_end() && !s.read_uint(ne)) {
     return Status::error(ErrorCode::kParse, name, "bad OFF header (expected edge count)", s.where());
   }
@@ -75,7 +80,8 @@ Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh,
                              " faces, more than the file can hold (" + std::to_string(s.remaining()) + " bytes left)",
                          "line " + std::to_string(s.line() - 1));
   }
-  if (nv > kMaxVertices) return Status::error(ErrorCode::kLimit, name, "too many vertices (" + std::to_string(nv) + ")");
+  if (nv > kMaxVertices)
+    return Status::error(ErrorCode::kLimit, name, "too many vertices (" + std::to_string(nv) + ")");
   if (nf > kMaxFaces) return Status::error(ErrorCode::kLimit, name, "too many faces (" + std::to_string(nf) + ")");
 
   // === Vertices: x y z, then anything up to the end of the line =================================
@@ -83,10 +89,12 @@ Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh,
   mesh.positions.resize(static_cast<size_t>(3 * nv));
   for (size_t i = 0; i < nv; ++i) {
     s.skip_space();
-    if (s.at_end()) return Status::error(ErrorCode::kParse, name, "unexpected end of file in vertex " + std::to_string(i), s.where());
+    if (s.at_end())
+      return Status::error(ErrorCode::kParse, name, "unexpected end of file in vertex " + std::to_string(i), s.where());
     if (!s.read_float(mesh.positions[3 * i]) || !s.read_float(mesh.positions[3 * i + 1]) ||
         !s.read_float(mesh.positions[3 * i + 2])) {
-      return Status::error(ErrorCode::kParse, name, "bad vertex " + std::to_string(i) + " (expected 3 numbers)", s.where());
+      return Status::error(ErrorCode::kParse, name, "bad vertex " + std::to_string(i) + " (expected 3 numbers)",
+                           s.where());
     }
     s.next_line();
   }
@@ -96,23 +104,31 @@ Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh,
   std::vector<uint32_t> poly;
   for (size_t f = 0; f < nf; ++f) {
     s.skip_space();
-    if (s.at_end()) return Status::error(ErrorCode::kParse, name, "unexpected end of file in face " + std::to_string(f), s.where());
+    if (s.at_end())
+      return Status::error(ErrorCode::kParse, name, "unexpected end of file in face " + std::to_string(f), s.where());
     uint64_t n = 0;
-    if (!s.read_uint(n)) return Status::error(ErrorCode::kParse, name, "bad face " + std::to_string(f) + " (expected a vertex count)", s.where());
-    if (n < 3) return Status::error(ErrorCode::kInvalidMesh, name, "face with " + std::to_string(n) + " vertices", s.where());
+    if (!s.read_uint(n))
+      return Status::error(ErrorCode::kParse, name, "bad face " + std::to_string(f) + " (expected a vertex count)",
+                           s.where());
+    if (n < 3)
+      return Status::error(ErrorCode::kInvalidMesh, name, "face with " + std::to_string(n) + " vertices", s.where());
     if (mul_sat(n, 2) > s.remaining() + 1) {
-      return Status::error(ErrorCode::kParse, name, "face of " + std::to_string(n) + " vertices runs past the end of the file", s.where());
+      return Status::error(ErrorCode::kParse, name,
+                           "face of " + std::to_string(n) + " vertices runs past the end of the file", s.where());
     }
     poly.resize(static_cast<size_t>(n));
     for (size_t k = 0; k < n; ++k) {
       uint64_t v = 0;
       if (!s.read_uint(v)) {
-        return Status::error(ErrorCode::kParse, name, "bad face " + std::to_string(f) + " (expected " + std::to_string(n) + " vertex indices)", s.where());
+        return Status::error(ErrorCode::kParse, name,
+                             "bad face " + std::to_string(f) + " (expected " + std::to_string(n) + " vertex indices)",
+                             s.where());
       }
       if (v >= nv) {
-        return Status::error(ErrorCode::kInvalidMesh, name,
-                             "face index " + std::to_string(v) + " out of range (mesh has " + std::to_string(nv) + " vertices)",
-                             s.where());
+        return Status::error(
+            ErrorCode::kInvalidMesh, name,
+            "face index " + std::to_string(v) + " out of range (mesh has " + std::to_string(nv) + " vertices)",
+            s.where());
       }
       poly[k] = static_cast<uint32_t>(v);
     }

@@ -21,8 +21,8 @@
 #include <type_traits>
 #include <vector>
 
-#include "util/huge_pages.h"
 #include "io/readers.h"
+#include "util/huge_pages.h"
 #include "util/text_scan.h"
 
 namespace tailor::internal {
@@ -123,29 +123,38 @@ Status parse_header(std::string_view data, const std::string& name, PlyHeader& h
     const std::string where = "line " + std::to_string(line_no);
     const auto w = split_words(line);
     if (line_no == 1) {
-      if (w.size() != 1 || w[0] != "ply") return Status::error(ErrorCode::kParse, name, "not a PLY file (no 'ply' magic)", where);
+      if (w.size() != 1 || w[0] != "ply")
+        return Status::error(ErrorCode::kParse, name, "not a PLY file (no 'ply' magic)", where);
       continue;
     }
     if (w.empty() || w[0] == "comment" || w[0] == "obj_info") continue;
     if (w[0] == "format") {
       if (w.size() < 2) return Status::error(ErrorCode::kParse, name, "PLY format line without a format", where);
-      if (w[1] == "ascii") h.format = PlyFormat::kAscii;
-      else if (w[1] == "binary_little_endian") h.format = PlyFormat::kBinaryLe;
-      else if (w[1] == "binary_big_endian") h.format = PlyFormat::kBinaryBe;
-      else return Status::error(ErrorCode::kUnsupported, name, "unknown PLY format '" + std::string(w[1]) + "'", where);
+      if (w[1] == "ascii")
+        h.format = PlyFormat::kAscii;
+      else if (w[1] == "binary_little_endian")
+        h.format = PlyFormat::kBinaryLe;
+      else if (w[1] == "binary_big_endian")
+        h.format = PlyFormat::kBinaryBe;
+      else
+        return Status::error(ErrorCode::kUnsupported, name, "unknown PLY format '" + std::string(w[1]) + "'", where);
       have_format = true;
     } else if (w[0] == "element") {
       uint64_t count = 0;
-      if (w.size() != 3 || std::from_chars(w[2].data(), w[2].data() + w[2].size(), count).ptr != w[2].data() + w[2].size() ||
+      if (w.size() != 3 ||
+          std::from_chars(w[2].data(), w[2].data() + w[2].size(), count).ptr != w[2].data() + w[2].size() ||
           w[2][0] == '-') {
         return Status::error(ErrorCode::kParse, name, "bad PLY element line", where);
       }
       PlyElement e;
       e.name = std::string(w[1]);
       e.count = count;
-      if (e.name == "vertex") e.kind = ElementKind::kVertex;
-      else if (e.name == "face") e.kind = ElementKind::kFace;
-      else if (e.name == "tristrips") e.kind = ElementKind::kTristrips;
+      if (e.name == "vertex")
+        e.kind = ElementKind::kVertex;
+      else if (e.name == "face")
+        e.kind = ElementKind::kFace;
+      else if (e.name == "tristrips")
+        e.kind = ElementKind::kTristrips;
       for (const PlyElement& other : h.elements) {
         if (other.kind != ElementKind::kOther && other.kind == e.kind) {
           return Status::error(ErrorCode::kUnsupported, name, "more than one PLY '" + e.name + "' element", where);
@@ -195,21 +204,31 @@ Status assign_roles(PlyHeader& h, const std::string& name) {
       const std::string& n = p.name;
       Role r = Role::kNone;
       if (e.kind == ElementKind::kVertex && !p.is_list()) {
-        if (n == "x") r = Role::kX;
-        else if (n == "y") r = Role::kY;
-        else if (n == "z") r = Role::kZ;
-        else if (n == "s" || n == "u" || n == "texture_u" || n == "texture_s") r = Role::kU;
-        else if (n == "t" || n == "v" || n == "texture_v" || n == "texture_t") r = Role::kV;
+        if (n == "x")
+          r = Role::kX;
+        else if (n == "y")
+          r = Role::kY;
+        else if (n == "z")
+          r = Role::kZ;
+        else if (n == "s" || n == "u" || n == "texture_u" || n == "texture_s")
+          r = Role::kU;
+        else if (n == "t" || n == "v" || n == "texture_v" || n == "texture_t")
+          r = Role::kV;
       } else if (e.kind == ElementKind::kFace) {
-        if (p.is_list() && (n == "vertex_indices" || n == "vertex_index")) r = Role::kIndices;
-        else if (p.is_list() && n == "texcoord") r = Role::kTexcoord;
-        else if (!p.is_list() && n == "seam") r = Role::kSeam;
+        if (p.is_list() && (n == "vertex_indices" || n == "vertex_index"))
+          r = Role::kIndices;
+        else if (p.is_list() && n == "texcoord")
+          r = Role::kTexcoord;
+        else if (!p.is_list() && n == "seam")
+          r = Role::kSeam;
       } else if (e.kind == ElementKind::kTristrips) {
         if (p.is_list() && !seen[static_cast<size_t>(Role::kIndices)]) r = Role::kIndices;
       }
       if (r != Role::kNone) {
-        if (seen[static_cast<size_t>(r)]) r = Role::kNone;  // a repeated name: first one wins
-        else seen[static_cast<size_t>(r)] = true;
+        if (seen[static_cast<size_t>(r)])
+          r = Role::kNone;  // a repeated name: first one wins
+        else
+          seen[static_cast<size_t>(r)] = true;
       }
       p.role = r;
     }
@@ -377,12 +396,14 @@ class BodyReader {
     double d;
     if (!src_.value(p.count_type, d)) return truncated(e, i);
     if (!is_index(d)) {
-      return Status::error(ErrorCode::kParse, name_, "bad PLY list count in element '" + e.name + "'", src_.where(e, i));
+      return Status::error(ErrorCode::kParse, name_, "bad PLY list count in element '" + e.name + "'",
+                           src_.where(e, i));
     }
     n = static_cast<uint64_t>(d);
     if (src_.list_min_bytes(n, p.type) > src_.remaining()) {
       return Status::error(ErrorCode::kParse, name_,
-                           "PLY list of " + std::to_string(n) + " items runs past the end of the file", src_.where(e, i));
+                           "PLY list of " + std::to_string(n) + " items runs past the end of the file",
+                           src_.where(e, i));
     }
     return Status::ok();
   }
@@ -501,8 +522,7 @@ class BodyReader {
     for (const PlyProperty& p : e.props) {
       if (p.role == Role::kIndices) ip = &p;
     }
-    const uint64_t tri_bytes =
-        Source::kBinary ? type_size(ip->count_type) + 3 * type_size(ip->type) : 6;
+    const uint64_t tri_bytes = Source::kBinary ? type_size(ip->count_type) + 3 * type_size(ip->type) : 6;
     const uint64_t bounded = std::min<uint64_t>(e.count, src_.remaining() / tri_bytes);
     reserve_huge(mesh_.indices, mesh_.indices.size() + static_cast<size_t>(3 * bounded));
     bool have_tc = false, have_seam = false;
@@ -558,7 +578,8 @@ class BodyReader {
         mesh_.indices.insert(mesh_.indices.end(), {poly_[0], poly_[k], poly_[k + 1]});
         if (have_seam) seams_.push_back(seam);
         if (face_uv_complete_) {
-          face_uvs_.insert(face_uvs_.end(), {tc_[0], tc_[1], tc_[2 * k], tc_[2 * k + 1], tc_[2 * k + 2], tc_[2 * k + 3]});
+          face_uvs_.insert(face_uvs_.end(),
+                           {tc_[0], tc_[1], tc_[2 * k], tc_[2 * k + 1], tc_[2 * k + 2], tc_[2 * k + 3]});
         }
       }
     }
@@ -586,10 +607,10 @@ class BodyReader {
   Status out_of_range(const PlyElement& e, uint64_t i, double d) const {
     char buf[64];
     std::snprintf(buf, sizeof buf, "%.17g", d);
-    return Status::error(ErrorCode::kInvalidMesh, name_,
-                         e.name + " index " + buf + " out of range (mesh has " + std::to_string(vertex_count_) +
-                             " vertices)",
-                         src_.where(e, i));
+    return Status::error(
+        ErrorCode::kInvalidMesh, name_,
+        e.name + " index " + buf + " out of range (mesh has " + std::to_string(vertex_count_) + " vertices)",
+        src_.where(e, i));
   }
 
   // Little-endian faces made of a single uchar-counted int/uint list: copies 12 bytes per
@@ -648,8 +669,10 @@ class BodyReader {
           const uint32_t c = static_cast<uint32_t>(d);
           if (run >= 2) {
             // Odd triangles of a strip are flipped to keep a consistent winding.
-            if (run % 2 == 0) mesh_.indices.insert(mesh_.indices.end(), {a, b, c});
-            else mesh_.indices.insert(mesh_.indices.end(), {b, a, c});
+            if (run % 2 == 0)
+              mesh_.indices.insert(mesh_.indices.end(), {a, b, c});
+            else
+              mesh_.indices.insert(mesh_.indices.end(), {b, a, c});
             ++report_.source_faces;
           }
           a = b;
@@ -705,8 +728,10 @@ Status check_counts(const PlyHeader& h, size_t body_bytes, const std::string& na
   for (const PlyElement& e : h.elements) {
     uint64_t min_size = 0;
     for (const PlyProperty& p : e.props) {
-      if (h.format == PlyFormat::kAscii) min_size += 2;
-      else min_size += type_size(p.is_list() ? p.count_type : p.type);
+      if (h.format == PlyFormat::kAscii)
+        min_size += 2;
+      else
+        min_size += type_size(p.is_list() ? p.count_type : p.type);
     }
     const uint64_t bytes = mul_sat(e.count, min_size);
     need = add_sat(need, h.format == PlyFormat::kAscii && bytes > 0 ? bytes - 1 : bytes);

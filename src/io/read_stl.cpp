@@ -9,8 +9,8 @@
 #include <string_view>
 #include <vector>
 
-#include "util/flat_hash.h"
 #include "io/readers.h"
+#include "util/flat_hash.h"
 #include "util/text_scan.h"
 
 namespace tailor::internal {
@@ -30,10 +30,10 @@ void weld(const std::vector<float>& corners, Mesh& mesh, LoadReport& report) {
     std::memcpy(bits, &corners[3 * c], 12);
     const uint64_t h = hash_mix((uint64_t{bits[0]} << 32 | bits[1]) ^ hash_mix(bits[2]));
     const uint32_t next = static_cast<uint32_t>(mesh.positions.size() / 3);
-    const uint32_t id = table.find_or_insert(h, next, [&](uint32_t stored) {
-      return std::memcmp(&mesh.positions[3 * size_t{stored}], bits, 12) == 0;
-    });
-    if (id == next) mesh.positions.insert(mesh.positions.end(), {corners[3 * c], corners[3 * c + 1], corners[3 * c + 2]});
+    const uint32_t id = table.find_or_insert(
+        h, next, [&](uint32_t stored) { return std::memcmp(&mesh.positions[3 * size_t{stored}], bits, 12) == 0; });
+    if (id == next)
+      mesh.positions.insert(mesh.positions.end(), {corners[3 * c], corners[3 * c + 1], corners[3 * c + 2]});
     mesh.indices[c] = id;
   }
   report.welded_vertices = nc - mesh.positions.size() / 3;
@@ -73,9 +73,9 @@ Status read_ascii(std::span<const char> data, const std::string& name, std::vect
     s.skip_space();
     const std::string_view w = s.word();
     if (w != word) {
-      return Status::error(ErrorCode::kParse, name,
-                           "expected '" + std::string(word) + "' in ascii STL, found '" + std::string(w.substr(0, 32)) + "'",
-                           s.where());
+      return Status::error(
+          ErrorCode::kParse, name,
+          "expected '" + std::string(word) + "' in ascii STL, found '" + std::string(w.substr(0, 32)) + "'", s.where());
     }
     return Status::ok();
   };
@@ -89,8 +89,8 @@ Status read_ascii(std::span<const char> data, const std::string& name, std::vect
       continue;
     }
     if (w != "facet") {
-      return Status::error(ErrorCode::kParse, name, "expected 'facet' in ascii STL, found '" + std::string(w.substr(0, 32)) + "'",
-                           s.where());
+      return Status::error(ErrorCode::kParse, name,
+                           "expected 'facet' in ascii STL, found '" + std::string(w.substr(0, 32)) + "'", s.where());
     }
     TAILOR_RETURN_IF_ERROR(expect("normal"));
     float ignored;
@@ -113,7 +113,8 @@ Status read_ascii(std::span<const char> data, const std::string& name, std::vect
       loop.insert(loop.end(), {x, y, z});
     }
     const size_t n = loop.size() / 3;
-    if (n < 3) return Status::error(ErrorCode::kInvalidMesh, name, "facet with " + std::to_string(n) + " vertices", s.where());
+    if (n < 3)
+      return Status::error(ErrorCode::kInvalidMesh, name, "facet with " + std::to_string(n) + " vertices", s.where());
     TAILOR_RETURN_IF_ERROR(expect("endfacet"));
     ++report.source_faces;
     if (n > 3) ++report.polygons_triangulated;
@@ -144,8 +145,10 @@ Status read_stl(std::span<const char> data, const std::string& name, Mesh& mesh,
     return Status::error(ErrorCode::kParse, name, "not an STL file (too short for binary, no 'solid' keyword)");
   }
   std::vector<float> corners;
-  if (binary) TAILOR_RETURN_IF_ERROR(read_binary(data, name, corners, report));
-  else TAILOR_RETURN_IF_ERROR(read_ascii(data, name, corners, report));
+  if (binary)
+    TAILOR_RETURN_IF_ERROR(read_binary(data, name, corners, report));
+  else
+    TAILOR_RETURN_IF_ERROR(read_ascii(data, name, corners, report));
   weld(corners, mesh, report);
   return Status::ok();
 }

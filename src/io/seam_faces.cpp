@@ -1,8 +1,8 @@
 // Seam-face lists (thesis 2.5): which faces the user wants seams on.
 #include <charconv>
 
-#include "util/atomic_file.h"
 #include "tailor/io.h"
+#include "util/atomic_file.h"
 
 namespace tailor {
 
@@ -25,15 +25,15 @@ Status load_seam_faces(const std::string& path, size_t face_count, std::vector<u
     uint64_t face = 0;
     const auto [ptr, ec] = std::from_chars(first, last, face);
     if (ec != std::errc() || ptr != last) {
-      return Status::error(ErrorCode::kParse, path, "expected one face index per line, got '" +
-                                                        std::string(first, last) + "'",
+      return Status::error(ErrorCode::kParse, path,
+                           "expected one face index per line, got '" + std::string(first, last) + "'",
                            "line " + std::to_string(line));
     }
     if (face >= face_count) {
-      return Status::error(ErrorCode::kParse, path,
-                           "face index " + std::to_string(face) + " out of range (mesh has " +
-                               std::to_string(face_count) + " faces)",
-                           "line " + std::to_string(line));
+      return Status::error(
+          ErrorCode::kParse, path,
+          "face index " + std::to_string(face) + " out of range (mesh has " + std::to_string(face_count) + " faces)",
+          "line " + std::to_string(line));
     }
     seam_faces[face] = 1;
   }

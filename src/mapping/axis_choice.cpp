@@ -2,7 +2,6 @@
 // seam shortening), ranked by the seam length its metrics measure.
 #include "tailor/axis_choice.h"
 
-
 namespace tailor {
 
 const char* axis_candidate_name(AxisCandidate candidate) {

@@ -29,8 +29,8 @@
 
 #include "mapping/crack_closer.h"
 #include "mapping/face_stretch.h"
-#include "util/huge_pages.h"
 #include "mapping/mapping_common.h"
+#include "util/huge_pages.h"
 #include "util/parallel_chunks.h"
 
 namespace tailor::internal {

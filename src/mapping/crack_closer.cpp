@@ -103,7 +103,8 @@ int CrackCloser::zip(uint32_t e) {
 }
 
 bool CrackCloser::merge(uint32_t vertex, uint32_t keep, uint32_t drop) {
-  const Merge m{vertex, keep, drop, {0.5f * (uv_of(keep)[0] + uv_of(drop)[0]), 0.5f * (uv_of(keep)[1] + uv_of(drop)[1])}};
+  const Merge m{
+      vertex, keep, drop, {0.5f * (uv_of(keep)[0] + uv_of(drop)[0]), 0.5f * (uv_of(keep)[1] + uv_of(drop)[1])}};
   const uint32_t patch = atlas_.patch[keep / 3];
   bool inside = true;
   for (uint32_t j = vertex_start_[vertex]; j < vertex_start_[vertex + 1]; ++j) {

@@ -72,16 +72,16 @@ void fresh(std::vector<T>& v, size_t n, T value) {
 // and close_cracks): bands processed at the same time are further apart than that, so they never
 // touch the same element.
 struct CrackShared {
-  std::vector<uint32_t> wedge;       // per corner: its wedge id
-  std::vector<uint32_t> wedge_size;  // per wedge id: corners
+  std::vector<uint32_t> wedge;                         // per corner: its wedge id
+  std::vector<uint32_t> wedge_size;                    // per wedge id: corners
   std::vector<uint32_t> vertex_start, vertex_corners;  // corners around each vertex (CSR)
-  std::vector<uint8_t> zero_area;    // per face: is_zero_area_frame (a moving face is in ~6 relaxations)
+  std::vector<uint8_t> zero_area;  // per face: is_zero_area_frame (a moving face is in ~6 relaxations)
   std::vector<uint32_t> face_stamp, wedge_stamp, wedge_local;  // per face / wedge id: relaxation marks
-  std::vector<uint8_t> queued;       // per half-edge: waiting in a band's queue or an outbox
+  std::vector<uint8_t> queued;                                 // per half-edge: waiting in a band's queue or an outbox
   std::vector<uint32_t> face_distance;    // per face: edge steps from its component's seed face (order)
   std::vector<uint32_t> vertex_distance;  // per vertex: edges from the nearest seed face's corners (bands)
-  std::atomic<uint32_t> stamp{0};    // the last relaxation mark handed out (unique across workers)
-  std::atomic<uint64_t> popped{0};   // queue entries taken, all workers
+  std::atomic<uint32_t> stamp{0};         // the last relaxation mark handed out (unique across workers)
+  std::atomic<uint64_t> popped{0};        // queue entries taken, all workers
   std::atomic<bool> cancelled{false};
 };
 
@@ -170,9 +170,7 @@ class CrackCloser {
   // Corner c's UV (size_t arithmetic: 2c wraps in 32 bits beyond 2^31 corners).
   const float* uv_of(uint32_t corner) const { return uv_ + 2 * size_t{corner}; }
 
-  bool same_uv(uint32_t a, uint32_t b) const {
-    return uv_of(a)[0] == uv_of(b)[0] && uv_of(a)[1] == uv_of(b)[1];
-  }
+  bool same_uv(uint32_t a, uint32_t b) const { return uv_of(a)[0] == uv_of(b)[0] && uv_of(a)[1] == uv_of(b)[1]; }
 
   // The corners of half-edge e = 3f + k at its start A and end B, and the neighbour's at A and B.
   struct EdgeCorners {

@@ -53,7 +53,7 @@ inline float stretch_error(const StretchFrame& s, const float* uv) {
   // checked on 2e7 random triangles). The growth runs this ~1.5 times per face: 3% of its
   // instructions saved (callgrind, horse).
   const __m128 first = _mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(uv)));  // uv0 uv1 0 0
-  const __m128 u = _mm_sub_ps(_mm_loadu_ps(uv + 2), _mm_movelh_ps(first, first));  // u1x u1y u2x u2y
+  const __m128 u = _mm_sub_ps(_mm_loadu_ps(uv + 2), _mm_movelh_ps(first, first));                // u1x u1y u2x u2y
   const __m128 q = _mm_setr_ps(s.q1x, s.q1y, s.q2x, s.q2y);
   // (a, b, c, d) = ((u1x, u2x, u1y, u2y) * (q2y, q1x, q2y, q1x) - (u2x, u1x, u2y, u1y) * (q1y, q2x, q1y, q2x)) * inv
   const __m128 p1 =

@@ -141,7 +141,8 @@ Status map_grid(const MappingInput& input, Atlas& atlas, MappingStats& stats) {
     }
   };
   for (uint32_t f = 0; f < nf; ++f)
-    if (placed[f]) continue;
+    if (placed[f])
+      continue;
     else
       for (uint32_t k = 0; k < 3; ++k) {
         const uint32_t o = topology.opposite[3 * f + k];

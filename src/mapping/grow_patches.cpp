@@ -12,12 +12,11 @@
 #include <limits>
 #include <memory>
 
-#include "util/simd.h"
-
 #include "mapping/face_stretch.h"
 #include "mapping/front_buckets.h"
-#include "util/huge_pages.h"
 #include "mapping/mapping_common.h"
+#include "util/huge_pages.h"
+#include "util/simd.h"
 
 namespace tailor::internal {
 namespace {
@@ -36,15 +35,15 @@ constexpr uint32_t kAnyPatch = kInvalid;
 // other, and the division by 3 took a few instructions at each of them.
 struct alignas(64) FaceRecord {
   uint32_t neighbour[3];  // face across edge k (Topology::opposite / 3), kInvalid on a boundary
-  uint32_t vertex[3];    // Mesh::indices
-  float local[6];        // FaceFrames::local
-  float variation;       // FaceFrames::variation
-  uint32_t patch;        // kInvalid until placed
-  uint8_t placed;        // placed edge neighbours (0..3)
-  uint8_t front;         // 1 + bucket of the face's live front entry, 0 = not on the front
-  uint8_t seam;          // user seam face
-  uint8_t degenerate;    // no meaningful Jacobian (is_zero_area_frame)
-  uint8_t across;        // bits 2k, 2k+1: the neighbour's index of the edge it shares with edge k
+  uint32_t vertex[3];     // Mesh::indices
+  float local[6];         // FaceFrames::local
+  float variation;        // FaceFrames::variation
+  uint32_t patch;         // kInvalid until placed
+  uint8_t placed;         // placed edge neighbours (0..3)
+  uint8_t front;          // 1 + bucket of the face's live front entry, 0 = not on the front
+  uint8_t seam;           // user seam face
+  uint8_t degenerate;     // no meaningful Jacobian (is_zero_area_frame)
+  uint8_t across;         // bits 2k, 2k+1: the neighbour's index of the edge it shares with edge k
 };
 static_assert(sizeof(FaceRecord) == 64);
 
@@ -267,9 +266,7 @@ class PatchMapper {
 
   bool is_degenerate(uint32_t f) const { return rec_[f].degenerate != 0; }
 
-  float stretch(uint32_t f, const float* uv) const {
-    return stretch_error(stretch_frame(rec_[f].local, scale_), uv);
-  }
+  float stretch(uint32_t f, const float* uv) const { return stretch_error(stretch_frame(rec_[f].local, scale_), uv); }
 
   // Rigid placement of face f: corner `at` goes to uv0, the rest follow the frame rotated by r.
   void place_rigid(uint32_t f, int at, const float* uv0, Rotation r, float* out) const {
@@ -580,8 +577,10 @@ class PatchMapper {
       hint = VertexHint{p, uv[2 * k], uv[2 * k + 1]};
     }
     ++patch_size_[p];
-    if (three_known) ++stats_.faces_three_textured;
-    else ++stats_.faces_unfolded;
+    if (three_known)
+      ++stats_.faces_three_textured;
+    else
+      ++stats_.faces_unfolded;
     stats_.max_error_px = std::max(stats_.max_error_px, error_px);
     stats_.max_stretch_accepted = std::max(stats_.max_stretch_accepted, stretch_error);
     // One pass over the neighbours: the placed ones are marked (on a seam) and give the hops, the
@@ -716,12 +715,12 @@ class PatchMapper {
   Atlas& atlas_;
   const float* anchor_ = nullptr;
   float scale_ = 1.f, bound_ = 0.f, max_seed_rotation_ = 0.f;
-  float relax_ = 0.f;  // 1 - field_following: share of the edge mismatch taken as rotation
+  float relax_ = 0.f;                        // 1 - field_following: share of the edge mismatch taken as rotation
   double factor_step_ = 0.0, factor_ = 0.0;  // the thesis's global age counter (when hop_age_ is 0)
-  float hop_age_ = 0.f;  // age per hop from the component's seed; 0 = the global counter
-  std::unique_ptr<uint32_t[]> hops_;  // per face: hops from its component's seed (hop_age_ > 0)
+  float hop_age_ = 0.f;                      // age per hop from the component's seed; 0 = the global counter
+  std::unique_ptr<uint32_t[]> hops_;         // per face: hops from its component's seed (hop_age_ > 0)
   float* uv_ = nullptr;
-  HugeArray<FaceRecord> rec_;  // per face
+  HugeArray<FaceRecord> rec_;     // per face
   std::vector<VertexHint> hint_;  // per vertex: the UV its patch first gave it
   std::vector<Rotation> patch_rotation_;
   std::vector<uint32_t> patch_size_;

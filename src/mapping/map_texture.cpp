@@ -8,8 +8,6 @@
 // This work is based on:
 //   V. Singh, A. M. Namboodiri, "Efficient texture mapping by homogeneous patch discovery",
 //   ICVGIP 2012 (thesis chapter 2).
-#include "tailor/mapping.h"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -18,6 +16,7 @@
 #include "mapping/face_stretch.h"
 #include "mapping/grid_map.h"
 #include "mapping/mapping_common.h"
+#include "tailor/mapping.h"
 
 namespace tailor {
 
@@ -37,7 +36,8 @@ std::vector<uint32_t> component_seed_faces(const Mesh& mesh, const Topology& top
     // Centre of the bounding box of the referenced vertices (found by the orientation; float
     // min/max are exact, so doubles are only needed for the centre).
     for (int i = 0; i < 3; ++i)
-      target[i] = 0.5 * (static_cast<double>(frames.bbox_min[static_cast<size_t>(i)]) + frames.bbox_max[static_cast<size_t>(i)]);
+      target[i] = 0.5 * (static_cast<double>(frames.bbox_min[static_cast<size_t>(i)]) +
+                         frames.bbox_max[static_cast<size_t>(i)]);
   }
   const uint32_t components = topology.edge_components;
   std::vector<double> best_distance(components, INFINITY);
@@ -139,9 +139,12 @@ void clear_atlas(Atlas& atlas) {
 const char* mapping_mode_name(MappingMode mode) { return mode == MappingMode::kThesis ? "thesis" : "patches"; }
 
 bool mapping_mode_from_name(std::string_view name, MappingMode& mode) {
-  if (name == "patches") mode = MappingMode::kPatches;
-  else if (name == "thesis") mode = MappingMode::kThesis;
-  else return false;
+  if (name == "patches")
+    mode = MappingMode::kPatches;
+  else if (name == "thesis")
+    mode = MappingMode::kThesis;
+  else
+    return false;
   return true;
 }
 
@@ -157,8 +160,8 @@ Status map_texture(const Mesh& mesh, const Topology& topology, const MapTextureO
   const auto start = std::chrono::steady_clock::now();
   TAILOR_RETURN_IF_ERROR(check_mapping_inputs(mesh, topology, map.frames, mapping));
   const bool thesis = mapping.mode == MappingMode::kThesis;
-  const bool grid = mapping.symmetry == 4;          // the integer-grid map replaces steps 2-4
-  const bool patches = !thesis && !grid;            // steps 3 and 4 follow the patches mode's growth
+  const bool grid = mapping.symmetry == 4;  // the integer-grid map replaces steps 2-4
+  const bool patches = !thesis && !grid;    // steps 3 and 4 follow the patches mode's growth
   const bool close_cracks = patches && mapping.close_cracks;
   // With crack closing the growth reports the first part of the progress, the closing the rest
   // (measured: the closing takes 70-90% of the mapping time).
@@ -169,7 +172,10 @@ Status map_texture(const Mesh& mesh, const Topology& topology, const MapTextureO
   ProgressCallback closing_progress;
   if (close_cracks && mapping.progress)
     closing_progress = [&mapping](float done) { return mapping.progress(kGrowthShare + (1.f - kGrowthShare) * done); };
-  const internal::MappingInput input{mesh, topology, map.frames, growth_options,
+  const internal::MappingInput input{mesh,
+                                     topology,
+                                     map.frames,
+                                     growth_options,
                                      factor_step_for(mapping, mesh.face_count()),
                                      component_seed_faces(mesh, topology, map.frames, mapping)};
   MappingStats& stats = map.stats;
@@ -200,8 +206,8 @@ Status map_texture(const Mesh& mesh, const Topology& topology, const MapTextureO
 
   // === 6. Metrics of the result (metrics/uv_metrics.cpp) ===
   if (options.measure)
-    TAILOR_RETURN_IF_ERROR(compute_uv_metrics(mesh, topology, map.atlas.corner_uv, map.atlas.patch, options.metrics,
-                                              map.metrics));
+    TAILOR_RETURN_IF_ERROR(
+        compute_uv_metrics(mesh, topology, map.atlas.corner_uv, map.atlas.patch, options.metrics, map.metrics));
   return Status::ok();
 }
 

@@ -43,7 +43,7 @@ struct MappingInput {
   const Topology& topology;
   const FaceFrames& frames;
   const MappingOptions& options;
-  double factor_step;                   // resolved for the mode; < 0 in kPatches = the hop rule
+  double factor_step;                     // resolved for the mode; < 0 in kPatches = the hop rule
   std::vector<uint32_t> component_seeds;  // first face of each component, in processing order
 };
 

@@ -201,8 +201,10 @@ class Relaxer {
     free_count_ = free_count;
     uint32_t wedges = free_count;
     for (uint32_t c = 0; c < corners; ++c) {  // a wedge's root comes before its other corners
-      if (id[c] != kInvalid) id[c] = final_id[id[c]];
-      else id[c] = root[c] == c ? wedges++ : id[root[c]];
+      if (id[c] != kInvalid)
+        id[c] = final_id[id[c]];
+      else
+        id[c] = root[c] == c ? wedges++ : id[root[c]];
     }
     corner_wedge_.swap(id);
     root = {};
@@ -341,8 +343,14 @@ class Relaxer {
     const float dy = (wn * (l[2 * k + 1] - l[2 * n + 1]) + wp * (l[2 * k + 1] - l[2 * p + 1])) * scale_;
     const float ox = l[2 * p] - l[2 * n], oy = l[2 * p + 1] - l[2 * n + 1];
     const float inv_height = std::sqrt(ox * ox + oy * oy) * inv_twice / scale_;
-    return Term{c, corner_wedge_[3 * f + static_cast<uint32_t>(n)], corner_wedge_[3 * f + static_cast<uint32_t>(p)], wn,
-                wp, dx, dy, inv_height};
+    return Term{c,
+                corner_wedge_[3 * f + static_cast<uint32_t>(n)],
+                corner_wedge_[3 * f + static_cast<uint32_t>(p)],
+                wn,
+                wp,
+                dx,
+                dy,
+                inv_height};
   }
 
   // Local step for face f: record_ gets its weight m and m times the rotation nearest to its

@@ -152,8 +152,8 @@ class SeamShortener {
     auto consider = [&](const float* candidate, int k) {
       const int lo = k == 0 ? 1 : 0, hi = k == 2 ? 1 : 2;
       const bool seam_lo = seam_at(candidate, lo), seam_hi = seam_at(candidate, hi);
-      if (seam_flags_ && ((fixed[k] && seam[k]) || (fixed[lo] && seam_lo != seam[lo]) ||
-                          (fixed[hi] && seam_hi != seam[hi])))
+      if (seam_flags_ &&
+          ((fixed[k] && seam[k]) || (fixed[lo] && seam_lo != seam[lo]) || (fixed[hi] && seam_hi != seam[hi])))
         return;
       const float gain = before - ((seam_lo ? length[lo] : 0.f) + (seam_hi ? length[hi] : 0.f));
       if (!(gain > min_gain) || gain < best_gain) return;

@@ -90,8 +90,10 @@ Status map_thesis(const MappingInput& in, Atlas& atlas, MappingStats& stats) {
       const uint32_t f = FaceQueue::face_of(key);
       int known = 0, missing = -1;
       for (int k = 0; k < 3; ++k) {
-        if (textured[idx[3 * f + k]]) ++known;
-        else missing = k;
+        if (textured[idx[3 * f + k]])
+          ++known;
+        else
+          missing = k;
       }
       if (known == 3) {
         ++stats.faces_three_textured;

@@ -87,8 +87,7 @@ Status measure_stability(const Mesh& mesh, const MapTextureOptions& options, Sta
     by_distance[f] = {distance2(c, centre), static_cast<uint32_t>(f)};
   }
   const size_t removed = std::clamp<size_t>(
-      static_cast<size_t>(std::lround(stability.remove_fraction * static_cast<double>(face_count))), 1,
-      face_count - 1);
+      static_cast<size_t>(std::lround(stability.remove_fraction * static_cast<double>(face_count))), 1, face_count - 1);
   std::nth_element(by_distance.begin(), by_distance.begin() + static_cast<std::ptrdiff_t>(removed - 1),
                    by_distance.end());
   std::vector<uint8_t> gone(face_count, 0);

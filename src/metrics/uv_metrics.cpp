@@ -6,14 +6,13 @@
 //     difference);
 //   - P. V. Sander, J. Snyder, S. J. Gortler, H. Hoppe, "Texture Mapping Progressive Meshes",
 //     SIGGRAPH 2001 (L2 and Linf stretch of the map from texture to surface).
-#include "tailor/metrics.h"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <numbers>
 #include <string>
 
+#include "tailor/metrics.h"
 #include "util/huge_pages.h"
 #include "util/parallel_chunks.h"
 
@@ -42,8 +41,8 @@ double norm(Vec3 a) { return std::sqrt(dot(a, a)); }
 struct Face {
   Vec3 p[3];
   double u[3], v[3];
-  double area3d = 0;     // A_f
-  double area_uv = 0;    // signed a_f (positive = counter-clockwise in UV)
+  double area3d = 0;   // A_f
+  double area_uv = 0;  // signed a_f (positive = counter-clockwise in UV)
   bool degenerate = false;
 };
 
@@ -59,8 +58,8 @@ Face load_face(const Mesh& mesh, std::span<const float> corner_uv, size_t f) {
   const double longest2 = std::max({dot(e1, e1), dot(e2, e2), dot(e3, e3)});
   face.area3d = 0.5 * twice_area;
   face.degenerate = !(twice_area > kDegenerateRelativeHeight * longest2);
-  face.area_uv = 0.5 * ((face.u[1] - face.u[0]) * (face.v[2] - face.v[0]) -
-                        (face.u[2] - face.u[0]) * (face.v[1] - face.v[0]));
+  face.area_uv =
+      0.5 * ((face.u[1] - face.u[0]) * (face.v[2] - face.v[0]) - (face.u[2] - face.u[0]) * (face.v[1] - face.v[0]));
   return face;
 }
 
@@ -195,16 +194,20 @@ uint32_t derive_patches(const Mesh& mesh, const Topology& topology, std::span<co
     if (!same_uv(corner_uv, s.fa, s.ga) || !same_uv(corner_uv, s.fb, s.gb)) continue;
     const uint32_t ra = find_root(parent, static_cast<uint32_t>(e / 3));
     const uint32_t rb = find_root(parent, o / 3);
-    if (ra < rb) parent[rb] = ra;
-    else if (rb < ra) parent[ra] = rb;
+    if (ra < rb)
+      parent[rb] = ra;
+    else if (rb < ra)
+      parent[ra] = rb;
   }
   patch.assign(nf, kInvalid);
   uint32_t count = 0;
   for (size_t f = 0; f < nf; ++f) {
     const uint32_t root = find_root(parent, static_cast<uint32_t>(f));
     // Roots are the lowest face of their set, so a root is labelled before any other member.
-    if (root == f) patch[f] = count++;
-    else patch[f] = patch[root];
+    if (root == f)
+      patch[f] = count++;
+    else
+      patch[f] = patch[root];
   }
   return count;
 }
@@ -268,8 +271,8 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
   if (!patch_in.empty() && patch_in.size() != nf)
     return Status::error(ErrorCode::kInvalidArgument, "", "patch ids do not match the mesh",
                          std::to_string(patch_in.size()) + " ids for " + std::to_string(nf) + " faces");
-  if (!(options.texture_width_px > 0) || !(options.texture_height_px > 0) ||
-      !std::isfinite(options.texture_width_px) || !std::isfinite(options.texture_height_px))
+  if (!(options.texture_width_px > 0) || !(options.texture_height_px > 0) || !std::isfinite(options.texture_width_px) ||
+      !std::isfinite(options.texture_height_px))
     return Status::error(ErrorCode::kInvalidArgument, "", "texture size must be positive");
   if (options.symmetry != 1 && options.symmetry != 4)
     return Status::error(ErrorCode::kInvalidArgument, "", "symmetry must be 1 or 4");
@@ -342,10 +345,8 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
     if (patch_faces[p] > 0) ++metrics.patches;
     if (patch_faces[p] == 1) ++metrics.single_face_patches;
   }
-  if (!(sum_3d > 0))
-    return Status::error(ErrorCode::kInvalidMesh, "", "every face has zero 3D area");
-  if (!(sum_uv > 0))
-    return Status::error(ErrorCode::kInvalidMesh, "", "every face has zero UV area");
+  if (!(sum_3d > 0)) return Status::error(ErrorCode::kInvalidMesh, "", "every face has zero 3D area");
+  if (!(sum_uv > 0)) return Status::error(ErrorCode::kInvalidMesh, "", "every face has zero UV area");
   const double scale = sum_uv / sum_3d;  // R
   metrics.uv_scale = scale;
 

@@ -8,9 +8,9 @@
 // arrays); this file holds everything that talks to GL: the context, the texture upload, the
 // buffers and draw calls, and render_preview, which runs the whole picture.
 #define GL_GLEXT_PROTOTYPES 1
-#include <GL/osmesa.h>
 #include <GL/gl.h>
 #include <GL/glext.h>
+#include <GL/osmesa.h>
 
 #include <algorithm>
 #include <array>
@@ -206,7 +206,9 @@ void draw_face_colored_surface(const Mesh& mesh, const std::vector<Rgb>& face_co
   for (size_t start = 0; start < faces; start += batch) {
     const size_t count = std::min(batch, faces - start);
     fill_face_colored_batch(mesh, face_colors, vertex_normal, frame, start, count, pos, nor, col);
-    bind_streams({std::span<const float>(pos).first(9 * count), std::span<const float>(nor).first(9 * count), {},
+    bind_streams({std::span<const float>(pos).first(9 * count),
+                  std::span<const float>(nor).first(9 * count),
+                  {},
                   std::span<const uint8_t>(col).first(12 * count)},
                  buffers);
     glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(3 * count));
@@ -329,7 +331,8 @@ Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::s
         upload_texture(*texture);
       } else {
         const bool checker = options.view == PreviewView::kChecker;
-        upload_texture(checker ? checker_image(kCheckerDark, kCheckerLight) : checker_image(kNeutralDark, kNeutralLight));
+        upload_texture(checker ? checker_image(kCheckerDark, kCheckerLight)
+                               : checker_image(kNeutralDark, kNeutralLight));
         // The generated image holds 2x2 squares.
         glMatrixMode(GL_TEXTURE);
         glLoadIdentity();

@@ -15,9 +15,7 @@ namespace tailor::internal {
 
 using Rgb = std::array<uint8_t, 3>;
 
-inline uint8_t to_byte(float v) {
-  return static_cast<uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
-}
+inline uint8_t to_byte(float v) { return static_cast<uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); }
 
 //! A distinct, deterministic colour per patch id: hues stepped by the golden ratio so that
 //! neighbouring ids (often neighbouring patches) differ strongly; saturation and value vary a
@@ -34,12 +32,36 @@ inline Rgb patch_color(uint32_t id) {
   const float t = val * (1.0f - sat * (1.0f - frac));
   float r = val, g = t, b = p;
   switch (sector) {
-    case 0: r = val; g = t; b = p; break;
-    case 1: r = q; g = val; b = p; break;
-    case 2: r = p; g = val; b = t; break;
-    case 3: r = p; g = q; b = val; break;
-    case 4: r = t; g = p; b = val; break;
-    default: r = val; g = p; b = q; break;
+    case 0:
+      r = val;
+      g = t;
+      b = p;
+      break;
+    case 1:
+      r = q;
+      g = val;
+      b = p;
+      break;
+    case 2:
+      r = p;
+      g = val;
+      b = t;
+      break;
+    case 3:
+      r = p;
+      g = q;
+      b = val;
+      break;
+    case 4:
+      r = t;
+      g = p;
+      b = val;
+      break;
+    default:
+      r = val;
+      g = p;
+      b = q;
+      break;
   }
   return {to_byte(r), to_byte(g), to_byte(b)};
 }
@@ -102,7 +124,8 @@ inline void draw_text(Image& image, std::string_view text, int x, int y, int sca
               const int px = x + c * scale + dx;
               const int py = y + r * scale + dy;
               if (px < 0 || py < 0 || px >= image.width || py >= image.height) continue;
-              const size_t at = (static_cast<size_t>(py) * static_cast<size_t>(image.width) + static_cast<size_t>(px)) * 3;
+              const size_t at =
+                  (static_cast<size_t>(py) * static_cast<size_t>(image.width) + static_cast<size_t>(px)) * 3;
               image.pixels[at] = color[0];
               image.pixels[at + 1] = color[1];
               image.pixels[at + 2] = color[2];

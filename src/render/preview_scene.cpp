@@ -133,7 +133,8 @@ std::vector<float> vertex_normals(const Mesh& mesh) {
     }
   }
   for (size_t v = 0; v < normals.size(); v += 3) {
-    const float len = std::sqrt(normals[v] * normals[v] + normals[v + 1] * normals[v + 1] + normals[v + 2] * normals[v + 2]);
+    const float len =
+        std::sqrt(normals[v] * normals[v] + normals[v + 1] * normals[v + 1] + normals[v + 2] * normals[v + 2]);
     if (len > 0.0f) {
       normals[v] /= len;
       normals[v + 1] /= len;
@@ -350,7 +351,8 @@ Image half_size(const Image& src) {
   };
   for (int y = 0; y < dst.height; ++y) {
     for (int x = 0; x < dst.width; ++x) {
-      const size_t a = at(2 * x, 2 * y), b = at(2 * x + 1, 2 * y), c = at(2 * x, 2 * y + 1), d = at(2 * x + 1, 2 * y + 1);
+      const size_t a = at(2 * x, 2 * y), b = at(2 * x + 1, 2 * y), c = at(2 * x, 2 * y + 1),
+                   d = at(2 * x + 1, 2 * y + 1);
       const size_t out = (static_cast<size_t>(y) * static_cast<size_t>(dst.width) + static_cast<size_t>(x)) * ch;
       for (size_t k = 0; k < ch; ++k) {
         const int sum = src.pixels[a + k] + src.pixels[b + k] + src.pixels[c + k] + src.pixels[d + k];

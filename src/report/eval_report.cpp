@@ -1,8 +1,7 @@
 // The reports of `tailor eval` (tailor/report.h): the metrics of a UV-mapped mesh, and the
 // stability experiment.
-#include "tailor/report.h"
-
 #include "report/report_text.h"
+#include "tailor/report.h"
 
 namespace tailor {
 
@@ -52,8 +51,8 @@ std::string eval_summary(const EvalRun& run) {
       "stretch %.4f (area-weighted %.4f), L2 %.4f, Linf %.4f, distortion %.2f deg (median), "
       "seam gap %.2f px, %.1f%% invisible, visible seams %.2f%% of edge length (%.2f%% off sharp edges, "
       "%zu dangling ends, %zu branch points) (texture %dx%d px, %s%s)\n",
-      run.file.c_str(), m.faces, m.patches, m.single_face_patches, 100.0 * m.seam_length_ratio, m.seam_edges,
-      m.flipped, m.stretch, m.stretch_area_weighted, m.l2_stretch, m.linf_stretch, m.distortion_deg, m.seam_gap_px,
+      run.file.c_str(), m.faces, m.patches, m.single_face_patches, 100.0 * m.seam_length_ratio, m.seam_edges, m.flipped,
+      m.stretch, m.stretch_area_weighted, m.l2_stretch, m.linf_stretch, m.distortion_deg, m.seam_gap_px,
       100.0 * m.seam_invisible_ratio, 100.0 * m.visible_seam_ratio, 100.0 * m.visible_off_sharp_ratio,
       m.visible_dangling_ends, m.visible_branch_points, run.texture_width, run.texture_height,
       run.texture_size_from.c_str(), run.symmetry == 4 ? ", symmetry 4" : "");

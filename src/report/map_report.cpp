@@ -1,7 +1,6 @@
 // The report of `tailor map` (tailor/report.h): the --stats JSON and the summary lines.
-#include "tailor/report.h"
-
 #include "report/report_text.h"
+#include "tailor/report.h"
 
 namespace tailor {
 
@@ -32,48 +31,78 @@ std::string map_report_json(const MapRun& run) {
   j["output"] = run.output;
   j["texture"] = run.texture;
   j["texture_size"] = {run.texture_width, run.texture_height};
-  j["options"] = {{"mode", mapping_mode_name(mapping.mode)}, {"scale", mapping.scale},
-                  {"threshold_px", mapping.threshold_px}, {"max_stretch", mapping.max_stretch},
-                  {"field_following", mapping.field_following}, {"min_patch_faces", mapping.min_patch_faces},
-                  {"shorten_seams", mapping.shorten_seams}, {"close_cracks", mapping.close_cracks},
-                  {"crack_rings", mapping.crack_rings}, {"relax_iterations", mapping.relax_iterations},
-                  {"hop_age", mapping.hop_age}, {"axis", run.axis},
-                  {"smooth", run.options.orientation.smooth_passes}, {"seed_point", run.seed_point},
-                  {"seam_faces", run.seam_faces}, {"symmetry", mapping.symmetry}};
-  j["mesh"] = {{"format", run.load.format}, {"vertices", run.vertices}, {"faces", run.faces},
-               {"components", run.components}, {"boundary_edges", run.boundary_edges},
-               {"nonmanifold_edges", run.nonmanifold_edges}, {"inconsistent_edges", run.inconsistent_edges},
+  j["options"] = {{"mode", mapping_mode_name(mapping.mode)},
+                  {"scale", mapping.scale},
+                  {"threshold_px", mapping.threshold_px},
+                  {"max_stretch", mapping.max_stretch},
+                  {"field_following", mapping.field_following},
+                  {"min_patch_faces", mapping.min_patch_faces},
+                  {"shorten_seams", mapping.shorten_seams},
+                  {"close_cracks", mapping.close_cracks},
+                  {"crack_rings", mapping.crack_rings},
+                  {"relax_iterations", mapping.relax_iterations},
+                  {"hop_age", mapping.hop_age},
+                  {"axis", run.axis},
+                  {"smooth", run.options.orientation.smooth_passes},
+                  {"seed_point", run.seed_point},
+                  {"seam_faces", run.seam_faces},
+                  {"symmetry", mapping.symmetry}};
+  j["mesh"] = {{"format", run.load.format},
+               {"vertices", run.vertices},
+               {"faces", run.faces},
+               {"components", run.components},
+               {"boundary_edges", run.boundary_edges},
+               {"nonmanifold_edges", run.nonmanifold_edges},
+               {"inconsistent_edges", run.inconsistent_edges},
                {"degenerate_faces_dropped", run.load.degenerate_faces},
                {"duplicate_faces_dropped", run.load.duplicate_faces},
                {"unreferenced_vertices", run.load.unreferenced_vertices}};
-  j["mapping"] = {{"patches", stats.patches}, {"patches_before_absorb", stats.patches_before_absorb},
-                  {"deferrals", stats.deferrals}, {"threshold_raises", stats.threshold_raises},
-                  {"final_threshold_px", stats.final_threshold_px}, {"max_error_px", stats.max_error_px},
+  j["mapping"] = {{"patches", stats.patches},
+                  {"patches_before_absorb", stats.patches_before_absorb},
+                  {"deferrals", stats.deferrals},
+                  {"threshold_raises", stats.threshold_raises},
+                  {"final_threshold_px", stats.final_threshold_px},
+                  {"max_error_px", stats.max_error_px},
                   {"max_stretch_accepted", stats.max_stretch_accepted},
-                  {"faces_three_textured", stats.faces_three_textured}, {"faces_unfolded", stats.faces_unfolded},
-                  {"faces_rigid", stats.faces_rigid}, {"faces_reseamed", stats.faces_reseamed},
-                  {"cracks_closed", stats.cracks_closed}, {"relax_moves", stats.relax_moves}, {"faces_seam", stats.faces_seam},
+                  {"faces_three_textured", stats.faces_three_textured},
+                  {"faces_unfolded", stats.faces_unfolded},
+                  {"faces_rigid", stats.faces_rigid},
+                  {"faces_reseamed", stats.faces_reseamed},
+                  {"cracks_closed", stats.cracks_closed},
+                  {"relax_moves", stats.relax_moves},
+                  {"faces_seam", stats.faces_seam},
                   {"inverted_accepted", stats.inverted_accepted}};
-  j["metrics"] = {{"patches", metrics.patches}, {"single_face_patches", metrics.single_face_patches},
-                  {"stretch", metrics.stretch}, {"stretch_area_weighted", metrics.stretch_area_weighted},
-                  {"distortion_deg", metrics.distortion_deg}, {"l2_stretch", metrics.l2_stretch},
-                  {"linf_stretch", metrics.linf_stretch}, {"flipped", metrics.flipped},
-                  {"seam_edges", metrics.seam_edges}, {"seam_length_ratio", metrics.seam_length_ratio},
-                  {"seam_gap_px", metrics.seam_gap_px}, {"seam_invisible_ratio", metrics.seam_invisible_ratio},
+  j["metrics"] = {{"patches", metrics.patches},
+                  {"single_face_patches", metrics.single_face_patches},
+                  {"stretch", metrics.stretch},
+                  {"stretch_area_weighted", metrics.stretch_area_weighted},
+                  {"distortion_deg", metrics.distortion_deg},
+                  {"l2_stretch", metrics.l2_stretch},
+                  {"linf_stretch", metrics.linf_stretch},
+                  {"flipped", metrics.flipped},
+                  {"seam_edges", metrics.seam_edges},
+                  {"seam_length_ratio", metrics.seam_length_ratio},
+                  {"seam_gap_px", metrics.seam_gap_px},
+                  {"seam_invisible_ratio", metrics.seam_invisible_ratio},
                   {"visible_seam_ratio", metrics.visible_seam_ratio},
                   {"visible_off_sharp_ratio", metrics.visible_off_sharp_ratio},
                   {"visible_dangling_ends", metrics.visible_dangling_ends},
-                  {"visible_branch_points", metrics.visible_branch_points}, {"uv_scale", metrics.uv_scale}};
+                  {"visible_branch_points", metrics.visible_branch_points},
+                  {"uv_scale", metrics.uv_scale}};
   if (run.stability) {
     const StabilityReport& s = *run.stability;
-    j["stability"] = {{"removed_faces", s.removed_faces}, {"compared_corners", s.compared_corners},
+    j["stability"] = {{"removed_faces", s.removed_faces},           {"compared_corners", s.compared_corners},
                       {"mean_difference_px", s.mean_difference_px}, {"max_difference_px", s.max_difference_px},
-                      {"identical_ratio", s.identical_ratio}, {"within_1px_ratio", s.within_1px_ratio}};
+                      {"identical_ratio", s.identical_ratio},       {"within_1px_ratio", s.within_1px_ratio}};
   }
-  j["time_ms"] = {{"load", ms(run.load.load_seconds)}, {"topology", ms(run.topology_seconds)},
-                  {"axis_choice", ms(run.axis_choice_seconds)}, {"orientation", ms(run.orientation_seconds)},
-                  {"mapping", ms(stats.seconds)}, {"metrics", ms(metrics.seconds)},
-                  {"export", ms(run.export_seconds)}, {"preview", ms(run.preview_seconds)},
+  j["time_ms"] = {{"load", ms(run.load.load_seconds)},
+                  {"topology", ms(run.topology_seconds)},
+                  {"axis_choice", ms(run.axis_choice_seconds)},
+                  {"orientation", ms(run.orientation_seconds)},
+                  {"mapping", ms(stats.seconds)},
+                  {"metrics", ms(metrics.seconds)},
+                  {"export", ms(run.export_seconds)},
+                  {"preview", ms(run.preview_seconds)},
                   {"total", ms(run.total_seconds)}};
   j["previews"] = run.previews;
   return internal::json_text(j);
@@ -85,19 +114,21 @@ std::string map_summary(const MapRun& run) {
       run.axis_auto ? "axis choice " + std::to_string(static_cast<long>(ms(run.axis_choice_seconds))) + ", " : "";
   std::string text = format_text(
       "%s: %zu faces, %u patches, seams %.2f%% of edge length, %zu flipped, stretch %.3f, L2 %.3f, "
-      "Linf %.2f, median angle %.2f deg, visible seams %.2f%% (%.0f%% of seam length invisible%s, %zu dangling ends) | load %.1f ms, topology %.1f, "
+      "Linf %.2f, median angle %.2f deg, visible seams %.2f%% (%.0f%% of seam length invisible%s, %zu dangling ends) | "
+      "load %.1f ms, topology %.1f, "
       "%sorientation %.1f, mapping %.1f, export %.1f ms -> %s\n",
       run.input.c_str(), run.faces, m.patches, 100.0 * m.seam_length_ratio, m.flipped, m.stretch, m.l2_stretch,
       m.linf_stretch, m.distortion_deg, 100.0 * m.visible_seam_ratio, 100.0 * m.seam_invisible_ratio,
-      run.options.metrics.symmetry == 4 ? " up to quarter turns" : "", m.visible_dangling_ends, ms(run.load.load_seconds),
-      ms(run.topology_seconds), axis_choice.c_str(), ms(run.orientation_seconds), ms(run.mapping.seconds),
-      ms(run.export_seconds), run.output.c_str());
+      run.options.metrics.symmetry == 4 ? " up to quarter turns" : "", m.visible_dangling_ends,
+      ms(run.load.load_seconds), ms(run.topology_seconds), axis_choice.c_str(), ms(run.orientation_seconds),
+      ms(run.mapping.seconds), ms(run.export_seconds), run.output.c_str());
   if (run.stability) {
     const StabilityReport& s = *run.stability;
-    text += format_text("stability: removed %zu faces, surviving corners moved %.3f px on average (max %.2f px), "
-                        "%.1f%% bit-identical, %.1f%% within 1 px\n",
-                        s.removed_faces, s.mean_difference_px, s.max_difference_px, 100.0 * s.identical_ratio,
-                        100.0 * s.within_1px_ratio);
+    text += format_text(
+        "stability: removed %zu faces, surviving corners moved %.3f px on average (max %.2f px), "
+        "%.1f%% bit-identical, %.1f%% within 1 px\n",
+        s.removed_faces, s.mean_difference_px, s.max_difference_px, 100.0 * s.identical_ratio,
+        100.0 * s.within_1px_ratio);
   }
   return text;
 }

@@ -4,9 +4,8 @@
 
 #include <cstdarg>
 #include <cstdio>
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 namespace tailor::internal {
 

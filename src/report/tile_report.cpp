@@ -2,9 +2,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "tailor/report.h"
-
 #include "report/report_text.h"
+#include "tailor/report.h"
 
 namespace tailor {
 namespace {
@@ -132,9 +131,9 @@ std::string tile_summary(const TileRun& run) {
       worst.wrap_ratio_x, worst.wrap_ratio_y, worst.worst_seam_ratio, worst.exemplar_worst_seam_ratio,
       worst.histogram_l1, worst.gradient_ratio, worst.patch_coherence, worst.exemplar_patch_coherence,
       worst.coherence_with_turns ? ", both with quarter turns" : "", verdict.c_str(),
-      run.report.symmetry != 4                 ? ""
+      run.report.symmetry != 4                  ? ""
       : run.report.quarter_turn_difference == 0 ? ", quarter-turn symmetric (exact)"
-                                               : ", quarter turn NOT exact",
+                                                : ", quarter turn NOT exact",
       run.seconds);
 }
 

@@ -235,8 +235,10 @@ Status compute_orientation(const Mesh& mesh, const Topology& topology, const Ori
           }
           Vec3 o;
           // The sum of neighbours can cancel at a field singularity: keep the face's own value.
-          if (project(sum, load(&frames.normal[3 * f]), 1.0, o)) sum = o;
-          else sum = load(&frames.orientation[3 * f]);
+          if (project(sum, load(&frames.normal[3 * f]), 1.0, o))
+            sum = o;
+          else
+            sum = load(&frames.orientation[3 * f]);
         }
         store(&next[3 * f], sum);
       }
@@ -301,8 +303,8 @@ double mean_neighbour_angle(const Topology& topology, const FaceFrames& frames) 
     const size_t f = e / 3, g = o / 3;
     const float* a = &frames.orientation[3 * f];
     const float* b = &frames.orientation[3 * g];
-    const double d = static_cast<double>(a[0]) * b[0] + static_cast<double>(a[1]) * b[1] +
-                     static_cast<double>(a[2]) * b[2];
+    const double d =
+        static_cast<double>(a[0]) * b[0] + static_cast<double>(a[1]) * b[1] + static_cast<double>(a[2]) * b[2];
     sum += std::acos(std::clamp(d, -1.0, 1.0));
     ++count;
   }

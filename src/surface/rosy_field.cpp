@@ -48,8 +48,14 @@ inline V3 match(V3 ref, V3 n, V3 q, int& k) {
   const float a = dot(ref, q), b = dot(ref, p);
   k = 0;
   float best = a;
-  if (b > best) { best = b; k = 1; }
-  if (-a > best) { best = -a; k = 2; }
+  if (b > best) {
+    best = b;
+    k = 1;
+  }
+  if (-a > best) {
+    best = -a;
+    k = 2;
+  }
   if (-b > best) k = 3;
   switch (k) {
     case 0: return q;
@@ -119,7 +125,9 @@ Level coarsen(Level& L, float cell) {
   std::vector<uint32_t> members;
   for (size_t v = 0; v < n; ++v) {
     const V3 p = load3(L.p, v), nv = load3(L.n, v);
-    const auto cell_of = [cell](float x) { return static_cast<uint64_t>(static_cast<int64_t>(std::floor(x / cell)) + (1 << 19)) & 0xFFFFF; };
+    const auto cell_of = [cell](float x) {
+      return static_cast<uint64_t>(static_cast<int64_t>(std::floor(x / cell)) + (1 << 19)) & 0xFFFFF;
+    };
     const float ax = std::abs(nv.x), ay = std::abs(nv.y), az = std::abs(nv.z);
     const uint64_t bin = ax >= ay && ax >= az ? (nv.x < 0) : ay >= az ? 2u + (nv.y < 0) : 4u + (nv.z < 0);
     const uint64_t key = (cell_of(p.x) << 43) | (cell_of(p.y) << 23) | (cell_of(p.z) << 3) | bin;
@@ -297,8 +305,7 @@ void compute_rosy_field(const Mesh& mesh, const Topology& topology, const FaceFr
   Level& F = levels[0];
   F.p.resize(3 * nv);
   for (size_t v = 0; v < nv; ++v)
-    for (size_t i = 0; i < 3; ++i)
-      F.p[3 * v + i] = (mesh.positions[3 * v + i] - frames.origin[i]) * frames.unit_scale;
+    for (size_t i = 0; i < 3; ++i) F.p[3 * v + i] = (mesh.positions[3 * v + i] - frames.origin[i]) * frames.unit_scale;
   F.n.assign(3 * nv, 0.f);
   F.q.assign(3 * nv, 0.f);
   F.c.assign(3 * nv, 0.f);

@@ -21,14 +21,14 @@
 namespace tailor::internal {
 
 struct RosyFieldOptions {
-  float scale = 800.f;             //!< pixels per normalised unit
-  float period = 512.f;            //!< lattice period in pixels (the square texture's size)
-  float sharp_angle_deg = 30.f;    //!< edges whose faces' normals differ by more are features the field follows
+  float scale = 800.f;                   //!< pixels per normalised unit
+  float period = 512.f;                  //!< lattice period in pixels (the square texture's size)
+  float sharp_angle_deg = 30.f;          //!< edges whose faces' normals differ by more are features the field follows
   uint32_t orientation_iterations = 40;  //!< Jacobi iterations per level (the coarsest gets 4x)
   uint32_t position_iterations = 100;    //!< Jacobi iterations per level (the coarsest gets 4x)
-  float robust = 0.04f;            //!< position smoothing weighs an edge by 1 / (1 + |r|^2 / (robust |d|^2)), r its
-                                   //!< residual, d its offset: edges far off are left as cuts (0 = least squares)
-  uint32_t threads = 0;            //!< 0 = one per 100k vertices, at most the cores and 8; same result for any count
+  float robust = 0.04f;  //!< position smoothing weighs an edge by 1 / (1 + |r|^2 / (robust |d|^2)), r its
+                         //!< residual, d its offset: edges far off are left as cuts (0 = least squares)
+  uint32_t threads = 0;  //!< 0 = one per 100k vertices, at most the cores and 8; same result for any count
 };
 
 //! The fields on the mesh's vertices; all arrays per vertex, normalised mesh units.
@@ -40,7 +40,7 @@ struct RosyField {
   std::vector<uint8_t> sharp;   //!< #V: 1 where the field is tied to a feature edge
   float scale = 800.f;
   float period = 512.f;
-  uint32_t levels = 0;          //!< levels of the hierarchy used
+  uint32_t levels = 0;  //!< levels of the hierarchy used
 };
 
 //! Computes both fields. Preconditions as map_texture. Cost: O(V) per iteration, a geometric sum
@@ -58,18 +58,42 @@ struct LatticeMap {
 
 inline void rotate_int(int r, int a, int b, int& x, int& y) {
   switch (r & 3) {
-    case 0: x = a; y = b; break;
-    case 1: x = b; y = -a; break;
-    case 2: x = -a; y = -b; break;
-    default: x = -b; y = a; break;
+    case 0:
+      x = a;
+      y = b;
+      break;
+    case 1:
+      x = b;
+      y = -a;
+      break;
+    case 2:
+      x = -a;
+      y = -b;
+      break;
+    default:
+      x = -b;
+      y = a;
+      break;
   }
 }
 inline void rotate_float(int r, float a, float b, float& x, float& y) {
   switch (r & 3) {
-    case 0: x = a; y = b; break;
-    case 1: x = b; y = -a; break;
-    case 2: x = -a; y = -b; break;
-    default: x = -b; y = a; break;
+    case 0:
+      x = a;
+      y = b;
+      break;
+    case 1:
+      x = b;
+      y = -a;
+      break;
+    case 2:
+      x = -a;
+      y = -b;
+      break;
+    default:
+      x = -b;
+      y = a;
+      break;
   }
 }
 //! (a o b)(x) = a(b(x)).

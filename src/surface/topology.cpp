@@ -6,10 +6,10 @@
 // (Same idea as meshoptimizer's buildTriangleAdjacency.)
 #include "tailor/topology.h"
 
-#include "util/huge_pages.h"
-
 #include <algorithm>
 #include <chrono>
+
+#include "util/huge_pages.h"
 
 namespace tailor {
 namespace {
@@ -76,8 +76,8 @@ Topology build_topology(const Mesh& mesh) {
       const uint32_t v[3] = {indices[f], indices[f + 1], indices[f + 2]};
       for (uint32_t k = 0; k < 3; ++k) {
         const uint32_t a = v[k], b = v[k == 2 ? 0 : k + 1];
-        sorted[cursor[std::min(a, b)]++] = (uint64_t{std::max(a, b)} << 33) | (uint64_t{a < b} << 32) |
-                                           static_cast<uint32_t>(f + k);
+        sorted[cursor[std::min(a, b)]++] =
+            (uint64_t{std::max(a, b)} << 33) | (uint64_t{a < b} << 32) | static_cast<uint32_t>(f + k);
       }
     }
   }

@@ -14,13 +14,14 @@
 // Vertex::xref do. Welding uses the same kind of table.
 // The corner UVs are converted (scaled, -0 -> +0) a block at a time, two corners per SSE2 step
 // where available, with the same IEEE operations as the scalar code, hence the same bits.
+#include "surface/vertex_split.h"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
 
-#include "surface/vertex_split.h"
 #include "tailor/export.h"
 #include "util/huge_pages.h"
 #include "util/simd.h"
@@ -53,7 +54,9 @@ uint64_t stored_key(const float* uvs, uint32_t s) {
   return key;
 }
 
-uint64_t key_of(float u, float w) { return uint64_t{std::bit_cast<uint32_t>(u)} | (uint64_t{std::bit_cast<uint32_t>(w)} << 32); }
+uint64_t key_of(float u, float w) {
+  return uint64_t{std::bit_cast<uint32_t>(u)} | (uint64_t{std::bit_cast<uint32_t>(w)} << 32);
+}
 
 // Where a split starts: clears the outputs and reserves them. The reservations of xref and uvs are
 // upper bounds (every corner its own vertex); pages never written are never touched, so they cost

@@ -1,9 +1,8 @@
 // The block search by FFT (block_search.h).
 #include "texture/block_search.h"
 
-#include <opencv2/core.hpp>
-
 #include <algorithm>
+#include <opencv2/core.hpp>
 #include <vector>
 
 namespace tailor::internal {

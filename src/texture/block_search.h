@@ -4,9 +4,8 @@
 // DFTs of the template and one inverse.
 #pragma once
 
-#include <opencv2/core.hpp>
-
 #include <cstddef>
+#include <opencv2/core.hpp>
 #include <vector>
 
 #include "texture/tiling_util.h"
@@ -29,8 +28,7 @@ class SsdSearch {
 
   //! templ: bw*bh*channels samples, mask: bw*bh weights (0 or 1), row-major.
   //! ssd: positions_x(bw) * positions_y(bh) values.
-  void search(int bw, int bh, const std::vector<float>& templ, const std::vector<float>& mask,
-              std::vector<float>& ssd);
+  void search(int bw, int bh, const std::vector<float>& templ, const std::vector<float>& mask, std::vector<float>& ssd);
 
  private:
   struct MaskEntry {

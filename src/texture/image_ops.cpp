@@ -1,12 +1,11 @@
 // Conversions and resampling of images (see tailor/image_ops.h).
 #include "tailor/image_ops.h"
 
-#include <opencv2/core.hpp>
-#include <opencv2/imgproc.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 namespace tailor {
 

@@ -7,11 +7,10 @@
 // [3, 2 size / 3] (at least a third of the pixels overlap): the fundamental is the first peak
 // reaching 80 % of the highest one (so harmonics 2p, 3p are not taken for the period), refined to sub-pixel by a
 // parabola and then by the highest harmonic k p still in range (dividing its position by k divides the error by k).
-#include <opencv2/core.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <opencv2/core.hpp>
 
 #include "tailor/image_ops.h"
 #include "tailor/tiling.h"

@@ -12,10 +12,10 @@
 namespace tailor::internal {
 namespace {
 
-constexpr double kCostTolerance = 0.01; // blocks whose patch cost is within this of the best are ties
-constexpr size_t kScanKeep = 8;         // the SSD scan keeps at least this many lowest positions (see select_candidates)
-constexpr double kProfilePower = 8.0;   // cost * (1 + relative profile deficit)^this
-constexpr double kStrongLine = 2.0;     // lines whose difference exceeds this x the median may not get stronger
+constexpr double kCostTolerance = 0.01;  // blocks whose patch cost is within this of the best are ties
+constexpr size_t kScanKeep = 8;        // the SSD scan keeps at least this many lowest positions (see select_candidates)
+constexpr double kProfilePower = 8.0;  // cost * (1 + relative profile deficit)^this
+constexpr double kStrongLine = 2.0;    // lines whose difference exceeds this x the median may not get stronger
 
 //! Minimum-error path through a strip of `length` x `width` errors (err[i * width + j], i along the
 //! strip): one j per i, |j(i) - j(i-1)| <= 1. Dynamic programming, ties to the smaller j.
@@ -110,7 +110,8 @@ void Quilter::place(int bx, int by, int bw, int bh, const Exclusion& exclusion) 
         }
         if (profile_axes_ != 0) profile_factor = std::pow(1.0 + profile_deficit(bx, by, cx, cy), kProfilePower);
         // A candidate whose partial cost already exceeds the ties' bound can be neither.
-        const double cost = patch_cost(bx, by, cx, cy, smooth_factor, profile_factor, best_cost * (1.0 + kCostTolerance));
+        const double cost =
+            patch_cost(bx, by, cx, cy, smooth_factor, profile_factor, best_cost * (1.0 + kCostTolerance));
         costs_[i] = cost;
         best_cost = std::min(best_cost, cost);
       }
@@ -192,7 +193,8 @@ void Quilter::set_profile(const Plane* original, int axes, int skip_first, int s
     const double median = sorted[static_cast<size_t>(n / 2)];
     std::vector<uint8_t>& strong = rows ? strong_rows_ : strong_cols_;
     strong.assign(static_cast<size_t>(n), 0);
-    for (int i = 0; i < n; ++i) strong[static_cast<size_t>(i)] = diff[static_cast<size_t>(i)] > kStrongLine * median ? 1 : 0;
+    for (int i = 0; i < n; ++i)
+      strong[static_cast<size_t>(i)] = diff[static_cast<size_t>(i)] > kStrongLine * median ? 1 : 0;
   }
 }
 
@@ -382,10 +384,11 @@ double Quilter::patch_cost(int bx, int by, int px, int py, double factor_a, doub
       const bool known = region_known_[r] != 0;
       row_unknown += known ? 0 : 1;
       if (i + 1 < rw) row_right += known && region_known_[r + 1] && region_src_[r + 1] == region_src_[r] + 1 ? 0 : 1;
-      if (j + 1 < rh) row_down += known && region_known_[r + static_cast<size_t>(rw)] &&
-                                          region_src_[r + static_cast<size_t>(rw)] == region_src_[r] + ew
-                                      ? 0
-                                      : 1;
+      if (j + 1 < rh)
+        row_down += known && region_known_[r + static_cast<size_t>(rw)] &&
+                            region_src_[r + static_cast<size_t>(rw)] == region_src_[r] + ew
+                        ? 0
+                        : 1;
       const size_t k = static_cast<size_t>(j + 1) * sw + i + 1;
       sat_unknown_[k] = sat_unknown_[k - static_cast<size_t>(sw)] + row_unknown;
       sat_right_[k] = sat_right_[k - static_cast<size_t>(sw)] + row_right;

@@ -13,9 +13,9 @@
 #include <limits>
 #include <vector>
 
-#include "texture/tiling_util.h"
 #include "tailor/image_ops.h"
 #include "tailor/tiling.h"
+#include "texture/tiling_util.h"
 
 namespace tailor {
 
@@ -304,7 +304,8 @@ int quarter_turn_difference(const Image& tile, int* shift_x, int* shift_y) {
         for (int x = 0; x < n; ++x) {
           const uint8_t* a = &tile.pixels[(static_cast<size_t>(n - 1 - x) * n + y) * c];
           const uint8_t* b = &tile.pixels[(static_cast<size_t>((y + sy) % n) * n + (x + sx) % n) * c];
-          for (int k = 0; k < c; ++k) worst = std::max(worst, std::abs(static_cast<int>(a[k]) - static_cast<int>(b[k])));
+          for (int k = 0; k < c; ++k)
+            worst = std::max(worst, std::abs(static_cast<int>(a[k]) - static_cast<int>(b[k])));
         }
       if (best < 0 || worst < best) {
         best = worst;
@@ -396,8 +397,7 @@ bool meets_tile_targets(const TileMetrics& m, std::string* failed) {
     check(m.gradient_ratio >= 0.95, "gradient ratio below 0.95");
     // No allowance: the estimator is deterministic (constant seed), and it can only overestimate
     // the tile's figure (patches not copied verbatim are matched approximately).
-    check(m.patch_coherence <= m.exemplar_patch_coherence,
-          "patch coherence worse than the exemplar's");
+    check(m.patch_coherence <= m.exemplar_patch_coherence, "patch coherence worse than the exemplar's");
   } else {
     check(m.worst_seam_ratio <= 1.5, "worst seam above 1.5");
   }

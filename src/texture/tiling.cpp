@@ -18,9 +18,9 @@
 #include <exception>
 #include <limits>
 
+#include "tailor/image_ops.h"
 #include "texture/quilting.h"
 #include "texture/tiling_util.h"
-#include "tailor/image_ops.h"
 
 namespace tailor {
 
@@ -33,19 +33,19 @@ using internal::SsdSearch;
 namespace {
 
 constexpr int kMinTileSide = 32;
-constexpr int kChainPercent = 100;      // arm blocks are this many percent as long as wide (150, 200: faster, worse seams)
-constexpr int kArmDivisor = 2;          // the '+' is repaired with blocks and overlaps this many times smaller
-constexpr int kCandidatePool = 32;      // near-best (SSD) blocks compared by the patch cost of their cuts
-constexpr double kSmoothPenalty = 2.0;  // cost * (mean gradient / block gradient)^this for smooth blocks
-constexpr double kRetryPenalty = 1.0;   // the same for the second try of the other exemplars
-constexpr double kSeamFloor = 1.5;      // worst-seam target: max(exemplar's interior worst, this)
-constexpr double kStrongEdge = 2.0;     // exemplars whose interior worst seam ratio exceeds this get kSmoothPenalty
-constexpr double kSeamHeadroom = 0.998; // an attempt meets the worst-seam target with this much room (a tie is a miss)
-constexpr int kMinCandidates = 8;       // a tolerance set smaller than this is topped up with the next best (SSD) blocks
-constexpr int kProfileCandidates = 16;  // the same where the straight-boundary profile is checked
+constexpr int kChainPercent = 100;  // arm blocks are this many percent as long as wide (150, 200: faster, worse seams)
+constexpr int kArmDivisor = 2;      // the '+' is repaired with blocks and overlaps this many times smaller
+constexpr int kCandidatePool = 32;  // near-best (SSD) blocks compared by the patch cost of their cuts
+constexpr double kSmoothPenalty = 2.0;   // cost * (mean gradient / block gradient)^this for smooth blocks
+constexpr double kRetryPenalty = 1.0;    // the same for the second try of the other exemplars
+constexpr double kSeamFloor = 1.5;       // worst-seam target: max(exemplar's interior worst, this)
+constexpr double kStrongEdge = 2.0;      // exemplars whose interior worst seam ratio exceeds this get kSmoothPenalty
+constexpr double kSeamHeadroom = 0.998;  // an attempt meets the worst-seam target with this much room (a tie is a miss)
+constexpr int kMinCandidates = 8;  // a tolerance set smaller than this is topped up with the next best (SSD) blocks
+constexpr int kProfileCandidates = 16;     // the same where the straight-boundary profile is checked
 constexpr int kAttemptPixels = 320 * 320;  // best of (this / pixels) attempts, at most kMaxAttempts
 constexpr int kMaxAttempts = 4;
-constexpr double kDirectional = 0.5;   // symmetry 4 warns above this orientation_anisotropy()
+constexpr double kDirectional = 0.5;  // symmetry 4 warns above this orientation_anisotropy()
 
 //! Square image cut out of `in`.
 Image crop(const Image& in, int x0, int y0, int w, int h) {
@@ -322,7 +322,8 @@ Status quilt_cross(const Setup& setup, const TileOptions& options, const CrossPl
   std::vector<int32_t> source(static_cast<size_t>(w) * h, -1);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
-      if (known[static_cast<size_t>(y) * w + x]) source[static_cast<size_t>(y) * w + x] = ((y + sy) % h) * w + (x + sx) % w;
+      if (known[static_cast<size_t>(y) * w + x])
+        source[static_cast<size_t>(y) * w + x] = ((y + sy) % h) * w + (x + sx) % w;
   const Plane original = canvas;
   SplitMix64 rng(mix_seed(options.seed, plan.stream));
   Quilter quilter(ex, search, canvas, known, locked, ov, options.tolerance, rng, &source, kCandidatePool,
@@ -379,9 +380,9 @@ Status quilt_pinwheel(const Setup& setup, const TileOptions& options, const Cros
   const int n = ex.width, m = n / 2, c = ex.channels;
   const int b = std::max(8, setup.block / kArmDivisor);
   const int ov = std::clamp(setup.overlap / kArmDivisor, 1, b / 2 - 1);
-  const int margin = b - 2 * ov;                   // unknown zone across each line
-  const int half = margin / 2;                     // the zone is [line - half, line - half + margin)
-  const int arm = margin + 2 * ov;                 // block extent across a line
+  const int margin = b - 2 * ov;    // unknown zone across each line
+  const int half = margin / 2;      // the zone is [line - half, line - half + margin)
+  const int arm = margin + 2 * ov;  // block extent across a line
   // A chain block must not reach its own quarter-turn image near a 4-fold point: the chains stop
   // `reach` px before it and a quarter block of side `quarter` (>= reach + ov) fills the rest.
   const int reach = half + 2 * ov;
@@ -534,7 +535,8 @@ Status make_tile_variants(const Image& exemplar, const TileOptions& options, int
     return Status::error(ErrorCode::kInvalidArgument, "", "variant count must be in [1, 64]",
                          "got " + std::to_string(count));
   if (options.symmetry == 4 && count > 1)
-    return Status::error(ErrorCode::kInvalidArgument, "", "--symmetry 4 makes one tile: --variants cannot be used with it",
+    return Status::error(ErrorCode::kInvalidArgument, "",
+                         "--symmetry 4 makes one tile: --variants cannot be used with it",
                          "variants re-quilt the interior freely, which would break the quarter-turn symmetry");
   TileReport local;
   TileReport& rep = report ? *report : local;
@@ -576,7 +578,8 @@ Status make_tile_variants(const Image& exemplar, const TileOptions& options, int
       plans.push_back({0, kSmoothPenalty, 0, 0, 2});
     } else {
       const int attempts = std::clamp(kAttemptPixels / std::max(1, w * h), 1, kMaxAttempts);
-      for (int a = 0; a < attempts; ++a) plans.push_back({a == 0 ? 0u : 1000u + static_cast<unsigned>(a), 0.0, kMinCandidates, 0, 0});
+      for (int a = 0; a < attempts; ++a)
+        plans.push_back({a == 0 ? 0u : 1000u + static_cast<unsigned>(a), 0.0, kMinCandidates, 0, 0});
       plans.push_back({0, kRetryPenalty, kMinCandidates, 0, 0});
     }
     Plane base;
@@ -600,8 +603,8 @@ Status make_tile_variants(const Image& exemplar, const TileOptions& options, int
       const double worst = worst_seam_ratio(canvas, true);
       const bool meets = worst <= target * kSeamHeadroom;
       // Meeting the seam target first, then the lower cut cost (or, both missing, the lower worst seam).
-      const bool better = i == 0 || (meets && !base_meets) ||
-                          (meets == base_meets && (meets ? cost < base_cost : worst < base_worst));
+      const bool better =
+          i == 0 || (meets && !base_meets) || (meets == base_meets && (meets ? cost < base_cost : worst < base_worst));
       if (better) {
         base = std::move(canvas);
         base_blocks = blocks;

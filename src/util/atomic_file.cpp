@@ -1,6 +1,5 @@
 // Whole-file reads and atomic writes (see internal/atomic_file.h).
 #include "util/atomic_file.h"
-#include "util/huge_pages.h"
 
 #include <sys/stat.h>
 #include <unistd.h>
@@ -9,6 +8,8 @@
 #include <cstdio>
 #include <cstring>
 #include <utility>
+
+#include "util/huge_pages.h"
 
 namespace tailor::internal {
 namespace {

@@ -42,7 +42,8 @@ void for_each_chunk(size_t n, size_t threads, Body body) {
   std::mutex failure_mutex;
   auto run = [&] {
     try {
-      for (size_t c; (c = next.fetch_add(1)) < chunks;) body(c * kParallelChunk, std::min(n, (c + 1) * kParallelChunk), c);
+      for (size_t c; (c = next.fetch_add(1)) < chunks;)
+        body(c * kParallelChunk, std::min(n, (c + 1) * kParallelChunk), c);
     } catch (...) {
       const std::lock_guard<std::mutex> lock(failure_mutex);
       if (!failure) failure = std::current_exception();

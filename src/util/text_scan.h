@@ -164,8 +164,7 @@ class TextScanner {
 
  private:
   bool ends_token(const char* q) const {
-    return q >= end_ || is_blank(*q) || *q == '\n' || (hash_comments_ && *q == '#') ||
-           (continuation_ && *q == '\\');
+    return q >= end_ || is_blank(*q) || *q == '\n' || (hash_comments_ && *q == '#') || (continuation_ && *q == '\\');
   }
   // A backslash at p_ followed by optional '\r' and '\n' (or the end of the file).
   bool continuation_follows() const { return continuation_follows_at(p_); }

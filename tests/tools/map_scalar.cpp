@@ -21,7 +21,8 @@ int main(int argc, char** argv) {
   options.measure = false;
   for (int i = 3; i + 1 < argc; i += 2) {
     const std::string flag = argv[i];
-    if (flag == "--field-following") options.mapping.field_following = std::strtof(argv[i + 1], nullptr);
+    if (flag == "--field-following")
+      options.mapping.field_following = std::strtof(argv[i + 1], nullptr);
     else if (flag == "--crack-rings")
       options.mapping.crack_rings = static_cast<uint32_t>(std::strtoul(argv[i + 1], nullptr, 10));
     else {
