@@ -100,7 +100,7 @@ inline void predict(const Level& L, size_t v, const Level& M, size_t w, float sc
   float d[2];
   edge_offset(L, v, M, w, scale, k, d);
   float x, y;
-  rotate_float(k, M.u[2 * w], M.u[2 * w + 1], x, y);
+  rotate_quarter(k, M.u[2 * w], M.u[2 * w + 1], x, y);
   out[0] = x - d[0];
   out[1] = y - d[1];
 }
@@ -226,7 +226,7 @@ void smooth_position(Level& L, uint32_t iterations, float scale, float period, f
         for (uint32_t i = L.start[v]; i < L.start[v + 1]; ++i) {
           const uint32_t w = L.adj[i];
           float x, y;
-          rotate_float(turns[i], L.u[2 * w], L.u[2 * w + 1], x, y);
+          rotate_quarter(turns[i], L.u[2 * w], L.u[2 * w + 1], x, y);
           x -= offset[2 * i];
           y -= offset[2 * i + 1];
           x += period * std::round((ux - x) * inv_period);
@@ -289,7 +289,7 @@ LatticeMap lattice_map(const RosyField& field, uint32_t v, uint32_t w) {
   const V3 e2 = l2 > 1e-12f ? e2s * (1.f / l2) : cross(load3(field.normal, a), qa);
   const V3 delta = load3(field.position, b) - load3(field.position, a);
   float x, y;
-  rotate_float(m.r, field.uv[2 * b], field.uv[2 * b + 1], x, y);
+  rotate_quarter(m.r, field.uv[2 * b], field.uv[2 * b + 1], x, y);
   const float inv = 1.f / field.period;
   m.tx = static_cast<int>(std::lround((field.uv[2 * a] + field.scale * dot(delta, e1) - x) * inv));
   m.ty = static_cast<int>(std::lround((field.uv[2 * a + 1] + field.scale * dot(delta, e2) - y) * inv));

@@ -56,27 +56,10 @@ struct LatticeMap {
   bool operator==(const LatticeMap&) const = default;
 };
 
-inline void rotate_int(int r, int a, int b, int& x, int& y) {
-  switch (r & 3) {
-    case 0:
-      x = a;
-      y = b;
-      break;
-    case 1:
-      x = b;
-      y = -a;
-      break;
-    case 2:
-      x = -a;
-      y = -b;
-      break;
-    default:
-      x = -b;
-      y = a;
-      break;
-  }
-}
-inline void rotate_float(int r, float a, float b, float& x, float& y) {
+// (x, y) = (a, b) turned by r quarter turns clockwise (r taken modulo 4); ints (lattice
+// translations) and floats (positions) alike.
+template <typename T>
+inline void rotate_quarter(int r, T a, T b, T& x, T& y) {
   switch (r & 3) {
     case 0:
       x = a;
@@ -101,7 +84,7 @@ inline LatticeMap compose(const LatticeMap& a, const LatticeMap& b) {
   LatticeMap c;
   c.r = (a.r + b.r) & 3;
   int x, y;
-  rotate_int(a.r, b.tx, b.ty, x, y);
+  rotate_quarter(a.r, b.tx, b.ty, x, y);
   c.tx = x + a.tx;
   c.ty = y + a.ty;
   return c;
@@ -110,14 +93,14 @@ inline LatticeMap inverse(const LatticeMap& a) {
   LatticeMap c;
   c.r = (4 - a.r) & 3;
   int x, y;
-  rotate_int(c.r, a.tx, a.ty, x, y);
+  rotate_quarter(c.r, a.tx, a.ty, x, y);
   c.tx = -x;
   c.ty = -y;
   return c;
 }
 inline void apply(const LatticeMap& m, float period, const float* in, float* out) {
   float x, y;
-  rotate_float(m.r, in[0], in[1], x, y);
+  rotate_quarter(m.r, in[0], in[1], x, y);
   out[0] = x + period * static_cast<float>(m.tx);
   out[1] = y + period * static_cast<float>(m.ty);
 }
