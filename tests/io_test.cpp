@@ -694,6 +694,76 @@ TEST(Errors, GarbageEmptyAndUnknown) {
   EXPECT_NE(s.what().find(".ply"), std::string::npos);
 }
 
+// Header caps: each limit fails with one line naming it (the parser is one linear pass; before the
+// caps, 200,000 element lines took 20 s because each new element was compared with all before it).
+TEST(Errors, OversizedPlyHeadersFailWithOneLine) {
+  Mesh m;
+  std::string many = "ply\nformat ascii 1.0\n";
+  for (int i = 0; i < 20000; ++i) many += "element e" + std::to_string(i) + " 0\n";
+  many += "end_header\n";
+  Status s = parse(many, MeshFormat::kPly, m);
+  ASSERT_FALSE(s.is_ok());
+  EXPECT_EQ(s.code(), ErrorCode::kLimit);
+  EXPECT_NE(s.message().find("more than 4096 elements"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("(line 4099)"), std::string::npos) << s.message();
+
+  std::string props = "ply\nformat ascii 1.0\nelement vertex 0\n";
+  for (int i = 0; i < 20000; ++i) props += "property float p" + std::to_string(i) + "\n";
+  props += "end_header\n";
+  s = parse(props, MeshFormat::kPly, m);
+  ASSERT_FALSE(s.is_ok());
+  EXPECT_NE(s.message().find("more than 16384 properties"), std::string::npos) << s.message();
+
+  std::string longer = "ply\nformat ascii 1.0\n";
+  while (longer.size() <= (size_t{1} << 20)) longer += "comment " + std::string(100, 'c') + "\n";
+  longer += "end_header\n";
+  s = parse(longer, MeshFormat::kPly, m);
+  ASSERT_FALSE(s.is_ok());
+  EXPECT_NE(s.message().find("PLY header longer than 1 MiB"), std::string::npos) << s.message();
+  // No newline at all: the same error, not a scan of the whole input.
+  s = parse("ply\nformat ascii 1.0\n" + std::string((size_t{1} << 20) + 10, 'x'), MeshFormat::kPly, m);
+  ASSERT_FALSE(s.is_ok());
+  EXPECT_NE(s.message().find("PLY header longer than 1 MiB"), std::string::npos) << s.message();
+}
+
+// Error lines quote file content as printable ASCII only, at most 200 characters, and end with
+// the position.
+TEST(Errors, QuotedInputIsEscapedAndShort) {
+  const auto ascii_only = [](const std::string& text) {
+    return std::all_of(text.begin(), text.end(), [](char c) { return c >= 0x20 && c < 0x7f; });
+  };
+  Mesh m;
+  Status s = parse("ply\nformat ascii 1.0\nbad\xff\x1b[2Jword\\x\nend_header\n", MeshFormat::kPly, m);
+  ASSERT_FALSE(s.is_ok());
+  EXPECT_TRUE(ascii_only(s.message())) << s.message();
+  EXPECT_NE(s.message().find("'bad\\xff\\x1b[2Jword\\\\x'"), std::string::npos) << s.message();
+  EXPECT_TRUE(s.message().ends_with("(line 3)")) << s.message();
+
+  s = parse("ply\nformat ascii 1.0\n" + std::string(1000000, '\xff') + "\nend_header\n", MeshFormat::kPly, m);
+  ASSERT_FALSE(s.is_ok());
+  EXPECT_TRUE(ascii_only(s.message())) << s.message();
+  EXPECT_LT(s.message().size(), 300u) << s.message();
+  EXPECT_TRUE(s.message().ends_with("(line 3)")) << s.message();
+
+  // An element name (quoted again in body errors) and the other readers go through the same helper.
+  s = parse("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nelement \x1b" + std::string(5000, 'n') +
+                " 1\nproperty float y\nend_header\n1\n",
+            MeshFormat::kPly, m);
+  ASSERT_FALSE(s.is_ok());
+  EXPECT_TRUE(ascii_only(s.message())) << s.message();
+  EXPECT_LT(s.message().size(), 300u) << s.message();
+  s = parse("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", MeshFormat::kOff, m);
+  ASSERT_TRUE(s.is_ok()) << s.message();
+  s = parse("\xff\x1b" + std::string(4000, 'O') + "\n3 1 0\n", MeshFormat::kOff, m);
+  ASSERT_FALSE(s.is_ok());
+  EXPECT_TRUE(ascii_only(s.message())) << s.message();
+  EXPECT_LT(s.message().size(), 300u) << s.message();
+  s = parse("solid x\n\x1b" + std::string(4000, 'f') + "\nendsolid\n", MeshFormat::kStl, m);
+  ASSERT_FALSE(s.is_ok());
+  EXPECT_TRUE(ascii_only(s.message())) << s.message();
+  EXPECT_LT(s.message().size(), 300u) << s.message();
+}
+
 TEST(LoadMesh, SniffsContentAndReportsIoErrors) {
   const std::string dir = ::testing::TempDir();
   const std::string copy = dir + "/io_test_fandisk.dat";

@@ -42,7 +42,7 @@ Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh,
       dimension_follows = true;
     }
     if (!prefix.empty())
-      return Status::error(ErrorCode::kParse, name, "unknown OFF keyword '" + std::string(kw) + "'", s.where());
+      return Status::error(ErrorCode::kParse, name, "unknown OFF keyword " + quote_input(kw), s.where());
     report.format = kw == "OFF" ? "OFF" : "OFF (" + std::string(kw) + ")";
     if (s.peek() == 'B') {
       return Status::error(ErrorCode::kUnsupported, name, "binary OFF files are not supported", s.where());

@@ -109,12 +109,26 @@ std::vector<std::string_view> split_words(std::string_view line) {
   return w;
 }
 
+// Caps on the header (untrusted): real headers are a few hundred bytes with a handful of elements.
+// Past them the reader fails with one line instead of spending time and memory on the header.
+constexpr size_t kMaxHeaderBytes = size_t{1} << 20;
+constexpr size_t kMaxHeaderElements = 4096;
+constexpr size_t kMaxHeaderProperties = 16384;
+
+// One pass over the header lines: O(header bytes), no step looks back at earlier elements.
 Status parse_header(std::string_view data, const std::string& name, PlyHeader& h) {
-  size_t pos = 0, line_no = 0;
+  size_t pos = 0, line_no = 0, property_count = 0;
   bool have_format = false;
+  std::array<bool, 4> seen_kind{};  // indexed by ElementKind: vertex, face, tristrips may appear once
+  // Lines are looked for only within the cap, so a file without newlines is not scanned to its end.
+  const std::string_view head = data.substr(0, kMaxHeaderBytes + 1);
   for (;;) {
     if (pos >= data.size()) return Status::error(ErrorCode::kParse, name, "PLY header has no end_header line");
-    size_t eol = data.find('\n', pos);
+    size_t eol = head.find('\n', pos);
+    if (eol == std::string_view::npos && data.size() > kMaxHeaderBytes) {
+      return Status::error(ErrorCode::kLimit, name, "PLY header longer than 1 MiB",
+                           "line " + std::to_string(line_no + 1));
+    }
     const bool last = eol == std::string_view::npos;
     if (last) eol = data.size();
     std::string_view line = data.substr(pos, eol - pos);
@@ -137,7 +151,7 @@ Status parse_header(std::string_view data, const std::string& name, PlyHeader& h
       else if (w[1] == "binary_big_endian")
         h.format = PlyFormat::kBinaryBe;
       else
-        return Status::error(ErrorCode::kUnsupported, name, "unknown PLY format '" + std::string(w[1]) + "'", where);
+        return Status::error(ErrorCode::kUnsupported, name, "unknown PLY format " + quote_input(w[1]), where);
       have_format = true;
     } else if (w[0] == "element") {
       uint64_t count = 0;
@@ -155,14 +169,26 @@ Status parse_header(std::string_view data, const std::string& name, PlyHeader& h
         e.kind = ElementKind::kFace;
       else if (e.name == "tristrips")
         e.kind = ElementKind::kTristrips;
-      for (const PlyElement& other : h.elements) {
-        if (other.kind != ElementKind::kOther && other.kind == e.kind) {
-          return Status::error(ErrorCode::kUnsupported, name, "more than one PLY '" + e.name + "' element", where);
+      if (e.kind != ElementKind::kOther) {
+        if (seen_kind[static_cast<size_t>(e.kind)]) {
+          return Status::error(ErrorCode::kUnsupported, name, "more than one PLY " + quote_input(e.name) + " element",
+                               where);
         }
+        seen_kind[static_cast<size_t>(e.kind)] = true;
+      }
+      if (h.elements.size() == kMaxHeaderElements) {
+        return Status::error(ErrorCode::kLimit, name,
+                             "PLY header declares more than " + std::to_string(kMaxHeaderElements) + " elements",
+                             where);
       }
       h.elements.push_back(std::move(e));
     } else if (w[0] == "property") {
       if (h.elements.empty()) return Status::error(ErrorCode::kParse, name, "PLY property before any element", where);
+      if (++property_count > kMaxHeaderProperties) {
+        return Status::error(ErrorCode::kLimit, name,
+                             "PLY header declares more than " + std::to_string(kMaxHeaderProperties) + " properties",
+                             where);
+      }
       PlyProperty p;
       if (w.size() == 5 && w[1] == "list") {
         p.count_type = parse_type(w[2]);
@@ -178,7 +204,7 @@ Status parse_header(std::string_view data, const std::string& name, PlyHeader& h
         p.type = parse_type(w[1]);
         p.name = std::string(w[2]);
         if (p.type == PlyType::kNone) {
-          return Status::error(ErrorCode::kParse, name, "unknown PLY property type '" + std::string(w[1]) + "'", where);
+          return Status::error(ErrorCode::kParse, name, "unknown PLY property type " + quote_input(w[1]), where);
         }
       } else {
         return Status::error(ErrorCode::kParse, name, "bad PLY property line", where);
@@ -190,7 +216,7 @@ Status parse_header(std::string_view data, const std::string& name, PlyHeader& h
       h.header_lines = line_no;
       return Status::ok();
     } else {
-      return Status::error(ErrorCode::kParse, name, "unknown PLY header keyword '" + std::string(w[0]) + "'", where);
+      return Status::error(ErrorCode::kParse, name, "unknown PLY header keyword " + quote_input(w[0]), where);
     }
   }
 }
@@ -385,10 +411,11 @@ class BodyReader {
  private:
   Status truncated(const PlyElement& e, uint64_t i) const {
     if (src_.remaining() == 0) {
-      return Status::error(ErrorCode::kParse, name_, "unexpected end of file in PLY element '" + e.name + "'",
+      return Status::error(ErrorCode::kParse, name_, "unexpected end of file in PLY element " + quote_input(e.name),
                            src_.where(e, i));
     }
-    return Status::error(ErrorCode::kParse, name_, "bad number in PLY element '" + e.name + "'", src_.where(e, i));
+    return Status::error(ErrorCode::kParse, name_, "bad number in PLY element " + quote_input(e.name),
+                         src_.where(e, i));
   }
 
   // Reads a list count, checking that the items can fit in the bytes left.
@@ -396,7 +423,7 @@ class BodyReader {
     double d;
     if (!src_.value(p.count_type, d)) return truncated(e, i);
     if (!is_index(d)) {
-      return Status::error(ErrorCode::kParse, name_, "bad PLY list count in element '" + e.name + "'",
+      return Status::error(ErrorCode::kParse, name_, "bad PLY list count in element " + quote_input(e.name),
                            src_.where(e, i));
     }
     n = static_cast<uint64_t>(d);
@@ -737,7 +764,7 @@ Status check_counts(const PlyHeader& h, size_t body_bytes, const std::string& na
     need = add_sat(need, h.format == PlyFormat::kAscii && bytes > 0 ? bytes - 1 : bytes);
     if (need > body_bytes) {
       return Status::error(ErrorCode::kParse, name,
-                           "PLY header declares " + std::to_string(e.count) + " " + e.name +
+                           "PLY header declares " + std::to_string(e.count) + " " + quote_input(e.name) +
                                " elements, more than the file can hold (" + std::to_string(body_bytes) +
                                " bytes of data)");
     }

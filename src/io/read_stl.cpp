@@ -73,9 +73,8 @@ Status read_ascii(std::span<const char> data, const std::string& name, std::vect
     s.skip_space();
     const std::string_view w = s.word();
     if (w != word) {
-      return Status::error(
-          ErrorCode::kParse, name,
-          "expected '" + std::string(word) + "' in ascii STL, found '" + std::string(w.substr(0, 32)) + "'", s.where());
+      return Status::error(ErrorCode::kParse, name,
+                           "expected '" + std::string(word) + "' in ascii STL, found " + quote_input(w, 32), s.where());
     }
     return Status::ok();
   };
@@ -89,8 +88,8 @@ Status read_ascii(std::span<const char> data, const std::string& name, std::vect
       continue;
     }
     if (w != "facet") {
-      return Status::error(ErrorCode::kParse, name,
-                           "expected 'facet' in ascii STL, found '" + std::string(w.substr(0, 32)) + "'", s.where());
+      return Status::error(ErrorCode::kParse, name, "expected 'facet' in ascii STL, found " + quote_input(w, 32),
+                           s.where());
     }
     TAILOR_RETURN_IF_ERROR(expect("normal"));
     float ignored;

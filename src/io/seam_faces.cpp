@@ -3,6 +3,7 @@
 
 #include "tailor/io.h"
 #include "util/atomic_file.h"
+#include "util/text_scan.h"
 
 namespace tailor {
 
@@ -26,7 +27,8 @@ Status load_seam_faces(const std::string& path, size_t face_count, std::vector<u
     const auto [ptr, ec] = std::from_chars(first, last, face);
     if (ec != std::errc() || ptr != last) {
       return Status::error(ErrorCode::kParse, path,
-                           "expected one face index per line, got '" + std::string(first, last) + "'",
+                           "expected one face index per line, got " +
+                               internal::quote_input(std::string_view(first, static_cast<size_t>(last - first))),
                            "line " + std::to_string(line));
     }
     if (face >= face_count) {

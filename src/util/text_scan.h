@@ -23,6 +23,36 @@ namespace tailor::internal {
 //! Space, tab, carriage return, vertical tab, form feed: separators that do not end a line.
 inline bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 
+//! `input` in single quotes, safe to print in an error line: printable ASCII is kept, a backslash
+//! becomes \\, every other byte (control characters, ESC, bytes >= 0x80) becomes \xNN, and at
+//! most `max_chars` characters of the escaped text are kept ("..." marks a cut). Every reader
+//! quotes file content through this, so no error line carries raw bytes or grows with the input.
+inline std::string quote_input(std::string_view input, size_t max_chars = 200) {
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string out = "'";
+  size_t used = 0;
+  for (const char c : input) {
+    const auto b = static_cast<unsigned char>(c);
+    const size_t width = b == '\\' ? 2 : (b >= 0x20 && b < 0x7f) ? 1 : 4;
+    if (used + width > max_chars) {
+      out += "...";
+      break;
+    }
+    used += width;
+    if (b == '\\') {
+      out += "\\\\";
+    } else if (width == 1) {
+      out += c;
+    } else {
+      out += "\\x";
+      out += kHex[b >> 4];
+      out += kHex[b & 15];
+    }
+  }
+  out += '\'';
+  return out;
+}
+
 class TextScanner {
  public:
   TextScanner(const char* begin, const char* end) : p_(begin), end_(end) {}
