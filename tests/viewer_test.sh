@@ -5,7 +5,8 @@
 #    mapped horse against `tailor eval --json`;
 # 1. makes a .glb with `tailor map` from the bundled example;
 # 2. `tailor render`: every view writes a PNG, bad input gives one error line and exit 1;
-# 3. `tailor view`: serves on 127.0.0.1, answers GET, refuses path traversal and POST;
+# 3. `tailor view`: serves on 127.0.0.1, answers GET, refuses path traversal and POST, a foreign
+#    Host header (tests/viewer_hardening.py), sends a CSP, survives 200 idle sockets;
 # 4. a real browser (headless Chromium + playwright-core) opens the viewer, waits for the first
 #    frame, checks for console errors, a non-blank canvas, that the views change the picture, red
 #    seam lines in the seams view and the viewer's seam figures against `tailor eval --json`;
@@ -98,6 +99,9 @@ size="$(curl -s --max-time 10 "${url}files/model.glb" | wc -c)"
 [ "$(status_of "${url}%2e%2e/CMakeLists.txt")" = 403 ] || fail "path traversal with %2e%2e was not refused"
 [ "$(status_of "${url}nothing-here.js")" = 404 ] || fail "a missing file is not 404"
 [ "$(status_of -X POST "${url}")" = 405 ] || fail "POST is not refused"
+# Host check (DNS rebinding), the CSP header, and 200 idle sockets not locking a real request out.
+timeout 30 python3 tests/viewer_hardening.py "$(echo "$url" | sed 's|.*:\([0-9]*\)/$|\1|')" web/index.html \
+  || fail "viewer hardening checks failed"
 
 # --- 4. the browser ---------------------------------------------------------------------------------
 timeout 60 "$tailor" eval "$tmp/spot.glb" --json -q >"$tmp/spot_eval.json" || fail "tailor eval of the test .glb failed"

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <climits>
@@ -18,6 +19,8 @@
 #include <cstring>
 #include <fstream>
 #include <list>
+#include <mutex>
+#include <string_view>
 #include <thread>
 
 namespace tailor::cli {
@@ -25,10 +28,20 @@ namespace {
 
 constexpr size_t kMaxHeaderBytes = 16 * 1024;  // a GET from a browser is well under 2 KB
 constexpr int kPollMillis = 200;               // how often the server and its workers look at the stop flag
-constexpr int kHeaderSeconds = 10;             // a client must send its whole request within this (slow or silent ones
-                                    // are dropped: a per-recv timeout would let a trickle hold a worker forever)
+constexpr int kHeaderSeconds = 2;              // a client must send its whole request within this (slow or silent ones
+                                   // are dropped: a per-recv timeout would let a trickle hold a worker forever)
 constexpr int kStallSeconds = 30;   // a client that accepts no byte of the answer for this long is dropped
-constexpr size_t kMaxWorkers = 64;  // connections served at once; more get 503
+constexpr size_t kMaxWorkers = 64;  // connections served at once; when full, the oldest one still
+                                    // waiting for its request is dropped; 503 only when none is waiting
+
+// Content-Security-Policy of every answer: scripts, styles, images and fetches from this server only.
+// The one inline script, index.html's importmap, is allowed by its SHA-256 (tests/viewer_test.sh
+// checks the hash against web/index.html); styles may be inline (index.html's <style> block and
+// style attributes); GLTFLoader reads embedded textures through blob: URLs.
+constexpr const char* kContentSecurityPolicy =
+    "default-src 'none'; script-src 'self' 'sha256-m3Nsq/c0thop7NTHfBJi1BT+HUVzyPDfkQMAS8PG5qw='; "
+    "style-src 'self' 'unsafe-inline'; img-src 'self' blob: data:; connect-src 'self' blob: data:; "
+    "base-uri 'none'; form-action 'none'; frame-ancestors 'none'";
 
 using Clock = std::chrono::steady_clock;
 
@@ -67,7 +80,8 @@ void send_status(int fd, int code, const char* reason, const std::atomic<bool>& 
 
 std::string header_for(size_t length, const std::string& type) {
   return "HTTP/1.1 200 OK\r\nContent-Type: " + type + "\r\nContent-Length: " + std::to_string(length) +
-         "\r\nCache-Control: no-cache\r\nX-Content-Type-Options: nosniff\r\nConnection: close\r\n\r\n";
+         "\r\nCache-Control: no-cache\r\nX-Content-Type-Options: nosniff\r\nContent-Security-Policy: " +
+         kContentSecurityPolicy + "\r\nConnection: close\r\n\r\n";
 }
 
 int hex_value(char c) {
@@ -75,6 +89,31 @@ int hex_value(char c) {
   if (c >= 'a' && c <= 'f') return c - 'a' + 10;
   if (c >= 'A' && c <= 'F') return c - 'A' + 10;
   return -1;
+}
+
+// The value of header `name` (lower case) in a request head, blanks trimmed; "" when absent.
+std::string header_value(const std::string& request, const std::string& name) {
+  size_t pos = request.find("\r\n");
+  while (pos != std::string::npos && pos + 2 < request.size()) {
+    const size_t start = pos + 2;
+    const size_t end = request.find("\r\n", start);
+    if (end == std::string::npos || end == start) break;
+    const size_t colon = request.find(':', start);
+    if (colon != std::string::npos && colon < end && colon - start == name.size()) {
+      bool same = true;
+      for (size_t i = 0; i < name.size() && same; ++i) {
+        same = std::tolower(static_cast<unsigned char>(request[start + i])) == name[i];
+      }
+      if (same) {
+        size_t b = colon + 1, e = end;
+        while (b < e && (request[b] == ' ' || request[b] == '\t')) ++b;
+        while (e > b && (request[e - 1] == ' ' || request[e - 1] == '\t')) --e;
+        return request.substr(b, e - b);
+      }
+    }
+    pos = end;
+  }
+  return {};
 }
 
 bool is_regular_file(const std::string& path) {
@@ -158,7 +197,7 @@ Status StaticServer::start(const std::string& web_root, std::vector<Route> route
     listen_fd_ = -1;
     return Status::error(ErrorCode::kIo, "", "cannot listen on 127.0.0.1:" + std::to_string(port), std::strerror(err));
   }
-  if (::listen(listen_fd_, 64) != 0) {
+  if (::listen(listen_fd_, SOMAXCONN) != 0) {
     ::close(listen_fd_);
     listen_fd_ = -1;
     return Status::error(ErrorCode::kIo, "", std::string("cannot listen: ") + std::strerror(errno));
@@ -175,6 +214,7 @@ void StaticServer::serve(const std::atomic<bool>& stop) {
   struct Worker {
     std::thread thread;
     std::atomic<bool> done{false};
+    Connection conn;
   };
   std::list<Worker> workers;
   auto reap = [&workers](bool all) {
@@ -194,15 +234,29 @@ void StaticServer::serve(const std::atomic<bool>& stop) {
     if (ready <= 0) continue;  // timeout, or EINTR from Ctrl-C: look at the flag again
     const int client = ::accept4(listen_fd_, nullptr, nullptr, SOCK_CLOEXEC);
     if (client < 0) continue;
-    if (workers.size() >= kMaxWorkers) {
-      send_status(client, 503, "Service Unavailable", stop);
-      ::close(client);
-      continue;
+    // Full: drop the oldest connection that has not sent its request yet (idle or trickling
+    // sockets cannot lock real requests out); its worker sees the shutdown at once and ends.
+    size_t busy = 0;
+    for (Worker& w : workers) busy += w.done.load() || w.conn.dropped() ? 0 : 1;
+    if (busy >= kMaxWorkers) {
+      bool dropped = false;
+      for (Worker& w : workers) {
+        if (!w.done.load() && w.conn.drop_if_waiting()) {
+          dropped = true;
+          break;
+        }
+      }
+      if (!dropped) {
+        send_status(client, 503, "Service Unavailable", stop);
+        ::close(client);
+        continue;
+      }
     }
     Worker& w = workers.emplace_back();
-    w.thread = std::thread([this, client, &stop, &w] {
-      handle(client, stop);
-      ::close(client);
+    w.conn.fd = client;
+    w.thread = std::thread([this, &stop, &w] {
+      handle(w.conn, stop);
+      w.conn.close();
       w.done.store(true);
     });
   }
@@ -220,7 +274,44 @@ std::string StaticServer::resolve_under_root(const std::string& path) const {
   return is_regular_file(resolved) ? resolved : std::string();
 }
 
-void StaticServer::handle(int client, const std::atomic<bool>& stop) const {
+bool StaticServer::Connection::drop_if_waiting() {
+  const std::lock_guard<std::mutex> lock(mutex);
+  if (state != State::kWaiting) return false;
+  state = State::kDropped;
+  ::shutdown(fd, SHUT_RDWR);
+  return true;
+}
+
+bool StaticServer::Connection::start_serving() {
+  const std::lock_guard<std::mutex> lock(mutex);
+  if (state != State::kWaiting) return false;
+  state = State::kServing;
+  return true;
+}
+
+bool StaticServer::Connection::dropped() {
+  const std::lock_guard<std::mutex> lock(mutex);
+  return state == State::kDropped;
+}
+
+void StaticServer::Connection::close() {
+  const std::lock_guard<std::mutex> lock(mutex);
+  state = State::kClosed;
+  ::close(fd);
+}
+
+bool StaticServer::host_allowed(const std::string& host) const {
+  std::string port = std::to_string(port_);
+  port.insert(port.begin(), ':');
+  std::string lower = host;
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (lower.size() <= port.size() || lower.compare(lower.size() - port.size(), port.size(), port) != 0) return false;
+  const std::string_view name = std::string_view(lower).substr(0, lower.size() - port.size());
+  return name == "127.0.0.1" || name == "localhost" || name == "[::1]";
+}
+
+void StaticServer::handle(Connection& conn, const std::atomic<bool>& stop) const {
+  const int client = conn.fd;
   std::string request;
   std::array<char, 4096> buf{};
   const auto deadline = Clock::now() + std::chrono::seconds(kHeaderSeconds);
@@ -232,11 +323,15 @@ void StaticServer::handle(int client, const std::atomic<bool>& stop) const {
     if (n <= 0) return;
     request.append(buf.data(), static_cast<size_t>(n));
   }
+  if (!conn.start_serving()) return;  // dropped for a newer connection just now
   const size_t line_end = request.find("\r\n");
   const std::string line = request.substr(0, line_end);
   const size_t sp1 = line.find(' ');
   const size_t sp2 = sp1 == std::string::npos ? std::string::npos : line.find(' ', sp1 + 1);
   if (sp2 == std::string::npos) return send_status(client, 400, "Bad Request", stop);
+  // DNS rebinding: a page from another site whose name now resolves to 127.0.0.1 sends its own
+  // name as Host. Only the loopback names with this port are answered.
+  if (!host_allowed(header_value(request, "host"))) return send_status(client, 403, "Forbidden", stop);
   const std::string method = line.substr(0, sp1);
   const std::string target = line.substr(sp1 + 1, sp2 - sp1 - 1);
   if (method != "GET" && method != "HEAD") return send_status(client, 405, "Method Not Allowed", stop);

@@ -12,6 +12,8 @@
 #pragma once
 
 #include <atomic>
+#include <cstdint>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -43,9 +45,13 @@ class StaticServer {
   int port() const { return port_; }
 
   //! Answers requests until `stop` becomes true (checked at least every 200 ms), e.g. set from
-  //! a SIGINT handler. Each connection is served on its own thread (at most 64 at once, more get
-  //! 503), joined as soon as it ends; a client must send its request within 10 s and take each
-  //! part of the answer within 30 s. Workers also watch `stop`, so the return is prompt.
+  //! a SIGINT handler. Each connection is served on its own thread, joined as soon as it ends; at
+  //! most 64 at once: when full, a new connection replaces the oldest one that has not sent its
+  //! request yet, and gets 503 only when all 64 are being answered. A client must send its request
+  //! within 2 s and take each part of the answer within 30 s. Requests whose Host is not
+  //! 127.0.0.1:PORT, localhost:PORT or [::1]:PORT get 403 (DNS rebinding). Every answer carries a
+  //! Content-Security-Policy limiting the page to this server's files. Workers also watch `stop`,
+  //! so the return is prompt.
   void serve(const std::atomic<bool>& stop);
 
   //! Content type for a path from its extension ("application/octet-stream" when unknown).
@@ -56,7 +62,21 @@ class StaticServer {
   static std::string safe_request_path(const std::string& target);
 
  private:
-  void handle(int client, const std::atomic<bool>& stop) const;
+  //! One accepted socket, shared by its worker and the accept loop (which may drop it while it
+  //! waits for its request). The mutex orders the drop against the worker's start and close.
+  struct Connection {
+    enum class State : uint8_t { kWaiting, kServing, kDropped, kClosed };
+    int fd = -1;
+    std::mutex mutex;
+    State state = State::kWaiting;
+    bool drop_if_waiting();  //!< shuts the socket down when still kWaiting; true when it did
+    bool start_serving();    //!< kWaiting -> kServing; false when dropped
+    bool dropped();
+    void close();
+  };
+
+  bool host_allowed(const std::string& host) const;
+  void handle(Connection& conn, const std::atomic<bool>& stop) const;
   std::string resolve_under_root(const std::string& path) const;
 
   int listen_fd_ = -1;
