@@ -148,7 +148,67 @@ expect_error 2 "" -- "$tailor" frobnicate
 expect_error 2 "symmetry 4 needs a square texture, got 64x48" -- "$tailor" map "$mesh" --texture "$tmp/wide.png" -o "$tmp/x.glb" --symmetry 4
 [[ ! -e $tmp/x.glb ]] && ok || fail "map --symmetry 4 with a non-square texture wrote its output"
 expect_error 2 "symmetry" -- "$tailor" eval "$tmp/a.glb" --symmetry 3
-ls "$tmp"/*.tmp-* >/dev/null 2>&1 && fail "temporary files left behind" || ok
+
+# --- hardening of outputs (docs/hardening.md) ---
+# 1. A device, FIFO or socket named as an output is refused, untouched; a symlink is written through.
+mkfifo "$tmp/fifo.glb" "$tmp/fifo.png" "$tmp/fifo.json"
+expect_error 2 "not a regular file" -- "$tailor" map "$mesh" -o "$tmp/fifo.glb"
+expect_error 2 "not a regular file" -- "$tailor" map "$mesh" -o "$tmp/h1.glb" --stats "$tmp/fifo.json"
+expect_error 2 "not a regular file" -- "$tailor" tile "$texture" -o "$tmp/fifo.png"
+# A device: a private node (as root) rather than /dev/null, which a regression would replace.
+if mknod "$tmp/null.json" c 1 3 2>/dev/null; then
+  expect_error 2 "not a regular file" -- "$tailor" map "$mesh" -o "$tmp/h1.glb" --stats "$tmp/null.json"
+  [[ -c $tmp/null.json ]] && ok || fail "a refused device output was replaced"
+fi
+[[ -p $tmp/fifo.glb && -p $tmp/fifo.png && -p $tmp/fifo.json && ! -e $tmp/h1.glb ]] && ok ||
+  fail "a refused FIFO or device output was touched"
+echo old >"$tmp/target.json"
+ln -s target.json "$tmp/link.json"
+"$tailor" map "$mesh" -o "$tmp/h2.glb" --stats "$tmp/link.json" -q && [[ -L $tmp/link.json ]] &&
+  grep -q '"faces"' "$tmp/target.json" && ok || fail "--stats through a symlink: link replaced or target not written"
+# 2. The output is the input under another name: a symlinked directory, a hard link.
+mkdir "$tmp/sub"
+cp "$mesh" "$tmp/sub/in.obj"
+ln -s sub "$tmp/sublink"
+ln "$tmp/sub/in.obj" "$tmp/hard.obj"
+expect_error 2 "overwrite an input" -- "$tailor" map "$tmp/sublink/in.obj" -o "$tmp/sub/in.obj"
+expect_error 2 "overwrite an input" -- "$tailor" map "$tmp/hard.obj" -o "$tmp/sub/in.obj"
+cmp -s "$mesh" "$tmp/sub/in.obj" && ok || fail "the input was overwritten through another name"
+# 3. (random temporary names, O_EXCL: tests/atomic_file_test.cpp)
+# 5. Output names up to NAME_MAX (255 bytes) work: the temporary name is short.
+long=$(printf 'n%.0s' $(seq 250))
+"$tailor" map "$mesh" -o "$tmp/$long.glb" -q && [[ -s $tmp/$long.glb ]] && ok || fail "a 254-byte output name failed"
+"$tailor" tile "$texture" -o "$tmp/$long.png" -q && [[ -s $tmp/$long.png ]] && ok || fail "tile to a 254-byte name failed"
+# 6. A failed write of stdout is an error.
+if [[ -w /dev/full ]]; then
+  expect_error 1 "cannot write standard output" -- bash -c '"$0" info "$1" --json >/dev/full' "$tailor" "$mesh"
+  expect_error 1 "cannot write standard output" -- bash -c '"$0" info "$1" >/dev/full' "$tailor" "$mesh"
+fi
+# 4. SIGTERM while an output is written: no temporary file left, exit 143 (killed by the signal).
+# The horse OBJ from above takes ~0.2 s to export; the signal is sent as soon as its temporary
+# file shows. (Background jobs of a script ignore SIGINT; the unit test atomic_file_test covers
+# SIGINT and SIGHUP.)
+mkdir "$tmp/sig"
+"$tailor" map "$tmp/horse.obj" -o "$tmp/sig/h.obj" --no-crack-closing -q 2>/dev/null &
+pid=$!
+sent=0
+for _ in $(seq 20000); do
+  if compgen -G "$tmp/sig/.tailor-*" >/dev/null; then
+    kill -TERM "$pid" && sent=1
+    break
+  fi
+  kill -0 "$pid" 2>/dev/null || break
+done
+wait "$pid"
+code=$?
+if [[ $sent -eq 1 ]]; then
+  [[ $code -eq 143 ]] && ! compgen -G "$tmp/sig/.tailor-*" >/dev/null && [[ ! -e $tmp/sig/h.obj ]] && ok ||
+    fail "SIGTERM during a write: exit $code, left: $(ls -A "$tmp/sig")"
+else
+  echo "note: the map ended before its temporary file showed (exit $code); SIGTERM not checked"
+fi
+
+ls "$tmp"/*.tmp-* "$tmp"/.tailor-* >/dev/null 2>&1 && fail "temporary files left behind" || ok
 
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]

@@ -2,6 +2,7 @@
 #include "cli.h"
 
 #include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -66,21 +67,34 @@ Status check_outputs(const std::vector<OutputPath>& outputs, const std::vector<s
     const fs::path absolute = fs::absolute(fs::path(p), ec);
     return (ec ? fs::path(p) : absolute).lexically_normal().string();
   };
+  // Two names of one existing file (a symlink, a symlinked directory, a hard link): same device
+  // and inode. Names that do not exist yet are compared as normalized paths.
+  auto same_file = [&key](const std::string& a, const std::string& b) {
+    struct stat sa, sb;
+    if (stat(a.c_str(), &sa) == 0 && stat(b.c_str(), &sb) == 0) return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+    return key(a) == key(b);
+  };
   for (size_t i = 0; i < outputs.size(); ++i) {
     const auto& [path, option] = outputs[i];
     const fs::path parent = fs::path(path).parent_path();
     std::error_code ec;
     if (fs::is_directory(path, ec))
       return Status::error(ErrorCode::kInvalidArgument, path, "output (" + option + ") is a directory");
+    // Only regular files are replaced (through a symlink: its target); a device, FIFO or socket
+    // (/dev/null, a named pipe) would be swapped for a regular file.
+    struct stat st;
+    if (stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
+      return Status::error(ErrorCode::kInvalidArgument, path,
+                           "output (" + option + ") is not a regular file (a device, FIFO or socket)");
     if (!parent.empty() && !fs::is_directory(parent, ec))
       return Status::error(ErrorCode::kInvalidArgument, path,
                            "directory of the output (" + option + ") does not exist");
     for (const std::string& in : inputs) {
-      if (!in.empty() && key(in) == key(path))
+      if (!in.empty() && same_file(in, path))
         return Status::error(ErrorCode::kInvalidArgument, path, "output (" + option + ") would overwrite an input");
     }
     for (size_t j = 0; j < i; ++j) {
-      if (key(outputs[j].path) == key(path))
+      if (same_file(outputs[j].path, path))
         return Status::error(ErrorCode::kInvalidArgument, path,
                              "two outputs share this path (" + outputs[j].option + " and " + option + ")");
     }

@@ -288,7 +288,9 @@ void register_map(CLI::App& app, Runner& run) {
   auto* cmd =
       app.add_subcommand("map", "Compute texture coordinates by homogeneous patch discovery and write a textured mesh");
   cmd->add_option("mesh", opt->input, "Input mesh (.ply .obj .off .stl)")->required();
-  cmd->add_option("-o,--output", opt->output, "Output mesh: .glb (texture embedded), .obj (+ .mtl) or .ply")
+  cmd->add_option("-o,--output", opt->output,
+                  "Output mesh: .glb (texture embedded), .obj (+ .mtl) or .ply; a symlink is written through (its "
+                  "target replaced)")
       ->required();
   cmd->add_option("-t,--texture", opt->texture,
                   "Texture image (PNG/JPEG), ideally self-tileable (see 'tailor tile'); sets the texture size");

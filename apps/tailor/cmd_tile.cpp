@@ -109,7 +109,9 @@ void register_tile(CLI::App& app, Runner& run) {
   auto opt = std::make_shared<TileCliOptions>();
   auto* cmd = app.add_subcommand("tile", "Make a texture image self-tileable (quadrant swap + image quilting)");
   cmd->add_option("input", opt->input, "Texture image (.png .jpg .tga .bmp, 8-bit or 16-bit PNG)")->required();
-  cmd->add_option("-o,--output", opt->output, "Output .png (with --variants: NAME_0.png ... and NAME.json)")
+  cmd->add_option("-o,--output", opt->output,
+                  "Output .png (with --variants: NAME_0.png ... and NAME.json); a symlink is written through (its "
+                  "target replaced)")
       ->required();
   TileOptions& options = opt->options;
   add_documented(cmd, option_doc(kTileOptionDocs, "block"), options.block)->check(CLI::Range(8, 256));

@@ -1,13 +1,18 @@
 // tailor: texture-map large triangle meshes by homogeneous patch discovery, and make textures
 // self-tileable. This file only wires the subcommands (one per cmd_<name>.cpp) together.
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <exception>
 #include <new>
 
 #include "cli.h"
 #include "tailor/version.h"
+#include "util/atomic_file.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+int run_command(int argc, char** argv) {
   using namespace tailor::cli;
   CLI::App app{
       "tailor: texture-map large triangle meshes at millions of faces per second,\n"
@@ -55,4 +60,27 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "tailor: error: internal error: %s\n", e.what());
   }
   return kExitBadInput;
+}
+
+// Whatever went to stdout must have arrived: a full disk or a closed pipe (`tailor info m.ply >
+// /dev/full`) is an error, found when the buffer is flushed and the stream closed.
+int check_stdout(int code) {
+  using namespace tailor::cli;
+  errno = 0;
+  const bool flushed = std::fflush(stdout) == 0 && std::ferror(stdout) == 0;
+  int err = flushed ? 0 : errno;
+  if (std::fclose(stdout) != 0 && err == 0 && flushed) err = errno;
+  const bool failed = !flushed || err != 0;
+  if (!failed) return code;
+  std::fprintf(stderr, "tailor: error: cannot write standard output%s%s\n", err != 0 ? ": " : "",
+               err != 0 ? std::strerror(err) : "");
+  return code == kExitOk ? kExitBadInput : code;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Temporary output files are removed on Ctrl-C, SIGTERM and SIGHUP (the signal still ends tailor).
+  tailor::internal::install_signal_cleanup();
+  return check_stdout(run_command(argc, argv));
 }

@@ -1,11 +1,16 @@
 // Whole-file reads and atomic writes (see internal/atomic_file.h).
 #include "util/atomic_file.h"
 
+#include <pthread.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
+#include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <utility>
 
@@ -14,32 +19,159 @@
 namespace tailor::internal {
 namespace {
 thread_local FileBatch* active_batch = nullptr;
+
+// The registry of live temporary files, for the signal handler: fixed slots (no allocation), each
+// claimed with a lock-free compare-exchange (0 free, 1 being filled, 2 live: the handler unlinks
+// only live ones). Paths longer than a slot, or a 257th live file, are simply not registered (the
+// file is then only removed on the ordinary paths).
+constexpr int kSlots = 256;
+constexpr size_t kSlotPath = 4096;
+struct Slot {
+  std::atomic<int> state{0};
+  char path[kSlotPath];
+};
+static_assert(std::atomic<int>::is_always_lock_free, "the signal handler needs lock-free atomics");
+Slot slots[kSlots];
+
+int register_temporary(const std::string& path) {
+  if (path.size() >= kSlotPath) return -1;
+  for (int i = 0; i < kSlots; ++i) {
+    int expected = 0;
+    if (slots[i].state.compare_exchange_strong(expected, 1)) {
+      std::memcpy(slots[i].path, path.c_str(), path.size() + 1);
+      slots[i].state.store(2);
+      return i;
+    }
+  }
+  return -1;
+}
+
+void unregister_temporary(int slot) {
+  if (slot >= 0 && slot < kSlots) slots[slot].state.store(0);
+}
+
+// Removes a temporary file, then forgets it (in this order: a signal in between only unlinks a
+// name that is already gone).
+void discard_temporary(const std::string& temporary, int slot) {
+  unlink(temporary.c_str());
+  unregister_temporary(slot);
+}
+
+extern "C" void on_terminating_signal(int signal) {
+  const int saved_errno = errno;
+  remove_temporaries_on_signal();
+  // SA_RESETHAND restored the default action; the signal is blocked while this handler runs, so it
+  // is delivered (and ends the process) as soon as the handler returns.
+  raise(signal);
+  errno = saved_errno;
+}
+
+// The process umask, read without changing it (umask() can only be read by setting it, which races
+// with other threads creating files): /proc/self/status, else the set-and-restore fallback, once.
+mode_t process_umask() {
+  static const mode_t mask = [] {
+    if (std::FILE* f = std::fopen("/proc/self/status", "r")) {
+      char line[256];
+      unsigned value = 0;
+      bool found = false;
+      while (!found && std::fgets(line, sizeof line, f)) found = std::sscanf(line, "Umask: %o", &value) == 1;
+      std::fclose(f);
+      if (found) return static_cast<mode_t>(value & 0777);
+    }
+    const mode_t m = umask(022);
+    umask(m);
+    return m;
+  }();
+  return mask;
+}
+
+Status io_error(const std::string& path, const std::string& what, int err) {
+  return Status::error(ErrorCode::kIo, path, what + ": " + std::strerror(err));
+}
+
+// The file that writing `path` replaces: `path` itself, or for a symlink to a regular file, the
+// file it points to (so the link is kept). Refuses what exists and is not a regular file.
+Status resolve_target(const std::string& path, std::string& target) {
+  struct stat st;
+  if (lstat(path.c_str(), &st) != 0) {
+    if (errno != ENOENT) return io_error(path, "cannot create file", errno);
+    target = path;
+    return Status::ok();
+  }
+  if (S_ISLNK(st.st_mode)) {
+    if (stat(path.c_str(), &st) != 0) {  // a dangling link: replaced by the file, like a missing path
+      if (errno != ENOENT) return io_error(path, "cannot create file", errno);
+      target = path;
+      return Status::ok();
+    }
+    if (S_ISREG(st.st_mode)) {
+      char* resolved = realpath(path.c_str(), nullptr);
+      if (!resolved) return io_error(path, "cannot create file", errno);
+      target = resolved;
+      std::free(resolved);
+      return Status::ok();
+    }
+  }
+  if (S_ISDIR(st.st_mode)) return Status::error(ErrorCode::kIo, path, "cannot create file: is a directory");
+  if (!S_ISREG(st.st_mode))
+    return Status::error(ErrorCode::kIo, path, "not a regular file (a device, FIFO or socket): not replaced");
+  target = path;
+  return Status::ok();
+}
 }  // namespace
+
+std::string temporary_template(const std::string& target) {
+  const size_t slash = target.rfind('/');
+  return (slash == std::string::npos ? std::string() : target.substr(0, slash + 1)) + ".tailor-XXXXXX";
+}
+
+void remove_temporaries_on_signal() {
+  for (Slot& slot : slots)
+    if (slot.state.load() == 2) unlink(slot.path);
+}
+
+void install_signal_cleanup() {
+  for (const int signal : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction old {};
+    if (sigaction(signal, nullptr, &old) != 0 || old.sa_handler == SIG_IGN) continue;  // nohup, background jobs
+    struct sigaction action {};
+    action.sa_handler = on_terminating_signal;
+    action.sa_flags = SA_RESETHAND;
+    sigemptyset(&action.sa_mask);
+    sigaction(signal, &action, nullptr);
+  }
+}
 
 FileBatch::FileBatch() : outer_(active_batch) { active_batch = this; }
 
 FileBatch::~FileBatch() {
-  for (const auto& [temporary, path] : staged_) std::remove(temporary.c_str());
+  for (const Staged& s : staged_) discard_temporary(s.temporary, s.slot);
   active_batch = outer_;
 }
 
-void FileBatch::add(std::string temporary, std::string path) {
-  // The same path written twice in one batch: its temporary file holds the last bytes already.
-  for (const auto& staged : staged_)
-    if (staged.second == path) return;
-  staged_.emplace_back(std::move(temporary), std::move(path));
+void FileBatch::add(std::string temporary, int slot, std::string target, std::string path) {
+  // The same file written twice in one batch: the last bytes win, at the place of the first write.
+  for (Staged& s : staged_) {
+    if (s.target == target) {
+      discard_temporary(s.temporary, s.slot);
+      s.temporary = std::move(temporary);
+      s.slot = slot;
+      return;
+    }
+  }
+  staged_.push_back({std::move(temporary), slot, std::move(target), std::move(path)});
 }
 
 Status FileBatch::commit() {
-  std::vector<std::pair<std::string, std::string>> staged;
+  std::vector<Staged> staged;
   staged.swap(staged_);
   for (size_t i = 0; i < staged.size(); ++i) {
-    if (std::rename(staged[i].first.c_str(), staged[i].second.c_str()) != 0) {
+    if (std::rename(staged[i].temporary.c_str(), staged[i].target.c_str()) != 0) {
       const int err = errno;
-      for (size_t j = i; j < staged.size(); ++j) std::remove(staged[j].first.c_str());
-      return Status::error(ErrorCode::kIo, staged[i].second,
-                           std::string("cannot rename temporary file: ") + std::strerror(err));
+      for (size_t j = i; j < staged.size(); ++j) discard_temporary(staged[j].temporary, staged[j].slot);
+      return io_error(staged[i].path, "cannot rename temporary file", err);
     }
+    unregister_temporary(staged[i].slot);
   }
   return Status::ok();
 }
@@ -48,27 +180,51 @@ AtomicFileWriter::AtomicFileWriter(std::string path) : path_(std::move(path)) {}
 
 AtomicFileWriter::~AtomicFileWriter() {
   if (file_) std::fclose(file_);
-  if (!temporary_.empty()) std::remove(temporary_.c_str());
+  if (!temporary_.empty()) discard_temporary(temporary_, slot_);
 }
 
 Status AtomicFileWriter::open() {
   if (file_ || !temporary_.empty()) return Status::error(ErrorCode::kIo, path_, "cannot create file: already open");
-  const std::string tmp = path_ + ".tmp-" + std::to_string(static_cast<long>(getpid()));
-  file_ = std::fopen(tmp.c_str(), "wb");
-  if (!file_) {
-    error_ = Status::error(ErrorCode::kIo, path_, std::string("cannot create file: ") + std::strerror(errno));
+  if (Status s = resolve_target(path_, target_); !s) {
+    error_ = s;
+    return error_;
+  }
+  // Created and registered with the cleanup signals blocked: a signal in between would leave it.
+  std::string tmp = temporary_template(target_);
+  sigset_t cleanup_signals, previous;
+  sigemptyset(&cleanup_signals);
+  for (const int signal : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&cleanup_signals, signal);
+  pthread_sigmask(SIG_BLOCK, &cleanup_signals, &previous);
+  const int fd = mkstemp(tmp.data());  // O_CREAT|O_EXCL, mode 0600, a random name
+  const int mkstemp_errno = errno;
+  const int slot = fd >= 0 ? register_temporary(tmp) : -1;
+  pthread_sigmask(SIG_SETMASK, &previous, nullptr);
+  if (fd < 0) {
+    error_ = io_error(path_, "cannot create file", mkstemp_errno);
     return error_;
   }
   temporary_ = tmp;
+  slot_ = slot;
+  // The mode a plain open(O_CREAT, 0666) gives: what the user's umask allows.
+  if (fchmod(fd, 0666 & ~process_umask()) != 0 || !(file_ = fdopen(fd, "wb"))) {
+    const int err = errno;
+    close(fd);
+    discard_temporary(temporary_, slot_);
+    temporary_.clear();
+    slot_ = -1;
+    error_ = io_error(path_, "cannot create file", err);
+    return error_;
+  }
   return Status::ok();
 }
 
 Status AtomicFileWriter::fail(int err) {
   if (file_) std::fclose(file_);
   file_ = nullptr;
-  if (!temporary_.empty()) std::remove(temporary_.c_str());
+  if (!temporary_.empty()) discard_temporary(temporary_, slot_);
   temporary_.clear();
-  error_ = Status::error(ErrorCode::kIo, path_, std::string("cannot write file: ") + std::strerror(err));
+  slot_ = -1;
+  error_ = io_error(path_, "cannot write file", err);
   return error_;
 }
 
@@ -89,16 +245,18 @@ Status AtomicFileWriter::commit() {
   if (write_error != 0) return fail(write_error);
   std::string tmp;
   tmp.swap(temporary_);  // from here on the batch or the rename owns the temporary file
+  const int slot = std::exchange(slot_, -1);
   if (active_batch) {
-    active_batch->add(tmp, path_);
+    active_batch->add(tmp, slot, target_, path_);
     return Status::ok();
   }
-  if (std::rename(tmp.c_str(), path_.c_str()) != 0) {
+  if (std::rename(tmp.c_str(), target_.c_str()) != 0) {
     const int err = errno;
-    std::remove(tmp.c_str());
-    error_ = Status::error(ErrorCode::kIo, path_, std::string("cannot rename temporary file: ") + std::strerror(err));
+    discard_temporary(tmp, slot);
+    error_ = io_error(path_, "cannot rename temporary file", err);
     return error_;
   }
+  unregister_temporary(slot);
   return Status::ok();
 }
 

@@ -1,5 +1,9 @@
 // Writing output files so that a failure never leaves a half-written file behind: everything goes
-// to "<path>.tmp-<pid>" first, and only a complete, flushed file is renamed onto <path>.
+// to a fresh temporary file ".tailor-XXXXXX" (mkstemp: O_CREAT|O_EXCL, a random name) in the
+// directory of the file that will be replaced, and only a complete, flushed file is renamed onto it.
+// The path may be a symlink to a regular file: the target is replaced, the link kept. A path that
+// exists and is not a regular file (a device, FIFO or socket) is refused, untouched. Live temporary
+// files are registered so that install_signal_cleanup()'s handler can remove them on a signal.
 #pragma once
 
 #include <cstdio>
@@ -26,10 +30,10 @@ Status write_file_atomic(const std::string& path, std::span<const std::span<cons
 //!     TAILOR_RETURN_IF_ERROR(file.open());
 //!     file.write(header); file.write(chunk); ...      // errors are sticky, checked by commit()
 //!     return file.commit();
-//! open() creates "<path>.tmp-<pid>"; commit() flushes, closes and renames it onto `path` (or
-//! stages it in the active FileBatch, like write_file_atomic). When any step failed, or the writer
-//! is destroyed without a commit (an early return), the temporary file is removed and `path` is
-//! left as it was. Error messages are those of write_file_atomic. Not copyable; one thread.
+//! open() creates the temporary file (see the top of this file); commit() flushes, closes and renames it onto `path`
+//! (or stages it in the active FileBatch, like write_file_atomic). When any step failed, or the writer is destroyed
+//! without a commit (an early return), the temporary file is removed and `path` is left as it was. Error messages are
+//! those of write_file_atomic. Not copyable; one thread.
 class AtomicFileWriter {
  public:
   explicit AtomicFileWriter(std::string path);
@@ -47,8 +51,10 @@ class AtomicFileWriter {
  private:
   Status fail(int err);  // records the first write error, closes and removes the temporary file
 
-  std::string path_;
+  std::string path_;    // as given (for messages)
+  std::string target_;  // what is replaced: path_ with its symlinks resolved
   std::string temporary_;
+  int slot_ = -1;  // in the signal-cleanup registry
   std::FILE* file_ = nullptr;
   Status error_;
 };
@@ -71,13 +77,32 @@ class FileBatch {
   //! renamed (the ones not yet renamed are removed).
   Status commit();
 
-  //! Called by write_file_atomic: records a staged file (temporary name, final path).
-  void add(std::string temporary, std::string path);
+  //! Called by AtomicFileWriter::commit: records a staged file (its temporary name and registry
+  //! slot, the file it replaces, the path as given). The batch owns the temporary file from then on.
+  void add(std::string temporary, int slot, std::string target, std::string path);
 
  private:
-  std::vector<std::pair<std::string, std::string>> staged_;
+  struct Staged {
+    std::string temporary;
+    int slot;
+    std::string target;
+    std::string path;
+  };
+  std::vector<Staged> staged_;
   FileBatch* outer_ = nullptr;
 };
+
+//! Installs handlers for SIGINT, SIGTERM and SIGHUP (those not ignored) that remove every live
+//! temporary file (async-signal-safe unlink), then re-raise the signal with its default action, so
+//! the process still dies of it (exit status 130, 143, 129 in a shell). For programs (the CLI); a
+//! library user with its own handlers can call remove_temporaries_on_signal() from them instead.
+void install_signal_cleanup();
+
+//! Async-signal-safe: unlinks every temporary file still registered (staged or being written).
+void remove_temporaries_on_signal();
+
+//! The name a temporary file for `target` gets: "<directory of target>/.tailor-XXXXXX".
+std::string temporary_template(const std::string& target);
 
 //! Largest file read_file accepts (also what stops an endless pipe or device).
 inline constexpr size_t kMaxReadBytes = size_t{4} << 30;
