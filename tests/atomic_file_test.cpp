@@ -13,6 +13,8 @@
 #include <filesystem>
 #include <string>
 
+#include "util/file_view.h"
+
 namespace fs = std::filesystem;
 using namespace tailor;
 
@@ -58,6 +60,30 @@ TEST(AtomicFile, RefusesADeviceOrFifoAndLeavesItAlone) {
     ASSERT_EQ(lstat(device.c_str(), &st), 0);
     EXPECT_TRUE(S_ISCHR(st.st_mode));
   }
+}
+
+TEST(ReadInput, OnlyRegularFilesAreRead) {
+  // A FIFO without a writer would block a plain open(); /dev/zero would be read forever; both are
+  // refused at once with one line, by read_file and view_file (open_input).
+  TempDir d("read_fifo");
+  const std::string fifo = d / "in.obj";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0644), 0);
+  for (const std::string& path : {fifo, std::string("/dev/zero"), d.dir.string()}) {
+    std::string bytes;
+    const Status s = internal::read_file(path, bytes);
+    EXPECT_EQ(s.code(), ErrorCode::kIo) << path;
+    EXPECT_NE(s.what().find("not a regular file"), std::string::npos) << s.what();
+    EXPECT_TRUE(bytes.empty());
+    internal::FileView view;
+    const Status v = internal::view_file(path, view);
+    EXPECT_EQ(v.code(), ErrorCode::kIo) << path;
+    EXPECT_NE(v.what().find("not a regular file"), std::string::npos) << v.what();
+  }
+  // A symlink to a regular file is read through.
+  const std::string file = d / "a.txt", link = d / "link.txt";
+  ASSERT_TRUE(internal::write_file_atomic(file, std::string("abc")).is_ok());
+  ASSERT_EQ(symlink(file.c_str(), link.c_str()), 0);
+  EXPECT_EQ(content(link), "abc");
 }
 
 TEST(AtomicFile, WritesThroughASymlinkAndKeepsIt) {

@@ -208,6 +208,52 @@ else
   echo "note: the map ended before its temporary file showed (exit $code); SIGTERM not checked"
 fi
 
+# --- hardening of inputs (docs/hardening.md, "inputs") ---
+# 7. Image sizes: a 30-byte TGA / 31-byte PPM claiming 16000 x 16000 px is over the pixel limit; raised,
+# it is refused as truncated (the uncompressed data cannot fit the file); BMP and PGM too. All under a
+# 300 MB address-space cap, fast: nothing is allocated for the claimed pixels.
+mkdir -p "$tmp/img"
+printf '\x00\x00\x02\x00\x00\x00\x00\x00\x00\x00\x00\x00\x80\x3e\x80\x3e\x18\x00' >"$tmp/img/big.tga"
+printf '\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00' >>"$tmp/img/big.tga"
+printf 'P6\n16000 16000\n255\n\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00' >"$tmp/img/big.ppm"
+printf 'P5\n4000 4000\n255\n\x00\x00\x00\x00' >"$tmp/img/mid.pgm"
+printf 'BM\x00\x00\x00\x00\x00\x00\x00\x00\x36\x00\x00\x00\x28\x00\x00\x00\xa0\x0f\x00\x00\xa0\x0f\x00\x00' >"$tmp/img/mid.bmp"
+printf '\x01\x00\x18\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00' >>"$tmp/img/mid.bmp"
+limited() { (ulimit -v 300000 && timeout 5 "$@"); }
+expect_error 1 "big.tga: image too large: 16000x16000 is 256000000 px, the limit is 67108864 px \(raise it with --max-image-pixels\)" -- limited "$tailor" tile "$tmp/img/big.tga" -o "$tmp/img/o.png"
+expect_error 1 "big.ppm: image too large: 16000x16000" -- limited "$tailor" map "$mesh" --texture "$tmp/img/big.ppm" -o "$tmp/img/o.glb"
+expect_error 1 "big.tga: truncated image: the header claims 16000x16000 px, which needs at least 768000018 bytes, but the file has 30" -- limited "$tailor" tile "$tmp/img/big.tga" -o "$tmp/img/o.png" --max-image-pixels 300000000
+expect_error 1 "big.ppm: truncated image: .* the file has 31" -- limited "$tailor" eval-tile "$tmp/img/big.ppm" --max-image-pixels 300000000
+expect_error 1 "mid.pgm: truncated image: the header claims 4000x4000 px" -- limited "$tailor" tile "$tmp/img/mid.pgm" -o "$tmp/img/o.png"
+expect_error 1 "mid.bmp: truncated image: the header claims 4000x4000 px" -- limited "$tailor" tile "$tmp/img/mid.bmp" -o "$tmp/img/o.png"
+expect_error 1 "vistex-tile04-128.png: image too large: 128x128 is 16384 px, the limit is 16383" -- "$tailor" tile tests/data/textures/vistex-tile04-128.png -o "$tmp/img/o.png" --max-image-pixels 16383
+[[ ! -e $tmp/img/o.png && ! -e $tmp/img/o.glb ]] && ok || fail "a refused image left an output"
+for cmd in map tile eval eval-tile; do
+  "$tailor" "$cmd" --help >"$tmp/help.txt" 2>&1 && grep -q -- "--max-image-pixels UINT:POSITIVE=67108864" "$tmp/help.txt" && ok ||
+    fail "tailor $cmd --help has no --max-image-pixels with its default"
+done
+# eval reads a .glb's embedded texture size from its header: a PNG header patched to 16000 x 16000
+# is reported as such under the 300 MB cap (decoding it would need 768 MB), and refused by the limit.
+cp "$tmp/a.glb" "$tmp/img/big.glb"
+ihdr=$(grep -obUa IHDR "$tmp/img/big.glb" | head -1 | cut -d: -f1)
+printf '\x00\x00\x3e\x80\x00\x00\x3e\x80' | dd of="$tmp/img/big.glb" bs=1 seek=$((ihdr + 4)) conv=notrunc status=none
+limited "$tailor" eval "$tmp/img/big.glb" --max-image-pixels 300000000 >"$tmp/img/eval.txt" 2>&1 &&
+  grep -q "texture 16000x16000 px, embedded texture" "$tmp/img/eval.txt" && ok || fail "eval big.glb: $(cat "$tmp/img/eval.txt")"
+expect_error 1 "big.glb: embedded texture too large: 16000x16000" -- limited "$tailor" eval "$tmp/img/big.glb"
+# 9. and 10. Only regular files are read: /dev/zero, a FIFO without a writer (it would block), a
+# directory are refused at once with one line, for every kind of input.
+mkfifo "$tmp/img/in.obj" "$tmp/img/in.png"
+notreg="not a regular file \(a device, FIFO or socket\); inputs must be regular files"
+expect_error 1 "/dev/zero: $notreg" -- limited "$tailor" info /dev/zero
+expect_error 1 "/dev/zero: $notreg" -- limited "$tailor" tile /dev/zero -o "$tmp/img/o.png"
+expect_error 1 "in.obj: $notreg" -- timeout 5 "$tailor" info "$tmp/img/in.obj"
+expect_error 1 "in.obj: $notreg" -- timeout 5 "$tailor" eval "$tmp/img/in.obj"
+expect_error 1 "in.png: $notreg" -- timeout 5 "$tailor" tile "$tmp/img/in.png" -o "$tmp/img/o.png"
+expect_error 1 "in.png: $notreg" -- timeout 5 "$tailor" map "$mesh" --texture "$tmp/img/in.png" -o "$tmp/img/o.glb"
+expect_error 1 "in.obj: $notreg" -- timeout 5 "$tailor" map "$mesh" --seam-faces "$tmp/img/in.obj" -o "$tmp/img/o.glb"
+expect_error 1 "img: is a directory, not a regular file" -- timeout 5 "$tailor" info "$tmp/img"
+[[ ! -e $tmp/img/o.png && ! -e $tmp/img/o.glb ]] && ok || fail "a refused input left an output"
+
 ls "$tmp"/*.tmp-* "$tmp"/.tailor-* >/dev/null 2>&1 && fail "temporary files left behind" || ok
 
 echo "$passed passed, $failed failed"

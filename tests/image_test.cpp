@@ -187,6 +187,40 @@ TEST(ImageIo, AbsurdHeaderSizeIsRejectedBeforeDecoding) {
   EXPECT_NE(s2.message().find("20000x20000"), std::string::npos) << s2.message();
 }
 
+TEST(ImageIo, ClaimedSizeIsCheckedAgainstThePixelLimitAndTheFileLength) {
+  // Uncompressed TGA: 18-byte header claiming 16000 x 16000 RGB, then 12 bytes.
+  std::string tga(18, '\0');
+  tga[2] = 2;
+  tga[12] = tga[14] = static_cast<char>(0x80);
+  tga[13] = tga[15] = 0x3e;
+  tga[16] = 24;
+  tga += std::string(12, '\0');
+  const std::string path = temp_path("claims16000.tga");
+  write_bytes(path, tga);
+  Image im;
+  Status s = load_image(path, im);  // default limit: 64 Mpx
+  EXPECT_EQ(s.code(), ErrorCode::kInvalidImage);
+  EXPECT_NE(s.what().find("image too large: 16000x16000 is 256000000 px"), std::string::npos) << s.message();
+  ImageLoadOptions raised;
+  raised.max_pixels = 300000000;
+  s = load_image(path, im, raised);
+  EXPECT_EQ(s.code(), ErrorCode::kInvalidImage);
+  EXPECT_NE(s.what().find("truncated image"), std::string::npos) << s.message();
+  EXPECT_NE(s.what().find("768000018 bytes"), std::string::npos) << s.message();
+  // Binary PPM: the same with the header in text.
+  const std::string ppm = temp_path("claims4000.ppm");
+  write_bytes(ppm, "P6\n4000 4000\n255\n" + std::string(12, '\0'));
+  s = load_image(ppm, im);
+  EXPECT_NE(s.what().find("truncated image: the header claims 4000x4000 px"), std::string::npos) << s.message();
+  EXPECT_TRUE(im.empty());
+  // A real image passes at its exact pixel count and is refused one pixel below.
+  ImageLoadOptions exact;
+  exact.max_pixels = 128 * 128;
+  EXPECT_TRUE(load_image(kData + "vistex-tile04-128.png", im, exact).is_ok());
+  exact.max_pixels -= 1;
+  EXPECT_EQ(load_image(kData + "vistex-tile04-128.png", im, exact).code(), ErrorCode::kInvalidImage);
+}
+
 TEST(ImageIo, MissingAndEmptyFiles) {
   Image im;
   EXPECT_EQ(load_image(temp_path("does_not_exist.png"), im).code(), ErrorCode::kIo);

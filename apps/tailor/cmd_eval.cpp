@@ -20,7 +20,8 @@ namespace {
 
 struct EvalOptions {
   std::string input;
-  int texture_size = 0;  // 0 = not given: the embedded image size for .glb, else MetricsOptions' default
+  int texture_size = 0;            // 0 = not given: the embedded image size for .glb, else MetricsOptions' default
+  ImageLoadOptions image_options;  // --max-image-pixels: the embedded texture's header size
   bool json = false;
   bool quiet = false;
   bool stability = false;
@@ -58,13 +59,11 @@ int run_eval(const EvalOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
   Mesh mesh;
   LoadReport report;
-  Image texture;
   const bool glb = mesh_format_from_path(opt.input) == MeshFormat::kGlb;
-  // Only decode the embedded texture when its size is needed.
+  // The embedded texture is never decoded: its size comes from its header (LoadReport).
   const Status status = [&] {
     const ReadingInput reading(opt.input);
-    return glb ? read_glb_file(opt.input, mesh, opt.texture_size > 0 ? nullptr : &texture, &report)
-               : load_mesh(opt.input, mesh, &report);
+    return glb ? read_glb_file(opt.input, mesh, nullptr, &report) : load_mesh(opt.input, mesh, &report);
   }();
   if (!status) return report_error(status);
   if (mesh.corner_uvs.empty())
@@ -81,9 +80,17 @@ int run_eval(const EvalOptions& opt) {
   if (opt.texture_size > 0) {
     width = height = opt.texture_size;
     size_source = "option";
-  } else if (!texture.empty()) {
-    width = texture.width;
-    height = texture.height;
+  } else if (report.texture_width > 0) {
+    const uint64_t pixels = static_cast<uint64_t>(report.texture_width) * static_cast<uint64_t>(report.texture_height);
+    if (report.texture_width > kMaxImageSide || report.texture_height > kMaxImageSide ||
+        pixels > opt.image_options.max_pixels)
+      return report_error(Status::error(ErrorCode::kInvalidImage, opt.input,
+                                        "embedded texture too large: " + std::to_string(report.texture_width) + "x" +
+                                            std::to_string(report.texture_height) + " is " + std::to_string(pixels) +
+                                            " px, the limit is " + std::to_string(opt.image_options.max_pixels) +
+                                            " px (raise it with --max-image-pixels)"));
+    width = report.texture_width;
+    height = report.texture_height;
     size_source = "embedded texture";
   }
   if (opt.symmetry == 4 && width != height)
@@ -141,6 +148,8 @@ void register_eval(CLI::App& app, Runner& run) {
                   "texture's size for .glb, else " +
                       std::to_string(static_cast<int>(MetricsOptions{}.texture_width_px)))
       ->check(CLI::Range(1, 1 << 16));
+  add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), opt->image_options.max_pixels)
+      ->check(CLI::PositiveNumber);
   add_documented(cmd, option_doc(kMetricsOptionDocs, "symmetry"), opt->symmetry)->check(CLI::IsMember({1u, 4u}));
   cmd->add_flag("--json", opt->json, "Print the full report as a JSON object");
   cmd->add_flag("-q,--quiet", opt->quiet, "Print nothing but the result and errors");

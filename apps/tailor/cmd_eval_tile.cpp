@@ -15,16 +15,17 @@ namespace {
 struct EvalTileOptions {
   std::string tile;
   std::string exemplar;
+  ImageLoadOptions image_options;  // --max-image-pixels
   bool json = false;
   bool quiet = false;
 };
 
 int run_eval_tile(const EvalTileOptions& opt) {
   Image tile, exemplar;
-  if (Status s = load_image(opt.tile, tile); !s) return report_error(s);
+  if (Status s = load_image(opt.tile, tile, opt.image_options); !s) return report_error(s);
   const bool with_exemplar = !opt.exemplar.empty();
   if (with_exemplar)
-    if (Status s = load_image(opt.exemplar, exemplar); !s) return report_error(s);
+    if (Status s = load_image(opt.exemplar, exemplar, opt.image_options); !s) return report_error(s);
   TileQuality quality;
   quality.file = opt.tile;
   const TileMetrics& m = quality.metrics;
@@ -80,6 +81,8 @@ void register_eval_tile(CLI::App& app, Runner& run) {
       app.add_subcommand("eval-tile", "Quality metrics of a tileable texture (seams, histogram, gradients, coherence)");
   cmd->add_option("tile", opt->tile, "The tile to check (.png .jpg .tga .bmp)")->required();
   cmd->add_option("exemplar", opt->exemplar, "The exemplar it was made from (enables histogram, gradient, coherence)");
+  add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), opt->image_options.max_pixels)
+      ->check(CLI::PositiveNumber);
   cmd->add_flag("--json", opt->json, "Print a JSON object instead of text");
   cmd->add_flag("-q,--quiet", opt->quiet, "Print only whether the targets are met");
   cmd->footer("Example:\n  tailor tile bricks.jpg -o bricks_tile.png && tailor eval-tile bricks_tile.png bricks.jpg");

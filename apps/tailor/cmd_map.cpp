@@ -42,6 +42,7 @@ struct MapArgs {
   std::string input;
   std::string output;
   std::string texture;
+  ImageLoadOptions image_options;  // --max-image-pixels (default: ImageLoadOptions')
   int texture_size = ExportOptions{}.texture_width;
   std::string preview_up = up_axis_name(RenderOptions{}.up);
   std::string stats;
@@ -138,7 +139,7 @@ int run_map(const MapArgs& opt) {
   // === Texture (read first: a bad texture should fail before minutes of work) ===
   Image texture;
   if (!opt.texture.empty()) {
-    if (Status s = load_image(opt.texture, texture); !s) return report_error(s);
+    if (Status s = load_image(opt.texture, texture, opt.image_options); !s) return report_error(s);
   }
   const int tex_w = texture.empty() ? opt.texture_size : texture.width;
   const int tex_h = texture.empty() ? opt.texture_size : texture.height;
@@ -296,6 +297,8 @@ void register_map(CLI::App& app, Runner& run) {
                   "Texture image (PNG/JPEG), ideally self-tileable (see 'tailor tile'); sets the texture size");
   cmd->add_option("--texture-size", opt->texture_size, "Texture size in pixels when no --texture is given")
       ->capture_default_str();
+  add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), opt->image_options.max_pixels)
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--stats", opt->stats, "Write a JSON report (mesh, mapping counters, metrics, timings)");
   cmd->add_option("--preview", opt->preview, "Render a 3/4 view of the textured mesh to this PNG");
   cmd->add_flag("--preview-all", opt->preview_all,

@@ -21,7 +21,8 @@ struct TileCliOptions {
   std::string input;
   std::string output;
   std::string json;
-  TileOptions options;  // bound to --block, --overlap, --seed, --fit-period (defaults: TileOptions')
+  TileOptions options;             // bound to --block, --overlap, --seed, --fit-period (defaults: TileOptions')
+  ImageLoadOptions image_options;  // --max-image-pixels (default: ImageLoadOptions')
   int variants = 1;
   bool quiet = false;
 };
@@ -48,7 +49,7 @@ int run_tile(const TileCliOptions& opt) {
     if (Status s = check_outputs(outputs, {opt.input}); !s) return report_error(s);
   }
   Image exemplar;
-  if (Status s = load_image(opt.input, exemplar); !s) return report_error(s);
+  if (Status s = load_image(opt.input, exemplar, opt.image_options); !s) return report_error(s);
 
   TileOptions options = opt.options;
   Progress progress("tile", opt.quiet);
@@ -124,6 +125,8 @@ void register_tile(CLI::App& app, Runner& run) {
   const OptionDoc& fit_period = option_doc(kTileOptionDocs, "fit_period");
   cmd->add_flag(std::string(fit_period.flag), options.fit_period, std::string(fit_period.help));
   add_documented(cmd, option_doc(kTileOptionDocs, "symmetry"), options.symmetry)->check(CLI::IsMember({1, 4}));
+  add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), opt->image_options.max_pixels)
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--json", opt->json, "Write the metrics and settings as JSON to this file");
   cmd->add_flag("-q,--quiet", opt->quiet, "Print nothing but errors");
   cmd->footer(

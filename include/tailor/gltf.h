@@ -13,7 +13,9 @@
 // used; buffers with a uri are kUnsupported, images with a uri are ignored), every accessor is
 // bounds-checked against its buffer view and the BIN chunk before it is read, every index against
 // the vertex count, output size is capped at a multiple of the file size, images larger than
-// kMaxImageSide are rejected before decoding, and nothing throws (allocation failure -> kLimit).
+// kMaxImageSide a side or ImageLoadOptions{}.max_pixels in all are rejected before decoding, and
+// nothing throws (allocation failure -> kLimit). The texture's size is read from its header into
+// LoadReport::texture_width/height whether or not it is decoded (`tailor eval` never decodes it).
 #pragma once
 
 #include <span>

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "tailor/api.h"
+#include "tailor/option_doc.h"
 #include "tailor/status.h"
 
 namespace tailor {
@@ -39,8 +40,24 @@ inline constexpr int kMaxImageSide = 16384;
 //! and pixels.size() == width * height * channels. Fails with kInvalidImage saying which.
 TAILOR_API Status check_image(const Image& image);
 
-//! Reads PNG (8 or 16 bit; 16-bit is reduced to 8), JPEG, TGA or BMP with 1-4 channels.
-TAILOR_API Status load_image(const std::string& path, Image& image);
+//! Limits on the images a reader accepts, checked from the header before anything is decoded.
+struct ImageLoadOptions {
+  uint64_t max_pixels = uint64_t{64} << 20;  //!< largest width x height (64 Mpx: 8192 x 8192)
+};
+
+//! Flags and help of the ImageLoadOptions a user sets (option_doc.h).
+inline constexpr OptionDoc kImageLoadOptionDocs[] = {
+    {"max_pixels", "--max-image-pixels",
+     "Largest input image accepted, in pixels (width x height), checked from its header before decoding; "
+     "each side is also limited to 16384 px"},
+};
+
+//! Reads PNG (8 or 16 bit; 16-bit is reduced to 8), JPEG, TGA, BMP or binary PPM/PGM with 1-4
+//! channels. Untrusted input: before decoding, the header's size is checked against kMaxImageSide
+//! and options.max_pixels, and for uncompressed formats (TGA, BMP, PPM/PGM) against the file's
+//! length (a 30-byte file claiming 4000 x 4000 px is refused as truncated without allocating).
+//! Fails with kIo (open, read, not a regular file), kInvalidImage (too large, truncated, corrupt).
+TAILOR_API Status load_image(const std::string& path, Image& image, const ImageLoadOptions& options = {});
 
 //! Writes a PNG atomically (temporary file, then rename).
 TAILOR_API Status write_png(const std::string& path, const Image& image);

@@ -2,17 +2,20 @@
 // (stb_image_write to memory, then internal::write_file_atomic).
 //
 // Untrusted input: the header is inspected with stbi_info_from_memory and the size checked
-// against kMaxImageSide before anything is decoded, so a 100-byte file claiming 100000 x 100000
-// pixels is refused without allocating.
+// against kMaxImageSide, ImageLoadOptions::max_pixels and (uncompressed formats) the file's
+// length before anything is decoded, so a 30-byte file claiming 16000 x 16000 pixels is refused
+// without allocating.
 #include <stb/stb_image.h>
 #include <stb/stb_image_write.h>
 
+#include <algorithm>
 #include <climits>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <string>
 
+#include "io/readers.h"
 #include "tailor/image.h"
 #include "util/atomic_file.h"
 
@@ -76,9 +79,69 @@ bool claimed_size(const std::string& bytes, long& width, long& height) {
   return false;
 }
 
+uint32_t le16(const unsigned char* p) { return uint32_t{p[0]} | (uint32_t{p[1]} << 8); }
+uint32_t le32(const unsigned char* p) { return le16(p) | (le16(p + 2) << 16); }
+
+//! The fewest bytes a file of this format needs for width x height pixels, from its header; 0
+//! when unknown (compressed formats: PNG, JPEG, GIF, PSD, HDR...).
+uint64_t min_file_bytes(std::span<const unsigned char> b, uint64_t width, uint64_t height) {
+  const uint64_t pixels = width * height;
+  const size_t n = b.size();
+  const unsigned char* p = b.data();
+  if (n >= 2 && p[0] == 'P' && (p[1] == '5' || p[1] == '6'))  // binary PGM / PPM, >= 1 byte a sample
+    return pixels * (p[1] == '5' ? 1 : 3);
+  if (n >= 2 && p[0] == 'B' && p[1] == 'M') {
+    if (n < 34) return 0;
+    const uint32_t bits = le16(p + 28), compression = le32(p + 30);
+    if (compression != 0 && compression != 3) return 0;  // RLE4/RLE8 and others
+    const uint64_t row = (width * bits + 31) / 32 * 4;
+    return row * height;
+  }
+  const bool magic = (n >= 8 && std::memcmp(p, "\x89PNG", 4) == 0) || (n >= 2 && p[0] == 0xFF && p[1] == 0xD8) ||
+                     (n >= 4 && std::memcmp(p, "GIF8", 4) == 0) || (n >= 4 && std::memcmp(p, "8BPS", 4) == 0) ||
+                     (n >= 2 && p[0] == '#' && p[1] == '?') ||
+                     (n >= 4 && p[0] == 0x53 && p[1] == 0x80 && p[2] == 0xF6 && p[3] == 0x34);
+  if (magic || n < 18) return 0;
+  // TGA (stb_image tries it last, it has no magic number): image type at byte 2, bits per pixel
+  // at 16; with a colour map each pixel is an index of (bits + 7) / 8 bytes.
+  const unsigned type = p[2];
+  const uint64_t bytes_per_pixel = (p[16] + 7u) / 8u;
+  if (type == 1 || type == 2 || type == 3) return 18 + pixels * std::max<uint64_t>(bytes_per_pixel, 1);
+  if (type == 9 || type == 10 || type == 11) return 18 + (pixels + 127) / 128 * 2;  // RLE: <= 128 px a packet
+  return 0;
+}
+
 }  // namespace
 
-Status load_image(const std::string& path, Image& image) {
+namespace internal {
+
+Status check_image_header(std::span<const unsigned char> bytes, long width, long height,
+                          const ImageLoadOptions& options, const std::string& name) {
+  if (width <= 0 || height <= 0)
+    return Status::error(ErrorCode::kInvalidImage, name, "image has no pixels",
+                         "header says " + size_text(width, height));
+  if (width > kMaxImageSide || height > kMaxImageSide)
+    return Status::error(ErrorCode::kInvalidImage, name,
+                         "image too large (the limit is " + std::to_string(kMaxImageSide) + " px a side)",
+                         "header says " + size_text(width, height));
+  const uint64_t pixels = static_cast<uint64_t>(width) * static_cast<uint64_t>(height);
+  if (pixels > options.max_pixels)
+    return Status::error(ErrorCode::kInvalidImage, name,
+                         "image too large: " + size_text(width, height) + " is " + std::to_string(pixels) +
+                             " px, the limit is " + std::to_string(options.max_pixels) +
+                             " px (raise it with --max-image-pixels)");
+  const uint64_t needed = min_file_bytes(bytes, static_cast<uint64_t>(width), static_cast<uint64_t>(height));
+  if (needed > bytes.size())
+    return Status::error(ErrorCode::kInvalidImage, name,
+                         "truncated image: the header claims " + size_text(width, height) +
+                             " px, which needs at least " + std::to_string(needed) + " bytes, but the file has " +
+                             std::to_string(bytes.size()));
+  return Status::ok();
+}
+
+}  // namespace internal
+
+Status load_image(const std::string& path, Image& image, const ImageLoadOptions& options) {
   image = Image{};
   std::string bytes;
   TAILOR_RETURN_IF_ERROR(internal::read_file(path, bytes));
@@ -99,13 +162,7 @@ Status load_image(const std::string& path, Image& image) {
     return Status::error(ErrorCode::kInvalidImage, path, "not a readable PNG, JPEG, TGA or BMP image",
                          std::string("header: ") + (reason ? reason : "unknown format"));
   }
-  if (width <= 0 || height <= 0)
-    return Status::error(ErrorCode::kInvalidImage, path, "image has no pixels",
-                         "header says " + size_text(width, height));
-  if (width > kMaxImageSide || height > kMaxImageSide)
-    return Status::error(ErrorCode::kInvalidImage, path,
-                         "image too large (the limit is " + std::to_string(kMaxImageSide) + " px a side)",
-                         "header says " + size_text(width, height));
+  TAILOR_RETURN_IF_ERROR(internal::check_image_header({data, bytes.size()}, width, height, options, path));
   if (channels < 1 || channels > 4)
     return Status::error(ErrorCode::kUnsupported, path, "unsupported channel count " + std::to_string(channels));
 

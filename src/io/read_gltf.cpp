@@ -263,9 +263,8 @@ Status decode_texture(std::span<const unsigned char> bytes, const std::string& n
   int width = 0, height = 0, channels = 0;
   if (!stbi_info_from_memory(bytes.data(), length, &width, &height, &channels))
     return Status::error(ErrorCode::kInvalidImage, name, "embedded texture cannot be decoded");
-  if (width <= 0 || height <= 0 || width > kMaxImageSide || height > kMaxImageSide)
-    return Status::error(ErrorCode::kInvalidImage, name,
-                         "embedded texture too large (" + std::to_string(width) + "x" + std::to_string(height) + ")");
+  if (Status s = internal::check_image_header(bytes, width, height, ImageLoadOptions{}, name); !s)
+    return Status::error(ErrorCode::kInvalidImage, name, "embedded texture: " + s.what(), s.where());
   unsigned char* pixels = stbi_load_from_memory(bytes.data(), length, &width, &height, &channels, 0);
   if (!pixels) return Status::error(ErrorCode::kInvalidImage, name, "embedded texture cannot be decoded");
   image.width = width;
@@ -402,8 +401,16 @@ Status read_glb_memory(std::span<const char> data, const std::string& name, Mesh
   Status s;
   try {
     std::span<const unsigned char> texture_bytes;
-    s = parse_glb(data, name, mesh, r, texture ? &texture_bytes : nullptr);
+    s = parse_glb(data, name, mesh, r, &texture_bytes);
     if (s.is_ok()) s = finalize_mesh(name, mesh, r);
+    int width = 0, height = 0, channels = 0;  // the texture's size from its header only
+    if (s.is_ok() && !texture_bytes.empty() && texture_bytes.size() <= size_t{INT_MAX} &&
+        stbi_info_from_memory(texture_bytes.data(), static_cast<int>(texture_bytes.size()), &width, &height,
+                              &channels) != 0 &&
+        width > 0 && height > 0) {
+      r.texture_width = width;
+      r.texture_height = height;
+    }
     if (s.is_ok() && texture && !texture_bytes.empty()) s = decode_texture(texture_bytes, name, *texture);
   } catch (const std::bad_alloc&) {
     s = Status::error(ErrorCode::kLimit, name, "not enough memory to load the mesh");

@@ -7,6 +7,7 @@
 #include <span>
 #include <string>
 
+#include "tailor/image.h"
 #include "tailor/mesh.h"
 #include "tailor/status.h"
 
@@ -18,5 +19,12 @@ Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh,
 Status read_stl(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report);
 //! glTF 2.0 binary (.glb): first triangle primitive(s), TEXCOORD_0 into corner_uvs (io_gltf.cpp).
 Status read_glb(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report);
+
+//! Checks the size an image header claims (width x height, read by stbi_info_from_memory) before
+//! decoding `bytes`: each side within kMaxImageSide, width x height within options.max_pixels, and
+//! for uncompressed TGA, BMP and binary PPM/PGM the file long enough for that many pixels (RLE TGA:
+//! at least 2 bytes per 128 pixels). kInvalidImage with one line otherwise (image_io.cpp).
+Status check_image_header(std::span<const unsigned char> bytes, long width, long height,
+                          const ImageLoadOptions& options, const std::string& name);
 
 }  // namespace tailor::internal

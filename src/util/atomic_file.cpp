@@ -1,6 +1,7 @@
 // Whole-file reads and atomic writes (see internal/atomic_file.h).
 #include "util/atomic_file.h"
 
+#include <fcntl.h>
 #include <pthread.h>
 #include <signal.h>
 #include <sys/stat.h>
@@ -271,15 +272,52 @@ Status write_file_atomic(const std::string& path, std::span<const char> bytes) {
   return write_file_atomic(path, std::span<const std::span<const char>>(&bytes, 1));
 }
 
+Status open_input(const std::string& path, int& fd, size_t& size) {
+  fd = -1;
+  size = 0;
+  // O_NONBLOCK: opening a FIFO for reading would otherwise wait for a writer. O_NOCTTY: a
+  // terminal never becomes the controlling one. Both only matter until the type is checked.
+  const int f = open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
+  if (f < 0) return Status::error(ErrorCode::kIo, path, std::string("cannot open file: ") + std::strerror(errno));
+  struct stat st;
+  if (fstat(f, &st) != 0) {
+    const int err = errno;
+    close(f);
+    return Status::error(ErrorCode::kIo, path, std::string("cannot stat file: ") + std::strerror(err));
+  }
+  if (!S_ISREG(st.st_mode)) {
+    close(f);
+    return Status::error(ErrorCode::kIo, path,
+                         S_ISDIR(st.st_mode)
+                             ? "is a directory, not a regular file"
+                             : "not a regular file (a device, FIFO or socket); inputs must be regular files");
+  }
+  const int flags = fcntl(f, F_GETFL);
+  if (flags < 0 || fcntl(f, F_SETFL, flags & ~O_NONBLOCK) != 0) {
+    const int err = errno;
+    close(f);
+    return Status::error(ErrorCode::kIo, path, std::string("cannot open file: ") + std::strerror(err));
+  }
+  fd = f;
+  size = static_cast<size_t>(st.st_size);
+  return Status::ok();
+}
+
 Status read_file(const std::string& path, std::string& bytes) {
   bytes.clear();
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) return Status::error(ErrorCode::kIo, path, std::string("cannot open file: ") + std::strerror(errno));
-  // Regular files: one read into a buffer of the right size (a chunked append costs 5x more on
-  // large meshes). Then read on in chunks, which also covers pipes and files that grew meanwhile.
-  struct stat st;
-  if (fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {
-    const size_t n = static_cast<size_t>(st.st_size);
+  int fd = -1;
+  size_t size = 0;
+  TAILOR_RETURN_IF_ERROR(open_input(path, fd, size));
+  std::FILE* f = fdopen(fd, "rb");
+  if (!f) {
+    const int err = errno;
+    close(fd);
+    return Status::error(ErrorCode::kIo, path, std::string("cannot open file: ") + std::strerror(err));
+  }
+  // One read into a buffer of the right size (a chunked append costs 5x more on large meshes).
+  // Then read on in chunks, which covers files that grew meanwhile.
+  if (size > 0) {
+    const size_t n = size;
     if (n > kMaxReadBytes) {
       std::fclose(f);
       return Status::error(ErrorCode::kLimit, path,
@@ -293,7 +331,7 @@ Status read_file(const std::string& path, std::string& bytes) {
   char chunk[1 << 16];
   size_t n = 0;
   while ((n = std::fread(chunk, 1, sizeof chunk, f)) > 0) {
-    // Pipes and devices have no size: stop an endless stream (/dev/zero) before it eats memory.
+    // A file that keeps growing while it is read is stopped at the cap too.
     if (bytes.size() + n > kMaxReadBytes) {
       std::fclose(f);
       bytes.clear();

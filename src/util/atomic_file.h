@@ -104,10 +104,20 @@ void remove_temporaries_on_signal();
 //! The name a temporary file for `target` gets: "<directory of target>/.tailor-XXXXXX".
 std::string temporary_template(const std::string& target);
 
-//! Largest file read_file accepts (also what stops an endless pipe or device).
+//! Largest file read_file accepts (also what stops a regular file that keeps growing).
 inline constexpr size_t kMaxReadBytes = size_t{4} << 30;
 
-//! Reads a whole file into `bytes`. Fails with kIo on open or read errors.
+//! Opens an input file for reading: the one place every input goes through (read_file,
+//! view_file). Only regular files (or symlinks to them) are accepted: a FIFO, socket, character or
+//! block device or directory is refused with one kIo line ("not a regular file ...") before any
+//! read, so a FIFO without a writer cannot block and /dev/zero cannot be read forever. The open
+//! itself is non-blocking (O_NONBLOCK, cleared again for regular files), so a FIFO swapped in
+//! after a stat cannot hang it either. On success `fd` is an open descriptor (O_CLOEXEC) the caller
+//! closes, and `size` the file's size.
+Status open_input(const std::string& path, int& fd, size_t& size);
+
+//! Reads a whole regular file into `bytes` (open_input). Fails with kIo on open or read errors
+//! and on inputs that are not regular files, kLimit above kMaxReadBytes.
 Status read_file(const std::string& path, std::string& bytes);
 
 }  // namespace tailor::internal

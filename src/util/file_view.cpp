@@ -48,12 +48,11 @@ std::span<const char> FileView::bytes() const {
 
 Status view_file(const std::string& path, FileView& view) {
   view.release();
-  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return Status::error(ErrorCode::kIo, path, std::string("cannot open file: ") + std::strerror(errno));
-  struct stat st;
-  if (fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0 &&
-      static_cast<uint64_t>(st.st_size) >= kMapMinBytes) {
-    const size_t n = static_cast<size_t>(st.st_size);
+  int fd = -1;
+  size_t size = 0;
+  TAILOR_RETURN_IF_ERROR(open_input(path, fd, size));  // regular files only
+  if (size > 0 && size >= kMapMinBytes) {
+    const size_t n = size;
     int flags = MAP_PRIVATE;
 #if defined(MAP_POPULATE)
     // Maps the (usually cached) pages now, in one call, instead of one fault per 64 KiB later.
@@ -68,7 +67,7 @@ Status view_file(const std::string& path, FileView& view) {
     }
   }
   close(fd);
-  // Not a regular file, small, or not mappable: read it (read_file also handles growing files).
+  // Small or not mappable: read it (read_file also handles growing files).
   Status s = read_file(path, view.copy_);
   if (!s.is_ok()) view.copy_.clear();
   return s;
