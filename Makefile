@@ -9,7 +9,7 @@ EXAMPLE_MESH := examples/spot.obj
 EXAMPLE_TEXTURE := examples/gravel.png
 PREFIX ?= /usr/local
 
-.PHONY: all deps configure build test run install bench fuzz tsan clean
+.PHONY: all deps configure build test run install bench fuzz tsan lsan clean
 
 all: build
 
@@ -52,9 +52,13 @@ fuzz: deps
 tsan: deps
 	@bash scripts/tsan.sh
 
+# The preview renderer (OSMesa) under LeakSanitizer: render_test in build-lsan (docs/hardening.md).
+lsan: deps
+	@bash scripts/lsan.sh
+
 # Rewrite the C++ sources as .clang-format says (make test fails on unformatted files).
 format: deps
 	@bash scripts/check_format.sh --fix
 
 clean:
-	rm -rf $(BUILD_DIR) build-fuzz build-tsan out
+	rm -rf $(BUILD_DIR) build-fuzz build-tsan build-lsan out

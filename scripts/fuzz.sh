@@ -9,6 +9,9 @@
 # written into the repository), and prints one line per target. Exits non-zero when a target
 # crashes; the crashing input is kept in build-fuzz/artifacts/. Without clang or the libFuzzer
 # runtime it prints "fuzz: skipped (clang/libFuzzer not installed)" and exits 0.
+#
+# Leak detection is on: a leak fails the target like a crash does. tests/lsan.supp lists the
+# leaks of system libraries that are not ours (each with its reason).
 set -euo pipefail
 
 mode="${1:-short}"
@@ -42,6 +45,10 @@ targets=(ply_fuzz obj_fuzz off_fuzz stl_fuzz glb_fuzz)
 cmake --build "$build" -j"$jobs" --target "${targets[@]}" >"$tmp/build.log" 2>&1 ||
   { tail -n 40 "$tmp/build.log" >&2; echo "fuzz: build failed" >&2; exit 1; }
 
+# Any ASAN_OPTIONS/LSAN_OPTIONS of the caller are kept; ours come last and win.
+export ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=1"
+export LSAN_OPTIONS="${LSAN_OPTIONS:+$LSAN_OPTIONS:}suppressions=$root/tests/lsan.supp:print_suppressions=0"
+
 mkdir -p "$build/artifacts"
 status=0
 for target in "${targets[@]}"; do
@@ -54,7 +61,7 @@ for target in "${targets[@]}"; do
   done < <(find "$root/tests/data/meshes" -type f -iname "*.$ext" -print0)
   log="$tmp/$target.log"
   if "$build/$target" "$corpus" -max_total_time="$seconds" -max_len="$max_len" -timeout=10 \
-      -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$build/artifacts/$target-" >"$log" 2>&1; then
+      -rss_limit_mb=2048 -detect_leaks=1 -print_final_stats=1 -artifact_prefix="$build/artifacts/$target-" >"$log" 2>&1; then
     runs="$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)"
     echo "fuzz: $target ok (${runs:-?} inputs in ${seconds} s)"
   else

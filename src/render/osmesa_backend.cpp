@@ -63,13 +63,20 @@ constexpr int kMaxRenderSide = 8192;
 
 // === OSMesa context, created and destroyed per call =============================================
 
+//! Owns the context of one render. The destructor unbinds it before destroying it, so that no
+//! freed context stays current on the thread (a later GL call or OSMesaGetCurrentContext would
+//! reach it). Objects made in the context (textures, buffers) are deleted by their owners before
+//! this runs. Mesa 22.3 still keeps the ~160-byte framebuffer of each OSMesaMakeCurrent: see
+//! tests/lsan.supp.
 class OffscreenContext {
  public:
   OffscreenContext() = default;
   OffscreenContext(const OffscreenContext&) = delete;
   OffscreenContext& operator=(const OffscreenContext&) = delete;
   ~OffscreenContext() {
-    if (context_ != nullptr) OSMesaDestroyContext(context_);
+    if (context_ == nullptr) return;
+    if (OSMesaGetCurrentContext() == context_) OSMesaMakeCurrent(nullptr, nullptr, 0, 0, 0);
+    OSMesaDestroyContext(context_);
   }
 
   bool create(int width, int height) {
@@ -89,14 +96,32 @@ class OffscreenContext {
 
 // === Textures ====================================================================================
 
-//! Uploads a repeating, trilinearly filtered texture. The mipmap chain is built on the CPU:
-//! glGenerateMipmap would make llvmpipe compile a blit shader, which costs more than the filtering.
-void upload_texture(const Image& image) {
+//! The texture of one render, deleted when it goes out of scope (before the context: it is
+//! declared after it).
+class Texture {
+ public:
+  Texture() = default;
+  Texture(const Texture&) = delete;
+  Texture& operator=(const Texture&) = delete;
+  ~Texture() {
+    if (id_ != 0) glDeleteTextures(1, &id_);
+  }
+  GLuint make() {
+    if (id_ == 0) glGenTextures(1, &id_);
+    return id_;
+  }
+
+ private:
+  GLuint id_ = 0;
+};
+
+//! Uploads a repeating, trilinearly filtered texture into `texture`. The mipmap chain is built on
+//! the CPU: glGenerateMipmap would make llvmpipe compile a blit shader, which costs more than the
+//! filtering.
+void upload_texture(const Image& image, Texture& texture) {
   static constexpr std::array<GLenum, 4> kFormats = {GL_LUMINANCE, GL_LUMINANCE_ALPHA, GL_RGB, GL_RGBA};
   const GLenum format = kFormats[static_cast<size_t>(image.channels - 1)];
-  GLuint id = 0;
-  glGenTextures(1, &id);
-  glBindTexture(GL_TEXTURE_2D, id);
+  glBindTexture(GL_TEXTURE_2D, texture.make());
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
   Image level_image;
   const Image* current = &image;
@@ -326,13 +351,15 @@ Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::s
     glMultMatrixf(camera.turn.data());
 
     glColor4ub(255, 255, 255, 255);
+    Texture gl_texture;  // after the context: deleted before it
     if (textured) {
       if (use_image) {
-        upload_texture(*texture);
+        upload_texture(*texture, gl_texture);
       } else {
         const bool checker = options.view == PreviewView::kChecker;
-        upload_texture(checker ? checker_image(kCheckerDark, kCheckerLight)
-                               : checker_image(kNeutralDark, kNeutralLight));
+        upload_texture(
+            checker ? checker_image(kCheckerDark, kCheckerLight) : checker_image(kNeutralDark, kNeutralLight),
+            gl_texture);
         // The generated image holds 2x2 squares.
         glMatrixMode(GL_TEXTURE);
         glLoadIdentity();
