@@ -9,7 +9,7 @@ EXAMPLE_MESH := examples/spot.obj
 EXAMPLE_TEXTURE := examples/gravel.png
 PREFIX ?= /usr/local
 
-.PHONY: all deps configure build test run install bench fuzz tsan lsan clean
+.PHONY: all deps configure build test run install bench fuzz tsan lsan format clean
 
 all: build
 
