@@ -16,6 +16,7 @@
 #include "tailor/render.h"
 #include "tailor/report.h"
 #include "tailor/stability.h"
+#include "tailor/texture_direction.h"
 #include "tailor/topology.h"
 #include "util/atomic_file.h"
 
@@ -51,6 +52,8 @@ struct MapArgs {
   MapTextureOptions options;
   std::string mode = mapping_mode_name(MappingOptions{}.mode);
   std::string axis = axis_text(OrientationOptions{});
+  std::string field_following = "auto";  // or a number in [0, 1]
+  bool crack_rings_given = false;        // --crack-rings on the command line (kept over auto's)
   std::string seed_point;
   std::string seam_faces;
   bool stability = false;
@@ -149,6 +152,17 @@ int run_map(const MapArgs& opt) {
         usage_error("--symmetry 4 needs a square texture, got " + std::to_string(tex_w) + "x" + std::to_string(tex_h)));
   mapping.texture_period_px = static_cast<float>(tex_w);
   options.metrics.symmetry = mapping.symmetry;
+  // auto: follow the field unless the texture has no direction to follow (texture_direction.h).
+  float texture_isotropy = -1.f;
+  if (opt.field_following == "auto") {
+    if (!texture.empty()) texture_isotropy = tailor::texture_isotropy(texture);
+    const uint32_t rings = mapping.crack_rings;
+    adapt_mapping_to_texture(texture, mapping);
+    if (opt.crack_rings_given) mapping.crack_rings = rings;
+  } else if (!parse_unit_float(opt.field_following, mapping.field_following)) {
+    return report_error(
+        usage_error("--field-following must be auto or a number in [0, 1], got '" + opt.field_following + "'"));
+  }
 
   // === Load, topology, orientation ===
   Mesh mesh;
@@ -181,6 +195,8 @@ int run_map(const MapArgs& opt) {
   run.texture = opt.texture;
   run.texture_width = tex_w;
   run.texture_height = tex_h;
+  run.texture_isotropy = texture_isotropy;
+  run.field_following = opt.field_following;
   run.axis = opt.axis;
   run.axis_auto = auto_axis;
   run.seed_point = opt.seed_point;
@@ -310,12 +326,16 @@ void register_map(CLI::App& app, Runner& run) {
   add_documented(group, option_doc(kMappingOptionDocs, "mode"), opt->mode);
   add_documented(group, option_doc(kMappingOptionDocs, "scale"), mapping.scale);
   add_documented(group, option_doc(kMappingOptionDocs, "max_stretch"), mapping.max_stretch);
-  add_documented(group, option_doc(kMappingOptionDocs, "field_following"), mapping.field_following);
+  group
+      ->add_option("--field-following", opt->field_following,
+                   std::string(option_doc(kMappingOptionDocs, "field_following").help))
+      ->capture_default_str();
   add_documented(group, option_doc(kMappingOptionDocs, "min_patch_faces"), mapping.min_patch_faces);
   add_documented(group, option_doc(kMappingOptionDocs, "hop_age"), mapping.hop_age);
   add_off_switch(group, option_doc(kMappingOptionDocs, "shorten_seams"), mapping.shorten_seams);
   add_off_switch(group, option_doc(kMappingOptionDocs, "close_cracks"), mapping.close_cracks);
-  add_documented(group, option_doc(kMappingOptionDocs, "crack_rings"), mapping.crack_rings)->check(CLI::Range(2u, 64u));
+  CLI::Option* crack_rings = add_documented(group, option_doc(kMappingOptionDocs, "crack_rings"), mapping.crack_rings)
+                                 ->check(CLI::Range(2u, 64u));
   add_documented(group, option_doc(kMappingOptionDocs, "relax_iterations"), mapping.relax_iterations)
       ->check(CLI::Range(0u, 1000u));
   add_documented(group, option_doc(kMappingOptionDocs, "threshold_px"), mapping.threshold_px);
@@ -339,9 +359,13 @@ void register_map(CLI::App& app, Runner& run) {
       "Prints one summary line: faces, patches, seam length, flipped faces, stretch, Sander L2/Linf,\n"
       "median angle distortion, seam gap, and the time of each stage.\n"
       "Trade-offs: --no-crack-closing maps 3-10x faster and keeps more UVs bit-identical when parts of\n"
-      "the mesh change, with about twice the seam length; --field-following 0 --crack-rings 32 gives the\n"
-      "fewest seams (one patch per component) for stochastic textures whose direction does not matter.");
-  cmd->callback([&run, opt] { run = [opt] { return run_map(*opt); }; });
+      "the mesh change, with about twice the seam length. --field-following auto (the default) maps a\n"
+      "texture without a direction (gravel, grass; its isotropy is in the --stats) with rigid unfolding\n"
+      "and 32 crack rings, the fewest seams; --field-following 1 keeps the orientation field.");
+  cmd->callback([&run, opt, crack_rings] {
+    opt->crack_rings_given = crack_rings->count() > 0;
+    run = [opt] { return run_map(*opt); };
+  });
 }
 
 }  // namespace tailor::cli

@@ -130,7 +130,8 @@ inline constexpr OptionDoc kMappingOptionDocs[] = {
     {"max_stretch", "--max-stretch", "patches mode: per-face singular values must stay within [1/(1+x), 1+x]"},
     {"field_following", "--field-following",
      "patches mode: 1 = texture direction follows the orientation field (thesis), 0 = faces are unfolded rigidly "
-     "(fewer seams, direction drifts); values between blend"},
+     "(fewer seams, direction drifts); values between blend; auto (tailor map) = 0 for a texture without a "
+     "direction (gravel, grass: 20-30% less seam), else 1 (texture_direction.h)"},
     {"min_patch_faces", "--min-patch-faces",
      "patches mode: smaller patches are absorbed into a neighbour (0 keeps all)"},
     {"hop_age", "--hop-age",
