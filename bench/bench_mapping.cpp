@@ -96,7 +96,9 @@ void BM_Mapping(benchmark::State& state, const std::string& key, const tailor::M
   state.counters["faces"] = faces;
   set_faces_rate(state, p.mesh.face_count());
   tailor::UvMetrics m;
-  if (!tailor::compute_uv_metrics(p.mesh, p.topology, atlas.corner_uv, atlas.patch, {}, m).is_ok()) {
+  tailor::MetricsOptions metrics;
+  metrics.symmetry = options.symmetry;  // symmetry 4: quarter turns across a seam count as invisible
+  if (!tailor::compute_uv_metrics(p.mesh, p.topology, atlas.corner_uv, atlas.patch, metrics, m).is_ok()) {
     state.SkipWithError("metrics failed");
     return;
   }
@@ -115,11 +117,12 @@ void BM_Mapping(benchmark::State& state, const std::string& key, const tailor::M
   if (options.mode == tailor::MappingMode::kThesis) state.counters["thr_px"] = stats.final_threshold_px;
 }
 
-// Registers one orientation and seven mapping benchmarks per mesh at static initialisation:
+// Registers one orientation and nine mapping benchmarks per mesh at static initialisation:
 // patches mode with a texture that has a direction, or none (default options, and ten times the
 // texture scale), with a texture without direction (`tailor map`'s default for gravel, grass:
-// adapt_mapping_to_texture, rigid unfolding with 32 crack rings; both scales), the growth alone
-// (no crack closing), thesis mode.
+// adapt_mapping_to_texture, rigid unfolding with 32 crack rings; both scales), the integer-grid
+// map for a 4-fold symmetric 512 px tile (`--symmetry 4`, experimental; both scales), the growth
+// alone (no crack closing), thesis mode.
 [[maybe_unused]] const bool registered = [] {
   std::vector<std::pair<std::string, std::string>> meshes = {{"horse_x16", "horse_x16"}};
   const std::filesystem::path dir = std::filesystem::path(TAILOR_SHARED_DATA) / "meshes";
@@ -139,6 +142,10 @@ void BM_Mapping(benchmark::State& state, const std::string& key, const tailor::M
   undirected.crack_rings = tailor::kUndirectedCrackRings;
   tailor::MappingOptions undirected_x10 = undirected;
   undirected_x10.scale = patches_x10.scale;
+  tailor::MappingOptions fourfold;
+  fourfold.symmetry = 4;  // texture_period_px: the default 512 px
+  tailor::MappingOptions fourfold_x10 = fourfold;
+  fourfold_x10.scale = patches_x10.scale;
   thesis.mode = tailor::MappingMode::kThesis;
   for (const auto& [name, key] : meshes) {
     benchmark::RegisterBenchmark(("Orientation/" + name).c_str(), BM_Orientation, key)
@@ -150,6 +157,14 @@ void BM_Mapping(benchmark::State& state, const std::string& key, const tailor::M
         ->MinTime(0.2)
         ->UseManualTime();
     benchmark::RegisterBenchmark(("Mapping/patches-x10/" + name).c_str(), BM_Mapping, key, patches_x10)
+        ->Unit(benchmark::kMillisecond)
+        ->MinTime(0.2)
+        ->UseManualTime();
+    benchmark::RegisterBenchmark(("Mapping/symmetry4/" + name).c_str(), BM_Mapping, key, fourfold)
+        ->Unit(benchmark::kMillisecond)
+        ->MinTime(0.2)
+        ->UseManualTime();
+    benchmark::RegisterBenchmark(("Mapping/symmetry4-x10/" + name).c_str(), BM_Mapping, key, fourfold_x10)
         ->Unit(benchmark::kMillisecond)
         ->MinTime(0.2)
         ->UseManualTime();
