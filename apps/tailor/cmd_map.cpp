@@ -361,7 +361,8 @@ void register_map(CLI::App& app, Runner& run) {
       "Trade-offs: --no-crack-closing maps 3-10x faster and keeps more UVs bit-identical when parts of\n"
       "the mesh change, with about twice the seam length. --field-following auto (the default) maps a\n"
       "texture without a direction (gravel, grass; its isotropy is in the --stats) with rigid unfolding\n"
-      "and 32 crack rings, the fewest seams; --field-following 1 keeps the orientation field.");
+      "and 32 crack rings, the fewest seams; --field-following 1 keeps the orientation field, and\n"
+      "the UVs of a mesh that is edited and re-mapped more stable (docs/mapping.md section 7).");
   cmd->callback([&run, opt, crack_rings] {
     opt->crack_rings_given = crack_rings->count() > 0;
     run = [opt] { return run_map(*opt); };
