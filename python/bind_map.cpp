@@ -134,7 +134,7 @@ void bind_map(py::module_& m) {
          uint32_t threads, const py::object& progress, const py::object& texture, const std::string& mode,
          float max_stretch, float field_following, uint32_t min_patch_faces, float hop_age, bool shorten_seams,
          bool close_cracks, uint32_t crack_rings, uint32_t relax_iterations, float threshold,
-         const py::object& seed_point, uint32_t symmetry) {
+         const py::object& seed_point, uint32_t symmetry, float unit_scale) {
         // === Options, checked before any work (the CLI's checks and messages) ===
         MapTextureOptions options;
         MappingOptions& mapping = options.mapping;
@@ -170,6 +170,8 @@ void bind_map(py::module_& m) {
           std::snprintf(text, sizeof text, "%g,%g,%g", p[0], p[1], p[2]);
           run.seed_point = text;
         }
+        if (!(unit_scale >= 0.f && unit_scale <= 1e30f)) raise_error("unit_scale must be 0 or a positive number");
+        options.orientation.fixed_unit_scale = unit_scale;  // about the origin (fixed_origin stays 0, 0, 0)
         if (texture_size <= 0) raise_error("--texture-size must be positive");
         if (Status s = check_map_options(options); !s) raise_status(s);
         // The texture sets the texture size, as --texture does.
@@ -256,6 +258,7 @@ void bind_map(py::module_& m) {
       py::arg("close_cracks") = md.close_cracks, py::arg("crack_rings") = md.crack_rings,
       py::arg("relax_iterations") = md.relax_iterations, py::arg("threshold") = md.threshold_px,
       py::arg("seed_point") = py::none(), py::arg("symmetry") = md.symmetry,
+      py::arg("unit_scale") = OrientationOptions{}.fixed_unit_scale,
       R"(map(mesh, texture_size=512, scale=800.0, axis='pca', seam_faces=None, threads=0, progress=None, *, ...) -> Result
 
 Computes per-corner texture coordinates by homogeneous patch discovery, exactly as `tailor map`
@@ -272,7 +275,10 @@ progress      callable(fraction) called every 50 ms or so; return False to stop 
               (KeyboardInterrupt) with or without it.
 Keyword-only: mode ('patches' or 'thesis'), max_stretch, field_following, min_patch_faces,
 hop_age, shorten_seams, close_cracks, crack_rings, relax_iterations, threshold (thesis mode),
-seed_point (x, y, z), symmetry (1 or 4): the CLI's options of the same names (tailor map --help).
+seed_point (x, y, z), symmetry (1 or 4): the CLI's options of the same names (tailor map --help);
+unit_scale: 0 normalises the mesh into the unit cube (as the CLI); > 0 uses coordinates times
+unit_scale instead, so with unit_scale=1, scale is pixels per mesh unit: the same texel density
+on every mesh (the Blender add-on's tile size).
 Raises tailor.Error with the CLI's message on bad options.)");
 }
 

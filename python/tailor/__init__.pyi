@@ -77,6 +77,7 @@ def map(
     threshold: float = 25.0,
     seed_point: Optional[Sequence[float]] = None,
     symmetry: Literal[1, 4] = 1,
+    unit_scale: float = 0.0,
 ) -> Result: ...
 @overload
 def tile(

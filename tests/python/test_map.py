@@ -111,3 +111,16 @@ def test_bad_seam_faces_and_mismatched_save(tmp_path):
     with pytest.raises(tailor.Error, match="directory"):
         tailor.save(tmp_path / "missing" / "x.glb", mesh, tailor.map(mesh))
     assert list(tmp_path.iterdir()) == []
+
+
+def test_unit_scale_gives_one_texel_density_whatever_the_size():
+    positions, faces = bumpy_grid(40)
+    densities = []
+    for factor in (1.0, 3.0):
+        mesh = tailor.Mesh(positions * factor, faces)
+        densities.append(tailor.map(mesh, scale=100, unit_scale=1.0).metrics["uv_scale"])  # px^2 per unit^2
+        normalised = tailor.map(mesh, scale=100).metrics["uv_scale"]
+        assert normalised == pytest.approx(100**2 / (4 * factor) ** 2, rel=0.05)  # the longest side is 4 * factor
+    assert densities[0] == pytest.approx(100**2, rel=0.05) and densities[1] == pytest.approx(100**2, rel=0.05)
+    with pytest.raises(tailor.Error, match="unit_scale"):
+        tailor.map(tailor.Mesh(positions, faces), unit_scale=-1)
