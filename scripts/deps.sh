@@ -15,6 +15,10 @@ packages=(
 )
 # pybind11, Python's headers, numpy and pytest: the Python module and its tests (/usr/bin/python3).
 # clang + its fuzzer runtime are optional: the fuzz step skips cleanly without them.
+# Blender only on request (TAILOR_BLENDER=1, make deps-blender): the add-on's test skips without it.
+if [[ ${TAILOR_BLENDER:-0} == 1 ]]; then
+  packages+=(blender)
+fi
 
 missing=()
 for p in "${packages[@]}"; do
