@@ -121,8 +121,11 @@ class TAILOR_OT_texture_map(bpy.types.Operator):
             self.status(context, f"tailor: mapping {obj.name} ({i + 1}/{len(objects)})")
             wm.progress_update(int(1000 * i / len(objects)))
 
-            def progress(fraction, i=i):
+            def progress(fraction, i=i, name=obj.name):
                 wm.progress_update(int(1000 * (i + fraction) / len(objects)))
+                self.status(context, f"tailor: mapping {name} ({i + 1}/{len(objects)}) {100 * fraction:.0f}%")
+                if not bpy.app.background:  # the window redraws only between operators otherwise
+                    bpy.ops.wm.redraw_timer(type="DRAW_WIN_SWAP", iterations=1)
 
             try:
                 triangles = mesh_data.Triangles(obj, self.use_seams)
