@@ -191,7 +191,9 @@ void bind_map(py::module_& m) {
         if (Status s = set_map_texture_size(options, width, height); !s) raise_status(s);
         std::vector<uint8_t> seams;
         if (!seam_faces.is_none()) {
-          seam_flags(py::array::ensure(seam_faces), mesh.mesh.face_count(), seams);
+          const py::array seam_array = py::array::ensure(seam_faces);
+          if (!seam_array) raise_error("seam_faces must be face indices or an (F,) bool mask");
+          seam_flags(seam_array, mesh.mesh.face_count(), seams);
           mapping.seam_faces = seams;
         } else if (!mesh.mesh.seam_faces.empty()) {
           mapping.seam_faces = mesh.mesh.seam_faces;

@@ -124,3 +124,10 @@ def test_unit_scale_gives_one_texel_density_whatever_the_size():
     assert densities[0] == pytest.approx(100**2, rel=0.05) and densities[1] == pytest.approx(100**2, rel=0.05)
     with pytest.raises(tailor.Error, match="unit_scale"):
         tailor.map(tailor.Mesh(positions, faces), unit_scale=-1)
+
+
+def test_seam_faces_that_are_no_array():
+    mesh = tailor.load(SPOT)
+    for bad in ("abc", [[1, 2], [3, 4]], [0.5, 2.0], object()):
+        with pytest.raises(tailor.Error, match="seam_faces"):
+            tailor.map(mesh, seam_faces=bad)
