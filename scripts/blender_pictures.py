@@ -3,14 +3,15 @@
 1. blender_texture_map.png: spot at two sizes, mapped in one click with a tile size of 0.4 units:
    the tileable gravel repeats at the same size on both;
 2. blender_uv_grid.png: the same with Blender's UV grid image, which shows the patches' directions
-   and the seams (where the grid breaks)."""
+   and the seams (where the grid breaks); the scene is saved to SCENE for the dialog's picture
+   (scripts/blender_dialog_picture.py)."""
 import math
 import os
 import sys
 
 import bpy
 
-ZIP, MESH, IMAGE, OUT = sys.argv[sys.argv.index("--") + 1:]
+ZIP, MESH, IMAGE, OUT, SCENE = sys.argv[sys.argv.index("--") + 1:]
 
 bpy.ops.preferences.addon_install(filepath=ZIP, overwrite=True)
 bpy.ops.preferences.addon_enable(module="tailor_addon")
@@ -76,3 +77,4 @@ for obj in (small, large):
         if node.type == "TEX_IMAGE":
             node.image = grid
 render("blender_uv_grid.png")
+bpy.ops.wm.save_as_mainfile(filepath=SCENE)
