@@ -10,12 +10,12 @@ build=${1:-build}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 bash "$repo/scripts/blender_addon.sh" "$build" "$tmp/tailor_addon.zip"
-HOME=$tmp/home XDG_CONFIG_HOME=$tmp/config PYTHONDONTWRITEBYTECODE=1 \
+HOME=$tmp/home XDG_CONFIG_HOME=$tmp/config TMPDIR=$tmp PYTHONDONTWRITEBYTECODE=1 \
   blender -b --factory-startup --python-exit-code 1 --python "$repo/scripts/blender_pictures.py" -- \
   "$tmp/tailor_addon.zip" "$repo/examples/spot.obj" "$repo/examples/gravel.png" "$repo/docs/images" \
   "$tmp/scene.blend" | grep -E "^(Saved|Error|Info: tailor)"
 if command -v xvfb-run >/dev/null 2>&1; then
-  HOME=$tmp/home XDG_CONFIG_HOME=$tmp/config PYTHONDONTWRITEBYTECODE=1 xvfb-run -a -s "-screen 0 1120x700x24" \
+  HOME=$tmp/home XDG_CONFIG_HOME=$tmp/config TMPDIR=$tmp PYTHONDONTWRITEBYTECODE=1 xvfb-run -a -s "-screen 0 1120x700x24" \
     blender "$tmp/scene.blend" --factory-startup --python "$repo/scripts/blender_dialog_picture.py" -- \
     "$tmp/tailor_addon.zip" "$tmp/dialog.png" >/dev/null 2>&1
   # Re-saved with the strongest PNG compression (Blender's screenshot uses a light one).

@@ -14,8 +14,9 @@ repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 bash "$repo/scripts/blender_addon.sh" "$build" "$tmp/tailor_addon.zip" || exit 1
-# Blender writes its user settings under HOME (the add-on install too): keep them in the temp folder.
-HOME=$tmp/home XDG_CONFIG_HOME=$tmp/config PYTHONDONTWRITEBYTECODE=1 \
+# Blender writes its user settings under HOME (the add-on install too) and its temporary files in
+# TMPDIR: keep both in the temp folder.
+HOME=$tmp/home XDG_CONFIG_HOME=$tmp/config TMPDIR=$tmp PYTHONDONTWRITEBYTECODE=1 \
   blender -b --factory-startup --python-exit-code 1 --python "$repo/tests/blender/test_addon.py" -- \
   "$tmp/tailor_addon.zip" "$repo/examples/spot.obj" "$repo/examples/gravel.png" "$tailor" "$tmp" 2>&1 |
   grep -v "^Read prefs\|^Blender quit$\|^$"
