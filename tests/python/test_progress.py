@@ -105,3 +105,15 @@ def test_tile_from_array_and_file(tmp_path, tailor_binary):
         tailor.tile(grey.astype(np.float32))
     with pytest.raises(tailor.Error):
         tailor.tile(np.zeros((8, 8, 3), np.uint8))  # too small to tile
+
+
+def test_maps_in_parallel_threads_give_the_sequential_bits():
+    from concurrent.futures import ThreadPoolExecutor
+
+    from conftest import DATA, SPOT
+
+    meshes = [tailor.load(SPOT), tailor.load(DATA / "meshes" / "fandisk.off")] * 2
+    sequential = [tailor.map(m).corner_uvs.tobytes() for m in meshes]
+    with ThreadPoolExecutor(4) as pool:
+        parallel = [r.corner_uvs.tobytes() for r in pool.map(tailor.map, meshes)]
+    assert parallel == sequential
