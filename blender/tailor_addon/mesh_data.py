@@ -32,7 +32,12 @@ class Triangles:
         self.vertices = vertices[:, order]
         self.loops = self.loops[:, order]
         # Exact duplicates (same vertex set): keep the first.
-        _, first, inverse = np.unique(np.sort(vertices, axis=1), axis=0, return_index=True, return_inverse=True)
+        ordered = np.sort(vertices, axis=1).astype(np.int64)
+        if len(mesh.vertices) < 1 << 21:  # one int64 key per triangle: a 1-D unique, ~10x faster
+            ordered = (ordered[:, 0] << 42) | (ordered[:, 1] << 21) | ordered[:, 2]
+            _, first, inverse = np.unique(ordered, return_index=True, return_inverse=True)
+        else:
+            _, first, inverse = np.unique(ordered, axis=0, return_index=True, return_inverse=True)
         inverse = inverse.ravel()
         self.kept = np.zeros(count, bool)
         self.kept[first] = True
