@@ -119,24 +119,19 @@ int run_map(const MapArgs& opt) {
   MappingOptions& mapping = options.mapping;
   if (!mapping_mode_from_name(opt.mode, mapping.mode))
     return report_error(usage_error("--mode must be patches or thesis, got '" + opt.mode + "'"));
-  if (mapping.symmetry == 4 && mapping.mode != MappingMode::kPatches)
-    return report_error(usage_error("--symmetry 4 needs --mode patches"));
   if (!opt.seed_point.empty()) {
     if (!parse_vec3(opt.seed_point, mapping.seed_point))
       return report_error(usage_error("--seed-point must be three numbers X,Y,Z, got '" + opt.seed_point + "'"));
     mapping.use_seed_point = true;
   }
   if (opt.texture_size <= 0) return report_error(usage_error("--texture-size must be positive"));
-  // Below ~1e-3 px per unit every UV rounds to the same float; above 1e7 faces span millions of px.
-  if (!(mapping.scale >= 1e-3f && mapping.scale <= 1e7f))
-    return report_error(usage_error("--scale must be between 0.001 and 1e7 pixels per unit"));
+  if (Status s = check_map_options(options); !s) return report_error(s);  // scale, hop age, symmetry
+  if (opt.field_following != "auto" && !parse_unit_float(opt.field_following, mapping.field_following))
+    return report_error(
+        usage_error("--field-following must be auto or a number in [0, 1], got '" + opt.field_following + "'"));
   UpAxis preview_up = RenderOptions{}.up;
   if (!up_axis_from_name(opt.preview_up, preview_up))
     return report_error(usage_error("--preview-up must be x, y, z, -x, -y or -z, got '" + opt.preview_up + "'"));
-  if (!(mapping.hop_age >= 0.f && mapping.hop_age <= 1.f))
-    return report_error(usage_error("--hop-age must be between 0 and 1 radians"));
-  // --threads is one count for every stage that has threads.
-  options.orientation.threads = options.metrics.threads = mapping.threads;
   if (Status s = check_outputs(output_paths(opt), {opt.input, opt.texture, opt.seam_faces}); !s) return report_error(s);
 
   // === Texture (read first: a bad texture should fail before minutes of work) ===
@@ -146,12 +141,8 @@ int run_map(const MapArgs& opt) {
   }
   const int tex_w = texture.empty() ? opt.texture_size : texture.width;
   const int tex_h = texture.empty() ? opt.texture_size : texture.height;
-  // Symmetry 4: the lattice is the texture's square period; the metrics count quarter turns as invisible.
-  if (mapping.symmetry == 4 && tex_w != tex_h)
-    return report_error(
-        usage_error("--symmetry 4 needs a square texture, got " + std::to_string(tex_w) + "x" + std::to_string(tex_h)));
-  mapping.texture_period_px = static_cast<float>(tex_w);
-  options.metrics.symmetry = mapping.symmetry;
+  // The lattice period, the metrics' texture size, the threads of every stage.
+  if (Status s = set_map_texture_size(options, tex_w, tex_h); !s) return report_error(s);
   // auto: follow the field unless the texture has no direction to follow (texture_direction.h).
   float texture_isotropy = -1.f;
   if (opt.field_following == "auto") {
@@ -159,9 +150,6 @@ int run_map(const MapArgs& opt) {
     const uint32_t rings = mapping.crack_rings;
     adapt_mapping_to_texture(texture, mapping);
     if (opt.crack_rings_given) mapping.crack_rings = rings;
-  } else if (!parse_unit_float(opt.field_following, mapping.field_following)) {
-    return report_error(
-        usage_error("--field-following must be auto or a number in [0, 1], got '" + opt.field_following + "'"));
   }
 
   // === Load, topology, orientation ===
@@ -187,8 +175,6 @@ int run_map(const MapArgs& opt) {
     warn(opt.quiet, opt.input + ": " + std::to_string(topology.nonmanifold_edges) + " non-manifold and " +
                         std::to_string(topology.inconsistent_edges) +
                         " inconsistently oriented edges treated as boundary");
-  options.metrics.texture_width_px = static_cast<float>(tex_w);
-  options.metrics.texture_height_px = static_cast<float>(tex_h);
   MapRun run;  // the report: what was asked, then what each step found
   run.input = opt.input;
   run.output = opt.output;
@@ -196,7 +182,7 @@ int run_map(const MapArgs& opt) {
   run.texture_width = tex_w;
   run.texture_height = tex_h;
   run.texture_isotropy = texture_isotropy;
-  run.field_following = opt.field_following;
+  run.field_following_auto = opt.field_following == "auto";
   run.axis = opt.axis;
   run.axis_auto = auto_axis;
   run.seed_point = opt.seed_point;

@@ -228,6 +228,18 @@ struct TextureMap {
 TAILOR_API Status map_texture(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options,
                               TextureMap& map);
 
+//! The checks `tailor map` makes on its options before any work, with its messages (the Python
+//! module raises the same): symmetry 4 only in the patches mode, scale in [1e-3, 1e7] pixels per
+//! unit (below, every UV rounds to the same float; above, faces span millions of pixels), hop_age
+//! in [0, 1]. Fails with kInvalidArgument. map_texture's own checks still apply. O(1).
+TAILOR_API Status check_map_options(const MapTextureOptions& options);
+
+//! Sets what the texture's size and the thread count decide, as `tailor map` does: the lattice
+//! period of symmetry 4 (texture_period_px), the metrics' texture size and symmetry, and
+//! mapping.threads for the orientation and the metrics too. Fails with kInvalidArgument when a
+//! size is not positive or symmetry 4 meets a texture that is not square. O(1).
+TAILOR_API Status set_map_texture_size(MapTextureOptions& options, int texture_width, int texture_height);
+
 //! The name of a mode, "patches" or "thesis" (CLI --mode).
 TAILOR_API const char* mapping_mode_name(MappingMode mode);
 

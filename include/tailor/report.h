@@ -35,12 +35,12 @@ struct MapRun {
   int texture_width = 0;  //!< texture size the UVs are in (px per repeat)
   int texture_height = 0;
   float texture_isotropy = -1.f;  //!< texture_isotropy of the texture when measured (--field-following auto), else -1
-  std::string field_following;    //!< as asked: "auto" or a number (options.mapping holds the value used)
-  MapTextureOptions options;      //!< as map_texture ran them (after --axis auto: the chosen axis)
-  std::string axis;               //!< the axis as asked ("pca", "x", "0,1,0"...), or "auto:<chosen>"
-  bool axis_auto = false;         //!< the axis was chosen by choose_orientation_axis (--axis auto)
-  std::string seed_point;         //!< the seed point as asked ("X,Y,Z"), empty when none
-  std::string seam_faces;         //!< seam-face file, empty when none
+  bool field_following_auto = false;  //!< --field-following auto: options.mapping holds what it chose
+  MapTextureOptions options;          //!< as map_texture ran them (after --axis auto: the chosen axis)
+  std::string axis;                   //!< the axis as asked ("pca", "x", "0,1,0"...), or "auto:<chosen>"
+  bool axis_auto = false;             //!< the axis was chosen by choose_orientation_axis (--axis auto)
+  std::string seed_point;             //!< the seed point as asked ("X,Y,Z"), empty when none
+  std::string seam_faces;             //!< seam-face file, empty when none
   // What the stages found (add_map_results fills these from the library's results)
   LoadReport load;  //!< what the reader saw and repaired, its time
   size_t vertices = 0;

@@ -37,7 +37,7 @@ std::string map_report_json(const MapRun& run) {
                   {"threshold_px", mapping.threshold_px},
                   {"max_stretch", mapping.max_stretch},
                   {"field_following", mapping.field_following},
-                  {"field_following_asked", run.field_following.empty() ? "" : run.field_following},
+                  {"field_following_auto", run.field_following_auto},
                   {"min_patch_faces", mapping.min_patch_faces},
                   {"shorten_seams", mapping.shorten_seams},
                   {"close_cracks", mapping.close_cracks},
