@@ -5,6 +5,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <span>
+#include <string>
 
 #include "bindings.h"
 #include "tailor/axis_choice.h"
@@ -88,6 +90,42 @@ void seam_flags(const py::array& seams, size_t face_count, std::vector<uint8_t>&
   }
 }
 
+// map()'s docstring: the call, then every option with the CLI's help text, from the library's
+// OptionDoc tables (the keyword is the field's name, threshold_px and smooth_passes shortened).
+const std::string& map_docstring() {
+  static const std::string text = [] {
+    std::string doc =
+        "map(mesh, texture_size=512, scale=800.0, axis='pca', seam_faces=None, threads=0, progress=None, *, ...) "
+        "-> Result\n\n"
+        "Computes per-corner texture coordinates by homogeneous patch discovery, exactly as `tailor map` (same\n"
+        "options, same bits; the GIL is released while it works). Raises tailor.Error with the CLI's message on\n"
+        "bad options.\n\n"
+        "texture_size: pixels of one texture repeat (--texture-size); texture=PATH sets it from the image (--texture)\n"
+        "axis: 'pca', 'x', 'y', 'z', 'auto' or three numbers\n"
+        "seam_faces: face indices or an (F,) bool mask of faces where seams should go; None: the file's\n"
+        "threads: 0 = automatic (--threads); the result is the same for any count\n"
+        "progress: callable(fraction), called every 50 ms or so and with 1.0 at the end; return False to stop\n"
+        "  (tailor.Error 'mapping cancelled'); an exception it raises propagates. Ctrl-C stops the map\n"
+        "  (KeyboardInterrupt) with or without it.\n"
+        "unit_scale: 0 normalises the mesh into the unit cube (as the CLI); > 0 uses coordinates times unit_scale,\n"
+        "  so with unit_scale=1, scale is pixels per mesh unit: one texel density on every mesh (no CLI flag)\n\n"
+        "The options with the CLI's help (tailor map --help):\n";
+    auto add = [&doc](std::span<const OptionDoc> docs) {
+      for (const OptionDoc& d : docs) {
+        std::string name(d.field);
+        if (name == "threshold_px") name = "threshold";
+        if (name == "smooth_passes") name = "smooth";
+        if (name == "shorten_seams" || name == "close_cracks") name += "=False";
+        doc += name + " (" + std::string(d.flag) + "): " + std::string(d.help) + "\n";
+      }
+    };
+    add(kMappingOptionDocs);
+    add(kOrientationOptionDocs);
+    return doc;
+  }();
+  return text;
+}
+
 }  // namespace
 
 void bind_map(py::module_& m) {
@@ -134,7 +172,7 @@ void bind_map(py::module_& m) {
          uint32_t threads, const py::object& progress, const py::object& texture, const std::string& mode,
          float max_stretch, float field_following, uint32_t min_patch_faces, float hop_age, bool shorten_seams,
          bool close_cracks, uint32_t crack_rings, uint32_t relax_iterations, float threshold,
-         const py::object& seed_point, uint32_t symmetry, float unit_scale) {
+         const py::object& seed_point, uint32_t symmetry, float unit_scale, uint32_t smooth) {
         // === Options, checked before any work (the CLI's checks and messages) ===
         MapTextureOptions options;
         MappingOptions& mapping = options.mapping;
@@ -172,6 +210,8 @@ void bind_map(py::module_& m) {
         }
         if (!(unit_scale >= 0.f && unit_scale <= 1e30f)) raise_error("unit_scale must be 0 or a positive number");
         options.orientation.fixed_unit_scale = unit_scale;  // about the origin (fixed_origin stays 0, 0, 0)
+        if (smooth > 1000) raise_error("--smooth: value " + std::to_string(smooth) + " not in range [0 - 1000]");
+        options.orientation.smooth_passes = smooth;
         if (texture_size <= 0) raise_error("--texture-size must be positive");
         if (Status s = check_map_options(options); !s) raise_status(s);
         // The texture sets the texture size, as --texture does.
@@ -261,27 +301,7 @@ void bind_map(py::module_& m) {
       py::arg("relax_iterations") = md.relax_iterations, py::arg("threshold") = md.threshold_px,
       py::arg("seed_point") = py::none(), py::arg("symmetry") = md.symmetry,
       py::arg("unit_scale") = OrientationOptions{}.fixed_unit_scale,
-      R"(map(mesh, texture_size=512, scale=800.0, axis='pca', seam_faces=None, threads=0, progress=None, *, ...) -> Result
-
-Computes per-corner texture coordinates by homogeneous patch discovery, exactly as `tailor map`
-(same options, same bits; the GIL is released while it works).
-
-texture_size  pixels of one texture repeat (the CLI's --texture-size); texture=PATH sets it from
-              the image, as --texture does
-scale         texture pixels per unit of the mesh normalised into the unit cube (--scale)
-axis          'pca', 'x', 'y', 'z', 'auto' (the axis leaving the least seam) or three numbers
-seam_faces    face indices or an (F,) bool mask of faces where seams should go; None: the file's
-threads       0 = automatic; the result is the same for any count
-progress      callable(fraction) called every 50 ms or so; return False to stop (tailor.Error
-              'mapping cancelled'); an exception it raises propagates. Ctrl-C stops the map
-              (KeyboardInterrupt) with or without it.
-Keyword-only: mode ('patches' or 'thesis'), max_stretch, field_following, min_patch_faces,
-hop_age, shorten_seams, close_cracks, crack_rings, relax_iterations, threshold (thesis mode),
-seed_point (x, y, z), symmetry (1 or 4): the CLI's options of the same names (tailor map --help);
-unit_scale: 0 normalises the mesh into the unit cube (as the CLI); > 0 uses coordinates times
-unit_scale instead, so with unit_scale=1, scale is pixels per mesh unit: the same texel density
-on every mesh (the Blender add-on's tile size).
-Raises tailor.Error with the CLI's message on bad options.)");
+      py::arg("smooth") = OrientationOptions{}.smooth_passes, map_docstring().c_str());
 }
 
 }  // namespace tailor::python

@@ -78,6 +78,7 @@ def map(
     seed_point: Optional[Sequence[float]] = None,
     symmetry: Literal[1, 4] = 1,
     unit_scale: float = 0.0,
+    smooth: int = 0,
 ) -> Result: ...
 @overload
 def tile(

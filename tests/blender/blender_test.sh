@@ -18,6 +18,7 @@ bash "$repo/scripts/blender_addon.sh" "$build" "$tmp/tailor_addon.zip" || exit 1
 # TMPDIR: keep both in the temp folder.
 HOME=$tmp/home XDG_CONFIG_HOME=$tmp/config TMPDIR=$tmp PYTHONDONTWRITEBYTECODE=1 \
   blender -b --factory-startup --python-exit-code 1 --python "$repo/tests/blender/test_addon.py" -- \
-  "$tmp/tailor_addon.zip" "$repo/examples/spot.obj" "$repo/examples/gravel.png" "$tailor" "$tmp" 2>&1 |
+  "$tmp/tailor_addon.zip" "$repo/examples/spot.obj" "$repo/examples/gravel.png" "$tailor" "$tmp" \
+  "$([[ -f $build/python/tailor/__init__.py ]] && echo 1 || echo 0)" 2>&1 |
   grep -v "^Read prefs\|^Blender quit$\|^$"
 exit "${PIPESTATUS[0]}"

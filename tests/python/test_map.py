@@ -17,8 +17,8 @@ def without_times(stats):
     [
         (SPOT, dict(texture=GRAVEL), ["--texture", GRAVEL]),
         (DATA / "meshes" / "fandisk.off", dict(axis="auto", texture_size=256), ["--axis", "auto", "--texture-size", "256"]),
-        (DATA / "meshes" / "horse.ply", dict(axis=(0, 1, 0), scale=400, threads=2, close_cracks=False),
-         ["--axis", "0,1,0", "--scale", "400", "--threads", "2", "--no-crack-closing"]),
+        (DATA / "meshes" / "horse.ply", dict(axis=(0, 1, 0), scale=400, threads=2, close_cracks=False, smooth=2),
+         ["--axis", "0,1,0", "--scale", "400", "--threads", "2", "--no-crack-closing", "--smooth", "2"]),
     ],
 )
 def test_map_is_bit_identical_to_the_cli(tmp_path, tailor_binary, mesh_path, options, cli_options):
@@ -131,3 +131,9 @@ def test_seam_faces_that_are_no_array():
     for bad in ("abc", [[1, 2], [3, 4]], [0.5, 2.0], object()):
         with pytest.raises(tailor.Error, match="seam_faces"):
             tailor.map(mesh, seam_faces=bad)
+
+
+def test_map_docstring_carries_the_cli_help(tailor_binary):
+    _, help_text, _ = run_cli(tailor_binary, "map", "--help")
+    for flag in ("--max-stretch", "--hop-age", "--crack-rings", "--relax-iterations", "--symmetry", "--smooth"):
+        assert flag in help_text and flag in tailor.map.__doc__, flag
