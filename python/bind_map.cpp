@@ -14,6 +14,7 @@
 #include "tailor/image.h"
 #include "tailor/mapping.h"
 #include "tailor/report.h"
+#include "tailor/texture_direction.h"
 #include "tailor/topology.h"
 
 namespace tailor::python {
@@ -107,6 +108,8 @@ const std::string& map_docstring() {
         "progress: callable(fraction), called every 50 ms or so and with 1.0 at the end; return False to stop\n"
         "  (tailor.Error 'mapping cancelled'); an exception it raises propagates. Ctrl-C stops the map\n"
         "  (KeyboardInterrupt) with or without it.\n"
+        "field_following: 'auto' (default) as the CLI: 0 with 32 crack rings when texture= has no direction\n"
+        "  (gravel, grass), else 1; crack_rings: None = 16, or auto's choice\n"
         "unit_scale: 0 normalises the mesh into the unit cube (as the CLI); > 0 uses coordinates times unit_scale,\n"
         "  so with unit_scale=1, scale is pixels per mesh unit: one texel density on every mesh (no CLI flag)\n\n"
         "The options with the CLI's help (tailor map --help):\n";
@@ -170,9 +173,9 @@ void bind_map(py::module_& m) {
       "map",
       [](const PyMesh& mesh, int texture_size, float scale, const py::object& axis, const py::object& seam_faces,
          uint32_t threads, const py::object& progress, const py::object& texture, const std::string& mode,
-         float max_stretch, float field_following, uint32_t min_patch_faces, float hop_age, bool shorten_seams,
-         bool close_cracks, uint32_t crack_rings, uint32_t relax_iterations, float threshold,
-         const py::object& seed_point, uint32_t symmetry, float unit_scale, uint32_t smooth) {
+         float max_stretch, const py::object& field_following, uint32_t min_patch_faces, float hop_age,
+         bool shorten_seams, bool close_cracks, const py::object& crack_rings, uint32_t relax_iterations,
+         float threshold, const py::object& seed_point, uint32_t symmetry, float unit_scale, uint32_t smooth) {
         // === Options, checked before any work (the CLI's checks and messages) ===
         MapTextureOptions options;
         MappingOptions& mapping = options.mapping;
@@ -183,12 +186,28 @@ void bind_map(py::module_& m) {
           raise_error("--mode must be patches or thesis, got '" + mode + "'");
         mapping.scale = scale;
         mapping.max_stretch = max_stretch;
-        mapping.field_following = field_following;
+        // 'auto' (the CLI's default): decided by the texture below, as --field-following auto.
+        const bool field_following_auto =
+            py::isinstance<py::str>(field_following) && field_following.cast<std::string>() == "auto";
+        if (!field_following_auto) {
+          float value = -1.f;
+          if (!py::isinstance<py::str>(field_following)) {
+            try {
+              value = field_following.cast<float>();
+            } catch (const py::cast_error&) {
+            }
+          }
+          if (!(value >= 0.f && value <= 1.f))
+            raise_error("--field-following must be auto or a number in [0, 1], got '" +
+                        py::str(field_following).cast<std::string>() + "'");
+          mapping.field_following = value;
+        }
+        run.field_following_auto = field_following_auto;
         mapping.min_patch_faces = min_patch_faces;
         mapping.hop_age = hop_age;
         mapping.shorten_seams = shorten_seams;
         mapping.close_cracks = close_cracks;
-        mapping.crack_rings = crack_rings;
+        if (!crack_rings.is_none()) mapping.crack_rings = crack_rings.cast<uint32_t>();  // else as auto decides
         mapping.relax_iterations = relax_iterations;
         mapping.threshold_px = threshold;
         mapping.symmetry = symmetry;
@@ -216,9 +235,9 @@ void bind_map(py::module_& m) {
         if (Status s = check_map_options(options); !s) raise_status(s);
         // The texture sets the texture size, as --texture does.
         int width = texture_size, height = texture_size;
+        Image image;
         if (!texture.is_none()) {
           run.texture = path_of(texture);
-          Image image;
           Status s;
           {
             const py::gil_scoped_release release;
@@ -227,6 +246,12 @@ void bind_map(py::module_& m) {
           if (!s) raise_status(s);
           width = image.width;
           height = image.height;
+          if (field_following_auto) run.texture_isotropy = texture_isotropy(image);
+        }
+        if (field_following_auto) {
+          const uint32_t rings = mapping.crack_rings;
+          adapt_mapping_to_texture(image, mapping);
+          if (!crack_rings.is_none()) mapping.crack_rings = rings;
         }
         if (Status s = set_map_texture_size(options, width, height); !s) raise_status(s);
         std::vector<uint8_t> seams;
@@ -295,9 +320,9 @@ void bind_map(py::module_& m) {
       py::arg("axis") = "pca", py::arg("seam_faces") = py::none(), py::arg("threads") = md.threads,
       py::arg("progress") = py::none(), py::kw_only(), py::arg("texture") = py::none(),
       py::arg("mode") = mapping_mode_name(md.mode), py::arg("max_stretch") = md.max_stretch,
-      py::arg("field_following") = md.field_following, py::arg("min_patch_faces") = md.min_patch_faces,
+      py::arg("field_following") = "auto", py::arg("min_patch_faces") = md.min_patch_faces,
       py::arg("hop_age") = md.hop_age, py::arg("shorten_seams") = md.shorten_seams,
-      py::arg("close_cracks") = md.close_cracks, py::arg("crack_rings") = md.crack_rings,
+      py::arg("close_cracks") = md.close_cracks, py::arg("crack_rings") = py::none(),
       py::arg("relax_iterations") = md.relax_iterations, py::arg("threshold") = md.threshold_px,
       py::arg("seed_point") = py::none(), py::arg("symmetry") = md.symmetry,
       py::arg("unit_scale") = OrientationOptions{}.fixed_unit_scale,

@@ -16,6 +16,8 @@ def without_times(stats):
     "mesh_path, options, cli_options",
     [
         (SPOT, dict(texture=GRAVEL), ["--texture", GRAVEL]),
+        (SPOT, dict(texture=GRAVEL, field_following=1, crack_rings=8), ["--texture", GRAVEL, "--field-following", "1",
+                                                                         "--crack-rings", "8"]),
         (DATA / "meshes" / "fandisk.off", dict(axis="auto", texture_size=256), ["--axis", "auto", "--texture-size", "256"]),
         (DATA / "meshes" / "horse.ply", dict(axis=(0, 1, 0), scale=400, threads=2, close_cracks=False, smooth=2),
          ["--axis", "0,1,0", "--scale", "400", "--threads", "2", "--no-crack-closing", "--smooth", "2"]),
@@ -37,6 +39,19 @@ def test_map_is_bit_identical_to_the_cli(tmp_path, tailor_binary, mesh_path, opt
     # The UVs as arrays are the file's UVs: reading the .ply back gives the same per-corner bits.
     back = tailor.load(tmp_path / "py.ply")
     assert back.corner_uvs.tobytes() == result.corner_uvs.tobytes()
+
+
+def test_field_following_auto_follows_the_texture():
+    mesh = tailor.load(SPOT)
+    gravel = tailor.map(mesh, texture=GRAVEL)  # no direction: rigid unfolding, 32 crack rings
+    assert gravel.stats["options"]["field_following"] == 0 and gravel.stats["options"]["crack_rings"] == 32
+    assert gravel.stats["options"]["field_following_auto"] and gravel.stats["texture_isotropy"] >= 0.8
+    plain = tailor.map(mesh)  # no texture: the orientation field, as the thesis
+    assert plain.stats["options"]["field_following"] == 1 and "texture_isotropy" not in plain.stats
+    assert tailor.map(mesh, texture=GRAVEL, crack_rings=12).stats["options"]["crack_rings"] == 12
+    for bad in (1.5, -0.1, "sometimes", None):
+        with pytest.raises(tailor.Error, match="--field-following must be auto or a number in"):
+            tailor.map(mesh, field_following=bad)
 
 
 def test_result_arrays(tmp_path):
