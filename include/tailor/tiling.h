@@ -135,6 +135,31 @@ TAILOR_API Status make_tileable(const Image& exemplar, const TileOptions& option
 TAILOR_API Status make_tile_variants(const Image& exemplar, const TileOptions& options, int count,
                                      std::vector<Image>& tiles, TileReport* report = nullptr);
 
+//! One map of a material set (make_tileable_set).
+struct TileMap {
+  Image16 image;        //!< 8- or 16-bit, 1 to 4 channels (alpha is a channel like any other)
+  bool normal = false;  //!< a normal map: blended as unit vectors (the first three channels), renormalised
+};
+
+//! Makes a set of registered maps (colour, normal, roughness, height...) self-tileable together:
+//! one plan of cuts found on a guide holding one channel per map (luminance of colour maps, the
+//! sample of grey ones; more than four maps share channels), so the seam search weighs every map,
+//! and the same cut and source offsets applied to every map, so the outputs stay registered.
+//! tiles[k][m] is variant k (as make_tile_variants) of map m, with its bit depth and channels.
+//! Where a 1 px feather blends two sources at a cut (images above kPlanMaxSide, see below, and
+//! every set), scalar maps are blended per channel and normal maps as vectors, renormalised;
+//! every output normal is renormalised. Fails with kInvalidArgument for an empty set, maps of
+//! different sizes (saying which), symmetry 4, or what make_tile_variants refuses.
+TAILOR_API Status make_tileable_set(const std::vector<TileMap>& maps, const TileOptions& options, int count,
+                                    std::vector<std::vector<Image16>>& tiles, TileReport* report = nullptr);
+
+//! Images whose larger side exceeds this are tiled coarse-to-fine: the quilting plan is found on
+//! a copy reduced to kPlanSide px (the larger side; the block, overlap and search are those of a
+//! kPlanSide px image), then replayed at full size with each block's source refined within
+//! (scale / 2 + 1) px and its cut recomputed inside the scaled overlap.
+inline constexpr int kPlanMaxSide = 640;
+inline constexpr int kPlanSide = 512;
+
 //! Largest absolute 8-bit sample difference between rot90(tile) (a quarter turn) and the tile
 //! shifted toroidally by the best of (0 | N/2, 0 | N/2): 0 for a tile that is exactly unchanged by
 //! a quarter turn about its centre or its corners (shift 0) or about the centre of a quadrant.
