@@ -257,6 +257,74 @@ TEST(TileSetCli, SetAndMaterialWriteTheInputNamesIntoTheFolder) {
   std::filesystem::remove_all(dir);
 }
 
+//! A running-bond brick wall: bricks bw x bh px (rows offset by bw / 2), `mortar` px joints of
+//! grey 150, brick tones 90-150, noise +-40, 3 x 3 box blur; fixed generator (deterministic).
+Image brick_wall(int width, int height, int bw, int bh, int mortar) {
+  uint64_t state = 5;
+  auto next = [&state](int n) {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<int>((state >> 33) % static_cast<uint64_t>(n));
+  };
+  std::vector<int> tone(static_cast<size_t>((height / bh + 1) * (width / bw + 2)));
+  for (int& t : tone) t = 90 + next(61);
+  std::vector<int> raw(static_cast<size_t>(width) * height);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const int course = y / bh, shifted = x + (bw / 2) * (course % 2);
+      const bool joint = y % bh < mortar || shifted % bw < mortar;
+      const int base = joint ? 150 : tone[static_cast<size_t>(course * (width / bw + 2) + shifted / bw)];
+      raw[static_cast<size_t>(y) * width + x] = base + next(81) - 40;
+    }
+  Image im;
+  im.width = width;
+  im.height = height;
+  im.channels = 1;
+  im.pixels.resize(raw.size());
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      int sum = 0;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx)
+          sum += raw[static_cast<size_t>(std::clamp(y + dy, 0, height - 1)) * width + std::clamp(x + dx, 0, width - 1)];
+      im.pixels[static_cast<size_t>(y) * width + x] = static_cast<uint8_t>(std::clamp((sum + 4) / 9, 0, 255));
+    }
+  return im;
+}
+
+TEST(TileRegular, BrickBondsFollowTheirPeriodAndMeetTheStraightSeamTarget) {
+  // 40 x 20 px bricks (period 40 x 40 with the offset rows) in 230 x 190 px: not whole periods.
+  const Image wall = brick_wall(230, 190, 40, 20, 3);
+  const PeriodEstimate p = estimate_period(wall);
+  ASSERT_TRUE(p.found_x && p.found_y);
+  EXPECT_GE(std::min(p.confidence_x, p.confidence_y), kStrongPeriod);
+  Image tile;
+  TileReport report;
+  ASSERT_TRUE(make_tileable(wall, TileOptions{}, tile, &report).is_ok());
+  // By default the size follows the period: whole periods, so courses and joints continue across the wrap.
+  EXPECT_TRUE(report.period_fitted);
+  EXPECT_EQ(tile.width % 40, 0);
+  EXPECT_EQ(tile.height % 40, 0);
+  TileMetrics m;
+  ASSERT_TRUE(tile_metrics(tile, &wall, m).is_ok());
+  std::string failed;
+  EXPECT_TRUE(meets_tile_targets(m, &failed)) << failed;
+  EXPECT_LE(m.worst_seam_ratio, std::max(m.exemplar_worst_seam_ratio, 1.5));
+  // --no-auto-period keeps the size.
+  TileOptions keep;
+  keep.auto_period = false;
+  Image plain;
+  TileReport plain_report;
+  ASSERT_TRUE(make_tileable(wall, keep, plain, &plain_report).is_ok());
+  EXPECT_FALSE(plain_report.period_fitted);
+  EXPECT_EQ(plain.width, 230);
+  // Noise has no strong period: the size is kept.
+  Image gravel_tile;
+  TileReport gravel_report;
+  ASSERT_TRUE(make_tileable(load("vistex-sand05-128.png"), TileOptions{}, gravel_tile, &gravel_report).is_ok());
+  EXPECT_FALSE(gravel_report.period_fitted);
+  EXPECT_EQ(gravel_tile.width, 128);
+}
+
 TEST(TileLarge, CoarseToFineAboveThePlanSizeMeetsTheSeamTargets) {
   // 768 px (above kPlanMaxSide): planned at 512 px, replayed at full size.
   const Image small = load("water-caustics-300.jpg");

@@ -397,6 +397,7 @@ void register_tile(CLI::App& app, Runner& run) {
       ->check(CLI::Range(1, 64));
   const OptionDoc& fit_period = option_doc(kTileOptionDocs, "fit_period");
   cmd->add_flag(std::string(fit_period.flag), options.fit_period, std::string(fit_period.help));
+  add_off_switch(cmd, option_doc(kTileOptionDocs, "auto_period"), options.auto_period);
   add_documented(cmd, option_doc(kTileOptionDocs, "symmetry"), options.symmetry)->check(CLI::IsMember({1, 4}));
   add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), opt->image_options.max_pixels)
       ->check(CLI::PositiveNumber);

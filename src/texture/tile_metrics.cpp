@@ -438,6 +438,23 @@ Status tile_metrics(const Image& tile_in, const Image* exemplar_in, TileMetrics&
   return Status::ok();
 }
 
+namespace internal {
+
+double fast_target_misses(const Image& tile, const Image& exemplar) {
+  if (!check_image(tile).is_ok() || !check_image(exemplar).is_ok() || tile.channels != exemplar.channels) return 1e9;
+  const SeamStats ts = seam_stats(view(tile)), es = seam_stats(view(exemplar));
+  double misses = 0.0;
+  auto over = [&](double value, double limit) { misses += std::max(0.0, value / limit - 1.0); };
+  over(ts.worst_all, std::max(es.worst_interior, 1.5));
+  over(std::max(ts.wrap_x, ts.wrap_y), 1.2);
+  over(0.8, std::min(ts.wrap_x, ts.wrap_y));
+  over(histogram_l1(tile, exemplar), 0.1);
+  over(0.95, ratio(gradient_energy(view(tile)), gradient_energy(view(exemplar))));
+  return misses;
+}
+
+}  // namespace internal
+
 bool meets_tile_targets(const TileMetrics& m, std::string* failed) {
   std::string out;
   auto check = [&](bool ok, const char* what) {
