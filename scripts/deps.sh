@@ -9,7 +9,7 @@ packages=(
   libeigen3-dev libstb-dev zlib1g-dev libcli11-dev nlohmann-json3-dev libfast-float-dev
   libopencv-core-dev libopencv-imgproc-dev libosmesa6-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  clang-format python3
+  clang-format python3 time
   chromium
 )
 # clang + its fuzzer runtime are optional: the fuzz step skips cleanly without them.

@@ -251,6 +251,12 @@ void nearest_patch_costs(const Plane& source, const Plane& target, std::vector<f
     wanted[i] = {hv, static_cast<uint32_t>(i)};
   }
   std::sort(wanted.begin(), wanted.end());
+  // A bit per hash bucket in front of the binary search: most exemplar positions hold no wanted
+  // patch, and the search over 16384 entries per position dominated the cost at 4096 px.
+  constexpr int kFilterBits = 22;
+  std::vector<uint64_t> filter((size_t{1} << kFilterBits) / 64, 0);
+  auto bucket = [](uint64_t hv) { return static_cast<size_t>((hv * 0x9E3779B97F4A7C15ull) >> (64 - kFilterBits)); };
+  for (const auto& entry : wanted) filter[bucket(entry.first) / 64] |= uint64_t{1} << (bucket(entry.first) % 64);
   std::vector<uint8_t> found(count, 0);
   std::vector<uint64_t> rows(static_cast<size_t>(kPatch + 1) * tx), column(static_cast<size_t>(tx), 0);
   auto row_hashes = [&](int y, uint64_t* out) {
@@ -282,6 +288,7 @@ void nearest_patch_costs(const Plane& source, const Plane& target, std::vector<f
     if (v < 0) continue;
     for (int u = 0; u < tx; ++u) {
       const uint64_t hv = column[static_cast<size_t>(u)];
+      if (((filter[bucket(hv) / 64] >> (bucket(hv) % 64)) & 1u) == 0) continue;
       auto it = std::lower_bound(wanted.begin(), wanted.end(), std::make_pair(hv, uint32_t{0}));
       for (; it != wanted.end() && it->first == hv; ++it) {
         const size_t i = it->second;
@@ -350,7 +357,7 @@ int quarter_turn_difference(const Image& tile, int* shift_x, int* shift_y) {
       // rot90(tile)(x, y) = tile(y, n - 1 - x) (the inverse of r in Quilter::set_quarter_turns),
       // against tile((x + sx) % n, (y + sy) % n).
       int worst = 0;
-      for (int y = 0; y < n && (best < 0 || worst < best); ++y)
+      for (int y = 0; y < n && (best < 0 || worst < best) && worst < 255; ++y)
         for (int x = 0; x < n; ++x) {
           const uint8_t* a = &tile.pixels[(static_cast<size_t>(n - 1 - x) * n + y) * c];
           const uint8_t* b = &tile.pixels[(static_cast<size_t>((y + sy) % n) * n + (x + sx) % n) * c];

@@ -44,8 +44,53 @@ struct Replayed {
   int width = 0, height = 0;  // output size (period-fitted or the input's)
   int period_x = 1, period_y = 1;
   double scale = 1.0;
-  int feather = 1;  // px each side of a cut blended: scale / 2, at least 1
+  int feather = 1;         // px each side of a cut blended: scale / 2, at least 1
+  int period_message = 0;  // auto_period: 0 none, 1 fitted, 2 kept
 };
+
+//! auto_period: whether `image` has a strong period (kStrongPeriod) on an axis that changes its
+//! fitted size; estimated on a copy of at most kPlanSide px (periods scaled back).
+bool strong_period(const Image& image, PeriodEstimate& period) {
+  Image small;
+  const int side = std::max(image.width, image.height);
+  const double scale = side > kPlanSide ? static_cast<double>(side) / kPlanSide : 1.0;
+  if (scale > 1.0) {
+    const int w = std::max(32, static_cast<int>(std::lround(image.width / scale)));
+    const int h = std::max(32, static_cast<int>(std::lround(image.height / scale)));
+    if (!resize_image(image, w, h, small).is_ok()) return false;
+  }
+  period = estimate_period(scale > 1.0 ? small : image);
+  period.found_x = period.found_x && period.confidence_x >= kStrongPeriod;
+  period.found_y = period.found_y && period.confidence_y >= kStrongPeriod;
+  if (!period.found_x && !period.found_y) return false;
+  period.period_x *= static_cast<double>(image.width) / (scale > 1.0 ? small.width : image.width);
+  period.period_y *= static_cast<double>(image.height) / (scale > 1.0 ? small.height : image.height);
+  int w = image.width, h = image.height;
+  period_fitted_size(period, image.width, image.height, w, h);
+  return w != image.width || h != image.height;
+}
+
+//! How far `tile` misses the targets against `reference`: the sum of relative excesses of every
+//! target of meets_tile_targets; patch coherence (about 0.1 s at 512 px, seconds at 4096) only up
+//! to kPlanMaxSide, where it is the tightest target (coarse-to-fine tiles have it 10-30 x below
+//! the exemplar's).
+double target_misses(const Image& tile, const Image& reference) {
+  double misses = internal::fast_target_misses(tile, reference);
+  if (std::max(reference.width, reference.height) <= kPlanMaxSide) {
+    TileMetrics m;
+    if (!tile_metrics(tile, &reference, m).is_ok()) return 1e9;
+    misses += std::max(0.0, m.patch_coherence / std::max(m.exemplar_patch_coherence, 1e-12) - 1.0);
+  }
+  return misses;
+}
+
+//! The two auto_period messages (the choice was made, or not).
+std::string period_message(bool fitted, const TileReport& rep) {
+  if (!fitted) return "strong period found, but the period-fitted tile missed more targets: size kept";
+  return "strong period (" + std::to_string(std::lround(rep.period.period_x)) + " x " +
+         std::to_string(std::lround(rep.period.period_y)) + " px): fitted to " + std::to_string(rep.width) + "x" +
+         std::to_string(rep.height) + " (--no-auto-period keeps the size)";
+}
 
 //! Plans on `guide` reduced to kPlanSide (when larger than kPlanMaxSide) and replays at full size.
 //! `guide` is replaced by its period-fitted copy when fit_period changed the size.
@@ -66,6 +111,27 @@ Status plan_and_replay(Image& guide, bool all_channels, const TileOptions& optio
   std::vector<Image> plan_tiles;
   TilePlan plan;
   TAILOR_RETURN_IF_ERROR(internal::plan_tile_variants(reduced, options, count, all_channels, plan_tiles, &rep, &plan));
+  rep.period_fitted = options.fit_period;
+  // auto_period, decided on the plans (the reduced tiles), so only one is replayed at full size.
+  PeriodEstimate period;
+  if (options.auto_period && !options.fit_period && options.symmetry == 1 && strong_period(reduced, period)) {
+    TileOptions fit = options;
+    fit.fit_period = true;
+    std::vector<Image> fit_tiles;
+    TilePlan fit_plan;
+    TileReport fit_rep;
+    TAILOR_RETURN_IF_ERROR(
+        internal::plan_tile_variants(reduced, fit, count, all_channels, fit_tiles, &fit_rep, &fit_plan));
+    const bool fitted = target_misses(fit_tiles[0], reduced) <= target_misses(plan_tiles[0], reduced);
+    if (fitted) {
+      plan = std::move(fit_plan);
+      rep = std::move(fit_rep);
+      rep.period_fitted = true;
+    } else {
+      rep.period = period;
+    }
+    out.period_message = fitted ? 1 : 2;
+  }
   // The plan's exemplar may be period-fitted: the full-size guide is fitted the same way, with
   // the period scaled.
   const int rw = reduced.width, rh = reduced.height;
@@ -107,6 +173,7 @@ Status plan_and_replay(Image& guide, bool all_channels, const TileOptions& optio
   rep.border = bx;
   rep.shift_x = refiner.map_x(rep.shift_x) % guide.width;
   rep.shift_y = refiner.map_y(rep.shift_y) % guide.height;
+  if (out.period_message != 0) rep.warnings.push_back(period_message(out.period_message == 1, rep));
   if (out.scale > 1.0)
     rep.warnings.push_back("planned on a " + std::to_string(rw) + "x" + std::to_string(rh) +
                            " px copy and refined at full size (block " + std::to_string(rep.block) + " px)");
@@ -253,42 +320,6 @@ Status tile_set_once(const std::vector<TileMap>& maps, const TileOptions& option
   return Status::ok();
 }
 
-//! auto_period: whether `image` has a strong period (kStrongPeriod) on an axis that changes its
-//! fitted size; estimated on a copy of at most kPlanSide px (periods scaled back).
-bool strong_period(const Image& image, PeriodEstimate& period) {
-  Image small;
-  const int side = std::max(image.width, image.height);
-  const double scale = side > kPlanSide ? static_cast<double>(side) / kPlanSide : 1.0;
-  if (scale > 1.0) {
-    const int w = std::max(32, static_cast<int>(std::lround(image.width / scale)));
-    const int h = std::max(32, static_cast<int>(std::lround(image.height / scale)));
-    if (!resize_image(image, w, h, small).is_ok()) return false;
-  }
-  period = estimate_period(scale > 1.0 ? small : image);
-  period.found_x = period.found_x && period.confidence_x >= kStrongPeriod;
-  period.found_y = period.found_y && period.confidence_y >= kStrongPeriod;
-  if (!period.found_x && !period.found_y) return false;
-  period.period_x *= static_cast<double>(image.width) / (scale > 1.0 ? small.width : image.width);
-  period.period_y *= static_cast<double>(image.height) / (scale > 1.0 ? small.height : image.height);
-  int w = image.width, h = image.height;
-  period_fitted_size(period, image.width, image.height, w, h);
-  return w != image.width || h != image.height;
-}
-
-//! How far `tile` misses the targets against `reference`: the sum of relative excesses of every
-//! target of meets_tile_targets; patch coherence (about 0.1 s at 512 px, seconds at 4096) only up
-//! to kPlanMaxSide, where it is the tightest target (coarse-to-fine tiles have it 10-30 x below
-//! the exemplar's).
-double target_misses(const Image& tile, const Image& reference) {
-  double misses = internal::fast_target_misses(tile, reference);
-  if (std::max(reference.width, reference.height) <= kPlanMaxSide) {
-    TileMetrics m;
-    if (!tile_metrics(tile, &reference, m).is_ok()) return 1e9;
-    misses += std::max(0.0, m.patch_coherence / std::max(m.exemplar_patch_coherence, 1e-12) - 1.0);
-  }
-  return misses;
-}
-
 //! Runs `once` plain and, for a strongly periodic exemplar, period-fitted; keeps the fitted result
 //! unless it misses the targets by more than the plain one (target_misses of the first tile
 //! against `reference`).
@@ -312,18 +343,15 @@ Status with_auto_period(const Image& reference, const TileOptions& options, Resu
   TAILOR_RETURN_IF_ERROR(once(fit, fitted, fitted_report));
   const double plain_misses = target_misses(first(result), reference);
   const double fitted_misses = target_misses(first(fitted), reference);
-  if (fitted_misses <= plain_misses) {
+  const bool keep_fitted = fitted_misses <= plain_misses;
+  if (keep_fitted) {
     result = std::move(fitted);
     rep = std::move(fitted_report);
     rep.period_fitted = true;
-    rep.warnings.push_back("strong period (" + std::to_string(std::lround(rep.period.period_x)) + " x " +
-                           std::to_string(std::lround(rep.period.period_y)) + " px): fitted to " +
-                           std::to_string(rep.width) + "x" + std::to_string(rep.height) +
-                           " (--no-auto-period keeps the size)");
   } else {
     rep.period = period;
-    rep.warnings.push_back("strong period found, but the period-fitted tile missed more targets: size kept");
   }
+  rep.warnings.push_back(period_message(keep_fitted, rep));
   return Status::ok();
 }
 
@@ -331,6 +359,9 @@ Status with_auto_period(const Image& reference, const TileOptions& options, Resu
 
 Status make_tile_variants(const Image& exemplar, const TileOptions& options, int count, std::vector<Image>& tiles,
                           TileReport* report) {
+  // Above kPlanMaxSide, auto_period is decided between the plans (plan_and_replay).
+  if (std::max(exemplar.width, exemplar.height) > kPlanMaxSide && options.symmetry == 1)
+    return tile_variants_once(exemplar, options, count, tiles, report);
   return with_auto_period(
       exemplar, options, tiles, report,
       [&](const TileOptions& o, std::vector<Image>& out, TileReport& rep) {
@@ -341,18 +372,8 @@ Status make_tile_variants(const Image& exemplar, const TileOptions& options, int
 
 Status make_tileable_set(const std::vector<TileMap>& maps, const TileOptions& options, int count,
                          std::vector<std::vector<Image16>>& tiles, TileReport* report) {
-  // The first map decides (8-bit): its tile against it.
-  const Image reference = maps.empty() ? Image{} : to_image8(maps[0].image);
-  Image first_tile;
-  return with_auto_period(
-      reference, options, tiles, report,
-      [&](const TileOptions& o, std::vector<std::vector<Image16>>& out, TileReport& rep) {
-        return tile_set_once(maps, o, count, out, &rep);
-      },
-      [&first_tile](const std::vector<std::vector<Image16>>& out) -> const Image& {
-        first_tile = to_image8(out[0][0]);
-        return first_tile;
-      });
+  // auto_period is decided between the plans on the guide (plan_and_replay).
+  return tile_set_once(maps, options, count, tiles, report);
 }
 
 }  // namespace tailor
