@@ -258,6 +258,8 @@ int run_tile_set(TileCliOptions opt) {
     outputs.push_back({outdir + "/material.json", "the material description"});
     if (!opt.json.empty()) outputs.push_back({opt.json, "--json"});
     if (Status s = check_outputs(outputs, opt.set); !s) return report_error(s);
+  } else if (!opt.json.empty()) {
+    if (Status s = check_outputs({{opt.json, "--json"}}, opt.set); !s) return report_error(s);
   }
   std::vector<TileMap> maps(opt.set.size());
   for (size_t m = 0; m < opt.set.size(); ++m) {
@@ -296,12 +298,9 @@ int run_tile_set(TileCliOptions opt) {
       return report_error(Status::error(ErrorCode::kIo, outdir, "cannot create the output folder"));
     created = true;
   }
-  auto fail = [&](const Status& s) {
-    if (created) ::rmdir(outdir.c_str());
-    return report_error(s);
-  };
-  int code = kExitOk;
-  {
+  // The writes, with their batch: on a failure the batch is gone (its staged files removed)
+  // before the folder is.
+  const Status written = [&]() -> Status {
     internal::FileBatch batch;
     nlohmann::json material;
     material["normal_convention"] = opt.normal_convention;
@@ -324,12 +323,12 @@ int run_tile_set(TileCliOptions opt) {
     for (int k = 0; k < opt.variants; ++k)
       for (size_t m = 0; m < maps.size(); ++m) {
         const std::string path = file_of(m, k);
-        if (Status s = write_png16(path, tiles[static_cast<size_t>(k)][m]); !s) return fail(s);
+        if (Status s = write_png16(path, tiles[static_cast<size_t>(k)][m]); !s) return s;
         TileQuality q;
         q.file = path;
         run.tiles.push_back(q);
       }
-    if (Status s = internal::write_file_atomic(outdir + "/material.json", material.dump(2) + "\n"); !s) return fail(s);
+    if (Status s = internal::write_file_atomic(outdir + "/material.json", material.dump(2) + "\n"); !s) return s;
     if (!opt.quiet || !opt.json.empty()) {
       // Metrics of every output map against its input (8-bit reductions of 16-bit maps).
       bool all_met = true;
@@ -340,7 +339,7 @@ int run_tile_set(TileCliOptions opt) {
           TileQuality& q = run.tiles[static_cast<size_t>(k) * maps.size() + m];
           const Image tile8 = to_image8(tiles[static_cast<size_t>(k)][m]);
           const Image input8 = to_image8(maps[m].image);
-          if (Status s = tile_metrics(tile8, &input8, q.metrics); !s) return fail(s.with_file(q.file));
+          if (Status s = tile_metrics(tile8, &input8, q.metrics); !s) return s.with_file(q.file);
           q.targets_met = meets_tile_targets(q.metrics, &q.targets_failed);
           if (!q.targets_met) {
             all_met = false;
@@ -352,13 +351,17 @@ int run_tile_set(TileCliOptions opt) {
       run.worst.targets_met = all_met;
       run.worst.targets_failed = failed;
       if (!opt.json.empty()) {
-        if (Status s = internal::write_file_atomic(opt.json, tile_report_json(run)); !s) return fail(s);
+        if (Status s = internal::write_file_atomic(opt.json, tile_report_json(run)); !s) return s;
       }
     }
-    if (Status s = batch.commit(); !s) return fail(s);
+    return batch.commit();
+  }();
+  if (!written) {
+    if (created) ::rmdir(outdir.c_str());
+    return report_error(written);
   }
   if (!opt.quiet) std::fputs(tile_summary(run).c_str(), stdout);
-  return code;
+  return kExitOk;
 }
 
 }  // namespace
