@@ -109,6 +109,23 @@ TEST(TileSet, VariantsAndPeriodFittingKeepTheMapsRegistered) {
     EXPECT_GE(registered_fraction(set[0], set[1]), 0.99);
   }
   EXPECT_NE(tiles[1][0].pixels, tiles[0][0].pixels);
+  // Every variant of every map shares the outer ring of report.border px with the first one.
+  ASSERT_GE(report.border, 1);
+  for (size_t k = 1; k < tiles.size(); ++k)
+    for (size_t m = 0; m < 2; ++m) {
+      const Image16& first = tiles[0][m];
+      const Image16& other = tiles[k][m];
+      size_t differing = 0;
+      for (int y = 0; y < first.height; ++y)
+        for (int x = 0; x < first.width; ++x) {
+          if (x >= report.border && y >= report.border && x < first.width - report.border &&
+              y < first.height - report.border)
+            continue;
+          const size_t i = (static_cast<size_t>(y) * first.width + x) * first.channels;
+          if (!std::equal(&first.pixels[i], &first.pixels[i] + first.channels, &other.pixels[i])) ++differing;
+        }
+      EXPECT_EQ(differing, 0u) << "variant " << k << " map " << m;
+    }
 }
 
 TEST(TileSet, OutputNormalsAreUnitLength) {
@@ -341,6 +358,22 @@ TEST(TileLarge, CoarseToFineAboveThePlanSizeMeetsTheSeamTargets) {
   EXPECT_TRUE(meets_tile_targets(m, &failed)) << failed;
   ASSERT_TRUE(make_tileable(big, TileOptions{}, again).is_ok());
   EXPECT_EQ(tile.pixels, again.pixels);
+  // Variants replayed at full size share the outer ring bit-exactly and differ inside.
+  std::vector<Image> variants;
+  TileReport vr;
+  ASSERT_TRUE(make_tile_variants(big, TileOptions{}, 2, variants, &vr).is_ok());
+  ASSERT_EQ(variants.size(), 2u);
+  EXPECT_EQ(variants[0].pixels, tile.pixels);
+  size_t ring_differs = 0, inside_differs = 0;
+  for (int y = 0; y < 768; ++y)
+    for (int x = 0; x < 768; ++x) {
+      const size_t i = (static_cast<size_t>(y) * 768 + x) * 3;
+      const bool same = std::equal(&variants[0].pixels[i], &variants[0].pixels[i] + 3, &variants[1].pixels[i]);
+      const bool ring = x < vr.border || y < vr.border || x >= 768 - vr.border || y >= 768 - vr.border;
+      if (!same) ++(ring ? ring_differs : inside_differs);
+    }
+  EXPECT_EQ(ring_differs, 0u);
+  EXPECT_GT(inside_differs, 768u * 768u / 4);
 }
 
 }  // namespace
