@@ -6,10 +6,10 @@ set -euo pipefail
 # Build tools and libraries (all Debian packages; see docs/ARCHITECTURE.md for why each is used).
 packages=(
   g++ cmake make pkg-config
-  libeigen3-dev libstb-dev libcli11-dev nlohmann-json3-dev libfast-float-dev
+  libeigen3-dev libstb-dev zlib1g-dev libcli11-dev nlohmann-json3-dev libfast-float-dev
   libopencv-core-dev libopencv-imgproc-dev libosmesa6-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  clang-format python3
+  clang-format python3 time
   pybind11-dev python3-dev python3-numpy python3-pytest
   chromium
 )

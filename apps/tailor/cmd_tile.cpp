@@ -1,10 +1,14 @@
 // tailor tile: make a texture self-tileable (thesis chapter 3), optionally period-fitted and with
 // variants sharing their borders; prints one summary line with the quality metrics and the time.
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
+#include <fstream>
 #include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -20,6 +24,10 @@ namespace {
 struct TileCliOptions {
   std::string input;
   std::string output;
+  std::vector<std::string> set;          // --set: the maps of a material set (-o is then a folder)
+  std::string material;                  // --material: a JSON naming the maps (alternative to --set)
+  std::vector<std::string> normal_maps;  // --normal-map: which of the set's maps are normal maps
+  std::string normal_convention = "gl";  // --normal-convention gl|dx (recorded in OUTDIR/material.json)
   std::string json;
   TileOptions options;             // bound to --block, --overlap, --seed, --fit-period (defaults: TileOptions')
   ImageLoadOptions image_options;  // --max-image-pixels (default: ImageLoadOptions')
@@ -35,7 +43,62 @@ bool ends_with_png(const std::string& path) {
   return ext == ".png";
 }
 
+int run_tile_set(TileCliOptions opt);
+
+//! A 16-bit PNG input: tiled as a set of one map (make_tileable_set keeps the 16 bits).
+int run_tile16(const TileCliOptions& opt, const Image16& input) {
+  TileOptions options = opt.options;
+  Progress progress("tile", opt.quiet);
+  options.progress = [&progress](double f) { return progress.update(f); };
+  std::vector<TileMap> maps(1);
+  maps[0].image = input;
+  TileRun run;
+  run.input = opt.input;
+  run.input_width = input.width;
+  run.input_height = input.height;
+  run.input_channels = input.channels;
+  const std::string stem = opt.output.substr(0, opt.output.size() - 4);
+  run.output = opt.variants == 1 ? opt.output : stem + "_{0.." + std::to_string(opt.variants - 1) + "}.png";
+  run.options = options;
+  run.variants = opt.variants;
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<std::vector<Image16>> tiles;
+  const Status status = make_tileable_set(maps, options, opt.variants, tiles, &run.report);
+  run.seconds = seconds_since(start);
+  progress.done();
+  if (!status) return report_error(status.with_file(opt.input));
+  for (const std::string& w : run.report.warnings) warn(opt.quiet, opt.input + ": " + w);
+  internal::FileBatch batch;
+  run.tiles.resize(tiles.size());
+  for (size_t k = 0; k < tiles.size(); ++k) {
+    const std::string path = opt.variants == 1 ? opt.output : stem + "_" + std::to_string(k) + ".png";
+    if (Status s = write_png16(path, tiles[k][0]); !s) return report_error(s);
+    run.tiles[k].file = path;
+  }
+  if (opt.variants > 1) {
+    if (Status s = internal::write_file_atomic(stem + ".json", tile_variants_json(run)); !s) return report_error(s);
+  }
+  if (!opt.quiet || !opt.json.empty()) {
+    const Image input8 = to_image8(input);
+    for (size_t k = 0; k < tiles.size(); ++k) {
+      TileQuality& tile = run.tiles[k];
+      if (Status s = tile_metrics(to_image8(tiles[k][0]), &input8, tile.metrics); !s)
+        return report_error(s.with_file(tile.file));
+      tile.targets_met = meets_tile_targets(tile.metrics, &tile.targets_failed);
+    }
+    run.worst.metrics = worst_tile_metrics(run.tiles);
+    run.worst.targets_met = meets_tile_targets(run.worst.metrics, &run.worst.targets_failed);
+    if (!opt.json.empty()) {
+      if (Status s = internal::write_file_atomic(opt.json, tile_report_json(run)); !s) return report_error(s);
+    }
+  }
+  if (Status s = batch.commit(); !s) return report_error(s);
+  if (!opt.quiet) std::fputs(tile_summary(run).c_str(), stdout);
+  return kExitOk;
+}
+
 int run_tile(const TileCliOptions& opt) {
+  if (!opt.set.empty() || !opt.material.empty()) return run_tile_set(opt);
   if (!ends_with_png(opt.output))
     return report_error(Status::error(ErrorCode::kInvalidArgument, opt.output, "output must be a .png file"));
   // Every file this run writes, checked before any work so that a refused run writes nothing.
@@ -49,7 +112,12 @@ int run_tile(const TileCliOptions& opt) {
     if (Status s = check_outputs(outputs, {opt.input}); !s) return report_error(s);
   }
   Image exemplar;
-  if (Status s = load_image(opt.input, exemplar, opt.image_options); !s) return report_error(s);
+  {
+    Image16 deep;
+    if (Status s = load_image16(opt.input, deep, opt.image_options); !s) return report_error(s);
+    if (deep.bits == 16) return run_tile16(opt, deep);
+    exemplar = to_image8(deep);
+  }
 
   TileOptions options = opt.options;
   Progress progress("tile", opt.quiet);
@@ -104,16 +172,224 @@ int run_tile(const TileCliOptions& opt) {
   return kExitOk;
 }
 
+std::string base_name(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+std::string dir_name(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? "." : path.substr(0, slash);
+}
+
+//! The set's output name: the input's file name, extension replaced by .png.
+std::string png_name(const std::string& path) {
+  std::string name = base_name(path);
+  const size_t dot = name.find_last_of('.');
+  if (dot != std::string::npos && dot > 0) name = name.substr(0, dot);
+  return name + ".png";
+}
+
+//! --material JSON: {"maps": [{"file": "color.png"}, {"file": "normal.png", "normal": true}, ...],
+//! "normal_convention": "gl"}; files relative to the JSON's folder. Fills opt.set / normal_maps.
+Status read_material(TileCliOptions& opt) {
+  std::ifstream in(opt.material);
+  if (!in) return Status::error(ErrorCode::kIo, opt.material, "cannot open the material description");
+  std::stringstream text;
+  text << in.rdbuf();
+  const nlohmann::json j = nlohmann::json::parse(text.str(), nullptr, false);
+  if (j.is_discarded() || !j.is_object() || !j.contains("maps") || !j["maps"].is_array() || j["maps"].empty())
+    return Status::error(ErrorCode::kInvalidArgument, opt.material,
+                         "not a material description (expected {\"maps\": [{\"file\": ...}, ...]})");
+  const std::string dir = dir_name(opt.material);
+  for (size_t i = 0; i < j["maps"].size(); ++i) {
+    const nlohmann::json& m = j["maps"][i];
+    if (!m.is_object() || !m.contains("file") || !m["file"].is_string())
+      return Status::error(ErrorCode::kInvalidArgument, opt.material, "map without a \"file\" string",
+                           "maps[" + std::to_string(i) + "]");
+    std::string file = m["file"].get<std::string>();
+    if (file.empty() || file[0] != '/') file = dir + "/" + file;
+    opt.set.push_back(file);
+    const bool normal = (m.contains("normal") && m["normal"].is_boolean() && m["normal"].get<bool>()) ||
+                        (m.contains("type") && m["type"].is_string() && m["type"].get<std::string>() == "normal");
+    if (normal) opt.normal_maps.push_back(file);
+  }
+  if (j.contains("normal_convention") && j["normal_convention"].is_string())
+    opt.normal_convention = j["normal_convention"].get<std::string>();
+  if (opt.normal_convention != "gl" && opt.normal_convention != "dx")
+    return Status::error(ErrorCode::kInvalidArgument, opt.material, "normal_convention must be \"gl\" or \"dx\"");
+  return Status::ok();
+}
+
+//! tailor tile --set / --material: one cut for every map (make_tileable_set), outputs named as
+//! the inputs inside the output folder, plus OUTDIR/material.json describing them.
+int run_tile_set(TileCliOptions opt) {
+  if (!opt.material.empty()) {
+    if (Status s = read_material(opt); !s) return report_error(s);
+  }
+  const std::string outdir = opt.output;
+  struct stat st {};
+  const bool existed = ::stat(outdir.c_str(), &st) == 0;
+  if (existed && !S_ISDIR(st.st_mode))
+    return report_error(Status::error(ErrorCode::kInvalidArgument, outdir,
+                                      "with --set or --material, -o names an output folder, not a file"));
+  for (const std::string& n : opt.normal_maps)
+    if (std::find(opt.set.begin(), opt.set.end(), n) == opt.set.end())
+      return report_error(Status::error(ErrorCode::kInvalidArgument, n,
+                                        "--normal-map must name one of the set's maps (the same path as in --set)"));
+  // Output names (inside OUTDIR), checked before any work.
+  std::vector<std::string> names;
+  for (const std::string& in : opt.set) {
+    const std::string name = png_name(in);
+    if (std::find(names.begin(), names.end(), name) != names.end())
+      return report_error(Status::error(ErrorCode::kInvalidArgument, in,
+                                        "two maps of the set would be written to the same file name",
+                                        outdir + "/" + name));
+    names.push_back(name);
+  }
+  auto file_of = [&](size_t m, int k) {
+    const std::string stem = names[m].substr(0, names[m].size() - 4);
+    return outdir + "/" + (opt.variants == 1 ? names[m] : stem + "_" + std::to_string(k) + ".png");
+  };
+  if (existed) {
+    std::vector<OutputPath> outputs;
+    for (size_t m = 0; m < names.size(); ++m)
+      for (int k = 0; k < opt.variants; ++k) outputs.push_back({file_of(m, k), "--output"});
+    outputs.push_back({outdir + "/material.json", "the material description"});
+    if (!opt.json.empty()) outputs.push_back({opt.json, "--json"});
+    if (Status s = check_outputs(outputs, opt.set); !s) return report_error(s);
+  } else if (!opt.json.empty()) {
+    if (Status s = check_outputs({{opt.json, "--json"}}, opt.set); !s) return report_error(s);
+  }
+  std::vector<TileMap> maps(opt.set.size());
+  for (size_t m = 0; m < opt.set.size(); ++m) {
+    if (Status s = load_image16(opt.set[m], maps[m].image, opt.image_options); !s) return report_error(s);
+    maps[m].normal = std::find(opt.normal_maps.begin(), opt.normal_maps.end(), opt.set[m]) != opt.normal_maps.end();
+    if (maps[m].image.width != maps[0].image.width || maps[m].image.height != maps[0].image.height)
+      return report_error(
+          Status::error(ErrorCode::kInvalidImage, opt.set[m], "every map of a set must have the same size",
+                        std::to_string(maps[m].image.width) + "x" + std::to_string(maps[m].image.height) + ", but " +
+                            base_name(opt.set[0]) + " is " + std::to_string(maps[0].image.width) + "x" +
+                            std::to_string(maps[0].image.height)));
+  }
+  TileOptions options = opt.options;
+  Progress progress("tile", opt.quiet);
+  options.progress = [&progress](double f) { return progress.update(f); };
+  TileRun run;
+  run.input = opt.set[0];
+  run.input_width = maps[0].image.width;
+  run.input_height = maps[0].image.height;
+  run.input_channels = maps[0].image.channels;
+  run.output = outdir + "/";
+  run.options = options;
+  run.variants = opt.variants;
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<std::vector<Image16>> tiles;
+  const Status status = make_tileable_set(maps, options, opt.variants, tiles, &run.report);
+  run.seconds = seconds_since(start);
+  progress.done();
+  if (!status) return report_error(status.with_file(opt.material.empty() ? opt.set[0] : opt.material));
+  for (const std::string& w : run.report.warnings) warn(opt.quiet, opt.set[0] + ": " + w);
+
+  // Everything is staged and lands together; a folder this run created is removed on failure.
+  bool created = false;
+  if (!existed) {
+    if (::mkdir(outdir.c_str(), 0777) != 0)
+      return report_error(Status::error(ErrorCode::kIo, outdir, "cannot create the output folder"));
+    created = true;
+  }
+  // The writes, with their batch: on a failure the batch is gone (its staged files removed)
+  // before the folder is.
+  const Status written = [&]() -> Status {
+    internal::FileBatch batch;
+    nlohmann::json material;
+    material["normal_convention"] = opt.normal_convention;
+    material["maps"] = nlohmann::json::array();
+    for (size_t m = 0; m < maps.size(); ++m) {
+      nlohmann::json entry;
+      entry["file"] = names[m];
+      entry["source"] = opt.set[m];
+      entry["normal"] = maps[m].normal;
+      entry["bits"] = maps[m].image.bits;
+      entry["channels"] = maps[m].image.channels;
+      if (opt.variants > 1) {
+        entry["variants"] = nlohmann::json::array();
+        for (int k = 0; k < opt.variants; ++k) entry["variants"].push_back(base_name(file_of(m, k)));
+      }
+      material["maps"].push_back(entry);
+    }
+    material["width"] = run.report.width;
+    material["height"] = run.report.height;
+    for (int k = 0; k < opt.variants; ++k)
+      for (size_t m = 0; m < maps.size(); ++m) {
+        const std::string path = file_of(m, k);
+        if (Status s = write_png16(path, tiles[static_cast<size_t>(k)][m]); !s) return s;
+        TileQuality q;
+        q.file = path;
+        run.tiles.push_back(q);
+      }
+    if (Status s = internal::write_file_atomic(outdir + "/material.json", material.dump(2) + "\n"); !s) return s;
+    if (!opt.quiet || !opt.json.empty()) {
+      // Metrics of every output map against its input (8-bit reductions of 16-bit maps).
+      bool all_met = true;
+      std::string failed;
+      std::vector<TileQuality> first_map;
+      for (int k = 0; k < opt.variants; ++k)
+        for (size_t m = 0; m < maps.size(); ++m) {
+          TileQuality& q = run.tiles[static_cast<size_t>(k) * maps.size() + m];
+          const Image tile8 = to_image8(tiles[static_cast<size_t>(k)][m]);
+          const Image input8 = to_image8(maps[m].image);
+          if (Status s = tile_metrics(tile8, &input8, q.metrics); !s) return s.with_file(q.file);
+          q.targets_met = meets_tile_targets(q.metrics, &q.targets_failed);
+          if (!q.targets_met) {
+            all_met = false;
+            failed += (failed.empty() ? "" : "; ") + names[m] + ": " + q.targets_failed;
+          }
+          if (m == 0) first_map.push_back(q);
+        }
+      run.worst.metrics = worst_tile_metrics(first_map);
+      run.worst.targets_met = all_met;
+      run.worst.targets_failed = failed;
+      if (!opt.json.empty()) {
+        if (Status s = internal::write_file_atomic(opt.json, tile_report_json(run)); !s) return s;
+      }
+    }
+    return batch.commit();
+  }();
+  if (!written) {
+    if (created) ::rmdir(outdir.c_str());
+    return report_error(written);
+  }
+  if (!opt.quiet) std::fputs(tile_summary(run).c_str(), stdout);
+  return kExitOk;
+}
+
 }  // namespace
 
 void register_tile(CLI::App& app, Runner& run) {
   auto opt = std::make_shared<TileCliOptions>();
   auto* cmd = app.add_subcommand("tile", "Make a texture image self-tileable (quadrant swap + image quilting)");
-  cmd->add_option("input", opt->input, "Texture image (.png .jpg .tga .bmp, 8-bit or 16-bit PNG)")->required();
+  cmd->add_option("input", opt->input,
+                  "Texture image (.png .jpg .tga .bmp; a 16-bit PNG gives a 16-bit tile); not with --set");
   cmd->add_option("-o,--output", opt->output,
                   "Output .png (with --variants: NAME_0.png ... and NAME.json); a symlink is written through (its "
-                  "target replaced)")
+                  "target replaced). With --set or --material: the output folder (created if missing)")
       ->required();
+  cmd->add_option("--set", opt->set,
+                  "Maps of one material (colour, normal, roughness, height...), all the same size: one cut for "
+                  "all, written under their own names (as .png) into the -o folder with material.json")
+      ->expected(1, -1);
+  cmd->add_option("--material", opt->material,
+                  "JSON naming the maps instead of --set: {\"maps\": [{\"file\": \"color.png\"}, {\"file\": "
+                  "\"normal.png\", \"normal\": true}], \"normal_convention\": \"gl\"} (files relative to it)");
+  cmd->add_option("--normal-map", opt->normal_maps,
+                  "A map of the set that is a normal map (its path as given to --set): blended as vectors and "
+                  "renormalised; may be repeated");
+  cmd->add_option("--normal-convention", opt->normal_convention,
+                  "Normal map convention, gl (+Y up) or dx (-Y): recorded in material.json (blending and "
+                  "renormalising do not depend on it)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"gl", "dx"}));
   TileOptions& options = opt->options;
   add_documented(cmd, option_doc(kTileOptionDocs, "block"), options.block)->check(CLI::Range(8, 256));
   const OptionDoc& overlap = option_doc(kTileOptionDocs, "overlap");  // its default, 0, stands for block/4
@@ -124,6 +400,7 @@ void register_tile(CLI::App& app, Runner& run) {
       ->check(CLI::Range(1, 64));
   const OptionDoc& fit_period = option_doc(kTileOptionDocs, "fit_period");
   cmd->add_flag(std::string(fit_period.flag), options.fit_period, std::string(fit_period.help));
+  add_off_switch(cmd, option_doc(kTileOptionDocs, "auto_period"), options.auto_period);
   add_documented(cmd, option_doc(kTileOptionDocs, "symmetry"), options.symmetry)->check(CLI::IsMember({1, 4}));
   add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), opt->image_options.max_pixels)
       ->check(CLI::PositiveNumber);
@@ -134,10 +411,20 @@ void register_tile(CLI::App& app, Runner& run) {
       "  tailor tile bricks.jpg -o bricks_tile.png\n"
       "  tailor tile bricks.jpg -o bricks.png --fit-period --variants 4   # bricks_0..3.png + bricks.json\n"
       "  tailor tile gravel.png -o gravel_tile.png --symmetry 4         # also unchanged by a quarter turn\n"
+      "  tailor tile --set color.png normal.png rough.png --normal-map normal.png -o tiled/   # one cut for all\n"
       "  tailor eval-tile bricks_tile.png bricks.jpg                     # check the result");
   cmd->callback([&run, opt] {
     run = [opt] {
       const TileOptions& o = opt->options;
+      const bool is_set = !opt->set.empty() || !opt->material.empty();
+      if (is_set == !opt->input.empty() || (!opt->set.empty() && !opt->material.empty()))
+        return report_error(Status::error(ErrorCode::kInvalidArgument, "",
+                                          "give one input image, or --set MAPS..., or --material JSON"));
+      if (!opt->normal_maps.empty() && opt->set.empty())
+        return report_error(Status::error(ErrorCode::kInvalidArgument, "", "--normal-map needs --set"));
+      if (is_set && o.symmetry == 4)
+        return report_error(
+            Status::error(ErrorCode::kInvalidArgument, "", "--symmetry 4 is not available for map sets"));
       if (o.overlap != 0 && o.overlap > o.block / 2 - 1)
         return report_error(Status::error(ErrorCode::kInvalidArgument, "", "--overlap must be at most block/2 - 1",
                                           "block " + std::to_string(o.block)));

@@ -33,6 +33,18 @@ struct ImageF {
   bool empty() const { return pixels.empty(); }
 };
 
+//! 8- or 16-bit image (the two depths of PNG), same layout; samples lie in [0, 2^bits - 1] and are
+//! stored in 16 bits whatever the depth. Map sets (tiling.h) use it so that 16-bit height maps keep
+//! their precision.
+struct Image16 {
+  int width = 0;
+  int height = 0;
+  int channels = 0;
+  int bits = 8;                  //!< 8 or 16
+  std::vector<uint16_t> pixels;  //!< width * height * channels samples
+  bool empty() const { return pixels.empty(); }
+};
+
 //! Largest width or height accepted by the readers (absurd sizes are rejected before decoding).
 inline constexpr int kMaxImageSide = 16384;
 
@@ -52,7 +64,7 @@ inline constexpr OptionDoc kImageLoadOptionDocs[] = {
      "each side is also limited to 16384 px"},
 };
 
-//! Reads PNG (8 or 16 bit; 16-bit is reduced to 8), JPEG, TGA, BMP or binary PPM/PGM with 1-4
+//! Reads PNG (8 or 16 bit; 16-bit is reduced to 8: see load_image16), JPEG, TGA, BMP or binary PPM/PGM with 1-4
 //! channels. Untrusted input: before decoding, the header's size is checked against kMaxImageSide
 //! and options.max_pixels, and for uncompressed formats (TGA, BMP, PPM/PGM) against the file's
 //! length (a 30-byte file claiming 4000 x 4000 px is refused as truncated without allocating).
@@ -61,5 +73,19 @@ TAILOR_API Status load_image(const std::string& path, Image& image, const ImageL
 
 //! Writes a PNG atomically (temporary file, then rename).
 TAILOR_API Status write_png(const std::string& path, const Image& image);
+
+//! Like load_image, but a 16-bit PNG keeps its 16 bits (bits = 16); every other image is read
+//! as 8 bits (bits = 8, samples widened to 16-bit storage). Same checks and errors.
+TAILOR_API Status load_image16(const std::string& path, Image16& image, const ImageLoadOptions& options = {});
+
+//! Writes an 8- or 16-bit PNG (by image.bits) atomically. Fails with kInvalidImage for an
+//! inconsistent image (sizes as check_image, bits not 8 or 16, a sample above 2^bits - 1).
+TAILOR_API Status write_png16(const std::string& path, const Image16& image);
+
+//! The 8-bit image of an Image16: 16-bit samples scaled by 255 / 65535 and rounded.
+TAILOR_API Image to_image8(const Image16& image);
+
+//! The Image16 (bits = 8) of an 8-bit image.
+TAILOR_API Image16 to_image16(const Image& image);
 
 }  // namespace tailor

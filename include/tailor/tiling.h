@@ -43,9 +43,12 @@
 // Images follow the layout of image.h (1 to 4 channels; alpha is just a channel, except that the
 // FFT search of 3- and 4-channel images runs on the RGB luminance; the ranking uses all channels).
 // Cost: O(blocks * N log N) for an N-pixel exemplar (one FFT correlation per block); about 0.6 s
-// for a 512 x 512 RGB or grey exemplar on one core (5-6 s for 1024 x 1024), twice that when a
-// second try is needed; about 0.07 s for 128 x 128 (several attempts). Memory: a few float
-// copies of the exemplar plus up to 8 FFT spectra.
+// for a 512 x 512 RGB or grey exemplar on one core, twice that when a second try is needed; about
+// 0.07 s for 128 x 128 (several attempts). Memory: a few float copies of the exemplar plus up to 8
+// FFT spectra. Images above kPlanMaxSide (640 px) are planned on a 512 px copy and replayed at full
+// size (see kPlanMaxSide): 2048 x 2048 in ~0.8 s, 4096 x 4096 in ~2.5 s, about 10 bytes a pixel
+// besides the input and output. With auto_period (default) a strongly periodic exemplar is tiled
+// twice (plain and period-fitted).
 // Deterministic: same input + options -> bit-identical output. Safe for untrusted images (sizes
 // are checked; nothing is assumed about the pixel values).
 #pragma once
@@ -72,9 +75,12 @@ struct TileOptions {
   uint64_t seed = 1;        //!< seeds the random choice among near-best blocks; same seed -> same tile
   double tolerance = 0.1;   //!< candidate blocks have SSD <= best * (1 + tolerance), [0, 1]
   bool fit_period = false;  //!< crop/extend to a whole number of texel periods first (thesis 3.1)
-  int symmetry = 1;         //!< 1: plain tile; 4: also unchanged by a quarter turn (square output, one tile,
-                            //!< no fit_period; see make_tileable)
-  TileProgress progress;    //!< optional progress callback (may be empty)
+  bool auto_period =
+      true;          //!< without fit_period: when a strong period is detected (confidence >= kStrongPeriod),
+                     //!< also make the period-fitted tile and keep it unless it misses a target the plain one meets
+  int symmetry = 1;  //!< 1: plain tile; 4: also unchanged by a quarter turn (square output, one tile,
+                     //!< no fit_period; see make_tileable)
+  TileProgress progress;  //!< optional progress callback (may be empty)
 };
 
 //! Flags and help of the TileOptions a user sets (option_doc.h).
@@ -83,6 +89,9 @@ inline constexpr OptionDoc kTileOptionDocs[] = {
     {"overlap", "--overlap", "Block overlap in px (when not given: block/4)"},
     {"seed", "--seed", "Seed of the random block choice (same seed, same output)"},
     {"fit_period", "--fit-period", "Crop or extend to a whole number of texel periods (regular patterns)"},
+    {"auto_period", "--no-auto-period",
+     "Do not fit a strongly periodic texture (bricks, tiles, planks) to its period by default (auto: the fitted tile "
+     "is kept unless it misses a seam or histogram target the plain one meets)"},
     {"symmetry", "--symmetry",
      "1 or 4: 4 makes a square tile that is also unchanged by a quarter turn (rot90(tile) == tile), for "
      "stochastic textures (gravel, sand, bark, moss); directional ones (bricks, planks, grain) cannot look "
@@ -112,7 +121,8 @@ struct TileReport {
   double anisotropy = 0.0;  //!< symmetry 4: orientation_anisotropy() of the exemplar (> 0.5 warns)
   int quarter_turn_difference = -1;   //!< symmetry 4: quarter_turn_difference() of the tile (0: exact)
   int blocks = 0;                     //!< quilting blocks placed (all variants)
-  PeriodEstimate period;              //!< filled when fit_period was asked for
+  PeriodEstimate period;              //!< filled when fit_period was asked for, or auto_period found a strong one
+  bool period_fitted = false;         //!< the output was fitted to the period (fit_period, or auto_period chose it)
   std::vector<std::string> warnings;  //!< e.g. "block shrunk from 32 to 16 px for a 64 px image"
 };
 
@@ -134,6 +144,35 @@ TAILOR_API Status make_tileable(const Image& exemplar, const TileOptions& option
 //! Cost: make_tileable plus 4 FFT block searches per extra tile.
 TAILOR_API Status make_tile_variants(const Image& exemplar, const TileOptions& options, int count,
                                      std::vector<Image>& tiles, TileReport* report = nullptr);
+
+//! One map of a material set (make_tileable_set).
+struct TileMap {
+  Image16 image;        //!< 8- or 16-bit, 1 to 4 channels (alpha is a channel like any other)
+  bool normal = false;  //!< a normal map: blended as unit vectors (the first three channels), renormalised
+};
+
+//! Makes a set of registered maps (colour, normal, roughness, height...) self-tileable together:
+//! one plan of cuts found on a guide holding one channel per map (luminance of colour maps, the
+//! sample of grey ones; more than four maps share channels), so the seam search weighs every map,
+//! and the same cut and source offsets applied to every map, so the outputs stay registered.
+//! tiles[k][m] is variant k (as make_tile_variants) of map m, with its bit depth and channels.
+//! Within max(1, scale / 2) px of a cut (scale: full size / plan size, see kPlanMaxSide) the
+//! sources of both sides are blended: scalar maps per channel, normal maps as vectors; every
+//! output normal is renormalised. Small sets are planned at full size (scale 1, 1 px feather). Fails with
+//! kInvalidArgument for an empty set, maps of different sizes (saying which), symmetry 4, or what make_tile_variants
+//! refuses.
+TAILOR_API Status make_tileable_set(const std::vector<TileMap>& maps, const TileOptions& options, int count,
+                                    std::vector<std::vector<Image16>>& tiles, TileReport* report = nullptr);
+
+//! Images whose larger side exceeds this are tiled coarse-to-fine: the quilting plan is found on
+//! a copy reduced to kPlanSide px (the larger side; the block, overlap and search are those of a
+//! kPlanSide px image), then replayed at full size with each block's source refined within
+//! (scale / 2 + 1) px and its cut recomputed inside the scaled overlap.
+inline constexpr int kPlanMaxSide = 640;
+//! auto_period: an axis whose period confidence reaches this is strongly periodic (shared photos:
+//! VisTex tile 0.56 / 0.66, fabric 0.47 along x; brick 0.23, the stochastic ones below 0.1).
+inline constexpr double kStrongPeriod = 0.3;
+inline constexpr int kPlanSide = 512;
 
 //! Largest absolute 8-bit sample difference between rot90(tile) (a quarter turn) and the tile
 //! shifted toroidally by the best of (0 | N/2, 0 | N/2): 0 for a tile that is exactly unchanged by

@@ -82,7 +82,8 @@ std::string tile_report_json(const TileRun& run) {
   j["border_px"] = report.border;
   j["blocks"] = report.blocks;
   j["seconds"] = run.seconds;
-  if (run.options.fit_period) j["period"] = period_json(report.period);
+  if (run.options.fit_period || report.period_fitted) j["period"] = period_json(report.period);
+  j["period_fitted"] = report.period_fitted;
   j["symmetry"] = report.symmetry;
   if (report.symmetry == 4) {
     // The check of the tile as written: rot90(tile) against the tile, 0 = exact.

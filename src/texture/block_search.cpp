@@ -7,11 +7,11 @@
 
 namespace tailor::internal {
 
-void SsdSearch::init(const Plane& exemplar) {
+void SsdSearch::init(const Plane& exemplar, bool all_channels) {
   ex_ = &exemplar;
   // Colour exemplars are searched in luminance (one correlation instead of three); the near-best
   // candidates are then ranked in full colour by their cut patches (Quilter::patch_cost).
-  search_channels_ = exemplar.channels >= 3 ? 1 : exemplar.channels;
+  search_channels_ = exemplar.channels >= 3 && !all_channels ? 1 : exemplar.channels;
   const int dft_w = cv::getOptimalDFTSize(exemplar.width);
   const int dft_h = cv::getOptimalDFTSize(exemplar.height);
   // Circular correlation is exact for the valid positions p <= size - block: p + q < size <= dft size.

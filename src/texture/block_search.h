@@ -15,7 +15,8 @@ namespace tailor::internal {
 //! SSD of a masked B x B template against every B x B block of the exemplar, by FFT.
 class SsdSearch {
  public:
-  void init(const Plane& exemplar);
+  //! all_channels: search every channel (a map set's guide) instead of a colour image's luminance.
+  void init(const Plane& exemplar, bool all_channels = false);
 
   //! Search sample c of a pixel: the channel itself, or the luminance (Rec. 601) of a colour pixel.
   float sample(const float* p, int c) const {

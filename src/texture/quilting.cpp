@@ -9,6 +9,8 @@
 #include <utility>
 #include <vector>
 
+#include "texture/cut_refine.h"
+
 namespace tailor::internal {
 namespace {
 
@@ -16,33 +18,6 @@ constexpr double kCostTolerance = 0.01;  // blocks whose patch cost is within th
 constexpr size_t kScanKeep = 8;        // the SSD scan keeps at least this many lowest positions (see select_candidates)
 constexpr double kProfilePower = 8.0;  // cost * (1 + relative profile deficit)^this
 constexpr double kStrongLine = 2.0;    // lines whose difference exceeds this x the median may not get stronger
-
-//! Minimum-error path through a strip of `length` x `width` errors (err[i * width + j], i along the
-//! strip): one j per i, |j(i) - j(i-1)| <= 1. Dynamic programming, ties to the smaller j.
-void min_error_path(const std::vector<float>& err, int length, int width, std::vector<float>& cost,
-                    std::vector<int>& path) {
-  cost.assign(err.begin(), err.begin() + static_cast<size_t>(length) * width);
-  for (int i = 1; i < length; ++i) {
-    for (int j = 0; j < width; ++j) {
-      float best = cost[static_cast<size_t>(i - 1) * width + j];
-      if (j > 0) best = std::min(best, cost[static_cast<size_t>(i - 1) * width + j - 1]);
-      if (j + 1 < width) best = std::min(best, cost[static_cast<size_t>(i - 1) * width + j + 1]);
-      cost[static_cast<size_t>(i) * width + j] += best;
-    }
-  }
-  path.assign(static_cast<size_t>(length), 0);
-  int j = 0;
-  for (int k = 1; k < width; ++k)
-    if (cost[static_cast<size_t>(length - 1) * width + k] < cost[static_cast<size_t>(length - 1) * width + j]) j = k;
-  path[static_cast<size_t>(length - 1)] = j;
-  for (int i = length - 2; i >= 0; --i) {
-    int next = j;
-    for (int k = std::max(0, j - 1); k <= std::min(width - 1, j + 1); ++k)
-      if (cost[static_cast<size_t>(i) * width + k] < cost[static_cast<size_t>(i) * width + next]) next = k;
-    j = next;
-    path[static_cast<size_t>(i)] = j;
-  }
-}
 
 }  // namespace
 
@@ -129,6 +104,7 @@ void Quilter::place(int bx, int by, int bw, int bh, const Exclusion& exclusion) 
   }
   const int px = chosen % nx;
   const int py = chosen / nx;
+  if (record_) record_->push_back({bx, by, bw, bh, px, py});
 
   // Boundary cuts on every side whose overlap strip holds known pixels.
   compute_error(px, py);

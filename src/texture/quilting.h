@@ -33,6 +33,13 @@ struct Exclusion {
   bool contains(int px, int py) const { return active && std::abs(px - x) < radius && std::abs(py - y) < radius; }
 };
 
+//! One block as placed: canvas rectangle (bx, by, bw, bh; bx, by modulo the canvas size) and the
+//! exemplar block (px, py) chosen for it. The list of a run is its plan (cut_refine.h replays it
+//! at full size).
+struct Placement {
+  int bx = 0, by = 0, bw = 0, bh = 0, px = 0, py = 0;
+};
+
 //! Image quilting on a toroidal canvas: known[] marks pixels that hold valid texture (fixed or
 //! already synthesised), locked[] those that must never change (the weight map's zeros).
 class Quilter {
@@ -79,6 +86,9 @@ class Quilter {
   //! the patch cost sees rotated copies as copies. The caller keeps blocks from overlapping their
   //! own images.
   void set_quarter_turns(const std::vector<Plane>* turns) { turns_ = turns; }
+
+  //! Appends every placement to `record` (may be null).
+  void set_record(std::vector<Placement>* record) { record_ = record; }
 
  private:
   //! candidates_ = the positions within the SSD tolerance of the best (raster order), excluded
@@ -150,6 +160,7 @@ class Quilter {
   int skip_first_ = 0, skip_count_ = 0;
   std::vector<uint8_t> strong_rows_, strong_cols_;
   const std::vector<Plane>* turns_ = nullptr;
+  std::vector<Placement>* record_ = nullptr;
 };
 
 }  // namespace tailor::internal

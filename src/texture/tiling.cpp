@@ -19,6 +19,7 @@
 #include <limits>
 
 #include "tailor/image_ops.h"
+#include "texture/cut_refine.h"
 #include "texture/quilting.h"
 #include "texture/tiling_util.h"
 
@@ -27,8 +28,10 @@ namespace tailor {
 using internal::Exclusion;
 using internal::Plane;
 using internal::Quilter;
+using internal::SessionRecord;
 using internal::SplitMix64;
 using internal::SsdSearch;
+using internal::TilePlan;
 
 namespace {
 
@@ -291,7 +294,7 @@ struct CrossPlan {
 //! Base tile: shift, then quilt the vertical arm, the horizontal arm and the centre.
 //! cut_cost: Quilter::cut_cost() of the result.
 Status quilt_cross(const Setup& setup, const TileOptions& options, const CrossPlan& plan, SsdSearch& search,
-                   Plane& canvas, int& placed, double& cut_cost) {
+                   Plane& canvas, int& placed, double& cut_cost, SessionRecord* record) {
   const Plane& ex = setup.exemplar;
   const int w = ex.width, h = ex.height;
   // The '+' is repaired with half-size blocks (and overlaps): a narrower strip holds fewer 7 x 7
@@ -329,6 +332,12 @@ Status quilt_cross(const Setup& setup, const TileOptions& options, const CrossPl
   Quilter quilter(ex, search, canvas, known, locked, ov, options.tolerance, rng, &source, kCandidatePool,
                   plan.gradient_penalty);
   quilter.set_min_candidates(plan.min_candidates);
+  if (record) {
+    record->known = known;
+    record->locked = locked;
+    record->overlap = ov;
+    quilter.set_record(&record->placements);
+  }
   // Arms are quilted with blocks `chain` px long: fewer chain cuts than square blocks.
   const int chain = std::min(b * kChainPercent / 100, std::min(w, h) / 2);
   const std::vector<int> vertical = chain_positions(zy + zone_y, h - zone_y, chain, ov);
@@ -521,15 +530,10 @@ Image swap_quadrants(const Image& image) {
   return out;
 }
 
-Status make_tileable(const Image& exemplar, const TileOptions& options, Image& tile, TileReport* report) {
-  std::vector<Image> tiles;
-  TAILOR_RETURN_IF_ERROR(make_tile_variants(exemplar, options, 1, tiles, report));
-  tile = std::move(tiles[0]);
-  return Status::ok();
-}
+namespace internal {
 
-Status make_tile_variants(const Image& exemplar, const TileOptions& options, int count, std::vector<Image>& tiles,
-                          TileReport* report) {
+Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int count, bool all_channels,
+                          std::vector<Image>& tiles, TileReport* report, TilePlan* tile_plan) {
   tiles.clear();
   if (count < 1 || count > 64)
     return Status::error(ErrorCode::kInvalidArgument, "", "variant count must be in [1, 64]",
@@ -547,7 +551,15 @@ Status make_tile_variants(const Image& exemplar, const TileOptions& options, int
     const Plane& ex = setup.exemplar;
     const int w = ex.width, h = ex.height, b = setup.block, ov = setup.overlap;
     SsdSearch search;
-    search.init(ex);
+    search.init(ex, all_channels);
+    if (tile_plan) {
+      *tile_plan = TilePlan{};
+      tile_plan->width = w;
+      tile_plan->height = h;
+      tile_plan->shift_x = setup.shift_x;
+      tile_plan->shift_y = setup.shift_y;
+      tile_plan->sessions.resize(static_cast<size_t>(count));
+    }
 
     // Progress: the base tile counts as one share, each variant as one more.
     TileOptions base_options = options;
@@ -596,10 +608,12 @@ Status make_tile_variants(const Image& exemplar, const TileOptions& options, int
       Plane canvas;
       int blocks = 0;
       double cost = 0.0;
+      SessionRecord record;
       if (setup.symmetry == 4)
         TAILOR_RETURN_IF_ERROR(quilt_pinwheel(setup, plan_options, plans[i], search, turns, canvas, blocks, cost));
       else
-        TAILOR_RETURN_IF_ERROR(quilt_cross(setup, plan_options, plans[i], search, canvas, blocks, cost));
+        TAILOR_RETURN_IF_ERROR(
+            quilt_cross(setup, plan_options, plans[i], search, canvas, blocks, cost, tile_plan ? &record : nullptr));
       const double worst = worst_seam_ratio(canvas, true);
       const bool meets = worst <= target * kSeamHeadroom;
       // Meeting the seam target first, then the lower cut cost (or, both missing, the lower worst seam).
@@ -611,6 +625,7 @@ Status make_tile_variants(const Image& exemplar, const TileOptions& options, int
         base_worst = worst;
         base_cost = cost;
         base_meets = meets;
+        if (tile_plan) tile_plan->sessions[0] = std::move(record);
       }
     }
     rep.blocks += base_blocks;
@@ -656,6 +671,13 @@ Status make_tile_variants(const Image& exemplar, const TileOptions& options, int
             known[static_cast<size_t>(y) * w + x] = 1;
       SplitMix64 rng(mix_seed(options.seed, static_cast<uint64_t>(k)));
       Quilter quilter(ex, search, canvas, known, locked, ov, options.tolerance, rng);
+      if (tile_plan) {
+        SessionRecord& record = tile_plan->sessions[static_cast<size_t>(k)];
+        record.known = known;
+        record.locked = locked;
+        record.overlap = ov;
+        quilter.set_record(&record.placements);
+      }
       const bool flip_x = ((k - 1) & 1) != 0, flip_y = ((k - 1) & 2) != 0;
       const size_t per_variant = xs.size() * ys.size();
       size_t done = 0;
@@ -685,5 +707,7 @@ Status make_tile_variants(const Image& exemplar, const TileOptions& options, int
   }
   return Status::ok();
 }
+
+}  // namespace internal
 
 }  // namespace tailor

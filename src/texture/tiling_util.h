@@ -53,4 +53,9 @@ inline Plane to_plane(const Image& image) {
   return p;
 }
 
+//! How far `tile` misses the O(N) targets of meets_tile_targets against `exemplar` (same
+//! channels): the sum of the relative excesses of the worst seam, the wrap ratios, histogram L1
+//! and gradient ratio (0 = all met; patch coherence is not measured). tile_metrics.cpp.
+double fast_target_misses(const Image& tile, const Image& exemplar);
+
 }  // namespace tailor::internal

@@ -1,0 +1,101 @@
+// Coarse-to-fine tiling: the quilting plan (which exemplar block goes where, in which order) is
+// found on a reduced copy of the exemplar (tiling.cpp), then replayed at full size here: each
+// block's rectangle and source are scaled up, the source is refined by a masked SSD search within
+// a few px of the scaled one (the reduced image placed it only to within one reduced pixel), and
+// the minimum-error boundary cut is recomputed at full size inside the scaled overlap, a narrow
+// band along the reduced cut. The result is a source map (which exemplar pixel each tile pixel
+// shows); compose() applies it to every map of a set, so all maps share one cut and one set of
+// offsets and stay registered.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "tailor/image.h"
+#include "tailor/tiling.h"
+#include "texture/quilting.h"
+
+namespace tailor::internal {
+
+//! One quilting run of the plan: the canvas's known and locked pixels before the first block
+//! (reduced size, row-major) and the blocks in the order placed, with the overlap they used.
+struct SessionRecord {
+  std::vector<uint8_t> known, locked;
+  std::vector<Placement> placements;
+  int overlap = 0;
+};
+
+//! The plan of a tile and its variants on the reduced exemplar: sessions[0] is the base tile
+//! (its canvas starts as the exemplar shifted by (shift_x, shift_y)), sessions[k] variant k (its
+//! canvas starts as the base tile).
+struct TilePlan {
+  int width = 0, height = 0;
+  int shift_x = 0, shift_y = 0;
+  std::vector<SessionRecord> sessions;
+};
+
+//! Full-size guide of the cut: `channels` 8-bit samples per pixel, the layout of image.h.
+struct Guide {
+  const uint8_t* px = nullptr;
+  int width = 0, height = 0, channels = 0;
+};
+
+//! Replays plan sessions at full size over a guide; see the top of this file.
+class CutRefiner {
+ public:
+  CutRefiner(const Guide& guide, int plan_width, int plan_height);
+
+  //! Full-size coordinate of reduced coordinate v along x (y): floor(v * W / w + 1/2), any integer v.
+  int map_x(int v) const { return scale(v, guide_.width, plan_w_); }
+  int map_y(int v) const { return scale(v, guide_.height, plan_h_); }
+
+  //! Replays session `s` of `plan` (base tile: the canvas starts as the shifted exemplar; a
+  //! variant: as `base`, the base tile's source map). radius: the refinement search (px).
+  void replay(const TilePlan& plan, size_t s, const std::vector<int32_t>* base, int radius);
+
+  //! Exemplar pixel index (y * W + x) shown by each tile pixel.
+  const std::vector<int32_t>& source() const { return source_; }
+
+ private:
+  static int scale(int v, int full, int reduced) {
+    const int64_t n = 2 * static_cast<int64_t>(v) * full + reduced, d = 2 * static_cast<int64_t>(reduced);
+    return static_cast<int>(n >= 0 ? n / d : -((-n + d - 1) / d));
+  }
+  //! Full-size mask of a reduced one: the reduced pixel whose scaled cell holds each full pixel.
+  void upsample(const std::vector<uint8_t>& reduced, std::vector<uint8_t>& full) const;
+  void place(const Placement& p, int overlap, int radius);
+
+  Guide guide_;
+  int plan_w_, plan_h_;
+  std::vector<int> cell_x_, cell_y_;
+  std::vector<int32_t> source_;
+  std::vector<uint8_t> known_, locked_, take_new_;
+  std::vector<int32_t> templ_;  // guide samples of the block's known pixels, -1 where unknown
+  std::vector<float> error_, strip_, cost_;
+  std::vector<int> path_;
+};
+
+//! Minimum-error path through a strip of `length` x `width` errors (err[i * width + j], i along the
+//! strip): one j per i, |j(i) - j(i-1)| <= 1. Dynamic programming, ties to the smaller j.
+void min_error_path(const std::vector<float>& err, int length, int width, std::vector<float>& cost,
+                    std::vector<int>& path);
+
+//! How a map's samples are blended where the feather mixes two sources.
+enum class BlendKind { kScalar, kNormal };
+
+//! out = the map gathered through `source` (out(p) = in(source[p])); within `feather` px of a
+//! cut (where the window of (2 feather + 1)^2 pixels holds more than one offset source - p), the
+//! sample is the window's mean of in(p + offset) over its pixels' offsets (Scalar: per channel;
+//! Normal: the first three channels as a vector in [-1, 1], renormalised; every output normal
+//! is renormalised). Samples are T (uint8_t or uint16_t) with maximum `max_value`.
+template <typename T>
+void compose(const T* in, int width, int height, int channels, int max_value, BlendKind kind,
+             const std::vector<int32_t>& source, int feather, std::vector<T>& out);
+
+//! The quilting of tiling.cpp (make_tile_variants for images up to kPlanMaxSide) on `exemplar`,
+//! recording its plan in `plan` (may be null). all_channels: the block search uses every channel
+//! (a map set's guide) rather than a colour image's luminance.
+Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int count, bool all_channels,
+                          std::vector<Image>& tiles, TileReport* report, TilePlan* plan);
+
+}  // namespace tailor::internal

@@ -1,0 +1,380 @@
+// Material sets tiled with one cut (make_tileable_set, `tailor tile --set`), 16-bit maps, and the
+// coarse-to-fine path of images above kPlanMaxSide.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "support/fixtures.h"
+#include "tailor/image.h"
+#include "tailor/image_ops.h"
+#include "tailor/tiling.h"
+
+namespace tailor {
+namespace {
+
+const std::string kData = std::string(TAILOR_TEST_DATA) + "/textures/";
+
+Image load(const std::string& name) {
+  Image im;
+  const Status s = load_image(kData + name, im);
+  EXPECT_TRUE(s.is_ok()) << s.message();
+  return im;
+}
+
+TileMap map_of(const Image& im, bool normal = false) {
+  TileMap m;
+  m.image = to_image16(im);
+  m.normal = normal;
+  return m;
+}
+
+//! A tangent-space normal map of the height `h` (grey): n = (-s dh/dx, -s dh/dy, 1) / |.|, times
+//! `length` (1: unit normals), encoded in 8 bits.
+Image normals_of(const Image& h, double s, double length) {
+  Image n;
+  n.width = h.width;
+  n.height = h.height;
+  n.channels = 3;
+  n.pixels.resize(static_cast<size_t>(h.width) * h.height * 3);
+  auto at = [&](int x, int y) {
+    return static_cast<double>(
+        h.pixels[static_cast<size_t>((y + h.height) % h.height) * h.width + (x + h.width) % h.width]);
+  };
+  for (int y = 0; y < h.height; ++y)
+    for (int x = 0; x < h.width; ++x) {
+      double v[3] = {-s * (at(x + 1, y) - at(x - 1, y)) / 2.0, -s * (at(x, y + 1) - at(x, y - 1)) / 2.0, 1.0};
+      const double len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      for (int k = 0; k < 3; ++k)
+        n.pixels[(static_cast<size_t>(y) * h.width + x) * 3 + k] =
+            static_cast<uint8_t>(std::lround(std::clamp((v[k] / len * length + 1.0) * 127.5, 0.0, 255.0)));
+    }
+  return n;
+}
+
+//! Fraction of pixels where grey(colour) and the height map differ by at most 2 levels.
+double registered_fraction(const Image16& colour, const Image16& height) {
+  const Image grey = to_grey(to_image8(colour));
+  const Image h = to_image8(height);
+  size_t close = 0;
+  for (size_t i = 0; i < grey.pixels.size(); ++i)
+    if (std::abs(static_cast<int>(grey.pixels[i]) - static_cast<int>(h.pixels[i])) <= 2) ++close;
+  return static_cast<double>(close) / static_cast<double>(grey.pixels.size());
+}
+
+TEST(TileSet, ColourAndItsGreyHeightShareOneCut) {
+  for (const char* name : {"vistex-bark11-128.png", "water-caustics-300.jpg"}) {
+    const Image a = load(name);
+    const Image h = to_grey(a);
+    std::vector<std::vector<Image16>> tiles;
+    ASSERT_TRUE(make_tileable_set({map_of(a), map_of(h)}, TileOptions{}, 1, tiles).is_ok());
+    ASSERT_EQ(tiles.size(), 1u);
+    ASSERT_EQ(tiles[0].size(), 2u);
+    EXPECT_EQ(tiles[0][0].channels, 3);
+    EXPECT_EQ(tiles[0][1].channels, 1);
+    EXPECT_GE(registered_fraction(tiles[0][0], tiles[0][1]), 0.99) << name;
+    // Each map tiled alone is cut differently: the check above can fail.
+    Image alone;
+    TileOptions other;
+    other.seed = 2;
+    ASSERT_TRUE(make_tileable(h, other, alone).is_ok());
+    EXPECT_LT(registered_fraction(tiles[0][0], to_image16(alone)), 0.99) << name;
+    // The shared cut still makes a seamless tile of the colour map.
+    TileMetrics m;
+    ASSERT_TRUE(tile_metrics(to_image8(tiles[0][0]), &a, m).is_ok());
+    EXPECT_GE(m.wrap_ratio_x, 0.8);
+    EXPECT_LE(m.wrap_ratio_x, 1.2);
+    EXPECT_GE(m.wrap_ratio_y, 0.8);
+    EXPECT_LE(m.wrap_ratio_y, 1.2);
+  }
+}
+
+TEST(TileSet, VariantsAndPeriodFittingKeepTheMapsRegistered) {
+  const Image a = load("vistex-tile04-128.png");
+  const Image h = to_grey(a);
+  TileOptions options;
+  options.fit_period = true;
+  std::vector<std::vector<Image16>> tiles;
+  TileReport report;
+  ASSERT_TRUE(make_tileable_set({map_of(a), map_of(h)}, options, 3, tiles, &report).is_ok());
+  ASSERT_EQ(tiles.size(), 3u);
+  for (const std::vector<Image16>& set : tiles) {
+    EXPECT_EQ(set[0].width, report.width);
+    EXPECT_EQ(set[1].height, report.height);
+    EXPECT_GE(registered_fraction(set[0], set[1]), 0.99);
+  }
+  EXPECT_NE(tiles[1][0].pixels, tiles[0][0].pixels);
+  // Every variant of every map shares the outer ring of report.border px with the first one.
+  ASSERT_GE(report.border, 1);
+  for (size_t k = 1; k < tiles.size(); ++k)
+    for (size_t m = 0; m < 2; ++m) {
+      const Image16& first = tiles[0][m];
+      const Image16& other = tiles[k][m];
+      size_t differing = 0;
+      for (int y = 0; y < first.height; ++y)
+        for (int x = 0; x < first.width; ++x) {
+          if (x >= report.border && y >= report.border && x < first.width - report.border &&
+              y < first.height - report.border)
+            continue;
+          const size_t i = (static_cast<size_t>(y) * first.width + x) * first.channels;
+          if (!std::equal(&first.pixels[i], &first.pixels[i] + first.channels, &other.pixels[i])) ++differing;
+        }
+      EXPECT_EQ(differing, 0u) << "variant " << k << " map " << m;
+    }
+}
+
+TEST(TileSet, OutputNormalsAreUnitLength) {
+  const Image a = load("vistex-sand05-128.png");
+  const Image h = to_grey(a);
+  // Input normals of length 0.8: only renormalisation makes them unit.
+  for (double length : {1.0, 0.8}) {
+    std::vector<std::vector<Image16>> tiles;
+    ASSERT_TRUE(
+        make_tileable_set({map_of(a), map_of(normals_of(h, 0.05, length), true)}, TileOptions{}, 1, tiles).is_ok());
+    const Image16& n = tiles[0][1];
+    ASSERT_EQ(n.channels, 3);
+    double worst = 0.0;
+    for (size_t i = 0; i < n.pixels.size(); i += 3) {
+      double len2 = 0.0;
+      for (int k = 0; k < 3; ++k) {
+        const double v = n.pixels[i + k] / 127.5 - 1.0;
+        len2 += v * v;
+      }
+      worst = std::max(worst, std::abs(std::sqrt(len2) - 1.0));
+    }
+    EXPECT_LE(worst, 0.01) << "input length " << length;
+  }
+}
+
+TEST(TileSet, SixteenBitMapsStaySixteenBit) {
+  const Image a = load("gravel-gray-512.png");
+  TileMap m;
+  m.image = to_image16(a);
+  m.image.bits = 16;
+  // Low bytes that 8 bits would lose.
+  for (size_t i = 0; i < m.image.pixels.size(); ++i)
+    m.image.pixels[i] = static_cast<uint16_t>(a.pixels[i] * 256 + (i * 37) % 251);
+  std::vector<std::vector<Image16>> tiles;
+  ASSERT_TRUE(make_tileable_set({m}, TileOptions{}, 1, tiles).is_ok());
+  const Image16& t = tiles[0][0];
+  EXPECT_EQ(t.bits, 16);
+  EXPECT_TRUE(std::any_of(t.pixels.begin(), t.pixels.end(), [](uint16_t v) { return v % 256 != 0; }));
+
+  // Through files and the CLI: a 16-bit PNG gives a 16-bit PNG, samples read back exactly.
+  const std::string dir = test::temp_dir();
+  ASSERT_TRUE(write_png16(dir + "/h16.png", m.image).is_ok());
+  Image16 back;
+  ASSERT_TRUE(load_image16(dir + "/h16.png", back).is_ok());
+  EXPECT_EQ(back.bits, 16);
+  EXPECT_EQ(back.pixels, m.image.pixels);
+  std::string out;
+  ASSERT_EQ(test::run_command(std::string(TAILOR_BINARY) + " tile " + dir + "/h16.png -o " + dir + "/t16.png -q", out),
+            0)
+      << out;
+  Image16 tiled;
+  ASSERT_TRUE(load_image16(dir + "/t16.png", tiled).is_ok());
+  EXPECT_EQ(tiled.bits, 16);
+  EXPECT_EQ(tiled.width, 512);
+  // An 8-bit PNG stays 8-bit.
+  Image16 eight;
+  ASSERT_TRUE(load_image16(kData + "gravel-gray-512.png", eight).is_ok());
+  EXPECT_EQ(eight.bits, 8);
+}
+
+TEST(TileSet, AlphaIsKept) {
+  const Image rgb = load("vistex-fabric02-128.png");
+  Image rgba;
+  rgba.width = rgb.width;
+  rgba.height = rgb.height;
+  rgba.channels = 4;
+  for (size_t i = 0; i < rgb.pixels.size(); i += 3) {
+    rgba.pixels.insert(rgba.pixels.end(), rgb.pixels.begin() + static_cast<std::ptrdiff_t>(i),
+                       rgb.pixels.begin() + static_cast<std::ptrdiff_t>(i + 3));
+    rgba.pixels.push_back(static_cast<uint8_t>(255 - rgb.pixels[i + 1]));  // alpha follows the texture
+  }
+  std::vector<std::vector<Image16>> tiles;
+  ASSERT_TRUE(make_tileable_set({map_of(rgba)}, TileOptions{}, 1, tiles).is_ok());
+  const Image16& t = tiles[0][0];
+  ASSERT_EQ(t.channels, 4);
+  size_t close = 0;
+  for (size_t i = 0; i < t.pixels.size(); i += 4)
+    if (std::abs(static_cast<int>(t.pixels[i + 3]) - (255 - static_cast<int>(t.pixels[i + 1]))) <= 2) ++close;
+  EXPECT_GE(static_cast<double>(close) / static_cast<double>(t.pixels.size() / 4), 0.99);
+}
+
+TEST(TileSet, MapsOfDifferentSizesAreAClearError) {
+  std::vector<std::vector<Image16>> tiles;
+  const Status s =
+      make_tileable_set({map_of(load("vistex-bark11-128.png")), map_of(load("gravel-gray-512.png"))}, {}, 1, tiles);
+  EXPECT_EQ(s.code(), ErrorCode::kInvalidImage);
+  EXPECT_NE(s.message().find("same size"), std::string::npos) << s.message();
+  EXPECT_TRUE(tiles.empty());
+  EXPECT_FALSE(make_tileable_set({}, {}, 1, tiles).is_ok());
+  TileMap grey_normal = map_of(load("gravel-gray-512.png"), true);
+  EXPECT_FALSE(make_tileable_set({grey_normal}, {}, 1, tiles).is_ok());
+
+  // The CLI: one error line, exit 1, no output folder.
+  const std::string dir = test::temp_dir() + "/mixed";
+  std::filesystem::remove_all(dir);
+  std::string out, err;
+  const int code = test::run_command(std::string(TAILOR_BINARY) + " tile --set " + kData + "vistex-bark11-128.png " +
+                                         kData + "gravel-gray-512.png -o " + dir,
+                                     out, &err);
+  EXPECT_EQ(code, 1);
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  EXPECT_NE(err.find("same size"), std::string::npos) << err;
+  EXPECT_FALSE(std::filesystem::exists(dir));
+}
+
+TEST(TileSetCli, SetAndMaterialWriteTheInputNamesIntoTheFolder) {
+  const std::string dir = test::empty_temp_dir("set");
+  const Image a = load("vistex-bark11-128.png");
+  ASSERT_TRUE(write_png(dir + "/bark_color.png", a).is_ok());
+  ASSERT_TRUE(write_png(dir + "/bark_height.png", to_grey(a)).is_ok());
+  ASSERT_TRUE(write_png(dir + "/bark_normal.png", normals_of(to_grey(a), 0.05, 1.0)).is_ok());
+  std::string out, err;
+  ASSERT_EQ(test::run_command(std::string(TAILOR_BINARY) + " tile --set " + dir + "/bark_color.png " + dir +
+                                  "/bark_height.png " + dir + "/bark_normal.png --normal-map " + dir +
+                                  "/bark_normal.png -o " + dir + "/out --variants 2 --quiet",
+                              out, &err),
+            0)
+      << err;
+  for (const char* f : {"bark_color_0.png", "bark_color_1.png", "bark_height_1.png", "bark_normal_0.png"})
+    EXPECT_TRUE(std::filesystem::exists(dir + "/out/" + f)) << f;
+  std::ifstream jf(dir + "/out/material.json");
+  const nlohmann::json j = nlohmann::json::parse(jf, nullptr, false);
+  ASSERT_FALSE(j.is_discarded());
+  EXPECT_EQ(j["maps"][2]["normal"], true);
+  EXPECT_EQ(j["normal_convention"], "gl");
+
+  // The JSON alternative, files relative to it.
+  {
+    std::ofstream m(dir + "/bark.json");
+    m << R"({"maps": [{"file": "bark_color.png"}, {"file": "bark_normal.png", "type": "normal"}],
+             "normal_convention": "dx"})";
+  }
+  ASSERT_EQ(
+      test::run_command(
+          std::string(TAILOR_BINARY) + " tile --material " + dir + "/bark.json -o " + dir + "/out2 --quiet", out, &err),
+      0)
+      << err;
+  Image16 c, n;
+  ASSERT_TRUE(load_image16(dir + "/out2/bark_color.png", c).is_ok());
+  ASSERT_TRUE(load_image16(dir + "/out2/bark_normal.png", n).is_ok());
+  EXPECT_EQ(c.width, 128);
+  std::ifstream jf2(dir + "/out2/material.json");
+  const nlohmann::json j2 = nlohmann::json::parse(jf2, nullptr, false);
+  EXPECT_EQ(j2["normal_convention"], "dx");
+  EXPECT_EQ(j2["maps"][1]["normal"], true);
+  std::filesystem::remove_all(dir);
+}
+
+//! A running-bond brick wall: bricks bw x bh px (rows offset by bw / 2), `mortar` px joints of
+//! grey 150, brick tones 90-150, noise +-40, 3 x 3 box blur; fixed generator (deterministic).
+Image brick_wall(int width, int height, int bw, int bh, int mortar) {
+  uint64_t state = 5;
+  auto next = [&state](int n) {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<int>((state >> 33) % static_cast<uint64_t>(n));
+  };
+  std::vector<int> tone(static_cast<size_t>((height / bh + 1) * (width / bw + 2)));
+  for (int& t : tone) t = 90 + next(61);
+  std::vector<int> raw(static_cast<size_t>(width) * height);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const int course = y / bh, shifted = x + (bw / 2) * (course % 2);
+      const bool joint = y % bh < mortar || shifted % bw < mortar;
+      const int base = joint ? 150 : tone[static_cast<size_t>(course * (width / bw + 2) + shifted / bw)];
+      raw[static_cast<size_t>(y) * width + x] = base + next(81) - 40;
+    }
+  Image im;
+  im.width = width;
+  im.height = height;
+  im.channels = 1;
+  im.pixels.resize(raw.size());
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      int sum = 0;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx)
+          sum += raw[static_cast<size_t>(std::clamp(y + dy, 0, height - 1)) * width + std::clamp(x + dx, 0, width - 1)];
+      im.pixels[static_cast<size_t>(y) * width + x] = static_cast<uint8_t>(std::clamp((sum + 4) / 9, 0, 255));
+    }
+  return im;
+}
+
+TEST(TileRegular, BrickBondsFollowTheirPeriodAndMeetTheStraightSeamTarget) {
+  // 40 x 20 px bricks (period 40 x 40 with the offset rows) in 230 x 190 px: not whole periods.
+  const Image wall = brick_wall(230, 190, 40, 20, 3);
+  const PeriodEstimate p = estimate_period(wall);
+  ASSERT_TRUE(p.found_x && p.found_y);
+  EXPECT_GE(std::min(p.confidence_x, p.confidence_y), kStrongPeriod);
+  Image tile;
+  TileReport report;
+  ASSERT_TRUE(make_tileable(wall, TileOptions{}, tile, &report).is_ok());
+  // By default the size follows the period: whole periods, so courses and joints continue across the wrap.
+  EXPECT_TRUE(report.period_fitted);
+  EXPECT_EQ(tile.width % 40, 0);
+  EXPECT_EQ(tile.height % 40, 0);
+  TileMetrics m;
+  ASSERT_TRUE(tile_metrics(tile, &wall, m).is_ok());
+  std::string failed;
+  EXPECT_TRUE(meets_tile_targets(m, &failed)) << failed;
+  EXPECT_LE(m.worst_seam_ratio, std::max(m.exemplar_worst_seam_ratio, 1.5));
+  // --no-auto-period keeps the size.
+  TileOptions keep;
+  keep.auto_period = false;
+  Image plain;
+  TileReport plain_report;
+  ASSERT_TRUE(make_tileable(wall, keep, plain, &plain_report).is_ok());
+  EXPECT_FALSE(plain_report.period_fitted);
+  EXPECT_EQ(plain.width, 230);
+  // Noise has no strong period: the size is kept.
+  Image gravel_tile;
+  TileReport gravel_report;
+  ASSERT_TRUE(make_tileable(load("vistex-sand05-128.png"), TileOptions{}, gravel_tile, &gravel_report).is_ok());
+  EXPECT_FALSE(gravel_report.period_fitted);
+  EXPECT_EQ(gravel_tile.width, 128);
+}
+
+TEST(TileLarge, CoarseToFineAboveThePlanSizeMeetsTheSeamTargets) {
+  // 768 px (above kPlanMaxSide): planned at 512 px, replayed at full size.
+  const Image small = load("water-caustics-300.jpg");
+  Image big;
+  ASSERT_TRUE(resize_image(small, 768, 768, big).is_ok());
+  Image tile, again;
+  TileReport report;
+  ASSERT_TRUE(make_tileable(big, TileOptions{}, tile, &report).is_ok());
+  EXPECT_EQ(tile.width, 768);
+  EXPECT_GT(report.block, TileOptions{}.block);  // the block scaled with the image
+  TileMetrics m;
+  ASSERT_TRUE(tile_metrics(tile, &big, m).is_ok());
+  std::string failed;
+  EXPECT_TRUE(meets_tile_targets(m, &failed)) << failed;
+  ASSERT_TRUE(make_tileable(big, TileOptions{}, again).is_ok());
+  EXPECT_EQ(tile.pixels, again.pixels);
+  // Variants replayed at full size share the outer ring bit-exactly and differ inside.
+  std::vector<Image> variants;
+  TileReport vr;
+  ASSERT_TRUE(make_tile_variants(big, TileOptions{}, 2, variants, &vr).is_ok());
+  ASSERT_EQ(variants.size(), 2u);
+  EXPECT_EQ(variants[0].pixels, tile.pixels);
+  size_t ring_differs = 0, inside_differs = 0;
+  for (int y = 0; y < 768; ++y)
+    for (int x = 0; x < 768; ++x) {
+      const size_t i = (static_cast<size_t>(y) * 768 + x) * 3;
+      const bool same = std::equal(&variants[0].pixels[i], &variants[0].pixels[i] + 3, &variants[1].pixels[i]);
+      const bool ring = x < vr.border || y < vr.border || x >= 768 - vr.border || y >= 768 - vr.border;
+      if (!same) ++(ring ? ring_differs : inside_differs);
+    }
+  EXPECT_EQ(ring_differs, 0u);
+  EXPECT_GT(inside_differs, 768u * 768u / 4);
+}
+
+}  // namespace
+}  // namespace tailor
