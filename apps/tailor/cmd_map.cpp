@@ -161,6 +161,9 @@ int run_map(const MapArgs& opt) {
     warn(opt.quiet, opt.input + ": dropped " + std::to_string(load.degenerate_faces) + " degenerate faces");
   if (load.duplicate_faces)
     warn(opt.quiet, opt.input + ": dropped " + std::to_string(load.duplicate_faces) + " duplicate faces");
+  if (load.skipped_primitives)
+    warn(opt.quiet, opt.input + ": skipped " + std::to_string(load.skipped_primitives) +
+                        " point and line primitives (only triangles are mapped)");
   std::vector<uint8_t> seam_faces;
   if (!opt.seam_faces.empty()) {
     if (Status s = load_seam_faces(opt.seam_faces, mesh.face_count(), seam_faces); !s) return report_error(s);
@@ -288,7 +291,9 @@ void register_map(CLI::App& app, Runner& run) {
   OrientationOptions& orientation = opt->options.orientation;
   auto* cmd =
       app.add_subcommand("map", "Compute texture coordinates by homogeneous patch discovery and write a textured mesh");
-  cmd->add_option("mesh", opt->input, "Input mesh (.ply .obj .off .stl)")->required();
+  cmd->add_option("mesh", opt->input,
+                  "Input mesh (.ply .obj .off .stl .glb .gltf; glTF: the default scene in world space)")
+      ->required();
   cmd->add_option("-o,--output", opt->output,
                   "Output mesh: .glb (texture embedded), .obj (+ .mtl) or .ply; a symlink is written through (its "
                   "target replaced)")

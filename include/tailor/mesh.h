@@ -46,6 +46,8 @@ struct LoadReport {
   size_t zero_area_faces = 0;        //!< distinct vertices but zero area: kept
   size_t unreferenced_vertices = 0;  //!< vertices no face uses: kept, so vertex ids match the file
   size_t welded_vertices = 0;        //!< STL: corners merged into shared vertices (bit-identical positions)
+  size_t mesh_instances = 0;         //!< glTF: meshes placed by the scene's nodes (world transforms applied)
+  size_t skipped_primitives = 0;     //!< glTF: point and line primitives of those instances, not read
   int texture_width = 0;             //!< glb: the embedded base colour texture's size, read from its header
   int texture_height = 0;            //!< without decoding it (0: no texture, or a header stb cannot read)
   double load_seconds = 0.0;
