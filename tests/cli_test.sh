@@ -116,6 +116,9 @@ cmp -s "$tmp/a.glb" "$tmp/keep.glb" && ok || fail "failed map damaged the existi
 expect_error 2 "share" -- "$tailor" map "$mesh" -o "$tmp/same.glb" --preview "$tmp/same.glb"
 expect_error 2 "overwrite an input" -- "$tailor" map "$mesh" -o "$tmp/z.obj" --texture "$tmp/z.mtl"
 expect_error 2 "does not exist" -- "$tailor" map "$mesh" -o "$tmp/ok.glb" --stats "$tmp/missing/s.json"
+expect_error 2 "needs a .glb output" -- "$tailor" map "$mesh" -o "$tmp/cx.obj" --compress draco
+expect_error 2 "--compress must be" -- "$tailor" map "$mesh" -o "$tmp/cx.glb" --compress zip
+[[ ! -e $tmp/cx.obj && ! -e $tmp/cx.glb ]] && ok || fail "output left after a bad --compress"
 [[ ! -e $tmp/ok.glb && ! -e $tmp/same.glb ]] && ok || fail "outputs written although the run was refused"
 expect_error 2 "scale" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --scale 1e-30
 expect_error 2 "share" -- "$tailor" tile "$texture" -o "$tmp/v.png" --variants 2 --json "$tmp/v.json"

@@ -44,6 +44,7 @@ struct MapArgs {
   std::string texture;
   ImageLoadOptions image_options;  // --max-image-pixels (default: ImageLoadOptions')
   int texture_size = ExportOptions{}.texture_width;
+  std::string compress = mesh_compression_name(ExportOptions{}.compression);
   std::string preview_up = up_axis_name(RenderOptions{}.up);
   std::string stats;
   std::string preview;
@@ -108,6 +109,11 @@ int run_map(const MapArgs& opt) {
   const std::string ext = std::filesystem::path(opt.output).extension().string();
   if (ext != ".glb" && ext != ".obj" && ext != ".ply")
     return report_error(usage_error("output must end in .glb, .obj or .ply, got '" + opt.output + "'"));
+  MeshCompression compression = MeshCompression::kNone;
+  if (!mesh_compression_from_name(opt.compress, compression))
+    return report_error(usage_error("--compress must be none, quantize, meshopt or draco, got '" + opt.compress + "'"));
+  if (compression != MeshCompression::kNone && ext != ".glb")
+    return report_error(usage_error("--compress needs a .glb output, got '" + opt.output + "'"));
   MapTextureOptions options = opt.options;
   const bool auto_axis = opt.axis == "auto";
   if (!auto_axis) {
@@ -261,6 +267,7 @@ int run_map(const MapArgs& opt) {
   export_options.texture_path = opt.texture;
   export_options.texture_width = tex_w;
   export_options.texture_height = tex_h;
+  export_options.compression = compression;
   if (Status s = export_mesh(opt.output, mesh, atlas, export_options); !s) return report_error(s);
   run.export_seconds = seconds_since(export_start);
   for (const auto& [path, picture] : pictures) {
@@ -304,6 +311,7 @@ void register_map(CLI::App& app, Runner& run) {
       ->capture_default_str();
   add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), opt->image_options.max_pixels)
       ->check(CLI::PositiveNumber);
+  add_documented(cmd, option_doc(kExportOptionDocs, "compression"), opt->compress);
   cmd->add_option("--stats", opt->stats, "Write a JSON report (mesh, mapping counters, metrics, timings)");
   cmd->add_option("--preview", opt->preview, "Render a 3/4 view of the textured mesh to this PNG");
   cmd->add_flag("--preview-all", opt->preview_all,

@@ -163,6 +163,8 @@ Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas
   if (atlas.corner_uv.size() != 6 * nf)
     return Status::error(ErrorCode::kInvalidArgument, path, "atlas does not match the mesh",
                          std::to_string(atlas.corner_uv.size()) + " UV floats for " + std::to_string(nf) + " faces");
+  if (options.compression != MeshCompression::kNone && format != ExportFormat::kGlb)
+    return Status::error(ErrorCode::kInvalidArgument, path, "compression needs a .glb output");
   if (options.texture_width <= 0 || options.texture_height <= 0)
     return Status::error(ErrorCode::kInvalidArgument, path, "texture size must be positive");
   // Branch-free scans first (they vectorize); the exact culprit is looked for only on failure.
@@ -198,7 +200,9 @@ Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas
     return Status::error(ErrorCode::kInvalidArgument, path, "UV is not finite", "corner " + std::to_string(bad_corner));
 
   switch (format) {
-    case ExportFormat::kGlb: return internal::write_glb(path, data, options);
+    case ExportFormat::kGlb:
+      return options.compression == MeshCompression::kNone ? internal::write_glb(path, data, options)
+                                                           : internal::write_glb_compressed(path, data, options);
     case ExportFormat::kObj: return internal::write_obj(path, data, options);
     case ExportFormat::kPly: return internal::write_ply(path, data, options);
     case ExportFormat::kUnknown: break;

@@ -73,6 +73,20 @@ size_t add_view(nlohmann::json& views, size_t offset, size_t length, int target)
 
 }  // namespace
 
+void add_glb_material(nlohmann::json& gltf, nlohmann::json& views, size_t texture_offset, size_t texture_size,
+                      const std::string& mime_type) {
+  nlohmann::json pbr = {{"metallicFactor", 0.0}, {"roughnessFactor", 1.0}};
+  if (texture_size > 0) {
+    const size_t view = add_view(views, texture_offset, texture_size, 0);
+    gltf["images"] = {{{"bufferView", view}, {"mimeType", mime_type}}};
+    gltf["samplers"] = {
+        {{"magFilter", kLinear}, {"minFilter", kLinearMipmapLinear}, {"wrapS", kRepeat}, {"wrapT", kRepeat}}};
+    gltf["textures"] = {{{"sampler", 0}, {"source", 0}}};
+    pbr["baseColorTexture"] = {{"index", 0}};
+  }
+  gltf["materials"] = {{{"name", "tailor"}, {"pbrMetallicRoughness", pbr}}};
+}
+
 Status write_glb(const std::string& path, const ExportData& data, const ExportOptions& options) {
   const Mesh& mesh = *data.mesh;
   const SplitMesh& split = data.split;
@@ -137,13 +151,11 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
         {{"bufferView", view}, {"componentType", kUnsignedInt}, {"count", index_count}, {"type", "SCALAR"}});
   }
 
-  nlohmann::json pbr = {{"metallicFactor", 0.0}, {"roughnessFactor", 1.0}};
   nlohmann::json gltf = {
       {"asset", {{"version", "2.0"}, {"generator", "tailor"}}},
       {"scene", 0},
       {"scenes", {{{"nodes", {0}}}}},
       {"nodes", {{{"mesh", 0}, {"name", "tailor"}}}},
-      {"materials", nlohmann::json::array()},
       {"meshes",
        {{{"primitives",
           {{{"attributes", attributes}, {"indices", indices_accessor}, {"material", 0}, {"mode", kTriangles}}}}}}},
@@ -152,17 +164,13 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
   if (!texture_bytes.empty()) {
     if (texture_bytes.size() > std::numeric_limits<uint32_t>::max() - bin_size)
       return Status::error(ErrorCode::kLimit, path, "texture too large for a .glb buffer");
-    const size_t view = add_view(views, bin_size, texture_bytes.size(), 0);
+  }
+  add_glb_material(gltf, views, bin_size, texture_bytes.size(), mime_type);
+  if (!texture_bytes.empty()) {
     bin_size += texture_bytes.size();
     texture_padding = (4 - bin_size % 4) % 4;
     bin_size += texture_padding;
-    gltf["images"] = {{{"bufferView", view}, {"mimeType", mime_type}}};
-    gltf["samplers"] = {
-        {{"magFilter", kLinear}, {"minFilter", kLinearMipmapLinear}, {"wrapS", kRepeat}, {"wrapT", kRepeat}}};
-    gltf["textures"] = {{{"sampler", 0}, {"source", 0}}};
-    pbr["baseColorTexture"] = {{"index", 0}};
   }
-  gltf["materials"].push_back({{"name", "tailor"}, {"pbrMetallicRoughness", pbr}});
   gltf["accessors"] = accessors;
   gltf["bufferViews"] = views;
   gltf["buffers"] = {{{"byteLength", bin_size}}};

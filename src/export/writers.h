@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <span>
 #include <string>
 #include <vector>
@@ -35,7 +36,15 @@ void append_float(std::string& out, float value);
 //! Path of `target` relative to the folder `base_dir` (generic separators), or absolute when none exists.
 std::string relative_path(const std::string& target, const std::filesystem::path& base_dir);
 
+//! The material every .glb gets (named "tailor", not metallic, fully rough) and, when
+//! texture_size > 0, the image (a new buffer view of buffer 0 at texture_offset), a REPEAT
+//! sampler and the texture as its base colour.
+void add_glb_material(nlohmann::json& gltf, nlohmann::json& views, size_t texture_offset, size_t texture_size,
+                      const std::string& mime_type);
+
 Status write_glb(const std::string& path, const ExportData& data, const ExportOptions& options);
+//! .glb with options.compression (quantize, meshopt or draco): the arrays are built in memory.
+Status write_glb_compressed(const std::string& path, const ExportData& data, const ExportOptions& options);
 Status write_obj(const std::string& path, const ExportData& data, const ExportOptions& options);
 Status write_ply(const std::string& path, const ExportData& data, const ExportOptions& options);
 
