@@ -505,5 +505,104 @@ TEST(GltfCompressed, EveryMethodReadsBackValidAndSmaller) {
   fs::remove_all(dir);
 }
 
+// === Kept attributes ==============================================================================
+
+const CornerAttribute* attribute(const Mesh& mesh, const std::string& name) {
+  for (const CornerAttribute& a : mesh.corner_attributes)
+    if (a.name == name) return &a;
+  return nullptr;
+}
+
+TEST(GltfKept, NormalsColoursAndOtherUvSetsSurviveAMapping) {
+  // A flat-shaded unit box (hard edges: 4 vertices per side with the side's normal), COLOR_0 =
+  // position, TEXCOORD_0 = (x + y, z), named, with a material.
+  Builder b;
+  std::vector<float> positions, normals, colours, uvs;
+  std::vector<uint32_t> indices;
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side = 0; side < 2; ++side) {
+      const uint32_t base = static_cast<uint32_t>(positions.size() / 3);
+      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+      for (int corner = 0; corner < 4; ++corner) {
+        float p[3];
+        p[axis] = float(side);
+        p[u] = float(corner == 1 || corner == 2);
+        p[v] = float(corner >= 2);
+        float n[3] = {0, 0, 0};
+        n[axis] = side ? 1.f : -1.f;
+        positions.insert(positions.end(), p, p + 3);
+        normals.insert(normals.end(), n, n + 3);
+        colours.insert(colours.end(), {p[0], p[1], p[2]});
+        uvs.insert(uvs.end(), {p[0] + p[1], p[2]});
+      }
+      // Counter-clockwise seen from outside: (0 1 2) (0 2 3) for the + side, reversed for the -.
+      if (side)
+        indices.insert(indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+      else
+        indices.insert(indices.end(), {base, base + 2, base + 1, base, base + 3, base + 2});
+    }
+  const size_t p = b.positions(positions), n = b.accessor(normals, 5126, "VEC3", normals.size() / 3);
+  const size_t c = b.accessor(colours, 5126, "VEC3", colours.size() / 3);
+  const size_t t = b.accessor(uvs, 5126, "VEC2", uvs.size() / 2), i = b.indices(indices);
+  Json primitive = {{"indices", i}, {"material", 0}};
+  primitive["attributes"] = {{"POSITION", p}, {"NORMAL", n}, {"COLOR_0", c}, {"TEXCOORD_0", t}};
+  Json box_mesh = {{"name", "box"}};
+  box_mesh["primitives"] = Json::array({primitive});
+  b.json["meshes"] = Json::array({box_mesh});
+  b.json["materials"] = {{{"name", "red"}}};
+  b.json["nodes"] = {{{"mesh", 0}, {"name", "box"}}};
+  b.json["scenes"] = {{{"nodes", {0}}}};
+  Mesh mesh;
+  LoadReport report;
+  ASSERT_TRUE(read(b.glb(), mesh, &report).is_ok());
+  EXPECT_EQ(mesh.vertex_count(), 8u);  // welded: the hard edges live in the corner normals
+  EXPECT_NE(report.not_kept.find("materials"), std::string::npos) << report.not_kept;
+  EXPECT_NE(report.not_kept.find("names"), std::string::npos) << report.not_kept;
+  ASSERT_NE(attribute(mesh, "NORMAL"), nullptr);
+
+  // Map into TEXCOORD_1 (any UVs will do): the file's normals, colours and TEXCOORD_0 come back.
+  Atlas atlas;
+  atlas.corner_uv.resize(6 * mesh.face_count());
+  for (size_t k = 0; k < atlas.corner_uv.size(); ++k) atlas.corner_uv[k] = float(k % 7) * 64;
+  atlas.patch.assign(mesh.face_count(), 0);
+  const std::string dir = test::empty_temp_dir("gltf_kept");
+  for (MeshCompression method : {MeshCompression::kNone, MeshCompression::kMeshopt, MeshCompression::kDraco}) {
+    SCOPED_TRACE(mesh_compression_name(method));
+    ExportOptions options;
+    options.uv_set = 1;
+    options.compression = method;
+    const std::string file = dir + "/kept.glb";
+    ASSERT_TRUE(export_mesh(file, mesh, atlas, options).is_ok());
+    if (!gltf_transform().empty()) expect_valid_gltf(file);
+    Mesh back;
+    ASSERT_TRUE(load_mesh(file, back).is_ok());
+    const CornerAttribute *normal = attribute(back, "NORMAL"), *colour = attribute(back, "COLOR_0"),
+                          *uv0 = attribute(back, "TEXCOORD_0"), *uv1 = attribute(back, "TEXCOORD_1");
+    ASSERT_TRUE(normal && colour && uv0 && uv1);
+    ASSERT_EQ(back.face_count(), 12u);
+    const float tolerance = method == MeshCompression::kNone ? 0.f : 0.01f;
+    for (size_t f = 0; f < back.face_count(); ++f) {
+      const float* a = &back.positions[3 * back.indices[3 * f]];
+      const float* bb = &back.positions[3 * back.indices[3 * f + 1]];
+      const float* cc = &back.positions[3 * back.indices[3 * f + 2]];
+      const float e1[3] = {bb[0] - a[0], bb[1] - a[1], bb[2] - a[2]},
+                  e2[3] = {cc[0] - a[0], cc[1] - a[1], cc[2] - a[2]};
+      float face[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+      const float length = std::sqrt(face[0] * face[0] + face[1] * face[1] + face[2] * face[2]);
+      for (int k = 0; k < 3; ++k) {
+        const size_t corner = 3 * f + size_t(k);
+        const float* q = &back.positions[3 * back.indices[corner]];
+        for (int d = 0; d < 3; ++d) {
+          EXPECT_NEAR(normal->values[3 * corner + size_t(d)], face[d] / length, tolerance) << "corner " << corner;
+          EXPECT_NEAR(colour->values[4 * corner + size_t(d)], q[d], tolerance + 1e-6f) << "corner " << corner;
+        }
+        EXPECT_NEAR(uv0->values[2 * corner], q[0] + q[1], tolerance + 1e-6f);
+        EXPECT_NEAR(uv0->values[2 * corner + 1], q[2], tolerance + 1e-6f);
+      }
+    }
+  }
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace tailor

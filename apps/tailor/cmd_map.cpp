@@ -45,6 +45,7 @@ struct MapArgs {
   ImageLoadOptions image_options;  // --max-image-pixels (default: ImageLoadOptions')
   int texture_size = ExportOptions{}.texture_width;
   std::string compress = mesh_compression_name(ExportOptions{}.compression);
+  int uv_set = ExportOptions{}.uv_set;
   std::string preview_up = up_axis_name(RenderOptions{}.up);
   std::string stats;
   std::string preview;
@@ -114,6 +115,8 @@ int run_map(const MapArgs& opt) {
     return report_error(usage_error("--compress must be none, quantize, meshopt or draco, got '" + opt.compress + "'"));
   if (compression != MeshCompression::kNone && ext != ".glb")
     return report_error(usage_error("--compress needs a .glb output, got '" + opt.output + "'"));
+  if (opt.uv_set != 0 && ext != ".glb")
+    return report_error(usage_error("--uv-set needs a .glb output, got '" + opt.output + "'"));
   MapTextureOptions options = opt.options;
   const bool auto_axis = opt.axis == "auto";
   if (!auto_axis) {
@@ -167,6 +170,7 @@ int run_map(const MapArgs& opt) {
     warn(opt.quiet, opt.input + ": dropped " + std::to_string(load.degenerate_faces) + " degenerate faces");
   if (load.duplicate_faces)
     warn(opt.quiet, opt.input + ": dropped " + std::to_string(load.duplicate_faces) + " duplicate faces");
+  if (!load.not_kept.empty()) warn(opt.quiet, opt.input + ": not kept in the output: " + load.not_kept);
   if (load.skipped_primitives)
     warn(opt.quiet, opt.input + ": skipped " + std::to_string(load.skipped_primitives) +
                         " point and line primitives (only triangles are mapped)");
@@ -268,6 +272,7 @@ int run_map(const MapArgs& opt) {
   export_options.texture_width = tex_w;
   export_options.texture_height = tex_h;
   export_options.compression = compression;
+  export_options.uv_set = opt.uv_set;
   if (Status s = export_mesh(opt.output, mesh, atlas, export_options); !s) return report_error(s);
   run.export_seconds = seconds_since(export_start);
   for (const auto& [path, picture] : pictures) {
@@ -312,6 +317,7 @@ void register_map(CLI::App& app, Runner& run) {
   add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), opt->image_options.max_pixels)
       ->check(CLI::PositiveNumber);
   add_documented(cmd, option_doc(kExportOptionDocs, "compression"), opt->compress);
+  add_documented(cmd, option_doc(kExportOptionDocs, "uv_set"), opt->uv_set)->check(CLI::Range(0, 7));
   cmd->add_option("--stats", opt->stats, "Write a JSON report (mesh, mapping counters, metrics, timings)");
   cmd->add_option("--preview", opt->preview, "Render a 3/4 view of the textured mesh to this PNG");
   cmd->add_flag("--preview-all", opt->preview_all,

@@ -66,6 +66,7 @@ struct ExportOptions {
   int texture_height = 512;  //!< pixels per texture repeat along v (> 0), usually the texture's height
   bool normals = true;       //!< .glb/.obj: write smooth per-vertex normals (area-weighted, shared across seams)
   MeshCompression compression = MeshCompression::kNone;  //!< .glb only (kInvalidArgument for .obj/.ply)
+  int uv_set = 0;  //!< .glb: the mapped UVs go to TEXCOORD_<uv_set> (0..7); the file's other sets are kept
 };
 
 //! Flags and help of the ExportOptions a user sets (option_doc.h).
@@ -73,8 +74,13 @@ inline constexpr OptionDoc kExportOptionDocs[] = {
     {"compression", "--compress",
      "geometry compression of a .glb output: none, quantize (KHR_mesh_quantization), meshopt "
      "(EXT_meshopt_compression) or draco (KHR_draco_mesh_compression); three.js and Blender read all of them"},
+    {"uv_set", "--uv-set",
+     "glTF texture coordinate set N (0-7, TEXCOORD_N) that receives the new UVs; the input's other sets, "
+     "normals and vertex colours are kept"},
 };
 
+//! The mesh's corner_attributes are written back (.glb: all of them but the mapped set's namesake,
+//! vertices split where they differ; .obj: NORMAL), its NORMAL instead of computed normals.
 //! Writes `mesh` with the UVs of `atlas` (atlas.corner_uv: #F*3 by 2 pixels) to `path`, the format
 //! chosen by the extension (case-insensitive): .glb (binary glTF 2.0, texture embedded, sampler
 //! REPEAT), .obj (+ <stem>.mtl next to it when a texture is given, map_Kd relative to the .obj),

@@ -74,7 +74,7 @@ size_t add_view(nlohmann::json& views, size_t offset, size_t length, int target)
 }  // namespace
 
 void add_glb_material(nlohmann::json& gltf, nlohmann::json& views, size_t texture_offset, size_t texture_size,
-                      const std::string& mime_type) {
+                      const std::string& mime_type, int uv_set) {
   nlohmann::json pbr = {{"metallicFactor", 0.0}, {"roughnessFactor", 1.0}};
   if (texture_size > 0) {
     const size_t view = add_view(views, texture_offset, texture_size, 0);
@@ -83,6 +83,7 @@ void add_glb_material(nlohmann::json& gltf, nlohmann::json& views, size_t textur
         {{"magFilter", kLinear}, {"minFilter", kLinearMipmapLinear}, {"wrapS", kRepeat}, {"wrapT", kRepeat}}};
     gltf["textures"] = {{{"sampler", 0}, {"source", 0}}};
     pbr["baseColorTexture"] = {{"index", 0}};
+    if (uv_set != 0) pbr["baseColorTexture"]["texCoord"] = uv_set;
   }
   gltf["materials"] = {{{"name", "tailor"}, {"pbrMetallicRoughness", pbr}}};
 }
@@ -136,10 +137,22 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
     attributes["NORMAL"] = accessors.size();
     accessors.push_back({{"bufferView", view}, {"componentType", kFloat}, {"count", vertex_count}, {"type", "VEC3"}});
   }
+  for (const CornerAttribute& a : data.kept) {  // the file's own: colours, other UV sets
+    const size_t bytes = 4 * size_t(a.components) * vertex_count;
+    const size_t view = add_view(views, bin_size, bytes, kArrayBuffer);
+    bin_size += bytes;
+    attributes[a.name] = accessors.size();
+    accessors.push_back({{"bufferView", view},
+                         {"componentType", kFloat},
+                         {"count", vertex_count},
+                         {"type", a.components == 2   ? "VEC2"
+                                  : a.components == 3 ? "VEC3"
+                                                      : "VEC4"}});
+  }
   {
     const size_t view = add_view(views, bin_size, 8 * vertex_count, kArrayBuffer);
     bin_size += 8 * vertex_count;
-    attributes["TEXCOORD_0"] = accessors.size();
+    attributes["TEXCOORD_" + std::to_string(data.uv_set)] = accessors.size();
     accessors.push_back({{"bufferView", view}, {"componentType", kFloat}, {"count", vertex_count}, {"type", "VEC2"}});
   }
   size_t indices_accessor = 0;
@@ -165,7 +178,7 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
     if (texture_bytes.size() > std::numeric_limits<uint32_t>::max() - bin_size)
       return Status::error(ErrorCode::kLimit, path, "texture too large for a .glb buffer");
   }
-  add_glb_material(gltf, views, bin_size, texture_bytes.size(), mime_type);
+  add_glb_material(gltf, views, bin_size, texture_bytes.size(), mime_type, data.uv_set);
   if (!texture_bytes.empty()) {
     bin_size += texture_bytes.size();
     texture_padding = (4 - bin_size % 4) % 4;
@@ -206,6 +219,13 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
     const float* source = data.normals.data();
     TAILOR_RETURN_IF_ERROR(write_gathered(file, vertex_count, 3, [&](size_t s, float* out) {
       std::memcpy(out, &source[3 * size_t{xref[s]}], 3 * sizeof(float));
+    }));
+  }
+  for (const CornerAttribute& a : data.kept) {
+    const size_t k = size_t(a.components);
+    const float* values = a.values.data();
+    TAILOR_RETURN_IF_ERROR(write_gathered(file, vertex_count, k, [&](size_t s, float* out) {
+      std::memcpy(out, &values[k * size_t{xref[s]}], k * sizeof(float));
     }));
   }
   // glTF's v axis points down the image: TEXCOORD_0 = (s, -t), the usual (s, 1 - t) shifted by a

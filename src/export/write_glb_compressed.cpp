@@ -66,6 +66,8 @@ void append_u32(std::string& out, uint32_t value) {
 // convention (s, -t: see export.h), indices.
 struct Arrays {
   std::vector<float> positions, normals, uvs;
+  std::vector<CornerAttribute> kept;  // per split vertex
+  std::string uv_name = "TEXCOORD_0";
   std::vector<uint32_t> indices;
   size_t vertex_count() const { return positions.size() / 3; }
 };
@@ -84,6 +86,14 @@ Arrays gather(const ExportData& data) {
     a.uvs[2 * s] = split.uvs[2 * s];
     a.uvs[2 * s + 1] = -split.uvs[2 * s + 1];
   }
+  for (const CornerAttribute& source : data.kept) {
+    const size_t k = size_t(source.components);
+    CornerAttribute& out = a.kept.emplace_back(CornerAttribute{source.name, source.components, {}});
+    out.values.resize(k * nv);
+    for (size_t s = 0; s < nv; ++s)
+      std::memcpy(&out.values[k * s], &source.values[k * split.xref[s]], k * sizeof(float));
+  }
+  a.uv_name = "TEXCOORD_" + std::to_string(data.uv_set);
   a.indices = split.indices;
   return a;
 }
@@ -102,6 +112,7 @@ void optimize_order(Arrays& a) {
   apply(a.positions, 3);
   apply(a.normals, 3);
   apply(a.uvs, 2);
+  for (CornerAttribute& k : a.kept) apply(k.values, size_t(k.components));
 }
 
 int16_t snorm16(double x) { return static_cast<int16_t>(std::lround(std::clamp(x, -1.0, 1.0) * 32767.0)); }
@@ -156,8 +167,21 @@ std::vector<Stream> quantized_streams(const Arrays& a, nlohmann::json& node) {
                        {{"componentType", kShort}, {"normalized", true}, {"count", nv}, {"type", "VEC3"}},
                        "NORMAL"});
   }
-  streams.push_back(
-      {bytes_of(a.uvs), 8, kArrayBuffer, {{"componentType", kFloat}, {"count", nv}, {"type", "VEC2"}}, "TEXCOORD_0"});
+  for (const CornerAttribute& k : a.kept)
+    streams.push_back({bytes_of(k.values),
+                       4 * size_t(k.components),
+                       kArrayBuffer,
+                       {{"componentType", kFloat},
+                        {"count", nv},
+                        {"type", k.components == 2   ? "VEC2"
+                                 : k.components == 3 ? "VEC3"
+                                                     : "VEC4"}},
+                       k.name.c_str()});
+  streams.push_back({bytes_of(a.uvs),
+                     8,
+                     kArrayBuffer,
+                     {{"componentType", kFloat}, {"count", nv}, {"type", "VEC2"}},
+                     a.uv_name.c_str()});
   if (nv <= 65535) {
     const std::vector<uint16_t> small(a.indices.begin(), a.indices.end());
     streams.push_back({bytes_of(small),
@@ -191,7 +215,7 @@ void apply_meshopt_filters(const Arrays& a, std::vector<Stream>& streams) {
       s = {out,          4,
            kArrayBuffer, {{"componentType", kByte}, {"normalized", true}, {"count", nv}, {"type", "VEC3"}},
            "NORMAL",     "OCTAHEDRAL"};
-    } else if (s.attribute == std::string_view("TEXCOORD_0")) {
+    } else if (s.attribute == std::string_view(a.uv_name)) {
       std::string out(8 * nv, '\0');
       meshopt_encodeFilterExp(out.data(), nv, 8, kUvBits, a.uvs.data());
       s.bytes = out;
@@ -277,7 +301,10 @@ Status draco_primitive(const std::string& path, const Arrays& a, std::string& bi
   nlohmann::json ids;
   ids["POSITION"] = add(draco::GeometryAttribute::POSITION, a.positions, 3);
   if (!a.normals.empty()) ids["NORMAL"] = add(draco::GeometryAttribute::NORMAL, a.normals, 3);
-  ids["TEXCOORD_0"] = add(draco::GeometryAttribute::TEX_COORD, a.uvs, 2);
+  for (const CornerAttribute& k : a.kept)
+    ids[k.name] = add(k.name == "COLOR_0" ? draco::GeometryAttribute::COLOR : draco::GeometryAttribute::TEX_COORD,
+                      k.values, k.components);
+  ids[a.uv_name] = add(draco::GeometryAttribute::TEX_COORD, a.uvs, 2);
   draco::Encoder encoder;
   encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, 16);
   encoder.SetAttributeQuantization(draco::GeometryAttribute::NORMAL, 12);
@@ -323,8 +350,18 @@ Status draco_primitive(const std::string& path, const Arrays& a, std::string& bi
   if (!a.normals.empty())
     streams.push_back(
         {{}, 0, kArrayBuffer, {{"componentType", kFloat}, {"count", points}, {"type", "VEC3"}}, "NORMAL"});
+  for (const CornerAttribute& k : a.kept)
+    streams.push_back({{},
+                       0,
+                       kArrayBuffer,
+                       {{"componentType", kFloat},
+                        {"count", points},
+                        {"type", k.components == 2   ? "VEC2"
+                                 : k.components == 3 ? "VEC3"
+                                                     : "VEC4"}},
+                       k.name.c_str()});
   streams.push_back(
-      {{}, 0, kArrayBuffer, {{"componentType", kFloat}, {"count", points}, {"type", "VEC2"}}, "TEXCOORD_0"});
+      {{}, 0, kArrayBuffer, {{"componentType", kFloat}, {"count", points}, {"type", "VEC2"}}, a.uv_name.c_str()});
   streams.push_back(
       {{},
        0,
@@ -407,7 +444,7 @@ Status write_glb_compressed(const std::string& path, const ExportData& data, con
       {"extensionsUsed", used},
       {"extensionsRequired", used},
   };
-  add_glb_material(gltf, views, bin.size(), texture_bytes.size(), mime_type);
+  add_glb_material(gltf, views, bin.size(), texture_bytes.size(), mime_type, data.uv_set);
   bin += texture_bytes;
   pad_to_4(bin);
   if (buffers.empty()) buffers.push_back(nullptr);

@@ -207,12 +207,37 @@ Status scene_instances(GltfDocument& doc, std::vector<Instance>& instances) {
 
 // One primitive in its mesh's own space, triangulated.
 struct Primitive {
-  std::vector<float> positions;     // #V by 3
-  std::vector<uint32_t> triangles;  // #T by 3, < #V
-  std::vector<float> uv;            // empty, or #V by 2 (glTF convention)
+  std::vector<float> positions;       // #V by 3
+  std::vector<uint32_t> triangles;    // #T by 3, < #V
+  std::vector<float> uv;              // empty, or #V by 2 (glTF convention)
+  std::vector<CornerAttribute> kept;  // NORMAL, COLOR_0 (as RGBA), TEXCOORD_n: #V by components
   size_t source_faces = 0;
   uint64_t material = UINT64_MAX;
 };
+
+// The vertex attributes kept beside POSITION and TEXCOORD_0 (what export can write back).
+bool is_kept_attribute(const std::string& name) {
+  if (name == "NORMAL" || name == "COLOR_0") return true;
+  return name.size() == 10 && name.starts_with("TEXCOORD_") && name[9] >= '0' && name[9] <= '7';
+}
+
+// Adds a kept attribute read as `values` (#V by components), checking its shape.
+Status keep_attribute(const GltfDocument& doc, const std::string& name, std::vector<float>&& values, int components,
+                      size_t vertex_count, const std::string& where, Primitive& out) {
+  const int want = name == "NORMAL" ? 3 : name == "COLOR_0" ? 0 : 2;
+  if ((want != 0 && components != want) || (want == 0 && components != 3 && components != 4))
+    return doc.parse_error(name + " has the wrong type", where);
+  if (values.size() != vertex_count * size_t(components))
+    return doc.parse_error(name + " and POSITION counts differ", where);
+  if (name == "COLOR_0" && components == 3) {  // RGBA, opaque
+    std::vector<float> rgba(4 * vertex_count, 1.0f);
+    for (size_t v = 0; v < vertex_count; ++v) std::copy_n(&values[3 * v], 3, &rgba[4 * v]);
+    values = std::move(rgba);
+    components = 4;
+  }
+  out.kept.push_back({name, components, std::move(values)});
+  return Status::ok();
+}
 
 // Triangles from a triangle list, strip or fan over `corners` (spec section 3.7.2.1).
 Status triangulate(const GltfDocument& doc, uint64_t mode, const std::vector<uint32_t>& corners, size_t vertex_count,
@@ -256,11 +281,17 @@ Status read_primitive(GltfDocument& doc, const Json& prim, uint64_t mode, const 
   }
   if (draco) {
     internal::DracoPrimitive decoded;
-    TAILOR_RETURN_IF_ERROR(
-        internal::decode_draco_primitive(doc, prim, *draco, {"POSITION", "TEXCOORD_0"}, where, decoded));
+    std::vector<std::string> names = {"POSITION", "TEXCOORD_0"};
+    for (const auto& item : attributes->items())
+      if (is_kept_attribute(item.key())) names.push_back(item.key());
+    TAILOR_RETURN_IF_ERROR(internal::decode_draco_primitive(doc, prim, *draco, names, where, decoded));
     if (decoded.components[0] != 3) return doc.unsupported("Draco POSITION is not 3D", where);
     out.positions = std::move(decoded.values[0]);
     if (decoded.components[1] == 2) out.uv = std::move(decoded.values[1]);
+    for (size_t n = 2; n < names.size(); ++n)
+      if (decoded.components[n] > 0)
+        TAILOR_RETURN_IF_ERROR(keep_attribute(doc, names[n], std::move(decoded.values[n]), decoded.components[n],
+                                              out.positions.size() / 3, where, out));
     corners = std::move(decoded.indices);
     mode = kTriangles;  // Draco decodes to a triangle list
   } else {
@@ -272,6 +303,15 @@ Status read_primitive(GltfDocument& doc, const Json& prim, uint64_t mode, const 
       TAILOR_RETURN_IF_ERROR(doc.read_floats(uv_index, out.uv, uv_info));
       if (uv_info.components != 2) return doc.parse_error("TEXCOORD_0 must be VEC2", where);
       if (uv_info.count != info.count) return doc.parse_error("TEXCOORD_0 and POSITION counts differ", where);
+    }
+    for (const auto& item : attributes->items()) {
+      uint64_t index = 0;
+      if (!is_kept_attribute(item.key()) || !get_uint(*attributes, item.key().c_str(), index)) continue;
+      std::vector<float> values;
+      AccessorInfo kept_info;
+      TAILOR_RETURN_IF_ERROR(doc.read_floats(index, values, kept_info));
+      TAILOR_RETURN_IF_ERROR(
+          keep_attribute(doc, item.key(), std::move(values), kept_info.components, info.count, where, out));
     }
     if (get_uint(prim, "indices", indices_index)) {
       TAILOR_RETURN_IF_ERROR(doc.read_indices(indices_index, corners));
@@ -375,6 +415,92 @@ void append_instance(const Primitive& p, const Matrix& world, Mesh& mesh) {
   }
 }
 
+// The kept attributes of `p`'s corners (appended by append_instance from corner `first` on, with
+// vertex ids from `base`): normals turned by the inverse transpose of `world` and renormalized.
+// An attribute that an earlier or this primitive lacks is marked in `incomplete` (dropped later).
+void append_kept(const Primitive& p, const Matrix& world, size_t base, size_t first, Mesh& mesh,
+                 std::vector<uint8_t>& incomplete) {
+  const size_t corners = mesh.indices.size();
+  // Cofactors of the 3x3 part: det * inverse transpose; the sign of det keeps normals outward.
+  const double c[9] = {world[5] * world[10] - world[6] * world[9], world[6] * world[8] - world[4] * world[10],
+                       world[4] * world[9] - world[5] * world[8],  world[2] * world[9] - world[1] * world[10],
+                       world[0] * world[10] - world[2] * world[8], world[1] * world[8] - world[0] * world[9],
+                       world[1] * world[6] - world[2] * world[5],  world[2] * world[4] - world[0] * world[6],
+                       world[0] * world[5] - world[1] * world[4]};
+  const double sign = determinant3(world) < 0 ? -1.0 : 1.0;
+  std::vector<uint8_t> seen(mesh.corner_attributes.size(), 0);
+  for (const CornerAttribute& a : p.kept) {
+    size_t slot = 0;
+    while (slot < mesh.corner_attributes.size() && mesh.corner_attributes[slot].name != a.name) ++slot;
+    if (slot == mesh.corner_attributes.size()) {  // new here: zeros before, incomplete unless first
+      mesh.corner_attributes.push_back({a.name, a.components, {}});
+      incomplete.push_back(first > 0);
+      seen.push_back(0);
+    }
+    seen[slot] = 1;
+    CornerAttribute& out = mesh.corner_attributes[slot];
+    const size_t k = size_t(a.components);
+    out.values.resize(k * corners, 0.0f);
+    for (size_t corner = first; corner < corners; ++corner) {
+      const float* in = &a.values[k * (mesh.indices[corner] - base)];
+      float* o = &out.values[k * corner];
+      if (a.name != "NORMAL") {
+        std::copy_n(in, k, o);
+        continue;
+      }
+      // Column-major: n'_r = sum_j cof[r][j] n_j, with cof stored by columns of the inverse transpose.
+      double n[3];
+      for (int r = 0; r < 3; ++r) n[r] = sign * (c[3 * 0 + r] * in[0] + c[3 * 1 + r] * in[1] + c[3 * 2 + r] * in[2]);
+      const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      for (int r = 0; r < 3; ++r) o[r] = length > 0 ? static_cast<float>(n[r] / length) : in[r];
+    }
+  }
+  for (size_t slot = 0; slot < seen.size(); ++slot) {
+    if (seen[slot]) continue;
+    CornerAttribute& out = mesh.corner_attributes[slot];
+    out.values.resize(size_t(out.components) * corners, 0.0f);
+    incomplete[slot] = 1;
+  }
+}
+
+// What the output cannot carry: materials (tailor writes its own), names, extras, attributes
+// other than the kept ones, skins, animations, cameras; and the hierarchy when it was flattened.
+void not_kept(const GltfDocument& doc, size_t instances, std::vector<std::string>& lost) {
+  const Json& json = doc.json();
+  auto any = [&](const char* array, auto&& predicate) {
+    const auto it = json.find(array);
+    if (it == json.end() || !it->is_array()) return false;
+    return std::any_of(it->begin(), it->end(), predicate);
+  };
+  auto non_empty = [&](const char* array) { return any(array, [](const Json&) { return true; }); };
+  if (non_empty("materials")) lost.push_back("materials");
+  if (any("nodes", [](const Json& n) { return n.is_object() && n.contains("name"); }) ||
+      any("meshes", [](const Json& m) { return m.is_object() && m.contains("name"); }))
+    lost.push_back("names");
+  if (json.contains("extras") || any("nodes", [](const Json& n) { return n.is_object() && n.contains("extras"); }) ||
+      any("meshes", [](const Json& m) { return m.is_object() && m.contains("extras"); }))
+    lost.push_back("extras");
+  std::vector<std::string> attributes;
+  const auto meshes = json.find("meshes");
+  if (meshes != json.end() && meshes->is_array())
+    for (const Json& m : *meshes) {
+      const auto primitives = m.is_object() ? m.find("primitives") : m.end();
+      if (!m.is_object() || primitives == m.end() || !primitives->is_array()) continue;
+      for (const Json& prim : *primitives) {
+        const auto a = prim.is_object() ? prim.find("attributes") : prim.end();
+        if (!prim.is_object() || a == prim.end() || !a->is_object()) continue;
+        for (const auto& item : a->items())
+          if (item.key() != "POSITION" && item.key() != "TEXCOORD_0" && !is_kept_attribute(item.key()) &&
+              std::find(attributes.begin(), attributes.end(), item.key()) == attributes.end())
+            attributes.push_back(item.key());
+      }
+    }
+  lost.insert(lost.end(), attributes.begin(), attributes.end());
+  for (const char* array : {"skins", "animations", "cameras"})
+    if (non_empty(array)) lost.push_back(array);
+  if (instances > 1) lost.push_back("the node hierarchy (one mesh in world space)");
+}
+
 // Parses the file into mesh (not finalized); the base colour texture bytes go to `texture_bytes`.
 Status parse_gltf(std::span<const char> data, const std::string& name, const std::string& base_dir, Mesh& mesh,
                   LoadReport& report, std::span<const unsigned char>* texture_bytes) {
@@ -398,6 +524,7 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
   std::vector<std::optional<std::vector<Primitive>>> decoded(meshes.size());
   size_t triangle_primitives = 0, with_uv = 0;
   bool texture_found = false;
+  std::vector<uint8_t> incomplete;  // per mesh.corner_attributes: missing on some primitive
   for (const Instance& instance : instances) {
     const size_t mi = instance.mesh;
     const Json& m = meshes[mi];
@@ -430,7 +557,9 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
       if (mesh.vertex_count() + nv > kMaxVertices || mesh.face_count() + nf > kMaxFaces)
         return Status::error(ErrorCode::kLimit, name, "too many vertices or faces", where);
       TAILOR_RETURN_IF_ERROR(doc.charge(12 * nv + 36 * nf, where));  // positions, indices, corner UVs
+      const size_t base = mesh.vertex_count(), first = mesh.indices.size();
       append_instance(p, instance.world, mesh);
+      append_kept(p, instance.world, base, first, mesh, incomplete);
       ++triangle_primitives;
       with_uv += !p.uv.empty();
       report.source_faces += p.source_faces;
@@ -446,8 +575,16 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
                              ? "no triangles in the scene (only " + std::to_string(report.skipped_primitives) +
                                    " point and line primitives)"
                              : std::string("no triangle primitive in the scene"));
-  // All or nothing: UVs are only meaningful when every primitive has them.
+  // All or nothing: UVs are only meaningful when every primitive has them; the same for the rest.
   if (with_uv != triangle_primitives) mesh.corner_uvs.clear();
+  std::vector<std::string> lost;
+  for (size_t slot = mesh.corner_attributes.size(); slot-- > 0;) {
+    if (!incomplete[slot]) continue;
+    lost.push_back(mesh.corner_attributes[slot].name + " (not on every primitive)");
+    mesh.corner_attributes.erase(mesh.corner_attributes.begin() + static_cast<std::ptrdiff_t>(slot));
+  }
+  not_kept(doc, instances.size(), lost);
+  for (const std::string& item : lost) report.not_kept += (report.not_kept.empty() ? "" : ", ") + item;
   // glTF splits vertices on UV seams; weld them so that seams are edges between faces again.
   report.welded_vertices = weld_identical_positions(mesh);
   return Status::ok();

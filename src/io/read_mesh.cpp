@@ -260,6 +260,9 @@ Status finalize_mesh(const std::string& name, Mesh& mesh, LoadReport& report) {
   if (!mesh.seam_faces.empty() && mesh.seam_faces.size() != nf) {
     return Status::error(ErrorCode::kInvalidMesh, name, "seam flags do not match the faces");
   }
+  for (const CornerAttribute& a : mesh.corner_attributes)
+    if (a.components < 1 || a.components > 4 || a.values.size() != nf * 3 * size_t(a.components))
+      return Status::error(ErrorCode::kInvalidMesh, name, "corner attribute " + a.name + " does not match the faces");
   if (nf == 0) return Status::error(ErrorCode::kInvalidMesh, name, "mesh has no faces");
 
   // === Three passes over the faces, on two threads ==============================================
@@ -377,6 +380,11 @@ Status finalize_mesh(const std::string& name, Mesh& mesh, LoadReport& report) {
       }
     }
   }
+  for (const CornerAttribute& a : mesh.corner_attributes)
+    for (size_t i = 0; i < a.values.size(); ++i)
+      if (!std::isfinite(a.values[i]))
+        return Status::error(ErrorCode::kInvalidMesh, name, "non-finite " + a.name,
+                             "face " + std::to_string(i / (3 * size_t(a.components))));
   for (size_t i = 0; i < mesh.corner_uvs.size(); ++i) {
     if (!std::isfinite(mesh.corner_uvs[i])) {
       return Status::error(ErrorCode::kInvalidMesh, name, "non-finite texture coordinate",
@@ -410,12 +418,17 @@ Status finalize_mesh(const std::string& name, Mesh& mesh, LoadReport& report) {
         std::memmove(&mesh.indices[3 * out], &mesh.indices[3 * f], 3 * sizeof(uint32_t));
         if (uvs) std::memmove(&mesh.corner_uvs[6 * out], &mesh.corner_uvs[6 * f], 6 * sizeof(float));
         if (seams) mesh.seam_faces[out] = mesh.seam_faces[f];
+        for (CornerAttribute& a : mesh.corner_attributes) {
+          const size_t k = 3 * size_t(a.components);
+          std::memmove(&a.values[k * out], &a.values[k * f], k * sizeof(float));
+        }
       }
       ++out;
     }
     mesh.indices.resize(3 * out);
     if (uvs) mesh.corner_uvs.resize(6 * out);
     if (seams) mesh.seam_faces.resize(out);
+    for (CornerAttribute& a : mesh.corner_attributes) a.values.resize(3 * size_t(a.components) * out);
   }
   report.degenerate_faces += degenerate;
   report.duplicate_faces += duplicates;
