@@ -604,5 +604,75 @@ TEST(GltfKept, NormalsColoursAndOtherUvSetsSurviveAMapping) {
   fs::remove_all(dir);
 }
 
+// === World units and up axis (tailor map) ===========================================================
+
+// Median over the faces' edges of texture pixels per scene unit (UVs in repeats of `texture_px`).
+double median_texels_per_unit(const Mesh& mesh, double texture_px) {
+  std::vector<double> ratios;
+  for (size_t c = 0; c < mesh.indices.size(); ++c) {
+    const size_t d = c % 3 == 2 ? c - 2 : c + 1;
+    const float* a = &mesh.positions[3 * mesh.indices[c]];
+    const float* b = &mesh.positions[3 * mesh.indices[d]];
+    const double length = std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+    const double uv = std::hypot(mesh.corner_uvs[2 * c] - mesh.corner_uvs[2 * d],
+                                 mesh.corner_uvs[2 * c + 1] - mesh.corner_uvs[2 * d + 1]);
+    if (length > 0) ratios.push_back(uv * texture_px / length);
+  }
+  std::nth_element(ratios.begin(), ratios.begin() + static_cast<std::ptrdiff_t>(ratios.size() / 2), ratios.end());
+  return ratios[ratios.size() / 2];
+}
+
+TEST(GltfWorld, TexelDensityIsPerSceneUnitForEveryMesh) {
+  // spot.obj and a copy twice its size: with --tile-size both get the same pixels per unit (the
+  // default --scale would give each the same pixels per own size, so the copy half the density).
+  const Mesh spot = test::load_test_mesh("spot.obj");
+  const std::string dir = test::empty_temp_dir("gltf_world");
+  std::ofstream big(dir + "/big.obj");
+  for (size_t v = 0; v < spot.vertex_count(); ++v)
+    big << "v " << 2 * spot.positions[3 * v] << ' ' << 2 * spot.positions[3 * v + 1] << ' '
+        << 2 * spot.positions[3 * v + 2] << '\n';
+  for (size_t f = 0; f < spot.face_count(); ++f)
+    big << "f " << spot.indices[3 * f] + 1 << ' ' << spot.indices[3 * f + 1] + 1 << ' ' << spot.indices[3 * f + 2] + 1
+        << '\n';
+  big.close();
+  std::string out;
+  double density[2] = {0, 0};
+  int i = 0;
+  for (const std::string& input : {test::mesh_path("spot.obj"), dir + "/big.obj"}) {
+    const std::string glb = dir + "/" + std::to_string(i) + ".glb";
+    ASSERT_EQ(run_command(std::string(TAILOR_BINARY) + " map '" + input + "' -o '" + glb +
+                              "' --tile-size 0.25 --no-crack-closing --stats '" + glb + ".json' -q",
+                          out),
+              0)
+        << out;
+    Mesh mesh;
+    ASSERT_TRUE(load_mesh(glb, mesh).is_ok());
+    density[i] = median_texels_per_unit(mesh, 512);
+    const Json stats = Json::parse(test::read_all(glb + ".json"));
+    EXPECT_EQ(stats["options"]["unit"], "scene");
+    EXPECT_NEAR(stats["options"]["texels_per_unit"].get<double>(), 512 / 0.25, 1e-6);
+    ++i;
+  }
+  EXPECT_NEAR(density[0], 2048, 2048 * 0.05);  // 512 px every 0.25 units, up to the mapping's stretch
+  EXPECT_NEAR(density[1], density[0], density[0] * 0.02);
+  // --up z: the .glb's node turns the scene Y-up; read back, (x, y, z) became (x, z, -y).
+  ASSERT_EQ(run_command(std::string(TAILOR_BINARY) + " map '" + test::mesh_path("spot.obj") + "' -o '" + dir +
+                            "/up.glb' --up z --compress quantize -q",
+                        out),
+            0)
+      << out;
+  Mesh up;
+  ASSERT_TRUE(load_mesh(dir + "/up.glb", up).is_ok());
+  Mesh turned = spot;
+  for (size_t v = 0; v < turned.vertex_count(); ++v) {
+    const float y = turned.positions[3 * v + 1], z = turned.positions[3 * v + 2];
+    turned.positions[3 * v + 1] = z;
+    turned.positions[3 * v + 2] = -y;
+  }
+  expect_same_points(up, turned, extent(spot) / 16384.f, "--up z");
+  if (!gltf_transform().empty()) expect_valid_gltf(dir + "/up.glb");
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace tailor

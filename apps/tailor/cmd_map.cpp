@@ -1,5 +1,6 @@
 // tailor map: load -> topology -> [axis choice] -> map_texture (orientation, mapping, metrics) -> export
 // (+ preview, stats).
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -46,6 +47,9 @@ struct MapArgs {
   int texture_size = ExportOptions{}.texture_width;
   std::string compress = mesh_compression_name(ExportOptions{}.compression);
   int uv_set = ExportOptions{}.uv_set;
+  std::string up = ExportOptions{}.up == SceneUp::kZ ? "z" : "y";
+  double tile_size = 0;        // --tile-size: scene units per texture repeat (0: not given)
+  double texels_per_unit = 0;  // --texels-per-unit (0: not given)
   std::string preview_up = up_axis_name(RenderOptions{}.up);
   std::string stats;
   std::string preview;
@@ -115,6 +119,12 @@ int run_map(const MapArgs& opt) {
     return report_error(usage_error("--compress must be none, quantize, meshopt or draco, got '" + opt.compress + "'"));
   if (compression != MeshCompression::kNone && ext != ".glb")
     return report_error(usage_error("--compress needs a .glb output, got '" + opt.output + "'"));
+  if (opt.up != "y" && opt.up != "z") return report_error(usage_error("--up must be y or z, got '" + opt.up + "'"));
+  if (opt.tile_size != 0 && opt.texels_per_unit != 0)
+    return report_error(usage_error("give --tile-size or --texels-per-unit, not both"));
+  if (!(opt.tile_size >= 0 && opt.texels_per_unit >= 0) || !std::isfinite(opt.tile_size) ||
+      !std::isfinite(opt.texels_per_unit))
+    return report_error(usage_error("--tile-size and --texels-per-unit must be positive"));
   if (opt.uv_set != 0 && ext != ".glb")
     return report_error(usage_error("--uv-set needs a .glb output, got '" + opt.output + "'"));
   MapTextureOptions options = opt.options;
@@ -188,7 +198,30 @@ int run_map(const MapArgs& opt) {
                         " inconsistently oriented edges treated as boundary");
   options.metrics.texture_width_px = static_cast<float>(tex_w);
   options.metrics.texture_height_px = static_cast<float>(tex_h);
+  // World units: the texel density is per scene unit, the same for every mesh (the mapping works
+  // in the unit cube: its scale becomes texels per unit times the normalisation's length).
+  double texels_per_unit = opt.texels_per_unit;
+  if (opt.tile_size > 0) texels_per_unit = tex_w / opt.tile_size;
+  if (texels_per_unit > 0) {
+    std::array<double, 3> lo = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    for (size_t v = 0; v < mesh.vertex_count(); ++v)
+      for (size_t k = 0; k < 3; ++k) {
+        lo[k] = std::min(lo[k], double{mesh.positions[3 * v + k]});
+        hi[k] = std::max(hi[k], double{mesh.positions[3 * v + k]});
+      }
+    const double longest = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-30});
+    options.orientation.fixed_unit_scale = static_cast<float>(1.0 / longest);
+    options.orientation.fixed_origin = {static_cast<float>(lo[0]), static_cast<float>(lo[1]),
+                                        static_cast<float>(lo[2])};
+    const double scale = texels_per_unit / options.orientation.fixed_unit_scale;
+    if (!(scale >= 1e-3 && scale <= 1e7))
+      return report_error(usage_error("--tile-size / --texels-per-unit give " + std::to_string(scale) +
+                                      " pixels per mesh size, outside 0.001 to 1e7"));
+    mapping.scale = static_cast<float>(scale);
+  }
   MapRun run;  // the report: what was asked, then what each step found
+  run.texels_per_unit = texels_per_unit;
+  run.up = opt.up;
   run.input = opt.input;
   run.output = opt.output;
   run.texture = opt.texture;
@@ -273,6 +306,7 @@ int run_map(const MapArgs& opt) {
   export_options.texture_height = tex_h;
   export_options.compression = compression;
   export_options.uv_set = opt.uv_set;
+  export_options.up = opt.up == "z" ? SceneUp::kZ : SceneUp::kY;
   if (Status s = export_mesh(opt.output, mesh, atlas, export_options); !s) return report_error(s);
   run.export_seconds = seconds_since(export_start);
   for (const auto& [path, picture] : pictures) {
@@ -318,6 +352,14 @@ void register_map(CLI::App& app, Runner& run) {
       ->check(CLI::PositiveNumber);
   add_documented(cmd, option_doc(kExportOptionDocs, "compression"), opt->compress);
   add_documented(cmd, option_doc(kExportOptionDocs, "uv_set"), opt->uv_set)->check(CLI::Range(0, 7));
+  add_documented(cmd, option_doc(kExportOptionDocs, "up"), opt->up);
+  auto* tile_size = cmd->add_option("--tile-size", opt->tile_size,
+                                    "World units: the texture repeats every LENGTH scene units (e.g. 0.5 for 50 cm "
+                                    "in metres), the same for every mesh; replaces --scale");
+  auto* texels = cmd->add_option("--texels-per-unit", opt->texels_per_unit,
+                                 "World units: texture pixels per scene unit, the same for every mesh; replaces "
+                                 "--scale");
+  tile_size->excludes(texels);
   cmd->add_option("--stats", opt->stats, "Write a JSON report (mesh, mapping counters, metrics, timings)");
   cmd->add_option("--preview", opt->preview, "Render a 3/4 view of the textured mesh to this PNG");
   cmd->add_flag("--preview-all", opt->preview_all,

@@ -60,13 +60,17 @@ inline bool mesh_compression_from_name(std::string_view name, MeshCompression& c
   return false;
 }
 
+//! The up axis of the mesh's coordinates (ExportOptions::up).
+enum class SceneUp { kY, kZ };
+
 struct ExportOptions {
   std::string texture_path;  //!< PNG or JPEG: embedded as is (.glb) or referenced by map_Kd (.mtl); empty = no texture
   int texture_width = 512;   //!< pixels per texture repeat along u (> 0), usually the texture's width
   int texture_height = 512;  //!< pixels per texture repeat along v (> 0), usually the texture's height
   bool normals = true;       //!< .glb/.obj: write smooth per-vertex normals (area-weighted, shared across seams)
   MeshCompression compression = MeshCompression::kNone;  //!< .glb only (kInvalidArgument for .obj/.ply)
-  int uv_set = 0;  //!< .glb: the mapped UVs go to TEXCOORD_<uv_set> (0..7); the file's other sets are kept
+  int uv_set = 0;            //!< .glb: the mapped UVs go to TEXCOORD_<uv_set> (0..7); the file's other sets are kept
+  SceneUp up = SceneUp::kY;  //!< .glb: kZ turns the scene Y-up as glTF wants (-90 degrees about x, on the node)
 };
 
 //! Flags and help of the ExportOptions a user sets (option_doc.h).
@@ -74,6 +78,9 @@ inline constexpr OptionDoc kExportOptionDocs[] = {
     {"compression", "--compress",
      "geometry compression of a .glb output: none, quantize (KHR_mesh_quantization), meshopt "
      "(EXT_meshopt_compression) or draco (KHR_draco_mesh_compression); three.js and Blender read all of them"},
+    {"up", "--up",
+     "up axis of the input's coordinates: y, or z (scans, CAD), which a .glb output turns Y-up by its node's "
+     "rotation"},
     {"uv_set", "--uv-set",
      "glTF texture coordinate set N (0-7, TEXCOORD_N) that receives the new UVs; the input's other sets, "
      "normals and vertex colours are kept"},

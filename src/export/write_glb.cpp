@@ -27,9 +27,10 @@ constexpr int kLinear = 9729;
 constexpr int kLinearMipmapLinear = 9987;
 constexpr int kRepeat = 10497;
 constexpr int kTriangles = 4;
-constexpr uint32_t kGlbMagic = 0x46546C67;   // "glTF"
-constexpr uint32_t kChunkJson = 0x4E4F534A;  // "JSON"
-constexpr uint32_t kChunkBin = 0x004E4942;   // "BIN\0"
+constexpr uint32_t kGlbMagic = 0x46546C67;          // "glTF"
+constexpr uint32_t kChunkJson = 0x4E4F534A;         // "JSON"
+constexpr uint32_t kChunkBin = 0x004E4942;          // "BIN\0"
+constexpr double kHalfSqrt2 = 0.70710678118654752;  // the node rotation of a Z-up scene: -90 degrees about x
 
 void append_u32(std::string& out, uint32_t value) {
   static_assert(std::endian::native == std::endian::little, "glb writer assumes a little-endian host");
@@ -164,11 +165,13 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
         {{"bufferView", view}, {"componentType", kUnsignedInt}, {"count", index_count}, {"type", "SCALAR"}});
   }
 
+  nlohmann::json node = {{"mesh", 0}, {"name", "tailor"}};
+  if (options.up == SceneUp::kZ) node["rotation"] = {-kHalfSqrt2, 0.0, 0.0, kHalfSqrt2};
   nlohmann::json gltf = {
       {"asset", {{"version", "2.0"}, {"generator", "tailor"}}},
       {"scene", 0},
       {"scenes", {{{"nodes", {0}}}}},
-      {"nodes", {{{"mesh", 0}, {"name", "tailor"}}}},
+      {"nodes", {node}},
       {"meshes",
        {{{"primitives",
           {{{"attributes", attributes}, {"indices", indices_accessor}, {"material", 0}, {"mode", kTriangles}}}}}}},

@@ -424,6 +424,14 @@ Status write_glb_compressed(const std::string& path, const ExportData& data, con
     }
     case MeshCompression::kNone: return write_glb(path, data, options);
   }
+  if (options.up == SceneUp::kZ) {  // -90 degrees about x: (x, y, z) -> (x, z, -y), after the quantization
+    constexpr double h = 0.70710678118654752;
+    node["rotation"] = {-h, 0.0, 0.0, h};
+    if (node.contains("translation")) {
+      const nlohmann::json t = node["translation"];
+      node["translation"] = {t[0], t[2], -t[1].get<double>()};
+    }
+  }
   nlohmann::json accessors = nlohmann::json::array(), attributes;
   for (const Stream& s : streams) {
     accessors.push_back(s.accessor);
