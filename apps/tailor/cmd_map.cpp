@@ -1,5 +1,7 @@
 // tailor map: load -> topology -> [axis choice] -> map_texture (orientation, mapping, metrics) -> export
 // (+ preview, stats).
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -40,7 +42,8 @@ std::string axis_text(const OrientationOptions& o) {
 // The command line of `tailor map`. The library's options are bound to their flags in `options`
 // (defaults: the structs' own); those given as text are parsed in run_map.
 struct MapArgs {
-  std::string input;
+  std::vector<std::string> inputs;  // as given: files or folders
+  std::string input;                // the one being mapped
   std::string output;
   std::string texture;
   ImageLoadOptions image_options;  // --max-image-pixels (default: ImageLoadOptions')
@@ -329,6 +332,79 @@ int run_map(const MapArgs& opt) {
   return kExitOk;
 }
 
+// Mesh files of a folder (not its subfolders), by the readers' extensions, sorted by name.
+std::vector<std::string> meshes_in(const std::string& folder) {
+  std::vector<std::string> files;
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator(folder, error)) {
+    if (entry.is_regular_file(error) && mesh_format_from_path(entry.path().string()) != MeshFormat::kUnknown)
+      files.push_back(entry.path().string());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+// `tailor map` over its inputs: one run_map for a single file; for several (or a folder) one per
+// file into the output folder, a summary line each and a total, going on past a failed file.
+int run_map_inputs(const MapArgs& args) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::string& out = args.output;
+  std::error_code error;
+  const bool out_folder = (!out.empty() && out.back() == '/') || std::filesystem::is_directory(out, error);
+  const bool in_folder = args.inputs.size() == 1 && std::filesystem::is_directory(args.inputs[0], error);
+  if (args.inputs.size() == 1 && !in_folder && !out_folder) {
+    MapArgs one = args;
+    one.input = args.inputs[0];
+    return run_map(one);
+  }
+  if (!out_folder)
+    return report_error(
+        usage_error("-o must be a folder (ending in '/') for several inputs or a folder, got '" + out + "'"));
+  if (!args.stats.empty() || !args.preview.empty())
+    return report_error(usage_error("--stats and --preview name one file: give a single input"));
+  std::vector<std::string> files;
+  for (const std::string& input : args.inputs) {
+    if (std::filesystem::is_directory(input, error)) {
+      const std::vector<std::string> found = meshes_in(input);
+      if (found.empty()) return report_error(usage_error("no mesh file in the folder '" + input + "'"));
+      files.insert(files.end(), found.begin(), found.end());
+    } else {
+      files.push_back(input);
+    }
+  }
+  // One output per input, named after it: two inputs of one name would write the same file.
+  std::vector<std::pair<std::string, std::string>> outputs;  // (output, input)
+  for (const std::string& file : files) {
+    const std::string target = (std::filesystem::path(out) / std::filesystem::path(file).stem()).string() + ".glb";
+    for (const auto& [other_out, other_in] : outputs)
+      if (other_out == target)
+        return report_error(usage_error("'" + other_in + "' and '" + file + "' would both write '" + target + "'"));
+    outputs.emplace_back(target, file);
+  }
+  if (!std::filesystem::is_directory(out, error) && !std::filesystem::create_directory(out, error))
+    return report_error(Status::error(ErrorCode::kIo, out, "cannot create the output folder: " + error.message()));
+  const bool terminal = !args.quiet && isatty(STDERR_FILENO) == 1;
+  size_t failed = 0;
+  std::string failures;
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    if (terminal) std::fprintf(stderr, "tailor: [%zu/%zu] %s\n", i + 1, outputs.size(), outputs[i].second.c_str());
+    MapArgs one = args;
+    one.input = outputs[i].second;
+    one.output = outputs[i].first;
+    const int rc = run_map(one);
+    std::fflush(stdout);
+    if (rc == kExitUsage) return rc;  // the options are wrong for every file
+    if (rc != kExitOk) {
+      ++failed;
+      failures += (failures.empty() ? "" : ", ") + outputs[i].second;
+    }
+  }
+  if (!args.quiet)
+    std::printf("batch: %zu files, %zu mapped, %zu failed%s in %.2f s -> %s\n", outputs.size(), outputs.size() - failed,
+                failed, failures.empty() ? "" : (" (" + failures + ")").c_str(), seconds_since(start), out.c_str());
+  return failed ? kExitBadInput : kExitOk;
+}
+
 }  // namespace
 
 void register_map(CLI::App& app, Runner& run) {
@@ -337,12 +413,14 @@ void register_map(CLI::App& app, Runner& run) {
   OrientationOptions& orientation = opt->options.orientation;
   auto* cmd =
       app.add_subcommand("map", "Compute texture coordinates by homogeneous patch discovery and write a textured mesh");
-  cmd->add_option("mesh", opt->input,
-                  "Input mesh (.ply .obj .off .stl .glb .gltf; glTF: the default scene in world space)")
+  cmd->add_option("mesh", opt->inputs,
+                  "Input meshes (.ply .obj .off .stl .glb .gltf; glTF: the default scene in world space); several "
+                  "files or a folder map each into the folder -o names")
       ->required();
   cmd->add_option("-o,--output", opt->output,
                   "Output mesh: .glb (texture embedded), .obj (+ .mtl) or .ply; a symlink is written through (its "
-                  "target replaced)")
+                  "target replaced). With several inputs or a folder: an existing folder (or one ending in '/'), "
+                  "where each input becomes <name>.glb")
       ->required();
   cmd->add_option("-t,--texture", opt->texture,
                   "Texture image (PNG/JPEG), ideally self-tileable (see 'tailor tile'); sets the texture size");
@@ -402,7 +480,7 @@ void register_map(CLI::App& app, Runner& run) {
       "Trade-offs: --no-crack-closing maps 3-10x faster and keeps more UVs bit-identical when parts of\n"
       "the mesh change, with about twice the seam length; --field-following 0 --crack-rings 32 gives the\n"
       "fewest seams (one patch per component) for stochastic textures whose direction does not matter.");
-  cmd->callback([&run, opt] { run = [opt] { return run_map(*opt); }; });
+  cmd->callback([&run, opt] { run = [opt] { return run_map_inputs(*opt); }; });
 }
 
 }  // namespace tailor::cli
