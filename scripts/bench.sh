@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # make bench: runs every Google Benchmark of tailor (load, topology, orientation, mapping, export,
-# end to end, tiling; export_as/load_output: PLY and .glb with each --compress, sizes in MB) and prints one line per benchmark with its throughput counters.
+# end to end, tiling; export_as/load_output: PLY and .glb with each --compress, sizes in MB) and
+# prints one line per benchmark with its throughput counters.
 # Usage: scripts/bench.sh BUILD_DIR [extra Google Benchmark flags, e.g. --benchmark_filter=Load]
 set -euo pipefail
 build=${1:-build}
