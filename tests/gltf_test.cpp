@@ -604,6 +604,43 @@ TEST(GltfKept, NormalsColoursAndOtherUvSetsSurviveAMapping) {
   fs::remove_all(dir);
 }
 
+TEST(GltfKept, PlyNormalsAndColoursReachTheGlb) {
+  // A tetrahedron whose vertices carry (not unit) normals and uchar colours.
+  const std::string dir = test::empty_temp_dir("gltf_ply_kept");
+  std::ofstream(dir + "/t.ply") << "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+                                   "property float z\nproperty float nx\nproperty float ny\nproperty float nz\n"
+                                   "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+                                   "element face 4\nproperty list uchar int vertex_indices\nend_header\n"
+                                   "0 0 0 -2 -2 -2 255 0 0\n1 0 0 2 0 0 0 255 0\n0 1 0 0 2 0 0 0 255\n"
+                                   "0 0 1 0 0 2 51 102 153\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  Mesh mesh;
+  ASSERT_TRUE(load_mesh(dir + "/t.ply", mesh).is_ok());
+  ASSERT_NE(attribute(mesh, "NORMAL"), nullptr);
+  ASSERT_NE(attribute(mesh, "COLOR_0"), nullptr);
+  Atlas atlas;
+  atlas.corner_uv.assign(6 * mesh.face_count(), 0.f);
+  atlas.patch.assign(mesh.face_count(), 0);
+  ASSERT_TRUE(export_mesh(dir + "/t.glb", mesh, atlas, ExportOptions{}).is_ok());
+  if (!gltf_transform().empty()) expect_valid_gltf(dir + "/t.glb");
+  Mesh back;
+  ASSERT_TRUE(load_mesh(dir + "/t.glb", back).is_ok());
+  const CornerAttribute *normal = attribute(back, "NORMAL"), *colour = attribute(back, "COLOR_0");
+  ASSERT_TRUE(normal && colour);
+  const float s = 1.f / std::sqrt(3.f);
+  for (size_t c = 0; c < back.indices.size(); ++c) {
+    const float* p = &back.positions[3 * back.indices[c]];
+    const int v = p[0] == 1 ? 1 : p[1] == 1 ? 2 : p[2] == 1 ? 3 : 0;  // which input vertex
+    const float expected_normal[4][3] = {{-s, -s, -s}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    const float expected_colour[4][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0.2f, 0.4f, 0.6f}};
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(normal->values[3 * c + size_t(k)], expected_normal[v][k], 1e-6) << c;
+      EXPECT_NEAR(colour->values[4 * c + size_t(k)], expected_colour[v][k], 1e-6) << c;
+    }
+    EXPECT_EQ(colour->values[4 * c + 3], 1.f);
+  }
+  fs::remove_all(dir);
+}
+
 // === World units and up axis (tailor map) ===========================================================
 
 // Median over the faces' edges of texture pixels per scene unit (UVs in repeats of `texture_px`).

@@ -247,6 +247,15 @@ Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas
     for (size_t i = 0; i < data.kept.size(); ++i)
       if (data.kept[i].name == "NORMAL") {
         data.normals = std::move(data.kept[i].values);
+        for (size_t v = 0; v < data.normals.size(); v += 3) {  // unit length, as glTF wants
+          float* n = &data.normals[v];
+          const double length = std::sqrt(double{n[0]} * n[0] + double{n[1]} * n[1] + double{n[2]} * n[2]);
+          if (length > 0 && std::isfinite(length)) {
+            for (int k = 0; k < 3; ++k) n[k] = static_cast<float>(n[k] / length);
+          } else {
+            n[0] = 0, n[1] = 0, n[2] = 1;
+          }
+        }
         data.kept.erase(data.kept.begin() + static_cast<std::ptrdiff_t>(i));
         input_normals = true;
         break;
