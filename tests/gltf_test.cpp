@@ -641,6 +641,32 @@ TEST(GltfKept, PlyNormalsAndColoursReachTheGlb) {
   fs::remove_all(dir);
 }
 
+TEST(GltfKept, ObjColoursAndNormalsReachTheGlb) {
+  const std::string dir = test::empty_temp_dir("gltf_obj_kept");
+  std::ofstream(dir + "/c.obj") << "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nv 1 1 0 0.5 0.5 0.5\n"
+                                   "vn 0 0 2\nvn 0 0.6 0.8\nf 1//1 2//1 3//1\nf 2//2 4//2 3//2\n";
+  Mesh mesh;
+  ASSERT_TRUE(load_mesh(dir + "/c.obj", mesh).is_ok());
+  Atlas atlas;
+  atlas.corner_uv.assign(6 * mesh.face_count(), 0.f);
+  atlas.patch.assign(mesh.face_count(), 0);
+  ASSERT_TRUE(export_mesh(dir + "/c.glb", mesh, atlas, ExportOptions{}).is_ok());
+  Mesh back;
+  ASSERT_TRUE(load_mesh(dir + "/c.glb", back).is_ok());
+  const CornerAttribute *normal = attribute(back, "NORMAL"), *colour = attribute(back, "COLOR_0");
+  ASSERT_TRUE(normal && colour);
+  ASSERT_EQ(back.face_count(), 2u);
+  for (size_t c = 0; c < back.indices.size(); ++c) {
+    const float* p = &back.positions[3 * back.indices[c]];
+    const bool second = c >= 3;  // faces keep their order in a plain .glb
+    EXPECT_NEAR(normal->values[3 * c + 1], second ? 0.6f : 0.f, 1e-6) << c;
+    EXPECT_NEAR(normal->values[3 * c + 2], second ? 0.8f : 1.f, 1e-6) << c;
+    const float expected_red = p[0] == 0 && p[1] == 0 ? 1.f : p[0] == 1 && p[1] == 1 ? 0.5f : 0.f;
+    EXPECT_NEAR(colour->values[4 * c], expected_red, 1e-6) << c;
+  }
+  fs::remove_all(dir);
+}
+
 // === World units and up axis (tailor map) ===========================================================
 
 // Median over the faces' edges of texture pixels per scene unit (UVs in repeats of `texture_px`).
