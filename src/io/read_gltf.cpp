@@ -127,6 +127,7 @@ Status gpu_instances(GltfDocument& doc, const Json& extension, size_t mesh, cons
     count = info.count;
   }
   if (count == SIZE_MAX) return doc.parse_error("EXT_mesh_gpu_instancing without attributes", where);
+  TAILOR_RETURN_IF_ERROR(doc.charge(count * sizeof(Instance), where));
   for (size_t i = 0; i < count; ++i) {
     double t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
     for (size_t c = 0; c < 3 && !values[0].empty(); ++c) t[c] = values[0][3 * i + c];
