@@ -9,12 +9,16 @@ EXAMPLE_MESH := examples/spot.obj
 EXAMPLE_TEXTURE := examples/gravel.png
 PREFIX ?= /usr/local
 
-.PHONY: all deps configure build test run install bench fuzz tsan lsan format clean
+.PHONY: all deps deps-blender configure build test run install bench fuzz tsan lsan format clean blender-addon
 
 all: build
 
 deps:
 	@bash scripts/deps.sh
+
+# Blender (Debian's, ~400 MB with its libraries): only for the add-on's test and its pictures.
+deps-blender:
+	@TAILOR_BLENDER=1 bash scripts/deps.sh
 
 configure: deps
 	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS) >/dev/null
@@ -40,6 +44,10 @@ run: build
 # pkg-config file, under PREFIX (default /usr/local); DESTDIR=/stage prefixes every path (packaging).
 install: build
 	@DESTDIR="$(DESTDIR)" cmake --install $(BUILD_DIR) --prefix "$(PREFIX)"
+
+# The Blender add-on as a zip (Edit > Preferences > Add-ons > Install...), with the Python module.
+blender-addon: build
+	@bash scripts/blender_addon.sh $(BUILD_DIR) out/tailor_addon.zip
 
 bench: build
 	@bash scripts/bench.sh $(BUILD_DIR)

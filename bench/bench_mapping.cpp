@@ -22,6 +22,7 @@
 #include "tailor/mapping.h"
 #include "tailor/metrics.h"
 #include "tailor/orientation.h"
+#include "tailor/texture_direction.h"
 #include "tailor/topology.h"
 
 namespace {
@@ -95,7 +96,9 @@ void BM_Mapping(benchmark::State& state, const std::string& key, const tailor::M
   state.counters["faces"] = faces;
   set_faces_rate(state, p.mesh.face_count());
   tailor::UvMetrics m;
-  if (!tailor::compute_uv_metrics(p.mesh, p.topology, atlas.corner_uv, atlas.patch, {}, m).is_ok()) {
+  tailor::MetricsOptions metrics;
+  metrics.symmetry = options.symmetry;  // symmetry 4: quarter turns across a seam count as invisible
+  if (!tailor::compute_uv_metrics(p.mesh, p.topology, atlas.corner_uv, atlas.patch, metrics, m).is_ok()) {
     state.SkipWithError("metrics failed");
     return;
   }
@@ -114,9 +117,12 @@ void BM_Mapping(benchmark::State& state, const std::string& key, const tailor::M
   if (options.mode == tailor::MappingMode::kThesis) state.counters["thr_px"] = stats.final_threshold_px;
 }
 
-// Registers one orientation and five mapping benchmarks per mesh at static initialisation:
-// patches mode (default options and ten times the texture scale), its growth alone (no crack closing), the fewest-seams
-// setting (pure unfolding, crack closing at 32 rings), thesis mode.
+// Registers one orientation and nine mapping benchmarks per mesh at static initialisation:
+// patches mode with a texture that has a direction, or none (default options, and ten times the
+// texture scale), with a texture without direction (`tailor map`'s default for gravel, grass:
+// adapt_mapping_to_texture, rigid unfolding with 32 crack rings; both scales), the integer-grid
+// map for a 4-fold symmetric 512 px tile (`--symmetry 4`, experimental; both scales), the growth
+// alone (no crack closing), thesis mode.
 [[maybe_unused]] const bool registered = [] {
   std::vector<std::pair<std::string, std::string>> meshes = {{"horse_x16", "horse_x16"}};
   const std::filesystem::path dir = std::filesystem::path(TAILOR_SHARED_DATA) / "meshes";
@@ -128,12 +134,18 @@ void BM_Mapping(benchmark::State& state, const std::string& key, const tailor::M
   }
   std::sort(files.begin(), files.end());
   for (const auto& f : files) meshes.emplace_back(f.stem().string(), f.string());
-  tailor::MappingOptions patches, patches_x10, growth, fewest_seams, thesis;
+  tailor::MappingOptions patches, patches_x10, growth, undirected, thesis;
   patches_x10.scale = 10 * patches.scale;  // `--scale 8000`: the texture repeats ~15 times across a mesh
   growth.close_cracks = false;
   growth.relax_iterations = 0;
-  fewest_seams.field_following = 0.f;  // `--field-following 0 --crack-rings 32`
-  fewest_seams.crack_rings = 32;
+  undirected.field_following = 0.f;  // what adapt_mapping_to_texture sets for a texture without direction
+  undirected.crack_rings = tailor::kUndirectedCrackRings;
+  tailor::MappingOptions undirected_x10 = undirected;
+  undirected_x10.scale = patches_x10.scale;
+  tailor::MappingOptions fourfold;
+  fourfold.symmetry = 4;  // texture_period_px: the default 512 px
+  tailor::MappingOptions fourfold_x10 = fourfold;
+  fourfold_x10.scale = patches_x10.scale;
   thesis.mode = tailor::MappingMode::kThesis;
   for (const auto& [name, key] : meshes) {
     benchmark::RegisterBenchmark(("Orientation/" + name).c_str(), BM_Orientation, key)
@@ -148,11 +160,23 @@ void BM_Mapping(benchmark::State& state, const std::string& key, const tailor::M
         ->Unit(benchmark::kMillisecond)
         ->MinTime(0.2)
         ->UseManualTime();
+    benchmark::RegisterBenchmark(("Mapping/symmetry4/" + name).c_str(), BM_Mapping, key, fourfold)
+        ->Unit(benchmark::kMillisecond)
+        ->MinTime(0.2)
+        ->UseManualTime();
+    benchmark::RegisterBenchmark(("Mapping/symmetry4-x10/" + name).c_str(), BM_Mapping, key, fourfold_x10)
+        ->Unit(benchmark::kMillisecond)
+        ->MinTime(0.2)
+        ->UseManualTime();
     benchmark::RegisterBenchmark(("Mapping/growth/" + name).c_str(), BM_Mapping, key, growth)
         ->Unit(benchmark::kMillisecond)
         ->MinTime(0.2)
         ->UseManualTime();
-    benchmark::RegisterBenchmark(("Mapping/fewest-seams/" + name).c_str(), BM_Mapping, key, fewest_seams)
+    benchmark::RegisterBenchmark(("Mapping/undirected/" + name).c_str(), BM_Mapping, key, undirected)
+        ->Unit(benchmark::kMillisecond)
+        ->MinTime(0.2)
+        ->UseManualTime();
+    benchmark::RegisterBenchmark(("Mapping/undirected-x10/" + name).c_str(), BM_Mapping, key, undirected_x10)
         ->Unit(benchmark::kMillisecond)
         ->MinTime(0.2)
         ->UseManualTime();

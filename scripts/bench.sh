@@ -10,3 +10,8 @@ bin="$build/tailor_bench"
 [[ -x $bin ]] || { echo "bench: $bin not built (configure with -DTAILOR_BUILD_BENCH=ON)" >&2; exit 1; }
 echo "bench: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
 "$bin" --benchmark_counters_tabular=false "$@"
+# The Python module's overhead over its C++ calls (1M faces), when the module is built.
+if [[ -d $build/python/tailor ]]; then
+  PYTHONPATH="$build/python" "$(sed -n 's/^Python_EXECUTABLE:FILEPATH=//p' "$build/CMakeCache.txt")" \
+    "$(dirname "$0")/../bench/python_overhead.py" "$build"
+fi

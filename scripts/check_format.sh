@@ -5,7 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 command -v clang-format >/dev/null || { echo "format: clang-format is missing (make deps installs it)" >&2; exit 1; }
-dirs=(src include apps tests bench fuzz examples)
+dirs=(src include apps python tests bench fuzz examples)
 if git rev-parse --is-inside-work-tree >/dev/null 2>&1; then
   mapfile -t files < <(git ls-files -co --exclude-standard -- "${dirs[@]}" | grep -E '\.(cpp|h|h\.in)$')
 else

@@ -11,9 +11,15 @@ packages=(
   libopencv-core-dev libopencv-imgproc-dev libosmesa6-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-format python3
+  pybind11-dev python3-dev python3-numpy python3-pytest
   chromium
 )
+# pybind11, Python's headers, numpy and pytest: the Python module and its tests (/usr/bin/python3).
 # clang + its fuzzer runtime are optional: the fuzz step skips cleanly without them.
+# Blender only on request (TAILOR_BLENDER=1, make deps-blender): the add-on's test skips without it.
+if [[ ${TAILOR_BLENDER:-0} == 1 ]]; then
+  packages+=(blender)
+fi
 
 missing=()
 for p in "${packages[@]}"; do

@@ -3,7 +3,8 @@
 #   bash tests/install_test.sh <build-dir>/tailor
 # 1. cmake --install of that build into a temporary prefix: the layout, and no installed text file
 #    naming the source or build tree;
-# 2. the installed `tailor` runs (--version, map);
+# 2. the installed `tailor` runs (--version, map); the installed Python module (when built) imports
+#    from the prefix alone and writes the same .glb;
 # 3. examples/consumer built against the prefix with find_package(tailor) and with pkg-config
 #    (static libraries): both run, write valid .glb files (node + glTF-Validator, skipped without
 #    node), byte-identical to the installed `tailor map`'s;
@@ -76,6 +77,21 @@ refs=$(grep -rIlF -e "$repo" -e "$build" "$prefix")
 "$prefix/bin/tailor" map "$mesh" --texture "$texture" -o "$tmp/reference.glb" --quiet && [[ -s $tmp/reference.glb ]] ||
   fatal "the installed tailor map failed"
 ok
+
+# --- 2b. the Python module (when the build has it): imported from the prefix alone, same .glb ---
+python=$(sed -n 's/^Python_EXECUTABLE:FILEPATH=//p' "$build/CMakeCache.txt")
+if [[ -d $build/python/tailor && -x $python ]]; then
+  module_dir=$(dirname "$(find "$prefix" -path '*-packages/tailor/__init__.py' | head -1)")
+  for f in __init__.py __init__.pyi py.typed; do [[ -f $module_dir/$f ]] && ok || fail "python: not installed: tailor/$f"; done
+  (cd "$tmp" && PYTHONPATH=$(dirname "$module_dir") PYTHONDONTWRITEBYTECODE=1 "$python" -c "
+import sys, tailor
+assert tailor.__file__.startswith('$prefix'), tailor.__file__
+mesh = tailor.load('$repo/$mesh')
+tailor.save('$tmp/python.glb', mesh, tailor.map(mesh, texture='$repo/$texture'))
+") && cmp -s "$tmp/python.glb" "$tmp/reference.glb" && ok || fail "python: the installed module does not give the installed tailor's .glb"
+else
+  echo "skipped: the Python module (not built)"
+fi
 
 # --- 3. examples/consumer with find_package and with pkg-config ---
 # run_consumer NAME BINARY: maps the test mesh, validates the .glb and compares it with tailor map's.

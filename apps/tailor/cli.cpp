@@ -110,6 +110,16 @@ bool parse_vec3(const std::string& text, std::array<float, 3>& v) {
   return in.eof() && std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
 }
 
+bool parse_unit_float(const std::string& text, float& value) {
+  std::istringstream in(text);
+  float parsed = 0.f;
+  if (!(in >> parsed)) return false;
+  in >> std::ws;
+  if (!in.eof() || !(parsed >= 0.f && parsed <= 1.f)) return false;
+  value = parsed;
+  return true;
+}
+
 Progress::Progress(std::string label, bool quiet)
     : label_(std::move(label)),
       enabled_(!quiet && isatty(STDERR_FILENO) == 1),

@@ -71,6 +71,9 @@ inline CLI::Option* add_off_switch(CLI::App* app, const OptionDoc& doc, bool& fi
 //! Parses "X,Y,Z" into three finite floats; false when the text is anything else.
 bool parse_vec3(const std::string& text, std::array<float, 3>& v);
 
+//! Parses a number in [0, 1] into `value`; false (value unchanged) when the text is anything else.
+bool parse_unit_float(const std::string& text, float& value);
+
 //! A progress bar on stderr, drawn only when stderr is a terminal and not quiet, and only once the
 //! work has run for more than ~1 s. update() is cheap enough to call per percent of work.
 class Progress {

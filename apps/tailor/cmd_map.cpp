@@ -19,6 +19,7 @@
 #include "tailor/render.h"
 #include "tailor/report.h"
 #include "tailor/stability.h"
+#include "tailor/texture_direction.h"
 #include "tailor/topology.h"
 #include "util/atomic_file.h"
 
@@ -60,6 +61,8 @@ struct MapArgs {
   MapTextureOptions options;
   std::string mode = mapping_mode_name(MappingOptions{}.mode);
   std::string axis = axis_text(OrientationOptions{});
+  std::string field_following = "auto";  // or a number in [0, 1]
+  bool crack_rings_given = false;        // --crack-rings on the command line (kept over auto's)
   std::string seed_point;
   std::string seam_faces;
   bool stability = false;
@@ -138,24 +141,19 @@ int run_map(const MapArgs& opt) {
   MappingOptions& mapping = options.mapping;
   if (!mapping_mode_from_name(opt.mode, mapping.mode))
     return report_error(usage_error("--mode must be patches or thesis, got '" + opt.mode + "'"));
-  if (mapping.symmetry == 4 && mapping.mode != MappingMode::kPatches)
-    return report_error(usage_error("--symmetry 4 needs --mode patches"));
   if (!opt.seed_point.empty()) {
     if (!parse_vec3(opt.seed_point, mapping.seed_point))
       return report_error(usage_error("--seed-point must be three numbers X,Y,Z, got '" + opt.seed_point + "'"));
     mapping.use_seed_point = true;
   }
   if (opt.texture_size <= 0) return report_error(usage_error("--texture-size must be positive"));
-  // Below ~1e-3 px per unit every UV rounds to the same float; above 1e7 faces span millions of px.
-  if (!(mapping.scale >= 1e-3f && mapping.scale <= 1e7f))
-    return report_error(usage_error("--scale must be between 0.001 and 1e7 pixels per unit"));
+  if (Status s = check_map_options(options); !s) return report_error(s);  // scale, hop age, symmetry
+  if (opt.field_following != "auto" && !parse_unit_float(opt.field_following, mapping.field_following))
+    return report_error(
+        usage_error("--field-following must be auto or a number in [0, 1], got '" + opt.field_following + "'"));
   UpAxis preview_up = RenderOptions{}.up;
   if (!up_axis_from_name(opt.preview_up, preview_up))
     return report_error(usage_error("--preview-up must be x, y, z, -x, -y or -z, got '" + opt.preview_up + "'"));
-  if (!(mapping.hop_age >= 0.f && mapping.hop_age <= 1.f))
-    return report_error(usage_error("--hop-age must be between 0 and 1 radians"));
-  // --threads is one count for every stage that has threads.
-  options.orientation.threads = options.metrics.threads = mapping.threads;
   if (Status s = check_outputs(output_paths(opt), {opt.input, opt.texture, opt.seam_faces}); !s) return report_error(s);
 
   // === Texture (read first: a bad texture should fail before minutes of work) ===
@@ -165,12 +163,16 @@ int run_map(const MapArgs& opt) {
   }
   const int tex_w = texture.empty() ? opt.texture_size : texture.width;
   const int tex_h = texture.empty() ? opt.texture_size : texture.height;
-  // Symmetry 4: the lattice is the texture's square period; the metrics count quarter turns as invisible.
-  if (mapping.symmetry == 4 && tex_w != tex_h)
-    return report_error(
-        usage_error("--symmetry 4 needs a square texture, got " + std::to_string(tex_w) + "x" + std::to_string(tex_h)));
-  mapping.texture_period_px = static_cast<float>(tex_w);
-  options.metrics.symmetry = mapping.symmetry;
+  // The lattice period, the metrics' texture size, the threads of every stage.
+  if (Status s = set_map_texture_size(options, tex_w, tex_h); !s) return report_error(s);
+  // auto: follow the field unless the texture has no direction to follow (texture_direction.h).
+  float texture_isotropy = -1.f;
+  if (opt.field_following == "auto") {
+    if (!texture.empty()) texture_isotropy = tailor::texture_isotropy(texture);
+    const uint32_t rings = mapping.crack_rings;
+    adapt_mapping_to_texture(texture, mapping);
+    if (opt.crack_rings_given) mapping.crack_rings = rings;
+  }
 
   // === Load, topology, orientation ===
   Mesh mesh;
@@ -199,8 +201,6 @@ int run_map(const MapArgs& opt) {
     warn(opt.quiet, opt.input + ": " + std::to_string(topology.nonmanifold_edges) + " non-manifold and " +
                         std::to_string(topology.inconsistent_edges) +
                         " inconsistently oriented edges treated as boundary");
-  options.metrics.texture_width_px = static_cast<float>(tex_w);
-  options.metrics.texture_height_px = static_cast<float>(tex_h);
   // World units: the texel density is per scene unit, the same for every mesh (the mapping works
   // in the unit cube: its scale becomes texels per unit times the normalisation's length).
   double texels_per_unit = opt.texels_per_unit;
@@ -230,6 +230,8 @@ int run_map(const MapArgs& opt) {
   run.texture = opt.texture;
   run.texture_width = tex_w;
   run.texture_height = tex_h;
+  run.texture_isotropy = texture_isotropy;
+  run.field_following_auto = opt.field_following == "auto";
   run.axis = opt.axis;
   run.axis_auto = auto_axis;
   run.seed_point = opt.seed_point;
@@ -449,12 +451,16 @@ void register_map(CLI::App& app, Runner& run) {
   add_documented(group, option_doc(kMappingOptionDocs, "mode"), opt->mode);
   add_documented(group, option_doc(kMappingOptionDocs, "scale"), mapping.scale);
   add_documented(group, option_doc(kMappingOptionDocs, "max_stretch"), mapping.max_stretch);
-  add_documented(group, option_doc(kMappingOptionDocs, "field_following"), mapping.field_following);
+  group
+      ->add_option("--field-following", opt->field_following,
+                   std::string(option_doc(kMappingOptionDocs, "field_following").help))
+      ->capture_default_str();
   add_documented(group, option_doc(kMappingOptionDocs, "min_patch_faces"), mapping.min_patch_faces);
   add_documented(group, option_doc(kMappingOptionDocs, "hop_age"), mapping.hop_age);
   add_off_switch(group, option_doc(kMappingOptionDocs, "shorten_seams"), mapping.shorten_seams);
   add_off_switch(group, option_doc(kMappingOptionDocs, "close_cracks"), mapping.close_cracks);
-  add_documented(group, option_doc(kMappingOptionDocs, "crack_rings"), mapping.crack_rings)->check(CLI::Range(2u, 64u));
+  CLI::Option* crack_rings = add_documented(group, option_doc(kMappingOptionDocs, "crack_rings"), mapping.crack_rings)
+                                 ->check(CLI::Range(2u, 64u));
   add_documented(group, option_doc(kMappingOptionDocs, "relax_iterations"), mapping.relax_iterations)
       ->check(CLI::Range(0u, 1000u));
   add_documented(group, option_doc(kMappingOptionDocs, "threshold_px"), mapping.threshold_px);
@@ -478,9 +484,14 @@ void register_map(CLI::App& app, Runner& run) {
       "Prints one summary line: faces, patches, seam length, flipped faces, stretch, Sander L2/Linf,\n"
       "median angle distortion, seam gap, and the time of each stage.\n"
       "Trade-offs: --no-crack-closing maps 3-10x faster and keeps more UVs bit-identical when parts of\n"
-      "the mesh change, with about twice the seam length; --field-following 0 --crack-rings 32 gives the\n"
-      "fewest seams (one patch per component) for stochastic textures whose direction does not matter.");
-  cmd->callback([&run, opt] { run = [opt] { return run_map_inputs(*opt); }; });
+      "the mesh change, with about twice the seam length. --field-following auto (the default) maps a\n"
+      "texture without a direction (gravel, grass; its isotropy is in the --stats) with rigid unfolding\n"
+      "and 32 crack rings, the fewest seams; --field-following 1 keeps the orientation field, and\n"
+      "the UVs of a mesh that is edited and re-mapped more stable (docs/mapping.md section 7).");
+  cmd->callback([&run, opt, crack_rings] {
+    opt->crack_rings_given = crack_rings->count() > 0;
+    run = [opt] { return run_map_inputs(*opt); };
+  });
 }
 
 }  // namespace tailor::cli

@@ -21,19 +21,24 @@ int main(int argc, char** argv) {
   if (tailor::Status s = tailor::load_mesh(argv[1], mesh); !s) return fail(s);
   const tailor::Topology topology = tailor::build_topology(mesh);  // which faces share an edge
 
-  // The pipeline: orientation field, growth, seam shortening, crack closing and metrics, with the
-  // default options of every stage (as `tailor map` uses them).
-  tailor::TextureMap map;  // per-face frames, the atlas (a UV per face corner, in texture pixels,
-                           // and a patch per face), what each stage did, and the quality metrics
-  if (tailor::Status s = tailor::map_texture(mesh, topology, {}, map); !s) return fail(s);
-  const tailor::Atlas& atlas = map.atlas;
-
+  // The texture, if any, first: its size is the UVs' pixel unit, and one without a direction
+  // (gravel, grass) is mapped with rigid unfolding, the fewest seams (as `tailor map` does).
   tailor::ExportOptions output;  // the texture to embed and its size (pixels per texture repeat)
+  tailor::MapTextureOptions options;
   if (argc > 3) {
     tailor::Image texture;
     if (tailor::Status s = tailor::load_image(argv[3], texture); !s) return fail(s);
     output = {.texture_path = argv[3], .texture_width = texture.width, .texture_height = texture.height};
+    tailor::adapt_mapping_to_texture(texture, options.mapping);
   }
+
+  // The pipeline: orientation field, growth, seam shortening, crack closing, relaxation and metrics,
+  // with the default options of every stage otherwise (as `tailor map` uses them).
+  tailor::TextureMap map;  // per-face frames, the atlas (a UV per face corner, in texture pixels,
+                           // and a patch per face), what each stage did, and the quality metrics
+  if (tailor::Status s = tailor::map_texture(mesh, topology, options, map); !s) return fail(s);
+  const tailor::Atlas& atlas = map.atlas;
+
   if (tailor::Status s = tailor::export_mesh(argv[2], mesh, atlas, output); !s) return fail(s);
   std::printf("%s: %zu faces in %u patches\n", argv[2], mesh.face_count(), atlas.patch_count);
   return 0;

@@ -34,14 +34,16 @@ struct MapRun {
   std::string texture;    //!< texture file, empty when none
   int texture_width = 0;  //!< texture size the UVs are in (px per repeat)
   int texture_height = 0;
-  MapTextureOptions options;   //!< as map_texture ran them (after --axis auto: the chosen axis)
-  std::string axis;            //!< the axis as asked ("pca", "x", "0,1,0"...), or "auto:<chosen>"
-  bool axis_auto = false;      //!< the axis was chosen by choose_orientation_axis (--axis auto)
-  std::string seed_point;      //!< the seed point as asked ("X,Y,Z"), empty when none
-  std::string seam_faces;      //!< seam-face file, empty when none
-  double texels_per_unit = 0;  //!< > 0: world units (--tile-size, --texels-per-unit), texture pixels per scene
+  float texture_isotropy = -1.f;  //!< texture_isotropy of the texture when measured (--field-following auto), else -1
+  bool field_following_auto = false;  //!< --field-following auto: options.mapping holds what it chose
+  MapTextureOptions options;          //!< as map_texture ran them (after --axis auto: the chosen axis)
+  std::string axis;                   //!< the axis as asked ("pca", "x", "0,1,0"...), or "auto:<chosen>"
+  bool axis_auto = false;             //!< the axis was chosen by choose_orientation_axis (--axis auto)
+  std::string seed_point;             //!< the seed point as asked ("X,Y,Z"), empty when none
+  std::string seam_faces;             //!< seam-face file, empty when none
+  double texels_per_unit = 0;         //!< > 0: world units (--tile-size, --texels-per-unit), texture pixels per scene
                                //!< unit; 0: options.mapping.scale is per unit of the mesh normalised into the unit cube
-  std::string up = "y";        //!< the input's up axis (--up); a .glb output is turned Y-up
+  std::string up = "y";  //!< the input's up axis (--up); a .glb output is turned Y-up
   // What the stages found (add_map_results fills these from the library's results)
   LoadReport load;  //!< what the reader saw and repaired, its time
   size_t vertices = 0;

@@ -1,6 +1,7 @@
 // tailor: the whole public API in one include. Link what the headers you use belong to:
 //   tailor::core     mesh.h io.h gltf.h image.h topology.h orientation.h mapping.h axis_choice.h
 //                    atlas.h metrics.h stability.h export.h status.h version.h
+//                    texture_direction.h
 //   tailor::texture  image_ops.h tiling.h (tileable textures, OpenCV inside)
 //   tailor::render   render.h (preview pictures, OSMesa inside)
 // Including a header whose library is not linked is harmless as long as none of its functions is
@@ -25,6 +26,7 @@
 #include "tailor/report.h"
 #include "tailor/stability.h"
 #include "tailor/status.h"
+#include "tailor/texture_direction.h"
 #include "tailor/tiling.h"
 #include "tailor/topology.h"
 #include "tailor/version.h"

@@ -31,12 +31,14 @@ std::string map_report_json(const MapRun& run) {
   j["output"] = run.output;
   j["texture"] = run.texture;
   j["texture_size"] = {run.texture_width, run.texture_height};
+  if (run.texture_isotropy >= 0.f) j["texture_isotropy"] = run.texture_isotropy;
   j["options"] = {
       {"mode", mapping_mode_name(mapping.mode)},
       {"scale", mapping.scale},
       {"threshold_px", mapping.threshold_px},
       {"max_stretch", mapping.max_stretch},
       {"field_following", mapping.field_following},
+      {"field_following_auto", run.field_following_auto},
       {"min_patch_faces", mapping.min_patch_faces},
       {"shorten_seams", mapping.shorten_seams},
       {"close_cracks", mapping.close_cracks},

@@ -1,0 +1,191 @@
+// tailor.Mesh (from numpy arrays or a file) and tailor.load. The arrays are validated and repaired
+// by finalize_mesh, the same pass every file reader runs, so a Mesh from arrays and one from a
+// file obey the same rules (and raise the same messages).
+#include <cstring>
+
+#include "bindings.h"
+#include "tailor/io.h"
+
+namespace tailor::python {
+namespace {
+
+constexpr const char* kArraysName = "tailor.Mesh";
+
+// (V, 3) float32 or float64 -> mesh.positions. float32 in C order is one memcpy; other layouts
+// and float64 are converted row by row (float64 values beyond float's range become inf, which
+// finalize_mesh refuses as non-finite).
+void copy_positions(const py::array& positions, std::vector<float>& out) {
+  if (positions.ndim() != 2 || positions.shape(1) != 3)
+    raise_error("positions must be a (V, 3) array, got " + describe(positions));
+  const size_t count = static_cast<size_t>(positions.shape(0)) * 3;
+  if (count / 3 > kMaxVertices) raise_status(Status::error(ErrorCode::kLimit, kArraysName, "too many vertices"));
+  out.resize(count);
+  if (positions.dtype().is(py::dtype::of<float>())) {
+    const auto typed = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(positions);
+    const py::gil_scoped_release release;
+    if (count) std::memcpy(out.data(), typed.data(), count * sizeof(float));
+  } else if (positions.dtype().is(py::dtype::of<double>())) {
+    const auto typed = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(positions);
+    const double* in = typed.data();
+    const py::gil_scoped_release release;
+    for (size_t i = 0; i < count; ++i) out[i] = static_cast<float>(in[i]);
+  } else {
+    raise_error("positions must be float32 or float64, got " + describe(positions));
+  }
+}
+
+// One face row of any integer type -> uint32 indices; a negative or too large index is refused
+// with finalize_mesh's message for an index out of range.
+template <class T>
+void copy_indices(const py::array& faces, size_t vertex_count, std::vector<uint32_t>& out) {
+  const auto typed = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(faces);
+  const T* in = typed.data();
+  const size_t count = out.size();
+  size_t bad = count;
+  {
+    const py::gil_scoped_release release;
+    for (size_t i = 0; i < count; ++i) {
+      const T v = in[i];
+      if constexpr (std::is_signed_v<T>) {
+        if (v < 0) {
+          bad = i;
+          break;
+        }
+      }
+      if (static_cast<uint64_t>(v) >= vertex_count) {  // finalize_mesh would name it too; uint32 may not hold it
+        bad = i;
+        break;
+      }
+      out[i] = static_cast<uint32_t>(v);
+    }
+  }
+  if (bad != count)
+    raise_status(Status::error(ErrorCode::kInvalidMesh, kArraysName,
+                               "face index " + std::to_string(in[bad]) + " out of range (mesh has " +
+                                   std::to_string(vertex_count) + " vertices)",
+                               "face " + std::to_string(bad / 3)));
+}
+
+void copy_faces(const py::array& faces, size_t vertex_count, std::vector<uint32_t>& out) {
+  if (faces.ndim() != 2 || faces.shape(1) != 3) raise_error("faces must be an (F, 3) array, got " + describe(faces));
+  if (static_cast<size_t>(faces.shape(0)) > kMaxFaces)
+    raise_status(Status::error(ErrorCode::kLimit, kArraysName, "too many faces"));
+  out.resize(static_cast<size_t>(faces.shape(0)) * 3);
+  const char kind = faces.dtype().kind();
+  const py::ssize_t size = faces.dtype().itemsize();
+  if (kind == 'u' && size == 4)
+    copy_indices<uint32_t>(faces, vertex_count, out);
+  else if (kind == 'i' && size == 4)
+    copy_indices<int32_t>(faces, vertex_count, out);
+  else if (kind == 'i' && size == 8)
+    copy_indices<int64_t>(faces, vertex_count, out);
+  else if (kind == 'u' && size == 8)
+    copy_indices<uint64_t>(faces, vertex_count, out);
+  else
+    raise_error("faces must be int32, int64, uint32 or uint64, got " + describe(faces));
+}
+
+py::dict load_report_dict(const LoadReport& r) {
+  py::dict d;
+  d["format"] = r.format;
+  d["source_faces"] = r.source_faces;
+  d["polygons_triangulated"] = r.polygons_triangulated;
+  d["degenerate_faces"] = r.degenerate_faces;
+  d["duplicate_faces"] = r.duplicate_faces;
+  d["zero_area_faces"] = r.zero_area_faces;
+  d["unreferenced_vertices"] = r.unreferenced_vertices;
+  d["welded_vertices"] = r.welded_vertices;
+  return d;
+}
+
+}  // namespace
+
+void bind_mesh(py::module_& m) {
+  py::class_<PyMesh>(m, "Mesh",
+                     "A triangle mesh: positions (V, 3) float32 and faces (F, 3) uint32, counter-clockwise.\n\n"
+                     "Mesh(positions, faces): positions float32 or float64 (V, 3), faces int32, int64, uint32 or\n"
+                     "uint64 (F, 3). float32 and uint32 arrays in C order are copied with one memcpy into the\n"
+                     "library's arrays (no conversion); other dtypes are converted. The arrays are checked\n"
+                     "as every file reader checks them: non-finite coordinates and indices out of range raise\n"
+                     "tailor.Error; faces with a repeated vertex and exact duplicate faces are dropped and\n"
+                     "counted in load_report (compare face_count with len(faces)).")
+      .def(py::init([](const py::array& positions, const py::array& faces) {
+             auto mesh = std::make_unique<PyMesh>();
+             copy_positions(positions, mesh->mesh.positions);
+             copy_faces(faces, mesh->mesh.vertex_count(), mesh->mesh.indices);
+             mesh->load.format = "arrays";
+             mesh->load.source_faces = mesh->mesh.face_count();
+             Status status;
+             {
+               const py::gil_scoped_release release;
+               status = finalize_mesh(kArraysName, mesh->mesh, mesh->load);
+             }
+             if (!status) raise_status(status);
+             return mesh;
+           }),
+           py::arg("positions"), py::arg("faces"))
+      .def_property_readonly(
+          "positions",
+          [](py::object self) {
+            const PyMesh& mesh = self.cast<const PyMesh&>();
+            return readonly_view(mesh.mesh.positions.data(), {py::ssize_t(mesh.mesh.vertex_count()), 3}, self);
+          },
+          "(V, 3) float32, a read-only view of the mesh's own array (no copy)")
+      .def_property_readonly(
+          "faces",
+          [](py::object self) {
+            const PyMesh& mesh = self.cast<const PyMesh&>();
+            return readonly_view(mesh.mesh.indices.data(), {py::ssize_t(mesh.mesh.face_count()), 3}, self);
+          },
+          "(F, 3) uint32, a read-only view (no copy); faces dropped as degenerate or duplicate are not in it")
+      .def_property_readonly(
+          "corner_uvs",
+          [](py::object self) -> py::object {
+            const PyMesh& mesh = self.cast<const PyMesh&>();
+            if (mesh.mesh.corner_uvs.empty()) return py::none();
+            return readonly_view(mesh.mesh.corner_uvs.data(), {py::ssize_t(mesh.mesh.face_count()), 3, 2}, self);
+          },
+          "(F, 3, 2) float32 texture coordinates read from the file (texture repeats), or None")
+      .def_property_readonly(
+          "seam_faces",
+          [](py::object self) -> py::object {
+            const PyMesh& mesh = self.cast<const PyMesh&>();
+            if (mesh.mesh.seam_faces.empty()) return py::none();
+            return readonly_view(mesh.mesh.seam_faces.data(), {py::ssize_t(mesh.mesh.face_count())}, self);
+          },
+          "(F,) uint8 seam flags read from the file (PLY 'seam' property), or None")
+      .def_property_readonly(
+          "vertex_count", [](const PyMesh& mesh) { return mesh.mesh.vertex_count(); }, "number of vertices")
+      .def_property_readonly(
+          "face_count", [](const PyMesh& mesh) { return mesh.mesh.face_count(); }, "number of faces")
+      .def_property_readonly(
+          "source", [](const PyMesh& mesh) { return mesh.source; }, "the file it was loaded from ('' for arrays)")
+      .def_property_readonly(
+          "load_report", [](const PyMesh& mesh) { return load_report_dict(mesh.load); },
+          "what loading found and repaired: format, source_faces, degenerate_faces, duplicate_faces, ...")
+      .def("__repr__", [](const PyMesh& mesh) {
+        return "<tailor.Mesh " + std::to_string(mesh.mesh.vertex_count()) + " vertices, " +
+               std::to_string(mesh.mesh.face_count()) + " faces" +
+               (mesh.source.empty() ? std::string() : " from '" + mesh.source + "'") + ">";
+      });
+
+  m.def(
+      "load",
+      [](const py::object& path_object) {
+        const std::string path = path_of(path_object);
+        auto mesh = std::make_unique<PyMesh>();
+        mesh->source = path;
+        Status status;
+        {
+          const py::gil_scoped_release release;
+          status = load_mesh(path, mesh->mesh, &mesh->load);
+        }
+        if (!status) raise_status(status);
+        return mesh;
+      },
+      py::arg("path"),
+      "load(path) -> Mesh\n\nReads a mesh file (.ply .obj .off .stl .glb; the format from the extension, else "
+      "the content), as `tailor map` does. Raises tailor.Error with the command's message on a bad file.");
+}
+
+}  // namespace tailor::python

@@ -1,0 +1,106 @@
+// tailor.tile: make_tileable on a numpy image or an image file, as `tailor tile` (report=True adds
+// the JSON of `tailor tile --json`).
+#include <chrono>
+#include <cstring>
+
+#include "bindings.h"
+#include "tailor/image.h"
+#include "tailor/report.h"
+#include "tailor/tiling.h"
+
+namespace tailor::python {
+namespace {
+
+// (H, W) or (H, W, C) uint8 with C in 1..4 -> Image (rows top first, interleaved channels).
+Image image_from_array(const py::array& array) {
+  if (!array.dtype().is(py::dtype::of<uint8_t>()))
+    raise_error("image must be a uint8 array (H, W) or (H, W, C), got " + describe(array));
+  if (array.ndim() != 2 && array.ndim() != 3)
+    raise_error("image must be a uint8 array (H, W) or (H, W, C), got " + describe(array));
+  Image image;
+  image.height = static_cast<int>(std::min<py::ssize_t>(array.shape(0), kMaxImageSide + 1));
+  image.width = static_cast<int>(std::min<py::ssize_t>(array.shape(1), kMaxImageSide + 1));
+  image.channels = array.ndim() == 3 ? static_cast<int>(std::min<py::ssize_t>(array.shape(2), 5)) : 1;
+  // The size is checked before the pixels are copied.
+  if (image.width > kMaxImageSide || image.height > kMaxImageSide || image.channels > 4 || image.width < 1 ||
+      image.height < 1)
+    raise_status(Status::error(ErrorCode::kInvalidImage, "image", "unsupported image size " + describe(array)));
+  const auto typed = py::array_t<uint8_t, py::array::c_style | py::array::forcecast>::ensure(array);
+  image.pixels.resize(static_cast<size_t>(typed.size()));
+  std::memcpy(image.pixels.data(), typed.data(), image.pixels.size());
+  return image;
+}
+
+py::array array_from_image(Image&& image) {
+  auto* owned = new Image(std::move(image));
+  py::capsule owner(owned, [](void* p) { delete static_cast<Image*>(p); });
+  std::vector<py::ssize_t> shape = {owned->height, owned->width, owned->channels};
+  return py::array_t<uint8_t>(shape, owned->pixels.data(), owner);
+}
+
+}  // namespace
+
+void bind_tile(py::module_& m) {
+  const TileOptions d;
+  m.def(
+      "tile",
+      [](const py::object& image_or_path, int block, int overlap, uint64_t seed, bool fit_period, int symmetry,
+         bool report, const py::object& progress) -> py::object {
+        Image exemplar;
+        TileRun run;
+        if (py::isinstance<py::array>(image_or_path)) {
+          exemplar = image_from_array(image_or_path.cast<py::array>());
+        } else {
+          run.input = path_of(image_or_path);
+          Status s;
+          {
+            const py::gil_scoped_release release;
+            s = load_image(run.input, exemplar);
+          }
+          if (!s) raise_status(s);
+        }
+        TileOptions options;
+        options.block = block;
+        options.overlap = overlap;
+        options.seed = seed;
+        options.fit_period = fit_period;
+        options.symmetry = symmetry;
+        ProgressBridge bridge(progress);
+        options.progress = bridge.function();
+        run.input_width = exemplar.width;
+        run.input_height = exemplar.height;
+        run.input_channels = exemplar.channels;
+        run.options = options;
+        std::vector<Image> tiles;
+        Status status;
+        {
+          const py::gil_scoped_release release;
+          const auto start = std::chrono::steady_clock::now();
+          status = make_tile_variants(exemplar, options, 1, tiles, &run.report);
+          run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+          if (status && report) {  // the metrics against the input as given, as `tailor tile --json`
+            run.tiles.resize(1);
+            status = tile_metrics(tiles[0], &exemplar, run.tiles[0].metrics);
+            run.tiles[0].targets_met = meets_tile_targets(run.tiles[0].metrics, &run.tiles[0].targets_failed);
+            run.worst.metrics = worst_tile_metrics(run.tiles);
+            run.worst.targets_met = meets_tile_targets(run.worst.metrics, &run.worst.targets_failed);
+          }
+        }
+        bridge.finish(status.with_file(run.input.empty() ? "image" : run.input));
+        py::array tile = array_from_image(std::move(tiles[0]));
+        if (!report) return tile;
+        return py::make_tuple(tile, json_to_dict(tile_report_json(run)));
+      },
+      py::arg("image"), py::arg("block") = d.block, py::arg("overlap") = d.overlap, py::arg("seed") = d.seed,
+      py::arg("fit_period") = d.fit_period, py::arg("symmetry") = d.symmetry, py::arg("report") = false,
+      py::arg("progress") = py::none(),
+      R"(tile(image, block=32, overlap=0, seed=1, fit_period=False, symmetry=1, report=False, progress=None)
+
+Makes a texture self-tileable (quadrant swap + image quilting), as `tailor tile`. image: a uint8
+array (H, W) or (H, W, C) with C in 1..4, or an image file path. Returns the tile as a uint8 array
+(H', W', C); with report=True, (tile, dict) where the dict is `tailor tile --json`'s report
+(metrics against the input). The same seed gives the same tile. The GIL is released while it
+works; progress works as in map().)");
+}
+
+}  // namespace tailor::python

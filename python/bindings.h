@@ -1,0 +1,98 @@
+// The Python module `tailor`: what the binding files share. One file per entry point
+// (bind_mesh.cpp, bind_map.cpp, bind_tile.cpp, bind_eval.cpp, bind_save.cpp); errors and the
+// progress bridge in errors.cpp and progress.cpp. Every call releases the GIL while the library works.
+#pragma once
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <chrono>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tailor/atlas.h"
+#include "tailor/mesh.h"
+#include "tailor/status.h"
+
+namespace tailor::python {
+
+namespace py = pybind11;
+
+//! A mesh as Python sees it: the library's Mesh, what loading it found, and where it came from.
+struct PyMesh {
+  Mesh mesh;
+  LoadReport load;
+  std::string source;  //!< the file it was loaded from, empty for arrays
+};
+
+//! What tailor.map returns: the atlas in pixels (for save), its texture size, and the reports.
+struct PyResult {
+  Atlas atlas;
+  int texture_width = 0;
+  int texture_height = 0;
+  std::string texture;            //!< the texture file given to map, empty when none
+  std::vector<float> corner_uvs;  //!< #F*3*2, texture repeats, exactly as export writes them
+  py::object stats;               //!< dict: the JSON of `tailor map --stats`
+  double library_seconds = 0;     //!< wall time inside the library's calls (the benchmark's baseline)
+};
+
+//! Raises tailor.Error with the CLI's one-line message (what follows "tailor: error: ").
+[[noreturn]] void raise_status(const Status& status);
+//! Raises tailor.Error with `what` (a bad argument found by the binding itself).
+[[noreturn]] void raise_error(const std::string& what);
+
+//! A read-only numpy view of `data` (shape given) that keeps `owner` alive: no copy.
+template <class T>
+py::array readonly_view(const T* data, std::vector<py::ssize_t> shape, py::handle owner) {
+  py::array_t<T> view(std::move(shape), data, owner);
+  py::detail::array_proxy(view.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+  return view;
+}
+
+//! "float32 (3, 4)": the dtype and shape of an array, for error messages.
+std::string describe(const py::array& array);
+
+//! A sequence as the CLI's text of it ("0,1,0"), for messages; other objects as str() shows them.
+std::string sequence_text(const py::handle& value);
+
+//! A path argument: str or os.PathLike, as a file system path.
+std::string path_of(const py::handle& path);
+
+//! Parses JSON text with Python's json module (the reports are text in the library).
+py::object json_to_dict(const std::string& text);
+
+//! Connects the library's progress callbacks to Python while the GIL is released: at most every
+//! 50 ms (and at the end) it takes the GIL, checks for signals (Ctrl-C raises KeyboardInterrupt)
+//! and calls the user's callback(fraction); an exception there, or a return value of False,
+//! cancels the work. finish() then re-raises that exception, or tailor.Error for a False.
+class ProgressBridge {
+ public:
+  explicit ProgressBridge(py::object callback) : callback_(std::move(callback)) {}
+  //! The function to hand to the library (MappingOptions::progress, TileOptions::progress).
+  std::function<bool(double)> function();
+  //! Under the GIL, after the library returned `status`: raises what stopped it, or tailor.Error;
+  //! on success the callback's last call says 1.0 (the library's last report may be earlier).
+  void finish(const Status& status);
+
+ private:
+  bool report(double fraction);
+  py::object callback_;
+  std::mutex mutex_;
+  std::optional<py::error_already_set> error_;
+  bool stopped_by_callback_ = false;
+  double last_fraction_ = -1;  //!< the last fraction the callback saw
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+void bind_errors(py::module_& m);
+void bind_mesh(py::module_& m);
+void bind_map(py::module_& m);
+void bind_tile(py::module_& m);
+void bind_eval(py::module_& m);
+void bind_save(py::module_& m);
+
+}  // namespace tailor::python

@@ -1,0 +1,67 @@
+// tailor.Error and the small helpers every binding uses (paths, JSON, array descriptions).
+#include "bindings.h"
+
+namespace tailor::python {
+namespace {
+// Set once by bind_errors; the module object keeps the exception type alive.
+PyObject* error_type = nullptr;
+
+const char* code_name(ErrorCode code) {
+  switch (code) {
+    case ErrorCode::kOk: return "ok";
+    case ErrorCode::kIo: return "io";
+    case ErrorCode::kParse: return "parse";
+    case ErrorCode::kInvalidMesh: return "invalid_mesh";
+    case ErrorCode::kInvalidImage: return "invalid_image";
+    case ErrorCode::kUnsupported: return "unsupported";
+    case ErrorCode::kLimit: return "limit";
+    case ErrorCode::kInvalidArgument: return "invalid_argument";
+    case ErrorCode::kCancelled: return "cancelled";
+  }
+  return "error";
+}
+
+[[noreturn]] void raise_with_code(const std::string& message, const char* code) {
+  py::object error = py::reinterpret_borrow<py::object>(error_type)(message);
+  error.attr("code") = code;
+  PyErr_SetObject(error_type, error.ptr());
+  throw py::error_already_set();
+}
+}  // namespace
+
+void raise_status(const Status& status) { raise_with_code(status.message(), code_name(status.code())); }
+
+void raise_error(const std::string& what) { raise_with_code(what, code_name(ErrorCode::kInvalidArgument)); }
+
+std::string describe(const py::array& array) {
+  std::string text = py::str(array.dtype()).cast<std::string>() + " (";
+  for (py::ssize_t i = 0; i < array.ndim(); ++i) text += (i ? ", " : "") + std::to_string(array.shape(i));
+  return text + (array.ndim() == 1 ? ",)" : ")");
+}
+
+std::string sequence_text(const py::handle& value) {
+  if (py::isinstance<py::str>(value) || !py::isinstance<py::sequence>(value)) return py::str(value).cast<std::string>();
+  std::string text;
+  for (const py::handle item : value.cast<py::sequence>())
+    text += (text.empty() ? "" : ",") + py::str(item).cast<std::string>();
+  return text;
+}
+
+std::string path_of(const py::handle& path) {
+  if (!py::isinstance<py::str>(path) && !py::hasattr(path, "__fspath__"))
+    raise_error("expected a path (str or os.PathLike), got " + py::str(py::type::of(path)).cast<std::string>());
+  return py::module_::import("os").attr("fsdecode")(path).cast<std::string>();
+}
+
+py::object json_to_dict(const std::string& text) { return py::module_::import("json").attr("loads")(text); }
+
+void bind_errors(py::module_& m) {
+  static py::exception<std::exception> type(m, "Error", PyExc_ValueError);
+  error_type = type.ptr();
+  type.doc() =
+      "Raised by every tailor call on bad input, bad options or failed I/O. str(error) is the line the "
+      "tailor command prints after 'tailor: error: ' (file: what (where)); error.code names the kind: "
+      "io, parse, invalid_mesh, invalid_image, unsupported, limit, invalid_argument or cancelled.";
+}
+
+}  // namespace tailor::python

@@ -1,0 +1,15 @@
+"""tailor: texture mapping of triangle meshes by homogeneous patch discovery, and self-tileable
+textures.
+
+    import tailor
+    mesh = tailor.load("bunny.ply")                  # or tailor.Mesh(positions, faces) from numpy
+    result = tailor.map(mesh, texture="gravel_tile.png")
+    result.corner_uvs                                # (F, 3, 2) float32, texture repeats
+    tailor.save("bunny.glb", mesh, result)
+
+Every call releases the GIL while the C++ library works; errors raise tailor.Error (a ValueError)
+with the message the tailor command prints. See docs/python.md.
+"""
+from ._tailor import Error, Mesh, Result, __version__, evaluate, load, map, save, tile
+
+__all__ = ["Error", "Mesh", "Result", "evaluate", "load", "map", "save", "tile", "__version__"]

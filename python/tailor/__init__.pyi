@@ -1,0 +1,112 @@
+# Type stubs of the tailor module (the C++ extension tailor._tailor); docstrings: help(tailor.map).
+import os
+from typing import Callable, Literal, Optional, Sequence, Tuple, Union, overload
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+_Path = Union[str, os.PathLike[str]]
+_Progress = Callable[[float], Optional[bool]]
+
+class Error(ValueError):
+    """Bad input, bad options or failed I/O; str() is the tailor command's one-line message."""
+
+    code: str
+
+class Mesh:
+    """A triangle mesh: positions (V, 3) float32, faces (F, 3) uint32."""
+
+    def __init__(self, positions: npt.ArrayLike, faces: npt.ArrayLike) -> None: ...
+    @property
+    def positions(self) -> npt.NDArray[np.float32]: ...
+    @property
+    def faces(self) -> npt.NDArray[np.uint32]: ...
+    @property
+    def corner_uvs(self) -> Optional[npt.NDArray[np.float32]]: ...
+    @property
+    def seam_faces(self) -> Optional[npt.NDArray[np.uint8]]: ...
+    @property
+    def vertex_count(self) -> int: ...
+    @property
+    def face_count(self) -> int: ...
+    @property
+    def source(self) -> str: ...
+    @property
+    def load_report(self) -> dict: ...
+
+class Result:
+    """What map() returns."""
+
+    @property
+    def corner_uvs(self) -> npt.NDArray[np.float32]: ...
+    @property
+    def patch(self) -> npt.NDArray[np.uint32]: ...
+    @property
+    def patch_count(self) -> int: ...
+    @property
+    def texture_size(self) -> Tuple[int, int]: ...
+    @property
+    def stats(self) -> dict: ...
+    @property
+    def metrics(self) -> dict: ...
+    @property
+    def library_seconds(self) -> float: ...
+
+def load(path: _Path) -> Mesh: ...
+def map(
+    mesh: Mesh,
+    texture_size: int = 512,
+    scale: float = 800.0,
+    axis: Union[Literal["pca", "x", "y", "z", "auto"], Sequence[float]] = "pca",
+    seam_faces: Optional[npt.ArrayLike] = None,
+    threads: int = 0,
+    progress: Optional[_Progress] = None,
+    *,
+    texture: Optional[_Path] = None,
+    mode: Literal["patches", "thesis"] = "patches",
+    max_stretch: float = 0.25,
+    field_following: Union[float, Literal["auto"]] = "auto",
+    min_patch_faces: int = 16,
+    hop_age: float = 0.02,
+    shorten_seams: bool = True,
+    close_cracks: bool = True,
+    crack_rings: Optional[int] = None,
+    relax_iterations: int = 10,
+    threshold: float = 25.0,
+    seed_point: Optional[Sequence[float]] = None,
+    symmetry: Literal[1, 4] = 1,
+    unit_scale: float = 0.0,
+    smooth: int = 0,
+) -> Result: ...
+@overload
+def tile(
+    image: Union[npt.NDArray[np.uint8], _Path],
+    block: int = 32,
+    overlap: int = 0,
+    seed: int = 1,
+    fit_period: bool = False,
+    symmetry: Literal[1, 4] = 1,
+    report: Literal[False] = False,
+    progress: Optional[_Progress] = None,
+) -> npt.NDArray[np.uint8]: ...
+@overload
+def tile(
+    image: Union[npt.NDArray[np.uint8], _Path],
+    block: int = 32,
+    overlap: int = 0,
+    seed: int = 1,
+    fit_period: bool = False,
+    symmetry: Literal[1, 4] = 1,
+    *,
+    report: Literal[True],
+    progress: Optional[_Progress] = None,
+) -> Tuple[npt.NDArray[np.uint8], dict]: ...
+def evaluate(
+    mesh: Mesh,
+    corner_uvs: npt.ArrayLike,
+    texture_size: Union[int, Tuple[int, int]] = 512,
+    symmetry: Literal[1, 4] = 1,
+) -> dict: ...
+def save(path: _Path, mesh: Mesh, result: Result, texture: Optional[_Path] = None) -> None: ...

@@ -1,0 +1,39 @@
+// The option checks and the texture-size settings `tailor map` applies before map_texture, shared
+// with the Python module so both refuse the same options with the same message.
+#include <string>
+
+#include "tailor/mapping.h"
+
+namespace tailor {
+namespace {
+Status usage_error(const std::string& what) { return Status::error(ErrorCode::kInvalidArgument, "", what); }
+}  // namespace
+
+Status check_map_options(const MapTextureOptions& options) {
+  const MappingOptions& mapping = options.mapping;
+  if (mapping.symmetry == 4 && mapping.mode != MappingMode::kPatches)
+    return usage_error("--symmetry 4 needs --mode patches");
+  if (!(mapping.scale >= 1e-3f && mapping.scale <= 1e7f))
+    return usage_error("--scale must be between 0.001 and 1e7 pixels per unit");
+  if (!(mapping.hop_age >= 0.f && mapping.hop_age <= 1.f))
+    return usage_error("--hop-age must be between 0 and 1 radians");
+  return Status::ok();
+}
+
+Status set_map_texture_size(MapTextureOptions& options, int texture_width, int texture_height) {
+  if (texture_width <= 0 || texture_height <= 0) return usage_error("--texture-size must be positive");
+  MappingOptions& mapping = options.mapping;
+  // Symmetry 4: the lattice is the texture's square period; the metrics count quarter turns as invisible.
+  if (mapping.symmetry == 4 && texture_width != texture_height)
+    return usage_error("--symmetry 4 needs a square texture, got " + std::to_string(texture_width) + "x" +
+                       std::to_string(texture_height));
+  mapping.texture_period_px = static_cast<float>(texture_width);
+  options.metrics.symmetry = mapping.symmetry;
+  options.metrics.texture_width_px = static_cast<float>(texture_width);
+  options.metrics.texture_height_px = static_cast<float>(texture_height);
+  // --threads is one count for every stage that has threads.
+  options.orientation.threads = options.metrics.threads = mapping.threads;
+  return Status::ok();
+}
+
+}  // namespace tailor

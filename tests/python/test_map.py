@@ -1,0 +1,154 @@
+"""tailor.map, save and evaluate: identity with the tailor command, options, errors."""
+import json
+
+import numpy as np
+import pytest
+
+import tailor
+from conftest import DATA, GRAVEL, SPOT, bumpy_grid, run_cli
+
+
+def without_times(stats):
+    return {k: v for k, v in stats.items() if k not in ("time_ms", "output", "input", "previews")}
+
+
+@pytest.mark.parametrize(
+    "mesh_path, options, cli_options",
+    [
+        (SPOT, dict(texture=GRAVEL), ["--texture", GRAVEL]),
+        (SPOT, dict(texture=GRAVEL, field_following=1, crack_rings=8), ["--texture", GRAVEL, "--field-following", "1",
+                                                                         "--crack-rings", "8"]),
+        (DATA / "meshes" / "fandisk.off", dict(axis="auto", texture_size=256), ["--axis", "auto", "--texture-size", "256"]),
+        (DATA / "meshes" / "horse.ply", dict(axis=(0, 1, 0), scale=400, threads=2, close_cracks=False, smooth=2),
+         ["--axis", "0,1,0", "--scale", "400", "--threads", "2", "--no-crack-closing", "--smooth", "2"]),
+    ],
+)
+def test_map_is_bit_identical_to_the_cli(tmp_path, tailor_binary, mesh_path, options, cli_options):
+    mesh = tailor.load(mesh_path)
+    result = tailor.map(mesh, **options)
+    for ext in (".glb", ".ply"):
+        cli_out, py_out = tmp_path / ("cli" + ext), tmp_path / ("py" + ext)
+        code, _, err = run_cli(tailor_binary, "map", mesh_path, "-o", cli_out, "-q", "--stats", tmp_path / "s.json",
+                               *cli_options)
+        assert code == 0, err
+        tailor.save(py_out, mesh, result)
+        assert py_out.read_bytes() == cli_out.read_bytes()
+    cli_stats = json.loads((tmp_path / "s.json").read_text())
+    assert without_times(result.stats) == without_times(cli_stats)
+    assert result.metrics == cli_stats["metrics"]
+    # The UVs as arrays are the file's UVs: reading the .ply back gives the same per-corner bits.
+    back = tailor.load(tmp_path / "py.ply")
+    assert back.corner_uvs.tobytes() == result.corner_uvs.tobytes()
+
+
+def test_field_following_auto_follows_the_texture():
+    mesh = tailor.load(SPOT)
+    gravel = tailor.map(mesh, texture=GRAVEL)  # no direction: rigid unfolding, 32 crack rings
+    assert gravel.stats["options"]["field_following"] == 0 and gravel.stats["options"]["crack_rings"] == 32
+    assert gravel.stats["options"]["field_following_auto"] and gravel.stats["texture_isotropy"] >= 0.8
+    plain = tailor.map(mesh)  # no texture: the orientation field, as the thesis
+    assert plain.stats["options"]["field_following"] == 1 and "texture_isotropy" not in plain.stats
+    assert tailor.map(mesh, texture=GRAVEL, crack_rings=12).stats["options"]["crack_rings"] == 12
+    for bad in (1.5, -0.1, "sometimes", None):
+        with pytest.raises(tailor.Error, match="--field-following must be auto or a number in"):
+            tailor.map(mesh, field_following=bad)
+
+
+def test_result_arrays(tmp_path):
+    mesh = tailor.load(SPOT)
+    result = tailor.map(mesh, texture_size=1024)
+    assert result.corner_uvs.shape == (mesh.face_count, 3, 2) and result.corner_uvs.dtype == np.float32
+    assert np.isfinite(result.corner_uvs).all()
+    assert result.patch.shape == (mesh.face_count,) and result.patch.max() + 1 == result.patch_count
+    assert result.texture_size == (1024, 1024)
+    assert result.metrics["flipped"] == 0 and result.stats["texture_size"] == [1024, 1024]
+    assert 0 < result.library_seconds
+    # Seams: faces listed as seam faces move the cuts there (the counter reports them).
+    seams = np.arange(0, mesh.face_count, 7)
+    flagged = tailor.map(mesh, seam_faces=seams)
+    mask = np.zeros(mesh.face_count, bool)
+    mask[seams] = True
+    assert flagged.stats["mapping"]["faces_seam"] == len(seams)
+    assert tailor.map(mesh, seam_faces=mask).corner_uvs.tobytes() == flagged.corner_uvs.tobytes()
+
+
+def test_evaluate_matches_the_map_and_the_cli(tmp_path, tailor_binary):
+    mesh = tailor.load(SPOT)
+    result = tailor.map(mesh)
+    report = tailor.evaluate(mesh, result.corner_uvs, 512)
+    for key in ("flipped", "seam_edges", "stretch", "l2_stretch", "seam_gap_px"):  # patches: derived
+        assert report[key] == result.metrics[key], key
+    tailor.save(tmp_path / "out.obj", mesh, result)
+    code, out, err = run_cli(tailor_binary, "eval", tmp_path / "out.obj", "--json", "--texture-size", "512")
+    assert code == 0, err
+    cli = json.loads(out)
+    back = tailor.load(tmp_path / "out.obj")
+    ours = tailor.evaluate(back, back.corner_uvs, 512)
+    for key in ("flipped", "seam_edges", "stretch", "l2_stretch", "linf_stretch", "distortion_deg"):
+        assert ours[key] == cli[key], key
+    with pytest.raises(tailor.Error, match=r"corner_uvs must be a float \(F, 3, 2\) array"):
+        tailor.evaluate(mesh, result.corner_uvs[:10], 512)
+    bad = np.array(result.corner_uvs)
+    bad[3, 1, 0] = np.inf
+    with pytest.raises(tailor.Error):
+        tailor.evaluate(mesh, bad, 512)
+
+
+@pytest.mark.parametrize(
+    "options, cli_options",
+    [
+        (dict(scale=0), ["--scale", "0"]),
+        (dict(hop_age=2.0), ["--hop-age", "2"]),
+        (dict(axis="w"), ["--axis", "w"]),
+        (dict(mode="thesis", symmetry=4), ["--mode", "thesis", "--symmetry", "4"]),
+        (dict(texture_size=0), ["--texture-size", "0"]),
+        (dict(seed_point=(0, 1)), ["--seed-point", "0,1"]),
+        (dict(texture=SPOT), ["--texture", SPOT]),
+    ],
+)
+def test_bad_options_raise_the_cli_message(tmp_path, tailor_binary, options, cli_options):
+    mesh = tailor.load(SPOT)
+    with pytest.raises(tailor.Error) as caught:
+        tailor.map(mesh, **options)
+    code, _, err = run_cli(tailor_binary, "map", SPOT, "-o", tmp_path / "x.glb", *cli_options)
+    assert code != 0 and err.strip() == "tailor: error: " + str(caught.value)
+
+
+def test_bad_seam_faces_and_mismatched_save(tmp_path):
+    mesh = tailor.load(SPOT)
+    with pytest.raises(tailor.Error, match=r"seam face index 5856 out of range \(mesh has 5856 faces\)"):
+        tailor.map(mesh, seam_faces=[1, 5856])
+    with pytest.raises(tailor.Error, match="one entry per face"):
+        tailor.map(mesh, seam_faces=np.zeros(3, bool))
+    other = tailor.Mesh(*bumpy_grid(8))
+    with pytest.raises(tailor.Error, match="save the mesh that was mapped"):
+        tailor.save(tmp_path / "x.glb", mesh, tailor.map(other))
+    with pytest.raises(tailor.Error, match="directory"):
+        tailor.save(tmp_path / "missing" / "x.glb", mesh, tailor.map(mesh))
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_unit_scale_gives_one_texel_density_whatever_the_size():
+    positions, faces = bumpy_grid(40)
+    densities = []
+    for factor in (1.0, 3.0):
+        mesh = tailor.Mesh(positions * factor, faces)
+        densities.append(tailor.map(mesh, scale=100, unit_scale=1.0).metrics["uv_scale"])  # px^2 per unit^2
+        normalised = tailor.map(mesh, scale=100).metrics["uv_scale"]
+        assert normalised == pytest.approx(100**2 / (4 * factor) ** 2, rel=0.05)  # the longest side is 4 * factor
+    assert densities[0] == pytest.approx(100**2, rel=0.05) and densities[1] == pytest.approx(100**2, rel=0.05)
+    with pytest.raises(tailor.Error, match="unit_scale"):
+        tailor.map(tailor.Mesh(positions, faces), unit_scale=-1)
+
+
+def test_seam_faces_that_are_no_array():
+    mesh = tailor.load(SPOT)
+    for bad in ("abc", [[1, 2], [3, 4]], [0.5, 2.0], object()):
+        with pytest.raises(tailor.Error, match="seam_faces"):
+            tailor.map(mesh, seam_faces=bad)
+
+
+def test_map_docstring_carries_the_cli_help(tailor_binary):
+    _, help_text, _ = run_cli(tailor_binary, "map", "--help")
+    for flag in ("--max-stretch", "--hop-age", "--crack-rings", "--relax-iterations", "--symmetry", "--smooth"):
+        assert flag in help_text and flag in tailor.map.__doc__, flag

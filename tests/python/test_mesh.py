@@ -1,0 +1,96 @@
+"""tailor.load and tailor.Mesh: round trips, dtypes, views, and bad arrays as errors."""
+import numpy as np
+import pytest
+
+import tailor
+from conftest import DATA, SPOT, bumpy_grid
+
+
+def test_load_counts_match_the_manifest():
+    mesh = tailor.load(SPOT)
+    assert (mesh.vertex_count, mesh.face_count) == (2930, 5856)
+    assert mesh.positions.shape == (2930, 3) and mesh.positions.dtype == np.float32
+    assert mesh.faces.shape == (5856, 3) and mesh.faces.dtype == np.uint32
+    assert mesh.source == str(SPOT)
+    assert mesh.load_report["format"] == "OBJ"
+    assert mesh.corner_uvs is not None and mesh.corner_uvs.shape == (5856, 3, 2)  # spot.obj has vt
+
+
+def test_arrays_round_trip_and_views_are_read_only():
+    loaded = tailor.load(DATA / "meshes" / "fandisk.off")
+    mesh = tailor.Mesh(loaded.positions, loaded.faces)
+    assert np.array_equal(mesh.positions, loaded.positions)
+    assert np.array_equal(mesh.faces, loaded.faces)
+    assert mesh.corner_uvs is None and mesh.seam_faces is None
+    view = mesh.positions
+    assert np.shares_memory(view, mesh.positions)  # views of the mesh's own array, no copy
+    assert not view.flags.writeable
+    with pytest.raises(ValueError):
+        view[0, 0] = 1.0
+
+
+@pytest.mark.parametrize("position_type", [np.float32, np.float64])
+@pytest.mark.parametrize("face_type", [np.int32, np.int64, np.uint32, np.uint64])
+def test_every_accepted_dtype_gives_the_same_map(position_type, face_type):
+    positions, faces = bumpy_grid(24)
+    reference = tailor.map(tailor.Mesh(positions, faces))
+    mesh = tailor.Mesh(positions.astype(position_type), faces.astype(face_type))
+    assert np.array_equal(mesh.positions, positions)
+    assert reference.corner_uvs.tobytes() == tailor.map(mesh).corner_uvs.tobytes()
+
+
+def test_non_contiguous_arrays_are_read_correctly():
+    positions, faces = bumpy_grid(16)
+    mesh = tailor.Mesh(np.asfortranarray(positions), faces[::-1][::-1].T.copy().T)
+    assert np.array_equal(mesh.positions, positions) and np.array_equal(mesh.faces, faces)
+    strided = np.zeros((positions.shape[0], 6), np.float64)
+    strided[:, ::2] = positions
+    assert np.array_equal(tailor.Mesh(strided[:, ::2], faces).positions, positions)
+
+
+def test_degenerate_and_duplicate_faces_are_dropped_and_counted():
+    positions = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], np.float32)
+    faces = np.array([[0, 1, 2], [1, 3, 2], [0, 0, 1], [2, 0, 1]])
+    mesh = tailor.Mesh(positions, faces)
+    assert mesh.face_count == 2
+    assert mesh.load_report["degenerate_faces"] == 1 and mesh.load_report["duplicate_faces"] == 1
+
+
+GOOD_POSITIONS = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
+GOOD_FACES = np.array([[0, 1, 2]], np.int32)
+
+
+@pytest.mark.parametrize(
+    "positions, faces, message",
+    [
+        (GOOD_POSITIONS[:, :2], GOOD_FACES, r"positions must be a \(V, 3\) array, got float32 \(3, 2\)"),
+        (GOOD_POSITIONS, np.array([[0, 1, 2, 0]]), r"faces must be an \(F, 3\) array"),
+        (GOOD_POSITIONS.astype(np.int32), GOOD_FACES, "positions must be float32 or float64"),
+        (GOOD_POSITIONS, GOOD_FACES.astype(np.float32), "faces must be int32, int64, uint32 or uint64"),
+        (np.array([[0, 0, 0], [1, 0, 0], [0, np.nan, 0]]), GOOD_FACES,
+         r"^tailor.Mesh: non-finite vertex coordinate \(vertex 2\)$"),
+        (np.array([[0, 0, 0], [1e39, 0, 0], [0, 1, 0]]), GOOD_FACES, "non-finite vertex coordinate"),
+        (GOOD_POSITIONS, np.array([[0, 1, 3]]),
+         r"^tailor.Mesh: face index 3 out of range \(mesh has 3 vertices\) \(face 0\)$"),
+        (GOOD_POSITIONS, np.array([[0, 1, 2], [0, -1, 2]]), r"face index -1 out of range .*\(face 1\)"),
+        (GOOD_POSITIONS, np.array([[0, 1, 2 ** 40]], np.int64), "face index 1099511627776 out of range"),
+        (GOOD_POSITIONS, np.zeros((0, 3), np.int32), "mesh has no faces"),
+    ],
+)
+def test_bad_arrays_raise_tailor_error(positions, faces, message):
+    with pytest.raises(tailor.Error, match=message) as caught:
+        tailor.Mesh(positions, faces)
+    assert isinstance(caught.value, ValueError)
+
+
+def test_bad_files_raise_the_cli_message(tmp_path, tailor_binary):
+    from conftest import run_cli
+
+    bad = tmp_path / "bad.off"
+    bad.write_text("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n")
+    for path in (bad, tmp_path / "missing.ply", DATA / "meshes"):
+        with pytest.raises(tailor.Error) as caught:
+            tailor.load(path)
+        code, _, err = run_cli(tailor_binary, "map", path, "-o", tmp_path / "out.glb")
+        assert code == 1 and err.strip() == "tailor: error: " + str(caught.value)
+    assert not (tmp_path / "out.glb").exists()
