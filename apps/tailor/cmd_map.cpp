@@ -353,8 +353,8 @@ int run_map_inputs(const MapArgs& args) {
   const std::string& out = args.output;
   std::error_code error;
   const bool out_folder = (!out.empty() && out.back() == '/') || std::filesystem::is_directory(out, error);
-  const bool in_folder = args.inputs.size() == 1 && std::filesystem::is_directory(args.inputs[0], error);
-  if (args.inputs.size() == 1 && !in_folder && !out_folder) {
+  // One input and a file to write: a single map (a folder as input then fails as any non-file does).
+  if (args.inputs.size() == 1 && !out_folder) {
     MapArgs one = args;
     one.input = args.inputs[0];
     return run_map(one);
