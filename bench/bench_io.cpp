@@ -88,6 +88,76 @@ void BM_ExportGlb(benchmark::State& state) {
 }
 BENCHMARK(BM_ExportGlb)->Unit(benchmark::kMillisecond)->MinTime(1.0)->UseRealTime();
 
+// Compressed glTF next to PLY (issue 18): export_mesh of the same mapping to .ply and to .glb with
+// each compression, the file's size as a counter ("MB"), then load_mesh of each file.
+std::string bench_output(const std::string& name) {
+  return (std::filesystem::temp_directory_path() / ("tailor_bench_" + name)).string();
+}
+
+void export_as(benchmark::State& state, const std::string& name, tailor::MeshCompression compression) {
+  const tailor::Mesh& mesh = subdivided_horse();
+  const tailor::Atlas& atlas = subdivided_horse_atlas();
+  const std::string output = bench_output(name);
+  tailor::ExportOptions options;
+  options.compression = compression;
+  for (auto _ : state) {
+    state.PauseTiming();
+    std::remove(output.c_str());
+    state.ResumeTiming();
+    const tailor::Status s = tailor::export_mesh(output, mesh, atlas, options);
+    if (!s.is_ok()) {
+      state.SkipWithError(s.message().c_str());
+      return;
+    }
+  }
+  state.counters["MB"] = static_cast<double>(std::filesystem::file_size(output)) * 1e-6;
+  set_faces_rate(state, mesh.face_count());
+}
+BENCHMARK_CAPTURE(export_as, ply, std::string("out.ply"), tailor::MeshCompression::kNone)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(export_as, glb, std::string("out.glb"), tailor::MeshCompression::kNone)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(export_as, glb_quantize, std::string("quantize.glb"), tailor::MeshCompression::kQuantize)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(export_as, glb_meshopt, std::string("meshopt.glb"), tailor::MeshCompression::kMeshopt)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(export_as, glb_draco, std::string("draco.glb"), tailor::MeshCompression::kDraco)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0)
+    ->UseRealTime();
+
+// Loads what export_as wrote (registered after it, so the files exist).
+void load_output(benchmark::State& state, const std::string& name) {
+  const std::string path = bench_output(name);
+  if (!std::filesystem::exists(path)) {
+    state.SkipWithError("run the export_as benchmarks first (same filter)");
+    return;
+  }
+  load_file(state, path);
+}
+BENCHMARK_CAPTURE(load_output, ply, std::string("out.ply"))->Unit(benchmark::kMillisecond)->MinTime(1.0)->UseRealTime();
+BENCHMARK_CAPTURE(load_output, glb, std::string("out.glb"))->Unit(benchmark::kMillisecond)->MinTime(1.0)->UseRealTime();
+BENCHMARK_CAPTURE(load_output, glb_quantize, std::string("quantize.glb"))
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(load_output, glb_meshopt, std::string("meshopt.glb"))
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(load_output, glb_draco, std::string("draco.glb"))
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0)
+    ->UseRealTime();
+
 }  // namespace
 
 // The one main() of tailor_bench (CMake links benchmark::benchmark, not benchmark_main).

@@ -7,6 +7,7 @@ set -euo pipefail
 packages=(
   g++ cmake make pkg-config
   libeigen3-dev libstb-dev zlib1g-dev libcli11-dev nlohmann-json3-dev libfast-float-dev
+  libmeshoptimizer-dev libdraco-dev
   libopencv-core-dev libopencv-imgproc-dev libosmesa6-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-format python3 time

@@ -116,6 +116,9 @@ cmp -s "$tmp/a.glb" "$tmp/keep.glb" && ok || fail "failed map damaged the existi
 expect_error 2 "share" -- "$tailor" map "$mesh" -o "$tmp/same.glb" --preview "$tmp/same.glb"
 expect_error 2 "overwrite an input" -- "$tailor" map "$mesh" -o "$tmp/z.obj" --texture "$tmp/z.mtl"
 expect_error 2 "does not exist" -- "$tailor" map "$mesh" -o "$tmp/ok.glb" --stats "$tmp/missing/s.json"
+expect_error 2 "needs a .glb output" -- "$tailor" map "$mesh" -o "$tmp/cx.obj" --compress draco
+expect_error 2 "--compress must be" -- "$tailor" map "$mesh" -o "$tmp/cx.glb" --compress zip
+[[ ! -e $tmp/cx.obj && ! -e $tmp/cx.glb ]] && ok || fail "output left after a bad --compress"
 [[ ! -e $tmp/ok.glb && ! -e $tmp/same.glb ]] && ok || fail "outputs written although the run was refused"
 expect_error 2 "scale" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --scale 1e-30
 expect_error 2 "share" -- "$tailor" tile "$texture" -o "$tmp/v.png" --variants 2 --json "$tmp/v.json"
@@ -255,6 +258,25 @@ expect_error 1 "img: is a directory, not a regular file" -- timeout 5 "$tailor" 
 [[ ! -e $tmp/img/o.png && ! -e $tmp/img/o.glb ]] && ok || fail "a refused input left an output"
 
 ls "$tmp"/*.tmp-* "$tmp"/.tailor-* >/dev/null 2>&1 && fail "temporary files left behind" || ok
+
+# --- batch: a folder and several files into an output folder; a bad file fails alone ---
+mkdir -p "$tmp/batch" "$tmp/batch2"
+cp tests/data/meshes/blobby-3cc.off tests/data/meshes/fertility.off "$tmp/batch/"
+printf 'ply\nformat ascii 1.0\nelement vertex 3\n' >"$tmp/batch/broken.ply"
+"$tailor" map "$tmp/batch" -o "$tmp/batch_out/" --no-crack-closing >"$tmp/batch.txt" 2>"$tmp/batch_err.txt"
+rc=$?
+[[ $rc -eq 1 ]] && ok || fail "batch with a bad file exited $rc, expected 1"
+[[ -s $tmp/batch_out/blobby-3cc.glb && -s $tmp/batch_out/fertility.glb && ! -e $tmp/batch_out/broken.glb ]] && ok ||
+  fail "batch outputs: $(ls "$tmp/batch_out" 2>&1)"
+[[ $(grep -c ' faces, .* -> ' "$tmp/batch.txt") -eq 2 ]] && ok || fail "batch: not one summary line per mapped file: $(cat "$tmp/batch.txt")"
+grep -q '^batch: 3 files, 2 mapped, 1 failed (.*broken.ply)' "$tmp/batch.txt" && ok || fail "batch total: $(cat "$tmp/batch.txt")"
+grep -q "^tailor: error: .*broken.ply" "$tmp/batch_err.txt" && ok || fail "batch: no error line for the bad file"
+"$tailor" map tests/data/meshes/blobby-3cc.off tests/data/meshes/fertility.off -o "$tmp/batch2" -q --compress draco &&
+  [[ -s $tmp/batch2/blobby-3cc.glb && -s $tmp/batch2/fertility.glb ]] && ok || fail "batch of two files failed"
+expect_error 2 "must be a folder" -- "$tailor" map tests/data/meshes/blobby-3cc.off tests/data/meshes/fertility.off -o "$tmp/x.glb"
+cp tests/data/meshes/blobby-3cc.off "$tmp/batch2/blobby-3cc.off"
+expect_error 2 "would both write" -- "$tailor" map tests/data/meshes/blobby-3cc.off "$tmp/batch2/blobby-3cc.off" -o "$tmp/batch3/"
+[[ ! -e $tmp/batch3 ]] && ok || fail "batch made its folder before a usage error"
 
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]

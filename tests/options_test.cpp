@@ -7,6 +7,7 @@
 #include <sstream>
 #include <string>
 
+#include "tailor/export.h"
 #include "tailor/mapping.h"
 #include "tailor/metrics.h"
 #include "tailor/orientation.h"
@@ -49,7 +50,8 @@ TEST(Options, TheTablesNameEachFieldOnce) {
   for (const std::span<const OptionDoc> docs :
        {std::span<const OptionDoc>(kMappingOptionDocs), std::span<const OptionDoc>(kOrientationOptionDocs),
         std::span<const OptionDoc>(kStabilityOptionDocs), std::span<const OptionDoc>(kTileOptionDocs),
-        std::span<const OptionDoc>(kRenderOptionDocs), std::span<const OptionDoc>(kMetricsOptionDocs)}) {
+        std::span<const OptionDoc>(kRenderOptionDocs), std::span<const OptionDoc>(kMetricsOptionDocs),
+        std::span<const OptionDoc>(kExportOptionDocs)}) {
     for (size_t i = 0; i < docs.size(); ++i) {
       EXPECT_FALSE(docs[i].help.empty()) << docs[i].field;
       EXPECT_EQ(docs[i].flag.substr(0, 2), "--") << docs[i].field;
@@ -63,6 +65,8 @@ TEST(Options, MapHelpShowsTheTablesAndTheStructsDefaults) {
   const std::string help = help_of("map");
   expect_documented(help, kMappingOptionDocs, "map");
   expect_documented(help, kOrientationOptionDocs, "map");
+  expect_documented(help, kExportOptionDocs, "map");
+  EXPECT_TRUE(shows(help, "--compress TEXT", mesh_compression_name(ExportOptions{}.compression)));
   EXPECT_NE(help.find(std::string(option_doc(kRenderOptionDocs, "up").help)), std::string::npos);
   const MappingOptions m;
   EXPECT_TRUE(shows(help, "--mode TEXT", mapping_mode_name(m.mode)));

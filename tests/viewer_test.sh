@@ -13,7 +13,8 @@
 # 5. a stalled client holds up neither other requests nor Ctrl-C;
 # 6. Ctrl-C (SIGINT) stops the server with exit status 0;
 # 7. the browser test with tile variants from `tailor tile --variants 3`;
-# 8. the seams view of a mapped horse (128 px texture): red and green seam lines, eval's figures.
+# 8. the seams view of a mapped horse (128 px texture): red and green seam lines, eval's figures;
+# 9. `tailor map --compress meshopt` and `draco` outputs load in the browser (eval's figures too).
 # Never skips: a missing Chromium or node_modules is a failure.
 set -euo pipefail
 
@@ -139,5 +140,17 @@ start_server "$tmp/horse.glb"
 timeout 120 node web/test/viewer_browser_test.mjs "$url" --eval "$tmp/horse_eval.json" --expect-invisible \
   || fail "browser test of the seams view (horse) failed"
 stop_server
+
+# --- 9. compressed outputs (three.js's meshopt and Draco decoders, WebAssembly under the CSP) -------
+for method in meshopt draco; do
+  timeout 60 "$tailor" map examples/spot.obj --texture examples/gravel.png --compress "$method" \
+    -o "$tmp/spot_$method.glb" -q || fail "tailor map --compress $method failed"
+  timeout 60 "$tailor" eval "$tmp/spot_$method.glb" --json -q >"$tmp/spot_${method}_eval.json" \
+    || fail "tailor eval of the $method .glb failed"
+  start_server "$tmp/spot_$method.glb"
+  timeout 120 node web/test/viewer_browser_test.mjs "$url" --eval "$tmp/spot_${method}_eval.json" \
+    || fail "browser test of the --compress $method .glb failed"
+  stop_server
+done
 
 echo "PASS: tailor render and tailor view (browser) work"

@@ -5,6 +5,8 @@
 // A small test hook (window.tailorViewer) lets the browser test switch views and read pixels.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+import { DRACOLoader } from 'three/addons/loaders/DRACOLoader.js';
+import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { buildSurface, seamRatios, kDefaultTextureSize } from './mesh_data.js';
 import { createSurfaceMaterial, updateSurfaceMaterial, kMaxVariants, kViews, kSeamColors } from './surface_material.js';
@@ -118,7 +120,12 @@ async function load() {
   const config = await (await fetch('/config.json')).json();
   document.getElementById('title').textContent = config.name || 'tailor viewer';
   document.title = `${config.name} - tailor viewer`;
-  const gltf = await new GLTFLoader().loadAsync(config.model);
+  // `tailor map --compress meshopt|draco` files: the decoders are three.js's own (WebAssembly; Draco's
+  // in a worker), served from node_modules like the rest of three.js.
+  const loader = new GLTFLoader();
+  loader.setMeshoptDecoder(MeshoptDecoder);
+  loader.setDRACOLoader(new DRACOLoader());  // its decoder: libs/draco/gltf/ beside the loader
+  const gltf = await loader.loadAsync(config.model);
 
   const meshes = [];
   gltf.scene.traverse((o) => { if (o.isMesh) meshes.push(o); });

@@ -59,7 +59,8 @@ int run_eval(const EvalOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
   Mesh mesh;
   LoadReport report;
-  const bool glb = mesh_format_from_path(opt.input) == MeshFormat::kGlb;
+  const MeshFormat input_format = mesh_format_from_path(opt.input);
+  const bool glb = input_format == MeshFormat::kGlb || input_format == MeshFormat::kGltf;
   // The embedded texture is never decoded: its size comes from its header (LoadReport).
   const Status status = [&] {
     const ReadingInput reading(opt.input);

@@ -1,5 +1,8 @@
 // tailor map: load -> topology -> [axis choice] -> map_texture (orientation, mapping, metrics) -> export
 // (+ preview, stats).
+#include <unistd.h>
+
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -40,11 +43,17 @@ std::string axis_text(const OrientationOptions& o) {
 // The command line of `tailor map`. The library's options are bound to their flags in `options`
 // (defaults: the structs' own); those given as text are parsed in run_map.
 struct MapArgs {
-  std::string input;
+  std::vector<std::string> inputs;  // as given: files or folders
+  std::string input;                // the one being mapped
   std::string output;
   std::string texture;
   ImageLoadOptions image_options;  // --max-image-pixels (default: ImageLoadOptions')
   int texture_size = ExportOptions{}.texture_width;
+  std::string compress = mesh_compression_name(ExportOptions{}.compression);
+  int uv_set = ExportOptions{}.uv_set;
+  std::string up = ExportOptions{}.up == SceneUp::kZ ? "z" : "y";
+  double tile_size = 0;        // --tile-size: scene units per texture repeat (0: not given)
+  double texels_per_unit = 0;  // --texels-per-unit (0: not given)
   std::string preview_up = up_axis_name(RenderOptions{}.up);
   std::string stats;
   std::string preview;
@@ -111,6 +120,19 @@ int run_map(const MapArgs& opt) {
   const std::string ext = std::filesystem::path(opt.output).extension().string();
   if (ext != ".glb" && ext != ".obj" && ext != ".ply")
     return report_error(usage_error("output must end in .glb, .obj or .ply, got '" + opt.output + "'"));
+  MeshCompression compression = MeshCompression::kNone;
+  if (!mesh_compression_from_name(opt.compress, compression))
+    return report_error(usage_error("--compress must be none, quantize, meshopt or draco, got '" + opt.compress + "'"));
+  if (compression != MeshCompression::kNone && ext != ".glb")
+    return report_error(usage_error("--compress needs a .glb output, got '" + opt.output + "'"));
+  if (opt.up != "y" && opt.up != "z") return report_error(usage_error("--up must be y or z, got '" + opt.up + "'"));
+  if (opt.tile_size != 0 && opt.texels_per_unit != 0)
+    return report_error(usage_error("give --tile-size or --texels-per-unit, not both"));
+  if (!(opt.tile_size >= 0 && opt.texels_per_unit >= 0) || !std::isfinite(opt.tile_size) ||
+      !std::isfinite(opt.texels_per_unit))
+    return report_error(usage_error("--tile-size and --texels-per-unit must be positive"));
+  if (opt.uv_set != 0 && ext != ".glb")
+    return report_error(usage_error("--uv-set needs a .glb output, got '" + opt.output + "'"));
   MapTextureOptions options = opt.options;
   const bool auto_axis = opt.axis == "auto";
   if (!auto_axis) {
@@ -163,6 +185,10 @@ int run_map(const MapArgs& opt) {
     warn(opt.quiet, opt.input + ": dropped " + std::to_string(load.degenerate_faces) + " degenerate faces");
   if (load.duplicate_faces)
     warn(opt.quiet, opt.input + ": dropped " + std::to_string(load.duplicate_faces) + " duplicate faces");
+  if (!load.not_kept.empty()) warn(opt.quiet, opt.input + ": not kept in the output: " + load.not_kept);
+  if (load.skipped_primitives)
+    warn(opt.quiet, opt.input + ": skipped " + std::to_string(load.skipped_primitives) +
+                        " point and line primitives (only triangles are mapped)");
   std::vector<uint8_t> seam_faces;
   if (!opt.seam_faces.empty()) {
     if (Status s = load_seam_faces(opt.seam_faces, mesh.face_count(), seam_faces); !s) return report_error(s);
@@ -175,7 +201,30 @@ int run_map(const MapArgs& opt) {
     warn(opt.quiet, opt.input + ": " + std::to_string(topology.nonmanifold_edges) + " non-manifold and " +
                         std::to_string(topology.inconsistent_edges) +
                         " inconsistently oriented edges treated as boundary");
+  // World units: the texel density is per scene unit, the same for every mesh (the mapping works
+  // in the unit cube: its scale becomes texels per unit times the normalisation's length).
+  double texels_per_unit = opt.texels_per_unit;
+  if (opt.tile_size > 0) texels_per_unit = tex_w / opt.tile_size;
+  if (texels_per_unit > 0) {
+    std::array<double, 3> lo = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    for (size_t v = 0; v < mesh.vertex_count(); ++v)
+      for (size_t k = 0; k < 3; ++k) {
+        lo[k] = std::min(lo[k], double{mesh.positions[3 * v + k]});
+        hi[k] = std::max(hi[k], double{mesh.positions[3 * v + k]});
+      }
+    const double longest = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-30});
+    options.orientation.fixed_unit_scale = static_cast<float>(1.0 / longest);
+    options.orientation.fixed_origin = {static_cast<float>(lo[0]), static_cast<float>(lo[1]),
+                                        static_cast<float>(lo[2])};
+    const double scale = texels_per_unit / options.orientation.fixed_unit_scale;
+    if (!(scale >= 1e-3 && scale <= 1e7))
+      return report_error(usage_error("--tile-size / --texels-per-unit give " + std::to_string(scale) +
+                                      " pixels per mesh size, outside 0.001 to 1e7"));
+    mapping.scale = static_cast<float>(scale);
+  }
   MapRun run;  // the report: what was asked, then what each step found
+  run.texels_per_unit = texels_per_unit;
+  run.up = opt.up;
   run.input = opt.input;
   run.output = opt.output;
   run.texture = opt.texture;
@@ -260,6 +309,9 @@ int run_map(const MapArgs& opt) {
   export_options.texture_path = opt.texture;
   export_options.texture_width = tex_w;
   export_options.texture_height = tex_h;
+  export_options.compression = compression;
+  export_options.uv_set = opt.uv_set;
+  export_options.up = opt.up == "z" ? SceneUp::kZ : SceneUp::kY;
   if (Status s = export_mesh(opt.output, mesh, atlas, export_options); !s) return report_error(s);
   run.export_seconds = seconds_since(export_start);
   for (const auto& [path, picture] : pictures) {
@@ -282,6 +334,79 @@ int run_map(const MapArgs& opt) {
   return kExitOk;
 }
 
+// Mesh files of a folder (not its subfolders), by the readers' extensions, sorted by name.
+std::vector<std::string> meshes_in(const std::string& folder) {
+  std::vector<std::string> files;
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator(folder, error)) {
+    if (entry.is_regular_file(error) && mesh_format_from_path(entry.path().string()) != MeshFormat::kUnknown)
+      files.push_back(entry.path().string());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+// `tailor map` over its inputs: one run_map for a single file; for several (or a folder) one per
+// file into the output folder, a summary line each and a total, going on past a failed file.
+int run_map_inputs(const MapArgs& args) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::string& out = args.output;
+  std::error_code error;
+  const bool out_folder = (!out.empty() && out.back() == '/') || std::filesystem::is_directory(out, error);
+  // One input and a file to write: a single map (a folder as input then fails as any non-file does).
+  if (args.inputs.size() == 1 && !out_folder) {
+    MapArgs one = args;
+    one.input = args.inputs[0];
+    return run_map(one);
+  }
+  if (!out_folder)
+    return report_error(
+        usage_error("-o must be a folder (ending in '/') for several inputs or a folder, got '" + out + "'"));
+  if (!args.stats.empty() || !args.preview.empty())
+    return report_error(usage_error("--stats and --preview name one file: give a single input"));
+  std::vector<std::string> files;
+  for (const std::string& input : args.inputs) {
+    if (std::filesystem::is_directory(input, error)) {
+      const std::vector<std::string> found = meshes_in(input);
+      if (found.empty()) return report_error(usage_error("no mesh file in the folder '" + input + "'"));
+      files.insert(files.end(), found.begin(), found.end());
+    } else {
+      files.push_back(input);
+    }
+  }
+  // One output per input, named after it: two inputs of one name would write the same file.
+  std::vector<std::pair<std::string, std::string>> outputs;  // (output, input)
+  for (const std::string& file : files) {
+    const std::string target = (std::filesystem::path(out) / std::filesystem::path(file).stem()).string() + ".glb";
+    for (const auto& [other_out, other_in] : outputs)
+      if (other_out == target)
+        return report_error(usage_error("'" + other_in + "' and '" + file + "' would both write '" + target + "'"));
+    outputs.emplace_back(target, file);
+  }
+  if (!std::filesystem::is_directory(out, error) && !std::filesystem::create_directory(out, error))
+    return report_error(Status::error(ErrorCode::kIo, out, "cannot create the output folder: " + error.message()));
+  const bool terminal = !args.quiet && isatty(STDERR_FILENO) == 1;
+  size_t failed = 0;
+  std::string failures;
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    if (terminal) std::fprintf(stderr, "tailor: [%zu/%zu] %s\n", i + 1, outputs.size(), outputs[i].second.c_str());
+    MapArgs one = args;
+    one.input = outputs[i].second;
+    one.output = outputs[i].first;
+    const int rc = run_map(one);
+    std::fflush(stdout);
+    if (rc == kExitUsage) return rc;  // the options are wrong for every file
+    if (rc != kExitOk) {
+      ++failed;
+      failures += (failures.empty() ? "" : ", ") + outputs[i].second;
+    }
+  }
+  if (!args.quiet)
+    std::printf("batch: %zu files, %zu mapped, %zu failed%s in %.2f s -> %s\n", outputs.size(), outputs.size() - failed,
+                failed, failures.empty() ? "" : (" (" + failures + ")").c_str(), seconds_since(start), out.c_str());
+  return failed ? kExitBadInput : kExitOk;
+}
+
 }  // namespace
 
 void register_map(CLI::App& app, Runner& run) {
@@ -290,10 +415,14 @@ void register_map(CLI::App& app, Runner& run) {
   OrientationOptions& orientation = opt->options.orientation;
   auto* cmd =
       app.add_subcommand("map", "Compute texture coordinates by homogeneous patch discovery and write a textured mesh");
-  cmd->add_option("mesh", opt->input, "Input mesh (.ply .obj .off .stl)")->required();
+  cmd->add_option("mesh", opt->inputs,
+                  "Input meshes (.ply .obj .off .stl .glb .gltf; glTF: the default scene in world space); several "
+                  "files or a folder map each into the folder -o names")
+      ->required();
   cmd->add_option("-o,--output", opt->output,
                   "Output mesh: .glb (texture embedded), .obj (+ .mtl) or .ply; a symlink is written through (its "
-                  "target replaced)")
+                  "target replaced). With several inputs or a folder: an existing folder (or one ending in '/'), "
+                  "where each input becomes <name>.glb")
       ->required();
   cmd->add_option("-t,--texture", opt->texture,
                   "Texture image (PNG/JPEG), ideally self-tileable (see 'tailor tile'); sets the texture size");
@@ -301,6 +430,16 @@ void register_map(CLI::App& app, Runner& run) {
       ->capture_default_str();
   add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), opt->image_options.max_pixels)
       ->check(CLI::PositiveNumber);
+  add_documented(cmd, option_doc(kExportOptionDocs, "compression"), opt->compress);
+  add_documented(cmd, option_doc(kExportOptionDocs, "uv_set"), opt->uv_set)->check(CLI::Range(0, 7));
+  add_documented(cmd, option_doc(kExportOptionDocs, "up"), opt->up);
+  auto* tile_size = cmd->add_option("--tile-size", opt->tile_size,
+                                    "World units: the texture repeats every LENGTH scene units (e.g. 0.5 for 50 cm "
+                                    "in metres), the same for every mesh; replaces --scale");
+  auto* texels = cmd->add_option("--texels-per-unit", opt->texels_per_unit,
+                                 "World units: texture pixels per scene unit, the same for every mesh; replaces "
+                                 "--scale");
+  tile_size->excludes(texels);
   cmd->add_option("--stats", opt->stats, "Write a JSON report (mesh, mapping counters, metrics, timings)");
   cmd->add_option("--preview", opt->preview, "Render a 3/4 view of the textured mesh to this PNG");
   cmd->add_flag("--preview-all", opt->preview_all,
@@ -351,7 +490,7 @@ void register_map(CLI::App& app, Runner& run) {
       "the UVs of a mesh that is edited and re-mapped more stable (docs/mapping.md section 7).");
   cmd->callback([&run, opt, crack_rings] {
     opt->crack_rings_given = crack_rings->count() > 0;
-    run = [opt] { return run_map(*opt); };
+    run = [opt] { return run_map_inputs(*opt); };
   });
 }
 

@@ -57,8 +57,9 @@ int run_render(const RenderArgs& args) {
   Image texture;
   Status status = [&] {
     const ReadingInput reading(args.input);
-    return mesh_format_from_path(args.input) == MeshFormat::kGlb ? read_glb_file(args.input, mesh, &texture)
-                                                                 : load_mesh(args.input, mesh);
+    const MeshFormat format = mesh_format_from_path(args.input);
+    return format == MeshFormat::kGlb || format == MeshFormat::kGltf ? read_glb_file(args.input, mesh, &texture)
+                                                                     : load_mesh(args.input, mesh);
   }();
   if (!status) return report_error(status.with_file(args.input));
   if (!args.texture.empty()) {

@@ -37,9 +37,12 @@ constexpr size_t kMaxWorkers = 64;  // connections served at once; when full, th
 // Content-Security-Policy of every answer: scripts, styles, images and fetches from this server only.
 // The one inline script, index.html's importmap, is allowed by its SHA-256 (tests/viewer_test.sh
 // checks the hash against web/index.html); styles may be inline (index.html's <style> block and
-// style attributes); GLTFLoader reads embedded textures through blob: URLs.
+// style attributes); GLTFLoader reads embedded textures through blob: URLs. The meshopt and Draco
+// decoders compile WebAssembly ('wasm-unsafe-eval': WebAssembly only, not JavaScript eval) and
+// Draco's runs in a worker made from a blob: URL.
 constexpr const char* kContentSecurityPolicy =
-    "default-src 'none'; script-src 'self' 'sha256-m3Nsq/c0thop7NTHfBJi1BT+HUVzyPDfkQMAS8PG5qw='; "
+    "default-src 'none'; script-src 'self' 'sha256-m3Nsq/c0thop7NTHfBJi1BT+HUVzyPDfkQMAS8PG5qw=' "
+    "'wasm-unsafe-eval'; worker-src blob:; "
     "style-src 'self' 'unsafe-inline'; img-src 'self' blob: data:; connect-src 'self' blob: data:; "
     "base-uri 'none'; form-action 'none'; frame-ancestors 'none'";
 

@@ -18,22 +18,76 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "tailor/api.h"
 #include "tailor/atlas.h"
 #include "tailor/mesh.h"
+#include "tailor/option_doc.h"
 #include "tailor/status.h"
 
 namespace tailor {
+
+//! How a .glb's geometry is stored (ExportOptions::compression).
+enum class MeshCompression {
+  kNone,      //!< float positions, normals and UVs, uint32 indices
+  kQuantize,  //!< KHR_mesh_quantization: int16 positions (the node's scale and offset undo it), int16
+              //!< normals, float UVs, uint16 indices where the vertices allow
+  kMeshopt,   //!< the quantized arrays, vertex-cache ordered and EXT_meshopt_compression coded
+  kDraco,     //!< KHR_draco_mesh_compression (positions 16 bits, normals 12, UVs 16)
+};
+
+//! "none", "quantize", "meshopt" or "draco".
+inline const char* mesh_compression_name(MeshCompression c) {
+  switch (c) {
+    case MeshCompression::kQuantize: return "quantize";
+    case MeshCompression::kMeshopt: return "meshopt";
+    case MeshCompression::kDraco: return "draco";
+    case MeshCompression::kNone: break;
+  }
+  return "none";
+}
+
+//! The inverse of mesh_compression_name; false for any other text.
+inline bool mesh_compression_from_name(std::string_view name, MeshCompression& c) {
+  for (MeshCompression v :
+       {MeshCompression::kNone, MeshCompression::kQuantize, MeshCompression::kMeshopt, MeshCompression::kDraco})
+    if (name == mesh_compression_name(v)) {
+      c = v;
+      return true;
+    }
+  return false;
+}
+
+//! The up axis of the mesh's coordinates (ExportOptions::up).
+enum class SceneUp { kY, kZ };
 
 struct ExportOptions {
   std::string texture_path;  //!< PNG or JPEG: embedded as is (.glb) or referenced by map_Kd (.mtl); empty = no texture
   int texture_width = 512;   //!< pixels per texture repeat along u (> 0), usually the texture's width
   int texture_height = 512;  //!< pixels per texture repeat along v (> 0), usually the texture's height
   bool normals = true;       //!< .glb/.obj: write smooth per-vertex normals (area-weighted, shared across seams)
+  MeshCompression compression = MeshCompression::kNone;  //!< .glb only (kInvalidArgument for .obj/.ply)
+  int uv_set = 0;            //!< .glb: the mapped UVs go to TEXCOORD_<uv_set> (0..7); the file's other sets are kept
+  SceneUp up = SceneUp::kY;  //!< .glb: kZ turns the scene Y-up as glTF wants (-90 degrees about x, on the node)
 };
 
+//! Flags and help of the ExportOptions a user sets (option_doc.h).
+inline constexpr OptionDoc kExportOptionDocs[] = {
+    {"compression", "--compress",
+     "geometry compression of a .glb output: none, quantize (KHR_mesh_quantization), meshopt "
+     "(EXT_meshopt_compression) or draco (KHR_draco_mesh_compression); three.js and Blender read all of them"},
+    {"up", "--up",
+     "up axis of the input's coordinates: y, or z (scans, CAD), which a .glb output turns Y-up by its node's "
+     "rotation"},
+    {"uv_set", "--uv-set",
+     "glTF texture coordinate set N (0-7, TEXCOORD_N) that receives the new UVs; the input's other sets, "
+     "normals and vertex colours are kept"},
+};
+
+//! The mesh's corner_attributes are written back (.glb: all of them but the mapped set's namesake,
+//! vertices split where they differ; .obj: NORMAL), its NORMAL instead of computed normals.
 //! Writes `mesh` with the UVs of `atlas` (atlas.corner_uv: #F*3 by 2 pixels) to `path`, the format
 //! chosen by the extension (case-insensitive): .glb (binary glTF 2.0, texture embedded, sampler
 //! REPEAT), .obj (+ <stem>.mtl next to it when a texture is given, map_Kd relative to the .obj),

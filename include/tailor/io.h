@@ -20,17 +20,18 @@
 
 namespace tailor {
 
-enum class MeshFormat { kUnknown, kPly, kObj, kOff, kStl, kGlb };
+enum class MeshFormat { kUnknown, kPly, kObj, kOff, kStl, kGlb, kGltf };
 
-//! Format from the file extension (case-insensitive): .ply .obj .off .stl .glb; kUnknown otherwise.
+//! Format from the file extension (case-insensitive): .ply .obj .off .stl .glb .gltf; kUnknown otherwise.
 TAILOR_API MeshFormat mesh_format_from_path(const std::string& path);
 
 //! Reads a mesh file; the format comes from the extension, or from the content when the extension
 //! is unknown. Cost: one pass over the file, O(F + V) memory.
 TAILOR_API Status load_mesh(const std::string& path, Mesh& mesh, LoadReport* report = nullptr);
 
-//! Parses a mesh held in memory (used by load_mesh, the fuzzers and the truncation tests).
-//! `name` is only used in error messages.
+//! Parses a mesh held in memory (used by the fuzzers and the truncation tests).
+//! `name` is only used in error messages. A .gltf whose buffers are files fails with kUnsupported
+//! here (no file is opened); load_mesh reads them from the .gltf's folder.
 TAILOR_API Status read_mesh(std::span<const char> data, MeshFormat format, const std::string& name, Mesh& mesh,
                             LoadReport* report = nullptr);
 

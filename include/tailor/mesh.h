@@ -21,6 +21,13 @@ inline constexpr size_t kMaxFaces = (size_t{kInvalid} - 1) / 3;
 //! (Positions alone would take 24 GiB at that count.)
 inline constexpr size_t kMaxVertices = (size_t{1} << 31) - 1;
 
+//! A per-corner attribute a file carried and export writes back (normals, colours, other UV sets).
+struct CornerAttribute {
+  std::string name;           //!< glTF semantic: "NORMAL", "COLOR_0", "TEXCOORD_1"...
+  int components = 0;         //!< 2, 3 or 4
+  std::vector<float> values;  //!< #F*3 by components, per corner (unit normals; linear RGBA colours in [0, 1])
+};
+
 //! A triangle mesh.
 //! Corner c = 3f + k is corner k of face f; indices[c] is its vertex.
 struct Mesh {
@@ -29,6 +36,8 @@ struct Mesh {
   std::vector<float> corner_uvs;    //!< empty, or #F*3 by 2: texture coordinates from the file, per corner,
                                     //!< in texture repeats (1.0 = one texture width), v up as in OBJ/glTF-flipped
   std::vector<uint8_t> seam_faces;  //!< empty, or #F flags: 1 = user-marked seam face (PLY `seam` property)
+  std::vector<CornerAttribute> corner_attributes;  //!< kept from the file (glTF NORMAL, COLOR_0, TEXCOORD_n
+                                                   //!< n > 0), written back by export; not used by the mapping
 
   size_t vertex_count() const { return positions.size() / 3; }
   size_t face_count() const { return indices.size() / 3; }
@@ -46,6 +55,10 @@ struct LoadReport {
   size_t zero_area_faces = 0;        //!< distinct vertices but zero area: kept
   size_t unreferenced_vertices = 0;  //!< vertices no face uses: kept, so vertex ids match the file
   size_t welded_vertices = 0;        //!< STL: corners merged into shared vertices (bit-identical positions)
+  size_t mesh_instances = 0;         //!< glTF: meshes placed by the scene's nodes (world transforms applied)
+  size_t skipped_primitives = 0;     //!< glTF: point and line primitives of those instances, not read
+  std::string not_kept;              //!< what the file has that the output will not (", "-separated), e.g.
+                                     //!< "materials, names, TANGENT"; empty when nothing is lost
   int texture_width = 0;             //!< glb: the embedded base colour texture's size, read from its header
   int texture_height = 0;            //!< without decoding it (0: no texture, or a header stb cannot read)
   double load_seconds = 0.0;

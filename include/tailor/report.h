@@ -41,6 +41,9 @@ struct MapRun {
   bool axis_auto = false;             //!< the axis was chosen by choose_orientation_axis (--axis auto)
   std::string seed_point;             //!< the seed point as asked ("X,Y,Z"), empty when none
   std::string seam_faces;             //!< seam-face file, empty when none
+  double texels_per_unit = 0;         //!< > 0: world units (--tile-size, --texels-per-unit), texture pixels per scene
+                               //!< unit; 0: options.mapping.scale is per unit of the mesh normalised into the unit cube
+  std::string up = "y";  //!< the input's up axis (--up); a .glb output is turned Y-up
   // What the stages found (add_map_results fills these from the library's results)
   LoadReport load;  //!< what the reader saw and repaired, its time
   size_t vertices = 0;

@@ -149,6 +149,48 @@ bool positions_finite(const Mesh& mesh) {
   return any == 0;
 }
 
+// Splits the vertices of `mesh` where corners of one vertex carry different values of the
+// attributes `kept` (per corner): `out` gets the split positions and indices, `kept_out` the
+// values per split vertex (those of the vertex's first corner). O(F): a chain of split vertices
+// per source vertex, usually one or two long (hard edges, colour borders).
+void split_on_attributes(const Mesh& mesh, const std::vector<const CornerAttribute*>& kept, Mesh& out,
+                         std::vector<CornerAttribute>& kept_out) {
+  const size_t corners = mesh.indices.size();
+  std::vector<uint32_t> head(mesh.vertex_count(), kInvalid), next, first_corner;
+  out.indices.resize(corners);
+  auto same = [&](size_t a, size_t b) {
+    for (const CornerAttribute* attribute : kept) {
+      const size_t k = size_t(attribute->components);
+      if (std::memcmp(&attribute->values[k * a], &attribute->values[k * b], k * sizeof(float)) != 0) return false;
+    }
+    return true;
+  };
+  for (size_t c = 0; c < corners; ++c) {
+    const uint32_t v = mesh.indices[c];
+    uint32_t id = head[v];
+    while (id != kInvalid && !same(first_corner[id], c)) id = next[id];
+    if (id == kInvalid) {
+      id = static_cast<uint32_t>(first_corner.size());
+      first_corner.push_back(static_cast<uint32_t>(c));
+      next.push_back(head[v]);
+      head[v] = id;
+    }
+    out.indices[c] = id;
+  }
+  const size_t nv = first_corner.size();
+  out.positions.resize(3 * nv);
+  for (size_t id = 0; id < nv; ++id)
+    std::memcpy(&out.positions[3 * id], &mesh.positions[3 * size_t{mesh.indices[first_corner[id]]}], 12);
+  kept_out.clear();
+  for (const CornerAttribute* attribute : kept) {
+    const size_t k = size_t(attribute->components);
+    CornerAttribute& a = kept_out.emplace_back(CornerAttribute{attribute->name, attribute->components, {}});
+    a.values.resize(k * nv);
+    for (size_t id = 0; id < nv; ++id)
+      std::memcpy(&a.values[k * id], &attribute->values[k * first_corner[id]], k * sizeof(float));
+  }
+}
+
 // Faces from which the normals get their own thread (below, starting it costs more than it saves).
 constexpr size_t kThreadedFaces = 100000;
 
@@ -163,6 +205,12 @@ Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas
   if (atlas.corner_uv.size() != 6 * nf)
     return Status::error(ErrorCode::kInvalidArgument, path, "atlas does not match the mesh",
                          std::to_string(atlas.corner_uv.size()) + " UV floats for " + std::to_string(nf) + " faces");
+  if (options.compression != MeshCompression::kNone && format != ExportFormat::kGlb)
+    return Status::error(ErrorCode::kInvalidArgument, path, "compression needs a .glb output");
+  if (options.uv_set < 0 || options.uv_set > 7)
+    return Status::error(ErrorCode::kInvalidArgument, path, "the UV set must be 0 to 7");
+  if (options.uv_set != 0 && format != ExportFormat::kGlb)
+    return Status::error(ErrorCode::kInvalidArgument, path, "a UV set other than 0 needs a .glb output");
   if (options.texture_width <= 0 || options.texture_height <= 0)
     return Status::error(ErrorCode::kInvalidArgument, path, "texture size must be positive");
   // Branch-free scans first (they vectorize); the exact culprit is looked for only on failure.
@@ -185,20 +233,51 @@ Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas
   // (both results are the same whichever thread runs them).
   internal::ExportData data;
   data.mesh = &mesh;
-  const bool want_normals = options.normals && format != ExportFormat::kPly;
+  data.uv_set = options.uv_set;
+  // The file's own attributes (glTF): the mapped UV set replaces its namesake; vertices split
+  // where they differ, the input's NORMAL used instead of computed normals.
+  std::vector<const CornerAttribute*> kept;
+  const std::string mapped_set = "TEXCOORD_" + std::to_string(options.uv_set);
+  for (const CornerAttribute& a : mesh.corner_attributes)
+    if (a.name != mapped_set && (format == ExportFormat::kGlb || a.name == "NORMAL")) kept.push_back(&a);
+  bool input_normals = false;
+  if (!kept.empty()) {
+    split_on_attributes(mesh, kept, data.attribute_split, data.kept);
+    data.mesh = &data.attribute_split;
+    for (size_t i = 0; i < data.kept.size(); ++i)
+      if (data.kept[i].name == "NORMAL") {
+        data.normals = std::move(data.kept[i].values);
+        for (size_t v = 0; v < data.normals.size(); v += 3) {  // unit length, as glTF wants
+          float* n = &data.normals[v];
+          const double length = std::sqrt(double{n[0]} * n[0] + double{n[1]} * n[1] + double{n[2]} * n[2]);
+          if (length > 0 && std::isfinite(length)) {
+            for (int k = 0; k < 3; ++k) n[k] = static_cast<float>(n[k] / length);
+          } else {
+            n[0] = 0, n[1] = 0, n[2] = 1;
+          }
+        }
+        data.kept.erase(data.kept.begin() + static_cast<std::ptrdiff_t>(i));
+        input_normals = true;
+        break;
+      }
+  }
+  const Mesh& source = *data.mesh;
+  const bool want_normals = options.normals && format != ExportFormat::kPly && !input_normals;
   const double su = 1.0 / options.texture_width, sv = 1.0 / options.texture_height;
   size_t bad_corner = internal::kNoBadCorner;
   internal::run_beside(
       want_normals && nf >= kThreadedFaces,
       [&] {
-        if (want_normals) vertex_normals(mesh, data.normals);
+        if (want_normals) vertex_normals(source, data.normals);
       },
-      [&] { bad_corner = internal::split_vertices_scaled(mesh, atlas.corner_uv, su, sv, data.split); });
+      [&] { bad_corner = internal::split_vertices_scaled(source, atlas.corner_uv, su, sv, data.split); });
   if (bad_corner != internal::kNoBadCorner)
     return Status::error(ErrorCode::kInvalidArgument, path, "UV is not finite", "corner " + std::to_string(bad_corner));
 
   switch (format) {
-    case ExportFormat::kGlb: return internal::write_glb(path, data, options);
+    case ExportFormat::kGlb:
+      return options.compression == MeshCompression::kNone ? internal::write_glb(path, data, options)
+                                                           : internal::write_glb_compressed(path, data, options);
     case ExportFormat::kObj: return internal::write_obj(path, data, options);
     case ExportFormat::kPly: return internal::write_ply(path, data, options);
     case ExportFormat::kUnknown: break;

@@ -27,9 +27,10 @@ constexpr int kLinear = 9729;
 constexpr int kLinearMipmapLinear = 9987;
 constexpr int kRepeat = 10497;
 constexpr int kTriangles = 4;
-constexpr uint32_t kGlbMagic = 0x46546C67;   // "glTF"
-constexpr uint32_t kChunkJson = 0x4E4F534A;  // "JSON"
-constexpr uint32_t kChunkBin = 0x004E4942;   // "BIN\0"
+constexpr uint32_t kGlbMagic = 0x46546C67;          // "glTF"
+constexpr uint32_t kChunkJson = 0x4E4F534A;         // "JSON"
+constexpr uint32_t kChunkBin = 0x004E4942;          // "BIN\0"
+constexpr double kHalfSqrt2 = 0.70710678118654752;  // the node rotation of a Z-up scene: -90 degrees about x
 
 void append_u32(std::string& out, uint32_t value) {
   static_assert(std::endian::native == std::endian::little, "glb writer assumes a little-endian host");
@@ -72,6 +73,21 @@ size_t add_view(nlohmann::json& views, size_t offset, size_t length, int target)
 }
 
 }  // namespace
+
+void add_glb_material(nlohmann::json& gltf, nlohmann::json& views, size_t texture_offset, size_t texture_size,
+                      const std::string& mime_type, int uv_set) {
+  nlohmann::json pbr = {{"metallicFactor", 0.0}, {"roughnessFactor", 1.0}};
+  if (texture_size > 0) {
+    const size_t view = add_view(views, texture_offset, texture_size, 0);
+    gltf["images"] = {{{"bufferView", view}, {"mimeType", mime_type}}};
+    gltf["samplers"] = {
+        {{"magFilter", kLinear}, {"minFilter", kLinearMipmapLinear}, {"wrapS", kRepeat}, {"wrapT", kRepeat}}};
+    gltf["textures"] = {{{"sampler", 0}, {"source", 0}}};
+    pbr["baseColorTexture"] = {{"index", 0}};
+    if (uv_set != 0) pbr["baseColorTexture"]["texCoord"] = uv_set;
+  }
+  gltf["materials"] = {{{"name", "tailor"}, {"pbrMetallicRoughness", pbr}}};
+}
 
 Status write_glb(const std::string& path, const ExportData& data, const ExportOptions& options) {
   const Mesh& mesh = *data.mesh;
@@ -122,10 +138,22 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
     attributes["NORMAL"] = accessors.size();
     accessors.push_back({{"bufferView", view}, {"componentType", kFloat}, {"count", vertex_count}, {"type", "VEC3"}});
   }
+  for (const CornerAttribute& a : data.kept) {  // the file's own: colours, other UV sets
+    const size_t bytes = 4 * size_t(a.components) * vertex_count;
+    const size_t view = add_view(views, bin_size, bytes, kArrayBuffer);
+    bin_size += bytes;
+    attributes[a.name] = accessors.size();
+    accessors.push_back({{"bufferView", view},
+                         {"componentType", kFloat},
+                         {"count", vertex_count},
+                         {"type", a.components == 2   ? "VEC2"
+                                  : a.components == 3 ? "VEC3"
+                                                      : "VEC4"}});
+  }
   {
     const size_t view = add_view(views, bin_size, 8 * vertex_count, kArrayBuffer);
     bin_size += 8 * vertex_count;
-    attributes["TEXCOORD_0"] = accessors.size();
+    attributes["TEXCOORD_" + std::to_string(data.uv_set)] = accessors.size();
     accessors.push_back({{"bufferView", view}, {"componentType", kFloat}, {"count", vertex_count}, {"type", "VEC2"}});
   }
   size_t indices_accessor = 0;
@@ -137,13 +165,13 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
         {{"bufferView", view}, {"componentType", kUnsignedInt}, {"count", index_count}, {"type", "SCALAR"}});
   }
 
-  nlohmann::json pbr = {{"metallicFactor", 0.0}, {"roughnessFactor", 1.0}};
+  nlohmann::json node = {{"mesh", 0}, {"name", "tailor"}};
+  if (options.up == SceneUp::kZ) node["rotation"] = {-kHalfSqrt2, 0.0, 0.0, kHalfSqrt2};
   nlohmann::json gltf = {
       {"asset", {{"version", "2.0"}, {"generator", "tailor"}}},
       {"scene", 0},
       {"scenes", {{{"nodes", {0}}}}},
-      {"nodes", {{{"mesh", 0}, {"name", "tailor"}}}},
-      {"materials", nlohmann::json::array()},
+      {"nodes", {node}},
       {"meshes",
        {{{"primitives",
           {{{"attributes", attributes}, {"indices", indices_accessor}, {"material", 0}, {"mode", kTriangles}}}}}}},
@@ -152,17 +180,13 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
   if (!texture_bytes.empty()) {
     if (texture_bytes.size() > std::numeric_limits<uint32_t>::max() - bin_size)
       return Status::error(ErrorCode::kLimit, path, "texture too large for a .glb buffer");
-    const size_t view = add_view(views, bin_size, texture_bytes.size(), 0);
+  }
+  add_glb_material(gltf, views, bin_size, texture_bytes.size(), mime_type, data.uv_set);
+  if (!texture_bytes.empty()) {
     bin_size += texture_bytes.size();
     texture_padding = (4 - bin_size % 4) % 4;
     bin_size += texture_padding;
-    gltf["images"] = {{{"bufferView", view}, {"mimeType", mime_type}}};
-    gltf["samplers"] = {
-        {{"magFilter", kLinear}, {"minFilter", kLinearMipmapLinear}, {"wrapS", kRepeat}, {"wrapT", kRepeat}}};
-    gltf["textures"] = {{{"sampler", 0}, {"source", 0}}};
-    pbr["baseColorTexture"] = {{"index", 0}};
   }
-  gltf["materials"].push_back({{"name", "tailor"}, {"pbrMetallicRoughness", pbr}});
   gltf["accessors"] = accessors;
   gltf["bufferViews"] = views;
   gltf["buffers"] = {{{"byteLength", bin_size}}};
@@ -198,6 +222,13 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
     const float* source = data.normals.data();
     TAILOR_RETURN_IF_ERROR(write_gathered(file, vertex_count, 3, [&](size_t s, float* out) {
       std::memcpy(out, &source[3 * size_t{xref[s]}], 3 * sizeof(float));
+    }));
+  }
+  for (const CornerAttribute& a : data.kept) {
+    const size_t k = size_t(a.components);
+    const float* values = a.values.data();
+    TAILOR_RETURN_IF_ERROR(write_gathered(file, vertex_count, k, [&](size_t s, float* out) {
+      std::memcpy(out, &values[k * size_t{xref[s]}], k * sizeof(float));
     }));
   }
   // glTF's v axis points down the image: TEXCOORD_0 = (s, -t), the usual (s, 1 - t) shifted by a

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <span>
 #include <string>
 #include <vector>
@@ -23,6 +24,14 @@ struct ExportData {
   const Mesh* mesh = nullptr;
   SplitMesh split;
   std::vector<float> normals;
+  //! The file's kept attributes (Mesh::corner_attributes but NORMAL, which is `normals`, and the
+  //! UV set the mapping replaces), per SOURCE vertex like `normals`; glTF writers only.
+  std::vector<CornerAttribute> kept;
+  //! The mapped UVs' set: TEXCOORD_<uv_set> (ExportOptions::uv_set).
+  int uv_set = 0;
+  //! When the mesh has kept attributes: its copy with vertices split where corners of one vertex
+  //! carry different values (mesh points here).
+  Mesh attribute_split;
 };
 
 //! A texture file's bytes and MIME type ("image/png" or "image/jpeg", from the magic bytes).
@@ -35,7 +44,15 @@ void append_float(std::string& out, float value);
 //! Path of `target` relative to the folder `base_dir` (generic separators), or absolute when none exists.
 std::string relative_path(const std::string& target, const std::filesystem::path& base_dir);
 
+//! The material every .glb gets (named "tailor", not metallic, fully rough) and, when
+//! texture_size > 0, the image (a new buffer view of buffer 0 at texture_offset), a REPEAT
+//! sampler and the texture as its base colour, read through TEXCOORD_<uv_set>.
+void add_glb_material(nlohmann::json& gltf, nlohmann::json& views, size_t texture_offset, size_t texture_size,
+                      const std::string& mime_type, int uv_set);
+
 Status write_glb(const std::string& path, const ExportData& data, const ExportOptions& options);
+//! .glb with options.compression (quantize, meshopt or draco): the arrays are built in memory.
+Status write_glb_compressed(const std::string& path, const ExportData& data, const ExportOptions& options);
 Status write_obj(const std::string& path, const ExportData& data, const ExportOptions& options);
 Status write_ply(const std::string& path, const ExportData& data, const ExportOptions& options);
 

@@ -1,244 +1,334 @@
-// Binary glTF 2.0 (.glb) reader: triangle primitives, TEXCOORD_0 and the base colour texture.
+// glTF 2.0 reader (.glb and .gltf): the default scene's mesh instances in world space.
 //
-// The container and its JSON are parsed here with nlohmann::json rather than with tinygltf:
-// tinygltf 2.7 hands an image's buffer view to the image loader without checking it against the
-// buffer's size (an out-of-bounds read on a crafted file) and fetches external URIs from disk.
-// Here every index is range-checked and every accessor is checked against its buffer view and
-// the BIN chunk before a byte is read; only the BIN chunk is ever used (no URI is opened).
-// Reference: glTF 2.0 specification, sections 3.6 (buffers, accessors), 3.7 (meshes), 4.4 (GLB).
+// The container and its JSON are parsed by our own code (gltf_document.cpp, nlohmann::json)
+// rather than by tinygltf: tinygltf 2.7 hands an image's buffer view to the image loader without
+// checking it against the buffer's size and opens any URI. Here every index is range-checked,
+// every accessor checked against its buffer view before a byte is read, and the only files
+// opened are buffers next to a .gltf (no scheme, no absolute path, no '..').
+//
+// What is read: the default scene (`scene`, else scene 0; every mesh once when the file has no
+// scene) walked from its root nodes; each node that uses a mesh places an instance of it with the
+// node's world transform (matrix or TRS, parents first) applied to the positions, winding flipped
+// where the transform mirrors. Triangles, strips and fans become triangles; points and lines are
+// skipped and counted (LoadReport::skipped_primitives). POSITION and TEXCOORD_0 of any component
+// type (KHR_mesh_quantization), sparse accessors, EXT_meshopt_compression buffer views and
+// KHR_draco_mesh_compression primitives, EXT_mesh_gpu_instancing nodes. A required extension outside those is an error
+// naming it. Reference: glTF 2.0 specification, sections 3.5 (scenes, nodes), 3.7 (meshes).
 #include <stb/stb_image.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <climits>
 #include <cmath>
-#include <cstring>
+#include <filesystem>
 #include <new>
-#include <nlohmann/json.hpp>
+#include <optional>
 
+#include "io/gltf_document.h"
 #include "io/readers.h"
 #include "tailor/export.h"
 #include "tailor/gltf.h"
 #include "tailor/io.h"
 #include "util/atomic_file.h"
+#include "util/text_scan.h"
 
 namespace tailor {
 namespace {
 
-using Json = nlohmann::json;
+using internal::AccessorInfo;
+using internal::get_element;
+using internal::get_uint;
+using internal::GltfDocument;
+using internal::Json;
+using internal::quote_input;
 
-constexpr uint32_t kGlbMagic = 0x46546C67;   // "glTF"
-constexpr uint32_t kChunkJson = 0x4E4F534A;  // "JSON"
-constexpr uint32_t kChunkBin = 0x004E4942;   // "BIN\0"
-constexpr int kByte = 5120, kUnsignedByte = 5121, kShort = 5122, kUnsignedShort = 5123, kUnsignedInt = 5125,
-              kFloat = 5126;
-constexpr uint64_t kTriangles = 4;
+constexpr uint64_t kTriangles = 4, kStrip = 5, kFan = 6;
+constexpr std::array<const char*, 4> kSupportedExtensions = {"KHR_mesh_quantization", "EXT_meshopt_compression",
+                                                             "KHR_draco_mesh_compression", "EXT_mesh_gpu_instancing"};
 
-uint32_t load_u32(const unsigned char* p) {
-  return uint32_t{p[0]} | uint32_t{p[1]} << 8 | uint32_t{p[2]} << 16 | uint32_t{p[3]} << 24;
+// Column-major 4x4, as glTF stores it.
+using Matrix = std::array<double, 16>;
+constexpr Matrix kIdentity = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+
+Matrix multiply(const Matrix& a, const Matrix& b) {
+  Matrix m{};
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      for (int k = 0; k < 4; ++k) m[size_t(4 * c + r)] += a[size_t(4 * k + r)] * b[size_t(4 * c + k)];
+  return m;
 }
 
-Status parse_error(const std::string& name, const std::string& what, const std::string& where = {}) {
-  return Status::error(ErrorCode::kParse, name, what, where);
-}
-
-// A non-negative integer member, or false when absent or of another type.
-bool get_uint(const Json& object, const char* key, uint64_t& out) {
-  if (!object.is_object()) return false;
-  const auto it = object.find(key);
-  if (it == object.end() || !it->is_number_integer() ||
-      (it->is_number_integer() && !it->is_number_unsigned() && it->get<int64_t>() < 0))
-    return false;
-  out = it->get<uint64_t>();
+// `n` finite numbers from the array member `key`; false when present but malformed.
+bool get_numbers(const Json& node, const char* key, double* out, size_t n, bool& present) {
+  const auto it = node.find(key);
+  present = it != node.end();
+  if (!present) return true;
+  if (!it->is_array() || it->size() != n) return false;
+  for (size_t i = 0; i < n; ++i) {
+    if (!(*it)[i].is_number()) return false;
+    out[i] = (*it)[i].get<double>();
+    if (!std::isfinite(out[i])) return false;
+  }
   return true;
 }
 
-// The element `index` of the top-level array `key`, or null when out of range / not an object.
-const Json* get_element(const Json& doc, const char* key, uint64_t index) {
-  const auto it = doc.find(key);
-  if (it == doc.end() || !it->is_array() || index >= it->size()) return nullptr;
-  const Json& element = (*it)[static_cast<size_t>(index)];
-  return element.is_object() ? &element : nullptr;
+// translation * rotation (unit quaternion x y z w) * scale.
+Matrix trs_matrix(const double* t, const double* q, const double* s) {
+  Matrix m = kIdentity;
+  const double x = q[0], y = q[1], z = q[2], w = q[3];
+  const double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w),     2 * (x * z - y * w),
+                       2 * (x * y - z * w),     1 - 2 * (x * x + z * z), 2 * (y * z + x * w),
+                       2 * (x * z + y * w),     2 * (y * z - x * w),     1 - 2 * (x * x + y * y)};
+  for (int c = 0; c < 3; ++c)
+    for (int row = 0; row < 3; ++row) m[size_t(4 * c + row)] = r[3 * c + row] * s[c];
+  for (int row = 0; row < 3; ++row) m[size_t(12 + row)] = t[row];
+  return m;
 }
 
-struct Glb {
-  std::span<const unsigned char> json;
-  std::span<const unsigned char> bin;  // empty when there is no BIN chunk
+// The node's local transform: `matrix`, or translation * rotation * scale.
+bool local_transform(const Json& node, Matrix& m) {
+  bool present = false;
+  if (!get_numbers(node, "matrix", m.data(), 16, present)) return false;
+  if (present) return true;
+  double t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
+  if (!get_numbers(node, "translation", t, 3, present) || !get_numbers(node, "rotation", q, 4, present) ||
+      !get_numbers(node, "scale", s, 3, present))
+    return false;
+  m = trs_matrix(t, q, s);
+  return true;
+}
+
+struct Instance {
+  size_t mesh = 0;
+  Matrix world = kIdentity;
 };
 
-Status split_glb(std::span<const char> data, const std::string& name, Glb& glb) {
-  const auto* bytes = reinterpret_cast<const unsigned char*>(data.data());
-  if (data.size() < 20 || load_u32(bytes) != kGlbMagic) return parse_error(name, "not a binary glTF file (bad magic)");
-  if (load_u32(bytes + 4) != 2)
-    return Status::error(ErrorCode::kUnsupported, name,
-                         "unsupported glTF container version " + std::to_string(load_u32(bytes + 4)));
-  const size_t total = load_u32(bytes + 8);
-  if (total > data.size() || total < 20) return parse_error(name, "glb length field does not match the file", "byte 8");
-  const size_t json_length = load_u32(bytes + 12);
-  if (load_u32(bytes + 16) != kChunkJson) return parse_error(name, "first chunk is not JSON", "byte 16");
-  if (json_length > total - 20) return parse_error(name, "JSON chunk runs past the end of the file", "byte 12");
-  glb.json = {bytes + 20, json_length};
-  size_t offset = 20 + json_length;
-  offset += (4 - offset % 4) % 4;  // chunks are 4-byte aligned (tolerate a missing pad at the end)
-  glb.bin = {};
-  if (offset + 8 <= total) {
-    const size_t bin_length = load_u32(bytes + offset);
-    if (load_u32(bytes + offset + 4) == kChunkBin) {
-      if (bin_length > total - offset - 8)
-        return parse_error(name, "BIN chunk runs past the end of the file", "byte " + std::to_string(offset));
-      glb.bin = {bytes + offset + 8, bin_length};
+// EXT_mesh_gpu_instancing: one instance per element of the TRANSLATION / ROTATION / SCALE
+// accessors, each placed by world * its TRS.
+Status gpu_instances(GltfDocument& doc, const Json& extension, size_t mesh, const Matrix& world,
+                     const std::string& where, std::vector<Instance>& instances) {
+  const auto attributes = extension.find("attributes");
+  if (attributes == extension.end() || !attributes->is_object())
+    return doc.parse_error("EXT_mesh_gpu_instancing without attributes", where);
+  static constexpr std::array<const char*, 3> kNames = {"TRANSLATION", "ROTATION", "SCALE"};
+  static constexpr std::array<int, 3> kComponents = {3, 4, 3};
+  std::array<std::vector<float>, 3> values;
+  size_t count = SIZE_MAX;
+  for (size_t k = 0; k < 3; ++k) {
+    uint64_t accessor = 0;
+    if (!get_uint(*attributes, kNames[k], accessor)) continue;
+    AccessorInfo info;
+    TAILOR_RETURN_IF_ERROR(doc.read_floats(accessor, values[k], info));
+    if (info.components != kComponents[k])
+      return doc.parse_error(std::string("EXT_mesh_gpu_instancing ") + kNames[k] + " has the wrong type", where);
+    if (count != SIZE_MAX && info.count != count)
+      return doc.parse_error("EXT_mesh_gpu_instancing attributes differ in count", where);
+    count = info.count;
+  }
+  if (count == SIZE_MAX) return doc.parse_error("EXT_mesh_gpu_instancing without attributes", where);
+  TAILOR_RETURN_IF_ERROR(doc.charge(count * sizeof(Instance), where));
+  for (size_t i = 0; i < count; ++i) {
+    double t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
+    for (size_t c = 0; c < 3 && !values[0].empty(); ++c) t[c] = values[0][3 * i + c];
+    for (size_t c = 0; c < 4 && !values[1].empty(); ++c) q[c] = values[1][4 * i + c];
+    for (size_t c = 0; c < 3 && !values[2].empty(); ++c) s[c] = values[2][3 * i + c];
+    instances.push_back({mesh, multiply(world, trs_matrix(t, q, s))});
+  }
+  return Status::ok();
+}
+
+double determinant3(const Matrix& m) {
+  return m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2]) + m[8] * (m[1] * m[6] - m[5] * m[2]);
+}
+
+// The mesh instances of the default scene, parents' transforms first. A node reached twice (the
+// hierarchy is not a tree, or has a cycle) is an error.
+Status scene_instances(GltfDocument& doc, std::vector<Instance>& instances) {
+  const Json& json = doc.json();
+  const auto meshes = json.find("meshes");
+  const size_t mesh_count = meshes != json.end() && meshes->is_array() ? meshes->size() : 0;
+  const auto scenes = json.find("scenes");
+  if (scenes == json.end()) {  // no scene: every mesh once, where it is
+    for (size_t m = 0; m < mesh_count; ++m) instances.push_back({m, kIdentity});
+    return Status::ok();
+  }
+  uint64_t scene = 0;
+  if (json.contains("scene") && !get_uint(json, "scene", scene)) return doc.parse_error("bad 'scene'");
+  const Json* root = get_element(json, "scenes", scene);
+  if (!root) return doc.parse_error("missing scene " + std::to_string(scene));
+  const auto nodes = json.find("nodes");
+  const size_t node_count = nodes != json.end() && nodes->is_array() ? nodes->size() : 0;
+  std::vector<uint8_t> seen(node_count, 0);
+  std::vector<std::pair<uint64_t, Matrix>> stack;
+  const auto roots = root->find("nodes");
+  if (roots != root->end()) {
+    if (!roots->is_array()) return doc.parse_error("scene nodes is not an array", "scene " + std::to_string(scene));
+    for (size_t i = roots->size(); i-- > 0;) {
+      if (!(*roots)[i].is_number_unsigned()) return doc.parse_error("bad node index", "scene " + std::to_string(scene));
+      stack.emplace_back((*roots)[i].get<uint64_t>(), kIdentity);
+    }
+  }
+  while (!stack.empty()) {
+    const auto [index, parent] = stack.back();
+    stack.pop_back();
+    const std::string where = "node " + std::to_string(index);
+    const Json* node = get_element(json, "nodes", index);
+    if (!node) return doc.parse_error("missing node", where);
+    if (seen[static_cast<size_t>(index)]) return doc.parse_error("node appears twice in the scene (not a tree)", where);
+    seen[static_cast<size_t>(index)] = 1;
+    Matrix local;
+    if (!local_transform(*node, local)) return doc.parse_error("bad matrix, translation, rotation or scale", where);
+    const Matrix world = multiply(parent, local);
+    uint64_t mesh = 0;
+    if (node->contains("mesh")) {
+      if (!get_uint(*node, "mesh", mesh) || mesh >= mesh_count) return doc.parse_error("bad mesh index", where);
+      const Json* gpu = nullptr;
+      const auto extensions = node->find("extensions");
+      if (extensions != node->end() && extensions->is_object()) {
+        const auto it = extensions->find("EXT_mesh_gpu_instancing");
+        if (it != extensions->end() && it->is_object()) gpu = &*it;
+      }
+      if (gpu)
+        TAILOR_RETURN_IF_ERROR(gpu_instances(doc, *gpu, static_cast<size_t>(mesh), world, where, instances));
+      else
+        instances.push_back({static_cast<size_t>(mesh), world});
+    }
+    const auto children = node->find("children");
+    if (children == node->end()) continue;
+    if (!children->is_array()) return doc.parse_error("children is not an array", where);
+    for (size_t i = children->size(); i-- > 0;) {
+      const Json& child = (*children)[i];
+      if (!child.is_number_unsigned()) return doc.parse_error("bad child index", where);
+      stack.emplace_back(child.get<uint64_t>(), world);
     }
   }
   return Status::ok();
 }
 
-// The bytes of buffer view `index`, checked against the BIN chunk. Only buffer 0 without a URI
-// (the GLB-stored buffer) is supported.
-Status buffer_view_bytes(const Json& doc, const Glb& glb, uint64_t index, const std::string& name,
-                         std::span<const unsigned char>& bytes, uint64_t& stride) {
-  const std::string where = "bufferView " + std::to_string(index);
-  const Json* view = get_element(doc, "bufferViews", index);
-  if (!view) return parse_error(name, "missing buffer view", where);
-  uint64_t buffer = 0, offset = 0, length = 0;
-  if (!get_uint(*view, "buffer", buffer) || !get_uint(*view, "byteLength", length))
-    return parse_error(name, "buffer view without buffer or byteLength", where);
-  if (view->contains("byteOffset") && !get_uint(*view, "byteOffset", offset))
-    return parse_error(name, "bad byteOffset", where);
-  stride = 0;
-  if (view->contains("byteStride") && !get_uint(*view, "byteStride", stride))
-    return parse_error(name, "bad byteStride", where);
-  const Json* buf = get_element(doc, "buffers", buffer);
-  if (!buf) return parse_error(name, "missing buffer", where);
-  if (buffer != 0 || buf->contains("uri"))
-    return Status::error(ErrorCode::kUnsupported, name, "only the embedded BIN buffer is supported (no URIs)", where);
-  if (offset > glb.bin.size() || length > glb.bin.size() - offset)
-    return parse_error(name, "buffer view runs past the end of the BIN chunk", where);
-  bytes = glb.bin.subspan(static_cast<size_t>(offset), static_cast<size_t>(length));
-  return Status::ok();
-}
-
-struct AccessorView {
-  const unsigned char* data = nullptr;
-  size_t stride = 0;
-  size_t count = 0;
-  int component_type = 0;
-  int components = 0;
-  bool normalized = false;
+// One primitive in its mesh's own space, triangulated.
+struct Primitive {
+  std::vector<float> positions;       // #V by 3
+  std::vector<uint32_t> triangles;    // #T by 3, < #V
+  std::vector<float> uv;              // empty, or #V by 2 (glTF convention)
+  std::vector<CornerAttribute> kept;  // NORMAL, COLOR_0 (as RGBA), TEXCOORD_n: #V by components
+  size_t source_faces = 0;
+  uint64_t material = UINT64_MAX;
 };
 
-int component_size(int type) {
-  switch (type) {
-    case kByte:
-    case kUnsignedByte: return 1;
-    case kShort:
-    case kUnsignedShort: return 2;
-    case kUnsignedInt:
-    case kFloat: return 4;
-    default: return 0;
-  }
+// The vertex attributes kept beside POSITION and TEXCOORD_0 (what export can write back).
+bool is_kept_attribute(const std::string& name) {
+  if (name == "NORMAL" || name == "COLOR_0") return true;
+  return name.size() == 10 && name.starts_with("TEXCOORD_") && name[9] >= '0' && name[9] <= '7';
 }
 
-int component_count(const std::string& type) {
-  if (type == "SCALAR") return 1;
-  if (type == "VEC2") return 2;
-  if (type == "VEC3") return 3;
-  if (type == "VEC4" || type == "MAT2") return 4;
-  if (type == "MAT3") return 9;
-  if (type == "MAT4") return 16;
-  return 0;
-}
-
-Status accessor_view(const Json& doc, const Glb& glb, uint64_t index, const std::string& name, AccessorView& out) {
-  const std::string where = "accessor " + std::to_string(index);
-  const Json* accessor = get_element(doc, "accessors", index);
-  if (!accessor) return parse_error(name, "missing accessor", where);
-  if (accessor->contains("sparse"))
-    return Status::error(ErrorCode::kUnsupported, name, "sparse accessors are not supported", where);
-  uint64_t view_index = 0, offset = 0, count = 0, component_type = 0;
-  if (!get_uint(*accessor, "bufferView", view_index))
-    return Status::error(ErrorCode::kUnsupported, name, "accessor without buffer view", where);
-  if (!get_uint(*accessor, "count", count) || !get_uint(*accessor, "componentType", component_type))
-    return parse_error(name, "accessor without count or componentType", where);
-  if (accessor->contains("byteOffset") && !get_uint(*accessor, "byteOffset", offset))
-    return parse_error(name, "bad accessor byteOffset", where);
-  const auto type_it = accessor->find("type");
-  if (type_it == accessor->end() || !type_it->is_string()) return parse_error(name, "accessor without type", where);
-  const int components = component_count(type_it->get<std::string>());
-  const int size = component_type <= INT_MAX ? component_size(static_cast<int>(component_type)) : 0;
-  if (components == 0 || size == 0) return parse_error(name, "bad accessor type or componentType", where);
-  const auto normalized_it = accessor->find("normalized");
-  out.normalized = normalized_it != accessor->end() && normalized_it->is_boolean() && normalized_it->get<bool>();
-
-  std::span<const unsigned char> bytes;
-  uint64_t stride = 0;
-  TAILOR_RETURN_IF_ERROR(buffer_view_bytes(doc, glb, view_index, name, bytes, stride));
-  const uint64_t element = uint64_t(size) * uint64_t(components);
-  if (stride == 0) stride = element;
-  if (stride < element || stride > 252) return parse_error(name, "bad byteStride", where);
-  if (count > 0) {
-    // offset + stride * (count - 1) + element <= view length, without overflow.
-    if (offset > bytes.size() || element > bytes.size() - offset ||
-        count - 1 > (bytes.size() - offset - element) / stride)
-      return parse_error(name, "accessor runs past the end of its buffer view", where);
+// Adds a kept attribute read as `values` (#V by components), checking its shape.
+Status keep_attribute(const GltfDocument& doc, const std::string& name, std::vector<float>&& values, int components,
+                      size_t vertex_count, const std::string& where, Primitive& out) {
+  const int want = name == "NORMAL" ? 3 : name == "COLOR_0" ? 0 : 2;
+  if ((want != 0 && components != want) || (want == 0 && components != 3 && components != 4))
+    return doc.parse_error(name + " has the wrong type", where);
+  if (values.size() != vertex_count * size_t(components))
+    return doc.parse_error(name + " and POSITION counts differ", where);
+  if (name == "COLOR_0" && components == 3) {  // RGBA, opaque
+    std::vector<float> rgba(4 * vertex_count, 1.0f);
+    for (size_t v = 0; v < vertex_count; ++v) std::copy_n(&values[3 * v], 3, &rgba[4 * v]);
+    values = std::move(rgba);
+    components = 4;
   }
-  out.data = bytes.data() + offset;
-  out.stride = static_cast<size_t>(stride);
-  out.count = static_cast<size_t>(count);
-  out.component_type = static_cast<int>(component_type);
-  out.components = components;
+  out.kept.push_back({name, components, std::move(values)});
   return Status::ok();
 }
 
-// Component c of element i as a float (normalized integers scaled to [0, 1] / [-1, 1]).
-float read_float(const AccessorView& a, size_t i, int c) {
-  const unsigned char* p = a.data + i * a.stride + size_t(c) * size_t(component_size(a.component_type));
-  switch (a.component_type) {
-    case kFloat: {
-      float v;
-      std::memcpy(&v, p, 4);
-      return v;
-    }
-    case kUnsignedByte: return a.normalized ? p[0] / 255.0f : p[0];
-    case kUnsignedShort: {
-      uint16_t v;
-      std::memcpy(&v, p, 2);
-      return a.normalized ? v / 65535.0f : v;
-    }
-    case kByte: {
-      int8_t v;
-      std::memcpy(&v, p, 1);
-      return a.normalized ? std::max(v / 127.0f, -1.0f) : v;
-    }
-    case kShort: {
-      int16_t v;
-      std::memcpy(&v, p, 2);
-      return a.normalized ? std::max(v / 32767.0f, -1.0f) : v;
-    }
-    default: return 0;
-  }
-}
-
-uint32_t read_index(const AccessorView& a, size_t i) {
-  const unsigned char* p = a.data + i * a.stride;
-  switch (a.component_type) {
-    case kUnsignedByte: return p[0];
-    case kUnsignedShort: {
-      uint16_t v;
-      std::memcpy(&v, p, 2);
-      return v;
-    }
-    default: {
-      uint32_t v;
-      std::memcpy(&v, p, 4);
-      return v;
+// Triangles from a triangle list, strip or fan over `corners` (spec section 3.7.2.1).
+Status triangulate(const GltfDocument& doc, uint64_t mode, const std::vector<uint32_t>& corners, size_t vertex_count,
+                   const std::string& where, Primitive& out) {
+  const size_t n = corners.size();
+  if (mode == kTriangles && n % 3 != 0) return doc.parse_error("triangle index count is not a multiple of 3", where);
+  const size_t faces = mode == kTriangles ? n / 3 : n >= 3 ? n - 2 : 0;
+  out.triangles.resize(3 * faces);
+  for (size_t i = 0; i < faces; ++i) {
+    uint32_t* t = &out.triangles[3 * i];
+    if (mode == kTriangles) {
+      t[0] = corners[3 * i], t[1] = corners[3 * i + 1], t[2] = corners[3 * i + 2];
+    } else if (mode == kStrip) {
+      t[0] = corners[i], t[1] = corners[i + 1 + i % 2], t[2] = corners[i + 2 - i % 2];
+    } else {
+      t[0] = corners[i + 1], t[1] = corners[i + 2], t[2] = corners[0];
     }
   }
+  for (size_t c = 0; c < out.triangles.size(); ++c)
+    if (out.triangles[c] >= vertex_count)
+      return Status::error(ErrorCode::kInvalidMesh, doc.name(), "index out of range",
+                           where + " index " + std::to_string(mode == kTriangles ? c : c / 3));
+  out.source_faces = faces;
+  return Status::ok();
 }
 
-// The base colour image of the first textured material used by a triangle primitive: its bytes.
-void find_texture(const Json& doc, const Glb& glb, uint64_t material, std::span<const unsigned char>& bytes) {
+// Reads primitive `pi` of mesh `mi` (mode already known to be triangles, strip or fan).
+Status read_primitive(GltfDocument& doc, const Json& prim, uint64_t mode, const std::string& where, Primitive& out) {
+  const auto attributes = prim.find("attributes");
+  uint64_t position_index = 0, uv_index = 0, indices_index = 0, material = 0;
+  if (attributes == prim.end() || !get_uint(*attributes, "POSITION", position_index))
+    return doc.parse_error("primitive without POSITION", where);
+  if (get_uint(prim, "material", material)) out.material = material;
+  const bool has_uv = get_uint(*attributes, "TEXCOORD_0", uv_index);
+  std::vector<uint32_t> corners;
+  const auto extensions = prim.find("extensions");
+  const Json* draco = nullptr;
+  if (extensions != prim.end() && extensions->is_object()) {
+    const auto it = extensions->find("KHR_draco_mesh_compression");
+    if (it != extensions->end() && it->is_object()) draco = &*it;
+  }
+  if (draco) {
+    internal::DracoPrimitive decoded;
+    std::vector<std::string> names = {"POSITION", "TEXCOORD_0"};
+    for (const auto& item : attributes->items())
+      if (is_kept_attribute(item.key())) names.push_back(item.key());
+    TAILOR_RETURN_IF_ERROR(internal::decode_draco_primitive(doc, prim, *draco, names, where, decoded));
+    if (decoded.components[0] != 3) return doc.unsupported("Draco POSITION is not 3D", where);
+    out.positions = std::move(decoded.values[0]);
+    if (decoded.components[1] == 2) out.uv = std::move(decoded.values[1]);
+    for (size_t n = 2; n < names.size(); ++n)
+      if (decoded.components[n] > 0)
+        TAILOR_RETURN_IF_ERROR(keep_attribute(doc, names[n], std::move(decoded.values[n]), decoded.components[n],
+                                              out.positions.size() / 3, where, out));
+    corners = std::move(decoded.indices);
+    mode = kTriangles;  // Draco decodes to a triangle list
+  } else {
+    AccessorInfo info;
+    TAILOR_RETURN_IF_ERROR(doc.read_floats(position_index, out.positions, info));
+    if (info.components != 3) return doc.unsupported("POSITION must be VEC3", where);
+    if (has_uv) {
+      AccessorInfo uv_info;
+      TAILOR_RETURN_IF_ERROR(doc.read_floats(uv_index, out.uv, uv_info));
+      if (uv_info.components != 2) return doc.parse_error("TEXCOORD_0 must be VEC2", where);
+      if (uv_info.count != info.count) return doc.parse_error("TEXCOORD_0 and POSITION counts differ", where);
+    }
+    for (const auto& item : attributes->items()) {
+      uint64_t index = 0;
+      if (!is_kept_attribute(item.key()) || !get_uint(*attributes, item.key().c_str(), index)) continue;
+      std::vector<float> values;
+      AccessorInfo kept_info;
+      TAILOR_RETURN_IF_ERROR(doc.read_floats(index, values, kept_info));
+      TAILOR_RETURN_IF_ERROR(
+          keep_attribute(doc, item.key(), std::move(values), kept_info.components, info.count, where, out));
+    }
+    if (get_uint(prim, "indices", indices_index)) {
+      TAILOR_RETURN_IF_ERROR(doc.read_indices(indices_index, corners));
+    } else {
+      TAILOR_RETURN_IF_ERROR(doc.charge(4 * info.count, where));
+      corners.resize(info.count);
+      for (size_t i = 0; i < info.count; ++i) corners[i] = static_cast<uint32_t>(i);
+    }
+  }
+  return triangulate(doc, mode, corners, out.positions.size() / 3, where, out);
+}
+
+// The base colour image of a material, if it is stored in a buffer view (URIs are never opened).
+void find_texture(GltfDocument& doc, uint64_t material, std::span<const unsigned char>& bytes) {
   bytes = {};
-  const Json* m = get_element(doc, "materials", material);
+  const Json* m = get_element(doc.json(), "materials", material);
   if (!m) return;
   const auto pbr = m->find("pbrMetallicRoughness");
   if (pbr == m->end() || !pbr->is_object()) return;
@@ -246,12 +336,12 @@ void find_texture(const Json& doc, const Glb& glb, uint64_t material, std::span<
   if (base == pbr->end()) return;
   uint64_t texture = 0, source = 0, view = 0, stride = 0;
   if (!get_uint(*base, "index", texture)) return;
-  const Json* t = get_element(doc, "textures", texture);
+  const Json* t = get_element(doc.json(), "textures", texture);
   if (!t || !get_uint(*t, "source", source)) return;
-  const Json* image = get_element(doc, "images", source);
-  if (!image || !get_uint(*image, "bufferView", view)) return;  // URIs are never opened
+  const Json* image = get_element(doc.json(), "images", source);
+  if (!image || !get_uint(*image, "bufferView", view)) return;
   std::span<const unsigned char> view_bytes;
-  if (!buffer_view_bytes(doc, glb, view, "", view_bytes, stride).is_ok()) return;
+  if (!doc.view_bytes(view, view_bytes, stride).is_ok()) return;
   bytes = view_bytes;
 }
 
@@ -275,123 +365,252 @@ Status decode_texture(std::span<const unsigned char> bytes, const std::string& n
   return Status::ok();
 }
 
-// Parses the glb into mesh (not finalized); the base colour texture bytes go to `texture_bytes`.
-Status parse_glb(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,
-                 std::span<const unsigned char>* texture_bytes) {
-  report.format = "glTF binary";
-  Glb glb;
-  TAILOR_RETURN_IF_ERROR(split_glb(data, name, glb));
-  const Json doc = Json::parse(glb.json.begin(), glb.json.end(), nullptr, /*allow_exceptions=*/false);
-  if (doc.is_discarded() || !doc.is_object()) return parse_error(name, "JSON chunk is not a valid JSON object");
-  const auto meshes = doc.find("meshes");
-  if (meshes == doc.end() || !meshes->is_array())
-    return Status::error(ErrorCode::kUnsupported, name, "no mesh in the file");
+Status check_required_extensions(const GltfDocument& doc) {
+  const auto required = doc.json().find("extensionsRequired");
+  if (required == doc.json().end()) return Status::ok();
+  if (!required->is_array()) return doc.parse_error("extensionsRequired is not an array");
+  for (const Json& extension : *required) {
+    if (!extension.is_string()) return doc.parse_error("extensionsRequired holds a non-string");
+    const std::string& name = extension.get_ref<const std::string&>();
+    if (std::find(kSupportedExtensions.begin(), kSupportedExtensions.end(), name) == kSupportedExtensions.end())
+      return doc.unsupported("required extension " + quote_input(name) +
+                             " is not supported (supported: KHR_mesh_quantization, EXT_meshopt_compression, "
+                             "KHR_draco_mesh_compression, EXT_mesh_gpu_instancing)");
+  }
+  return Status::ok();
+}
 
-  // Output size is bounded by a multiple of the input, so repeated references to one large
-  // accessor cannot blow up memory.
-  const size_t budget_floats = 16 * data.size() + (size_t{1} << 20);
+// Appends `p` placed by `world` to `mesh` (UVs per corner, OBJ convention up to a whole repeat:
+// t = -v_gltf, see export.h).
+void append_instance(const Primitive& p, const Matrix& world, Mesh& mesh) {
+  const size_t base = mesh.vertex_count(), first = mesh.indices.size();
+  const size_t nv = p.positions.size() / 3;
+  mesh.positions.resize(mesh.positions.size() + 3 * nv);
+  const bool identity = world == kIdentity;
+  for (size_t i = 0; i < nv; ++i) {
+    const float* in = &p.positions[3 * i];
+    float* out = &mesh.positions[3 * (base + i)];
+    if (identity) {
+      out[0] = in[0], out[1] = in[1], out[2] = in[2];
+      continue;
+    }
+    for (int r = 0; r < 3; ++r)
+      out[r] = static_cast<float>(world[size_t(r)] * in[0] + world[size_t(4 + r)] * in[1] +
+                                  world[size_t(8 + r)] * in[2] + world[size_t(12 + r)]);
+  }
+  const bool mirrored = determinant3(world) < 0;  // keep faces counter-clockwise seen from outside
+  mesh.indices.resize(first + p.triangles.size());
+  for (size_t c = 0; c < p.triangles.size(); c += 3) {
+    const uint32_t b = static_cast<uint32_t>(base);
+    mesh.indices[first + c] = b + p.triangles[c];
+    mesh.indices[first + c + 1] = b + p.triangles[mirrored ? c + 2 : c + 1];
+    mesh.indices[first + c + 2] = b + p.triangles[mirrored ? c + 1 : c + 2];
+  }
+  mesh.corner_uvs.resize(2 * mesh.indices.size(), 0.0f);
+  if (!p.uv.empty()) {
+    for (size_t c = first; c < mesh.indices.size(); ++c) {
+      const size_t local = mesh.indices[c] - base;
+      mesh.corner_uvs[2 * c] = p.uv[2 * local];
+      mesh.corner_uvs[2 * c + 1] = -p.uv[2 * local + 1];
+    }
+  }
+}
+
+// The kept attributes of `p`'s corners (appended by append_instance from corner `first` on, with
+// vertex ids from `base`): normals turned by the inverse transpose of `world` and renormalized.
+// An attribute that an earlier or this primitive lacks is marked in `incomplete` (dropped later).
+void append_kept(const Primitive& p, const Matrix& world, size_t base, size_t first, Mesh& mesh,
+                 std::vector<uint8_t>& incomplete) {
+  const size_t corners = mesh.indices.size();
+  // Cofactors of the 3x3 part: det * inverse transpose; the sign of det keeps normals outward.
+  const double c[9] = {world[5] * world[10] - world[6] * world[9], world[6] * world[8] - world[4] * world[10],
+                       world[4] * world[9] - world[5] * world[8],  world[2] * world[9] - world[1] * world[10],
+                       world[0] * world[10] - world[2] * world[8], world[1] * world[8] - world[0] * world[9],
+                       world[1] * world[6] - world[2] * world[5],  world[2] * world[4] - world[0] * world[6],
+                       world[0] * world[5] - world[1] * world[4]};
+  const double sign = determinant3(world) < 0 ? -1.0 : 1.0;
+  std::vector<uint8_t> seen(mesh.corner_attributes.size(), 0);
+  for (const CornerAttribute& a : p.kept) {
+    size_t slot = 0;
+    while (slot < mesh.corner_attributes.size() && mesh.corner_attributes[slot].name != a.name) ++slot;
+    if (slot == mesh.corner_attributes.size()) {  // new here: zeros before, incomplete unless first
+      mesh.corner_attributes.push_back({a.name, a.components, {}});
+      incomplete.push_back(first > 0);
+      seen.push_back(0);
+    }
+    seen[slot] = 1;
+    CornerAttribute& out = mesh.corner_attributes[slot];
+    const size_t k = size_t(a.components);
+    out.values.resize(k * corners, 0.0f);
+    for (size_t corner = first; corner < corners; ++corner) {
+      const float* in = &a.values[k * (mesh.indices[corner] - base)];
+      float* o = &out.values[k * corner];
+      if (a.name != "NORMAL") {
+        std::copy_n(in, k, o);
+        continue;
+      }
+      // Column-major: n'_r = sum_j cof[r][j] n_j, with cof stored by columns of the inverse transpose.
+      double n[3];
+      for (int r = 0; r < 3; ++r) n[r] = sign * (c[3 * 0 + r] * in[0] + c[3 * 1 + r] * in[1] + c[3 * 2 + r] * in[2]);
+      const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      for (int r = 0; r < 3; ++r) o[r] = length > 0 ? static_cast<float>(n[r] / length) : in[r];
+    }
+  }
+  for (size_t slot = 0; slot < seen.size(); ++slot) {
+    if (seen[slot]) continue;
+    CornerAttribute& out = mesh.corner_attributes[slot];
+    out.values.resize(size_t(out.components) * corners, 0.0f);
+    incomplete[slot] = 1;
+  }
+}
+
+// What the output cannot carry: materials (tailor writes its own), names, extras, attributes
+// other than the kept ones, skins, animations, cameras; and the hierarchy when it was flattened.
+void not_kept(const GltfDocument& doc, size_t instances, std::vector<std::string>& lost) {
+  const Json& json = doc.json();
+  auto any = [&](const char* array, auto&& predicate) {
+    const auto it = json.find(array);
+    if (it == json.end() || !it->is_array()) return false;
+    return std::any_of(it->begin(), it->end(), predicate);
+  };
+  auto non_empty = [&](const char* array) { return any(array, [](const Json&) { return true; }); };
+  if (non_empty("materials")) lost.push_back("materials");
+  if (any("nodes", [](const Json& n) { return n.is_object() && n.contains("name"); }) ||
+      any("meshes", [](const Json& m) { return m.is_object() && m.contains("name"); }))
+    lost.push_back("names");
+  if (json.contains("extras") || any("nodes", [](const Json& n) { return n.is_object() && n.contains("extras"); }) ||
+      any("meshes", [](const Json& m) { return m.is_object() && m.contains("extras"); }))
+    lost.push_back("extras");
+  std::vector<std::string> attributes;
+  const auto meshes = json.find("meshes");
+  if (meshes != json.end() && meshes->is_array())
+    for (const Json& m : *meshes) {
+      const auto primitives = m.is_object() ? m.find("primitives") : m.end();
+      if (!m.is_object() || primitives == m.end() || !primitives->is_array()) continue;
+      for (const Json& prim : *primitives) {
+        const auto a = prim.is_object() ? prim.find("attributes") : prim.end();
+        if (!prim.is_object() || a == prim.end() || !a->is_object()) continue;
+        for (const auto& item : a->items())
+          if (item.key() != "POSITION" && item.key() != "TEXCOORD_0" && !is_kept_attribute(item.key()) &&
+              std::find(attributes.begin(), attributes.end(), item.key()) == attributes.end())
+            attributes.push_back(item.key());
+      }
+    }
+  lost.insert(lost.end(), attributes.begin(), attributes.end());
+  for (const char* array : {"skins", "animations", "cameras"})
+    if (non_empty(array)) lost.push_back(array);
+  if (instances > 1) lost.push_back("the node hierarchy (one mesh in world space)");
+}
+
+// Parses the file into mesh (not finalized); the base colour texture bytes go to `texture_bytes`.
+Status parse_gltf(std::span<const char> data, const std::string& name, const std::string& base_dir, Mesh& mesh,
+                  LoadReport& report, std::span<const unsigned char>* texture_bytes) {
+  GltfDocument doc;
+  TAILOR_RETURN_IF_ERROR(doc.open(data, name, base_dir));
+  report.format = doc.is_binary() ? "glTF binary" : "glTF";
+  TAILOR_RETURN_IF_ERROR(check_required_extensions(doc));
+  const auto used = doc.json().find("extensionsUsed");
+  if (used != doc.json().end() && used->is_array())
+    for (const Json& e : *used)
+      if (e.is_string() && std::find(kSupportedExtensions.begin(), kSupportedExtensions.end(), e.get<std::string>()) !=
+                               kSupportedExtensions.end())
+        report.format += " + " + e.get<std::string>();
+
+  std::vector<Instance> instances;
+  TAILOR_RETURN_IF_ERROR(scene_instances(doc, instances));
+  static const Json kNoMeshes = Json::array();
+  const auto meshes_it = doc.json().find("meshes");
+  const Json& meshes = meshes_it != doc.json().end() && meshes_it->is_array() ? *meshes_it : kNoMeshes;
+  // Each mesh is decoded once, however many nodes use it.
+  std::vector<std::optional<std::vector<Primitive>>> decoded(meshes.size());
   size_t triangle_primitives = 0, with_uv = 0;
   bool texture_found = false;
-  for (size_t mi = 0; mi < meshes->size(); ++mi) {
-    const Json& m = (*meshes)[mi];
+  std::vector<uint8_t> incomplete;  // per mesh.corner_attributes: missing on some primitive
+  for (const Instance& instance : instances) {
+    const size_t mi = instance.mesh;
+    const Json& m = meshes[mi];
     const auto primitives = m.is_object() ? m.find("primitives") : m.end();
-    if (!m.is_object() || primitives == m.end() || !primitives->is_array()) continue;
-    for (size_t pi = 0; pi < primitives->size(); ++pi) {
-      const Json& prim = (*primitives)[pi];
-      const std::string where = "mesh " + std::to_string(mi) + " primitive " + std::to_string(pi);
-      if (!prim.is_object()) return parse_error(name, "primitive is not an object", where);
+    if (!m.is_object() || primitives == m.end() || !primitives->is_array())
+      return doc.parse_error("mesh without primitives", "mesh " + std::to_string(mi));
+    const bool first_use = !decoded[mi].has_value();
+    if (first_use) {
+      decoded[mi].emplace();
+      for (size_t pi = 0; pi < primitives->size(); ++pi) {
+        const Json& prim = (*primitives)[pi];
+        const std::string where = "mesh " + std::to_string(mi) + " primitive " + std::to_string(pi);
+        if (!prim.is_object()) return doc.parse_error("primitive is not an object", where);
+        uint64_t mode = kTriangles;
+        if (prim.contains("mode") && !get_uint(prim, "mode", mode)) return doc.parse_error("bad primitive mode", where);
+        if (mode < kTriangles) continue;  // counted per instance below
+        if (mode > kFan) return doc.parse_error("unknown primitive mode " + std::to_string(mode), where);
+        decoded[mi]->emplace_back();
+        TAILOR_RETURN_IF_ERROR(read_primitive(doc, prim, mode, where, decoded[mi]->back()));
+      }
+    }
+    for (const Json& prim : *primitives) {
       uint64_t mode = kTriangles;
-      if (prim.contains("mode") && !get_uint(prim, "mode", mode)) return parse_error(name, "bad primitive mode", where);
-      if (mode != kTriangles) continue;  // points, lines, strips and fans are skipped
-      const auto attributes = prim.find("attributes");
-      uint64_t position_index = 0;
-      if (attributes == prim.end() || !get_uint(*attributes, "POSITION", position_index))
-        return parse_error(name, "triangle primitive without POSITION", where);
-      AccessorView positions;
-      TAILOR_RETURN_IF_ERROR(accessor_view(doc, glb, position_index, name, positions));
-      if (positions.component_type != kFloat || positions.components != 3)
-        return Status::error(ErrorCode::kUnsupported, name, "POSITION must be float VEC3", where);
-      AccessorView uvs;
-      uint64_t uv_index = 0;
-      const bool has_uv = get_uint(*attributes, "TEXCOORD_0", uv_index);
-      if (has_uv) {
-        TAILOR_RETURN_IF_ERROR(accessor_view(doc, glb, uv_index, name, uvs));
-        const bool ok_type =
-            uvs.component_type == kFloat ||
-            ((uvs.component_type == kUnsignedByte || uvs.component_type == kUnsignedShort) && uvs.normalized);
-        if (!ok_type || uvs.components != 2)
-          return Status::error(ErrorCode::kUnsupported, name, "TEXCOORD_0 must be float or normalized VEC2", where);
-        if (uvs.count != positions.count) return parse_error(name, "TEXCOORD_0 and POSITION counts differ", where);
-      }
-      AccessorView indices;
-      uint64_t indices_index = 0;
-      const bool indexed = get_uint(prim, "indices", indices_index);
-      if (indexed) {
-        TAILOR_RETURN_IF_ERROR(accessor_view(doc, glb, indices_index, name, indices));
-        const int t = indices.component_type;
-        if ((t != kUnsignedByte && t != kUnsignedShort && t != kUnsignedInt) || indices.components != 1)
-          return parse_error(name, "indices must be unsigned integer scalars", where);
-      }
-      const size_t corner_count = indexed ? indices.count : positions.count;
-      if (corner_count % 3 != 0) return parse_error(name, "triangle index count is not a multiple of 3", where);
-
-      const size_t base = mesh.vertex_count();
-      if (base + positions.count > kMaxVertices || mesh.face_count() + corner_count / 3 > kMaxFaces)
+      if (get_uint(prim, "mode", mode) && mode < kTriangles) ++report.skipped_primitives;
+    }
+    ++report.mesh_instances;
+    for (const Primitive& p : *decoded[mi]) {
+      const std::string where = "mesh " + std::to_string(mi);
+      const size_t nv = p.positions.size() / 3, nf = p.triangles.size() / 3;
+      if (mesh.vertex_count() + nv > kMaxVertices || mesh.face_count() + nf > kMaxFaces)
         return Status::error(ErrorCode::kLimit, name, "too many vertices or faces", where);
-      if (mesh.positions.size() + 3 * positions.count + 3 * (mesh.indices.size() + corner_count) > budget_floats)
-        return Status::error(ErrorCode::kLimit, name, "accessors referenced too often for the file size", where);
-      const size_t first_corner = mesh.indices.size();
-      mesh.positions.resize(mesh.positions.size() + 3 * positions.count);
-      for (size_t i = 0; i < positions.count; ++i)
-        for (int c = 0; c < 3; ++c) mesh.positions[3 * (base + i) + size_t(c)] = read_float(positions, i, c);
-      mesh.indices.resize(first_corner + corner_count);
-      for (size_t i = 0; i < corner_count; ++i) {
-        const size_t local = indexed ? read_index(indices, i) : i;
-        if (local >= positions.count)
-          return Status::error(ErrorCode::kInvalidMesh, name, "index out of range",
-                               where + " index " + std::to_string(i));
-        mesh.indices[first_corner + i] = static_cast<uint32_t>(base + local);
-      }
-      // UVs per corner, OBJ convention up to a whole repeat (t = -v_gltf, see export.h).
-      mesh.corner_uvs.resize(2 * mesh.indices.size(), 0.0f);
-      if (has_uv) {
-        ++with_uv;
-        for (size_t i = 0; i < corner_count; ++i) {
-          const size_t local = mesh.indices[first_corner + i] - base;
-          mesh.corner_uvs[2 * (first_corner + i)] = read_float(uvs, local, 0);
-          mesh.corner_uvs[2 * (first_corner + i) + 1] = -read_float(uvs, local, 1);
-        }
-      }
+      TAILOR_RETURN_IF_ERROR(doc.charge(12 * nv + 36 * nf, where));  // positions, indices, corner UVs
+      const size_t base = mesh.vertex_count(), first = mesh.indices.size();
+      append_instance(p, instance.world, mesh);
+      append_kept(p, instance.world, base, first, mesh, incomplete);
       ++triangle_primitives;
-      report.source_faces += corner_count / 3;
-      uint64_t material = 0;
-      if (texture_bytes && !texture_found && get_uint(prim, "material", material)) {
-        find_texture(doc, glb, material, *texture_bytes);
+      with_uv += !p.uv.empty();
+      report.source_faces += p.source_faces;
+      if (texture_bytes && !texture_found && p.material != UINT64_MAX) {
+        find_texture(doc, p.material, *texture_bytes);
         texture_found = !texture_bytes->empty();
       }
     }
   }
   if (triangle_primitives == 0)
-    return Status::error(ErrorCode::kUnsupported, name, "no triangle primitive in the file");
-  // All or nothing: UVs are only meaningful when every primitive has them.
+    return Status::error(ErrorCode::kUnsupported, name,
+                         report.skipped_primitives
+                             ? "no triangles in the scene (only " + std::to_string(report.skipped_primitives) +
+                                   " point and line primitives)"
+                             : std::string("no triangle primitive in the scene"));
+  // All or nothing: UVs are only meaningful when every primitive has them; the same for the rest.
   if (with_uv != triangle_primitives) mesh.corner_uvs.clear();
+  std::vector<std::string> lost;
+  for (size_t slot = mesh.corner_attributes.size(); slot-- > 0;) {
+    if (!incomplete[slot]) continue;
+    lost.push_back(mesh.corner_attributes[slot].name + " (not on every primitive)");
+    mesh.corner_attributes.erase(mesh.corner_attributes.begin() + static_cast<std::ptrdiff_t>(slot));
+  }
+  not_kept(doc, instances.size(), lost);
+  for (const std::string& item : lost) report.not_kept += (report.not_kept.empty() ? "" : ", ") + item;
   // glTF splits vertices on UV seams; weld them so that seams are edges between faces again.
   report.welded_vertices = weld_identical_positions(mesh);
   return Status::ok();
+}
+
+std::string folder_of(const std::string& path) {
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  return parent.empty() ? std::string(".") : parent.string();
 }
 
 }  // namespace
 
 namespace internal {
 
-Status read_glb(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report) {
-  return parse_glb(data, name, mesh, report, nullptr);
+Status read_gltf(std::span<const char> data, const std::string& name, const std::string& base_dir, Mesh& mesh,
+                 LoadReport& report) {
+  return parse_gltf(data, name, base_dir, mesh, report, nullptr);
 }
 
 }  // namespace internal
 
-Status read_glb_memory(std::span<const char> data, const std::string& name, Mesh& mesh, Image* texture,
-                       LoadReport* report) {
+namespace {
+
+Status read_gltf_with_texture(std::span<const char> data, const std::string& name, const std::string& base_dir,
+                              Mesh& mesh, Image* texture, LoadReport* report) {
   mesh = Mesh{};
   if (texture) *texture = Image{};
   LoadReport local;
@@ -401,7 +620,7 @@ Status read_glb_memory(std::span<const char> data, const std::string& name, Mesh
   Status s;
   try {
     std::span<const unsigned char> texture_bytes;
-    s = parse_glb(data, name, mesh, r, &texture_bytes);
+    s = parse_gltf(data, name, base_dir, mesh, r, &texture_bytes);
     if (s.is_ok()) s = finalize_mesh(name, mesh, r);
     int width = 0, height = 0, channels = 0;  // the texture's size from its header only
     if (s.is_ok() && !texture_bytes.empty() && texture_bytes.size() <= size_t{INT_MAX} &&
@@ -425,6 +644,13 @@ Status read_glb_memory(std::span<const char> data, const std::string& name, Mesh
   return s;
 }
 
+}  // namespace
+
+Status read_glb_memory(std::span<const char> data, const std::string& name, Mesh& mesh, Image* texture,
+                       LoadReport* report) {
+  return read_gltf_with_texture(data, name, "", mesh, texture, report);
+}
+
 Status read_glb_file(const std::string& path, Mesh& mesh, Image* texture, LoadReport* report) {
   const auto start = std::chrono::steady_clock::now();
   mesh = Mesh{};
@@ -432,7 +658,7 @@ Status read_glb_file(const std::string& path, Mesh& mesh, Image* texture, LoadRe
   TAILOR_RETURN_IF_ERROR(internal::read_file(path, bytes));
   LoadReport local;
   LoadReport& r = report ? *report : local;
-  const Status s = read_glb_memory(bytes, path, mesh, texture, &r);
+  const Status s = read_gltf_with_texture(bytes, path, folder_of(path), mesh, texture, &r);
   r.load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return s;
 }

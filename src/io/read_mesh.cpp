@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <new>
 #include <string_view>
 #include <thread>
@@ -19,7 +20,7 @@
 namespace tailor {
 namespace {
 
-constexpr const char* kSupported = "supported: .ply .obj .off .stl .glb";
+constexpr const char* kSupported = "supported: .ply .obj .off .stl .glb .gltf";
 
 bool ends_with_ci(const std::string& s, std::string_view suffix) {
   if (s.size() < suffix.size()) return false;
@@ -45,6 +46,7 @@ MeshFormat sniff_format(std::span<const char> data) {
   const std::string_view s(data.data(), data.size());
   if (s.size() >= 4 && s.substr(0, 3) == "ply" && (s[3] == '\n' || s[3] == '\r')) return MeshFormat::kPly;
   if (s.size() >= 4 && s.substr(0, 4) == "glTF") return MeshFormat::kGlb;
+  if (s.size() >= 1 && s[0] == '{') return MeshFormat::kGltf;  // JSON: only glTF among ours
   if (s.size() >= 84) {
     uint32_t n = 0;
     std::memcpy(&n, s.data() + 80, 4);
@@ -167,11 +169,15 @@ MeshFormat mesh_format_from_path(const std::string& path) {
   if (ends_with_ci(path, ".off")) return MeshFormat::kOff;
   if (ends_with_ci(path, ".stl")) return MeshFormat::kStl;
   if (ends_with_ci(path, ".glb")) return MeshFormat::kGlb;
+  if (ends_with_ci(path, ".gltf")) return MeshFormat::kGltf;
   return MeshFormat::kUnknown;
 }
 
-Status read_mesh(std::span<const char> data, MeshFormat format, const std::string& name, Mesh& mesh,
-                 LoadReport* report) {
+namespace {
+
+// read_mesh with the folder where a .gltf's buffer files are (empty: none is opened).
+Status read_mesh_in(std::span<const char> data, MeshFormat format, const std::string& name, const std::string& base_dir,
+                    Mesh& mesh, LoadReport* report) {
   mesh = Mesh{};
   LoadReport local;
   LoadReport& r = report ? *report : local;
@@ -186,7 +192,8 @@ Status read_mesh(std::span<const char> data, MeshFormat format, const std::strin
       case MeshFormat::kObj: s = internal::read_obj(data, name, mesh, r); break;
       case MeshFormat::kOff: s = internal::read_off(data, name, mesh, r); break;
       case MeshFormat::kStl: s = internal::read_stl(data, name, mesh, r); break;
-      case MeshFormat::kGlb: s = internal::read_glb(data, name, mesh, r); break;
+      case MeshFormat::kGlb:
+      case MeshFormat::kGltf: s = internal::read_gltf(data, name, base_dir, mesh, r); break;
       case MeshFormat::kUnknown:
         s = Status::error(ErrorCode::kUnsupported, name, std::string("unknown mesh format (") + kSupported + ")");
         break;
@@ -202,6 +209,13 @@ Status read_mesh(std::span<const char> data, MeshFormat format, const std::strin
     return s.with_file(name);
   }
   return s;
+}
+
+}  // namespace
+
+Status read_mesh(std::span<const char> data, MeshFormat format, const std::string& name, Mesh& mesh,
+                 LoadReport* report) {
+  return read_mesh_in(data, format, name, "", mesh, report);
 }
 
 Status load_mesh(const std::string& path, Mesh& mesh, LoadReport* report) {
@@ -221,7 +235,8 @@ Status load_mesh(const std::string& path, Mesh& mesh, LoadReport* report) {
   }
   LoadReport local;
   LoadReport& r = report ? *report : local;
-  const Status s = read_mesh(bytes, format, path, mesh, &r);
+  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+  const Status s = read_mesh_in(bytes, format, path, folder.empty() ? "." : folder.string(), mesh, &r);
   r.load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return s;
 }
@@ -245,6 +260,9 @@ Status finalize_mesh(const std::string& name, Mesh& mesh, LoadReport& report) {
   if (!mesh.seam_faces.empty() && mesh.seam_faces.size() != nf) {
     return Status::error(ErrorCode::kInvalidMesh, name, "seam flags do not match the faces");
   }
+  for (const CornerAttribute& a : mesh.corner_attributes)
+    if (a.components < 1 || a.components > 4 || a.values.size() != nf * 3 * size_t(a.components))
+      return Status::error(ErrorCode::kInvalidMesh, name, "corner attribute " + a.name + " does not match the faces");
   if (nf == 0) return Status::error(ErrorCode::kInvalidMesh, name, "mesh has no faces");
 
   // === Three passes over the faces, on two threads ==============================================
@@ -362,6 +380,11 @@ Status finalize_mesh(const std::string& name, Mesh& mesh, LoadReport& report) {
       }
     }
   }
+  for (const CornerAttribute& a : mesh.corner_attributes)
+    for (size_t i = 0; i < a.values.size(); ++i)
+      if (!std::isfinite(a.values[i]))
+        return Status::error(ErrorCode::kInvalidMesh, name, "non-finite " + a.name,
+                             "face " + std::to_string(i / (3 * size_t(a.components))));
   for (size_t i = 0; i < mesh.corner_uvs.size(); ++i) {
     if (!std::isfinite(mesh.corner_uvs[i])) {
       return Status::error(ErrorCode::kInvalidMesh, name, "non-finite texture coordinate",
@@ -395,12 +418,17 @@ Status finalize_mesh(const std::string& name, Mesh& mesh, LoadReport& report) {
         std::memmove(&mesh.indices[3 * out], &mesh.indices[3 * f], 3 * sizeof(uint32_t));
         if (uvs) std::memmove(&mesh.corner_uvs[6 * out], &mesh.corner_uvs[6 * f], 6 * sizeof(float));
         if (seams) mesh.seam_faces[out] = mesh.seam_faces[f];
+        for (CornerAttribute& a : mesh.corner_attributes) {
+          const size_t k = 3 * size_t(a.components);
+          std::memmove(&a.values[k * out], &a.values[k * f], k * sizeof(float));
+        }
       }
       ++out;
     }
     mesh.indices.resize(3 * out);
     if (uvs) mesh.corner_uvs.resize(6 * out);
     if (seams) mesh.seam_faces.resize(out);
+    for (CornerAttribute& a : mesh.corner_attributes) a.values.resize(3 * size_t(a.components) * out);
   }
   report.degenerate_faces += degenerate;
   report.duplicate_faces += duplicates;

@@ -1,12 +1,14 @@
 // Wavefront OBJ reader: `v`, `vt` and `f` statements (v, v/vt, v//vn, v/vt/vn corners, negative
 // indices relative to the current counts), polygons fan-triangulated, `\r\n` line ends, `#`
-// comments, backslash line continuation. `vn`, `o`, `g`, `s`, `usemtl`, `mtllib`, `l`, `p` and any
-// other statement are ignored; no .mtl file is ever opened.
+// comments, backslash line continuation. Vertex colours (`v x y z r g b`) and normals (`vn`, when
+// every corner names one) are kept as COLOR_0 and NORMAL corner attributes. `o`, `g`, `s`,
+// `usemtl`, `mtllib`, `l`, `p` and any other statement are ignored; no .mtl file is ever opened.
 //
 // Hand-written instead of tinyobjloader (which Debian ships): tinyobjloader reports bad indices as
 // warnings without line numbers (or silently clamps them), stores per-shape index structs that we
 // would copy again, and its float parser is slower than fast_float. This reader is a single pass
 // over the bytes with exact float parsing (fast_float) and line-accurate errors.
+#include <cstring>
 #include <string_view>
 #include <vector>
 
@@ -55,6 +57,13 @@ Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh,
   std::vector<ForwardRef> forward_v, forward_vt;
   std::vector<uint32_t> poly, poly_vt;
   size_t corners_without_vt = 0;  // once nonzero, corner_vt is dropped and no longer filled
+  // Kept attributes: vertex colours (`v x y z r g b`, when every vertex has them) and normals
+  // (`vn`, referenced by every face corner as v/vt/vn or v//vn).
+  std::vector<float> colours, normals;  // #V by 3, #VN by 3
+  size_t vertices_without_colour = 0;
+  std::vector<uint32_t> corner_vn, poly_vn;
+  std::vector<ForwardRef> forward_vn;
+  size_t corners_without_vn = 0;
 
   while (!s.at_end()) {
     const std::string_view w = s.word();
@@ -68,6 +77,18 @@ Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh,
         return Status::error(ErrorCode::kParse, name, "bad vertex line (expected 3 numbers)", s.where());
       }
       mesh.positions.insert(mesh.positions.end(), {x, y, z});
+      float rgb[3];
+      int extra = 0;
+      while (extra < 3 && !s.at_line_end() && s.read_float(rgb[extra])) ++extra;
+      if (extra == 3 && s.at_line_end())
+        colours.insert(colours.end(), rgb, rgb + 3);
+      else
+        ++vertices_without_colour;
+    } else if (w == "vn") {
+      float n[3];
+      if (!s.read_float(n[0]) || !s.read_float(n[1]) || !s.read_float(n[2]))
+        return Status::error(ErrorCode::kParse, name, "bad normal line (expected 3 numbers)", s.where());
+      normals.insert(normals.end(), n, n + 3);
     } else if (w == "vt") {
       float u, v = 0.0f;
       if (!s.read_float(u)) return Status::error(ErrorCode::kParse, name, "bad texture coordinate line", s.where());
@@ -78,10 +99,11 @@ Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh,
     } else if (w == "f") {
       poly.clear();
       poly_vt.clear();
-      const size_t nv = mesh.positions.size() / 3, nt = texcoords.size() / 2;
+      poly_vn.clear();
+      const size_t nv = mesh.positions.size() / 3, nt = texcoords.size() / 2, nn = normals.size() / 3;
       while (!s.at_line_end()) {
         int64_t raw = 0;
-        uint64_t vi = 0, ti = kInvalid;
+        uint64_t vi = 0, ti = kInvalid, ni = kInvalid;
         if (!s.read_int(raw, false)) return Status::error(ErrorCode::kParse, name, "bad face corner", s.where());
         if (!resolve(raw, nv, vi)) {
           return Status::error(ErrorCode::kInvalidMesh, name, out_of_range_text("face", raw, nv), s.where());
@@ -97,13 +119,17 @@ Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh,
             if (ti >= nt) forward_vt.push_back({ti, s.line()});
           }
           if (s.consume('/')) {
-            int64_t normal = 0;  // normals are not used; only the syntax is checked
+            int64_t normal = 0;
             if (!s.read_int(normal, false)) return Status::error(ErrorCode::kParse, name, "bad face corner", s.where());
+            if (!resolve(normal, nn, ni))
+              return Status::error(ErrorCode::kInvalidMesh, name, out_of_range_text("normal", normal, nn), s.where());
+            if (ni >= nn) forward_vn.push_back({ni, s.line()});
           }
         }
         if (!s.at_token_end()) return Status::error(ErrorCode::kParse, name, "bad face corner", s.where());
         poly.push_back(static_cast<uint32_t>(vi));
         poly_vt.push_back(static_cast<uint32_t>(ti));
+        poly_vn.push_back(static_cast<uint32_t>(ni));
       }
       const size_t n = poly.size();
       if (n < 3) {
@@ -119,6 +145,15 @@ Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh,
             corner_vt.insert(corner_vt.end(), {poly_vt[0], poly_vt[k], poly_vt[k + 1]});
         } else {
           std::vector<uint32_t>().swap(corner_vt);  // no uvs after all: stop recording them
+        }
+      }
+      if (corners_without_vn == 0) {
+        for (uint32_t t : poly_vn) corners_without_vn += t == kInvalid;
+        if (corners_without_vn == 0) {
+          for (size_t k = 1; k + 1 < n; ++k)
+            corner_vn.insert(corner_vn.end(), {poly_vn[0], poly_vn[k], poly_vn[k + 1]});
+        } else {
+          std::vector<uint32_t>().swap(corner_vn);
         }
       }
       if (mesh.indices.size() / 3 > kMaxFaces)
@@ -142,6 +177,26 @@ Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh,
       return Status::error(ErrorCode::kInvalidMesh, name,
                            out_of_range_text("texture", static_cast<int64_t>(r.index + 1), nt),
                            "line " + std::to_string(r.line));
+    }
+  }
+  for (const ForwardRef& r : forward_vn) {
+    if (r.index >= normals.size() / 3) {
+      return Status::error(ErrorCode::kInvalidMesh, name,
+                           out_of_range_text("normal", static_cast<int64_t>(r.index + 1), normals.size() / 3),
+                           "line " + std::to_string(r.line));
+    }
+  }
+  if (!mesh.indices.empty() && corners_without_vn == 0 && corner_vn.size() == mesh.indices.size()) {
+    CornerAttribute& a = mesh.corner_attributes.emplace_back(CornerAttribute{"NORMAL", 3, {}});
+    a.values.resize(3 * corner_vn.size());
+    for (size_t c = 0; c < corner_vn.size(); ++c) std::memcpy(&a.values[3 * c], &normals[3 * corner_vn[c]], 12);
+  }
+  if (!mesh.indices.empty() && vertices_without_colour == 0 && colours.size() == mesh.positions.size()) {
+    CornerAttribute& a = mesh.corner_attributes.emplace_back(CornerAttribute{"COLOR_0", 4, {}});
+    a.values.resize(4 * mesh.indices.size());
+    for (size_t c = 0; c < mesh.indices.size(); ++c) {
+      std::memcpy(&a.values[4 * c], &colours[3 * size_t{mesh.indices[c]}], 12);
+      a.values[4 * c + 3] = 1.0f;
     }
   }
   // Corner uvs only when every corner has one: a partial set cannot be used as a mapping.

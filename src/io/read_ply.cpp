@@ -1,8 +1,9 @@
 // PLY reader: ascii, binary_little_endian and binary_big_endian (Turk 1994, "The PLY Polygon File
 // Format"). Any property order and scalar type, any list count/index type, `face` lists named
 // vertex_indices or vertex_index, `tristrips` with -1 restarts, per-vertex s/t, u/v or
-// texture_u/texture_v, per-face `texcoord` lists and a per-face `seam` flag; other elements and
-// properties are skipped.
+// texture_u/texture_v, per-vertex normals (nx ny nz) and colours (red green blue [alpha], kept as
+// NORMAL and COLOR_0 corner attributes), per-face `texcoord` lists and a per-face `seam` flag;
+// other elements and properties are skipped.
 //
 // Hand-written rather than taken from a library: the PLY parsers Debian ships (rply, the VCG and
 // PCL readers, tinyply-style code) either go through a callback or a per-property dispatch for
@@ -62,7 +63,38 @@ PlyType parse_type(std::string_view s) {
 }
 
 // What a property means to tailor; everything else is skipped.
-enum class Role : uint8_t { kNone, kX, kY, kZ, kU, kV, kIndices, kTexcoord, kSeam };
+enum class Role : uint8_t {
+  kNone,
+  kX,
+  kY,
+  kZ,
+  kU,
+  kV,
+  kIndices,
+  kTexcoord,
+  kSeam,
+  kNx,
+  kNy,
+  kNz,
+  kRed,
+  kGreen,
+  kBlue,
+  kAlpha  // kept per vertex: normals and colours
+};
+constexpr size_t kRoles = 16;
+
+// A colour component's full scale by its type: 255 for (u)char, 65535 for (u)short, 1 for floats.
+float colour_scale(PlyType t) {
+  switch (t) {
+    case PlyType::kInt8:
+    case PlyType::kUint8: return 255.f;
+    case PlyType::kInt16:
+    case PlyType::kUint16: return 65535.f;
+    case PlyType::kFloat32:
+    case PlyType::kFloat64: return 1.f;
+    default: return 4294967295.f;
+  }
+}
 
 struct PlyProperty {
   std::string name;
@@ -225,7 +257,7 @@ Status parse_header(std::string_view data, const std::string& name, PlyHeader& h
 Status assign_roles(PlyHeader& h, const std::string& name) {
   bool have_vertex = false;
   for (PlyElement& e : h.elements) {
-    std::array<bool, 9> seen{};
+    std::array<bool, kRoles> seen{};
     for (PlyProperty& p : e.props) {
       const std::string& n = p.name;
       Role r = Role::kNone;
@@ -240,6 +272,16 @@ Status assign_roles(PlyHeader& h, const std::string& name) {
           r = Role::kU;
         else if (n == "t" || n == "v" || n == "texture_v" || n == "texture_t")
           r = Role::kV;
+        else if (n == "nx" || n == "ny" || n == "nz")
+          r = n == "nx" ? Role::kNx : n == "ny" ? Role::kNy : Role::kNz;
+        else if (n == "red" || n == "r" || n == "diffuse_red")
+          r = Role::kRed;
+        else if (n == "green" || n == "g" || n == "diffuse_green")
+          r = Role::kGreen;
+        else if (n == "blue" || n == "b" || n == "diffuse_blue")
+          r = Role::kBlue;
+        else if (n == "alpha" || n == "a")
+          r = Role::kAlpha;
       } else if (e.kind == ElementKind::kFace) {
         if (p.is_list() && (n == "vertex_indices" || n == "vertex_index"))
           r = Role::kIndices;
@@ -268,6 +310,15 @@ Status assign_roles(PlyHeader& h, const std::string& name) {
         for (PlyProperty& p : e.props) {
           if (p.role == Role::kU || p.role == Role::kV) p.role = Role::kNone;  // half a uv pair is no uv
         }
+      }
+      auto all = [&](std::initializer_list<Role> roles) {
+        return std::all_of(roles.begin(), roles.end(), [&](Role r) { return seen[static_cast<size_t>(r)]; });
+      };
+      const bool normals = all({Role::kNx, Role::kNy, Role::kNz}),
+                 colours = all({Role::kRed, Role::kGreen, Role::kBlue});
+      for (PlyProperty& p : e.props) {  // part of a normal or a colour is neither
+        if (!normals && (p.role == Role::kNx || p.role == Role::kNy || p.role == Role::kNz)) p.role = Role::kNone;
+        if (!colours && p.role >= Role::kRed) p.role = Role::kNone;
       }
     }
     if ((e.kind == ElementKind::kFace || e.kind == ElementKind::kTristrips) &&
@@ -478,10 +529,16 @@ class BodyReader {
     // Counts were checked against the file size before this point (check_counts).
     reserve_huge(mesh_.positions, static_cast<size_t>(3 * e.count));
     mesh_.positions.resize(static_cast<size_t>(3 * e.count));
-    bool have_uv = false;
-    for (const PlyProperty& p : e.props) have_uv = have_uv || p.role == Role::kU;
+    bool have_uv = false, have_normals = false, have_colours = false;
+    for (const PlyProperty& p : e.props) {
+      have_uv = have_uv || p.role == Role::kU;
+      have_normals = have_normals || p.role == Role::kNx;
+      have_colours = have_colours || p.role == Role::kRed;
+    }
     if (have_uv) vertex_uvs_.resize(static_cast<size_t>(2 * e.count));
-    if (fast_vertices(e, have_uv)) return Status::ok();
+    if (have_normals) vertex_normals_.resize(static_cast<size_t>(3 * e.count));
+    if (have_colours) vertex_colours_.assign(static_cast<size_t>(4 * e.count), 1.0f);  // alpha 1 unless given
+    if (!have_normals && !have_colours && fast_vertices(e, have_uv)) return Status::ok();
     float* pos = mesh_.positions.data();
     for (uint64_t i = 0; i < e.count; ++i) {
       for (const PlyProperty& p : e.props) {
@@ -498,6 +555,18 @@ class BodyReader {
           case Role::kZ: pos[3 * i + 2] = f; break;
           case Role::kU: vertex_uvs_[2 * i] = f; break;
           case Role::kV: vertex_uvs_[2 * i + 1] = f; break;
+          case Role::kNx:
+          case Role::kNy:
+          case Role::kNz:
+            vertex_normals_[3 * i + static_cast<size_t>(p.role) - static_cast<size_t>(Role::kNx)] = f;
+            break;
+          case Role::kRed:
+          case Role::kGreen:
+          case Role::kBlue:
+          case Role::kAlpha:
+            vertex_colours_[4 * i + static_cast<size_t>(p.role) - static_cast<size_t>(Role::kRed)] =
+                static_cast<float>(d / colour_scale(p.type));
+            break;
           default: break;
         }
       }
@@ -714,6 +783,16 @@ class BodyReader {
   // === Texture coordinates ======================================================================
   void finish_uvs() {
     const size_t nf = mesh_.indices.size() / 3;
+    // Normals and colours per vertex become per-corner attributes (export writes them back).
+    auto per_corner = [&](const std::vector<float>& values, const char* name, int k) {
+      if (values.empty() || values.size() != size_t(k) * mesh_.vertex_count()) return;
+      CornerAttribute& a = mesh_.corner_attributes.emplace_back(CornerAttribute{name, k, {}});
+      a.values.resize(3 * nf * size_t(k));
+      for (size_t c = 0; c < 3 * nf; ++c)
+        std::memcpy(&a.values[size_t(k) * c], &values[size_t(k) * mesh_.indices[c]], size_t(k) * sizeof(float));
+    };
+    per_corner(vertex_normals_, "NORMAL", 3);
+    per_corner(vertex_colours_, "COLOR_0", 4);
     if (!seams_.empty() || seam_triangles_ > 0) {
       seams_.resize(nf, 0);  // strip triangles carry no seam flag
       mesh_.seam_faces = std::move(seams_);
@@ -741,6 +820,7 @@ class BodyReader {
   std::vector<uint32_t> poly_;
   std::vector<float> tc_;
   std::vector<float> vertex_uvs_;
+  std::vector<float> vertex_normals_, vertex_colours_;  // #V by 3 / 4, when the file has them
   std::vector<float> face_uvs_;
   std::vector<uint8_t> seams_;
   bool face_uv_complete_ = false;

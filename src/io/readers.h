@@ -17,8 +17,10 @@ Status read_ply(std::span<const char> data, const std::string& name, Mesh& mesh,
 Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report);
 Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report);
 Status read_stl(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report);
-//! glTF 2.0 binary (.glb): first triangle primitive(s), TEXCOORD_0 into corner_uvs (io_gltf.cpp).
-Status read_glb(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report);
+//! glTF 2.0 (.glb or .gltf): the default scene's mesh instances in world space, TEXCOORD_0 into
+//! corner_uvs (read_gltf.cpp). Buffer URIs are looked up in `base_dir` (empty: none is opened).
+Status read_gltf(std::span<const char> data, const std::string& name, const std::string& base_dir, Mesh& mesh,
+                 LoadReport& report);
 
 //! Checks the size an image header claims (width x height, read by stbi_info_from_memory) before
 //! decoding `bytes`: each side within kMaxImageSide, width x height within options.max_pixels, and
