@@ -14,6 +14,7 @@
 #include "tailor/image.h"
 #include "tailor/io.h"
 #include "tailor/mapping.h"
+#include "tailor/material.h"
 #include "tailor/metrics.h"
 #include "tailor/orientation.h"
 #include "tailor/render.h"
@@ -47,6 +48,7 @@ struct MapArgs {
   std::string input;                // the one being mapped
   std::string output;
   std::string texture;
+  std::string material;            // --material: a folder of PBR maps or a JSON naming them (material.h)
   ImageLoadOptions image_options;  // --max-image-pixels (default: ImageLoadOptions')
   int texture_size = ExportOptions{}.texture_width;
   std::string compress = mesh_compression_name(ExportOptions{}.compression);
@@ -154,15 +156,28 @@ int run_map(const MapArgs& opt) {
   UpAxis preview_up = RenderOptions{}.up;
   if (!up_axis_from_name(opt.preview_up, preview_up))
     return report_error(usage_error("--preview-up must be x, y, z, -x, -y or -z, got '" + opt.preview_up + "'"));
+  if (!opt.material.empty() && !opt.texture.empty())
+    return report_error(
+        usage_error("give --texture or --material, not both (the material's colour map is the texture)"));
+  if (!opt.material.empty() && ext != ".glb")
+    return report_error(usage_error("--material needs a .glb output, got '" + opt.output + "'"));
   if (Status s = check_outputs(output_paths(opt), {opt.input, opt.texture, opt.seam_faces}); !s) return report_error(s);
 
-  // === Texture (read first: a bad texture should fail before minutes of work) ===
-  Image texture;
-  if (!opt.texture.empty()) {
-    if (Status s = load_image(opt.texture, texture, opt.image_options); !s) return report_error(s);
+  // === Texture and material (read first: a bad map should fail before minutes of work) ===
+  MaterialMaps material;
+  std::string texture_path = opt.texture;
+  if (!opt.material.empty()) {
+    if (Status s = load_material(opt.material, material, opt.image_options); !s) return report_error(s);
+    for (const std::string& note : material.notes) warn(opt.quiet, note);
+    texture_path = material.color;
   }
-  const int tex_w = texture.empty() ? opt.texture_size : texture.width;
-  const int tex_h = texture.empty() ? opt.texture_size : texture.height;
+  Image texture;
+  if (!texture_path.empty()) {
+    if (Status s = load_image(texture_path, texture, opt.image_options); !s) return report_error(s);
+  }
+  // The UV lattice: the texture's size (a material's: its colour map's, which every map shares).
+  const int tex_w = !texture.empty() ? texture.width : material.width > 0 ? material.width : opt.texture_size;
+  const int tex_h = !texture.empty() ? texture.height : material.height > 0 ? material.height : opt.texture_size;
   // The lattice period, the metrics' texture size, the threads of every stage.
   if (Status s = set_map_texture_size(options, tex_w, tex_h); !s) return report_error(s);
   // auto: follow the field unless the texture has no direction to follow (texture_direction.h).
@@ -227,7 +242,7 @@ int run_map(const MapArgs& opt) {
   run.up = opt.up;
   run.input = opt.input;
   run.output = opt.output;
-  run.texture = opt.texture;
+  run.texture = texture_path;
   run.texture_width = tex_w;
   run.texture_height = tex_h;
   run.texture_isotropy = texture_isotropy;
@@ -306,7 +321,8 @@ int run_map(const MapArgs& opt) {
   internal::FileBatch batch;
   const auto export_start = std::chrono::steady_clock::now();
   ExportOptions export_options;
-  export_options.texture_path = opt.texture;
+  export_options.texture_path = texture_path;
+  export_options.material = std::move(material.textures);
   export_options.texture_width = tex_w;
   export_options.texture_height = tex_h;
   export_options.compression = compression;
@@ -426,6 +442,14 @@ void register_map(CLI::App& app, Runner& run) {
       ->required();
   cmd->add_option("-t,--texture", opt->texture,
                   "Texture image (PNG/JPEG), ideally self-tileable (see 'tailor tile'); sets the texture size");
+  cmd->add_option("--material", opt->material,
+                  "PBR material instead of --texture (.glb output): a folder whose maps are recognised by name "
+                  "(NAME_color/albedo/basecolor/diffuse, _normal/_nor/_nrm with _gl or _dx, _roughness/_rough, "
+                  "_metallic/_metalness, _ao/_occlusion, _height/_disp), or a JSON naming them ({\"color\": "
+                  "\"a.png\", \"normal\": \"b.png\", ...}, or OUTDIR/material.json of 'tailor tile --set'). "
+                  "The colour map sets the texture size; all maps must share it. The .glb gets baseColor, normal "
+                  "(+ per-vertex tangents; a DX map's green is flipped), metallicRoughness (G roughness, B "
+                  "metallic) and occlusion (R); height is not a glTF map and is left out");
   cmd->add_option("--texture-size", opt->texture_size, "Texture size in pixels when no --texture is given")
       ->capture_default_str();
   add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), opt->image_options.max_pixels)
@@ -481,6 +505,7 @@ void register_map(CLI::App& app, Runner& run) {
       "Example:\n"
       "  tailor tile gravel.png -o gravel_tile.png\n"
       "  tailor map bunny.ply --texture gravel_tile.png -o bunny.glb --stats bunny.json --preview bunny.png\n"
+      "  tailor map bunny.ply --material bricks/ -o bunny.glb   # bricks/bricks_color.png, _normal.png, ...\n"
       "Prints one summary line: faces, patches, seam length, flipped faces, stretch, Sander L2/Linf,\n"
       "median angle distortion, seam gap, and the time of each stage.\n"
       "Trade-offs: --no-crack-closing maps 3-10x faster and keeps more UVs bit-identical when parts of\n"

@@ -63,14 +63,25 @@ inline bool mesh_compression_from_name(std::string_view name, MeshCompression& c
 //! The up axis of the mesh's coordinates (ExportOptions::up).
 enum class SceneUp { kY, kZ };
 
+//! A glTF PBR material's maps beyond the base colour (.glb only; see material.h for building them
+//! from a folder of maps). Each image is an encoded PNG (8 or 16 bit) embedded as is.
+struct MaterialTextures {
+  std::string normal_png;               //!< tangent-space normal map, glTF (GL) convention; adds per-vertex TANGENT
+  std::string orm_png;                  //!< glTF packing: R occlusion, G roughness, B metallic
+  bool orm_roughness_metallic = false;  //!< orm_png is the metallicRoughnessTexture
+  bool orm_occlusion = false;           //!< orm_png's R channel is the occlusionTexture
+  bool empty() const { return normal_png.empty() && orm_png.empty(); }
+};
+
 struct ExportOptions {
   std::string texture_path;  //!< PNG or JPEG: embedded as is (.glb) or referenced by map_Kd (.mtl); empty = no texture
   int texture_width = 512;   //!< pixels per texture repeat along u (> 0), usually the texture's width
   int texture_height = 512;  //!< pixels per texture repeat along v (> 0), usually the texture's height
   bool normals = true;       //!< .glb/.obj: write smooth per-vertex normals (area-weighted, shared across seams)
   MeshCompression compression = MeshCompression::kNone;  //!< .glb only (kInvalidArgument for .obj/.ply)
-  int uv_set = 0;            //!< .glb: the mapped UVs go to TEXCOORD_<uv_set> (0..7); the file's other sets are kept
-  SceneUp up = SceneUp::kY;  //!< .glb: kZ turns the scene Y-up as glTF wants (-90 degrees about x, on the node)
+  int uv_set = 0;             //!< .glb: the mapped UVs go to TEXCOORD_<uv_set> (0..7); the file's other sets are kept
+  SceneUp up = SceneUp::kY;   //!< .glb: kZ turns the scene Y-up as glTF wants (-90 degrees about x, on the node)
+  MaterialTextures material;  //!< .glb: normal, metallic-roughness and occlusion maps (kInvalidArgument otherwise)
 };
 
 //! Flags and help of the ExportOptions a user sets (option_doc.h).

@@ -82,6 +82,9 @@ TAILOR_API Status load_image16(const std::string& path, Image16& image, const Im
 //! inconsistent image (sizes as check_image, bits not 8 or 16, a sample above 2^bits - 1).
 TAILOR_API Status write_png16(const std::string& path, const Image16& image);
 
+//! The PNG file's bytes of an 8- or 16-bit image (as write_png16 writes, in memory): for embedding.
+TAILOR_API Status encode_png16(const Image16& image, std::string& encoded);
+
 //! The 8-bit image of an Image16: 16-bit samples scaled by 255 / 65535 and rounded.
 TAILOR_API Image to_image8(const Image16& image);
 

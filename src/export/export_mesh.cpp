@@ -211,6 +211,8 @@ Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas
     return Status::error(ErrorCode::kInvalidArgument, path, "the UV set must be 0 to 7");
   if (options.uv_set != 0 && format != ExportFormat::kGlb)
     return Status::error(ErrorCode::kInvalidArgument, path, "a UV set other than 0 needs a .glb output");
+  if (!options.material.empty() && format != ExportFormat::kGlb)
+    return Status::error(ErrorCode::kInvalidArgument, path, "material maps need a .glb output");
   if (options.texture_width <= 0 || options.texture_height <= 0)
     return Status::error(ErrorCode::kInvalidArgument, path, "texture size must be positive");
   // Branch-free scans first (they vectorize); the exact culprit is looked for only on failure.
@@ -273,6 +275,9 @@ Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas
       [&] { bad_corner = internal::split_vertices_scaled(source, atlas.corner_uv, su, sv, data.split); });
   if (bad_corner != internal::kNoBadCorner)
     return Status::error(ErrorCode::kInvalidArgument, path, "UV is not finite", "corner " + std::to_string(bad_corner));
+
+  if (format == ExportFormat::kGlb && !options.material.normal_png.empty() && !data.normals.empty())
+    internal::compute_tangents(*data.mesh, data.split, data.normals, data.tangents);
 
   switch (format) {
     case ExportFormat::kGlb:

@@ -74,19 +74,41 @@ size_t add_view(nlohmann::json& views, size_t offset, size_t length, int target)
 
 }  // namespace
 
-void add_glb_material(nlohmann::json& gltf, nlohmann::json& views, size_t texture_offset, size_t texture_size,
-                      const std::string& mime_type, int uv_set) {
+void add_glb_material(nlohmann::json& gltf, nlohmann::json& views, size_t blob_offset, std::string& blob,
+                      const std::string& base_color, const std::string& mime_type, const MaterialTextures& material,
+                      int uv_set) {
   nlohmann::json pbr = {{"metallicFactor", 0.0}, {"roughnessFactor", 1.0}};
-  if (texture_size > 0) {
-    const size_t view = add_view(views, texture_offset, texture_size, 0);
-    gltf["images"] = {{{"bufferView", view}, {"mimeType", mime_type}}};
+  nlohmann::json out = {{"name", "tailor"}};
+  nlohmann::json images = nlohmann::json::array(), textures = nlohmann::json::array();
+  // One image, texture and view per map; returns the texture's reference.
+  auto add = [&](const std::string& bytes, const std::string& mime) {
+    const size_t view = add_view(views, blob_offset + blob.size(), bytes.size(), 0);
+    blob += bytes;
+    pad_to_4(blob, '\0');
+    images.push_back({{"bufferView", view}, {"mimeType", mime}});
+    textures.push_back({{"sampler", 0}, {"source", images.size() - 1}});
+    nlohmann::json ref = {{"index", textures.size() - 1}};
+    if (uv_set != 0) ref["texCoord"] = uv_set;
+    return ref;
+  };
+  if (!base_color.empty()) pbr["baseColorTexture"] = add(base_color, mime_type);
+  if (!material.normal_png.empty()) out["normalTexture"] = add(material.normal_png, "image/png");
+  if (!material.orm_png.empty()) {
+    const nlohmann::json ref = add(material.orm_png, "image/png");
+    if (material.orm_roughness_metallic) {
+      pbr["metallicRoughnessTexture"] = ref;
+      pbr["metallicFactor"] = 1.0;  // the B channel says how metallic (0 where no metallic map was given)
+    }
+    if (material.orm_occlusion) out["occlusionTexture"] = ref;  // glTF reads occlusion from R
+  }
+  if (!images.empty()) {
+    gltf["images"] = images;
     gltf["samplers"] = {
         {{"magFilter", kLinear}, {"minFilter", kLinearMipmapLinear}, {"wrapS", kRepeat}, {"wrapT", kRepeat}}};
-    gltf["textures"] = {{{"sampler", 0}, {"source", 0}}};
-    pbr["baseColorTexture"] = {{"index", 0}};
-    if (uv_set != 0) pbr["baseColorTexture"]["texCoord"] = uv_set;
+    gltf["textures"] = textures;
   }
-  gltf["materials"] = {{{"name", "tailor"}, {"pbrMetallicRoughness", pbr}}};
+  out["pbrMetallicRoughness"] = pbr;
+  gltf["materials"] = {out};
 }
 
 Status write_glb(const std::string& path, const ExportData& data, const ExportOptions& options) {
@@ -116,7 +138,8 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
     }
   }
 
-  // The BIN chunk's layout: positions, normals (optional), texcoords, indices, texture. Every block
+  // The BIN chunk's layout: positions, normals (optional), kept attributes, texcoords, indices,
+  // tangents (optional), images. Every block
   // is a multiple of 4 bytes long, so each starts 4-byte aligned.
   const bool normals = !data.normals.empty();
   size_t bin_size = 0;
@@ -156,6 +179,7 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
     attributes["TEXCOORD_" + std::to_string(data.uv_set)] = accessors.size();
     accessors.push_back({{"bufferView", view}, {"componentType", kFloat}, {"count", vertex_count}, {"type", "VEC2"}});
   }
+  const bool tangents = !data.tangents.empty();
   size_t indices_accessor = 0;
   {
     const size_t view = add_view(views, bin_size, 4 * index_count, kElementArrayBuffer);
@@ -163,6 +187,12 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
     indices_accessor = accessors.size();
     accessors.push_back(
         {{"bufferView", view}, {"componentType", kUnsignedInt}, {"count", index_count}, {"type", "SCALAR"}});
+  }
+  if (tangents) {  // per split vertex, after the indices (written straight from data.tangents)
+    const size_t view = add_view(views, bin_size, 16 * vertex_count, kArrayBuffer);
+    bin_size += 16 * vertex_count;
+    attributes["TANGENT"] = accessors.size();
+    accessors.push_back({{"bufferView", view}, {"componentType", kFloat}, {"count", vertex_count}, {"type", "VEC4"}});
   }
 
   nlohmann::json node = {{"mesh", 0}, {"name", "tailor"}};
@@ -176,17 +206,12 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
        {{{"primitives",
           {{{"attributes", attributes}, {"indices", indices_accessor}, {"material", 0}, {"mode", kTriangles}}}}}}},
   };
-  size_t texture_padding = 0;
-  if (!texture_bytes.empty()) {
-    if (texture_bytes.size() > std::numeric_limits<uint32_t>::max() - bin_size)
-      return Status::error(ErrorCode::kLimit, path, "texture too large for a .glb buffer");
-  }
-  add_glb_material(gltf, views, bin_size, texture_bytes.size(), mime_type, data.uv_set);
-  if (!texture_bytes.empty()) {
-    bin_size += texture_bytes.size();
-    texture_padding = (4 - bin_size % 4) % 4;
-    bin_size += texture_padding;
-  }
+  std::string images;  // the material's images, after the indices
+  add_glb_material(gltf, views, bin_size, images, texture_bytes, mime_type, options.material, data.uv_set);
+  texture_bytes = {};
+  if (images.size() > std::numeric_limits<uint32_t>::max() - bin_size)
+    return Status::error(ErrorCode::kLimit, path, "texture too large for a .glb buffer");
+  bin_size += images.size();
   gltf["accessors"] = accessors;
   gltf["bufferViews"] = views;
   gltf["buffers"] = {{{"byteLength", bin_size}}};
@@ -239,9 +264,8 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
     out[1] = -uvs[2 * s + 1];
   }));
   TAILOR_RETURN_IF_ERROR(file.write(bytes_of(split.indices.data(), index_count)));
-  TAILOR_RETURN_IF_ERROR(file.write(texture_bytes));
-  static constexpr char kZeros[4] = {0, 0, 0, 0};
-  TAILOR_RETURN_IF_ERROR(file.write({kZeros, texture_padding}));
+  if (tangents) TAILOR_RETURN_IF_ERROR(file.write(bytes_of(data.tangents.data(), data.tangents.size())));
+  TAILOR_RETURN_IF_ERROR(file.write(images));
   return file.commit();
 }
 

@@ -93,6 +93,7 @@ Arrays gather(const ExportData& data) {
     for (size_t s = 0; s < nv; ++s)
       std::memcpy(&out.values[k * s], &source.values[k * split.xref[s]], k * sizeof(float));
   }
+  if (!data.tangents.empty()) a.kept.push_back(CornerAttribute{"TANGENT", 4, data.tangents});  // per split vertex
   a.uv_name = "TEXCOORD_" + std::to_string(data.uv_set);
   a.indices = split.indices;
   return a;
@@ -302,7 +303,9 @@ Status draco_primitive(const std::string& path, const Arrays& a, std::string& bi
   ids["POSITION"] = add(draco::GeometryAttribute::POSITION, a.positions, 3);
   if (!a.normals.empty()) ids["NORMAL"] = add(draco::GeometryAttribute::NORMAL, a.normals, 3);
   for (const CornerAttribute& k : a.kept)
-    ids[k.name] = add(k.name == "COLOR_0" ? draco::GeometryAttribute::COLOR : draco::GeometryAttribute::TEX_COORD,
+    ids[k.name] = add(k.name == "COLOR_0"   ? draco::GeometryAttribute::COLOR
+                      : k.name == "TANGENT" ? draco::GeometryAttribute::GENERIC  // not quantized: stays unit length
+                                            : draco::GeometryAttribute::TEX_COORD,
                       k.values, k.components);
   ids[a.uv_name] = add(draco::GeometryAttribute::TEX_COORD, a.uvs, 2);
   draco::Encoder encoder;
@@ -452,9 +455,10 @@ Status write_glb_compressed(const std::string& path, const ExportData& data, con
       {"extensionsUsed", used},
       {"extensionsRequired", used},
   };
-  add_glb_material(gltf, views, bin.size(), texture_bytes.size(), mime_type, data.uv_set);
-  bin += texture_bytes;
   pad_to_4(bin);
+  std::string images;
+  add_glb_material(gltf, views, bin.size(), images, texture_bytes, mime_type, options.material, data.uv_set);
+  bin += images;
   if (buffers.empty()) buffers.push_back(nullptr);
   buffers[0] = {{"byteLength", bin.size()}};
   gltf["buffers"] = buffers;

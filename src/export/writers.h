@@ -32,7 +32,15 @@ struct ExportData {
   //! When the mesh has kept attributes: its copy with vertices split where corners of one vertex
   //! carry different values (mesh points here).
   Mesh attribute_split;
+  //! #S by 4: unit tangent xyz and handedness w per SPLIT vertex (tangent_frames.cpp); empty unless
+  //! the material has a normal map and the mesh has normals.
+  std::vector<float> tangents;
 };
+
+//! Per-vertex tangents for the split mesh (ExportData::tangents), from its UVs (split.uvs, t up)
+//! and the unit normals per source vertex.
+void compute_tangents(const Mesh& mesh, const SplitMesh& split, std::span<const float> normals,
+                      std::vector<float>& tangents);
 
 //! A texture file's bytes and MIME type ("image/png" or "image/jpeg", from the magic bytes).
 //! Fails with kIo (unreadable) or kInvalidImage (neither PNG nor JPEG).
@@ -44,11 +52,13 @@ void append_float(std::string& out, float value);
 //! Path of `target` relative to the folder `base_dir` (generic separators), or absolute when none exists.
 std::string relative_path(const std::string& target, const std::filesystem::path& base_dir);
 
-//! The material every .glb gets (named "tailor", not metallic, fully rough) and, when
-//! texture_size > 0, the image (a new buffer view of buffer 0 at texture_offset), a REPEAT
-//! sampler and the texture as its base colour, read through TEXCOORD_<uv_set>.
-void add_glb_material(nlohmann::json& gltf, nlohmann::json& views, size_t texture_offset, size_t texture_size,
-                      const std::string& mime_type, int uv_set);
+//! The material every .glb gets (named "tailor", not metallic, fully rough) and its images: the
+//! base colour `base_color` (PNG/JPEG bytes of type mime_type, may be empty) and the maps of
+//! `material`, appended to `blob` (each 4-byte aligned), which the caller places at byte
+//! blob_offset of buffer 0; a REPEAT sampler; textures read through TEXCOORD_<uv_set>.
+void add_glb_material(nlohmann::json& gltf, nlohmann::json& views, size_t blob_offset, std::string& blob,
+                      const std::string& base_color, const std::string& mime_type, const MaterialTextures& material,
+                      int uv_set);
 
 Status write_glb(const std::string& path, const ExportData& data, const ExportOptions& options);
 //! .glb with options.compression (quantize, meshopt or draco): the arrays are built in memory.

@@ -336,6 +336,13 @@ Status encode_png(const std::string& path, int width, int height, int channels, 
 }  // namespace
 
 Status write_png16(const std::string& path, const Image16& image) {
+  std::string encoded;
+  TAILOR_RETURN_IF_ERROR(encode_png16(image, encoded).with_file(path));
+  return internal::write_file_atomic(path, std::span<const char>(encoded.data(), encoded.size()));
+}
+
+Status encode_png16(const Image16& image, std::string& encoded) {
+  const std::string path;
   if (image.bits != 8 && image.bits != 16)
     return Status::error(ErrorCode::kInvalidImage, path, "bit depth must be 8 or 16",
                          "got " + std::to_string(image.bits));
@@ -347,8 +354,7 @@ Status write_png16(const std::string& path, const Image16& image) {
   for (uint16_t v : image.pixels)
     if (v > limit) return Status::error(ErrorCode::kInvalidImage, path, "8-bit image with a sample above 255");
   const size_t row = static_cast<size_t>(image.width) * image.channels;
-  std::string encoded;
-  TAILOR_RETURN_IF_ERROR(encode_png(
+  return encode_png(
       path, image.width, image.height, image.channels, image.bits,
       [&](int y, unsigned char* out) {
         const uint16_t* s = &image.pixels[row * y];
@@ -361,8 +367,7 @@ Status write_png16(const std::string& path, const Image16& image) {
           }
         }
       },
-      encoded));
-  return internal::write_file_atomic(path, std::span<const char>(encoded.data(), encoded.size()));
+      encoded);
 }
 
 Status write_png(const std::string& path, const Image& image) {

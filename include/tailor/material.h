@@ -1,0 +1,45 @@
+// tailor: a PBR material's maps (a folder or a JSON naming them) turned into the glTF material of a
+// .glb (export.h MaterialTextures): base colour embedded as is, the normal map in glTF's (GL)
+// convention, roughness and metallic packed as glTF wants (G and B), occlusion in R.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "tailor/api.h"
+#include "tailor/export.h"
+#include "tailor/image.h"
+#include "tailor/status.h"
+
+namespace tailor {
+
+//! The role of a map, from its file name's suffix (material_role_from_name).
+enum class MaterialRole { kNone, kColor, kNormal, kRoughness, kMetallic, kOcclusion, kHeight };
+
+//! The role a file's name claims: its stem (case-insensitive) ends with a known word after _ - . or
+//! space (or is that word): color/colour/basecolor/base_color/albedo/diffuse, normal/nor/nrm (with
+//! _gl/_dx: normal_dx sets *directx), roughness/rough, metallic/metalness/metal, ao/occlusion/
+//! ambientocclusion, height/disp/displacement/bump. kNone for any other name.
+TAILOR_API MaterialRole material_role_from_name(const std::string& file_name, bool* directx = nullptr);
+
+//! A material read by load_material.
+struct MaterialMaps {
+  std::string color;  //!< the base colour map's path (embedded as is), or empty
+  int width = 0;      //!< the texture size, i.e. the UV lattice: the colour map's (else the first map's)
+  int height = 0;
+  MaterialTextures textures;       //!< the other maps, encoded for the .glb
+  std::vector<std::string> files;  //!< every map read, "role: path", for reports
+  std::vector<std::string> notes;  //!< one-line warnings (height map not embedded, ...)
+};
+
+//! Reads a material: a folder (its .png/.jpg/.jpeg files with a recognised suffix; others ignored) or
+//! a JSON file, either {"color": "a.png", "normal": "b.png", ..., "normal_convention": "gl"} or the
+//! material.json of `tailor tile --set` ({"maps": [{"file": ..., "normal": true}, ...]}: roles from
+//! "role"/"type" or the file names). Paths are relative to the JSON's folder. A DX normal map
+//! (normal_convention "dx" or a _dx/_directx suffix) has its green channel flipped. 16-bit maps
+//! stay 16-bit. Fails (kInvalidArgument, one line naming the file) when no map is recognised, two
+//! files claim one role, maps differ in size; kIo / kInvalidImage for unreadable files.
+TAILOR_API Status load_material(const std::string& dir_or_json, MaterialMaps& out,
+                                const ImageLoadOptions& options = {});
+
+}  // namespace tailor
