@@ -18,6 +18,7 @@
 #include "tailor/image_ops.h"
 #include "tailor/io.h"
 #include "tailor/mapping.h"
+#include "tailor/material.h"
 #include "tailor/mesh.h"
 #include "tailor/metrics.h"
 #include "tailor/option_doc.h"

@@ -1,0 +1,257 @@
+// tailor map --material (material.h): a PBR material folder made here from real photos, mapped on
+// spot; the .glb's material, packing, tangents and validity are read back from the file.
+#include "tailor/material.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "support/fixtures.h"
+#include "tailor/image.h"
+
+namespace tailor {
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+const std::string kTextures = std::string(TAILOR_TEST_DATA) + "/textures/";
+
+Image grey_of(const Image& rgb) {
+  Image g{rgb.width, rgb.height, 1, {}};
+  g.pixels.resize(size_t(rgb.width) * rgb.height);
+  for (size_t i = 0; i < g.pixels.size(); ++i) {
+    const uint8_t* p = &rgb.pixels[size_t(rgb.channels) * i];
+    g.pixels[i] = rgb.channels >= 3 ? uint8_t((299 * p[0] + 587 * p[1] + 114 * p[2] + 500) / 1000) : p[0];
+  }
+  return g;
+}
+
+// A tangent-space normal map (GL convention) from a height map's gradient, wrapping at the borders.
+Image normals_of(const Image& height, float strength) {
+  Image n{height.width, height.height, 3, {}};
+  n.pixels.resize(3 * size_t(height.width) * height.height);
+  const int w = height.width, h = height.height;
+  auto at = [&](int x, int y) { return height.pixels[size_t((y + h) % h) * w + size_t((x + w) % w)] / 255.f; };
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const float dx = (at(x + 1, y) - at(x - 1, y)) * strength, dy = (at(x, y - 1) - at(x, y + 1)) * strength;
+      const float l = std::sqrt(dx * dx + dy * dy + 1);
+      const float v[3] = {-dx / l, -dy / l, 1 / l};
+      for (int c = 0; c < 3; ++c)
+        n.pixels[3 * (size_t(y) * w + x) + c] = uint8_t(std::lround((v[c] * 0.5f + 0.5f) * 255));
+    }
+  return n;
+}
+
+struct Glb {
+  Json json;
+  std::string bin;
+};
+
+Glb read_glb(const std::string& file) {
+  const std::string bytes = test::read_all(file);
+  Glb g;
+  if (bytes.size() < 28) return g;
+  uint32_t json_size = 0, bin_size = 0;
+  std::memcpy(&json_size, bytes.data() + 12, 4);
+  g.json = Json::parse(bytes.substr(20, json_size));
+  std::memcpy(&bin_size, bytes.data() + 20 + json_size, 4);
+  g.bin = bytes.substr(28 + json_size, bin_size);
+  return g;
+}
+
+// The image a texture reference points at, decoded through a file.
+Image16 texture_image(const Glb& g, const Json& ref, const std::string& scratch) {
+  const Json& image = g.json["images"][ref["index"].get<size_t>()];
+  const Json& view = g.json["bufferViews"][image["bufferView"].get<size_t>()];
+  std::ofstream(scratch, std::ios::binary)
+      << g.bin.substr(view["byteOffset"].get<size_t>(), view["byteLength"].get<size_t>());
+  Image16 out;
+  EXPECT_TRUE(load_image16(scratch, out).is_ok());
+  return out;
+}
+
+std::vector<float> float_accessor(const Glb& g, size_t index, size_t components) {
+  const Json& a = g.json["accessors"][index];
+  const Json& view = g.json["bufferViews"][a["bufferView"].get<size_t>()];
+  std::vector<float> out(a["count"].get<size_t>() * components);
+  std::memcpy(out.data(), g.bin.data() + view["byteOffset"].get<size_t>(), out.size() * 4);
+  return out;
+}
+
+void expect_valid_gltf(const std::string& file) {
+  std::string out;
+  if (test::run_command("command -v node", out) != 0) GTEST_SKIP() << "node not installed";
+  const int rc = test::run_command(
+      std::string("node ") + TAILOR_SOURCE_DIR + "/tests/tools/validate_gltf.mjs --strict '" + file + "'", out);
+  EXPECT_EQ(rc, 0) << out;
+}
+
+class MaterialTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = test::empty_temp_dir("material");
+    ASSERT_TRUE(load_image(kTextures + "vistex-bark11-128.png", color_).is_ok());
+    grey_ = grey_of(color_);
+    metal_ = grey_;
+    for (uint8_t& v : metal_.pixels) v = v > 128 ? 255 : 0;  // metal where bright
+    ASSERT_TRUE(write_png(dir_ + "/bark_Color.png", color_).is_ok());
+    ASSERT_TRUE(write_png(dir_ + "/bark_normal-GL.png", normals_of(grey_, 4)).is_ok());
+    ASSERT_TRUE(write_png(dir_ + "/bark_roughness.png", grey_).is_ok());
+    ASSERT_TRUE(write_png(dir_ + "/bark metalness.png", metal_).is_ok());
+    ASSERT_TRUE(write_png(dir_ + "/bark.height.png", grey_).is_ok());
+    std::ofstream(dir_ + "/notes.txt") << "not a map\n";
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  int map(const std::string& material, const std::string& out, const std::string& extra, std::string& text) {
+    return test::run_command(std::string(TAILOR_BINARY) + " map " + TAILOR_SOURCE_DIR +
+                                 "/examples/spot.obj --material '" + material + "' -o '" + out + "' " + extra,
+                             text);
+  }
+
+  std::string dir_;
+  Image color_, grey_, metal_;
+};
+
+TEST(MaterialRoles, SuffixesAreRecognised) {
+  bool dx = false;
+  EXPECT_EQ(material_role_from_name("Bricks_BaseColor.png"), MaterialRole::kColor);
+  EXPECT_EQ(material_role_from_name("rock-albedo.jpg"), MaterialRole::kColor);
+  EXPECT_EQ(material_role_from_name("rock_diff.png"), MaterialRole::kNone);
+  EXPECT_EQ(material_role_from_name("wood_nrm.png"), MaterialRole::kNormal);
+  EXPECT_EQ(material_role_from_name("wood_Normal_DX.png", &dx), MaterialRole::kNormal);
+  EXPECT_TRUE(dx);
+  EXPECT_EQ(material_role_from_name("wood_NormalGL.png", &dx), MaterialRole::kNormal);
+  EXPECT_FALSE(dx);
+  EXPECT_EQ(material_role_from_name("wood_rough.png"), MaterialRole::kRoughness);
+  EXPECT_EQ(material_role_from_name("metal.png"), MaterialRole::kMetallic);
+  EXPECT_EQ(material_role_from_name("floor_AO.png"), MaterialRole::kOcclusion);
+  EXPECT_EQ(material_role_from_name("floor_disp.png"), MaterialRole::kHeight);
+  EXPECT_EQ(material_role_from_name("tornado.png"), MaterialRole::kNone);  // "ao" only as a whole word
+  EXPECT_EQ(material_role_from_name("windsor.png"), MaterialRole::kNone);
+}
+
+TEST_F(MaterialTest, GlbHasThePackedMaterialAndTangents) {
+  const std::string out = dir_ + "/spot.glb";
+  std::string text;
+  ASSERT_EQ(map(dir_, out, "", text), 0) << text;
+  EXPECT_NE(text.find("height map not embedded"), std::string::npos) << text;
+  const Glb g = read_glb(out);
+  const Json& m = g.json["materials"][0];
+  const Json& pbr = m["pbrMetallicRoughness"];
+  ASSERT_TRUE(pbr.contains("baseColorTexture") && pbr.contains("metallicRoughnessTexture") &&
+              m.contains("normalTexture"))
+      << m.dump();
+  EXPECT_FALSE(m.contains("occlusionTexture"));  // no AO map given
+
+  // metallicRoughness: G = roughness, B = metallic, same size as the colour map.
+  const Image16 orm = texture_image(g, pbr["metallicRoughnessTexture"], dir_ + "/orm.png");
+  ASSERT_EQ(orm.width, color_.width);
+  ASSERT_EQ(orm.channels, 3);
+  size_t metal_pixels = 0;
+  for (size_t i = 0; i < grey_.pixels.size(); i += 37) {
+    EXPECT_EQ(orm.pixels[3 * i + 1], grey_.pixels[i]) << i;
+    EXPECT_EQ(orm.pixels[3 * i + 2], metal_.pixels[i]) << i;
+    metal_pixels += metal_.pixels[i] != 0;
+  }
+  EXPECT_GT(metal_pixels, 0u);
+  // The base colour is the file itself.
+  const Image16 base = texture_image(g, pbr["baseColorTexture"], dir_ + "/base.png");
+  EXPECT_EQ(to_image8(base).pixels, color_.pixels);
+
+  // TANGENT: unit xyz, w = +-1, orthogonal to the normal.
+  const Json& attributes = g.json["meshes"][0]["primitives"][0]["attributes"];
+  ASSERT_TRUE(attributes.contains("TANGENT"));
+  const std::vector<float> t = float_accessor(g, attributes["TANGENT"].get<size_t>(), 4);
+  const std::vector<float> n = float_accessor(g, attributes["NORMAL"].get<size_t>(), 3);
+  ASSERT_EQ(t.size() / 4, n.size() / 3);
+  for (size_t v = 0; v < n.size() / 3; ++v) {
+    const float* tv = &t[4 * v];
+    const float* nv = &n[3 * v];
+    ASSERT_NEAR(std::sqrt(tv[0] * tv[0] + tv[1] * tv[1] + tv[2] * tv[2]), 1.0, 1e-3) << v;
+    ASSERT_EQ(std::abs(tv[3]), 1.0f) << v;
+    ASSERT_NEAR(tv[0] * nv[0] + tv[1] * nv[1] + tv[2] * nv[2], 0.0, 1e-3) << v;
+  }
+  expect_valid_gltf(out);
+}
+
+TEST_F(MaterialTest, CompressedFilesKeepTangentsAndValidate) {
+  for (const char* mode : {"quantize", "meshopt", "draco"}) {
+    SCOPED_TRACE(mode);
+    const std::string out = dir_ + "/spot_" + mode + ".glb";
+    std::string text;
+    ASSERT_EQ(map(dir_, out, std::string("--quiet --compress ") + mode, text), 0) << text;
+    const Glb g = read_glb(out);
+    const Json& primitive = g.json["meshes"][0]["primitives"][0];
+    const bool draco = primitive.contains("extensions");
+    EXPECT_TRUE(primitive["attributes"].contains("TANGENT"));
+    if (draco) {
+      EXPECT_TRUE(primitive["extensions"]["KHR_draco_mesh_compression"]["attributes"].contains("TANGENT"));
+    }
+    expect_valid_gltf(out);
+  }
+}
+
+TEST_F(MaterialTest, JsonAndDirectXConvention) {
+  // {"color": ..., "normal": ..., "normal_convention": "dx"}: the embedded green is flipped.
+  std::ofstream(dir_ + "/m.json") << R"({"color": "bark_Color.png", "normal": "bark_normal-GL.png",
+                                          "occlusion": "bark_roughness.png", "normal_convention": "dx"})";
+  MaterialMaps gl, dx;
+  ASSERT_TRUE(load_material(dir_, gl).is_ok());
+  ASSERT_TRUE(load_material(dir_ + "/m.json", dx).is_ok());
+  EXPECT_EQ(gl.color, dir_ + "/bark_Color.png");
+  EXPECT_EQ(dx.width, 128);
+  std::ofstream(dir_ + "/gl.png", std::ios::binary) << gl.textures.normal_png;
+  std::ofstream(dir_ + "/dx.png", std::ios::binary) << dx.textures.normal_png;
+  Image a, b;
+  ASSERT_TRUE(load_image(dir_ + "/gl.png", a).is_ok());
+  ASSERT_TRUE(load_image(dir_ + "/dx.png", b).is_ok());
+  for (size_t i = 0; i < a.pixels.size(); i += 3) {
+    ASSERT_EQ(a.pixels[i], b.pixels[i]);
+    ASSERT_EQ(a.pixels[i + 1], 255 - b.pixels[i + 1]);
+  }
+  // Occlusion alone: its own packed image, read from R, no metallicRoughness texture.
+  EXPECT_TRUE(dx.textures.orm_occlusion);
+  EXPECT_FALSE(dx.textures.orm_roughness_metallic);
+}
+
+TEST_F(MaterialTest, BadMaterialsFailWithOneLineAndNoOutput) {
+  const std::string out = dir_ + "/bad.glb";
+  auto expect_error = [&](const std::string& material, const std::string& what, int code = 2) {
+    std::string err, text;
+    const int rc = test::run_command(std::string(TAILOR_BINARY) + " map " + TAILOR_SOURCE_DIR +
+                                         "/examples/spot.obj --material '" + material + "' -o '" + out + "'",
+                                     text, &err);
+    EXPECT_EQ(rc, code) << err;  // 2: the material as given is wrong; 1: a file is unreadable
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+    EXPECT_NE(err.find(what), std::string::npos) << err;
+    EXPECT_FALSE(fs::exists(out));
+  };
+  // Maps of different sizes.
+  Image big;
+  ASSERT_TRUE(load_image(kTextures + "brick-gray-512.png", big).is_ok());
+  ASSERT_TRUE(write_png(dir_ + "/bark_ao.png", big).is_ok());
+  expect_error(dir_, "share one size");
+  fs::remove(dir_ + "/bark_ao.png");
+  // Two files for one role.
+  ASSERT_TRUE(write_png(dir_ + "/bark_albedo.png", color_).is_ok());
+  expect_error(dir_, "two files claim the color map");
+  // A folder with no recognised map.
+  const std::string empty = dir_ + "/plain";
+  fs::create_directory(empty);
+  ASSERT_TRUE(write_png(empty + "/photo.png", color_).is_ok());
+  expect_error(empty, "no map recognised");
+  // An unreadable map.
+  std::ofstream(empty + "/x_normal.png") << "not a png";
+  expect_error(empty, "x_normal.png", 1);
+}
+
+}  // namespace
+}  // namespace tailor
