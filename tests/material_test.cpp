@@ -179,6 +179,37 @@ TEST_F(MaterialTest, GlbHasThePackedMaterialAndTangents) {
     ASSERT_EQ(std::abs(tv[3]), 1.0f) << v;
     ASSERT_NEAR(tv[0] * nv[0] + tv[1] * nv[1] + tv[2] * nv[2], 0.0, 1e-3) << v;
   }
+  // The frame follows the UVs: T along +s and B = w (N x T) along up the image (glTF: -v) on
+  // nearly every face (a sign error would flip them all).
+  const Json& primitive = g.json["meshes"][0]["primitives"][0];
+  const std::vector<float> p = float_accessor(g, attributes["POSITION"].get<size_t>(), 3);
+  const std::vector<float> uv = float_accessor(g, attributes["TEXCOORD_0"].get<size_t>(), 2);
+  const Json& ia = g.json["accessors"][primitive["indices"].get<size_t>()];
+  std::vector<uint32_t> idx(ia["count"].get<size_t>());
+  std::memcpy(idx.data(),
+              g.bin.data() + g.json["bufferViews"][ia["bufferView"].get<size_t>()]["byteOffset"].get<size_t>(),
+              idx.size() * 4);
+  size_t agree_t = 0, agree_b = 0, faces = 0;
+  for (size_t f = 0; f < idx.size() / 3; ++f) {
+    const uint32_t a = idx[3 * f], b = idx[3 * f + 1], c = idx[3 * f + 2];
+    double e1[3], e2[3];
+    for (int k = 0; k < 3; ++k) e1[k] = p[3 * b + k] - p[3 * a + k], e2[k] = p[3 * c + k] - p[3 * a + k];
+    const double s1 = uv[2 * b] - uv[2 * a], s2 = uv[2 * c] - uv[2 * a];
+    const double t1 = -(uv[2 * b + 1] - uv[2 * a + 1]), t2 = -(uv[2 * c + 1] - uv[2 * a + 1]);  // up the image
+    const double r = s1 * t2 - s2 * t1;
+    if (std::abs(r) < 1e-12) continue;
+    double dps[3], dpt[3];
+    for (int k = 0; k < 3; ++k) dps[k] = (e1[k] * t2 - e2[k] * t1) / r, dpt[k] = (e2[k] * s1 - e1[k] * s2) / r;
+    const float* tv = &t[4 * a];
+    const float* nv = &n[3 * a];
+    const double bv[3] = {tv[3] * (nv[1] * tv[2] - nv[2] * tv[1]), tv[3] * (nv[2] * tv[0] - nv[0] * tv[2]),
+                          tv[3] * (nv[0] * tv[1] - nv[1] * tv[0])};
+    agree_t += dps[0] * tv[0] + dps[1] * tv[1] + dps[2] * tv[2] > 0;
+    agree_b += dpt[0] * bv[0] + dpt[1] * bv[1] + dpt[2] * bv[2] > 0;
+    ++faces;
+  }
+  EXPECT_GT(agree_t, faces * 95 / 100) << faces;
+  EXPECT_GT(agree_b, faces * 95 / 100) << faces;
   expect_valid_gltf(out);
 }
 

@@ -14,7 +14,8 @@
 # 6. Ctrl-C (SIGINT) stops the server with exit status 0;
 # 7. the browser test with tile variants from `tailor tile --variants 3`;
 # 8. the seams view of a mapped horse (128 px texture): red and green seam lines, eval's figures;
-# 9. `tailor map --compress meshopt` and `draco` outputs load in the browser (eval's figures too).
+# 9. `tailor map --compress meshopt` and `draco` outputs load in the browser (eval's figures too);
+# 10. a `tailor map --material` output: its normal map and tangents change the texture view.
 # Never skips: a missing Chromium or node_modules is a failure.
 set -euo pipefail
 
@@ -152,5 +153,15 @@ for method in meshopt draco; do
     || fail "browser test of the --compress $method .glb failed"
   stop_server
 done
+
+# --- 10. a PBR material: colour + normal map (tangents in the file) -----------------------------
+mkdir -p "$tmp/material"
+cp tests/data/textures/vistex-bark11-128.png "$tmp/material/bark_color.png"
+cp tests/data/textures/vistex-fabric02-128.png "$tmp/material/bark_normal.png"  # any RGB bumps do
+timeout 60 "$tailor" map examples/spot.obj --material "$tmp/material" -o "$tmp/spot_material.glb" -q \
+  || fail "tailor map --material failed"
+start_server "$tmp/spot_material.glb"
+timeout 120 node web/test/viewer_browser_test.mjs "$url" --normal-map || fail "browser test of the material .glb failed"
+stop_server
 
 echo "PASS: tailor render and tailor view (browser) work"

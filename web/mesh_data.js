@@ -327,7 +327,7 @@ function floatArray(attribute) {
 
 /**
  * Builds the viewer geometry from an (indexed or not) BufferGeometry with position, optional
- * normal and uv; textureWidth, textureHeight: the embedded texture's size in pixels (eval's default
+ * normal, uv and tangent; textureWidth, textureHeight: the embedded texture's size in pixels (eval's default
  * 512 without one), for the seam classes. Returns { geometry, faces, patches, seamEdges, hasUv,
  * seams } with seams = seamClasses()'s sums (no per-edge array).
  */
@@ -342,6 +342,8 @@ export function buildSurface(source, { textureWidth = kDefaultTextureSize, textu
   if (!source.getAttribute('normal')) source.computeVertexNormals();
   const normal = floatArray(source.getAttribute('normal'));
   const uv = floatArray(source.getAttribute('uv'));
+  // The file's tangents (`tailor map --material` with a normal map): the shader's normal mapping.
+  const tangent = floatArray(source.getAttribute('tangent'));
 
   const faces = index.length / 3;
   const { seam, patch, count } = edgesAndPatches(index);
@@ -352,6 +354,7 @@ export function buildSurface(source, { textureWidth = kDefaultTextureSize, textu
   const outPos = new Float32Array(3 * n);
   const outNor = new Float32Array(3 * n);
   const outUv = new Float32Array(2 * n);
+  const outTangent = tangent ? new Float32Array(4 * n) : null;
   const outBary = new Uint8Array(3 * n);
   const outSeam = new Uint8Array(3 * n);
   const outSeamClass = new Uint8Array(3 * n);
@@ -376,6 +379,7 @@ export function buildSurface(source, { textureWidth = kDefaultTextureSize, textu
       outNor[3 * corner] = normal[3 * v];
       outNor[3 * corner + 1] = normal[3 * v + 1];
       outNor[3 * corner + 2] = normal[3 * v + 2];
+      if (outTangent) for (let c = 0; c < 4; ++c) outTangent[4 * corner + c] = tangent[4 * v + c];
       if (uv) {
         outUv[2 * corner] = uv[2 * v];
         outUv[2 * corner + 1] = uv[2 * v + 1];
@@ -396,6 +400,7 @@ export function buildSurface(source, { textureWidth = kDefaultTextureSize, textu
   geometry.setAttribute('position', new THREE.BufferAttribute(outPos, 3));
   geometry.setAttribute('normal', new THREE.BufferAttribute(outNor, 3));
   geometry.setAttribute('uv', new THREE.BufferAttribute(outUv, 2));
+  if (outTangent) geometry.setAttribute('fileTangent', new THREE.BufferAttribute(outTangent, 4));
   geometry.setAttribute('bary', new THREE.BufferAttribute(outBary, 3, true));
   geometry.setAttribute('seam', new THREE.BufferAttribute(outSeam, 3, true));
   geometry.setAttribute('seamClass', new THREE.BufferAttribute(outSeamClass, 3));

@@ -19,6 +19,7 @@ const glslColor = (c) => `vec3(${c.map((x) => x.toFixed(3)).join(', ')})`;
 // What the vertex shader hands to the fragment shader (both must declare the same).
 const varyings = /* glsl */ `
 varying vec3 vNormal;
+varying vec4 vTangent;
 varying vec2 vUv;
 varying vec3 vBary;
 varying vec3 vSeam;
@@ -33,9 +34,11 @@ attribute vec3 seam;
 attribute vec3 seamClass;
 attribute vec3 patchColor;
 attribute float stretch;
+attribute vec4 fileTangent;  // the file's TANGENT (xyz, handedness w); zero when it has none
 ${varyings}
 void main() {
   vNormal = normalize(normalMatrix * normal);
+  vTangent = vec4(mat3(modelViewMatrix) * fileTangent.xyz, fileTangent.w);
   vUv = uv;
   vBary = bary;
   vSeam = seam;
@@ -64,6 +67,8 @@ const fragmentShader = /* glsl */ `
 uniform int mode;
 uniform sampler2D map;
 uniform bool hasMap;
+uniform sampler2D normalMap;
+uniform bool hasNormalMap;
 ${variantUniforms()}
 uniform int variantCount;
 uniform uint variantSeed;
@@ -119,12 +124,21 @@ vec3 seamFlags(float c) {
 
 void main() {
   vec3 n = normalize(vNormal);
+  float c = cos(uvRotation), s = sin(uvRotation);
+  vec2 uv = mat2(c, s, -s, c) * vUv * uvScale;
+  if (mode == 0 && hasNormalMap && dot(vTangent.xyz, vTangent.xyz) > 1e-8) {
+    // glTF normal map (GL convention): the file's tangent frame; the panel's rotation turns the
+    // texture, so the map's xy turn back with it.
+    vec3 t = normalize(vTangent.xyz - n * dot(n, vTangent.xyz));
+    vec3 b = cross(n, t) * (vTangent.w < 0.0 ? -1.0 : 1.0);
+    vec3 m = texture2D(normalMap, uv).xyz * 2.0 - 1.0;
+    m.xy = mat2(c, -s, s, c) * m.xy;
+    n = normalize(t * m.x + b * m.y + n * m.z);
+  }
   if (!gl_FrontFacing) n = -n;
   float diffuse = max(dot(n, normalize(vec3(-0.35, 0.55, 0.76))), 0.0);
   float light = 0.36 + 0.72 * diffuse;
 
-  float c = cos(uvRotation), s = sin(uvRotation);
-  vec2 uv = mat2(c, s, -s, c) * vUv * uvScale;
   vec3 base;
   if (mode == 0) {
     if (variantCount > 0) base = sampleVariant(uv);
@@ -158,6 +172,8 @@ export function createSurfaceMaterial() {
     mode: { value: 0 },
     map: { value: null },
     hasMap: { value: false },
+    normalMap: { value: null },
+    hasNormalMap: { value: false },
     variantCount: { value: 0 },
     variantSeed: { value: 1 },
     uvScale: { value: 1 },
@@ -179,6 +195,9 @@ export function updateSurfaceMaterial(material, state, textures) {
   const map = textures.variants.length > 0 ? textures.variants[0] : textures.map;
   u.map.value = map;
   u.hasMap.value = !!map;
+  // The file's normal map shades the texture view (its tiles match the embedded colour map's).
+  u.normalMap.value = textures.normalMap || textures.blank;
+  u.hasNormalMap.value = !!textures.normalMap && state.normalMapping !== false;
   const variants = state.useVariants ? textures.variants : [];
   u.variantCount.value = variants.length;
   for (let k = 0; k < kMaxVariants; ++k) {

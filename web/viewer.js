@@ -18,11 +18,12 @@ const state = {
   wireframe: false,
   seams: true,
   useVariants: true,
+  normalMapping: true,  // the file's normal map (`tailor map --material`), when it has one
   seed: 1,
   checkerSquares: 8,
   distortionRange: 2,
 };
-const textures = { map: null, variants: [], blank: null };
+const textures = { map: null, normalMap: null, variants: [], blank: null };
 const stats = {
   faces: 0, patches: 0, seamEdges: 0, loadSeconds: 0, analysisSeconds: 0,
   // Seam lengths of the welded mesh (mesh_data.js seamClasses) and eval's ratios from them.
@@ -133,6 +134,10 @@ async function load() {
   let hasUv = false;
   for (const mesh of meshes) {
     if (!textures.map && mesh.material && mesh.material.map) textures.map = prepareTexture(mesh.material.map);
+    // `tailor map --material`: the file's normal map, with the TANGENT that buildSurface keeps.
+    if (!textures.normalMap && mesh.material && mesh.material.normalMap && mesh.geometry.getAttribute('tangent')) {
+      textures.normalMap = prepareTexture(mesh.material.normalMap);
+    }
     // UVs are in repeats of the embedded texture: its size turns them into pixels for the seam
     // gaps, as `tailor eval` does (512 without one).
     const image = (mesh.material && mesh.material.map ? mesh.material.map : textures.map)?.image;
@@ -290,6 +295,9 @@ window.tailorViewer = {
   get state() { return { ...state }; },
   setView,
   pixelStats,
+  get hasNormalMap() { return !!textures.normalMap; },
+  /** Turns the file's normal map on or off (the test compares both pictures). */
+  setNormalMapping(on) { state.normalMapping = on; applyState(); },
 };
 
 bindPanel();

@@ -8,7 +8,7 @@
 //     with --expect-invisible green ones for invisible seams) and the seam legend;
 //   - with --eval FILE (the output of `tailor eval MODEL --json`): the viewer's visible seam share
 //     of edge length and invisible share of seam length agree with eval's figures.
-// Usage: node web/test/viewer_browser_test.mjs URL [--variants] [--expect-invisible] [--eval FILE]
+// Usage: node web/test/viewer_browser_test.mjs URL [--variants] [--expect-invisible] [--normal-map] [--eval FILE]
 //        [--screenshots DIR]
 // Exits 0 on success, 1 with a FAIL line otherwise.
 import { chromium } from 'playwright-core';
@@ -19,6 +19,7 @@ import path from 'node:path';
 const url = process.argv[2];
 const expectVariants = process.argv.includes('--variants');
 const expectInvisible = process.argv.includes('--expect-invisible');
+const expectNormalMap = process.argv.includes('--normal-map');
 const evalIndex = process.argv.indexOf('--eval');
 const evaluation = evalIndex > 0 ? JSON.parse(fs.readFileSync(process.argv[evalIndex + 1], 'utf8')) : null;
 // --screenshots DIR: also save a PNG of each view there (for looking at, not for judging).
@@ -91,6 +92,18 @@ try {
   if (shotDir) await page.screenshot({ path: path.join(shotDir, 'viewer_texture.png') });
   console.log(`texture view: ${texture.width}x${texture.height}, mean ${texture.mean.toFixed(1)}, variance ${texture.variance.toFixed(1)}`);
   if (!(texture.variance > kMinVariance)) fail(`the canvas looks blank (variance ${texture.variance.toFixed(1)})`);
+
+  if (expectNormalMap) {
+    // `tailor map --material`: the file's normal map and tangents shade the texture view.
+    if (!(await page.evaluate(() => window.tailorViewer.hasNormalMap))) fail('the file\'s normal map is not used');
+    const flat = await page.evaluate(() => { window.tailorViewer.setNormalMapping(false); return window.tailorViewer.pixelStats(); });
+    await page.evaluate(() => window.tailorViewer.setNormalMapping(true));
+    const change = signatureDistance(texture, flat);
+    console.log(`normal map: change when turned off ${change.toFixed(1)}`);
+    if (!(change > 1)) fail('turning the normal map off did not change the picture');
+  } else if (await page.evaluate(() => window.tailorViewer.hasNormalMap)) {
+    fail('a normal map is used for a file without one');
+  }
 
   const views = {};
   for (const view of ['patches', 'distortion', 'checker']) {
