@@ -253,6 +253,25 @@ TEST_F(MaterialTest, JsonAndDirectXConvention) {
   EXPECT_FALSE(dx.textures.orm_roughness_metallic);
 }
 
+TEST_F(MaterialTest, SixteenBitMapsStaySixteenBit) {
+  // A 16-bit roughness map (the grey widened with distinct low bits): the packed image is 16-bit
+  // and its G channel is the map itself; the 8-bit metallic map is widened (255 -> 65535).
+  Image16 rough = to_image16(grey_);
+  rough.bits = 16;
+  for (size_t i = 0; i < rough.pixels.size(); ++i) rough.pixels[i] = uint16_t(rough.pixels[i] * 257 + i % 200);
+  ASSERT_TRUE(write_png16(dir_ + "/bark_roughness.png", rough).is_ok());
+  MaterialMaps m;
+  ASSERT_TRUE(load_material(dir_, m).is_ok());
+  std::ofstream(dir_ + "/orm16.png", std::ios::binary) << m.textures.orm_png;
+  Image16 orm;
+  ASSERT_TRUE(load_image16(dir_ + "/orm16.png", orm).is_ok());
+  ASSERT_EQ(orm.bits, 16);
+  for (size_t i = 0; i < rough.pixels.size(); i += 17) {
+    ASSERT_EQ(orm.pixels[3 * i + 1], rough.pixels[i]) << i;
+    ASSERT_EQ(orm.pixels[3 * i + 2], metal_.pixels[i] * 257) << i;
+  }
+}
+
 TEST_F(MaterialTest, BadMaterialsFailWithOneLineAndNoOutput) {
   const std::string out = dir_ + "/bad.glb";
   auto expect_error = [&](const std::string& material, const std::string& what, int code = 2) {
