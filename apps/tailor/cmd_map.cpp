@@ -304,7 +304,7 @@ int run_map(const MapArgs& opt) {
       RenderOptions render_options;
       render_options.view = view;
       render_options.up = preview_up;
-      render_options.seam_texture_px = texture.empty() ? opt.texture_size : 0;
+      render_options.seam_texture_px = texture.empty() ? tex_w : 0;  // a material without colour: its maps' size
       render_options.seam_symmetry = mapping.symmetry;
       Image picture;
       if (Status s = render_preview(mesh, uv_repeats, atlas.patch, texture.empty() ? nullptr : &texture, render_options,
