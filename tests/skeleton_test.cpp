@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "support/fixtures.h"
@@ -160,6 +161,28 @@ TEST(Skeleton, SeveralOpenComponentsEachGetASkeleton) {
   EXPECT_EQ(skeleton.skipped_components, 0u);
   for (uint8_t done : skeleton.component_done) EXPECT_EQ(done, 1);
   for (double p : skeleton.points) ASSERT_TRUE(std::isfinite(p));
+}
+
+TEST(Skeleton, CliAxisSkeletonGivesTheSameFileForAnyThreadCount) {
+  const std::string mesh = test::mesh_path("spot.obj");
+  std::string out;
+  for (const char* threads : {"1", "2"}) {
+    const std::string glb = test::temp_path(std::string("spot_skeleton_") + threads + ".glb");
+    ASSERT_EQ(test::run_command(std::string(TAILOR_BINARY) + " map " + mesh + " -q --axis skeleton --threads " +
+                                    threads + " -o " + glb + " --stats " + glb + ".json",
+                                out),
+              0)
+        << out;
+  }
+  EXPECT_EQ(test::read_all(test::temp_path("spot_skeleton_1.glb")),
+            test::read_all(test::temp_path("spot_skeleton_2.glb")));
+  EXPECT_NE(test::read_all(test::temp_path("spot_skeleton_1.glb.json")).find("\"axis\": \"skeleton\""),
+            std::string::npos);
+  // A misspelt axis names the values it accepts.
+  EXPECT_NE(test::run_command(
+                std::string(TAILOR_BINARY) + " map " + mesh + " --axis skeletn -o " + test::temp_path("bad.glb"), out),
+            0);
+  EXPECT_NE(out.find("--axis must be pca, skeleton, x, y, z"), std::string::npos) << out;
 }
 
 }  // namespace
