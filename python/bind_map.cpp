@@ -24,7 +24,7 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// axis: "pca", "x", "y", "z", "auto" or three numbers; sets the orientation and returns the text the
+// axis: "pca", "skeleton", "x", "y", "z", "auto" or three numbers; sets the orientation and returns the text the
 // report shows (as `tailor map --axis` writes it).
 std::string set_axis(const py::object& axis, OrientationOptions& orientation, bool& automatic) {
   automatic = false;
@@ -38,6 +38,10 @@ std::string set_axis(const py::object& axis, OrientationOptions& orientation, bo
       orientation.axis = AxisSource::kPca;
       return text;
     }
+    if (text == "skeleton") {
+      orientation.axis = AxisSource::kSkeleton;
+      return text;
+    }
     orientation.axis = AxisSource::kUser;
     if (text == "x")
       orientation.user_axis = {1, 0, 0};
@@ -46,7 +50,7 @@ std::string set_axis(const py::object& axis, OrientationOptions& orientation, bo
     else if (text == "z")
       orientation.user_axis = {0, 0, 1};
     else
-      raise_error("--axis must be pca, x, y, z or three numbers X,Y,Z, got '" + text + "'");
+      raise_error("--axis must be pca, skeleton, x, y, z or three numbers X,Y,Z, got '" + text + "'");
     return text;
   }
   std::array<float, 3> v{};
@@ -55,10 +59,10 @@ std::string set_axis(const py::object& axis, OrientationOptions& orientation, bo
     if (values.size() != 3) throw py::cast_error();
     for (size_t i = 0; i < 3; ++i) v[i] = static_cast<float>(values[i]);
   } catch (const py::cast_error&) {
-    raise_error("--axis must be pca, x, y, z or three numbers X,Y,Z, got '" + sequence_text(axis) + "'");
+    raise_error("--axis must be pca, skeleton, x, y, z or three numbers X,Y,Z, got '" + sequence_text(axis) + "'");
   }
   if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
-    raise_error("--axis must be pca, x, y, z or three numbers X,Y,Z, got '" + sequence_text(axis) + "'");
+    raise_error("--axis must be pca, skeleton, x, y, z or three numbers X,Y,Z, got '" + sequence_text(axis) + "'");
   orientation.axis = AxisSource::kUser;
   orientation.user_axis = v;
   char text[64];

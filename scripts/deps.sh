@@ -12,9 +12,11 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-format python3 time
   pybind11-dev python3-dev python3-numpy python3-pytest
+  libcgal-dev
   chromium
 )
 # pybind11, Python's headers, numpy and pytest: the Python module and its tests (/usr/bin/python3).
+# libcgal-dev (header-only in Debian 12's CGAL 5.5, with GMP/MPFR and Boost headers): --axis skeleton.
 # clang + its fuzzer runtime are optional: the fuzz step skips cleanly without them.
 # Blender only on request (TAILOR_BLENDER=1, make deps-blender): the add-on's test skips without it.
 if [[ ${TAILOR_BLENDER:-0} == 1 ]]; then

@@ -32,6 +32,7 @@ Status usage_error(const std::string& what) { return Status::error(ErrorCode::kI
 // --axis as the user writes it: pca, x, y, z or X,Y,Z (the inverse of parse_axis).
 std::string axis_text(const OrientationOptions& o) {
   if (o.axis == AxisSource::kPca) return "pca";
+  if (o.axis == AxisSource::kSkeleton) return "skeleton";
   const std::array<float, 3>& a = o.user_axis;
   if (a == std::array<float, 3>{1, 0, 0}) return "x";
   if (a == std::array<float, 3>{0, 1, 0}) return "y";
@@ -76,6 +77,10 @@ Status parse_axis(const std::string& text, OrientationOptions& o) {
     o.axis = AxisSource::kPca;
     return Status::ok();
   }
+  if (text == "skeleton") {
+    o.axis = AxisSource::kSkeleton;
+    return Status::ok();
+  }
   o.axis = AxisSource::kUser;
   if (text == "x")
     o.user_axis = {1, 0, 0};
@@ -84,7 +89,7 @@ Status parse_axis(const std::string& text, OrientationOptions& o) {
   else if (text == "z")
     o.user_axis = {0, 0, 1};
   else if (!parse_vec3(text, o.user_axis))
-    return usage_error("--axis must be pca, x, y, z or three numbers X,Y,Z, got '" + text + "'");
+    return usage_error("--axis must be pca, skeleton, x, y, z or three numbers X,Y,Z, got '" + text + "'");
   return Status::ok();
 }
 

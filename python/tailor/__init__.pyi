@@ -59,7 +59,7 @@ def map(
     mesh: Mesh,
     texture_size: int = 512,
     scale: float = 800.0,
-    axis: Union[Literal["pca", "x", "y", "z", "auto"], Sequence[float]] = "pca",
+    axis: Union[Literal["pca", "skeleton", "x", "y", "z", "auto"], Sequence[float]] = "pca",
     seam_faces: Optional[npt.ArrayLike] = None,
     threads: int = 0,
     progress: Optional[_Progress] = None,

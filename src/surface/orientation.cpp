@@ -13,6 +13,7 @@
 #include <functional>
 #include <string>
 
+#include "surface/skeleton.h"
 #include "util/huge_pages.h"
 #include "util/parallel_chunks.h"
 
@@ -144,6 +145,22 @@ Status compute_orientation(const Mesh& mesh, const Topology& topology, const Ori
     }
   }
 
+  // === Skeleton: a per-face axis, the PCA axes kept as the fallbacks ===
+  const size_t threads = internal::parallel_threads(face_count, options.threads);
+  std::vector<float> face_axis;  // #F by 3; (0,0,0) where the face has no skeleton edge
+  if (options.axis == AxisSource::kSkeleton) {
+    const auto skeleton_start = std::chrono::steady_clock::now();
+    internal::CurveSkeleton skeleton;
+    if (Status s = internal::compute_curve_skeleton(mesh, topology, skeleton); !s) return s;
+    internal::skeleton_face_directions(mesh, topology, skeleton, {axis.x, axis.y, axis.z}, threads, face_axis);
+    frames.skeleton_edges = static_cast<uint32_t>(skeleton.edge_count());
+    frames.skeleton_closed_holes = skeleton.closed_holes;
+    for (size_t f = 0; f < face_count; ++f)
+      if (face_axis[3 * f] == 0.f && face_axis[3 * f + 1] == 0.f && face_axis[3 * f + 2] == 0.f)
+        ++frames.skeleton_pca_faces;
+    frames.skeleton_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - skeleton_start).count();
+  }
+
   // === Per-face normal, area, orientation ===
   // ~76 bytes per face of fresh memory: on large meshes, faulting it in 4 KiB pages costs more than
   // the arithmetic, so ask for huge pages first.
@@ -198,7 +215,9 @@ Status compute_orientation(const Mesh& mesh, const Topology& topology, const Ori
         if (!project(axis, n, degenerate_cos, o)) o = perpendicular(n);
       } else {
         n = mul(n, 1.0 / twice_area);
-        if (!project(axis, n, degenerate_cos, o)) {
+        // With a skeleton, its edge is this face's axis and the PCA axes are the fallbacks.
+        const bool own = !face_axis.empty() && project(load(&face_axis[3 * f]), n, degenerate_cos, o);
+        if (!own && !project(axis, n, degenerate_cos, o)) {
           ++fallback_faces;
           if (!project(axis2, n, degenerate_cos, o)) o = perpendicular(n);
         }
@@ -210,7 +229,6 @@ Status compute_orientation(const Mesh& mesh, const Topology& topology, const Ori
       if (options.smooth_passes == 0) write_corner_frame(f, p0, p1, p2);
     }
   };
-  const size_t threads = internal::parallel_threads(face_count, options.threads);
   std::vector<size_t> degenerate_count(internal::chunk_count(face_count), 0),
       fallback_count(internal::chunk_count(face_count), 0);
   internal::for_each_chunk(face_count, threads, [&](size_t begin, size_t end, size_t chunk) {
