@@ -250,11 +250,10 @@ void bind_map(py::module_& m) {
           if (!s) raise_status(s);
           width = image.width;
           height = image.height;
-          if (field_following_auto) run.texture_isotropy = texture_isotropy(image);
         }
         if (field_following_auto) {
           const uint32_t rings = mapping.crack_rings;
-          adapt_mapping_to_texture(image, mapping);
+          run.texture_isotropy = adapt_mapping_to_texture(image, mapping);
           if (!crack_rings.is_none()) mapping.crack_rings = rings;
         }
         if (Status s = set_map_texture_size(options, width, height); !s) raise_status(s);

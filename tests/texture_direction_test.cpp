@@ -78,7 +78,7 @@ TEST(TextureDirection, AdaptsTheMappingOnlyForTexturesWithoutDirection) {
   adapt_mapping_to_texture(load("vistex-bark11-128.png"), options);
   EXPECT_EQ(options.field_following, MappingOptions{}.field_following);
   EXPECT_EQ(options.crack_rings, MappingOptions{}.crack_rings);
-  adapt_mapping_to_texture(Image{}, options);
+  EXPECT_EQ(adapt_mapping_to_texture(Image{}, options), -1.f);
   EXPECT_EQ(options.field_following, MappingOptions{}.field_following);
   adapt_mapping_to_texture(load("gravel-gray-512.png"), options);
   EXPECT_EQ(options.field_following, 0.f);

@@ -188,9 +188,8 @@ int run_map(const MapArgs& opt) {
   // auto: follow the field unless the texture has no direction to follow (texture_direction.h).
   float texture_isotropy = -1.f;
   if (opt.field_following == "auto") {
-    if (!texture.empty()) texture_isotropy = tailor::texture_isotropy(texture);
     const uint32_t rings = mapping.crack_rings;
-    adapt_mapping_to_texture(texture, mapping);
+    texture_isotropy = adapt_mapping_to_texture(texture, mapping);
     if (opt.crack_rings_given) mapping.crack_rings = rings;
   }
 

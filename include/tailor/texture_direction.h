@@ -39,7 +39,8 @@ inline constexpr uint32_t kUndirectedCrackRings = 32;
 //! What `tailor map` does by default (--field-following auto): for a texture without direction,
 //! rigid unfolding (field_following 0) with kUndirectedCrackRings crack rings, which gives 20-30 %
 //! less seam length and fewer dangling seam ends (docs/mapping.md section 7); for any other
-//! texture, or none, the options stay as they are.
-TAILOR_API void adapt_mapping_to_texture(const Image& texture, MappingOptions& options);
+//! texture, or none, the options stay as they are. Returns the texture's isotropy (measured once,
+//! for reports), or -1 for an empty image.
+TAILOR_API float adapt_mapping_to_texture(const Image& texture, MappingOptions& options);
 
 }  // namespace tailor

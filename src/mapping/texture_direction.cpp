@@ -86,10 +86,14 @@ bool texture_has_direction(const Image& texture) {
   return texture.empty() || texture_isotropy(texture) < kIsotropicTextureAbove;
 }
 
-void adapt_mapping_to_texture(const Image& texture, MappingOptions& options) {
-  if (texture_has_direction(texture)) return;
-  options.field_following = 0.f;
-  options.crack_rings = kUndirectedCrackRings;
+float adapt_mapping_to_texture(const Image& texture, MappingOptions& options) {
+  if (texture.empty()) return -1.f;
+  const float isotropy = texture_isotropy(texture);
+  if (isotropy >= kIsotropicTextureAbove) {
+    options.field_following = 0.f;
+    options.crack_rings = kUndirectedCrackRings;
+  }
+  return isotropy;
 }
 
 }  // namespace tailor
