@@ -18,6 +18,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "tailor/api.h"
@@ -36,6 +37,14 @@ enum class AxisSource {
               //!< faces of components without a skeleton, and where it is ~normal to the face, use PCA
 };
 
+//! A curve the user drew on the surface (tailor edit, tailor map --strokes FILE): near it the
+//! orientation field follows the curve's direction, blended into the axis field with a weight
+//! that falls from 1 on the curve to 0 at `radius` (smoothly), so strokes act locally.
+struct OrientationStroke {
+  std::vector<float> points;  //!< N by 3 (N >= 2): points along the curve, mesh coordinates
+  float radius = 0.f;         //!< reach of the stroke, mesh units (> 0)
+};
+
 struct OrientationOptions {
   AxisSource axis = AxisSource::kPca;              //!< source of the global axis projected on each face
   std::array<float, 3> user_axis{0.f, 1.f, 0.f};   //!< kUser: axis, any non-zero length (normalised inside)
@@ -50,6 +59,7 @@ struct OrientationOptions {
   float fixed_unit_scale = 0.f;  //!< > 0: normalised = (x - origin) * this; 0 = 1 / longest bbox side
   uint32_t threads = 0;          //!< threads for the per-face frames (0 = one per 100k faces, at most
                                  //!< the cores and 8); the result is identical for any count
+  std::span<const OrientationStroke> strokes;  //!< user strokes blended into the field (empty = none)
 };
 
 //! Flags and help of the OrientationOptions a user sets (option_doc.h).
