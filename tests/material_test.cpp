@@ -13,7 +13,10 @@
 #include <vector>
 
 #include "support/fixtures.h"
+#include "tailor/gltf.h"
 #include "tailor/image.h"
+#include "tailor/io.h"
+#include "tailor/render.h"
 
 namespace tailor {
 namespace {
@@ -211,6 +214,87 @@ TEST_F(MaterialTest, GlbHasThePackedMaterialAndTangents) {
   EXPECT_GT(agree_t, faces * 95 / 100) << faces;
   EXPECT_GT(agree_b, faces * 95 / 100) << faces;
   expect_valid_gltf(out);
+}
+
+// tailor render and tailor map --preview shade with the .glb's normal map (render.h PreviewMaterial):
+// the file's maps and tangents are read back, the normal map changes the picture, a flat one does not.
+TEST_F(MaterialTest, RenderAndPreviewShadeWithTheNormalMap) {
+  const std::string out = dir_ + "/spot.glb", preview = dir_ + "/map_preview.png";
+  std::string text;
+  ASSERT_EQ(map(dir_, out, "--preview '" + preview + "' --preview-all", text), 0) << text;
+  Mesh mesh;
+  Image base;
+  GltfMaterialMaps maps;
+  ASSERT_TRUE(read_glb_with_material(out, mesh, &base, &maps).is_ok());
+  EXPECT_EQ(base.pixels, color_.pixels);
+  ASSERT_EQ(maps.normal.width, color_.width);
+  EXPECT_EQ(maps.normal.pixels, normals_of(grey_, 4).pixels);  // 8-bit in, 8-bit back
+  EXPECT_FALSE(maps.metallic_roughness.empty());
+  EXPECT_TRUE(maps.occlusion.empty());
+  ASSERT_EQ(maps.corner_tangents.size(), 4 * mesh.indices.size());
+  for (const CornerAttribute& a : mesh.corner_attributes) EXPECT_NE(a.name, "TANGENT");
+  // Without asking for the material, nothing of it is read.
+  Mesh plain;
+  ASSERT_TRUE(read_glb_file(out, plain, nullptr).is_ok());
+  EXPECT_EQ(plain.indices, mesh.indices);
+
+  // The file's tangents are the UVs' frames (as corner_tangents computes them): the same picture.
+  RenderOptions o;
+  o.width = 320;
+  o.height = 240;
+  PreviewMaterial from_file, computed;
+  from_file.normal = computed.normal = &maps.normal;
+  from_file.corner_tangents = maps.corner_tangents;
+  Image a, b, none;
+  ASSERT_TRUE(render_preview(mesh, mesh.corner_uvs, {}, &base, from_file, o, a).is_ok());
+  ASSERT_TRUE(render_preview(mesh, mesh.corner_uvs, {}, &base, computed, o, b).is_ok());
+  ASSERT_TRUE(render_preview(mesh, mesh.corner_uvs, {}, &base, o, none).is_ok());
+  double diff_ab = 0, diff_none = 0;
+  for (size_t i = 0; i < a.pixels.size(); ++i) {
+    diff_ab += std::abs(int{a.pixels[i]} - int{b.pixels[i]});
+    diff_none += std::abs(int{a.pixels[i]} - int{none.pixels[i]});
+  }
+  EXPECT_LT(diff_ab / double(a.pixels.size()), 0.1);
+  EXPECT_GT(diff_none / double(a.pixels.size()), 0.5) << diff_ab / double(a.pixels.size());  // background included
+
+  // The command: the material's picture differs from --no-material's; so does map's preview from a
+  // flat normal map's, whose picture equals the colour map's alone within 2 levels.
+  const std::string cli = std::string(TAILOR_BINARY);
+  ASSERT_EQ(test::run_command(cli + " render '" + out + "' -o '" + dir_ + "/with.png' --size 320x240", text), 0)
+      << text;
+  ASSERT_EQ(
+      test::run_command(cli + " render '" + out + "' --no-material -o '" + dir_ + "/without.png' --size 320x240", text),
+      0)
+      << text;
+  Image with, without;
+  ASSERT_TRUE(load_image(dir_ + "/with.png", with).is_ok());
+  ASSERT_TRUE(load_image(dir_ + "/without.png", without).is_ok());
+  EXPECT_EQ(with.pixels, a.pixels);
+  EXPECT_EQ(without.pixels, none.pixels);
+
+  const std::string flat_dir = dir_ + "/flat";
+  fs::create_directory(flat_dir);
+  ASSERT_TRUE(write_png(flat_dir + "/bark_color.png", color_).is_ok());
+  Image flat{color_.width, color_.height, 3, {}};
+  for (int i = 0; i < color_.width * color_.height; ++i) flat.pixels.insert(flat.pixels.end(), {128, 128, 255});
+  ASSERT_TRUE(write_png(flat_dir + "/bark_normal.png", flat).is_ok());
+  const std::string colour_only = dir_ + "/colour_only";
+  fs::create_directory(colour_only);
+  ASSERT_TRUE(write_png(colour_only + "/bark_color.png", color_).is_ok());
+  ASSERT_EQ(map(flat_dir, dir_ + "/flat.glb", "--preview '" + dir_ + "/flat_preview.png'", text), 0) << text;
+  ASSERT_EQ(map(colour_only, dir_ + "/colour.glb", "--preview '" + dir_ + "/colour_preview.png'", text), 0) << text;
+  Image map_bumps, map_flat, map_colour;
+  ASSERT_TRUE(load_image(preview, map_bumps).is_ok());
+  ASSERT_TRUE(load_image(dir_ + "/flat_preview.png", map_flat).is_ok());
+  ASSERT_TRUE(load_image(dir_ + "/colour_preview.png", map_colour).is_ok());
+  int worst = 0;
+  double bump_diff = 0;
+  for (size_t i = 0; i < map_flat.pixels.size(); ++i) {
+    worst = std::max(worst, std::abs(int{map_flat.pixels[i]} - int{map_colour.pixels[i]}));
+    bump_diff += std::abs(int{map_bumps.pixels[i]} - int{map_colour.pixels[i]});
+  }
+  EXPECT_LE(worst, 2);
+  EXPECT_GT(bump_diff / double(map_flat.pixels.size()), 0.5) << worst;
 }
 
 TEST_F(MaterialTest, CompressedFilesKeepTangentsAndValidate) {

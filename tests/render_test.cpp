@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "support/fixtures.h"
+#include "tailor/export.h"
 #include "tailor/image.h"
 #include "tailor/io.h"
 
@@ -416,6 +417,159 @@ TEST(RenderPreview, InvisibleSeamsDoNotJumpInPixelsAndVisibleOnesDo) {
   const double along_fraction = mean_gradient(c, cut);
   EXPECT_NEAR(along_whole, along_uncut, 0.05 * along_uncut + 0.1);
   EXPECT_GT(along_fraction, 1.5 * along_uncut) << along_fraction << " vs " << along_uncut;
+}
+
+// === Material: normal and occlusion maps (PreviewMaterial) ======================================
+
+//! A w x h RGB image of one colour.
+Image constant_image(int w, int h, std::array<uint8_t, 3> rgb) {
+  Image img{w, h, 3, {}};
+  for (int i = 0; i < w * h; ++i) img.pixels.insert(img.pixels.end(), rgb.begin(), rgb.end());
+  return img;
+}
+
+//! A tangent-space normal map (GL convention: +Y up the image) from the grey levels of `image`
+//! taken as heights, wrapping at the borders.
+Image bump_normals(const Image& image, float strength) {
+  const int w = image.width, h = image.height, ch = image.channels;
+  auto height = [&](int x, int y) {
+    return image.pixels[(size_t((y + h) % h) * size_t(w) + size_t((x + w) % w)) * size_t(ch)] / 255.0f;
+  };
+  Image n{w, h, 3, {}};
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const float dx = (height(x + 1, y) - height(x - 1, y)) * strength;
+      const float dy = (height(x, y - 1) - height(x, y + 1)) * strength;  // rows run down, +Y up
+      const float l = std::sqrt(dx * dx + dy * dy + 1.0f);
+      for (const float c : {-dx / l, -dy / l, 1.0f / l})
+        n.pixels.push_back(static_cast<uint8_t>(std::lround((c * 0.5f + 0.5f) * 255.0f)));
+    }
+  return n;
+}
+
+Image render_material(const Mesh& mesh, const Image* texture, const PreviewMaterial& material,
+                      const RenderOptions& options) {
+  Image out;
+  const Status s = render_preview(mesh, mesh.corner_uvs, {}, texture, material, options, out);
+  EXPECT_TRUE(s.is_ok()) << s.message();
+  return out;
+}
+
+TEST(RenderMaterial, NormalMapTurnsTheLightByTheTangentFrame) {
+  // A white square facing the camera (+z), u along +x and v along +y; one constant normal map per
+  // case. The light comes from the upper left (eye space (-0.35, 0.55, 0.76)), so a normal tilted
+  // left or up must brighten and one tilted right or down darken, by exactly the diffuse term:
+  // level = 255 * (0.36 + 0.72 * max(0, n . l)), n the map's decoded normal in (t, b, n) = (x, y, z).
+  const Mesh square = unit_square();
+  const Image white = constant_image(4, 4, {255, 255, 255});
+  RenderOptions o = small(PreviewView::kTexture);
+  o.yaw_degrees = 0.0f;
+  o.pitch_degrees = 0.0f;
+  const double light[3] = {-0.35, 0.55, 0.76};
+  const double light_length = std::sqrt(light[0] * light[0] + light[1] * light[1] + light[2] * light[2]);
+  std::vector<int> levels;
+  for (const std::array<float, 2> tilt :
+       {std::array<float, 2>{0, 0}, {-0.45f, 0}, {0.45f, 0}, {0, 0.45f}, {0, -0.45f}}) {
+    const float z = std::sqrt(1.0f - tilt[0] * tilt[0] - tilt[1] * tilt[1]);
+    std::array<uint8_t, 3> rgb{};
+    double n[3];
+    for (int c = 0; c < 3; ++c) {
+      rgb[c] = static_cast<uint8_t>(std::lround(((c < 2 ? tilt[c] : z) * 0.5 + 0.5) * 255.0));
+      n[c] = rgb[c] / 255.0 * 2.0 - 1.0;  // what the shader decodes
+    }
+    const Image map = constant_image(4, 4, rgb);
+    PreviewMaterial material;
+    material.normal = &map;
+    const Image img = render_material(square, &white, material, o);
+    const double nl = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    const double diffuse = std::max(0.0, (n[0] * light[0] + n[1] * light[1] + n[2] * light[2]) / (nl * light_length));
+    const double expected = 255.0 * std::min(1.0, 0.36 + 0.72 * diffuse);
+    const uint8_t* centre = pixel(img, img.width / 2, img.height / 2);
+    EXPECT_NEAR(centre[0], expected, 2.0) << "tilt " << tilt[0] << "," << tilt[1];
+    levels.push_back(centre[0]);
+  }
+  EXPECT_GT(levels[1], levels[0] + 10);  // left: towards the light
+  EXPECT_LT(levels[2], levels[0] - 10);  // right: away
+  EXPECT_GT(levels[3], levels[0] + 10);  // up: towards
+  EXPECT_LT(levels[4], levels[0] - 10);  // down: away
+}
+
+TEST(RenderMaterial, BumpyNormalMapChangesLitPixelsAndAFlatOneDoesNot) {
+  const Fixture& f = spot();
+  const RenderOptions o = small(PreviewView::kTexture);
+  const Image none = render_material(f.mesh, &f.texture, PreviewMaterial{}, o);
+  const Image bumps = bump_normals(f.texture, 6.0f);
+  const Image flat = constant_image(f.texture.width, f.texture.height, {128, 128, 255});
+  PreviewMaterial bumpy, flat_material;
+  bumpy.normal = &bumps;
+  flat_material.normal = &flat;
+  const Image with_bumps = render_material(f.mesh, &f.texture, bumpy, o);
+  const Image with_flat = render_material(f.mesh, &f.texture, flat_material, o);
+  // The plain overload is the same picture as no material.
+  EXPECT_EQ(render_ok(f.mesh, &f.texture, o).pixels, none.pixels);
+  // Lit surface pixels (not background, bright enough to be lit): the bumps move them, the flat map not.
+  size_t lit = 0, moved = 0;
+  int flat_worst = 0;
+  double bump_sum = 0;
+  for (size_t i = 0; i < none.pixels.size(); i += 3) {
+    const uint8_t* p = &none.pixels[i];
+    const bool background = p[0] == 236 && p[1] == 238 && p[2] == 242;
+    for (size_t c = 0; c < 3; ++c)
+      flat_worst = std::max(flat_worst, std::abs(int{with_flat.pixels[i + c]} - int{none.pixels[i + c]}));
+    if (background || p[0] + p[1] + p[2] < 3 * 60) continue;
+    ++lit;
+    const int d = std::abs(int{with_bumps.pixels[i]} - int{p[0]});
+    bump_sum += d;
+    moved += d > 2;
+  }
+  ASSERT_GT(lit, size_t{5000});
+  EXPECT_LE(flat_worst, 2);
+  EXPECT_GT(static_cast<double>(moved) / static_cast<double>(lit), 0.3) << moved << " of " << lit;
+  EXPECT_GT(bump_sum / static_cast<double>(lit), 4.0);
+}
+
+TEST(RenderMaterial, OcclusionDarkensAndFileTangentsAreUsed) {
+  const Fixture& f = spot();
+  const RenderOptions o = small(PreviewView::kTexture);
+  const Image none = render_material(f.mesh, &f.texture, PreviewMaterial{}, o);
+  const Image half = constant_image(8, 8, {128, 128, 128});
+  PreviewMaterial occluded;
+  occluded.occlusion = &half;
+  const Image dark = render_material(f.mesh, &f.texture, occluded, o);
+  EXPECT_LT(mean_abs_difference(dark, none), 40.0);
+  EXPECT_GT(mean_abs_difference(dark, none), 1.0);
+  double sum_none = 0, sum_dark = 0;
+  for (size_t i = 0; i < none.pixels.size(); ++i) sum_none += none.pixels[i], sum_dark += dark.pixels[i];
+  EXPECT_LT(sum_dark, sum_none);
+
+  // Tangents given per corner are the frame: the UVs' own frames give the computed picture, the
+  // same frames turned a quarter (t -> b) another.
+  const Image bumps = bump_normals(f.texture, 6.0f);
+  std::vector<float> tangents;
+  ASSERT_TRUE(corner_tangents(f.mesh, f.mesh.corner_uvs, tangents).is_ok());
+  ASSERT_EQ(tangents.size(), 4 * f.mesh.indices.size());
+  PreviewMaterial computed, given;
+  computed.normal = given.normal = &bumps;
+  given.corner_tangents = tangents;
+  const Image a = render_material(f.mesh, &f.texture, computed, o);
+  const Image b = render_material(f.mesh, &f.texture, given, o);
+  EXPECT_LT(mean_abs_difference(a, b), 0.05);
+  std::vector<float> flipped = tangents;
+  for (size_t c = 0; c < flipped.size(); c += 4) flipped[c + 3] = -flipped[c + 3];  // the bitangent reversed
+  given.corner_tangents = flipped;
+  EXPECT_GT(mean_abs_difference(render_material(f.mesh, &f.texture, given, o), a), 1.0);
+
+  // Bad material input is refused.
+  Image out;
+  given.corner_tangents = std::span<const float>(tangents).first(8);
+  EXPECT_EQ(render_preview(f.mesh, f.mesh.corner_uvs, {}, &f.texture, given, o, out).code(),
+            ErrorCode::kInvalidArgument);
+  Image grey1{4, 4, 1, std::vector<uint8_t>(16, 128)};
+  PreviewMaterial not_rgb;
+  not_rgb.normal = &grey1;
+  EXPECT_EQ(render_preview(f.mesh, f.mesh.corner_uvs, {}, &f.texture, not_rgb, o, out).code(),
+            ErrorCode::kInvalidImage);
+  EXPECT_TRUE(out.empty());
 }
 
 TEST(RenderPreview, ViewNamesRoundTrip) {

@@ -310,9 +310,12 @@ int run_map(const MapArgs& opt) {
       render_options.up = preview_up;
       render_options.seam_texture_px = texture.empty() ? tex_w : 0;  // a material without colour: its maps' size
       render_options.seam_symmetry = mapping.symmetry;
+      PreviewMaterial shading;  // a material's normal and occlusion maps (tangents as the .glb gets them)
+      if (!material.normal_image.empty()) shading.normal = &material.normal_image;
+      if (!material.occlusion_image.empty()) shading.occlusion = &material.occlusion_image;
       Image picture;
-      if (Status s = render_preview(mesh, uv_repeats, atlas.patch, texture.empty() ? nullptr : &texture, render_options,
-                                    picture);
+      if (Status s = render_preview(mesh, uv_repeats, atlas.patch, texture.empty() ? nullptr : &texture, shading,
+                                    render_options, picture);
           !s)
         return report_error(s.with_file(path));
       pictures.emplace_back(path, std::move(picture));

@@ -20,6 +20,8 @@ struct RenderArgs {
   std::string input;
   std::string output;
   std::string texture;
+  std::string normal_map;
+  bool no_material = false;
   RenderOptions options;
   std::string view = preview_view_name(RenderOptions{}.view);
   std::string size = std::to_string(RenderOptions{}.width) + "x" + std::to_string(RenderOptions{}.height);
@@ -55,17 +57,28 @@ int run_render(const RenderArgs& args) {
 
   Mesh mesh;
   Image texture;
+  GltfMaterialMaps maps;  // a .glb's normal and occlusion maps, and its tangents
   Status status = [&] {
     const ReadingInput reading(args.input);
     const MeshFormat format = mesh_format_from_path(args.input);
-    return format == MeshFormat::kGlb || format == MeshFormat::kGltf ? read_glb_file(args.input, mesh, &texture)
-                                                                     : load_mesh(args.input, mesh);
+    return format == MeshFormat::kGlb || format == MeshFormat::kGltf
+               ? read_glb_with_material(args.input, mesh, &texture, args.no_material ? nullptr : &maps)
+               : load_mesh(args.input, mesh);
   }();
   if (!status) return report_error(status.with_file(args.input));
   if (!args.texture.empty()) {
     status = load_image(args.texture, texture);
     if (!status) return report_error(status.with_file(args.texture));
   }
+  if (!args.normal_map.empty()) {  // replaces the file's; tangents then come from the UVs
+    status = load_image(args.normal_map, maps.normal);
+    if (!status) return report_error(status.with_file(args.normal_map));
+    maps.corner_tangents.clear();
+  }
+  PreviewMaterial material;
+  if (!maps.normal.empty()) material.normal = &maps.normal;
+  if (!maps.occlusion.empty()) material.occlusion = &maps.occlusion;
+  material.corner_tangents = maps.corner_tangents;
   if (mesh.corner_uvs.empty() && options.view != PreviewView::kPatches) {
     return report_error(Status::error(ErrorCode::kInvalidMesh, args.input, "mesh has no texture coordinates",
                                       "run 'tailor map' first, or use --view patches"));
@@ -75,7 +88,7 @@ int run_render(const RenderArgs& args) {
   }
 
   Image picture;
-  status = render_preview(mesh, mesh.corner_uvs, {}, texture.empty() ? nullptr : &texture, options, picture);
+  status = render_preview(mesh, mesh.corner_uvs, {}, texture.empty() ? nullptr : &texture, material, options, picture);
   if (!status) return report_error(status);
   status = write_png(args.output, picture);
   if (!status) return report_error(status.with_file(args.output));
@@ -97,6 +110,11 @@ void register_render(CLI::App& app, Runner& run) {
       ->check(CLI::IsMember({"texture", "patches", "distortion", "checker", "seams"}));
   add_documented(cmd, option_doc(kRenderOptionDocs, "width"), args->size);
   cmd->add_option("--texture", args->texture, "texture image to use instead of the one in the .glb");
+  cmd->add_option("--normal-map", args->normal_map,
+                  "tangent-space normal map (OpenGL convention, +Y up) to shade the texture view with, instead of "
+                  "the .glb's normalTexture (tangents from the UVs)");
+  cmd->add_flag("--no-material", args->no_material,
+                "texture view: ignore the .glb's normal and occlusion maps (only the base colour)");
   add_documented(cmd, option_doc(kRenderOptionDocs, "up"), args->up);
   add_documented(cmd, option_doc(kRenderOptionDocs, "yaw_degrees"), args->options.yaw_degrees);
   add_documented(cmd, option_doc(kRenderOptionDocs, "pitch_degrees"), args->options.pitch_degrees);
@@ -106,7 +124,9 @@ void register_render(CLI::App& app, Runner& run) {
       "Examples:\n"
       "  tailor render spot.glb -o spot.png\n"
       "  tailor render spot.glb -o spot_patches.png --view patches --size 800x600\n"
-      "  tailor render spot.glb -o spot_checker.png --view checker --checker 16");
+      "  tailor render spot.glb -o spot_checker.png --view checker --checker 16\n"
+      "A .glb written by 'tailor map --material' is shaded with its normal map (tangent space, the file's\n"
+      "TANGENT) and occlusion map.");
   cmd->callback([&run, args] { run = [args] { return run_render(*args); }; });
 }
 

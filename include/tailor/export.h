@@ -124,6 +124,12 @@ struct SplitMesh {
 //! allocation. Deterministic.
 TAILOR_API void split_vertices(const Mesh& mesh, std::span<const float> corner_uv_repeats, SplitMesh& out);
 
+//! Per-corner tangents (#F*3 by 4: unit xyz, w = +-1 the bitangent's sign, glTF TANGENT) for a
+//! normal map on corner_uv (#F*3 by 2, v up, any unit): the frames export_mesh writes with a
+//! material's normal map, per corner. Fails with kInvalidArgument (sizes) or kInvalidMesh (an index
+//! out of range). Cost: O(F).
+TAILOR_API Status corner_tangents(const Mesh& mesh, std::span<const float> corner_uv, std::vector<float>& tangents);
+
 //! The inverse, for readers of split files (.glb, .ply): merges vertices with bit-identical
 //! positions (-0 and +0 merged), keeping the first one, and rewrites mesh.indices; corner UVs are
 //! per corner and stay as they are. Returns the number of vertices removed. Cost: O(V + F).

@@ -27,6 +27,7 @@
 
 #include <span>
 #include <string>
+#include <vector>
 
 #include "tailor/api.h"
 #include "tailor/image.h"
@@ -41,6 +42,23 @@ namespace tailor {
 //! bad accessor), kUnsupported (no triangle primitive, a required extension, a URI outside the folder),
 //! kInvalidMesh, kInvalidImage (texture present but undecodable). Cost: O(file size).
 TAILOR_API Status read_glb_file(const std::string& path, Mesh& mesh, Image* texture, LoadReport* report = nullptr);
+
+//! The maps of a glTF material beside its base colour, and the tangents its normal map needs: what a
+//! preview shades with (render.h PreviewMaterial).
+struct GltfMaterialMaps {
+  Image normal;                        //!< normalTexture (tangent space, +Y up the image), 8 bits; empty: none
+  Image occlusion;                     //!< occlusionTexture (ambient occlusion in R); empty: none
+  Image metallic_roughness;            //!< metallicRoughnessTexture (G roughness, B metallic); empty: none
+  std::vector<float> corner_tangents;  //!< the file's TANGENT per corner (#F*3 by 4: world-space unit xyz, w = +-1
+                                       //!< the bitangent's sign); empty when the file has none on every primitive
+};
+
+//! read_glb_file, and the other maps of the same material (the first textured one; 16-bit PNGs
+//! decoded to 8 bits) and its TANGENT attribute into `material` (may be null). TANGENT is not
+//! kept in mesh.corner_attributes (a new mapping would make it wrong). Same errors; a map that
+//! cannot be decoded is kInvalidImage.
+TAILOR_API Status read_glb_with_material(const std::string& path, Mesh& mesh, Image* texture,
+                                         GltfMaterialMaps* material, LoadReport* report = nullptr);
 
 //! Same from memory (.glb, or .gltf whose buffers are data: URIs); `name` is used in error messages only.
 TAILOR_API Status read_glb_memory(std::span<const char> data, const std::string& name, Mesh& mesh, Image* texture,

@@ -27,7 +27,9 @@ struct MaterialMaps {
   std::string color;  //!< the base colour map's path (embedded as is), or empty
   int width = 0;      //!< the texture size, i.e. the UV lattice: the colour map's (else the first map's)
   int height = 0;
-  MaterialTextures textures;       //!< the other maps, encoded for the .glb
+  MaterialTextures textures;  //!< the other maps, encoded for the .glb
+  Image normal_image;         //!< the normal map as embedded (GL convention), 8 bits: for previews (render.h); or empty
+  Image occlusion_image;      //!< the occlusion map, one 8-bit channel: for previews; or empty
   std::vector<std::string> files;  //!< every map read, "role: path", for reports
   std::vector<std::string> notes;  //!< one-line warnings (height map not embedded, ...)
 };

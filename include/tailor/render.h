@@ -1,7 +1,8 @@
 // tailor: headless preview pictures of a UV-mapped mesh.
 //
 // Renders the mesh on the CPU with Mesa's off-screen OpenGL (OSMesa, llvmpipe): a 3/4 view from
-// above with one directional light plus ambient, textured with GL_REPEAT and mipmaps. Four views:
+// above with one directional light plus ambient, textured with GL_REPEAT and mipmaps (the texture
+// view lit per pixel, with a material's normal and occlusion maps: PreviewMaterial). Views:
 //   kTexture     the texture (or, when none is given, a neutral grey checker) on the surface;
 //   kPatches     each patch in its own colour, seams (edges whose two faces disagree on patch or
 //                UV) drawn as dark lines;
@@ -91,6 +92,19 @@ inline constexpr OptionDoc kRenderOptionDocs[] = {
     {"checker_squares", "--checker", "checker squares per texture repeat"},
 };
 
+//! What the texture view shades with besides the base colour: glTF's material maps, all optional.
+//! With a normal map the surface is lit per pixel with the map's normal in the tangent frame
+//! (t, b = w * n x t, n), as glTF, three.js and `tailor view` do; occlusion scales the ambient
+//! light only (glTF: indirect light). Roughness and metallic have no part in this light model
+//! (one directional light, diffuse, plus ambient) and are not read.
+struct PreviewMaterial {
+  const Image* normal = nullptr;           //!< tangent-space normal map, glTF (OpenGL) convention: +Y up the image
+  const Image* occlusion = nullptr;        //!< ambient occlusion in the R channel (glTF occlusionTexture)
+  std::span<const float> corner_tangents;  //!< #F*3 by 4 (unit xyz, w = +-1), glTF TANGENT per corner;
+                                           //!< empty: corner_tangents (export.h) of the UVs
+  bool empty() const { return normal == nullptr && occlusion == nullptr; }
+};
+
 //! Renders a preview picture of `mesh`.
 //!   mesh:      a valid mesh (after finalize_mesh: indices < #V, finite positions), at least one face.
 //!   corner_uv: #F*3 by 2 texture coordinates per corner in texture repeats (1.0 = one texture
@@ -108,5 +122,13 @@ inline constexpr OptionDoc kRenderOptionDocs[] = {
 //! 1 M faces at 1024x768 on two cores. Never prints, never throws.
 TAILOR_API Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::span<const uint32_t> patch,
                                  const Image* texture, const RenderOptions& options, Image& out);
+
+//! The same with a material's other maps (PreviewMaterial), used by the texture view only. Every
+//! texture view is lit per pixel (with or without a material, so that a flat normal map changes
+//! nothing); the maps must share the texture's UVs. Also fails with kInvalidImage for an
+//! inconsistent map and kInvalidArgument for tangents of the wrong size or not finite.
+TAILOR_API Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::span<const uint32_t> patch,
+                                 const Image* texture, const PreviewMaterial& material, const RenderOptions& options,
+                                 Image& out);
 
 }  // namespace tailor

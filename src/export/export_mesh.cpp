@@ -5,6 +5,9 @@
 #include <cstring>
 #include <filesystem>
 #include <limits>
+#include <new>
+#include <span>
+#include <vector>
 
 #include "export/writers.h"
 #include "tailor/export.h"
@@ -288,6 +291,29 @@ Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas
     case ExportFormat::kUnknown: break;
   }
   return Status::error(ErrorCode::kInvalidArgument, path, "unsupported output format");
+}
+
+Status corner_tangents(const Mesh& mesh, std::span<const float> corner_uv, std::vector<float>& tangents) {
+  tangents.clear();
+  const size_t corners = mesh.indices.size();
+  if (corner_uv.size() != 2 * corners)
+    return Status::error(ErrorCode::kInvalidArgument, "", "corner UVs must hold #F*3 by 2 floats");
+  for (const uint32_t v : mesh.indices)
+    if (v >= mesh.vertex_count()) return Status::error(ErrorCode::kInvalidMesh, "", "vertex index out of range");
+  try {
+    // As export_mesh: split on the UVs, area-weighted normals, the frames per split vertex.
+    SplitMesh split;
+    split_vertices(mesh, corner_uv, split);
+    std::vector<float> normals, per_split;
+    vertex_normals(mesh, normals);
+    internal::compute_tangents(mesh, split, normals, per_split);
+    tangents.resize(4 * corners);
+    for (size_t c = 0; c < corners; ++c) std::copy_n(&per_split[4 * size_t{split.indices[c]}], 4, &tangents[4 * c]);
+  } catch (const std::bad_alloc&) {
+    tangents.clear();
+    return Status::error(ErrorCode::kLimit, "", "out of memory while computing tangents");
+  }
+  return Status::ok();
 }
 
 }  // namespace tailor

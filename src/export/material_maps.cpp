@@ -221,6 +221,7 @@ Status load_material(const std::string& dir_or_json, MaterialMaps& out, const Im
       gl.pixels[3 * i + 2] = s[2];
     }
     TAILOR_RETURN_IF_ERROR(encode_png16(gl, out.textures.normal_png));
+    out.normal_image = to_image8(gl);
   }
   const bool rough = has(MaterialRole::kRoughness), metal = has(MaterialRole::kMetallic),
              ao = has(MaterialRole::kOcclusion);
@@ -247,6 +248,12 @@ Status load_material(const std::string& dir_or_json, MaterialMaps& out, const Im
             src.empty() ? fill[c] : static_cast<uint16_t>(src.pixels[size_t(src.channels) * i] * scale);
     }
     TAILOR_RETURN_IF_ERROR(encode_png16(orm, out.textures.orm_png));
+    if (ao) {
+      const Image16& src = images[static_cast<size_t>(MaterialRole::kOcclusion)];
+      Image16 r{src.width, src.height, 1, src.bits, std::vector<uint16_t>(pixels)};
+      for (size_t i = 0; i < pixels; ++i) r.pixels[i] = src.pixels[size_t(src.channels) * i];
+      out.occlusion_image = to_image8(r);
+    }
     out.textures.orm_roughness_metallic = rough || metal;
     out.textures.orm_occlusion = ao;
   }

@@ -24,6 +24,8 @@
 #include <filesystem>
 #include <new>
 #include <optional>
+#include <string_view>
+#include <utility>
 
 #include "io/gltf_document.h"
 #include "io/readers.h"
@@ -216,16 +218,17 @@ struct Primitive {
   uint64_t material = UINT64_MAX;
 };
 
-// The vertex attributes kept beside POSITION and TEXCOORD_0 (what export can write back).
-bool is_kept_attribute(const std::string& name) {
-  if (name == "NORMAL" || name == "COLOR_0") return true;
+// The vertex attributes kept beside POSITION and TEXCOORD_0 (what export can write back), and
+// TANGENT when the material is read (read_glb_with_material: for shading, never written back).
+bool is_kept_attribute(const std::string& name, bool tangents = false) {
+  if (name == "NORMAL" || name == "COLOR_0" || (tangents && name == "TANGENT")) return true;
   return name.size() == 10 && name.starts_with("TEXCOORD_") && name[9] >= '0' && name[9] <= '7';
 }
 
 // Adds a kept attribute read as `values` (#V by components), checking its shape.
 Status keep_attribute(const GltfDocument& doc, const std::string& name, std::vector<float>&& values, int components,
                       size_t vertex_count, const std::string& where, Primitive& out) {
-  const int want = name == "NORMAL" ? 3 : name == "COLOR_0" ? 0 : 2;
+  const int want = name == "NORMAL" ? 3 : name == "TANGENT" ? 4 : name == "COLOR_0" ? 0 : 2;
   if ((want != 0 && components != want) || (want == 0 && components != 3 && components != 4))
     return doc.parse_error(name + " has the wrong type", where);
   if (values.size() != vertex_count * size_t(components))
@@ -266,7 +269,8 @@ Status triangulate(const GltfDocument& doc, uint64_t mode, const std::vector<uin
 }
 
 // Reads primitive `pi` of mesh `mi` (mode already known to be triangles, strip or fan).
-Status read_primitive(GltfDocument& doc, const Json& prim, uint64_t mode, const std::string& where, Primitive& out) {
+Status read_primitive(GltfDocument& doc, const Json& prim, uint64_t mode, const std::string& where, bool tangents,
+                      Primitive& out) {
   const auto attributes = prim.find("attributes");
   uint64_t position_index = 0, uv_index = 0, indices_index = 0, material = 0;
   if (attributes == prim.end() || !get_uint(*attributes, "POSITION", position_index))
@@ -284,7 +288,7 @@ Status read_primitive(GltfDocument& doc, const Json& prim, uint64_t mode, const 
     internal::DracoPrimitive decoded;
     std::vector<std::string> names = {"POSITION", "TEXCOORD_0"};
     for (const auto& item : attributes->items())
-      if (is_kept_attribute(item.key())) names.push_back(item.key());
+      if (is_kept_attribute(item.key(), tangents)) names.push_back(item.key());
     TAILOR_RETURN_IF_ERROR(internal::decode_draco_primitive(doc, prim, *draco, names, where, decoded));
     if (decoded.components[0] != 3) return doc.unsupported("Draco POSITION is not 3D", where);
     out.positions = std::move(decoded.values[0]);
@@ -307,7 +311,7 @@ Status read_primitive(GltfDocument& doc, const Json& prim, uint64_t mode, const 
     }
     for (const auto& item : attributes->items()) {
       uint64_t index = 0;
-      if (!is_kept_attribute(item.key()) || !get_uint(*attributes, item.key().c_str(), index)) continue;
+      if (!is_kept_attribute(item.key(), tangents) || !get_uint(*attributes, item.key().c_str(), index)) continue;
       std::vector<float> values;
       AccessorInfo kept_info;
       TAILOR_RETURN_IF_ERROR(doc.read_floats(index, values, kept_info));
@@ -325,15 +329,21 @@ Status read_primitive(GltfDocument& doc, const Json& prim, uint64_t mode, const 
   return triangulate(doc, mode, corners, out.positions.size() / 3, where, out);
 }
 
-// The base colour image of a material, if it is stored in a buffer view (URIs are never opened).
-void find_texture(GltfDocument& doc, uint64_t material, std::span<const unsigned char>& bytes) {
+// The image of a material's texture `key` ("baseColorTexture" and "metallicRoughnessTexture" in
+// pbrMetallicRoughness, "normalTexture" and "occlusionTexture" in the material itself), if it is
+// stored in a buffer view (URIs are never opened).
+void find_texture(GltfDocument& doc, uint64_t material, const char* key, std::span<const unsigned char>& bytes) {
   bytes = {};
   const Json* m = get_element(doc.json(), "materials", material);
-  if (!m) return;
-  const auto pbr = m->find("pbrMetallicRoughness");
-  if (pbr == m->end() || !pbr->is_object()) return;
-  const auto base = pbr->find("baseColorTexture");
-  if (base == pbr->end()) return;
+  if (!m || !m->is_object()) return;
+  const Json* holder = m;
+  if (std::string_view(key) == "baseColorTexture" || std::string_view(key) == "metallicRoughnessTexture") {
+    const auto pbr = m->find("pbrMetallicRoughness");
+    if (pbr == m->end() || !pbr->is_object()) return;
+    holder = &*pbr;
+  }
+  const auto base = holder->find(key);
+  if (base == holder->end() || !base->is_object()) return;
   uint64_t texture = 0, source = 0, view = 0, stride = 0;
   if (!get_uint(*base, "index", texture)) return;
   const Json* t = get_element(doc.json(), "textures", texture);
@@ -445,6 +455,15 @@ void append_kept(const Primitive& p, const Matrix& world, size_t base, size_t fi
     for (size_t corner = first; corner < corners; ++corner) {
       const float* in = &a.values[k * (mesh.indices[corner] - base)];
       float* o = &out.values[k * corner];
+      if (a.name == "TANGENT") {  // a direction in the surface: the linear part, w flips with a mirror
+        double t[3];
+        for (int r = 0; r < 3; ++r)
+          t[r] = world[size_t(r)] * in[0] + world[size_t(4 + r)] * in[1] + world[size_t(8 + r)] * in[2];
+        const double length = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+        for (int r = 0; r < 3; ++r) o[r] = length > 0 ? static_cast<float>(t[r] / length) : in[r];
+        o[3] = static_cast<float>(sign) * (in[3] < 0 ? -1.0f : 1.0f);
+        continue;
+      }
       if (a.name != "NORMAL") {
         std::copy_n(in, k, o);
         continue;
@@ -502,9 +521,17 @@ void not_kept(const GltfDocument& doc, size_t instances, std::vector<std::string
   if (instances > 1) lost.push_back("the node hierarchy (one mesh in world space)");
 }
 
-// Parses the file into mesh (not finalized); the base colour texture bytes go to `texture_bytes`.
+// The encoded images of the first textured material's other maps (read_glb_with_material).
+struct MaterialBytes {
+  std::span<const unsigned char> normal, occlusion, metallic_roughness;
+};
+
+// Parses the file into mesh (not finalized); the base colour texture bytes go to `texture_bytes`,
+// the other maps of the same material to `material` (which also keeps TANGENT in the mesh's
+// corner attributes).
 Status parse_gltf(std::span<const char> data, const std::string& name, const std::string& base_dir, Mesh& mesh,
-                  LoadReport& report, std::span<const unsigned char>* texture_bytes) {
+                  LoadReport& report, std::span<const unsigned char>* texture_bytes,
+                  MaterialBytes* material = nullptr) {
   GltfDocument doc;
   TAILOR_RETURN_IF_ERROR(doc.open(data, name, base_dir));
   report.format = doc.is_binary() ? "glTF binary" : "glTF";
@@ -544,7 +571,7 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
         if (mode < kTriangles) continue;  // counted per instance below
         if (mode > kFan) return doc.parse_error("unknown primitive mode " + std::to_string(mode), where);
         decoded[mi]->emplace_back();
-        TAILOR_RETURN_IF_ERROR(read_primitive(doc, prim, mode, where, decoded[mi]->back()));
+        TAILOR_RETURN_IF_ERROR(read_primitive(doc, prim, mode, where, material != nullptr, decoded[mi]->back()));
       }
     }
     for (const Json& prim : *primitives) {
@@ -565,8 +592,15 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
       with_uv += !p.uv.empty();
       report.source_faces += p.source_faces;
       if (texture_bytes && !texture_found && p.material != UINT64_MAX) {
-        find_texture(doc, p.material, *texture_bytes);
+        find_texture(doc, p.material, "baseColorTexture", *texture_bytes);
         texture_found = !texture_bytes->empty();
+        if (material) {
+          find_texture(doc, p.material, "normalTexture", material->normal);
+          find_texture(doc, p.material, "occlusionTexture", material->occlusion);
+          find_texture(doc, p.material, "metallicRoughnessTexture", material->metallic_roughness);
+          // A material without a colour map but with others: its maps still count.
+          texture_found = texture_found || !material->normal.empty();
+        }
       }
     }
   }
@@ -610,9 +644,10 @@ Status read_gltf(std::span<const char> data, const std::string& name, const std:
 namespace {
 
 Status read_gltf_with_texture(std::span<const char> data, const std::string& name, const std::string& base_dir,
-                              Mesh& mesh, Image* texture, LoadReport* report) {
+                              Mesh& mesh, Image* texture, LoadReport* report, GltfMaterialMaps* material = nullptr) {
   mesh = Mesh{};
   if (texture) *texture = Image{};
+  if (material) *material = GltfMaterialMaps{};
   LoadReport local;
   LoadReport& r = report ? *report : local;
   r = LoadReport{};
@@ -620,8 +655,24 @@ Status read_gltf_with_texture(std::span<const char> data, const std::string& nam
   Status s;
   try {
     std::span<const unsigned char> texture_bytes;
-    s = parse_gltf(data, name, base_dir, mesh, r, &texture_bytes);
+    MaterialBytes material_bytes;
+    s = parse_gltf(data, name, base_dir, mesh, r, &texture_bytes, material ? &material_bytes : nullptr);
     if (s.is_ok()) s = finalize_mesh(name, mesh, r);
+    if (s.is_ok() && material) {
+      // TANGENT went through the repairs with the other corner attributes; it is not written back.
+      for (size_t slot = 0; slot < mesh.corner_attributes.size(); ++slot) {
+        if (mesh.corner_attributes[slot].name != "TANGENT") continue;
+        material->corner_tangents = std::move(mesh.corner_attributes[slot].values);
+        mesh.corner_attributes.erase(mesh.corner_attributes.begin() + static_cast<std::ptrdiff_t>(slot));
+        break;
+      }
+      const std::pair<std::span<const unsigned char>, Image*> maps[] = {
+          {material_bytes.normal, &material->normal},
+          {material_bytes.occlusion, &material->occlusion},
+          {material_bytes.metallic_roughness, &material->metallic_roughness}};
+      for (const auto& [bytes, image] : maps)
+        if (s.is_ok() && !bytes.empty()) s = decode_texture(bytes, name, *image);
+    }
     int width = 0, height = 0, channels = 0;  // the texture's size from its header only
     if (s.is_ok() && !texture_bytes.empty() && texture_bytes.size() <= size_t{INT_MAX} &&
         stbi_info_from_memory(texture_bytes.data(), static_cast<int>(texture_bytes.size()), &width, &height,
@@ -639,6 +690,7 @@ Status read_gltf_with_texture(std::span<const char> data, const std::string& nam
   if (!s.is_ok()) {
     mesh = Mesh{};
     if (texture) *texture = Image{};
+    if (material) *material = GltfMaterialMaps{};
     return s.with_file(name);
   }
   return s;
@@ -652,13 +704,19 @@ Status read_glb_memory(std::span<const char> data, const std::string& name, Mesh
 }
 
 Status read_glb_file(const std::string& path, Mesh& mesh, Image* texture, LoadReport* report) {
+  return read_glb_with_material(path, mesh, texture, nullptr, report);
+}
+
+Status read_glb_with_material(const std::string& path, Mesh& mesh, Image* texture, GltfMaterialMaps* material,
+                              LoadReport* report) {
   const auto start = std::chrono::steady_clock::now();
   mesh = Mesh{};
+  if (material) *material = GltfMaterialMaps{};
   std::string bytes;
   TAILOR_RETURN_IF_ERROR(internal::read_file(path, bytes));
   LoadReport local;
   LoadReport& r = report ? *report : local;
-  const Status s = read_gltf_with_texture(bytes, path, folder_of(path), mesh, texture, &r);
+  const Status s = read_gltf_with_texture(bytes, path, folder_of(path), mesh, texture, &r, material);
   r.load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return s;
 }

@@ -14,12 +14,15 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "render/preview_scene.h"
 #include "tailor/export.h"
+#include "tailor/image.h"
 #include "tailor/render.h"
 
 namespace tailor {
@@ -140,18 +143,120 @@ void upload_texture(const Image& image, Texture& texture) {
   glEnable(GL_TEXTURE_2D);
 }
 
+// === The texture view's shader ===================================================================
+
+// The vertex attribute the tangents go to (0 is gl_Vertex in a compatibility context).
+constexpr GLuint kTangentAttribute = 1;
+
+// Per-pixel light, the viewer's (web/surface_material.js) with the same constants as the
+// fixed-function light of the other views: ambient 0.36 (times the occlusion map) plus 0.72 times
+// the diffuse term of one directional light fixed in eye space; two-sided. A normal map turns the
+// interpolated normal by the tangent frame (t projected into the tangent plane, b = w * n x t),
+// glTF's convention; a tangent of zero length leaves the normal as it is.
+constexpr const char* kVertexShader = R"(#version 120
+attribute vec4 tangent;
+varying vec3 v_normal;
+varying vec4 v_tangent;
+varying vec2 v_uv;
+void main() {
+  v_normal = gl_NormalMatrix * gl_Normal;
+  v_tangent = vec4(mat3(gl_ModelViewMatrix) * tangent.xyz, tangent.w);
+  v_uv = gl_MultiTexCoord0.st;
+  gl_Position = ftransform();
+}
+)";
+
+constexpr const char* kFragmentShader = R"(#version 120
+uniform sampler2D base_map;
+uniform sampler2D normal_map;
+uniform sampler2D occlusion_map;
+uniform bool has_normal;
+uniform bool has_occlusion;
+uniform vec3 light_dir;
+varying vec3 v_normal;
+varying vec4 v_tangent;
+varying vec2 v_uv;
+void main() {
+  vec3 n = normalize(v_normal);
+  if (has_normal) {
+    vec3 t = v_tangent.xyz - n * dot(n, v_tangent.xyz);
+    if (dot(t, t) > 1e-12) {
+      t = normalize(t);
+      vec3 b = cross(n, t) * (v_tangent.w < 0.0 ? -1.0 : 1.0);
+      vec3 m = texture2D(normal_map, v_uv).xyz * 2.0 - 1.0;
+      n = normalize(t * m.x + b * m.y + n * m.z);
+    }
+  }
+  if (!gl_FrontFacing) n = -n;
+  float ambient = has_occlusion ? 0.36 * texture2D(occlusion_map, v_uv).r : 0.36;
+  float light = ambient + 0.72 * max(dot(n, light_dir), 0.0);
+  vec3 base = texture2D(base_map, (gl_TextureMatrix[0] * vec4(v_uv, 0.0, 1.0)).st).rgb;
+  gl_FragColor = vec4(min(base * light, vec3(1.0)), 1.0);
+}
+)";
+
+//! The linked program of the texture view, deleted when it goes out of scope (before the context).
+class ShaderProgram {
+ public:
+  ShaderProgram() = default;
+  ShaderProgram(const ShaderProgram&) = delete;
+  ShaderProgram& operator=(const ShaderProgram&) = delete;
+  ~ShaderProgram() {
+    if (program_ != 0) glDeleteProgram(program_);
+  }
+
+  //! Compiles and links; false (with the compiler's first line in `log`) when GLSL is missing.
+  bool build(std::string& log) {
+    program_ = glCreateProgram();
+    if (program_ == 0) return fail("no GLSL", log);
+    for (const auto& [type, source] :
+         {std::pair{GL_VERTEX_SHADER, kVertexShader}, {GL_FRAGMENT_SHADER, kFragmentShader}}) {
+      const GLuint shader = glCreateShader(type);
+      glShaderSource(shader, 1, &source, nullptr);
+      glCompileShader(shader);
+      GLint ok = GL_FALSE;
+      glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+      if (ok != GL_TRUE) {
+        std::array<char, 256> text{};
+        glGetShaderInfoLog(shader, static_cast<GLsizei>(text.size()), nullptr, text.data());
+        glDeleteShader(shader);
+        return fail(text.data(), log);
+      }
+      glAttachShader(program_, shader);
+      glDeleteShader(shader);  // freed with the program
+    }
+    glBindAttribLocation(program_, kTangentAttribute, "tangent");
+    glLinkProgram(program_);
+    GLint ok = GL_FALSE;
+    glGetProgramiv(program_, GL_LINK_STATUS, &ok);
+    return ok == GL_TRUE || fail("link failed", log);
+  }
+
+  GLint uniform(const char* name) const { return glGetUniformLocation(program_, name); }
+  GLuint id() const { return program_; }
+
+ private:
+  static bool fail(const std::string& what, std::string& log) {
+    log = what.substr(0, what.find('\n'));
+    return false;
+  }
+  GLuint program_ = 0;
+};
+
 // === Drawing =====================================================================================
 
 //! Attribute pointers of one draw: positions and normals always, then either texture coordinates
-//! or RGBA colours. Buffers are bound to GL_ARRAY_BUFFER one after the other.
+//! or RGBA colours, and tangents for the texture view's shader. Buffers are bound to
+//! GL_ARRAY_BUFFER one after the other.
 struct VertexStreams {
   std::span<const float> positions;  // xyz, centred on the framing sphere
   std::span<const float> normals;    // xyz
   std::span<const float> texcoords;  // st, or empty
   std::span<const uint8_t> colors;   // rgba, or empty
+  std::span<const float> tangents;   // xyzw, or empty
 };
 
-void bind_streams(const VertexStreams& in, const std::array<GLuint, 4>& buffers) {
+void bind_streams(const VertexStreams& in, const std::array<GLuint, 5>& buffers) {
   const auto upload = [](GLuint buffer, const void* data, size_t bytes) {
     glBindBuffer(GL_ARRAY_BUFFER, buffer);
     glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(bytes), data, GL_STREAM_DRAW);
@@ -172,6 +277,13 @@ void bind_streams(const VertexStreams& in, const std::array<GLuint, 4>& buffers)
     upload(buffers[3], in.colors.data(), in.colors.size_bytes());
     glColorPointer(4, GL_UNSIGNED_BYTE, 0, nullptr);
   }
+  if (!in.tangents.empty()) {
+    glEnableVertexAttribArray(kTangentAttribute);
+    upload(buffers[4], in.tangents.data(), in.tangents.size_bytes());
+    glVertexAttribPointer(kTangentAttribute, 4, GL_FLOAT, GL_FALSE, 0, nullptr);
+  } else {
+    glVertexAttrib4f(kTangentAttribute, 0.0f, 0.0f, 0.0f, 1.0f);
+  }
   glBindBuffer(GL_ARRAY_BUFFER, 0);
 }
 
@@ -180,6 +292,7 @@ void unbind_streams() {
   glDisableClientState(GL_NORMAL_ARRAY);
   glDisableClientState(GL_TEXTURE_COORD_ARRAY);
   glDisableClientState(GL_COLOR_ARRAY);
+  glDisableVertexAttribArray(kTangentAttribute);
 }
 
 //! Indexed drawing of a mesh split so that every vertex carries one key (a UV, or a patch id):
@@ -187,14 +300,15 @@ void unbind_streams() {
 //! cost on large meshes. `key` is #F*3 by 2 floats; `key_is_uv` says whether it is a texture
 //! coordinate (else a patch id encoded as two exact floats, see draw_patch_surface).
 void draw_split_surface(const Mesh& mesh, std::span<const float> key, bool key_is_uv,
-                        std::span<const float> vertex_normal, const Framing& frame) {
-  const SplitSurface surface = split_surface(mesh, key, key_is_uv, vertex_normal, frame);
+                        std::span<const float> vertex_normal, const Framing& frame,
+                        std::span<const float> corner_tangent = {}) {
+  const SplitSurface surface = split_surface(mesh, key, key_is_uv, vertex_normal, frame, corner_tangent);
   const SplitMesh& split = surface.split;
-  std::array<GLuint, 4> buffers{};
+  std::array<GLuint, 5> buffers{};
   GLuint element_buffer = 0;
-  glGenBuffers(4, buffers.data());
+  glGenBuffers(5, buffers.data());
   glGenBuffers(1, &element_buffer);
-  bind_streams({surface.positions, surface.normals, surface.texcoords, surface.colors}, buffers);
+  bind_streams({surface.positions, surface.normals, surface.texcoords, surface.colors, surface.tangents}, buffers);
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, element_buffer);
   glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(split.indices.size() * sizeof(uint32_t)),
                split.indices.data(), GL_STATIC_DRAW);
@@ -208,7 +322,7 @@ void draw_split_surface(const Mesh& mesh, std::span<const float> key, bool key_i
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, 0);
   unbind_streams();
   glDeleteBuffers(1, &element_buffer);
-  glDeleteBuffers(4, buffers.data());
+  glDeleteBuffers(5, buffers.data());
 }
 
 //! Patch colours: vertices are split on (vertex, patch) so each patch keeps its own colour.
@@ -226,20 +340,21 @@ void draw_face_colored_surface(const Mesh& mesh, const std::vector<Rgb>& face_co
   const size_t batch = std::min(faces, kBatchFaces);
   std::vector<float> pos(9 * batch), nor(9 * batch);
   std::vector<uint8_t> col(12 * batch);
-  std::array<GLuint, 4> buffers{};
-  glGenBuffers(4, buffers.data());
+  std::array<GLuint, 5> buffers{};
+  glGenBuffers(5, buffers.data());
   for (size_t start = 0; start < faces; start += batch) {
     const size_t count = std::min(batch, faces - start);
     fill_face_colored_batch(mesh, face_colors, vertex_normal, frame, start, count, pos, nor, col);
     bind_streams({std::span<const float>(pos).first(9 * count),
                   std::span<const float>(nor).first(9 * count),
                   {},
-                  std::span<const uint8_t>(col).first(12 * count)},
+                  std::span<const uint8_t>(col).first(12 * count),
+                  {}},
                  buffers);
     glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(3 * count));
   }
   unbind_streams();
-  glDeleteBuffers(4, buffers.data());
+  glDeleteBuffers(5, buffers.data());
 }
 
 void draw_lines(const std::vector<float>& lines, float width, const internal::Rgb& color) {
@@ -288,8 +403,13 @@ void draw_legend_bar(const LegendBox& box, int target_width, int target_height, 
 
 Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::span<const uint32_t> patch,
                       const Image* texture, const RenderOptions& options, Image& out) {
+  return render_preview(mesh, corner_uv, patch, texture, PreviewMaterial{}, options, out);
+}
+
+Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::span<const uint32_t> patch,
+                      const Image* texture, const PreviewMaterial& material, const RenderOptions& options, Image& out) {
   out = Image{};
-  TAILOR_RETURN_IF_ERROR(check_inputs(mesh, corner_uv, patch, texture, options));
+  TAILOR_RETURN_IF_ERROR(check_inputs(mesh, corner_uv, patch, texture, material, options));
   try {
     // Supersampling is reduced rather than refused when the target would get too large.
     int scale = options.supersample;
@@ -312,9 +432,26 @@ Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::s
     GLint max_texture = 0;
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture);
     const bool use_image = options.view == PreviewView::kTexture && texture != nullptr;
-    if (use_image && (texture->width > max_texture || texture->height > max_texture)) {
-      return Status::error(ErrorCode::kUnsupported, "", "texture larger than the renderer allows",
-                           std::to_string(max_texture) + " pixels a side");
+    const bool shaded = options.view == PreviewView::kTexture;  // lit per pixel, with the material's maps
+    const Image* normal_map = shaded ? material.normal : nullptr;
+    const Image* occlusion_map = shaded ? material.occlusion : nullptr;
+    for (const Image* image : {use_image ? texture : nullptr, normal_map, occlusion_map}) {
+      if (image != nullptr && (image->width > max_texture || image->height > max_texture)) {
+        return Status::error(ErrorCode::kUnsupported, "", "texture larger than the renderer allows",
+                             std::to_string(max_texture) + " pixels a side");
+      }
+    }
+    ShaderProgram program;  // after the context: deleted before it
+    std::string shader_log;
+    if (shaded && !program.build(shader_log)) {
+      return Status::error(ErrorCode::kUnsupported, "", "the renderer cannot compile its shader", shader_log);
+    }
+    // The normal map's tangent frames: the file's, else those export_mesh would write for these UVs.
+    std::vector<float> computed_tangents;
+    std::span<const float> tangents = material.corner_tangents;
+    if (normal_map != nullptr && tangents.empty()) {
+      TAILOR_RETURN_IF_ERROR(corner_tangents(mesh, corner_uv, computed_tangents));
+      tangents = computed_tangents;
     }
 
     // The distortion view keeps a band at the bottom for its legend, so the mesh never hides it.
@@ -351,7 +488,18 @@ Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::s
     glMultMatrixf(camera.turn.data());
 
     glColor4ub(255, 255, 255, 255);
-    Texture gl_texture;  // after the context: deleted before it
+    Texture gl_texture, gl_normal, gl_occlusion;  // after the context: deleted before it
+    if (normal_map != nullptr || occlusion_map != nullptr) {
+      if (normal_map != nullptr) {
+        glActiveTexture(GL_TEXTURE1);
+        upload_texture(*normal_map, gl_normal);
+      }
+      if (occlusion_map != nullptr) {
+        glActiveTexture(GL_TEXTURE2);
+        upload_texture(*occlusion_map, gl_occlusion);
+      }
+      glActiveTexture(GL_TEXTURE0);
+    }
     if (textured) {
       if (use_image) {
         upload_texture(*texture, gl_texture);
@@ -371,7 +519,19 @@ Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::s
     glEnable(GL_POLYGON_OFFSET_FILL);
     glPolygonOffset(1.0f, 1.0f);
 
-    if (textured) {
+    if (shaded) {
+      glUseProgram(program.id());
+      glUniform1i(program.uniform("base_map"), 0);
+      glUniform1i(program.uniform("normal_map"), 1);
+      glUniform1i(program.uniform("occlusion_map"), 2);
+      glUniform1i(program.uniform("has_normal"), normal_map != nullptr ? 1 : 0);
+      glUniform1i(program.uniform("has_occlusion"), occlusion_map != nullptr ? 1 : 0);
+      const float length =
+          std::sqrt(light_dir[0] * light_dir[0] + light_dir[1] * light_dir[1] + light_dir[2] * light_dir[2]);
+      glUniform3f(program.uniform("light_dir"), light_dir[0] / length, light_dir[1] / length, light_dir[2] / length);
+      draw_split_surface(mesh, corner_uv, true, scene.normals, scene.frame, tangents);
+      glUseProgram(0);
+    } else if (textured) {
       draw_split_surface(mesh, corner_uv, true, scene.normals, scene.frame);
     } else if (options.view == PreviewView::kPatches) {
       draw_patch_surface(mesh, scene.patch_ids, scene.normals, scene.frame);

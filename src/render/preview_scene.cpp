@@ -55,7 +55,7 @@ std::string ratio_label(double ratio) {
 }  // namespace
 
 Status check_inputs(const Mesh& mesh, std::span<const float> corner_uv, std::span<const uint32_t> patch,
-                    const Image* texture, const RenderOptions& o) {
+                    const Image* texture, const PreviewMaterial& material, const RenderOptions& o) {
   auto bad = [](const std::string& what) { return Status::error(ErrorCode::kInvalidArgument, "", what); };
   if (o.width < 16 || o.height < 16 || o.width > kMaxOutputSide || o.height > kMaxOutputSide) {
     return bad("preview size must be between 16 and " + std::to_string(kMaxOutputSide) + " pixels a side");
@@ -82,13 +82,26 @@ Status check_inputs(const Mesh& mesh, std::span<const float> corner_uv, std::spa
     return bad(std::string("the ") + preview_view_name(o.view) + " view needs texture coordinates");
   }
   if (!patch.empty() && patch.size() != faces) return bad("patch ids must hold one id per face");
-  if (texture != nullptr && o.view == PreviewView::kTexture) {
-    if (texture->channels < 1 || texture->channels > 4 || texture->width < 1 || texture->height < 1 ||
-        texture->width > kMaxImageSide || texture->height > kMaxImageSide ||
-        texture->pixels.size() != static_cast<size_t>(texture->width) * static_cast<size_t>(texture->height) *
-                                      static_cast<size_t>(texture->channels)) {
-      return Status::error(ErrorCode::kInvalidImage, "", "texture image is empty or inconsistent");
-    }
+  if (o.view != PreviewView::kTexture) return Status::ok();
+  const auto consistent = [](const Image& image) {
+    return image.channels >= 1 && image.channels <= 4 && image.width >= 1 && image.height >= 1 &&
+           image.width <= kMaxImageSide && image.height <= kMaxImageSide &&
+           image.pixels.size() == static_cast<size_t>(image.width) * static_cast<size_t>(image.height) *
+                                      static_cast<size_t>(image.channels);
+  };
+  if (texture != nullptr && !consistent(*texture)) {
+    return Status::error(ErrorCode::kInvalidImage, "", "texture image is empty or inconsistent");
+  }
+  if (material.normal != nullptr && (!consistent(*material.normal) || material.normal->channels < 3)) {
+    return Status::error(ErrorCode::kInvalidImage, "", "normal map is empty, inconsistent or not RGB");
+  }
+  if (material.occlusion != nullptr && !consistent(*material.occlusion)) {
+    return Status::error(ErrorCode::kInvalidImage, "", "occlusion map is empty or inconsistent");
+  }
+  if (!material.corner_tangents.empty()) {
+    if (material.corner_tangents.size() != 4 * mesh.indices.size()) return bad("tangents must hold #F*3 by 4 floats");
+    for (const float t : material.corner_tangents)
+      if (!std::isfinite(t)) return bad("tangents must be finite");
   }
   return Status::ok();
 }
@@ -366,7 +379,8 @@ Image half_size(const Image& src) {
 // === Vertex arrays ===============================================================================
 
 SplitSurface split_surface(const Mesh& mesh, std::span<const float> key, bool key_is_uv,
-                           std::span<const float> vertex_normal, const Framing& frame) {
+                           std::span<const float> vertex_normal, const Framing& frame,
+                           std::span<const float> corner_tangent) {
   SplitMesh split;
   split_vertices(mesh, key, split);
   const size_t count = split.xref.size();
@@ -397,7 +411,21 @@ SplitSurface split_surface(const Mesh& mesh, std::span<const float> key, bool ke
       colors[4 * s + 3] = 255;
     }
   }
-  return {std::move(split), std::move(positions), std::move(normals), std::move(texcoords), std::move(colors)};
+  // Corners of one split vertex share its UV; a file's tangents may still differ there (hard edges):
+  // their sum is the vertex's, the shader projects it into the tangent plane.
+  std::vector<float> tangents;
+  if (!corner_tangent.empty()) {
+    tangents.assign(4 * count, 0.0f);
+    for (size_t c = 0; c < split.indices.size(); ++c) {
+      float* t = &tangents[4 * size_t{split.indices[c]}];
+      const float* in = &corner_tangent[4 * c];
+      t[0] += in[0], t[1] += in[1], t[2] += in[2];
+      t[3] += in[3] < 0.0f ? -1.0f : 1.0f;
+    }
+    for (size_t s = 0; s < count; ++s) tangents[4 * s + 3] = tangents[4 * s + 3] < 0.0f ? -1.0f : 1.0f;
+  }
+  return {std::move(split),     std::move(positions), std::move(normals),
+          std::move(texcoords), std::move(tangents),  std::move(colors)};
 }
 
 std::vector<float> patch_keys(const Mesh& mesh, std::span<const uint32_t> patch) {

@@ -43,7 +43,7 @@ inline constexpr int kCheckerTexels = 64;  // per checker square in the generate
 //! Sizes, angles and array lengths of a render_preview call (the public entry point checks them
 //! before anything else).
 Status check_inputs(const Mesh& mesh, std::span<const float> corner_uv, std::span<const uint32_t> patch,
-                    const Image* texture, const RenderOptions& o);
+                    const Image* texture, const PreviewMaterial& material, const RenderOptions& o);
 
 // === Geometry set-up =============================================================================
 
@@ -123,13 +123,15 @@ Image half_size(const Image& src);
 struct SplitSurface {
   SplitMesh split;
   std::vector<float> positions, normals, texcoords;
+  std::vector<float> tangents;  // xyzw per split vertex: the sum of its corners' tangents, w their majority sign
   std::vector<uint8_t> colors;
 };
 
 //! `key` is #F*3 by 2 floats; `key_is_uv` says whether it is a texture coordinate (else a patch
-//! id encoded as two exact floats, see patch_keys).
+//! id encoded as two exact floats, see patch_keys). corner_tangent: empty, or #F*3 by 4.
 SplitSurface split_surface(const Mesh& mesh, std::span<const float> key, bool key_is_uv,
-                           std::span<const float> vertex_normal, const Framing& frame);
+                           std::span<const float> vertex_normal, const Framing& frame,
+                           std::span<const float> corner_tangent = {});
 
 //! The split key of each corner for the patch colours (vertices split on (vertex, patch), so each
 //! patch keeps its own colour): its face's patch id.
