@@ -251,11 +251,8 @@ void bind_map(py::module_& m) {
           width = image.width;
           height = image.height;
         }
-        if (field_following_auto) {
-          const uint32_t rings = mapping.crack_rings;
-          run.texture_isotropy = adapt_mapping_to_texture(image, mapping);
-          if (!crack_rings.is_none()) mapping.crack_rings = rings;
-        }
+        if (field_following_auto)
+          run.texture_isotropy = adapt_mapping_to_texture(image, mapping, !crack_rings.is_none());
         if (Status s = set_map_texture_size(options, width, height); !s) raise_status(s);
         std::vector<uint8_t> seams;
         if (!seam_faces.is_none()) {

@@ -83,6 +83,12 @@ TEST(TextureDirection, AdaptsTheMappingOnlyForTexturesWithoutDirection) {
   adapt_mapping_to_texture(load("gravel-gray-512.png"), options);
   EXPECT_EQ(options.field_following, 0.f);
   EXPECT_EQ(options.crack_rings, kUndirectedCrackRings);
+  // Crack rings the user chose stay; the field following still goes to 0.
+  MappingOptions chosen;
+  chosen.crack_rings = 5;
+  adapt_mapping_to_texture(load("gravel-gray-512.png"), chosen, true);
+  EXPECT_EQ(chosen.field_following, 0.f);
+  EXPECT_EQ(chosen.crack_rings, 5u);
 }
 
 }  // namespace

@@ -187,11 +187,8 @@ int run_map(const MapArgs& opt) {
   if (Status s = set_map_texture_size(options, tex_w, tex_h); !s) return report_error(s);
   // auto: follow the field unless the texture has no direction to follow (texture_direction.h).
   float texture_isotropy = -1.f;
-  if (opt.field_following == "auto") {
-    const uint32_t rings = mapping.crack_rings;
-    texture_isotropy = adapt_mapping_to_texture(texture, mapping);
-    if (opt.crack_rings_given) mapping.crack_rings = rings;
-  }
+  if (opt.field_following == "auto")
+    texture_isotropy = adapt_mapping_to_texture(texture, mapping, opt.crack_rings_given);
 
   // === Load, topology, orientation ===
   Mesh mesh;

@@ -40,7 +40,9 @@ inline constexpr uint32_t kUndirectedCrackRings = 32;
 //! rigid unfolding (field_following 0) with kUndirectedCrackRings crack rings, which gives 20-30 %
 //! less seam length and fewer dangling seam ends (docs/mapping.md section 7); for any other
 //! texture, or none, the options stay as they are. Returns the texture's isotropy (measured once,
-//! for reports), or -1 for an empty image.
-TAILOR_API float adapt_mapping_to_texture(const Image& texture, MappingOptions& options);
+//! for reports), or -1 for an empty image. keep_crack_rings: the user chose options.crack_rings
+//! (--crack-rings, crack_rings=), so only field_following changes; the CLI and the Python module
+//! both pass it.
+TAILOR_API float adapt_mapping_to_texture(const Image& texture, MappingOptions& options, bool keep_crack_rings = false);
 
 }  // namespace tailor

@@ -86,12 +86,12 @@ bool texture_has_direction(const Image& texture) {
   return texture.empty() || texture_isotropy(texture) < kIsotropicTextureAbove;
 }
 
-float adapt_mapping_to_texture(const Image& texture, MappingOptions& options) {
+float adapt_mapping_to_texture(const Image& texture, MappingOptions& options, bool keep_crack_rings) {
   if (texture.empty()) return -1.f;
   const float isotropy = texture_isotropy(texture);
   if (isotropy >= kIsotropicTextureAbove) {
     options.field_following = 0.f;
-    options.crack_rings = kUndirectedCrackRings;
+    if (!keep_crack_rings) options.crack_rings = kUndirectedCrackRings;
   }
   return isotropy;
 }
