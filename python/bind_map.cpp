@@ -13,6 +13,7 @@
 #include "tailor/export.h"
 #include "tailor/image.h"
 #include "tailor/mapping.h"
+#include "tailor/material.h"
 #include "tailor/report.h"
 #include "tailor/texture_direction.h"
 #include "tailor/topology.h"
@@ -106,6 +107,9 @@ const std::string& map_docstring() {
         "options, same bits; the GIL is released while it works). Raises tailor.Error with the CLI's message on\n"
         "bad options.\n\n"
         "texture_size: pixels of one texture repeat (--texture-size); texture=PATH sets it from the image (--texture)\n"
+        "material: a PBR material instead of texture (--material): a folder of maps named *_color, *_normal,\n"
+        "  *_roughness, *_metallic, *_ao, *_height..., or a JSON naming them; its colour map (else its first\n"
+        "  map) sets the texture size and field_following 'auto'; tailor.save embeds it in a .glb\n"
         "axis: 'pca', 'x', 'y', 'z', 'auto' or three numbers\n"
         "seam_faces: face indices or an (F,) bool mask of faces where seams should go; None: the file's\n"
         "threads: 0 = automatic (--threads); the result is the same for any count\n"
@@ -179,7 +183,8 @@ void bind_map(py::module_& m) {
          uint32_t threads, const py::object& progress, const py::object& texture, const std::string& mode,
          float max_stretch, const py::object& field_following, uint32_t min_patch_faces, float hop_age,
          bool shorten_seams, bool close_cracks, const py::object& crack_rings, uint32_t relax_iterations,
-         float threshold, const py::object& seed_point, uint32_t symmetry, float unit_scale, uint32_t smooth) {
+         float threshold, const py::object& seed_point, uint32_t symmetry, float unit_scale, uint32_t smooth,
+         const py::object& material) {
         // === Options, checked before any work (the CLI's checks and messages) ===
         MapTextureOptions options;
         MappingOptions& mapping = options.mapping;
@@ -237,11 +242,30 @@ void bind_map(py::module_& m) {
         options.orientation.smooth_passes = smooth;
         if (texture_size <= 0) raise_error("--texture-size must be positive");
         if (Status s = check_map_options(options); !s) raise_status(s);
-        // The texture sets the texture size, as --texture does.
+        // The texture sets the texture size, as --texture does; a material's colour map (else its
+        // maps' size), as --material does.
         int width = texture_size, height = texture_size;
         Image image;
-        if (!texture.is_none()) {
+        std::string material_path;
+        if (!material.is_none()) {
+          if (!texture.is_none())
+            raise_error("give --texture or --material, not both (the material's colour map is the texture)");
+          material_path = path_of(material);
+          MaterialMaps maps;
+          Status s;
+          {
+            const py::gil_scoped_release release;
+            s = load_material(material_path, maps);
+          }
+          if (!s) raise_status(s);
+          for (const std::string& note : maps.notes) PyErr_WarnEx(PyExc_UserWarning, note.c_str(), 1);
+          run.texture = maps.color;
+          width = maps.width;
+          height = maps.height;
+        } else if (!texture.is_none()) {
           run.texture = path_of(texture);
+        }
+        if (!run.texture.empty()) {
           Status s;
           {
             const py::gil_scoped_release release;
@@ -271,6 +295,7 @@ void bind_map(py::module_& m) {
         result->texture_width = width;
         result->texture_height = height;
         result->texture = run.texture;
+        result->material = material_path;
         ProgressBridge bridge(progress);
         const auto report_progress = bridge.function();
         Status status;
@@ -326,7 +351,8 @@ void bind_map(py::module_& m) {
       py::arg("relax_iterations") = md.relax_iterations, py::arg("threshold") = md.threshold_px,
       py::arg("seed_point") = py::none(), py::arg("symmetry") = md.symmetry,
       py::arg("unit_scale") = OrientationOptions{}.fixed_unit_scale,
-      py::arg("smooth") = OrientationOptions{}.smooth_passes, map_docstring().c_str());
+      py::arg("smooth") = OrientationOptions{}.smooth_passes, py::arg("material") = py::none(),
+      map_docstring().c_str());
 }
 
 }  // namespace tailor::python

@@ -34,7 +34,8 @@ struct PyResult {
   Atlas atlas;
   int texture_width = 0;
   int texture_height = 0;
-  std::string texture;            //!< the texture file given to map, empty when none
+  std::string texture;            //!< the texture file given to map (a material's colour map), empty when none
+  std::string material;           //!< the material (folder or JSON) given to map, empty when none
   std::vector<float> corner_uvs;  //!< #F*3*2, texture repeats, exactly as export writes them
   py::object stats;               //!< dict: the JSON of `tailor map --stats`
   double library_seconds = 0;     //!< wall time inside the library's calls (the benchmark's baseline)

@@ -79,6 +79,7 @@ def map(
     symmetry: Literal[1, 4] = 1,
     unit_scale: float = 0.0,
     smooth: int = 0,
+    material: Optional[_Path] = None,
 ) -> Result: ...
 @overload
 def tile(
@@ -109,4 +110,9 @@ def evaluate(
     texture_size: Union[int, Tuple[int, int]] = 512,
     symmetry: Literal[1, 4] = 1,
 ) -> dict: ...
-def save(path: _Path, mesh: Mesh, result: Result, texture: Optional[_Path] = None) -> None: ...
+def save(
+    path: _Path, mesh: Mesh, result: Result, texture: Optional[_Path] = None, material: Optional[_Path] = None
+) -> None: ...
+def material_role(
+    file_name: str,
+) -> Tuple[Optional[Literal["color", "normal", "roughness", "metallic", "occlusion", "height"]], bool]: ...
