@@ -2,9 +2,11 @@
 copy bundled in the add-on's zip first sits in _bundled/), else through the `tailor` command."""
 import os
 import shutil
+import struct
 import subprocess
 import sys
 import tempfile
+import zlib
 
 import numpy as np
 
@@ -69,8 +71,11 @@ def map_with_module(tailor, request, progress):
     if mesh.face_count != len(request.faces):
         raise RuntimeError(f"{len(request.faces) - mesh.face_count} degenerate faces")
     seams = request.seam_faces if request.seam_faces is not None and request.seam_faces.any() else None
+    options = dict(request.options)
+    if options.get("texture") is None:
+        options.pop("texture", None)
     result = tailor.map(mesh, texture_size=request.texture_size, scale=request.scale, axis=request.axis,
-                        seam_faces=seams, progress=progress, unit_scale=1.0, **request.options)
+                        seam_faces=seams, progress=progress, unit_scale=1.0, **options)
     return np.array(result.corner_uvs), result.stats
 
 
@@ -117,11 +122,13 @@ def map_with_cli(path, request):
         write_ply(mesh_in, request.positions, request.faces)
         command = [path, "map", mesh_in, "-o", mesh_out, "-q", "--texture-size", str(request.texture_size),
                    "--scale", repr(request.scale * side), "--axis", request.axis,
-                   "--max-stretch", repr(o["max_stretch"]), "--field-following", repr(o["field_following"]),
+                   "--max-stretch", repr(o["max_stretch"]), "--field-following", str(o["field_following"]),
                    "--relax-iterations", str(o["relax_iterations"]), "--threads", str(o["threads"]),
                    "--stats", os.path.join(tmp, "stats.json")]
         if not o["close_cracks"]:
             command.append("--no-crack-closing")
+        if o.get("texture"):  # its size is the texture size; 'auto' measures it
+            command += ["--texture", o["texture"]]
         if request.seam_faces is not None and request.seam_faces.any():
             seam_file = os.path.join(tmp, "seams.txt")
             np.savetxt(seam_file, np.flatnonzero(request.seam_faces), fmt="%d")
@@ -143,3 +150,20 @@ def make_tileable(kind, tool, image_path, out_png):
         _run([tool, "tile", image_path, "-o", out_png, "-q"])
         return None
     return tool.tile(image_path)  # (H, W, C) uint8: the caller makes a Blender image of it
+
+
+def write_png(path, pixels):
+    """An 8-bit PNG of a uint8 (H, W[, C]) array, rows top first (the tile the module made, so that
+    the mapping can measure it as the command does)."""
+    pixels = np.ascontiguousarray(pixels, np.uint8)
+    if pixels.ndim == 2:
+        pixels = pixels[:, :, None]
+    height, width, channels = pixels.shape
+    raw = b"".join(b"\0" + pixels[y].tobytes() for y in range(height))
+
+    def chunk(kind, body):
+        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
+
+    header = struct.pack(">IIBBBBB", width, height, 8, {1: 0, 2: 4, 3: 2, 4: 6}[channels], 0, 0, 0)
+    with open(path, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))

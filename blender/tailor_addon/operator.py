@@ -1,13 +1,14 @@
 """The operator "tailor: Texture Map" (UV menu in Edit Mode, Object menu): maps every selected mesh
 object into the UV map "tailor" at one world-space texel density, then optionally assigns a
-material with an image. Errors become Blender reports; Blender itself never sees an exception."""
+material with an image or a PBR material folder. Errors become Blender reports; Blender itself
+never sees an exception."""
 import os
 import tempfile
 
 import bpy
 import numpy as np
 
-from . import backend, material, mesh_data
+from . import backend, material, material_files, mesh_data
 
 
 class TAILOR_OT_texture_map(bpy.types.Operator):
@@ -22,7 +23,8 @@ class TAILOR_OT_texture_map(bpy.types.Operator):
         name="Tile size", description="Scene units one repeat of the texture covers, on every object",
         default=1.0, min=1e-6, soft_min=0.01, soft_max=100.0, unit="LENGTH")
     texture_size: bpy.props.IntProperty(
-        name="Texture size", description="Pixels of one repeat when no image is given (the image's width otherwise)",
+        name="Texture size",
+        description="Pixels of one repeat when no image is given (the image's or the material's width otherwise)",
         default=512, min=8, max=16384)
     axis: bpy.props.EnumProperty(
         name="Axis", description="Direction the texture follows (projected on each face)",
@@ -36,6 +38,11 @@ class TAILOR_OT_texture_map(bpy.types.Operator):
     max_stretch: bpy.props.FloatProperty(
         name="Max stretch", description="Per-face bound on the stretch: singular values within [1/(1+x), 1+x]",
         default=0.25, min=0.01, max=4.0)
+    auto_field_following: bpy.props.BoolProperty(
+        name="Automatic field following",
+        description="As tailor map's default (auto): rigid unfolding (fewer seams) for an image or material "
+                    "without direction (gravel, grass), the field otherwise; without an image, Field following",
+        default=True)
     field_following: bpy.props.FloatProperty(
         name="Field following", description="1: the texture direction follows the field; 0: rigid unfolding (fewer seams)",
         default=1.0, min=0.0, max=1.0)
@@ -51,6 +58,11 @@ class TAILOR_OT_texture_map(bpy.types.Operator):
         default=False)
     image_path: bpy.props.StringProperty(
         name="Image", description="Texture image (PNG, JPEG...)", subtype="FILE_PATH", default="")
+    material_path: bpy.props.StringProperty(
+        name="Material folder",
+        description="A PBR material instead of the image: a folder of maps named *_color, *_normal, *_roughness, "
+                    "*_metallic, *_ao (as tailor map --material)",
+        subtype="DIR_PATH", default="")
     make_tileable: bpy.props.BoolProperty(
         name="Make tileable", description="Make the image self-tileable with tailor first (packed into the .blend)",
         default=False)
@@ -68,8 +80,8 @@ class TAILOR_OT_texture_map(bpy.types.Operator):
         box.prop(self, "texture_size")
         box = layout.box()
         box.label(text="Mapping")
-        for name in ("axis", "use_seams", "max_stretch", "field_following", "close_cracks", "relax_iterations",
-                     "threads"):
+        for name in ("axis", "use_seams", "max_stretch", "auto_field_following", "field_following", "close_cracks",
+                     "relax_iterations", "threads"):
             box.prop(self, name)
         box = layout.box()
         box.label(text="Material")
@@ -77,7 +89,10 @@ class TAILOR_OT_texture_map(bpy.types.Operator):
         row = box.column()
         row.enabled = self.assign_material
         row.prop(self, "image_path")
-        row.prop(self, "make_tileable")
+        row.prop(self, "material_path")
+        tileable = row.row()
+        tileable.enabled = not self.material_path
+        tileable.prop(self, "make_tileable")
 
     def invoke(self, context, event):
         return context.window_manager.invoke_props_dialog(self, width=380)
@@ -105,16 +120,27 @@ class TAILOR_OT_texture_map(bpy.types.Operator):
             context.workspace.status_text_set(text)
 
     def run(self, context, objects):
+        with tempfile.TemporaryDirectory(prefix="tailor-blender-") as tmp:
+            return self.run_in(context, objects, tmp)
+
+    def run_in(self, context, objects, tmp):
         preferences = context.preferences.addons[__package__].preferences
         kind, tool = backend.choose(preferences)
-        image = None
+        image = maps = texture_file = None
         texture_width = texture_height = self.texture_size
-        if self.assign_material:
-            image = self.load_image(kind, tool)
+        if self.assign_material and self.material_path:
+            maps = material_files.find_maps(bpy.path.abspath(self.material_path))
+            images = material.load_maps(maps)
+            texture_width, texture_height = images[next(iter(images))].size
+            texture_file = maps["color"][0] if "color" in maps else None  # decides 'auto', as --material does
+        elif self.assign_material:
+            image, texture_file = self.load_image(kind, tool, tmp)
             texture_width, texture_height = image.size
-        options = {"max_stretch": self.max_stretch, "field_following": self.field_following,
+        # 'auto' measures the image the mapping is for (tailor map's default); without one, the number.
+        automatic = self.auto_field_following and texture_file is not None
+        options = {"max_stretch": self.max_stretch, "field_following": "auto" if automatic else self.field_following,
                    "close_cracks": self.close_cracks, "relax_iterations": self.relax_iterations,
-                   "threads": self.threads}
+                   "threads": self.threads, "texture": texture_file}
         wm = context.window_manager
         mapped, failed = 0, []
         for i, obj in enumerate(objects):
@@ -150,9 +176,12 @@ class TAILOR_OT_texture_map(bpy.types.Operator):
             metrics = stats["metrics"]
             obj["tailor"] = {"backend": kind, "faces_seam": stats["mapping"]["faces_seam"],
                              "patches": metrics["patches"], "flipped": metrics["flipped"],
-                             "seam_length_ratio": metrics["seam_length_ratio"], "tile_size": self.tile_size}
+                             "seam_length_ratio": metrics["seam_length_ratio"], "tile_size": self.tile_size,
+                             "field_following": stats["options"]["field_following"]}
             if image is not None:
                 material.assign(obj, image)
+            elif maps is not None:
+                material.assign_maps(obj, maps, images)
             mapped += 1
         wm.progress_update(1000)
         if mapped == 0:
@@ -161,18 +190,19 @@ class TAILOR_OT_texture_map(bpy.types.Operator):
                     (f"; failed: {', '.join(failed)}" if failed else ""))
         return {"FINISHED"}
 
-    def load_image(self, kind, tool):
+    def load_image(self, kind, tool, tmp):
+        """The Blender image and the file the mapping measures (the tile, when made here, in tmp)."""
         path = bpy.path.abspath(self.image_path)
         if not path or not os.path.isfile(path):
             raise RuntimeError(f"{path or 'no image'}: the image file does not exist")
         name = os.path.basename(path)
         if not self.make_tileable:
-            return bpy.data.images.load(path, check_existing=True)
-        with tempfile.TemporaryDirectory(prefix="tailor-blender-") as tmp:
-            out = os.path.join(tmp, os.path.splitext(name)[0] + "_tile.png")
-            pixels = backend.make_tileable(kind, tool, path, out)
-            if pixels is not None:
-                return material.image_from_pixels(os.path.splitext(name)[0] + "_tile", pixels)
-            image = bpy.data.images.load(out)
-            image.pack()
-            return image
+            return bpy.data.images.load(path, check_existing=True), path
+        out = os.path.join(tmp, os.path.splitext(name)[0] + "_tile.png")
+        pixels = backend.make_tileable(kind, tool, path, out)
+        if pixels is not None:
+            backend.write_png(out, pixels)
+            return material.image_from_pixels(os.path.splitext(name)[0] + "_tile", pixels), out
+        image = bpy.data.images.load(out)
+        image.pack()
+        return image, out

@@ -3,8 +3,11 @@
 Installs and enables the add-on from its zip, imports a mesh, marks seams, runs the operator with
 the module backend and the command backend, and checks the UV map "tailor": every loop finite, no
 flipped triangle, the marked seams handed to tailor, one texel density on objects of two sizes,
-the material, errors as reports, and the UVs after saving and reloading the .blend."""
+the material (an image, or a PBR material folder wired into the Principled BSDF), the automatic
+field following on textures without direction, errors as reports, and the UVs after saving and
+reloading the .blend."""
 import os
+import shutil
 import sys
 import traceback
 
@@ -62,6 +65,51 @@ def select_only(*objects):
     for o in objects:
         o.select_set(True)
     bpy.context.view_layer.objects.active = objects[0]
+
+
+def make_material(folder, backend):
+    """gravel.png as the colour map, a bumpy DirectX normal map, roughness and occlusion of its size."""
+    os.makedirs(folder, exist_ok=True)
+    shutil.copy(IMAGE, os.path.join(folder, "gravel_color.png"))
+    image = bpy.data.images.load(IMAGE)
+    width, height = image.size
+    y, x = np.mgrid[0:height, 0:width] / width * 2 * np.pi
+    bumps = np.sin(4 * x) * np.cos(6 * y)
+    n = np.stack([-np.gradient(bumps, axis=1) * 20, np.gradient(bumps, axis=0) * 20, np.ones_like(bumps)], -1)
+    n /= np.linalg.norm(n, axis=-1, keepdims=True)
+    backend.write_png(os.path.join(folder, "gravel_normal_dx.png"), np.round((n * 0.5 + 0.5) * 255))
+    backend.write_png(os.path.join(folder, "gravel_roughness.png"), np.round(127 + 100 * bumps))
+    backend.write_png(os.path.join(folder, "gravel_ao.png"), np.round(200 + 50 * bumps))
+    with open(os.path.join(folder, "notes.txt"), "w") as f:
+        f.write("not a map")
+    return folder
+
+
+def check_material_nodes(material):
+    """The maps are wired as glTF means them: colour x occlusion, roughness, metallic, the normal map
+    in tangent space of the UV map "tailor" (green flipped for the DirectX map)."""
+    check(material.name == "tailor gravel_material", f"material named after the folder: {material.name}")
+    nodes = material.node_tree.nodes
+    shader = next(n for n in nodes if n.type == "BSDF_PRINCIPLED")
+    textures = {n.label: n for n in nodes if n.type == "TEX_IMAGE"}
+    check(sorted(textures) == ["color", "normal", "occlusion", "roughness"], f"four maps: {sorted(textures)}")
+    check(all(t.image.colorspace_settings.name == "Non-Color" for r, t in textures.items() if r != "color"),
+          "data maps are Non-Color")
+
+    def source(socket):
+        return socket.links[0].from_node if socket.is_linked else None
+
+    check(source(shader.inputs["Roughness"]) == textures["roughness"], "roughness map -> Roughness")
+    base = source(shader.inputs["Base Color"])
+    check(base is not None and base.type == "MIX_RGB" and base.blend_type == "MULTIPLY" and
+          source(base.inputs["Color2"]) == textures["occlusion"], "base colour x occlusion -> Base Color")
+    normal = source(shader.inputs["Normal"])
+    check(normal is not None and normal.type == "NORMAL_MAP" and normal.space == "TANGENT" and normal.uv_map == "tailor",
+          "normal map node (tangent space, UV map tailor) -> Normal")
+    check(normal is not None and source(normal.inputs["Color"]).type == "COMBINE_COLOR",
+          "the DirectX normal map's green is flipped")
+    check(all(source(t.inputs["Vector"]).type == "UVMAP" and source(t.inputs["Vector"]).uv_map == "tailor"
+              for t in textures.values()), "every map reads the UV map tailor")
 
 
 def main():
@@ -150,6 +198,28 @@ def main():
     check(seam_share[True] > seam_share[False],
           f"more marked edges become UV cuts with the marks honoured ({seam_share[True]:.2f}) than without "
           f"({seam_share[False]:.2f})")
+
+    # --- automatic field following: rigid unfolding under gravel (no direction), the number otherwise ---
+    check(large["tailor"]["field_following"] == 0, "auto field following: gravel's tile unfolds rigidly (0)")
+    select_only(small)
+    bpy.ops.uv.tailor_texture_map(tile_size=0.25, assign_material=True, image_path=IMAGE, auto_field_following=False)
+    check(small["tailor"]["field_following"] == 1, "auto off: the Field following number (1)")
+    bpy.ops.uv.tailor_texture_map(tile_size=0.25)
+    check(small["tailor"]["field_following"] == 1, "no image: the Field following number (1)")
+
+    # --- a material folder (gravel with a DirectX normal map, roughness, occlusion) ---
+    folder = make_material(os.path.join(TMP, "gravel_material"), backend)
+    for kind in ([KIND, "cli"] if KIND == "module" else ["cli"]):
+        preferences.backend = "MODULE" if kind == "module" else "CLI"
+        select_only(small)
+        result = bpy.ops.uv.tailor_texture_map(tile_size=0.25, assign_material=True, material_path=folder)
+        check(result == {"FINISHED"} and small["tailor"]["backend"] == kind, f"material folder ({kind}) finished")
+        check(small["tailor"]["field_following"] == 0, f"material ({kind}): auto on its colour map (0)")
+        finite, flipped, density = uv_figures(small)
+        check(finite and flipped == 0 and abs(density / 16.0 - 1) < 0.1,
+              f"material ({kind}): finite, 0 flipped, 16 repeats^2/unit^2 from the colour map's size ({density})")
+    check_material_nodes(small.data.materials[-1])
+    preferences.backend = "MODULE" if KIND == "module" else "CLI"
 
     # --- errors are reports, never a crash ---
     try:
