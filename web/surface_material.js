@@ -69,6 +69,8 @@ uniform sampler2D map;
 uniform bool hasMap;
 uniform sampler2D normalMap;
 uniform bool hasNormalMap;
+uniform sampler2D occlusionMap;
+uniform bool hasOcclusionMap;
 ${variantUniforms()}
 uniform int variantCount;
 uniform uint variantSeed;
@@ -137,7 +139,9 @@ void main() {
   }
   if (!gl_FrontFacing) n = -n;
   float diffuse = max(dot(n, normalize(vec3(-0.35, 0.55, 0.76))), 0.0);
-  float light = 0.36 + 0.72 * diffuse;
+  // The file's occlusion map scales the ambient light only (glTF: indirect light).
+  float ambient = mode == 0 && hasOcclusionMap ? 0.36 * texture2D(occlusionMap, uv).r : 0.36;
+  float light = ambient + 0.72 * diffuse;
 
   vec3 base;
   if (mode == 0) {
@@ -174,6 +178,8 @@ export function createSurfaceMaterial() {
     hasMap: { value: false },
     normalMap: { value: null },
     hasNormalMap: { value: false },
+    occlusionMap: { value: null },
+    hasOcclusionMap: { value: false },
     variantCount: { value: 0 },
     variantSeed: { value: 1 },
     uvScale: { value: 1 },
@@ -198,6 +204,8 @@ export function updateSurfaceMaterial(material, state, textures) {
   // The file's normal map shades the texture view (its tiles match the embedded colour map's).
   u.normalMap.value = textures.normalMap || textures.blank;
   u.hasNormalMap.value = !!textures.normalMap && state.normalMapping !== false;
+  u.occlusionMap.value = textures.occlusionMap || textures.blank;
+  u.hasOcclusionMap.value = !!textures.occlusionMap && state.normalMapping !== false;
   const variants = state.useVariants ? textures.variants : [];
   u.variantCount.value = variants.length;
   for (let k = 0; k < kMaxVariants; ++k) {

@@ -23,7 +23,7 @@ const state = {
   checkerSquares: 8,
   distortionRange: 2,
 };
-const textures = { map: null, normalMap: null, variants: [], blank: null };
+const textures = { map: null, normalMap: null, occlusionMap: null, variants: [], blank: null };
 const stats = {
   faces: 0, patches: 0, seamEdges: 0, loadSeconds: 0, analysisSeconds: 0,
   // Seam lengths of the welded mesh (mesh_data.js seamClasses) and eval's ratios from them.
@@ -137,6 +137,10 @@ async function load() {
     // `tailor map --material`: the file's normal map, with the TANGENT that buildSurface keeps.
     if (!textures.normalMap && mesh.material && mesh.material.normalMap && mesh.geometry.getAttribute('tangent')) {
       textures.normalMap = prepareTexture(mesh.material.normalMap);
+    }
+    // Its occlusion map (three.js's aoMap) darkens the ambient light, as `tailor render` does.
+    if (!textures.occlusionMap && mesh.material && mesh.material.aoMap) {
+      textures.occlusionMap = prepareTexture(mesh.material.aoMap);
     }
     // UVs are in repeats of the embedded texture: its size turns them into pixels for the seam
     // gaps, as `tailor eval` does (512 without one).
