@@ -151,6 +151,13 @@ expect_error 2 "" -- "$tailor" frobnicate
 expect_error 2 "symmetry 4 needs a square texture, got 64x48" -- "$tailor" map "$mesh" --texture "$tmp/wide.png" -o "$tmp/x.glb" --symmetry 4
 [[ ! -e $tmp/x.glb ]] && ok || fail "map --symmetry 4 with a non-square texture wrote its output"
 expect_error 2 "symmetry" -- "$tailor" eval "$tmp/a.glb" --symmetry 3
+# render --normal-map: an RGB map shades the texture view (a different picture), a grey one is refused.
+"$tailor" render "$tmp/s4a.glb" --size 64x48 -o "$tmp/plain.png" -q &&
+  "$tailor" render "$tmp/s4a.glb" --size 64x48 --normal-map "$tmp/wide.png" -o "$tmp/bumpy.png" -q &&
+  ! cmp -s "$tmp/plain.png" "$tmp/bumpy.png" && ok || fail "render --normal-map: no picture or no change"
+expect_error 1 "grass-gray-512.png: a normal map needs RGB channels" -- "$tailor" render "$tmp/s4a.glb" --normal-map \
+  tests/data/textures/grass-gray-512.png -o "$tmp/x.png"
+[[ ! -e $tmp/x.png ]] && ok || fail "render with a grey normal map wrote its output"
 
 # --- hardening of outputs (docs/hardening.md) ---
 # 1. A device, FIFO or socket named as an output is refused, untouched; a symlink is written through.

@@ -73,6 +73,8 @@ int run_render(const RenderArgs& args) {
   if (!args.normal_map.empty()) {  // replaces the file's; tangents then come from the UVs
     status = load_image(args.normal_map, maps.normal);
     if (!status) return report_error(status.with_file(args.normal_map));
+    if (maps.normal.channels < 3)
+      return report_error(Status::error(ErrorCode::kInvalidImage, args.normal_map, "a normal map needs RGB channels"));
     maps.corner_tangents.clear();
   }
   PreviewMaterial material;
