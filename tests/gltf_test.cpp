@@ -147,6 +147,36 @@ TEST(GltfScene, NodeTransformsAreAppliedParentsFirst) {
   EXPECT_FLOAT_EQ(mesh.positions[0], 100.f);
 }
 
+TEST(GltfScene, TangentsAreTurnedByTheNodesAndFlippedByMirrors) {
+  // TANGENT (1, 0, 0, +1) on every vertex; node 0 turns the mesh 90 degrees about z and scales it,
+  // node 1 mirrors x. read_glb_with_material gives per-corner world tangents: (0, 1, 0, +1) and
+  // (-1, 0, 0, -1) (a mirror reverses the bitangent: w flips); read_glb_file keeps none of it.
+  const double s = std::sqrt(0.5);
+  const Json nodes = {{{"mesh", 0}, {"rotation", {0, 0, s, s}}, {"scale", {3, 3, 3}}},
+                      {{"mesh", 0}, {"matrix", {-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 5, 1}}}};
+  Builder b = one_triangle(nodes, {{{"nodes", {0, 1}}}});
+  const size_t t = b.accessor(std::vector<float>{1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1}, 5126, "VEC4", 3);
+  b.json["meshes"][0]["primitives"][0]["attributes"]["TANGENT"] = t;
+  const std::string dir = test::empty_temp_dir("gltf_tangents");
+  const std::string path = dir + "/tangents.glb";
+  std::ofstream(path, std::ios::binary) << b.glb();
+  Mesh mesh;
+  GltfMaterialMaps maps;
+  ASSERT_TRUE(read_glb_with_material(path, mesh, nullptr, &maps).is_ok());
+  ASSERT_EQ(mesh.face_count(), 2u);
+  ASSERT_EQ(maps.corner_tangents.size(), 4 * 6u);
+  EXPECT_TRUE(maps.normal.empty());
+  EXPECT_TRUE(mesh.corner_attributes.empty());
+  const float expected[2][4] = {{0, 1, 0, 1}, {-1, 0, 0, -1}};
+  for (size_t c = 0; c < 6; ++c)
+    for (size_t i = 0; i < 4; ++i) EXPECT_NEAR(maps.corner_tangents[4 * c + i], expected[c / 3][i], 1e-6) << c;
+  LoadReport report;
+  ASSERT_TRUE(read_glb_file(path, mesh, nullptr, &report).is_ok());
+  EXPECT_TRUE(mesh.corner_attributes.empty());
+  EXPECT_NE(report.not_kept.find("TANGENT"), std::string::npos) << report.not_kept;
+  fs::remove_all(dir);
+}
+
 TEST(GltfScene, BadHierarchiesFailWithOneLine) {
   Mesh mesh;
   Builder cycle = one_triangle({{{"mesh", 0}, {"children", {1}}}, {{"children", {0}}}}, {{{"nodes", {0}}}});

@@ -310,6 +310,17 @@ TEST_F(MaterialTest, CompressedFilesKeepTangentsAndValidate) {
     if (draco) {
       EXPECT_TRUE(primitive["extensions"]["KHR_draco_mesh_compression"]["attributes"].contains("TANGENT"));
     }
+    // The reader decodes them too (tailor render shades with them): unit xyz, w = +-1, per corner.
+    Mesh mesh;
+    GltfMaterialMaps maps;
+    ASSERT_TRUE(read_glb_with_material(out, mesh, nullptr, &maps).is_ok());
+    ASSERT_EQ(maps.corner_tangents.size(), 4 * mesh.indices.size());
+    EXPECT_FALSE(maps.normal.empty());
+    for (size_t c = 0; c < maps.corner_tangents.size(); c += 4) {
+      const float* t = &maps.corner_tangents[c];
+      ASSERT_NEAR(std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]), 1.0, 1e-2) << c / 4;
+      ASSERT_EQ(std::abs(t[3]), 1.0f) << c / 4;
+    }
     expect_valid_gltf(out);
   }
 }
