@@ -124,9 +124,11 @@ TAILOR_API Status render_preview(const Mesh& mesh, std::span<const float> corner
                                  const Image* texture, const RenderOptions& options, Image& out);
 
 //! The same with a material's other maps (PreviewMaterial), used by the texture view only. Every
-//! texture view is lit per pixel (with or without a material, so that a flat normal map changes
-//! nothing); the maps must share the texture's UVs. Also fails with kInvalidImage for an
-//! inconsistent map and kInvalidArgument for tangents of the wrong size or not finite.
+//! texture view is lit per pixel by a GLSL shader (with or without a material, so that a flat
+//! normal map changes nothing; an OpenGL without GLSL falls back to per-vertex light when no map is
+//! given, and fails with kUnsupported when one is); the maps share the texture's UVs. Also fails
+//! with kInvalidImage for an inconsistent map and kInvalidArgument for tangents of the wrong size
+//! or not finite.
 TAILOR_API Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::span<const uint32_t> patch,
                                  const Image* texture, const PreviewMaterial& material, const RenderOptions& options,
                                  Image& out);

@@ -432,7 +432,7 @@ Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::s
     GLint max_texture = 0;
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture);
     const bool use_image = options.view == PreviewView::kTexture && texture != nullptr;
-    const bool shaded = options.view == PreviewView::kTexture;  // lit per pixel, with the material's maps
+    bool shaded = options.view == PreviewView::kTexture;  // lit per pixel, with the material's maps
     const Image* normal_map = shaded ? material.normal : nullptr;
     const Image* occlusion_map = shaded ? material.occlusion : nullptr;
     for (const Image* image : {use_image ? texture : nullptr, normal_map, occlusion_map}) {
@@ -444,7 +444,10 @@ Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::s
     ShaderProgram program;  // after the context: deleted before it
     std::string shader_log;
     if (shaded && !program.build(shader_log)) {
-      return Status::error(ErrorCode::kUnsupported, "", "the renderer cannot compile its shader", shader_log);
+      // Without GLSL (an OSMesa without llvmpipe) the fixed-function light still draws the texture.
+      if (normal_map != nullptr || occlusion_map != nullptr)
+        return Status::error(ErrorCode::kUnsupported, "", "the renderer cannot compile its shader", shader_log);
+      shaded = false;
     }
     // The normal map's tangent frames: the file's, else those export_mesh would write for these UVs.
     std::vector<float> computed_tangents;
