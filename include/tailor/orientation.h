@@ -70,6 +70,9 @@ inline constexpr OptionDoc kOrientationOptionDocs[] = {
      "its nearest curve-skeleton edge, so the texture runs along limbs; CGAL mean curvature flow: 3 s on the "
      "97k-face horse, up to 30 s on scans; holes are closed first, see docs/mapping.md)"},
     {"smooth_passes", "--smooth", "Orientation smoothing passes over face neighbours"},
+    {"strokes", "--strokes",
+     "JSON file of orientation strokes, {\"strokes\": [{\"points\": [[x,y,z], ...], \"radius\": r}]} in mesh "
+     "coordinates (what tailor edit saves): within r of a stroke the field turns to follow it, fully on the curve"},
 };
 
 //! Per-face frames. Shapes: #F by 3 arrays are packed xyz per face.
