@@ -3,7 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <span>
 #include <thread>
 #include <vector>
 
@@ -45,14 +48,21 @@ std::vector<float> uvs_of(const EditSession& session, uint64_t version) {
   return uv;
 }
 
-// A stroke through a run of the mesh's vertices (on the surface), with a radius of a tenth of it.
+// A stroke through the first corners of a run of faces (on the surface), with a radius of a
+// twentieth of the mesh's longest side.
 OrientationStroke stroke_along(const Mesh& mesh, uint32_t first, uint32_t count) {
   OrientationStroke s;
   for (uint32_t f = first; f < first + count; ++f) {
     const uint32_t v = mesh.indices[3 * f];
     for (int c = 0; c < 3; ++c) s.points.push_back(mesh.positions[3 * v + c]);
   }
-  s.radius = 0.1f;
+  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (size_t v = 0; v < mesh.vertex_count(); ++v)
+    for (int c = 0; c < 3; ++c) {
+      lo[c] = std::min(lo[c], mesh.positions[3 * v + c]);
+      hi[c] = std::max(hi[c], mesh.positions[3 * v + c]);
+    }
+  s.radius = 0.05f * std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
   return s;
 }
 
@@ -205,6 +215,159 @@ TEST(EditSession, BadEditsChangeNothing) {
   EXPECT_EQ(result.version, 0u);
   EXPECT_EQ(result.changed_faces, 0u);
   EXPECT_TRUE(result.settled);
+}
+
+// The most a local update may change: faces of the patches holding `edited` faces and of the
+// patches bordering those, and (local_update.cpp: 24) within 40 edge rings of the edited faces.
+std::vector<uint8_t> patch_region(const Topology& topology, const Atlas& atlas, const std::vector<uint32_t>& edited) {
+  std::vector<uint8_t> mark(atlas.patch_count, 0), region(atlas.patch.size(), 0);
+  for (const uint32_t f : edited) mark[atlas.patch[f]] = 1;
+  for (size_t f = 0; f < atlas.patch.size(); ++f)
+    if (mark[atlas.patch[f]] == 1)
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t g = neighbour_face(topology, static_cast<uint32_t>(3 * f + k));
+        if (g != kInvalid && mark[atlas.patch[g]] == 0) mark[atlas.patch[g]] = 2;
+      }
+  std::vector<uint32_t> ring(atlas.patch.size(), kInvalid), fifo;
+  for (const uint32_t f : edited)
+    if (ring[f] == kInvalid) ring[f] = 0, fifo.push_back(f);
+  for (size_t head = 0; head < fifo.size(); ++head)
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t g = neighbour_face(topology, 3 * fifo[head] + k);
+      if (g != kInvalid && ring[g] == kInvalid) ring[g] = ring[fifo[head]] + 1, fifo.push_back(g);
+    }
+  for (size_t f = 0; f < atlas.patch.size(); ++f) region[f] = mark[atlas.patch[f]] != 0 && ring[f] <= 40;
+  return region;
+}
+
+uint32_t faces_changed(const Atlas& a, const Atlas& b) {
+  uint32_t n = 0;
+  for (size_t f = 0; f < a.patch.size(); ++f) {
+    bool same = a.patch[f] == b.patch[f];
+    for (int i = 0; i < 6; ++i) same = same && a.corner_uv[6 * f + i] == b.corner_uv[6 * f + i];
+    n += same ? 0 : 1;
+  }
+  return n;
+}
+
+// Edges (each once) whose two faces' UVs differ along them, touching one of `faces`.
+size_t seam_edges_at(const Mesh& mesh, const Topology& topology, const Atlas& atlas,
+                     const std::vector<uint8_t>& faces) {
+  size_t n = 0;
+  for (size_t e = 0; e < 3 * mesh.face_count(); ++e) {
+    const uint32_t o = topology.opposite[e];
+    if (o == kInvalid || o < e || !(faces[e / 3] || faces[o / 3])) continue;
+    const float* a = &atlas.corner_uv[2 * e];
+    const float* a1 = &atlas.corner_uv[2 * (3 * (e / 3) + (e + 1) % 3)];
+    const float* b = &atlas.corner_uv[2 * o];
+    const float* b1 = &atlas.corner_uv[2 * (3 * (o / 3) + (o + 1) % 3)];
+    n += !(a[0] == b1[0] && a[1] == b1[1] && a1[0] == b[0] && a1[1] == b[1]);
+  }
+  return n;
+}
+
+// Every face placed with finite UVs, within the per-face stretch bound, not inverted.
+void expect_valid(const Mesh& mesh, const Atlas& atlas, const MapTextureOptions& options) {
+  FaceFrames frames;
+  ASSERT_TRUE(compute_orientation(mesh, build_topology(mesh), options.orientation, frames).is_ok());
+  ASSERT_EQ(atlas.corner_uv.size(), 6 * mesh.face_count());
+  for (size_t f = 0; f < mesh.face_count(); ++f) {
+    ASSERT_LT(atlas.patch[f], atlas.patch_count);
+    for (int i = 0; i < 6; ++i) ASSERT_TRUE(std::isfinite(atlas.corner_uv[6 * f + i])) << "face " << f;
+    const float* l = &frames.local[6 * f];
+    if (l[2] * l[5] - l[3] * l[4] <= 0.f) continue;  // zero-area face
+    const float e = face_stretch_error(std::span<const float, 6>(l, 6), options.mapping.scale,
+                                       std::span<const float, 6>(&atlas.corner_uv[6 * f], 6));
+    ASSERT_LE(e, options.mapping.max_stretch * 1.001f) << "face " << f;
+  }
+}
+
+TEST(EditSession, ALocalUpdateKeepsTheFacesBeyondTheEditedPatchesBitForBit) {
+  const Mesh mesh = test::load_test_mesh("fertility.off");
+  const Topology topology = build_topology(mesh);
+  const auto session = open_session(mesh, default_options());
+  ASSERT_TRUE(session);
+  // A brush of 80 faces, breadth first from a face in the middle of the face order.
+  std::vector<uint32_t> brush{static_cast<uint32_t>(mesh.face_count() / 2)};
+  std::vector<uint8_t> in_brush(mesh.face_count(), 0);
+  in_brush[brush[0]] = 1;
+  for (size_t i = 0; i < brush.size() && brush.size() < 80; ++i)
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t g = neighbour_face(topology, 3 * brush[i] + k);
+      if (g != kInvalid && !in_brush[g] && brush.size() < 80) in_brush[g] = 1, brush.push_back(g);
+    }
+  const Atlas before = current_atlas(*session);
+  EditRequest edit;
+  edit.add_seam_faces = brush;
+  EditResult result;
+  ASSERT_TRUE(session->apply(edit, result).is_ok());
+  EXPECT_FALSE(result.settled);
+  EXPECT_FALSE(session->settled());
+  const Atlas after = current_atlas(*session);
+  const std::vector<uint8_t> region = patch_region(topology, before, brush);
+  size_t outside = 0;
+  for (size_t f = 0; f < mesh.face_count(); ++f) {
+    if (region[f]) continue;
+    ++outside;
+    ASSERT_EQ(after.patch[f], before.patch[f]) << "face " << f;
+    for (int i = 0; i < 6; ++i) ASSERT_EQ(after.corner_uv[6 * f + i], before.corner_uv[6 * f + i]) << "face " << f;
+  }
+  EXPECT_GT(outside, 0u);
+  EXPECT_EQ(result.changed_faces, faces_changed(before, after));
+  EXPECT_GT(result.changed_faces, 0u);
+  expect_valid(mesh, after, default_options());
+  // The seams move onto the marked faces (thesis figure 2.8), already in the fast update.
+  const size_t seams_before = seam_edges_at(mesh, topology, before, in_brush);
+  const size_t seams_after = seam_edges_at(mesh, topology, after, in_brush);
+  std::printf("brush of %zu faces: %zu seam edges at it before, %zu after the local update; %u faces changed\n",
+              brush.size(), seams_before, seams_after, result.changed_faces);
+  EXPECT_GT(seams_after, seams_before);
+
+  // Unmarking them again is local too; settling gives the full map of the state.
+  EditRequest undo_edit;
+  undo_edit.remove_seam_faces = brush;
+  ASSERT_TRUE(session->apply(undo_edit, result).is_ok());
+  expect_valid(mesh, current_atlas(*session), default_options());
+  ASSERT_TRUE(session->settle(result).is_ok());
+  EXPECT_EQ(current_atlas(*session).corner_uv, before.corner_uv);
+}
+
+TEST(EditSession, AStrokeUpdatesOnlyThePatchesItReaches) {
+  const Mesh mesh = test::load_test_mesh("fertility.off");
+  const Topology topology = build_topology(mesh);
+  const auto session = open_session(mesh, default_options());
+  ASSERT_TRUE(session);
+  const Atlas before = current_atlas(*session);
+  const OrientationStroke stroke = stroke_along(mesh, static_cast<uint32_t>(mesh.face_count() / 3), 12);
+  // The faces whose frame the stroke can change: those it reaches (centroid within the radius).
+  FaceFrames plain, stroked;
+  MapTextureOptions options = default_options();
+  ASSERT_TRUE(compute_orientation(mesh, topology, options.orientation, plain).is_ok());
+  options.orientation.strokes = std::span<const OrientationStroke>(&stroke, 1);
+  ASSERT_TRUE(compute_orientation(mesh, topology, options.orientation, stroked).is_ok());
+  std::vector<uint32_t> reached;
+  for (uint32_t f = 0; f < mesh.face_count(); ++f)
+    if (plain.orientation[3 * f] != stroked.orientation[3 * f] ||
+        plain.orientation[3 * f + 1] != stroked.orientation[3 * f + 1] ||
+        plain.orientation[3 * f + 2] != stroked.orientation[3 * f + 2])
+      reached.push_back(f);
+  ASSERT_GT(reached.size(), 10u);
+  EditRequest edit;
+  edit.strokes.push_back(stroke);
+  EditResult result;
+  ASSERT_TRUE(session->apply(edit, result).is_ok());
+  const Atlas after = current_atlas(*session);
+  const std::vector<uint8_t> region = patch_region(topology, before, reached);
+  for (size_t f = 0; f < mesh.face_count(); ++f) {
+    if (region[f]) continue;
+    ASSERT_EQ(after.patch[f], before.patch[f]) << "face " << f;
+    for (int i = 0; i < 6; ++i) ASSERT_EQ(after.corner_uv[6 * f + i], before.corner_uv[6 * f + i]) << "face " << f;
+  }
+  EXPECT_EQ(result.changed_faces, faces_changed(before, after));
+  EXPECT_GT(result.changed_faces, 0u);
+  expect_valid(mesh, after, options);
+  ASSERT_TRUE(session->settle(result).is_ok());
+  EXPECT_EQ(current_atlas(*session).corner_uv, full_map(mesh, {}, {stroke}, default_options()).corner_uv);
 }
 
 TEST(EditSession, EditsFromSeveralThreadsSettleToTheFullMap) {

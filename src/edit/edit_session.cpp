@@ -91,15 +91,13 @@ struct EditSession::State {
   mutable std::mutex versions_mutex;
   std::deque<std::pair<uint64_t, std::vector<float>>> versions;  // recent versions' UVs in repeats
 
-  // The full map of the current state (seam flags, strokes, options) into `out`.
-  Status map_fully(const std::vector<uint8_t>& seam_flags, const std::vector<OrientationStroke>& stroke_list,
-                   const MapTextureOptions& base, const ProgressCallback& progress, TextureMap& out) const {
+  // The options of a state with its seam flags and strokes set.
+  static MapTextureOptions with_state(const MapTextureOptions& base, const std::vector<uint8_t>& seam_flags,
+                                      const std::vector<OrientationStroke>& stroke_list) {
     MapTextureOptions o = base;
     o.mapping.seam_faces = seam_flags;
     o.orientation.strokes = stroke_list;
-    o.mapping.progress = progress;
-    o.measure = false;  // the session shows no metrics (the atlas does not depend on them)
-    return map_texture(mesh, topology, o, out);
+    return o;
   }
 
   // Makes the current atlas version v's and keeps its UVs.
@@ -133,42 +131,51 @@ struct EditSession::State {
   }
 
   // The state moved to history position `applied` by undo or redo: its kept atlas when there is
-  // one (bit for bit what it showed), else a fast update from the previous version.
-  Status move_to_position(const std::vector<uint32_t>& flipped, size_t stroke_count_before, bool options_changed,
-                          EditResult& result) {
-    const Atlas before = map.atlas;
+  // one (bit for bit what it showed, the frames updated to match), else an update as for an edit.
+  Status move_to_position(const std::vector<uint32_t>& flipped, const std::vector<OrientationStroke>& changed_strokes,
+                          bool options_changed, EditResult& result) {
     const KeptAtlas* found = nullptr;
     for (const KeptAtlas& k : kept)
       if (k.position == applied) found = &k;
-    bool is_settled = false;
-    if (found) {
-      TextureMap restored;
-      // The frames of that state (the local update reads them); the atlas is the kept one.
-      MapTextureOptions o = options;
-      o.orientation.strokes = strokes;
-      TAILOR_RETURN_IF_ERROR(compute_orientation(mesh, topology, o.orientation, restored.frames));
-      map.frames = std::move(restored.frames);
-      map.atlas = found->atlas;
-      is_settled = found->settled;
-      local.reset();
-    } else {
-      TAILOR_RETURN_IF_ERROR(update(flipped, stroke_count_before, options_changed));
+    if (!found) {
+      TAILOR_RETURN_IF_ERROR(update(flipped, changed_strokes, options_changed, result.changed_faces));
+      publish(version.load() + 1, false);
+      return Status::ok();
     }
-    result.changed_faces = count_changed(before, map.atlas);
-    publish(version.load() + 1, is_settled);
+    const MapTextureOptions o = with_state(options, seam, strokes);
+    if (options_changed || !internal::can_update_locally(o, local)) {
+      local.reset();
+      TAILOR_RETURN_IF_ERROR(
+          internal::compute_orientation_setup(mesh, topology, o.orientation, map.frames, &local.setup));
+      local.seeds = component_seed_faces(mesh, topology, map.frames, o.mapping);
+      local.region.assign(mesh.face_count(), 0);
+      local.ring.resize(mesh.face_count());
+      local.ready = true;
+    } else {
+      std::vector<uint32_t> affected;
+      internal::refresh_stroke_frames(mesh, topology, o, changed_strokes, map, local, affected);
+    }
+    result.changed_faces = count_changed(map.atlas, found->atlas);
+    map.atlas = found->atlas;
+    publish(version.load() + 1, found->settled);
     return Status::ok();
   }
 
-  // The new state's map after an edit: a local update of the current one where possible.
-  Status update(const std::vector<uint32_t>& flipped, size_t stroke_count_before, bool options_changed) {
-    (void)flipped;
-    (void)stroke_count_before;
-    (void)options_changed;
-    TextureMap next;
-    TAILOR_RETURN_IF_ERROR(map_fully(seam, strokes, options, nullptr, next));
-    map = std::move(next);
-    local.reset();
-    return Status::ok();
+  // The new state's map after an edit: a local update of the current one where possible, else the
+  // full map. changed: faces whose UVs or patch changed.
+  Status update(const std::vector<uint32_t>& flipped, const std::vector<OrientationStroke>& changed_strokes,
+                bool options_changed, uint32_t& changed) {
+    const MapTextureOptions o = with_state(options, seam, strokes);
+    if (options_changed || !internal::can_update_locally(o, local)) {
+      TextureMap next;
+      TAILOR_RETURN_IF_ERROR(internal::map_keeping_setup(mesh, topology, o, next, local));
+      changed = count_changed(map.atlas, next.atlas);
+      map = std::move(next);
+      return Status::ok();
+    }
+    std::vector<uint32_t> affected;
+    internal::refresh_stroke_frames(mesh, topology, o, changed_strokes, map, local, affected);
+    return internal::update_region(mesh, topology, o, flipped, affected, map, local, changed);
   }
 };
 
@@ -188,7 +195,9 @@ Status EditSession::open(Mesh mesh, const MapTextureOptions& options, std::uniqu
   else
     st.seam.assign(st.mesh.face_count(), 0);
   st.strokes.assign(options.orientation.strokes.begin(), options.orientation.strokes.end());
-  TAILOR_RETURN_IF_ERROR(st.map_fully(st.seam, st.strokes, st.options, options.mapping.progress, st.map));
+  MapTextureOptions first = State::with_state(st.options, st.seam, st.strokes);
+  first.mapping.progress = options.mapping.progress;
+  TAILOR_RETURN_IF_ERROR(internal::map_keeping_setup(st.mesh, st.topology, first, st.map, st.local));
   st.publish(0, true);
   session = std::move(s);
   return Status::ok();
@@ -249,8 +258,8 @@ Status EditSession::apply(const EditRequest& edit, EditResult& result) {
   st.seam = std::move(seam);
   st.strokes.insert(st.strokes.end(), step.strokes.begin(), step.strokes.end());
   if (new_options) st.options = *new_options;
-  const Atlas atlas_before = st.map.atlas;
-  if (Status s = st.update(step.flipped, strokes_before, differs); !s) {
+  if (Status s = st.update(step.flipped, step.strokes, differs, result.changed_faces); !s) {
+    // Only the full map can fail (options map_texture refuses): the frames and atlas are intact.
     st.seam = seam_before;
     st.strokes.resize(strokes_before);
     st.options = options_before;
@@ -263,7 +272,6 @@ Status EditSession::apply(const EditRequest& edit, EditResult& result) {
       st.kept.end());
   st.steps.push_back(std::move(step));
   st.applied = st.steps.size();
-  result.changed_faces = count_changed(atlas_before, st.map.atlas);
   st.publish(st.version.load() + 1, false);
   result.version = st.version.load();
   result.settled = false;
@@ -280,11 +288,10 @@ Status EditSession::undo(EditResult& result) {
   if (st.applied == 0) return Status::error(ErrorCode::kInvalidArgument, "", "nothing to undo");
   const Step& step = st.steps[st.applied - 1];
   for (const uint32_t f : step.flipped) st.seam[f] ^= 1;
-  const size_t strokes_before = st.strokes.size();
   st.strokes.resize(st.strokes.size() - step.strokes.size());
   if (step.options_before) st.options = *step.options_before;
   --st.applied;
-  TAILOR_RETURN_IF_ERROR(st.move_to_position(step.flipped, strokes_before, step.options_before.has_value(), result));
+  TAILOR_RETURN_IF_ERROR(st.move_to_position(step.flipped, step.strokes, step.options_before.has_value(), result));
   result.version = st.version.load();
   result.settled = st.settled.load();
   result.ms = ms_since(start);
@@ -300,11 +307,10 @@ Status EditSession::redo(EditResult& result) {
   if (st.applied == st.steps.size()) return Status::error(ErrorCode::kInvalidArgument, "", "nothing to redo");
   const Step& step = st.steps[st.applied];
   for (const uint32_t f : step.flipped) st.seam[f] ^= 1;
-  const size_t strokes_before = st.strokes.size();
   st.strokes.insert(st.strokes.end(), step.strokes.begin(), step.strokes.end());
   if (step.options_after) st.options = *step.options_after;
   ++st.applied;
-  TAILOR_RETURN_IF_ERROR(st.move_to_position(step.flipped, strokes_before, step.options_after.has_value(), result));
+  TAILOR_RETURN_IF_ERROR(st.move_to_position(step.flipped, step.strokes, step.options_after.has_value(), result));
   result.version = st.version.load();
   result.settled = st.settled.load();
   result.ms = ms_since(start);
@@ -334,8 +340,10 @@ Status EditSession::settle(EditResult& result) {
   }
   // The full map without a lock; an edit arriving meanwhile cancels it.
   TextureMap map;
-  const ProgressCallback cancel_on_edit = [&st, edits](float) { return st.edits.load() == edits; };
-  const Status s = st.map_fully(seam, strokes, options, cancel_on_edit, map);
+  internal::LocalUpdate local;
+  MapTextureOptions o = State::with_state(options, seam, strokes);
+  o.mapping.progress = [&st, edits](float) { return st.edits.load() == edits; };
+  const Status s = internal::map_keeping_setup(st.mesh, st.topology, o, map, local);
   result.ms = ms_since(start);
   if (s.code() == ErrorCode::kCancelled) return Status::ok();
   TAILOR_RETURN_IF_ERROR(s);
@@ -346,7 +354,7 @@ Status EditSession::settle(EditResult& result) {
   }
   result.changed_faces = count_changed(st.map.atlas, map.atlas);
   st.map = std::move(map);
-  st.local.reset();
+  st.local = std::move(local);
   if (result.changed_faces == 0) {
     st.settled.store(true);
     st.keep_atlas(true);
