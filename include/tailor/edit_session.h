@@ -6,14 +6,15 @@
 // (src/edit/local_update.h): the region is the faces of the patches the edit touches (a face
 // whose seam flag flipped, or whose orientation a stroke added or removed changes) and of the
 // patches bordering them, within 24 edge rings of the edited faces; it is grown again from the
-// faces around it and its seams shortened, and every other face keeps its UVs and patch bit for
-// bit. Crack closing and the relaxation are left to settle(), so an unsettled version shows more
-// seam in the region. settle() then computes the full map_texture result for the current state,
+// faces around it, its seams shortened and (meshes up to 500k faces) its cracks closed, and every
+// other face keeps its UVs and patch bit for bit. The relaxation, and the cracks next to the
+// faces kept, are left to settle(), so an unsettled version shows somewhat more seam in the
+// region. settle() then computes the full map_texture result for the current state,
 // which is byte for byte what `tailor map --seam-faces F --strokes S` gives with the same options
 // (any thread count). Edits that change the options, and sessions in the thesis mode, with
 // symmetry 4 or with field smoothing, map the whole mesh at each edit instead.
-// Measured (bench/bench_edit.cpp, docs/performance.md): apply 3 ms on 100k faces, 90-120 ms on
-// 1.55 M faces, where the full map takes 0.2-0.3 s and 4.5 s.
+// Measured (bench/bench_edit.cpp, docs/performance.md): apply about 20 ms of CPU on 100k faces
+// and 120 ms on 1.55 M faces, where the full map takes 0.17-0.3 s and 4.5 s.
 // `tailor edit` serves a session over HTTP (docs/edit-api.md).
 //
 // Memory: besides the mesh and one TextureMap, the UVs of the last 8 versions (24 bytes per face
