@@ -380,6 +380,49 @@ TEST(EditSession, AStrokeUpdatesOnlyThePatchesItReaches) {
   EXPECT_EQ(current_atlas(*session).corner_uv, full_map(mesh, {}, {stroke}, default_options()).corner_uv);
 }
 
+TEST(EditSession, LocalUpdatesAreTheSameForAnyThreadCount) {
+  const Mesh mesh = test::load_test_mesh("fertility.off");
+  MapTextureOptions one = default_options(), three = default_options();
+  one.mapping.threads = one.orientation.threads = 1;
+  three.mapping.threads = three.orientation.threads = 3;
+  const auto a = open_session(mesh, one);
+  const auto b = open_session(mesh, three);
+  ASSERT_TRUE(a && b);
+  for (uint32_t i = 0; i < 3; ++i) {
+    EditRequest edit;
+    for (uint32_t f = 2000 * i; f < 2000 * i + 50; ++f) edit.add_seam_faces.push_back(f);
+    edit.strokes.push_back(stroke_along(mesh, 2000 * i + 1000, 8));
+    EditResult ra, rb;
+    ASSERT_TRUE(a->apply(edit, ra).is_ok());
+    ASSERT_TRUE(b->apply(edit, rb).is_ok());
+    EXPECT_EQ(ra.changed_faces, rb.changed_faces);
+    EXPECT_EQ(uvs_of(*a, ra.version), uvs_of(*b, rb.version));
+  }
+}
+
+// Beyond the 8 kept atlases, undo updates locally (strokes removed, seam flags flipped back):
+// settled, the state is the full map of what is left.
+TEST(EditSession, UndoingPastTheKeptAtlasesSettlesToTheFullMap) {
+  const Mesh mesh = test::load_test_mesh("spot.obj");
+  const auto session = open_session(mesh, default_options());
+  ASSERT_TRUE(session);
+  EditResult result;
+  for (uint32_t i = 0; i < 11; ++i) {
+    EditRequest edit;
+    for (uint32_t f = 500 * i; f < 500 * i + 30; ++f) edit.add_seam_faces.push_back(f);
+    if (i % 2 == 0) edit.strokes.push_back(stroke_along(mesh, 500 * i + 200, 6));
+    ASSERT_TRUE(session->apply(edit, result).is_ok());
+  }
+  for (int i = 0; i < 9; ++i) ASSERT_TRUE(session->undo(result).is_ok());
+  EXPECT_FALSE(result.settled);
+  ASSERT_TRUE(session->settle(result).is_ok());
+  std::vector<uint8_t> seam(mesh.face_count(), 0);
+  for (uint32_t f = 0; f < 30; ++f) seam[f] = seam[500 + f] = 1;
+  const Atlas expected = full_map(mesh, seam, {stroke_along(mesh, 200, 6)}, default_options());
+  EXPECT_EQ(current_atlas(*session).corner_uv, expected.corner_uv);
+  EXPECT_EQ(current_atlas(*session).patch, expected.patch);
+}
+
 TEST(EditSession, EditsFromSeveralThreadsSettleToTheFullMap) {
   const Mesh mesh = test::load_test_mesh("spot.obj");
   const auto session = open_session(mesh, default_options());
