@@ -40,6 +40,13 @@ enum class AxisSource {
 //! A curve the user drew on the surface (tailor edit, tailor map --strokes FILE): near it the
 //! orientation field follows the curve's direction, blended into the axis field with a weight
 //! that falls from 1 on the curve to 0 at `radius` (smoothly), so strokes act locally.
+//! Per face (its centroid): each stroke within reach gives the tangent at its nearest point (the
+//! nearest segment's direction, turning towards the next segment's near a shared point) and the
+//! weight w = 1 - smoothstep(distance / radius); several strokes add their tangents times their
+//! weights and the largest weight counts. The face's o is turned in its plane towards that
+//! direction projected onto the face by w times the angle between them (at w = 1, o is the
+//! direction; the sign of the stroke counts: a texture runs the way it was drawn). Blended before
+//! smoothing; without smoothing, faces beyond every radius keep their frames bit for bit.
 struct OrientationStroke {
   std::vector<float> points;  //!< N by 3 (N >= 2): points along the curve, mesh coordinates
   float radius = 0.f;         //!< reach of the stroke, mesh units (> 0)
@@ -56,9 +63,9 @@ struct OrientationOptions {
   // Normalisation into the unit cube. Leave fixed_unit_scale at 0 to derive it from the mesh's
   // bounding box; stability runs pass the full mesh's values so a cut mesh keeps the same frame.
   std::array<float, 3> fixed_origin{0.f, 0.f, 0.f};  //!< with fixed_unit_scale > 0: bbox minimum, mesh units
-  float fixed_unit_scale = 0.f;  //!< > 0: normalised = (x - origin) * this; 0 = 1 / longest bbox side
-  uint32_t threads = 0;          //!< threads for the per-face frames (0 = one per 100k faces, at most
-                                 //!< the cores and 8); the result is identical for any count
+  float fixed_unit_scale = 0.f;                //!< > 0: normalised = (x - origin) * this; 0 = 1 / longest bbox side
+  uint32_t threads = 0;                        //!< threads for the per-face frames (0 = one per 100k faces, at most
+                                               //!< the cores and 8); the result is identical for any count
   std::span<const OrientationStroke> strokes;  //!< user strokes blended into the field (empty = none)
 };
 
@@ -70,6 +77,9 @@ inline constexpr OptionDoc kOrientationOptionDocs[] = {
      "its nearest curve-skeleton edge, so the texture runs along limbs; CGAL mean curvature flow: 3 s on the "
      "97k-face horse, up to 30 s on scans; holes are closed first, see docs/mapping.md)"},
     {"smooth_passes", "--smooth", "Orientation smoothing passes over face neighbours"},
+    {"strokes", "--strokes",
+     "JSON file of orientation strokes, {\"strokes\": [{\"points\": [[x,y,z], ...], \"radius\": r}]} in mesh "
+     "coordinates (what tailor edit saves): within r of a stroke the field turns to follow it, fully on the curve"},
 };
 
 //! Per-face frames. Shapes: #F by 3 arrays are packed xyz per face.
@@ -103,8 +113,10 @@ struct FaceFrames {
 //! Computes normals, areas, the orientation field, corner positions in each face's frame and the
 //! per-face variation. Inputs: a finalised mesh and its topology (build_topology(mesh)).
 //! Never produces NaN: zero-area faces get an arbitrary orthonormal frame and variation 0 to
-//! themselves. Fails with kInvalidArgument on a zero user axis or smooth_passes > 1000, and with
-//! kInvalidMesh on an empty mesh or a topology of the wrong size. Cost: O(V + F * (1 + passes)).
+//! themselves. Fails with kInvalidArgument on a zero user axis, smooth_passes > 1000 or a bad
+//! stroke (naming it: points not x, y, z triples, fewer than 2, not finite, radius <= 0), and with
+//! kInvalidMesh on an empty mesh or a topology of the wrong size. Cost: O(V + F * (1 + passes)) plus, with
+//! strokes, a uniform grid over their segments and one cell's segments per face.
 //! Deterministic; safe for any mesh that passed finalize_mesh.
 TAILOR_API Status compute_orientation(const Mesh& mesh, const Topology& topology, const OrientationOptions& options,
                                       FaceFrames& frames);
