@@ -556,8 +556,9 @@ TEST(GltfKept, NormalsColoursAndOtherUvSetsSurviveAMapping) {
   LoadReport report;
   ASSERT_TRUE(read(b.glb(), mesh, &report).is_ok());
   EXPECT_EQ(mesh.vertex_count(), 8u);  // welded: the hard edges live in the corner normals
-  EXPECT_NE(report.not_kept.find("materials"), std::string::npos) << report.not_kept;
-  EXPECT_NE(report.not_kept.find("names"), std::string::npos) << report.not_kept;
+  EXPECT_EQ(report.not_kept, "") << "names and materials are kept";
+  ASSERT_EQ(mesh.scene.instances.size(), 1u);
+  EXPECT_EQ(mesh.scene.instances[0].node_name, "box");
   ASSERT_NE(attribute(mesh, "NORMAL"), nullptr);
 
   // Map into TEXCOORD_1 (any UVs will do): the file's normals, colours and TEXCOORD_0 come back.
@@ -663,6 +664,168 @@ TEST(GltfKept, ObjColoursAndNormalsReachTheGlb) {
     EXPECT_NEAR(normal->values[3 * c + 2], second ? 0.8f : 1.f, 1e-6) << c;
     const float expected_red = p[0] == 0 && p[1] == 0 ? 1.f : p[0] == 1 && p[1] == 1 ? 0.5f : 0.f;
     EXPECT_NEAR(colour->values[4 * c], expected_red, 1e-6) << c;
+  }
+  fs::remove_all(dir);
+}
+
+// The JSON chunk of a .glb file.
+Json glb_json_of(const std::string& file) {
+  const std::string glb = test::read_all(file);
+  uint32_t json_length = 0;
+  std::memcpy(&json_length, glb.data() + 12, 4);
+  return Json::parse(glb.substr(20, json_length));
+}
+
+// The names, extras and materials of a scene made by glTF-Transform reach the output: two
+// instances of one mesh (named nodes with extras), two materials (factors, doubleSided, alphaMode,
+// emissive, extras), the scene's and the asset's extras; plain, meshopt and Draco inputs, every
+// compression on output; each output valid, read back with the same faces per material.
+TEST_F(GltfTransformTest, NamesExtrasAndMaterialsSurviveAMapping) {
+  std::string glb = test::read_all(path("source.glb"));
+  uint32_t json_length = 0;
+  std::memcpy(&json_length, glb.data() + 12, 4);
+  Json j = Json::parse(glb.substr(20, json_length));
+  // The source's one primitive cut in two (its first half of the faces, its second), each with
+  // its own material: the indices accessor split by byte offset.
+  Json& primitive = j["meshes"][0]["primitives"][0];
+  const size_t indices = primitive["indices"], count = j["accessors"][indices]["count"];
+  const size_t half = count / 6 * 3;
+  Json second_indices = j["accessors"][indices];
+  j["accessors"][indices]["count"] = half;
+  second_indices["count"] = count - half;
+  second_indices["byteOffset"] = 4 * half;
+  j["accessors"].push_back(second_indices);
+  Json second = primitive;
+  second["indices"] = j["accessors"].size() - 1;
+  second["material"] = 1;
+  primitive["material"] = 0;
+  j["meshes"][0]["primitives"].push_back(second);
+  j["meshes"][0]["name"] = "cow";
+  j["meshes"][0]["extras"] = {{"scan", 7}};
+  j["materials"] = {{{"name", "hide"},
+                     {"doubleSided", true},
+                     {"emissiveFactor", {0.1, 0.2, 0.3}},
+                     {"extras", {{"grade", "A"}}},
+                     {"pbrMetallicRoughness", {{"metallicFactor", 0.25}, {"roughnessFactor", 0.75}}}},
+                    {{"name", "horn"},
+                     {"alphaMode", "MASK"},
+                     {"alphaCutoff", 0.4},
+                     {"pbrMetallicRoughness", {{"baseColorFactor", {1, 0.5, 0.25, 1}}, {"metallicFactor", 1.0}}}}};
+  j["nodes"] = {{{"mesh", 0}, {"name", "left"}, {"extras", {{"id", 1}}}},
+                {{"mesh", 0}, {"name", "right"}, {"translation", {3, 0, 0}}, {"extras", {{"id", 2}}}}};
+  j["scenes"] = {{{"nodes", {0, 1}}, {"name", "barn"}, {"extras", {{"season", "spring"}}}}};
+  j["asset"]["extras"] = {{"author", "test"}};
+  j["asset"]["copyright"] = "CC0";
+  std::string text = j.dump();
+  while (text.size() % 4) text += ' ';
+  const std::string bin_chunk = glb.substr(20 + json_length);
+  std::string out(20, '\0');
+  const uint32_t header[5] = {0x46546C67, 2, static_cast<uint32_t>(20 + text.size() + bin_chunk.size()),
+                              static_cast<uint32_t>(text.size()), 0x4E4F534A};
+  std::memcpy(out.data(), header, 20);
+  std::ofstream(path("scene.glb"), std::ios::binary) << out + text + bin_chunk;
+  transform("meshopt scene.glb scene_meshopt.glb");
+  transform("draco scene.glb scene_draco.glb");
+
+  for (const char* input : {"scene.glb", "scene_meshopt.glb", "scene_draco.glb"}) {
+    Mesh mesh;
+    LoadReport report;
+    const Status loaded = load_mesh(path(input), mesh, &report);
+    ASSERT_TRUE(loaded.is_ok()) << input << ": " << loaded.message();
+    EXPECT_EQ(report.not_kept.find("names"), std::string::npos) << report.not_kept;
+    EXPECT_EQ(report.not_kept.find("materials,"), std::string::npos) << report.not_kept;
+    ASSERT_EQ(mesh.scene.parts.size(), 4u) << input;  // 2 instances x 2 materials
+    Atlas atlas;
+    atlas.corner_uv.resize(6 * mesh.face_count());
+    for (size_t k = 0; k < atlas.corner_uv.size(); ++k) atlas.corner_uv[k] = float(k % 11) * 32;
+    atlas.patch.assign(mesh.face_count(), 0);
+    for (MeshCompression method :
+         {MeshCompression::kNone, MeshCompression::kQuantize, MeshCompression::kMeshopt, MeshCompression::kDraco}) {
+      SCOPED_TRACE(std::string(input) + " -> " + mesh_compression_name(method));
+      ExportOptions options;
+      options.compression = method;
+      const std::string file = path("out.glb");
+      ASSERT_TRUE(export_mesh(file, mesh, atlas, options).is_ok());
+      expect_valid_gltf(file);
+      const Json o = glb_json_of(file);
+      // The root "tailor" and one node per instance, named, with its extras, over one mesh each.
+      ASSERT_EQ(o["nodes"].size(), 3u);
+      EXPECT_EQ(o["nodes"][0]["children"], Json({1, 2}));
+      EXPECT_EQ(o["nodes"][1]["name"], "left");
+      EXPECT_EQ(o["nodes"][2]["name"], "right");
+      EXPECT_EQ(o["nodes"][1]["extras"]["id"], 1);
+      EXPECT_EQ(o["nodes"][2]["extras"]["id"], 2);
+      for (const Json& m : o["meshes"]) {
+        EXPECT_EQ(m["name"], "cow");
+        EXPECT_EQ(m["extras"]["scan"], 7);
+        ASSERT_EQ(m["primitives"].size(), 2u);
+      }
+      EXPECT_EQ(o["scenes"][0]["name"], "barn");
+      EXPECT_EQ(o["scenes"][0]["extras"]["season"], "spring");
+      EXPECT_EQ(o["asset"]["extras"]["author"], "test");
+      EXPECT_EQ(o["asset"]["copyright"], "CC0");
+      // Materials: the input's properties and tailor's texture coordinates' material.
+      ASSERT_EQ(o["materials"].size(), 2u);
+      const Json& hide = o["materials"][o["meshes"][0]["primitives"][0]["material"].get<size_t>()];
+      const Json& horn = o["materials"][o["meshes"][0]["primitives"][1]["material"].get<size_t>()];
+      EXPECT_EQ(hide["name"], "hide");
+      EXPECT_EQ(hide["doubleSided"], true);
+      EXPECT_EQ(hide["extras"]["grade"], "A");
+      EXPECT_NEAR(hide["emissiveFactor"][2].get<double>(), 0.3, 1e-6);
+      EXPECT_NEAR(hide["pbrMetallicRoughness"]["metallicFactor"].get<double>(), 0.25, 1e-6);
+      EXPECT_NEAR(hide["pbrMetallicRoughness"]["roughnessFactor"].get<double>(), 0.75, 1e-6);
+      EXPECT_EQ(horn["name"], "horn");
+      EXPECT_EQ(horn["alphaMode"], "MASK");
+      EXPECT_NEAR(horn["pbrMetallicRoughness"]["baseColorFactor"][1].get<double>(), 0.5, 1e-6);
+      // Read back: the same faces, in world space, the same parts and names.
+      Mesh back;
+      ASSERT_TRUE(load_mesh(file, back).is_ok());
+      EXPECT_EQ(back.face_count(), mesh.face_count());
+      const float tolerance = method == MeshCompression::kNone ? 0.f : extent(mesh) / 4000.f;
+      expect_same_points(back, mesh, tolerance, "world positions");
+      ASSERT_EQ(back.scene.parts.size(), 4u);
+      EXPECT_EQ(back.scene.instances[1].node_name, "right");
+      for (uint32_t part = 0; part < 4; ++part)
+        EXPECT_EQ(std::count(back.face_parts.begin(), back.face_parts.end(), part),
+                  std::count(mesh.face_parts.begin(), mesh.face_parts.end(), part));
+    }
+  }
+}
+
+// Per-vertex colours of a PLY (uchar red green blue alpha) and an OBJ (v x y z r g b) are written
+// back to .ply and .obj outputs and read back the same.
+TEST(GltfKept, PlyAndObjColoursRoundTrip) {
+  const std::string dir = test::empty_temp_dir("colour_round_trip");
+  std::ofstream(dir + "/t.ply") << "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+                                   "property float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n"
+                                   "property uchar alpha\nelement face 4\nproperty list uchar int vertex_indices\n"
+                                   "end_header\n0 0 0 255 0 0 255\n1 0 0 0 255 0 128\n0 1 0 0 0 255 0\n"
+                                   "0 0 1 51 102 153 7\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  std::ofstream(dir + "/t.obj") << "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nv 0 0 1 0.2 0.4 0.6\n"
+                                   "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  for (const char* input : {"t.ply", "t.obj"}) {
+    Mesh mesh;
+    ASSERT_TRUE(load_mesh(dir + "/" + input, mesh).is_ok()) << input;
+    const CornerAttribute* colour = attribute(mesh, "COLOR_0");
+    ASSERT_NE(colour, nullptr) << input;
+    Atlas atlas;
+    atlas.corner_uv.assign(6 * mesh.face_count(), 0.f);
+    for (size_t k = 0; k < atlas.corner_uv.size(); ++k) atlas.corner_uv[k] = float(k % 5) * 100;
+    atlas.patch.assign(mesh.face_count(), 0);
+    for (const char* output : {"out.ply", "out.obj", "out.glb"}) {
+      SCOPED_TRACE(std::string(input) + " -> " + output);
+      ASSERT_TRUE(export_mesh(dir + "/" + output, mesh, atlas, ExportOptions{}).is_ok());
+      Mesh back;
+      ASSERT_TRUE(load_mesh(dir + "/" + output, back).is_ok());
+      const CornerAttribute* back_colour = attribute(back, "COLOR_0");
+      ASSERT_NE(back_colour, nullptr);
+      ASSERT_EQ(back.face_count(), mesh.face_count());
+      // Faces keep their order; compare the colour of each corner (OBJ keeps no alpha).
+      const bool alpha = std::string(output) != "out.obj";
+      for (size_t c = 0; c < mesh.indices.size(); ++c)
+        for (size_t k = 0; k < (alpha ? 4u : 3u); ++k)
+          EXPECT_NEAR(back_colour->values[4 * c + k], colour->values[4 * c + k], 1e-6) << "corner " << c;
+    }
   }
   fs::remove_all(dir);
 }

@@ -16,6 +16,14 @@
 
 namespace tailor::internal {
 
+//! The faces of one scene part (Mesh::scene.parts[part]) in the split mesh: faces are sorted by
+//! part and vertices split on it, so each part is a range of split vertices and of indices.
+struct ExportPart {
+  uint32_t part = 0;
+  size_t vertex_begin = 0, vertex_end = 0;  //!< split vertices
+  size_t index_begin = 0, index_end = 0;    //!< into split.indices (global vertex ids)
+};
+
 //! What every writer gets: the source mesh, its vertices split on UV with uvs in texture repeats
 //! (OBJ convention, t up: see export.h), and unit normals per SOURCE vertex (#V by 3, or empty).
 //! split.positions is left EMPTY: writers read mesh->positions[3 * split.xref[s]] as they stream,
@@ -35,7 +43,20 @@ struct ExportData {
   //! #S by 4: unit tangent xyz and handedness w per SPLIT vertex (tangent_frames.cpp); empty unless
   //! the material has a normal map and the mesh has normals.
   std::vector<float> tangents;
+  //! .glb of a glTF scene (Mesh::scene not empty): the parts in order, and the scene they come
+  //! from; empty / null: one part, tailor's own node and material.
+  std::vector<ExportPart> parts;
+  const SceneParts* scene = nullptr;
+  //! The mesh with its faces sorted by part (mesh points here, or attribute_split does).
+  Mesh part_sorted;
 };
+
+//! The nodes, meshes, materials, scene and asset of a .glb: `primitives` holds one primitive per
+//! ExportPart (attributes and indices set) or one in all when data.parts is empty; `root` is
+//! the node that carries the file's transform (up axis, quantization). gltf["materials"] must hold
+//! tailor's material (add_glb_material): input materials get its maps, keeping their own properties.
+void add_glb_scene(nlohmann::json& gltf, const ExportData& data, nlohmann::json root,
+                   std::vector<nlohmann::json> primitives);
 
 //! Per-vertex tangents for the split mesh (ExportData::tangents), from its UVs (split.uvs, t up)
 //! and the unit normals per source vertex.

@@ -260,6 +260,9 @@ Status finalize_mesh(const std::string& name, Mesh& mesh, LoadReport& report) {
   if (!mesh.seam_faces.empty() && mesh.seam_faces.size() != nf) {
     return Status::error(ErrorCode::kInvalidMesh, name, "seam flags do not match the faces");
   }
+  if (!mesh.face_parts.empty() && mesh.face_parts.size() != nf) {
+    return Status::error(ErrorCode::kInvalidMesh, name, "face parts do not match the faces");
+  }
   for (const CornerAttribute& a : mesh.corner_attributes)
     if (a.components < 1 || a.components > 4 || a.values.size() != nf * 3 * size_t(a.components))
       return Status::error(ErrorCode::kInvalidMesh, name, "corner attribute " + a.name + " does not match the faces");
@@ -406,7 +409,7 @@ Status finalize_mesh(const std::string& name, Mesh& mesh, LoadReport& report) {
   // === Compact, keeping corner_uvs and seam_faces in step ======================================
   if (degenerate + duplicates > 0) {
     size_t out = 0;
-    const bool uvs = !mesh.corner_uvs.empty(), seams = !mesh.seam_faces.empty();
+    const bool uvs = !mesh.corner_uvs.empty(), seams = !mesh.seam_faces.empty(), parts = !mesh.face_parts.empty();
     for (size_t f = 0; f < nf; ++f) {
       if (!(flags[f] & kKeep)) {
         const uint32_t a = idx[3 * f], b = idx[3 * f + 1], c = idx[3 * f + 2];
@@ -418,6 +421,7 @@ Status finalize_mesh(const std::string& name, Mesh& mesh, LoadReport& report) {
         std::memmove(&mesh.indices[3 * out], &mesh.indices[3 * f], 3 * sizeof(uint32_t));
         if (uvs) std::memmove(&mesh.corner_uvs[6 * out], &mesh.corner_uvs[6 * f], 6 * sizeof(float));
         if (seams) mesh.seam_faces[out] = mesh.seam_faces[f];
+        if (parts) mesh.face_parts[out] = mesh.face_parts[f];
         for (CornerAttribute& a : mesh.corner_attributes) {
           const size_t k = 3 * size_t(a.components);
           std::memmove(&a.values[k * out], &a.values[k * f], k * sizeof(float));
@@ -428,6 +432,7 @@ Status finalize_mesh(const std::string& name, Mesh& mesh, LoadReport& report) {
     mesh.indices.resize(3 * out);
     if (uvs) mesh.corner_uvs.resize(6 * out);
     if (seams) mesh.seam_faces.resize(out);
+    if (parts) mesh.face_parts.resize(out);
     for (CornerAttribute& a : mesh.corner_attributes) a.values.resize(3 * size_t(a.components) * out);
   }
   report.degenerate_faces += degenerate;
