@@ -19,6 +19,8 @@
 #include "support/fixtures.h"
 #include "tailor/export.h"
 #include "tailor/io.h"
+#include "tailor/mapping.h"
+#include "tailor/topology.h"
 
 namespace tailor {
 namespace {
@@ -898,6 +900,114 @@ TEST(GltfWorld, TexelDensityIsPerSceneUnitForEveryMesh) {
   expect_same_points(up, turned, extent(spot) / 16384.f, "--up z");
   if (!gltf_transform().empty()) expect_valid_gltf(dir + "/up.glb");
   fs::remove_all(dir);
+}
+
+// === Progress (issue 18 point 5) ================================================================
+
+// What a progress callback saw: every value in [0, 1], never going back, the last one 1.
+struct Seen {
+  std::vector<float> values;
+  bool keep_going = true;
+  ProgressCallback callback() {
+    return [this](float f) {
+      values.push_back(f);
+      return keep_going;
+    };
+  }
+  void expect_complete(const std::string& what) const {
+    ASSERT_FALSE(values.empty()) << what;
+    for (size_t i = 0; i < values.size(); ++i) {
+      EXPECT_TRUE(values[i] >= 0.f && values[i] <= 1.f) << what << " " << values[i];
+      if (i > 0) {
+        EXPECT_GE(values[i], values[i - 1]) << what;
+      }
+    }
+    EXPECT_EQ(values.back(), 1.f) << what;
+  }
+};
+
+TEST(Progress, LoadingReportsAndCancels) {
+  // The same mesh as PLY (generic ascii loop), OBJ, .glb (plain and Draco).
+  const std::string dir = test::empty_temp_dir("progress_load");
+  const Mesh source = test::load_test_mesh("horse.ply");
+  Atlas atlas;
+  atlas.corner_uv.assign(6 * source.face_count(), 0.f);
+  for (size_t k = 0; k < atlas.corner_uv.size(); ++k) atlas.corner_uv[k] = float(k % 13) * 16;
+  atlas.patch.assign(source.face_count(), 0);
+  ASSERT_TRUE(export_mesh(dir + "/h.obj", source, atlas, ExportOptions{}).is_ok());
+  ASSERT_TRUE(export_mesh(dir + "/h.glb", source, atlas, ExportOptions{}).is_ok());
+  ExportOptions draco;
+  draco.compression = MeshCompression::kDraco;
+  ASSERT_TRUE(export_mesh(dir + "/h_draco.glb", source, atlas, draco).is_ok());
+  for (const std::string& file : {test::mesh_path("horse.ply"), dir + "/h.obj", dir + "/h.glb", dir + "/h_draco.glb"}) {
+    Seen seen;
+    Mesh mesh;
+    ASSERT_TRUE(load_mesh(file, mesh, nullptr, seen.callback()).is_ok()) << file;
+    EXPECT_EQ(mesh.face_count(), source.face_count()) << file;
+    seen.expect_complete(file);
+    Seen stop;
+    stop.keep_going = false;
+    const Status s = load_mesh(file, mesh, nullptr, stop.callback());
+    EXPECT_EQ(s.code(), ErrorCode::kCancelled) << file;
+    EXPECT_TRUE(mesh.empty()) << file;
+  }
+  fs::remove_all(dir);
+}
+
+TEST(Progress, ExportReportsAndCancelsWritingNothing) {
+  const std::string dir = test::empty_temp_dir("progress_export");
+  const Mesh mesh = test::load_test_mesh("spot.obj");
+  Atlas atlas;
+  atlas.corner_uv.assign(6 * mesh.face_count(), 0.f);
+  for (size_t k = 0; k < atlas.corner_uv.size(); ++k) atlas.corner_uv[k] = float(k % 9) * 40;
+  atlas.patch.assign(mesh.face_count(), 0);
+  for (MeshCompression method :
+       {MeshCompression::kNone, MeshCompression::kQuantize, MeshCompression::kMeshopt, MeshCompression::kDraco}) {
+    SCOPED_TRACE(mesh_compression_name(method));
+    Seen seen;
+    ExportOptions options;
+    options.compression = method;
+    options.progress = seen.callback();
+    ASSERT_TRUE(export_mesh(dir + "/p.glb", mesh, atlas, options).is_ok());
+    seen.expect_complete("export");
+    Seen stop;
+    stop.keep_going = false;
+    options.progress = stop.callback();
+    EXPECT_EQ(export_mesh(dir + "/q.glb", mesh, atlas, options).code(), ErrorCode::kCancelled);
+    EXPECT_FALSE(fs::exists(dir + "/q.glb"));
+  }
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);  // p.glb, no temporaries
+  fs::remove_all(dir);
+}
+
+TEST(Progress, MappingReportsEachStage) {
+  const Mesh mesh = test::load_test_mesh("spot.obj");
+  const Topology topology = build_topology(mesh);
+  MapTextureOptions options;
+  std::vector<std::pair<std::string, float>> seen;
+  options.stage_progress = [&seen](std::string_view stage, float done) {
+    seen.emplace_back(std::string(stage), done);
+    return true;
+  };
+  TextureMap map;
+  ASSERT_TRUE(map_texture(mesh, topology, options, map).is_ok());
+  // The stages in order, each ending at 1.
+  std::vector<std::string> order;
+  for (const auto& [stage, done] : seen)
+    if (order.empty() || order.back() != stage) order.push_back(stage);
+  EXPECT_EQ(order, (std::vector<std::string>{"orientation", "mapping", "closing", "relaxing", "metrics"}));
+  for (const std::string& stage : order) {
+    float last = -1.f;
+    for (const auto& [s, done] : seen)
+      if (s == stage) last = done;
+    EXPECT_EQ(last, 1.f) << stage;
+  }
+  // Cancelling in any stage fails with kCancelled and leaves the atlas empty.
+  for (const char* cancel_in : {"orientation", "mapping", "closing", "relaxing"}) {
+    options.stage_progress = [cancel_in](std::string_view stage, float) { return stage != cancel_in; };
+    EXPECT_EQ(map_texture(mesh, topology, options, map).code(), ErrorCode::kCancelled) << cancel_in;
+    EXPECT_TRUE(map.atlas.corner_uv.empty()) << cancel_in;
+  }
 }
 
 }  // namespace

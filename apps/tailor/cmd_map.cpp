@@ -198,7 +198,9 @@ int run_map(const MapArgs& opt) {
   LoadReport load;
   {
     const ReadingInput reading(opt.input);
-    if (Status s = load_mesh(opt.input, mesh, &load); !s) return report_error(s);
+    Progress loading("loading", opt.quiet);
+    if (Status s = load_mesh(opt.input, mesh, &load, [&loading](float f) { return loading.update(f); }); !s)
+      return report_error(s);
   }
   if (load.degenerate_faces)
     warn(opt.quiet, opt.input + ": dropped " + std::to_string(load.degenerate_faces) + " degenerate faces");
@@ -279,8 +281,9 @@ int run_map(const MapArgs& opt) {
     }
   }
   // === Orientation, mapping, metrics ===
-  Progress progress("mapping", opt.quiet);
-  mapping.progress = [&progress](float f) { return progress.update(f); };
+  Progress progress("orientation", opt.quiet);  // then mapping, closing, relaxing, metrics: a bar each
+  mapping.progress = nullptr;
+  options.stage_progress = [&progress](std::string_view stage, float f) { return progress.update(stage, f); };
   TextureMap map;
   if (Status s = map_texture(mesh, topology, options, map); !s) return report_error(s.with_file(opt.input));
   progress.done();
@@ -332,7 +335,10 @@ int run_map(const MapArgs& opt) {
   export_options.compression = compression;
   export_options.uv_set = opt.uv_set;
   export_options.up = opt.up == "z" ? SceneUp::kZ : SceneUp::kY;
+  Progress exporting("export", opt.quiet);
+  export_options.progress = [&exporting](float f) { return exporting.update(f); };
   if (Status s = export_mesh(opt.output, mesh, atlas, export_options); !s) return report_error(s);
+  exporting.done();
   run.export_seconds = seconds_since(export_start);
   for (const auto& [path, picture] : pictures) {
     if (Status s = write_png(path, picture); !s) return report_error(s);

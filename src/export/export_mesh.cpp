@@ -352,6 +352,8 @@ Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas
       [&] { bad_corner = internal::split_vertices_scaled(source, corner_uv, su, sv, data.split); });
   if (bad_corner != internal::kNoBadCorner)
     return Status::error(ErrorCode::kInvalidArgument, path, "UV is not finite", "corner " + std::to_string(bad_corner));
+  if (options.progress && !options.progress(internal::ExportProgress::kSplitShare))
+    return internal::ExportProgress::cancelled(path);
   if (scene) part_ranges(data.part_sorted.face_parts, data.split, data.parts);
 
   if (format == ExportFormat::kGlb && !options.material.normal_png.empty() && !data.normals.empty())

@@ -52,7 +52,8 @@ std::span<const char> bytes_of(const T* data, size_t count) {
 // Streams `count` items of `floats_per_item` floats, each made by make(item, float* out), through
 // one small reusable buffer: the arrays gathered for the file are never held whole in memory.
 template <class Make>
-Status write_gathered(AtomicFileWriter& file, size_t count, size_t floats_per_item, Make&& make) {
+Status write_gathered(AtomicFileWriter& file, ExportProgress& progress, size_t count, size_t floats_per_item,
+                      Make&& make) {
   constexpr size_t kChunkItems = 16384;
   std::vector<float> chunk(kChunkItems * floats_per_item);
   for (size_t begin = 0; begin < count; begin += kChunkItems) {
@@ -60,6 +61,7 @@ Status write_gathered(AtomicFileWriter& file, size_t count, size_t floats_per_it
     float* out = chunk.data();
     for (size_t i = begin; i < end; ++i, out += floats_per_item) make(i, out);
     TAILOR_RETURN_IF_ERROR(file.write(bytes_of(chunk.data(), (end - begin) * floats_per_item)));
+    if (!progress.wrote(4 * (end - begin) * floats_per_item)) return progress.cancelled();
   }
   return Status::ok();
 }
@@ -221,30 +223,31 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
   append_u32(head, static_cast<uint32_t>(bin_size));
   append_u32(head, kChunkBin);
 
+  ExportProgress progress(options.progress, bin_size, path);
   AtomicFileWriter file(path);
   TAILOR_RETURN_IF_ERROR(file.open());
   TAILOR_RETURN_IF_ERROR(file.write(head));
   const uint32_t* xref = split.xref.data();
-  TAILOR_RETURN_IF_ERROR(write_gathered(file, vertex_count, 3, [&](size_t s, float* out) {
+  TAILOR_RETURN_IF_ERROR(write_gathered(file, progress, vertex_count, 3, [&](size_t s, float* out) {
     std::memcpy(out, &positions[3 * size_t{xref[s]}], 3 * sizeof(float));
   }));
   if (normals) {
     const float* source = data.normals.data();
-    TAILOR_RETURN_IF_ERROR(write_gathered(file, vertex_count, 3, [&](size_t s, float* out) {
+    TAILOR_RETURN_IF_ERROR(write_gathered(file, progress, vertex_count, 3, [&](size_t s, float* out) {
       std::memcpy(out, &source[3 * size_t{xref[s]}], 3 * sizeof(float));
     }));
   }
   for (const CornerAttribute& a : data.kept) {
     const size_t k = size_t(a.components);
     const float* values = a.values.data();
-    TAILOR_RETURN_IF_ERROR(write_gathered(file, vertex_count, k, [&](size_t s, float* out) {
+    TAILOR_RETURN_IF_ERROR(write_gathered(file, progress, vertex_count, k, [&](size_t s, float* out) {
       std::memcpy(out, &values[k * size_t{xref[s]}], k * sizeof(float));
     }));
   }
   // glTF's v axis points down the image: TEXCOORD_0 = (s, -t), the usual (s, 1 - t) shifted by a
   // whole repeat (invisible with REPEAT) but exact, so a round trip is bit-exact (see export.h).
   const float* uvs = split.uvs.data();
-  TAILOR_RETURN_IF_ERROR(write_gathered(file, vertex_count, 2, [&](size_t s, float* out) {
+  TAILOR_RETURN_IF_ERROR(write_gathered(file, progress, vertex_count, 2, [&](size_t s, float* out) {
     out[0] = uvs[2 * s];
     out[1] = -uvs[2 * s + 1];
   }));
@@ -259,11 +262,13 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
         const size_t end = std::min(p.index_end, begin + kChunk);
         for (size_t i = begin; i < end; ++i) chunk[i - begin] = split.indices[i] - base;
         TAILOR_RETURN_IF_ERROR(file.write(bytes_of(chunk.data(), end - begin)));
+        if (!progress.wrote(4 * (end - begin))) return ExportProgress::cancelled(path);
       }
     }
   }
   if (tangents) TAILOR_RETURN_IF_ERROR(file.write(bytes_of(data.tangents.data(), data.tangents.size())));
   TAILOR_RETURN_IF_ERROR(file.write(images));
+  if (!progress.reached(1.f)) return ExportProgress::cancelled(path);
   return file.commit();
 }
 

@@ -301,7 +301,7 @@ Status meshopt_views(const std::string& path, std::vector<Stream>& streams, std:
 
 // KHR_draco_mesh_compression: the stream into `bin` (one view), accessors without views.
 Status draco_primitive(const std::string& path, const Arrays& a, std::string& bin, nlohmann::json& views,
-                       std::vector<Stream>& streams, nlohmann::json& extension) {
+                       std::vector<Stream>& streams, nlohmann::json& extension, const ProgressCallback& step) {
   const size_t nv = a.vertex_count(), nf = a.indices.size() / 3;
   draco::Mesh mesh;
   mesh.set_num_points(static_cast<uint32_t>(nv));
@@ -339,6 +339,7 @@ Status draco_primitive(const std::string& path, const Arrays& a, std::string& bi
     return Status::error(ErrorCode::kInvalidArgument, path,
                          "Draco cannot encode the mesh: " + encoded.error_msg_string());
 
+  if (!step(0.75f)) return ExportProgress::cancelled(path);
   // What a reader will get: the counts and the dequantized positions' bounds.
   draco::DecoderBuffer in;
   in.Init(buffer.data(), buffer.size());
@@ -424,17 +425,27 @@ Status write_glb_compressed(const std::string& path, const ExportData& data, con
     node["scale"] = {half, half, half};
   }
   size_t fallback = 0;
+  // Progress: each part's share of the indices, in steps (the codecs give none of their own).
+  ExportProgress progress(options.progress, 0, path);
+  const double index_count = static_cast<double>(std::max<size_t>(1, arrays.indices.size()));
+  if (!progress.reached(0.05f)) return progress.cancelled();
   for (const ExportPart& p : parts) {
+    auto step = [&](float done) {
+      const double begin = static_cast<double>(p.index_begin) / index_count;
+      const double share = static_cast<double>(p.index_end - p.index_begin) / index_count;
+      return progress.reached(static_cast<float>(0.05 + 0.9 * (begin + share * done)));
+    };
     Arrays part_arrays = whole ? Arrays{} : slice(arrays, p);
     Arrays& a = whole ? arrays : part_arrays;
     nlohmann::json primitive = {{"mode", kTriangles}};
     std::vector<Stream> streams;
     if (options.compression == MeshCompression::kDraco) {
       nlohmann::json extension;
-      TAILOR_RETURN_IF_ERROR(draco_primitive(path, a, bin, views, streams, extension));
+      TAILOR_RETURN_IF_ERROR(draco_primitive(path, a, bin, views, streams, extension, step));
       primitive["extensions"] = {{"KHR_draco_mesh_compression", extension}};
     } else {
       if (meshopt) optimize_order(a);
+      if (!step(0.5f)) return progress.cancelled();
       streams = quantized_streams(a, center, half);
       if (meshopt) {
         apply_meshopt_filters(a, streams);
@@ -451,6 +462,7 @@ Status write_glb_compressed(const std::string& path, const ExportData& data, con
         }
       }
     }
+    if (!step(1.f)) return progress.cancelled();
     nlohmann::json attributes;
     for (const Stream& s : streams) {
       accessors.push_back(s.accessor);
@@ -513,6 +525,7 @@ Status write_glb_compressed(const std::string& path, const ExportData& data, con
   TAILOR_RETURN_IF_ERROR(file.open());
   TAILOR_RETURN_IF_ERROR(file.write(head));
   TAILOR_RETURN_IF_ERROR(file.write(bin));
+  if (!progress.reached(1.f)) return progress.cancelled();
   return file.commit();
 }
 

@@ -2,6 +2,7 @@
 // vertices and computes normals once; each writer only serialises and writes atomically.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -15,6 +16,33 @@
 #include "tailor/status.h"
 
 namespace tailor::internal {
+
+//! Export's progress (ExportOptions::progress): the split takes [0, kSplitShare], the writer the
+//! rest, told in bytes written (at most every few MB) or in steps of its own.
+class ExportProgress {
+ public:
+  static constexpr float kSplitShare = 0.2f;
+  ExportProgress(const ProgressCallback& callback, size_t total_bytes, const std::string& path)
+      : callback_(callback), total_(total_bytes), path_(path) {}
+  //! The writer's own share reached, in [0, 1]; false: cancelled.
+  bool reached(float done) const { return !callback_ || callback_(kSplitShare + (1.f - kSplitShare) * done); }
+  //! `bytes` more written; false: cancelled.
+  bool wrote(size_t bytes) {
+    written_ += bytes;
+    if (!callback_ || written_ < next_) return true;
+    next_ = written_ + (size_t{4} << 20);
+    return reached(total_ > 0 ? static_cast<float>(std::min(written_, total_)) / static_cast<float>(total_) : 1.f);
+  }
+  static Status cancelled(const std::string& path) {
+    return Status::error(ErrorCode::kCancelled, path, "export cancelled");
+  }
+  Status cancelled() const { return cancelled(path_); }
+
+ private:
+  const ProgressCallback& callback_;
+  size_t total_ = 0, written_ = 0, next_ = 0;
+  const std::string& path_;
+};
 
 //! The faces of one scene part (Mesh::scene.parts[part]) in the split mesh: faces are sorted by
 //! part and vertices split on it, so each part is a range of split vertices and of indices.
