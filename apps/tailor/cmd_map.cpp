@@ -189,7 +189,9 @@ int run_map(const MapArgs& opt) {
   float texture_isotropy = -1.f;
   if (opt.field_following == "auto") {
     const uint32_t rings = mapping.crack_rings;
-    texture_isotropy = adapt_mapping_to_texture(texture, mapping);
+    Progress measuring("texture", opt.quiet);
+    texture_isotropy =
+        adapt_mapping_to_texture(texture, mapping, [&measuring](float f) { return measuring.update(f); });
     if (opt.crack_rings_given) mapping.crack_rings = rings;
   }
 
@@ -217,7 +219,9 @@ int run_map(const MapArgs& opt) {
   } else if (!mesh.seam_faces.empty()) {
     mapping.seam_faces = mesh.seam_faces;
   }
-  const Topology topology = build_topology(mesh);
+  Progress connecting("topology", opt.quiet);
+  const Topology topology = build_topology(mesh, [&connecting](float f) { return connecting.update(f); });
+  connecting.done();
   if (topology.nonmanifold_edges || topology.inconsistent_edges)
     warn(opt.quiet, opt.input + ": " + std::to_string(topology.nonmanifold_edges) + " non-manifold and " +
                         std::to_string(topology.inconsistent_edges) +
