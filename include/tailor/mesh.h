@@ -82,7 +82,7 @@ struct LoadReport {
   size_t mesh_instances = 0;         //!< glTF: meshes placed by the scene's nodes (world transforms applied)
   size_t skipped_primitives = 0;     //!< glTF: point and line primitives of those instances, not read
   std::string not_kept;              //!< what the file has that the output will not (", "-separated), e.g.
-                                     //!< "material textures (tailor writes its own), TANGENT"; empty when nothing is lost
+                                     //!< "material textures, TANGENT"; empty when nothing is lost
   int texture_width = 0;             //!< glb: the embedded base colour texture's size, read from its header
   int texture_height = 0;            //!< without decoding it (0: no texture, or a header stb cannot read)
   double load_seconds = 0.0;
