@@ -791,6 +791,15 @@ TEST_F(GltfTransformTest, NamesExtrasAndMaterialsSurviveAMapping) {
         EXPECT_EQ(std::count(back.face_parts.begin(), back.face_parts.end(), part),
                   std::count(mesh.face_parts.begin(), mesh.face_parts.end(), part));
     }
+    // A bad UV is named by its corner in the caller's numbering, though export sorts the faces
+    // by part (here the parts' order reversed, so the sort moves every face).
+    Mesh reversed = mesh;
+    for (uint32_t& part : reversed.face_parts) part = 3 - part;
+    const size_t corner = 3 * (mesh.face_count() / 8) + 1;
+    atlas.corner_uv[2 * corner] = std::nanf("");
+    const Status bad = export_mesh(path("bad.glb"), reversed, atlas, ExportOptions{});
+    EXPECT_EQ(bad.where(), "corner " + std::to_string(corner)) << bad.message();
+    EXPECT_FALSE(fs::exists(path("bad.glb")));
   }
 }
 

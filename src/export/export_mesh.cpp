@@ -195,12 +195,12 @@ void split_on_attributes(const Mesh& mesh, const std::vector<const CornerAttribu
 // id as a corner attribute (its float's bits; named "" so that it is told apart), so that vertices
 // are split where parts meet.
 void sort_faces_by_part(const Mesh& mesh, std::span<const float> corner_uv, size_t part_count, Mesh& out,
-                        std::vector<float>& uv) {
+                        std::vector<float>& uv, std::vector<uint32_t>& order) {
   const size_t nf = mesh.face_count();
   std::vector<size_t> start(part_count + 1, 0);
   for (uint32_t p : mesh.face_parts) ++start[p + 1];
   for (size_t p = 0; p < part_count; ++p) start[p + 1] += start[p];
-  std::vector<uint32_t> order(nf);
+  order.resize(nf);  // sorted position -> face
   for (size_t f = 0; f < nf; ++f) order[start[mesh.face_parts[f]]++] = static_cast<uint32_t>(f);
   out.positions = mesh.positions;
   out.indices.resize(3 * nf);
@@ -296,6 +296,7 @@ Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas
   // that each part becomes a primitive with its own vertex range.
   std::span<const float> corner_uv = atlas.corner_uv;
   std::vector<float> sorted_uv;
+  std::vector<uint32_t> sorted_order;  // the input face of each sorted face (for error messages)
   const bool scene = format == ExportFormat::kGlb && !mesh.scene.empty() && mesh.face_parts.size() == nf;
   if (scene) {
     const SceneParts& parts = mesh.scene;
@@ -305,7 +306,7 @@ Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas
         return Status::error(ErrorCode::kInvalidArgument, path, "scene part out of range");
     for (uint32_t p : mesh.face_parts)
       if (p >= parts.parts.size()) return Status::error(ErrorCode::kInvalidArgument, path, "face part out of range");
-    sort_faces_by_part(mesh, atlas.corner_uv, parts.parts.size(), data.part_sorted, sorted_uv);
+    sort_faces_by_part(mesh, atlas.corner_uv, parts.parts.size(), data.part_sorted, sorted_uv, sorted_order);
     corner_uv = sorted_uv;
     data.mesh = &data.part_sorted;
     data.scene = &parts;
@@ -350,8 +351,10 @@ Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas
         if (want_normals) vertex_normals(source, data.normals);
       },
       [&] { bad_corner = internal::split_vertices_scaled(source, corner_uv, su, sv, data.split); });
-  if (bad_corner != internal::kNoBadCorner)
+  if (bad_corner != internal::kNoBadCorner) {
+    if (scene) bad_corner = 3 * size_t{sorted_order[bad_corner / 3]} + bad_corner % 3;  // the caller's corner id
     return Status::error(ErrorCode::kInvalidArgument, path, "UV is not finite", "corner " + std::to_string(bad_corner));
+  }
   if (options.progress && !options.progress(internal::ExportProgress::kSplitShare))
     return internal::ExportProgress::cancelled(path);
   if (scene) part_ranges(data.part_sorted.face_parts, data.split, data.parts);
