@@ -985,7 +985,19 @@ TEST(Progress, ExportReportsAndCancelsWritingNothing) {
     EXPECT_EQ(export_mesh(dir + "/q.glb", mesh, atlas, options).code(), ErrorCode::kCancelled);
     EXPECT_FALSE(fs::exists(dir + "/q.glb"));
   }
-  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);  // p.glb, no temporaries
+  for (const char* name : {"p.obj", "p.ply"}) {
+    Seen seen;
+    ExportOptions options;
+    options.progress = seen.callback();
+    ASSERT_TRUE(export_mesh(dir + "/" + name, mesh, atlas, options).is_ok());
+    seen.expect_complete(name);
+    Seen stop;
+    stop.keep_going = false;
+    options.progress = stop.callback();
+    EXPECT_EQ(export_mesh(dir + "/q" + std::string(name + 1), mesh, atlas, options).code(), ErrorCode::kCancelled);
+  }
+  // p.glb, p.obj, p.ply; no temporaries, nothing of the cancelled exports.
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 3);
   fs::remove_all(dir);
 }
 

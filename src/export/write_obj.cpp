@@ -40,7 +40,11 @@ Status write_obj(const std::string& path, const ExportData& data, const ExportOp
   constexpr size_t kFlushBytes = size_t{1} << 20;
   std::string out;
   out.reserve(kFlushBytes + 4096);
+  // Progress in lines: v and vn per vertex, vt per split vertex, f per face.
+  const size_t lines = mesh.vertex_count() * (data.normals.empty() ? 1 : 2) + split.xref.size() + mesh.face_count();
+  ExportProgress progress(options.progress, lines, path);
   auto flush_if_full = [&]() -> Status {
+    if (!progress.wrote(1)) return progress.cancelled();
     if (out.size() < kFlushBytes) return Status::ok();
     Status s = file.write(out);
     out.clear();
@@ -103,6 +107,7 @@ Status write_obj(const std::string& path, const ExportData& data, const ExportOp
     TAILOR_RETURN_IF_ERROR(flush_if_full());
   }
   TAILOR_RETURN_IF_ERROR(file.write(out));
+  if (!progress.reached(1.f)) return progress.cancelled();
   return file.commit();
 }
 

@@ -48,6 +48,7 @@ Status write_ply(const std::string& path, const ExportData& data, const ExportOp
   out += "element face " + std::to_string(face_count) + "\n";
   out += "property list uchar uint vertex_indices\nend_header\n";
   // Streamed through one small buffer of whole records: the file is never held whole in memory.
+  ExportProgress progress(options.progress, vertex_count * record + face_count * 13, path);
   AtomicFileWriter file(path);
   TAILOR_RETURN_IF_ERROR(file.open());
   TAILOR_RETURN_IF_ERROR(file.write(out));
@@ -65,6 +66,7 @@ Status write_ply(const std::string& path, const ExportData& data, const ExportOp
           p[20 + k] = static_cast<char>(unit_to_byte(colour->values[4 * size_t{split.xref[s]} + k]));
     }
     TAILOR_RETURN_IF_ERROR(file.write({chunk.data(), (end - begin) * record}));
+    if (!progress.wrote((end - begin) * record)) return progress.cancelled();
   }
   for (size_t begin = 0; begin < face_count; begin += kChunkRecords) {
     const size_t end = std::min(face_count, begin + kChunkRecords);
@@ -74,7 +76,9 @@ Status write_ply(const std::string& path, const ExportData& data, const ExportOp
       std::memcpy(p + 1, &split.indices[3 * f], 12);
     }
     TAILOR_RETURN_IF_ERROR(file.write({chunk.data(), (end - begin) * 13}));
+    if (!progress.wrote((end - begin) * 13)) return progress.cancelled();
   }
+  if (!progress.reached(1.f)) return progress.cancelled();
   return file.commit();
 }
 

@@ -30,7 +30,7 @@ class ExportProgress {
   bool wrote(size_t bytes) {
     written_ += bytes;
     if (!callback_ || written_ < next_) return true;
-    next_ = written_ + (size_t{4} << 20);
+    next_ = written_ + std::min(size_t{4} << 20, std::max<size_t>(total_ / 100, 1));  // every 1 % or 4 MiB
     return reached(total_ > 0 ? static_cast<float>(std::min(written_, total_)) / static_cast<float>(total_) : 1.f);
   }
   static Status cancelled(const std::string& path) {
