@@ -19,6 +19,8 @@
 #include "support/fixtures.h"
 #include "tailor/export.h"
 #include "tailor/io.h"
+#include "tailor/mapping.h"
+#include "tailor/topology.h"
 
 namespace tailor {
 namespace {
@@ -586,8 +588,9 @@ TEST(GltfKept, NormalsColoursAndOtherUvSetsSurviveAMapping) {
   LoadReport report;
   ASSERT_TRUE(read(b.glb(), mesh, &report).is_ok());
   EXPECT_EQ(mesh.vertex_count(), 8u);  // welded: the hard edges live in the corner normals
-  EXPECT_NE(report.not_kept.find("materials"), std::string::npos) << report.not_kept;
-  EXPECT_NE(report.not_kept.find("names"), std::string::npos) << report.not_kept;
+  EXPECT_EQ(report.not_kept, "") << "names and materials are kept";
+  ASSERT_EQ(mesh.scene.instances.size(), 1u);
+  EXPECT_EQ(mesh.scene.instances[0].node_name, "box");
   ASSERT_NE(attribute(mesh, "NORMAL"), nullptr);
 
   // Map into TEXCOORD_1 (any UVs will do): the file's normals, colours and TEXCOORD_0 come back.
@@ -697,6 +700,177 @@ TEST(GltfKept, ObjColoursAndNormalsReachTheGlb) {
   fs::remove_all(dir);
 }
 
+// The JSON chunk of a .glb file.
+Json glb_json_of(const std::string& file) {
+  const std::string glb = test::read_all(file);
+  uint32_t json_length = 0;
+  std::memcpy(&json_length, glb.data() + 12, 4);
+  return Json::parse(glb.substr(20, json_length));
+}
+
+// The names, extras and materials of a scene made by glTF-Transform reach the output: two
+// instances of one mesh (named nodes with extras), two materials (factors, doubleSided, alphaMode,
+// emissive, extras), the scene's and the asset's extras; plain, meshopt and Draco inputs, every
+// compression on output; each output valid, read back with the same faces per material.
+TEST_F(GltfTransformTest, NamesExtrasAndMaterialsSurviveAMapping) {
+  std::string glb = test::read_all(path("source.glb"));
+  uint32_t json_length = 0;
+  std::memcpy(&json_length, glb.data() + 12, 4);
+  Json j = Json::parse(glb.substr(20, json_length));
+  // The source's one primitive cut in two (its first half of the faces, its second), each with
+  // its own material: the indices accessor split by byte offset.
+  Json& primitive = j["meshes"][0]["primitives"][0];
+  const size_t indices = primitive["indices"], count = j["accessors"][indices]["count"];
+  const size_t half = count / 6 * 3;
+  Json second_indices = j["accessors"][indices];
+  j["accessors"][indices]["count"] = half;
+  second_indices["count"] = count - half;
+  second_indices["byteOffset"] = 4 * half;
+  j["accessors"].push_back(second_indices);
+  Json second = primitive;
+  second["indices"] = j["accessors"].size() - 1;
+  second["material"] = 1;
+  primitive["material"] = 0;
+  j["meshes"][0]["primitives"].push_back(second);
+  j["meshes"][0]["name"] = "cow";
+  j["meshes"][0]["extras"] = {{"scan", 7}};
+  j["materials"] = {{{"name", "hide"},
+                     {"doubleSided", true},
+                     {"emissiveFactor", {0.1, 0.2, 0.3}},
+                     {"extras", {{"grade", "A"}}},
+                     {"pbrMetallicRoughness", {{"metallicFactor", 0.25}, {"roughnessFactor", 0.75}}}},
+                    {{"name", "horn"},
+                     {"alphaMode", "MASK"},
+                     {"alphaCutoff", 0.4},
+                     {"pbrMetallicRoughness", {{"baseColorFactor", {1, 0.5, 0.25, 1}}, {"metallicFactor", 1.0}}}}};
+  j["nodes"] = {{{"mesh", 0}, {"name", "left"}, {"extras", {{"id", 1}}}},
+                {{"mesh", 0}, {"name", "right"}, {"translation", {3, 0, 0}}, {"extras", {{"id", 2}}}}};
+  j["scenes"] = {{{"nodes", {0, 1}}, {"name", "barn"}, {"extras", {{"season", "spring"}}}}};
+  j["asset"]["extras"] = {{"author", "test"}};
+  j["asset"]["copyright"] = "CC0";
+  std::string text = j.dump();
+  while (text.size() % 4) text += ' ';
+  const std::string bin_chunk = glb.substr(20 + json_length);
+  std::string out(20, '\0');
+  const uint32_t header[5] = {0x46546C67, 2, static_cast<uint32_t>(20 + text.size() + bin_chunk.size()),
+                              static_cast<uint32_t>(text.size()), 0x4E4F534A};
+  std::memcpy(out.data(), header, 20);
+  std::ofstream(path("scene.glb"), std::ios::binary) << out + text + bin_chunk;
+  transform("meshopt scene.glb scene_meshopt.glb");
+  transform("draco scene.glb scene_draco.glb");
+
+  for (const char* input : {"scene.glb", "scene_meshopt.glb", "scene_draco.glb"}) {
+    Mesh mesh;
+    LoadReport report;
+    const Status loaded = load_mesh(path(input), mesh, &report);
+    ASSERT_TRUE(loaded.is_ok()) << input << ": " << loaded.message();
+    EXPECT_EQ(report.not_kept.find("names"), std::string::npos) << report.not_kept;
+    EXPECT_EQ(report.not_kept.find("materials,"), std::string::npos) << report.not_kept;
+    ASSERT_EQ(mesh.scene.parts.size(), 4u) << input;  // 2 instances x 2 materials
+    Atlas atlas;
+    atlas.corner_uv.resize(6 * mesh.face_count());
+    for (size_t k = 0; k < atlas.corner_uv.size(); ++k) atlas.corner_uv[k] = float(k % 11) * 32;
+    atlas.patch.assign(mesh.face_count(), 0);
+    for (MeshCompression method :
+         {MeshCompression::kNone, MeshCompression::kQuantize, MeshCompression::kMeshopt, MeshCompression::kDraco}) {
+      SCOPED_TRACE(std::string(input) + " -> " + mesh_compression_name(method));
+      ExportOptions options;
+      options.compression = method;
+      const std::string file = path("out.glb");
+      ASSERT_TRUE(export_mesh(file, mesh, atlas, options).is_ok());
+      expect_valid_gltf(file);
+      const Json o = glb_json_of(file);
+      // The root "tailor" and one node per instance, named, with its extras, over one mesh each.
+      ASSERT_EQ(o["nodes"].size(), 3u);
+      EXPECT_EQ(o["nodes"][0]["children"], Json({1, 2}));
+      EXPECT_EQ(o["nodes"][1]["name"], "left");
+      EXPECT_EQ(o["nodes"][2]["name"], "right");
+      EXPECT_EQ(o["nodes"][1]["extras"]["id"], 1);
+      EXPECT_EQ(o["nodes"][2]["extras"]["id"], 2);
+      for (const Json& m : o["meshes"]) {
+        EXPECT_EQ(m["name"], "cow");
+        EXPECT_EQ(m["extras"]["scan"], 7);
+        ASSERT_EQ(m["primitives"].size(), 2u);
+      }
+      EXPECT_EQ(o["scenes"][0]["name"], "barn");
+      EXPECT_EQ(o["scenes"][0]["extras"]["season"], "spring");
+      EXPECT_EQ(o["asset"]["extras"]["author"], "test");
+      EXPECT_EQ(o["asset"]["copyright"], "CC0");
+      // Materials: the input's properties and tailor's texture coordinates' material.
+      ASSERT_EQ(o["materials"].size(), 2u);
+      const Json& hide = o["materials"][o["meshes"][0]["primitives"][0]["material"].get<size_t>()];
+      const Json& horn = o["materials"][o["meshes"][0]["primitives"][1]["material"].get<size_t>()];
+      EXPECT_EQ(hide["name"], "hide");
+      EXPECT_EQ(hide["doubleSided"], true);
+      EXPECT_EQ(hide["extras"]["grade"], "A");
+      EXPECT_NEAR(hide["emissiveFactor"][2].get<double>(), 0.3, 1e-6);
+      EXPECT_NEAR(hide["pbrMetallicRoughness"]["metallicFactor"].get<double>(), 0.25, 1e-6);
+      EXPECT_NEAR(hide["pbrMetallicRoughness"]["roughnessFactor"].get<double>(), 0.75, 1e-6);
+      EXPECT_EQ(horn["name"], "horn");
+      EXPECT_EQ(horn["alphaMode"], "MASK");
+      EXPECT_NEAR(horn["pbrMetallicRoughness"]["baseColorFactor"][1].get<double>(), 0.5, 1e-6);
+      // Read back: the same faces, in world space, the same parts and names.
+      Mesh back;
+      ASSERT_TRUE(load_mesh(file, back).is_ok());
+      EXPECT_EQ(back.face_count(), mesh.face_count());
+      const float tolerance = method == MeshCompression::kNone ? 0.f : extent(mesh) / 4000.f;
+      expect_same_points(back, mesh, tolerance, "world positions");
+      ASSERT_EQ(back.scene.parts.size(), 4u);
+      EXPECT_EQ(back.scene.instances[1].node_name, "right");
+      for (uint32_t part = 0; part < 4; ++part)
+        EXPECT_EQ(std::count(back.face_parts.begin(), back.face_parts.end(), part),
+                  std::count(mesh.face_parts.begin(), mesh.face_parts.end(), part));
+    }
+    // A bad UV is named by its corner in the caller's numbering, though export sorts the faces
+    // by part (here the parts' order reversed, so the sort moves every face).
+    Mesh reversed = mesh;
+    for (uint32_t& part : reversed.face_parts) part = 3 - part;
+    const size_t corner = 3 * (mesh.face_count() / 8) + 1;
+    atlas.corner_uv[2 * corner] = std::nanf("");
+    const Status bad = export_mesh(path("bad.glb"), reversed, atlas, ExportOptions{});
+    EXPECT_EQ(bad.where(), "corner " + std::to_string(corner)) << bad.message();
+    EXPECT_FALSE(fs::exists(path("bad.glb")));
+  }
+}
+
+// Per-vertex colours of a PLY (uchar red green blue alpha) and an OBJ (v x y z r g b) are written
+// back to .ply and .obj outputs and read back the same.
+TEST(GltfKept, PlyAndObjColoursRoundTrip) {
+  const std::string dir = test::empty_temp_dir("colour_round_trip");
+  std::ofstream(dir + "/t.ply") << "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+                                   "property float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n"
+                                   "property uchar alpha\nelement face 4\nproperty list uchar int vertex_indices\n"
+                                   "end_header\n0 0 0 255 0 0 255\n1 0 0 0 255 0 128\n0 1 0 0 0 255 0\n"
+                                   "0 0 1 51 102 153 7\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  std::ofstream(dir + "/t.obj") << "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nv 0 0 1 0.2 0.4 0.6\n"
+                                   "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  for (const char* input : {"t.ply", "t.obj"}) {
+    Mesh mesh;
+    ASSERT_TRUE(load_mesh(dir + "/" + input, mesh).is_ok()) << input;
+    const CornerAttribute* colour = attribute(mesh, "COLOR_0");
+    ASSERT_NE(colour, nullptr) << input;
+    Atlas atlas;
+    atlas.corner_uv.assign(6 * mesh.face_count(), 0.f);
+    for (size_t k = 0; k < atlas.corner_uv.size(); ++k) atlas.corner_uv[k] = float(k % 5) * 100;
+    atlas.patch.assign(mesh.face_count(), 0);
+    for (const char* output : {"out.ply", "out.obj", "out.glb"}) {
+      SCOPED_TRACE(std::string(input) + " -> " + output);
+      ASSERT_TRUE(export_mesh(dir + "/" + output, mesh, atlas, ExportOptions{}).is_ok());
+      Mesh back;
+      ASSERT_TRUE(load_mesh(dir + "/" + output, back).is_ok());
+      const CornerAttribute* back_colour = attribute(back, "COLOR_0");
+      ASSERT_NE(back_colour, nullptr);
+      ASSERT_EQ(back.face_count(), mesh.face_count());
+      // Faces keep their order; compare the colour of each corner (OBJ keeps no alpha).
+      const bool alpha = std::string(output) != "out.obj";
+      for (size_t c = 0; c < mesh.indices.size(); ++c)
+        for (size_t k = 0; k < (alpha ? 4u : 3u); ++k)
+          EXPECT_NEAR(back_colour->values[4 * c + k], colour->values[4 * c + k], 1e-6) << "corner " << c;
+    }
+  }
+  fs::remove_all(dir);
+}
+
 // === World units and up axis (tailor map) ===========================================================
 
 // Median over the faces' edges of texture pixels per scene unit (UVs in repeats of `texture_px`).
@@ -765,6 +939,126 @@ TEST(GltfWorld, TexelDensityIsPerSceneUnitForEveryMesh) {
   expect_same_points(up, turned, extent(spot) / 16384.f, "--up z");
   if (!gltf_transform().empty()) expect_valid_gltf(dir + "/up.glb");
   fs::remove_all(dir);
+}
+
+// === Progress (issue 18 point 5) ================================================================
+
+// What a progress callback saw: every value in [0, 1], never going back, the last one 1.
+struct Seen {
+  std::vector<float> values;
+  bool keep_going = true;
+  ProgressCallback callback() {
+    return [this](float f) {
+      values.push_back(f);
+      return keep_going;
+    };
+  }
+  void expect_complete(const std::string& what) const {
+    ASSERT_FALSE(values.empty()) << what;
+    for (size_t i = 0; i < values.size(); ++i) {
+      EXPECT_TRUE(values[i] >= 0.f && values[i] <= 1.f) << what << " " << values[i];
+      if (i > 0) {
+        EXPECT_GE(values[i], values[i - 1]) << what;
+      }
+    }
+    EXPECT_EQ(values.back(), 1.f) << what;
+  }
+};
+
+TEST(Progress, LoadingReportsAndCancels) {
+  // The same mesh as PLY (generic ascii loop), OBJ, .glb (plain and Draco).
+  const std::string dir = test::empty_temp_dir("progress_load");
+  const Mesh source = test::load_test_mesh("horse.ply");
+  Atlas atlas;
+  atlas.corner_uv.assign(6 * source.face_count(), 0.f);
+  for (size_t k = 0; k < atlas.corner_uv.size(); ++k) atlas.corner_uv[k] = float(k % 13) * 16;
+  atlas.patch.assign(source.face_count(), 0);
+  ASSERT_TRUE(export_mesh(dir + "/h.obj", source, atlas, ExportOptions{}).is_ok());
+  ASSERT_TRUE(export_mesh(dir + "/h.glb", source, atlas, ExportOptions{}).is_ok());
+  ExportOptions draco;
+  draco.compression = MeshCompression::kDraco;
+  ASSERT_TRUE(export_mesh(dir + "/h_draco.glb", source, atlas, draco).is_ok());
+  for (const std::string& file : {test::mesh_path("horse.ply"), dir + "/h.obj", dir + "/h.glb", dir + "/h_draco.glb"}) {
+    Seen seen;
+    Mesh mesh;
+    ASSERT_TRUE(load_mesh(file, mesh, nullptr, seen.callback()).is_ok()) << file;
+    EXPECT_EQ(mesh.face_count(), source.face_count()) << file;
+    seen.expect_complete(file);
+    Seen stop;
+    stop.keep_going = false;
+    const Status s = load_mesh(file, mesh, nullptr, stop.callback());
+    EXPECT_EQ(s.code(), ErrorCode::kCancelled) << file;
+    EXPECT_TRUE(mesh.empty()) << file;
+  }
+  fs::remove_all(dir);
+}
+
+TEST(Progress, ExportReportsAndCancelsWritingNothing) {
+  const std::string dir = test::empty_temp_dir("progress_export");
+  const Mesh mesh = test::load_test_mesh("spot.obj");
+  Atlas atlas;
+  atlas.corner_uv.assign(6 * mesh.face_count(), 0.f);
+  for (size_t k = 0; k < atlas.corner_uv.size(); ++k) atlas.corner_uv[k] = float(k % 9) * 40;
+  atlas.patch.assign(mesh.face_count(), 0);
+  for (MeshCompression method :
+       {MeshCompression::kNone, MeshCompression::kQuantize, MeshCompression::kMeshopt, MeshCompression::kDraco}) {
+    SCOPED_TRACE(mesh_compression_name(method));
+    Seen seen;
+    ExportOptions options;
+    options.compression = method;
+    options.progress = seen.callback();
+    ASSERT_TRUE(export_mesh(dir + "/p.glb", mesh, atlas, options).is_ok());
+    seen.expect_complete("export");
+    Seen stop;
+    stop.keep_going = false;
+    options.progress = stop.callback();
+    EXPECT_EQ(export_mesh(dir + "/q.glb", mesh, atlas, options).code(), ErrorCode::kCancelled);
+    EXPECT_FALSE(fs::exists(dir + "/q.glb"));
+  }
+  for (const char* name : {"p.obj", "p.ply"}) {
+    Seen seen;
+    ExportOptions options;
+    options.progress = seen.callback();
+    ASSERT_TRUE(export_mesh(dir + "/" + name, mesh, atlas, options).is_ok());
+    seen.expect_complete(name);
+    Seen stop;
+    stop.keep_going = false;
+    options.progress = stop.callback();
+    EXPECT_EQ(export_mesh(dir + "/q" + std::string(name + 1), mesh, atlas, options).code(), ErrorCode::kCancelled);
+  }
+  // p.glb, p.obj, p.ply; no temporaries, nothing of the cancelled exports.
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 3);
+  fs::remove_all(dir);
+}
+
+TEST(Progress, MappingReportsEachStage) {
+  const Mesh mesh = test::load_test_mesh("spot.obj");
+  const Topology topology = build_topology(mesh);
+  MapTextureOptions options;
+  std::vector<std::pair<std::string, float>> seen;
+  options.stage_progress = [&seen](std::string_view stage, float done) {
+    seen.emplace_back(std::string(stage), done);
+    return true;
+  };
+  TextureMap map;
+  ASSERT_TRUE(map_texture(mesh, topology, options, map).is_ok());
+  // The stages in order, each ending at 1.
+  std::vector<std::string> order;
+  for (const auto& [stage, done] : seen)
+    if (order.empty() || order.back() != stage) order.push_back(stage);
+  EXPECT_EQ(order, (std::vector<std::string>{"orientation", "mapping", "closing", "relaxing", "metrics"}));
+  for (const std::string& stage : order) {
+    float last = -1.f;
+    for (const auto& [s, done] : seen)
+      if (s == stage) last = done;
+    EXPECT_EQ(last, 1.f) << stage;
+  }
+  // Cancelling in any stage fails with kCancelled and leaves the atlas empty.
+  for (const char* cancel_in : {"orientation", "mapping", "closing", "relaxing"}) {
+    options.stage_progress = [cancel_in](std::string_view stage, float) { return stage != cancel_in; };
+    EXPECT_EQ(map_texture(mesh, topology, options, map).code(), ErrorCode::kCancelled) << cancel_in;
+    EXPECT_TRUE(map.atlas.corner_uv.empty()) << cancel_in;
+  }
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 # 8. the seams view of a mapped horse (128 px texture): red and green seam lines, eval's figures;
 # 9. `tailor map --compress meshopt` and `draco` outputs load in the browser (eval's figures too);
 # 10. a `tailor map --material` output: its normal map and tangents change the texture view.
+# 11. the output of a glTF scene (two meshes: a node each, Draco per primitive) loads too.
 # Never skips: a missing Chromium or node_modules is a failure.
 set -euo pipefail
 
@@ -163,5 +164,20 @@ timeout 60 "$tailor" map examples/spot.obj --material "$tmp/material" -o "$tmp/s
 start_server "$tmp/spot_material.glb"
 timeout 120 node web/test/viewer_browser_test.mjs "$url" --normal-map || fail "browser test of the material .glb failed"
 stop_server
+
+# --- 11. a glTF scene (two meshes merged by glTF-Transform): one node per mesh, primitives per
+#          material, each its own Draco stream (issue 18: names and materials kept) ----------------
+gltf_transform=web/node_modules/.bin/gltf-transform
+if [ -x "$gltf_transform" ]; then
+  timeout 120 "$gltf_transform" merge "$tmp/spot.glb" "$tmp/horse.glb" "$tmp/scene.glb" --merge-scenes >/dev/null 2>&1 \
+    || fail "gltf-transform merge failed"
+  timeout 60 "$tailor" map "$tmp/scene.glb" --texture examples/gravel.png --compress draco -o "$tmp/scene_out.glb" -q \
+    || fail "tailor map of a merged scene failed"
+  timeout 60 "$tailor" eval "$tmp/scene_out.glb" --json -q >"$tmp/scene_eval.json" || fail "tailor eval of the scene failed"
+  start_server "$tmp/scene_out.glb"
+  timeout 120 node web/test/viewer_browser_test.mjs "$url" --eval "$tmp/scene_eval.json" \
+    || fail "browser test of the scene .glb failed"
+  stop_server
+fi
 
 echo "PASS: tailor render and tailor view (browser) work"

@@ -143,6 +143,16 @@ bool Progress::update(double fraction) {
   return true;
 }
 
+bool Progress::update(std::string_view label, double fraction) {
+  if (label != label_) {
+    done();
+    label_ = label;
+    last_percent_ = -1;
+    start_ = std::chrono::steady_clock::now();
+  }
+  return update(fraction);
+}
+
 void Progress::done() {
   if (drawn_) {
     std::fprintf(stderr, "\r\033[K");

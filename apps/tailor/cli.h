@@ -8,6 +8,7 @@
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "tailor/option_doc.h"
@@ -82,6 +83,9 @@ class Progress {
   ~Progress();
   //! fraction in [0, 1]; returns true (never cancels: the hook matches the library's callbacks).
   bool update(double fraction);
+  //! The same for the stage `label` of a pipeline: a new label clears the bar and starts its own
+  //! (drawn once that stage has run for ~1 s).
+  bool update(std::string_view label, double fraction);
   void done();
 
  private:

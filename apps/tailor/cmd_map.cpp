@@ -194,15 +194,20 @@ int run_map(const MapArgs& opt) {
   if (Status s = set_map_texture_size(options, tex_w, tex_h); !s) return report_error(s);
   // auto: follow the field unless the texture has no direction to follow (texture_direction.h).
   float texture_isotropy = -1.f;
-  if (opt.field_following == "auto")
-    texture_isotropy = adapt_mapping_to_texture(texture, mapping, opt.crack_rings_given);
+  if (opt.field_following == "auto") {
+    Progress measuring("texture", opt.quiet);
+    texture_isotropy = adapt_mapping_to_texture(texture, mapping, opt.crack_rings_given,
+                                                [&measuring](float f) { return measuring.update(f); });
+  }
 
   // === Load, topology, orientation ===
   Mesh mesh;
   LoadReport load;
   {
     const ReadingInput reading(opt.input);
-    if (Status s = load_mesh(opt.input, mesh, &load); !s) return report_error(s);
+    Progress loading("loading", opt.quiet);
+    if (Status s = load_mesh(opt.input, mesh, &load, [&loading](float f) { return loading.update(f); }); !s)
+      return report_error(s);
   }
   if (load.degenerate_faces)
     warn(opt.quiet, opt.input + ": dropped " + std::to_string(load.degenerate_faces) + " degenerate faces");
@@ -219,7 +224,9 @@ int run_map(const MapArgs& opt) {
   } else if (!mesh.seam_faces.empty()) {
     mapping.seam_faces = mesh.seam_faces;
   }
-  const Topology topology = build_topology(mesh);
+  Progress connecting("topology", opt.quiet);
+  const Topology topology = build_topology(mesh, [&connecting](float f) { return connecting.update(f); });
+  connecting.done();
   if (topology.nonmanifold_edges || topology.inconsistent_edges)
     warn(opt.quiet, opt.input + ": " + std::to_string(topology.nonmanifold_edges) + " non-manifold and " +
                         std::to_string(topology.inconsistent_edges) +
@@ -283,8 +290,9 @@ int run_map(const MapArgs& opt) {
     }
   }
   // === Orientation, mapping, metrics ===
-  Progress progress("mapping", opt.quiet);
-  mapping.progress = [&progress](float f) { return progress.update(f); };
+  Progress progress("orientation", opt.quiet);  // then mapping, closing, relaxing, metrics: a bar each
+  mapping.progress = nullptr;
+  options.stage_progress = [&progress](std::string_view stage, float f) { return progress.update(stage, f); };
   TextureMap map;
   if (Status s = map_texture(mesh, topology, options, map); !s) return report_error(s.with_file(opt.input));
   progress.done();
@@ -339,7 +347,10 @@ int run_map(const MapArgs& opt) {
   export_options.compression = compression;
   export_options.uv_set = opt.uv_set;
   export_options.up = opt.up == "z" ? SceneUp::kZ : SceneUp::kY;
+  Progress exporting("export", opt.quiet);
+  export_options.progress = [&exporting](float f) { return exporting.update(f); };
   if (Status s = export_mesh(opt.output, mesh, atlas, export_options); !s) return report_error(s);
+  exporting.done();
   run.export_seconds = seconds_since(export_start);
   for (const auto& [path, picture] : pictures) {
     if (Status s = write_png(path, picture); !s) return report_error(s);

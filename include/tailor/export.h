@@ -25,6 +25,7 @@
 #include "tailor/atlas.h"
 #include "tailor/mesh.h"
 #include "tailor/option_doc.h"
+#include "tailor/progress.h"
 #include "tailor/status.h"
 
 namespace tailor {
@@ -82,6 +83,8 @@ struct ExportOptions {
   int uv_set = 0;             //!< .glb: the mapped UVs go to TEXCOORD_<uv_set> (0..7); the file's other sets are kept
   SceneUp up = SceneUp::kY;   //!< .glb: kZ turns the scene Y-up as glTF wants (-90 degrees about x, on the node)
   MaterialTextures material;  //!< .glb: normal, metallic-roughness and occlusion maps (kInvalidArgument otherwise)
+  ProgressCallback progress;  //!< optional: the vertex split, then the bytes written (every few MB) or the
+                              //!< codec's steps; false cancels (kCancelled, nothing written)
 };
 
 //! Flags and help of the ExportOptions a user sets (option_doc.h).

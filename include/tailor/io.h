@@ -18,6 +18,7 @@
 #include "tailor/api.h"
 #include "tailor/mesh.h"
 #include "tailor/orientation.h"
+#include "tailor/progress.h"
 #include "tailor/status.h"
 
 namespace tailor {
@@ -30,6 +31,11 @@ TAILOR_API MeshFormat mesh_format_from_path(const std::string& path);
 //! Reads a mesh file; the format comes from the extension, or from the content when the extension
 //! is unknown. Cost: one pass over the file, O(F + V) memory.
 TAILOR_API Status load_mesh(const std::string& path, Mesh& mesh, LoadReport* report = nullptr);
+
+//! load_mesh with progress in [0, 1] (tailor/progress.h): the parse (PLY and OBJ by bytes, glTF by
+//! accessor data decoded; checked every few MB, never per element), then the repairs; false
+//! cancels (kCancelled, the mesh left empty). OFF and STL report only the repairs.
+TAILOR_API Status load_mesh(const std::string& path, Mesh& mesh, LoadReport* report, const ProgressCallback& progress);
 
 //! Parses a mesh held in memory (used by the fuzzers and the truncation tests).
 //! `name` is only used in error messages. A .gltf whose buffers are files fails with kUnsupported

@@ -47,6 +47,7 @@
 #include "tailor/metrics.h"
 #include "tailor/option_doc.h"
 #include "tailor/orientation.h"
+#include "tailor/progress.h"
 #include "tailor/status.h"
 #include "tailor/topology.h"
 
@@ -57,9 +58,8 @@ enum class MappingMode {
   kThesis,   //!< per-vertex UVs, absolute threshold raised by 10 px when stuck (reference)
 };
 
-//! Called now and then with progress in [0, 1]; return false to cancel (map_texture then returns
-//! kCancelled and leaves the atlas empty).
-using ProgressCallback = std::function<bool(float)>;
+// ProgressCallback (tailor/progress.h): called now and then with progress in [0, 1]; return false
+// to cancel (map_texture then returns kCancelled and leaves the atlas empty).
 
 struct MappingOptions {
   MappingMode mode = MappingMode::kPatches;  //!< algorithm (CLI --mode patches|thesis)
@@ -196,6 +196,9 @@ struct MapTextureOptions {
   MappingOptions mapping;          //!< steps 2-4: growth, seam shortening, crack closing (and the progress)
   MetricsOptions metrics;          //!< step 5 (the texture size, for the seam gap)
   bool measure = true;             //!< false skips step 5 (TextureMap::metrics stays empty)
+  //! Optional, beside mapping.progress: each stage's own progress ("orientation", "mapping" (the
+  //! growth and seam shortening), "closing", "relaxing", "metrics"); return false to cancel.
+  StageProgressCallback stage_progress;
 };
 
 //! What map_texture computes, stage by stage.

@@ -28,6 +28,28 @@ struct CornerAttribute {
   std::vector<float> values;  //!< #F*3 by components, per corner (unit normals; linear RGBA colours in [0, 1])
 };
 
+//! Where the faces of a glTF scene came from, so that export can give them back their names,
+//! extras and materials (the geometry itself stays one mesh in world space). JSON values are kept
+//! as JSON text ("" when absent); export writes them back as they are.
+struct SceneParts {
+  //! One mesh instance of the scene: the node that placed it and the mesh it placed.
+  struct Instance {
+    std::string node_name, node_extras, mesh_name, mesh_extras;
+  };
+  //! The faces of one instance that share one material (a glTF primitive of the output).
+  struct Part {
+    uint32_t instance = 0;         //!< into instances
+    uint32_t material = kInvalid;  //!< into materials; kInvalid: none (tailor's default material)
+  };
+  std::string asset_extras, asset_copyright, scene_name, scene_extras;
+  std::vector<Instance> instances;
+  //! The input materials used, as JSON objects without their textures and extensions (name,
+  //! factors, alphaMode, alphaCutoff, doubleSided, emissiveFactor, extras): export adds its own maps.
+  std::vector<std::string> materials;
+  std::vector<Part> parts;
+  bool empty() const { return parts.empty(); }
+};
+
 //! A triangle mesh.
 //! Corner c = 3f + k is corner k of face f; indices[c] is its vertex.
 struct Mesh {
@@ -38,6 +60,8 @@ struct Mesh {
   std::vector<uint8_t> seam_faces;  //!< empty, or #F flags: 1 = user-marked seam face (PLY `seam` property)
   std::vector<CornerAttribute> corner_attributes;  //!< kept from the file (glTF NORMAL, COLOR_0, TEXCOORD_n
                                                    //!< n > 0), written back by export; not used by the mapping
+  std::vector<uint32_t> face_parts;  //!< empty, or #F: the scene part of each face (glTF; index into scene.parts)
+  SceneParts scene;                  //!< glTF: names, extras and materials of the parts, written back by export
 
   size_t vertex_count() const { return positions.size() / 3; }
   size_t face_count() const { return indices.size() / 3; }
@@ -58,7 +82,7 @@ struct LoadReport {
   size_t mesh_instances = 0;         //!< glTF: meshes placed by the scene's nodes (world transforms applied)
   size_t skipped_primitives = 0;     //!< glTF: point and line primitives of those instances, not read
   std::string not_kept;              //!< what the file has that the output will not (", "-separated), e.g.
-                                     //!< "materials, names, TANGENT"; empty when nothing is lost
+                                     //!< "material textures, TANGENT"; empty when nothing is lost
   int texture_width = 0;             //!< glb: the embedded base colour texture's size, read from its header
   int texture_height = 0;            //!< without decoding it (0: no texture, or a header stb cannot read)
   double load_seconds = 0.0;

@@ -24,6 +24,7 @@
 #include "tailor/api.h"
 #include "tailor/mesh.h"
 #include "tailor/option_doc.h"
+#include "tailor/progress.h"
 #include "tailor/status.h"
 #include "tailor/topology.h"
 
@@ -67,6 +68,7 @@ struct OrientationOptions {
   uint32_t threads = 0;                        //!< threads for the per-face frames (0 = one per 100k faces, at most
                                                //!< the cores and 8); the result is identical for any count
   std::span<const OrientationStroke> strokes;  //!< user strokes blended into the field (empty = none)
+  ProgressCallback progress;                   //!< optional, at each pass over the faces; false cancels (kCancelled)
 };
 
 //! Flags and help of the OrientationOptions a user sets (option_doc.h).

@@ -24,6 +24,7 @@
 #include "tailor/metrics.h"
 #include "tailor/option_doc.h"
 #include "tailor/orientation.h"
+#include "tailor/progress.h"
 #include "tailor/render.h"
 #include "tailor/report.h"
 #include "tailor/stability.h"

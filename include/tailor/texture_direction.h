@@ -22,6 +22,8 @@ namespace tailor {
 //! grass 0.91, gravel 0.89, water caustics 0.82; bark 0.73, tiles 0.65, weave 0.59, sand ripples
 //! 0.35, bricks 0.25. A flat image reads 1. The image must pass check_image.
 TAILOR_API float texture_isotropy(const Image& texture);
+//! The same, telling `progress` the share measured every 64 rows (it cannot cancel).
+TAILOR_API float texture_isotropy(const Image& texture, const ProgressCallback& progress);
 
 //! Textures at or above this isotropy have no direction worth following: less than a fifth of
 //! their gradient energy prefers a direction.
@@ -42,7 +44,8 @@ inline constexpr uint32_t kUndirectedCrackRings = 32;
 //! texture, or none, the options stay as they are. Returns the texture's isotropy (measured once,
 //! for reports), or -1 for an empty image. keep_crack_rings: the user chose options.crack_rings
 //! (--crack-rings, crack_rings=), so only field_following changes; the CLI and the Python module
-//! both pass it.
-TAILOR_API float adapt_mapping_to_texture(const Image& texture, MappingOptions& options, bool keep_crack_rings = false);
+//! both pass it. progress: texture_isotropy's (optional).
+TAILOR_API float adapt_mapping_to_texture(const Image& texture, MappingOptions& options, bool keep_crack_rings = false,
+                                          const ProgressCallback& progress = {});
 
 }  // namespace tailor

@@ -15,6 +15,7 @@
 
 #include "tailor/api.h"
 #include "tailor/mesh.h"
+#include "tailor/progress.h"
 
 namespace tailor {
 
@@ -33,6 +34,10 @@ struct Topology {
 //! Builds the opposite-edge table and components. O(F) time with a flat open-addressing hash of
 //! directed edges; no per-edge allocation. Precondition: mesh passed finalize_mesh (indices < #V).
 TAILOR_API Topology build_topology(const Mesh& mesh);
+
+//! The same, telling `progress` (tailor/progress.h) the share done after each of its passes; it
+//! cannot cancel (its return value is ignored).
+TAILOR_API Topology build_topology(const Mesh& mesh, const ProgressCallback& progress);
 
 //! The neighbour face across edge e, or kInvalid.
 inline uint32_t neighbour_face(const Topology& t, uint32_t e) {

@@ -194,6 +194,62 @@ void split_on_attributes(const Mesh& mesh, const std::vector<const CornerAttribu
   }
 }
 
+// Sorts the faces of `mesh` by part into `out` (stable) and its corner UVs into `uv`, adding the part
+// id as a corner attribute (its float's bits; named "" so that it is told apart), so that vertices
+// are split where parts meet.
+void sort_faces_by_part(const Mesh& mesh, std::span<const float> corner_uv, size_t part_count, Mesh& out,
+                        std::vector<float>& uv, std::vector<uint32_t>& order) {
+  const size_t nf = mesh.face_count();
+  std::vector<size_t> start(part_count + 1, 0);
+  for (uint32_t p : mesh.face_parts) ++start[p + 1];
+  for (size_t p = 0; p < part_count; ++p) start[p + 1] += start[p];
+  order.resize(nf);  // sorted position -> face
+  for (size_t f = 0; f < nf; ++f) order[start[mesh.face_parts[f]]++] = static_cast<uint32_t>(f);
+  out.positions = mesh.positions;
+  out.indices.resize(3 * nf);
+  uv.resize(6 * nf);
+  out.face_parts.resize(nf);
+  for (size_t i = 0; i < nf; ++i) {
+    const size_t f = order[i];
+    std::memcpy(&out.indices[3 * i], &mesh.indices[3 * f], 12);
+    std::memcpy(&uv[6 * i], &corner_uv[6 * f], 24);
+    out.face_parts[i] = mesh.face_parts[f];
+  }
+  for (const CornerAttribute& a : mesh.corner_attributes) {
+    const size_t k = 3 * size_t(a.components);
+    CornerAttribute& b = out.corner_attributes.emplace_back(CornerAttribute{a.name, a.components, {}});
+    b.values.resize(a.values.size());
+    for (size_t i = 0; i < nf; ++i) std::memcpy(&b.values[k * i], &a.values[k * order[i]], k * sizeof(float));
+  }
+  CornerAttribute& id = out.corner_attributes.emplace_back(CornerAttribute{"", 1, {}});
+  id.values.resize(3 * nf);
+  for (size_t c = 0; c < 3 * nf; ++c) {
+    const uint32_t part = out.face_parts[c / 3];
+    std::memcpy(&id.values[c], &part, 4);
+  }
+}
+
+// The parts' ranges in the split mesh (faces sorted by part, vertices split on it and numbered
+// in order of first corner, so each part's vertices follow those of the part before).
+void part_ranges(const std::vector<uint32_t>& face_parts, const SplitMesh& split,
+                 std::vector<internal::ExportPart>& parts) {
+  const size_t nf = face_parts.size();
+  size_t vertex_begin = 0;
+  for (size_t f = 0; f < nf;) {
+    internal::ExportPart part;
+    part.part = face_parts[f];
+    part.index_begin = 3 * f;
+    part.vertex_begin = vertex_begin;
+    uint32_t largest = 0;
+    for (; f < nf && face_parts[f] == part.part; ++f)
+      for (int k = 0; k < 3; ++k) largest = std::max(largest, split.indices[3 * f + size_t(k)]);
+    part.index_end = 3 * f;
+    part.vertex_end = size_t{largest} + 1;
+    vertex_begin = part.vertex_end;
+    parts.push_back(part);
+  }
+}
+
 // Faces from which the normals get their own thread (below, starting it costs more than it saves).
 constexpr size_t kThreadedFaces = 100000;
 
@@ -239,16 +295,38 @@ Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas
   internal::ExportData data;
   data.mesh = &mesh;
   data.uv_set = options.uv_set;
+  // A glTF scene's parts (.glb only): faces sorted by part, vertices split where parts meet, so
+  // that each part becomes a primitive with its own vertex range.
+  std::span<const float> corner_uv = atlas.corner_uv;
+  std::vector<float> sorted_uv;
+  std::vector<uint32_t> sorted_order;  // the input face of each sorted face (for error messages)
+  const bool scene = format == ExportFormat::kGlb && !mesh.scene.empty() && mesh.face_parts.size() == nf;
+  if (scene) {
+    const SceneParts& parts = mesh.scene;
+    for (const SceneParts::Part& part : parts.parts)
+      if (part.instance >= parts.instances.size() ||
+          (part.material != kInvalid && part.material >= parts.materials.size()))
+        return Status::error(ErrorCode::kInvalidArgument, path, "scene part out of range");
+    for (uint32_t p : mesh.face_parts)
+      if (p >= parts.parts.size()) return Status::error(ErrorCode::kInvalidArgument, path, "face part out of range");
+    sort_faces_by_part(mesh, atlas.corner_uv, parts.parts.size(), data.part_sorted, sorted_uv, sorted_order);
+    corner_uv = sorted_uv;
+    data.mesh = &data.part_sorted;
+    data.scene = &parts;
+  }
+  const Mesh& input = *data.mesh;
   // The file's own attributes (glTF): the mapped UV set replaces its namesake; vertices split
   // where they differ, the input's NORMAL used instead of computed normals.
   std::vector<const CornerAttribute*> kept;
   const std::string mapped_set = "TEXCOORD_" + std::to_string(options.uv_set);
-  for (const CornerAttribute& a : mesh.corner_attributes)
-    if (a.name != mapped_set && (format == ExportFormat::kGlb || a.name == "NORMAL")) kept.push_back(&a);
+  for (const CornerAttribute& a : input.corner_attributes)
+    if (a.name != mapped_set && (format == ExportFormat::kGlb || a.name == "NORMAL" || a.name == "COLOR_0"))
+      kept.push_back(&a);
   bool input_normals = false;
   if (!kept.empty()) {
-    split_on_attributes(mesh, kept, data.attribute_split, data.kept);
+    split_on_attributes(input, kept, data.attribute_split, data.kept);
     data.mesh = &data.attribute_split;
+    if (scene) data.kept.pop_back();  // the part ids (last): not written
     for (size_t i = 0; i < data.kept.size(); ++i)
       if (data.kept[i].name == "NORMAL") {
         data.normals = std::move(data.kept[i].values);
@@ -275,9 +353,14 @@ Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas
       [&] {
         if (want_normals) vertex_normals(source, data.normals);
       },
-      [&] { bad_corner = internal::split_vertices_scaled(source, atlas.corner_uv, su, sv, data.split); });
-  if (bad_corner != internal::kNoBadCorner)
+      [&] { bad_corner = internal::split_vertices_scaled(source, corner_uv, su, sv, data.split); });
+  if (bad_corner != internal::kNoBadCorner) {
+    if (scene) bad_corner = 3 * size_t{sorted_order[bad_corner / 3]} + bad_corner % 3;  // the caller's corner id
     return Status::error(ErrorCode::kInvalidArgument, path, "UV is not finite", "corner " + std::to_string(bad_corner));
+  }
+  if (options.progress && !options.progress(internal::ExportProgress::kSplitShare))
+    return internal::ExportProgress::cancelled(path);
+  if (scene) part_ranges(data.part_sorted.face_parts, data.split, data.parts);
 
   if (format == ExportFormat::kGlb && !options.material.normal_png.empty() && !data.normals.empty())
     internal::compute_tangents(*data.mesh, data.split, data.normals, data.tangents);

@@ -52,7 +52,8 @@ std::span<const char> bytes_of(const T* data, size_t count) {
 // Streams `count` items of `floats_per_item` floats, each made by make(item, float* out), through
 // one small reusable buffer: the arrays gathered for the file are never held whole in memory.
 template <class Make>
-Status write_gathered(AtomicFileWriter& file, size_t count, size_t floats_per_item, Make&& make) {
+Status write_gathered(AtomicFileWriter& file, ExportProgress& progress, size_t count, size_t floats_per_item,
+                      Make&& make) {
   constexpr size_t kChunkItems = 16384;
   std::vector<float> chunk(kChunkItems * floats_per_item);
   for (size_t begin = 0; begin < count; begin += kChunkItems) {
@@ -60,6 +61,7 @@ Status write_gathered(AtomicFileWriter& file, size_t count, size_t floats_per_it
     float* out = chunk.data();
     for (size_t i = begin; i < end; ++i, out += floats_per_item) make(i, out);
     TAILOR_RETURN_IF_ERROR(file.write(bytes_of(chunk.data(), (end - begin) * floats_per_item)));
+    if (!progress.wrote(4 * (end - begin) * floats_per_item)) return progress.cancelled();
   }
   return Status::ok();
 }
@@ -123,91 +125,76 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
   std::string texture_bytes, mime_type;
   if (!options.texture_path.empty())
     TAILOR_RETURN_IF_ERROR(read_texture_bytes(options.texture_path, texture_bytes, mime_type));
-
-  // Split positions are source positions through xref, in split order (the order matters for
-  // min/max: -0 and +0 compare equal, the first one seen is kept).
-  const float* positions = mesh.positions.data();
-  float lo[3] = {std::numeric_limits<float>::max(), std::numeric_limits<float>::max(),
-                 std::numeric_limits<float>::max()};
-  float hi[3] = {-lo[0], -lo[1], -lo[2]};
-  for (size_t s = 0; s < vertex_count; ++s) {
-    const float* p = &positions[3 * size_t{split.xref[s]}];
-    for (int i = 0; i < 3; ++i) {
-      lo[i] = std::min(lo[i], p[i]);
-      hi[i] = std::max(hi[i], p[i]);
-    }
-  }
+  // One primitive per part (a glTF scene's), each over its own range of split vertices and indices.
+  std::vector<ExportPart> parts = data.parts;
+  if (parts.empty()) parts.push_back({0, 0, vertex_count, 0, index_count});
 
   // The BIN chunk's layout: positions, normals (optional), kept attributes, texcoords, indices,
-  // tangents (optional), images. Every block
-  // is a multiple of 4 bytes long, so each starts 4-byte aligned.
+  // tangents (optional), images; one view each, one accessor per part into it. Every block is a
+  // multiple of 4 bytes long, so each starts 4-byte aligned.
+  const float* positions = mesh.positions.data();
   const bool normals = !data.normals.empty();
   size_t bin_size = 0;
-  nlohmann::json views = nlohmann::json::array(), accessors = nlohmann::json::array(), attributes;
-  {
-    const size_t view = add_view(views, bin_size, 12 * vertex_count, kArrayBuffer);
-    bin_size += 12 * vertex_count;
-    attributes["POSITION"] = accessors.size();
-    accessors.push_back({{"bufferView", view},
-                         {"componentType", kFloat},
-                         {"count", vertex_count},
-                         {"type", "VEC3"},
-                         {"min", {lo[0], lo[1], lo[2]}},
-                         {"max", {hi[0], hi[1], hi[2]}}});
-  }
-  if (normals) {
-    const size_t view = add_view(views, bin_size, 12 * vertex_count, kArrayBuffer);
-    bin_size += 12 * vertex_count;
-    attributes["NORMAL"] = accessors.size();
-    accessors.push_back({{"bufferView", view}, {"componentType", kFloat}, {"count", vertex_count}, {"type", "VEC3"}});
-  }
-  for (const CornerAttribute& a : data.kept) {  // the file's own: colours, other UV sets
-    const size_t bytes = 4 * size_t(a.components) * vertex_count;
-    const size_t view = add_view(views, bin_size, bytes, kArrayBuffer);
-    bin_size += bytes;
-    attributes[a.name] = accessors.size();
-    accessors.push_back({{"bufferView", view},
-                         {"componentType", kFloat},
-                         {"count", vertex_count},
-                         {"type", a.components == 2   ? "VEC2"
-                                  : a.components == 3 ? "VEC3"
-                                                      : "VEC4"}});
-  }
-  {
-    const size_t view = add_view(views, bin_size, 8 * vertex_count, kArrayBuffer);
-    bin_size += 8 * vertex_count;
-    attributes["TEXCOORD_" + std::to_string(data.uv_set)] = accessors.size();
-    accessors.push_back({{"bufferView", view}, {"componentType", kFloat}, {"count", vertex_count}, {"type", "VEC2"}});
-  }
-  const bool tangents = !data.tangents.empty();
-  size_t indices_accessor = 0;
-  {
-    const size_t view = add_view(views, bin_size, 4 * index_count, kElementArrayBuffer);
-    bin_size += 4 * index_count;
-    indices_accessor = accessors.size();
-    accessors.push_back(
-        {{"bufferView", view}, {"componentType", kUnsignedInt}, {"count", index_count}, {"type", "SCALAR"}});
-  }
-  if (tangents) {  // per split vertex, after the indices (written straight from data.tangents)
-    const size_t view = add_view(views, bin_size, 16 * vertex_count, kArrayBuffer);
-    bin_size += 16 * vertex_count;
-    attributes["TANGENT"] = accessors.size();
-    accessors.push_back({{"bufferView", view}, {"componentType", kFloat}, {"count", vertex_count}, {"type", "VEC4"}});
-  }
-
-  nlohmann::json node = {{"mesh", 0}, {"name", "tailor"}};
-  if (options.up == SceneUp::kZ) node["rotation"] = {-kHalfSqrt2, 0.0, 0.0, kHalfSqrt2};
-  nlohmann::json gltf = {
-      {"asset", {{"version", "2.0"}, {"generator", "tailor"}}},
-      {"scene", 0},
-      {"scenes", {{{"nodes", {0}}}}},
-      {"nodes", {node}},
-      {"meshes",
-       {{{"primitives",
-          {{{"attributes", attributes}, {"indices", indices_accessor}, {"material", 0}, {"mode", kTriangles}}}}}}},
+  nlohmann::json views = nlohmann::json::array(), accessors = nlohmann::json::array();
+  std::vector<nlohmann::json> primitives(parts.size(), {{"mode", kTriangles}});
+  // A view of `width` bytes per element (of `count`) and one accessor per part into it.
+  auto add_array = [&](const std::string& attribute, size_t width, size_t count, int component_type, const char* type,
+                       int target, auto&& extra) {
+    const size_t view = add_view(views, bin_size, width * count, target);
+    bin_size += width * count;
+    // Several accessors on one vertex view need its stride (spec 3.6.2.4).
+    if (target == kArrayBuffer && parts.size() > 1) views[view]["byteStride"] = width;
+    for (size_t i = 0; i < parts.size(); ++i) {
+      const ExportPart& p = parts[i];
+      const bool vertices = target == kArrayBuffer;
+      const size_t begin = vertices ? p.vertex_begin : p.index_begin, end = vertices ? p.vertex_end : p.index_end;
+      nlohmann::json accessor = {
+          {"bufferView", view}, {"componentType", component_type}, {"count", end - begin}, {"type", type}};
+      if (begin != 0) accessor["byteOffset"] = width * begin;
+      extra(p, accessor);
+      if (attribute.empty())
+        primitives[i]["indices"] = accessors.size();
+      else
+        primitives[i]["attributes"][attribute] = accessors.size();
+      accessors.push_back(std::move(accessor));
+    }
   };
+  auto nothing = [](const ExportPart&, nlohmann::json&) {};
+  // Split positions are source positions through xref, in split order (the order matters for
+  // min/max: -0 and +0 compare equal, the first one seen is kept).
+  add_array("POSITION", 12, vertex_count, kFloat, "VEC3", kArrayBuffer, [&](const ExportPart& p, nlohmann::json& a) {
+    float lo[3] = {std::numeric_limits<float>::max(), std::numeric_limits<float>::max(),
+                   std::numeric_limits<float>::max()};
+    float hi[3] = {-lo[0], -lo[1], -lo[2]};
+    for (size_t s = p.vertex_begin; s < p.vertex_end; ++s) {
+      const float* q = &positions[3 * size_t{split.xref[s]}];
+      for (int i = 0; i < 3; ++i) {
+        lo[i] = std::min(lo[i], q[i]);
+        hi[i] = std::max(hi[i], q[i]);
+      }
+    }
+    a["min"] = {lo[0], lo[1], lo[2]};
+    a["max"] = {hi[0], hi[1], hi[2]};
+  });
+  if (normals) add_array("NORMAL", 12, vertex_count, kFloat, "VEC3", kArrayBuffer, nothing);
+  for (const CornerAttribute& a : data.kept)  // the file's own: colours, other UV sets
+    add_array(a.name, 4 * size_t(a.components), vertex_count, kFloat,
+              a.components == 2   ? "VEC2"
+              : a.components == 3 ? "VEC3"
+                                  : "VEC4",
+              kArrayBuffer, nothing);
+  add_array("TEXCOORD_" + std::to_string(data.uv_set), 8, vertex_count, kFloat, "VEC2", kArrayBuffer, nothing);
+  add_array("", 4, index_count, kUnsignedInt, "SCALAR", kElementArrayBuffer, nothing);
+  const bool tangents = !data.tangents.empty();
+  // per split vertex, after the indices (written straight from data.tangents)
+  if (tangents) add_array("TANGENT", 16, vertex_count, kFloat, "VEC4", kArrayBuffer, nothing);
+
+  nlohmann::json node = {{"name", "tailor"}};
+  if (options.up == SceneUp::kZ) node["rotation"] = {-kHalfSqrt2, 0.0, 0.0, kHalfSqrt2};
+  nlohmann::json gltf;
   std::string images;  // the material's images, after the indices
   add_glb_material(gltf, views, bin_size, images, texture_bytes, mime_type, options.material, data.uv_set);
+  add_glb_scene(gltf, data, node, std::move(primitives));
   texture_bytes = {};
   if (images.size() > std::numeric_limits<uint32_t>::max() - bin_size)
     return Status::error(ErrorCode::kLimit, path, "texture too large for a .glb buffer");
@@ -224,7 +211,7 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
     return Status::error(ErrorCode::kLimit, path, "output larger than the 4 GiB a .glb can hold");
 
   // Header, JSON chunk and BIN chunk header in one small string; the rest goes straight from the
-  // split (indices, texture bytes) or through a small buffer (positions, normals, texcoords).
+  // split (texture bytes) or through a small buffer (positions, normals, texcoords, indices).
   std::string head;
   head.reserve(28 + json.size());
   append_u32(head, kGlbMagic);
@@ -236,36 +223,52 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
   append_u32(head, static_cast<uint32_t>(bin_size));
   append_u32(head, kChunkBin);
 
+  ExportProgress progress(options.progress, bin_size, path);
   AtomicFileWriter file(path);
   TAILOR_RETURN_IF_ERROR(file.open());
   TAILOR_RETURN_IF_ERROR(file.write(head));
   const uint32_t* xref = split.xref.data();
-  TAILOR_RETURN_IF_ERROR(write_gathered(file, vertex_count, 3, [&](size_t s, float* out) {
+  TAILOR_RETURN_IF_ERROR(write_gathered(file, progress, vertex_count, 3, [&](size_t s, float* out) {
     std::memcpy(out, &positions[3 * size_t{xref[s]}], 3 * sizeof(float));
   }));
   if (normals) {
     const float* source = data.normals.data();
-    TAILOR_RETURN_IF_ERROR(write_gathered(file, vertex_count, 3, [&](size_t s, float* out) {
+    TAILOR_RETURN_IF_ERROR(write_gathered(file, progress, vertex_count, 3, [&](size_t s, float* out) {
       std::memcpy(out, &source[3 * size_t{xref[s]}], 3 * sizeof(float));
     }));
   }
   for (const CornerAttribute& a : data.kept) {
     const size_t k = size_t(a.components);
     const float* values = a.values.data();
-    TAILOR_RETURN_IF_ERROR(write_gathered(file, vertex_count, k, [&](size_t s, float* out) {
+    TAILOR_RETURN_IF_ERROR(write_gathered(file, progress, vertex_count, k, [&](size_t s, float* out) {
       std::memcpy(out, &values[k * size_t{xref[s]}], k * sizeof(float));
     }));
   }
   // glTF's v axis points down the image: TEXCOORD_0 = (s, -t), the usual (s, 1 - t) shifted by a
   // whole repeat (invisible with REPEAT) but exact, so a round trip is bit-exact (see export.h).
   const float* uvs = split.uvs.data();
-  TAILOR_RETURN_IF_ERROR(write_gathered(file, vertex_count, 2, [&](size_t s, float* out) {
+  TAILOR_RETURN_IF_ERROR(write_gathered(file, progress, vertex_count, 2, [&](size_t s, float* out) {
     out[0] = uvs[2 * s];
     out[1] = -uvs[2 * s + 1];
   }));
-  TAILOR_RETURN_IF_ERROR(file.write(bytes_of(split.indices.data(), index_count)));
+  if (parts.size() == 1) {
+    TAILOR_RETURN_IF_ERROR(file.write(bytes_of(split.indices.data(), index_count)));
+  } else {  // indices of a part count from its first vertex
+    for (const ExportPart& p : parts) {
+      constexpr size_t kChunk = 3 * 16384;
+      std::vector<uint32_t> chunk(kChunk);
+      const uint32_t base = static_cast<uint32_t>(p.vertex_begin);
+      for (size_t begin = p.index_begin; begin < p.index_end; begin += kChunk) {
+        const size_t end = std::min(p.index_end, begin + kChunk);
+        for (size_t i = begin; i < end; ++i) chunk[i - begin] = split.indices[i] - base;
+        TAILOR_RETURN_IF_ERROR(file.write(bytes_of(chunk.data(), end - begin)));
+        if (!progress.wrote(4 * (end - begin))) return ExportProgress::cancelled(path);
+      }
+    }
+  }
   if (tangents) TAILOR_RETURN_IF_ERROR(file.write(bytes_of(data.tangents.data(), data.tangents.size())));
   TAILOR_RETURN_IF_ERROR(file.write(images));
+  if (!progress.reached(1.f)) return ExportProgress::cancelled(path);
   return file.commit();
 }
 

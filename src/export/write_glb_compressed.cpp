@@ -118,8 +118,9 @@ void optimize_order(Arrays& a) {
 
 int16_t snorm16(double x) { return static_cast<int16_t>(std::lround(std::clamp(x, -1.0, 1.0) * 32767.0)); }
 
-// The quantized streams (KHR_mesh_quantization) and the node's translation and scale.
-std::vector<Stream> quantized_streams(const Arrays& a, nlohmann::json& node) {
+// The quantization of all positions: centre and half side of the bounding cube, which the node's
+// translation and scale undo.
+void quantization(const Arrays& a, double center[3], double& half) {
   const size_t nv = a.vertex_count();
   double lo[3] = {std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
                   std::numeric_limits<double>::max()};
@@ -129,15 +130,36 @@ std::vector<Stream> quantized_streams(const Arrays& a, nlohmann::json& node) {
       lo[k] = std::min(lo[k], double{a.positions[3 * v + size_t(k)]});
       hi[k] = std::max(hi[k], double{a.positions[3 * v + size_t(k)]});
     }
-  double center[3], half = 0;
+  half = 0;
   for (int k = 0; k < 3; ++k) {
     center[k] = static_cast<float>(0.5 * (lo[k] + hi[k]));  // the value the file stores
     half = std::max(half, 0.5 * (hi[k] - lo[k]));
   }
   half = half > 0 ? static_cast<float>(half * (1 + 1e-6)) : 1.0;  // every point inside [-1, 1] after rounding
-  node["translation"] = {center[0], center[1], center[2]};
-  node["scale"] = {half, half, half};
+}
 
+// The part of `a` over split vertices [p.vertex_begin, p.vertex_end) and its indices, renumbered.
+Arrays slice(const Arrays& a, const ExportPart& p) {
+  Arrays out;
+  const size_t vb = p.vertex_begin, ve = p.vertex_end;
+  auto range = [&](const std::vector<float>& v, size_t width) {
+    return v.empty() ? std::vector<float>()
+                     : std::vector<float>(v.begin() + long(width * vb), v.begin() + long(width * ve));
+  };
+  out.positions = range(a.positions, 3);
+  out.normals = range(a.normals, 3);
+  out.uvs = range(a.uvs, 2);
+  for (const CornerAttribute& k : a.kept)
+    out.kept.push_back(CornerAttribute{k.name, k.components, range(k.values, size_t(k.components))});
+  out.uv_name = a.uv_name;
+  out.indices.assign(a.indices.begin() + long(p.index_begin), a.indices.begin() + long(p.index_end));
+  for (uint32_t& i : out.indices) i -= static_cast<uint32_t>(vb);
+  return out;
+}
+
+// The quantized streams (KHR_mesh_quantization) under the quantization (center, half).
+std::vector<Stream> quantized_streams(const Arrays& a, const double center[3], double half) {
+  const size_t nv = a.vertex_count();
   std::vector<Stream> streams;
   std::vector<int16_t> q(4 * nv, 0);
   int qlo[3] = {32767, 32767, 32767}, qhi[3] = {-32767, -32767, -32767};
@@ -228,7 +250,6 @@ void apply_meshopt_filters(const Arrays& a, std::vector<Stream>& streams) {
 // EXT_meshopt_compression: each stream coded into `bin`, its view declared over the fallback buffer 1.
 Status meshopt_views(const std::string& path, std::vector<Stream>& streams, std::string& bin, nlohmann::json& views,
                      size_t& fallback_size) {
-  fallback_size = 0;
   for (Stream& s : streams) {
     const size_t count = s.bytes.size() / s.stride;
     std::string coded;
@@ -280,7 +301,7 @@ Status meshopt_views(const std::string& path, std::vector<Stream>& streams, std:
 
 // KHR_draco_mesh_compression: the stream into `bin` (one view), accessors without views.
 Status draco_primitive(const std::string& path, const Arrays& a, std::string& bin, nlohmann::json& views,
-                       std::vector<Stream>& streams, nlohmann::json& extension) {
+                       std::vector<Stream>& streams, nlohmann::json& extension, const ProgressCallback& step) {
   const size_t nv = a.vertex_count(), nf = a.indices.size() / 3;
   draco::Mesh mesh;
   mesh.set_num_points(static_cast<uint32_t>(nv));
@@ -318,6 +339,7 @@ Status draco_primitive(const std::string& path, const Arrays& a, std::string& bi
     return Status::error(ErrorCode::kInvalidArgument, path,
                          "Draco cannot encode the mesh: " + encoded.error_msg_string());
 
+  if (!step(0.75f)) return ExportProgress::cancelled(path);
   // What a reader will get: the counts and the dequantized positions' bounds.
   draco::DecoderBuffer in;
   in.Init(buffer.data(), buffer.size());
@@ -385,25 +407,49 @@ Status write_glb_compressed(const std::string& path, const ExportData& data, con
     TAILOR_RETURN_IF_ERROR(read_texture_bytes(options.texture_path, texture_bytes, mime_type));
 
   Arrays arrays = gather(data);
-  nlohmann::json node = {{"mesh", 0}, {"name", "tailor"}};
-  nlohmann::json views = nlohmann::json::array(), primitive = {{"material", 0}, {"mode", kTriangles}};
+  // One primitive per part (a glTF scene's), each its own streams (Draco codes one per primitive).
+  std::vector<ExportPart> parts = data.parts;
+  const bool whole = parts.empty();
+  if (whole) parts.push_back({0, 0, nv, 0, arrays.indices.size()});
+  nlohmann::json node = {{"name", "tailor"}};
+  nlohmann::json views = nlohmann::json::array(), accessors = nlohmann::json::array();
   nlohmann::json used = nlohmann::json::array(), buffers = nlohmann::json::array();
-  std::vector<Stream> streams;
+  std::vector<nlohmann::json> primitives;
   std::string bin;
-  switch (options.compression) {
-    case MeshCompression::kQuantize:
-    case MeshCompression::kMeshopt: {
-      const bool meshopt = options.compression == MeshCompression::kMeshopt;
-      if (meshopt) optimize_order(arrays);
-      streams = quantized_streams(arrays, node);
+  const bool meshopt = options.compression == MeshCompression::kMeshopt;
+  if (options.compression == MeshCompression::kNone) return write_glb(path, data, options);
+  double center[3] = {0, 0, 0}, half = 1;
+  if (options.compression != MeshCompression::kDraco) {
+    quantization(arrays, center, half);
+    node["translation"] = {center[0], center[1], center[2]};
+    node["scale"] = {half, half, half};
+  }
+  size_t fallback = 0;
+  // Progress: each part's share of the indices, in steps (the codecs give none of their own).
+  ExportProgress progress(options.progress, 0, path);
+  const double index_count = static_cast<double>(std::max<size_t>(1, arrays.indices.size()));
+  if (!progress.reached(0.05f)) return progress.cancelled();
+  for (const ExportPart& p : parts) {
+    auto step = [&](float done) {
+      const double begin = static_cast<double>(p.index_begin) / index_count;
+      const double share = static_cast<double>(p.index_end - p.index_begin) / index_count;
+      return progress.reached(static_cast<float>(0.05 + 0.9 * (begin + share * done)));
+    };
+    Arrays part_arrays = whole ? Arrays{} : slice(arrays, p);
+    Arrays& a = whole ? arrays : part_arrays;
+    nlohmann::json primitive = {{"mode", kTriangles}};
+    std::vector<Stream> streams;
+    if (options.compression == MeshCompression::kDraco) {
+      nlohmann::json extension;
+      TAILOR_RETURN_IF_ERROR(draco_primitive(path, a, bin, views, streams, extension, step));
+      primitive["extensions"] = {{"KHR_draco_mesh_compression", extension}};
+    } else {
+      if (meshopt) optimize_order(a);
+      if (!step(0.5f)) return progress.cancelled();
+      streams = quantized_streams(a, center, half);
       if (meshopt) {
-        apply_meshopt_filters(arrays, streams);
-        size_t fallback = 0;
+        apply_meshopt_filters(a, streams);
         TAILOR_RETURN_IF_ERROR(meshopt_views(path, streams, bin, views, fallback));
-        buffers.push_back(nullptr);  // buffer 0, the BIN chunk: its length is known at the end
-        buffers.push_back(
-            {{"byteLength", fallback}, {"extensions", {{"EXT_meshopt_compression", {{"fallback", true}}}}}});
-        used.push_back("EXT_meshopt_compression");
       } else {
         for (Stream& s : streams) {
           nlohmann::json view = {
@@ -415,17 +461,29 @@ Status write_glb_compressed(const std::string& path, const ExportData& data, con
           pad_to_4(bin);
         }
       }
-      used.push_back("KHR_mesh_quantization");
-      break;
     }
-    case MeshCompression::kDraco: {
-      nlohmann::json extension;
-      TAILOR_RETURN_IF_ERROR(draco_primitive(path, arrays, bin, views, streams, extension));
-      primitive["extensions"] = {{"KHR_draco_mesh_compression", extension}};
-      used.push_back("KHR_draco_mesh_compression");
-      break;
+    if (!step(1.f)) return progress.cancelled();
+    nlohmann::json attributes;
+    for (const Stream& s : streams) {
+      accessors.push_back(s.accessor);
+      if (s.attribute)
+        attributes[s.attribute] = accessors.size() - 1;
+      else
+        primitive["indices"] = accessors.size() - 1;
     }
-    case MeshCompression::kNone: return write_glb(path, data, options);
+    primitive["attributes"] = attributes;
+    primitives.push_back(std::move(primitive));
+  }
+  if (options.compression == MeshCompression::kDraco) {
+    used.push_back("KHR_draco_mesh_compression");
+  } else {
+    if (meshopt) {
+      buffers.push_back(nullptr);  // buffer 0, the BIN chunk: its length is known at the end
+      buffers.push_back(
+          {{"byteLength", fallback}, {"extensions", {{"EXT_meshopt_compression", {{"fallback", true}}}}}});
+      used.push_back("EXT_meshopt_compression");
+    }
+    used.push_back("KHR_mesh_quantization");
   }
   if (options.up == SceneUp::kZ) {  // -90 degrees about x: (x, y, z) -> (x, z, -y), after the quantization
     constexpr double h = 0.70710678118654752;
@@ -435,29 +493,13 @@ Status write_glb_compressed(const std::string& path, const ExportData& data, con
       node["translation"] = {t[0], t[2], -t[1].get<double>()};
     }
   }
-  nlohmann::json accessors = nlohmann::json::array(), attributes;
-  for (const Stream& s : streams) {
-    accessors.push_back(s.accessor);
-    if (s.attribute)
-      attributes[s.attribute] = accessors.size() - 1;
-    else
-      primitive["indices"] = accessors.size() - 1;
-  }
-  primitive["attributes"] = attributes;
   std::sort(used.begin(), used.end());
 
-  nlohmann::json gltf = {
-      {"asset", {{"version", "2.0"}, {"generator", "tailor"}}},
-      {"scene", 0},
-      {"scenes", {{{"nodes", {0}}}}},
-      {"nodes", {node}},
-      {"meshes", {{{"primitives", {primitive}}}}},
-      {"extensionsUsed", used},
-      {"extensionsRequired", used},
-  };
+  nlohmann::json gltf = {{"extensionsUsed", used}, {"extensionsRequired", used}};
   pad_to_4(bin);
   std::string images;
   add_glb_material(gltf, views, bin.size(), images, texture_bytes, mime_type, options.material, data.uv_set);
+  add_glb_scene(gltf, data, node, std::move(primitives));
   bin += images;
   if (buffers.empty()) buffers.push_back(nullptr);
   buffers[0] = {{"byteLength", bin.size()}};
@@ -483,6 +525,7 @@ Status write_glb_compressed(const std::string& path, const ExportData& data, con
   TAILOR_RETURN_IF_ERROR(file.open());
   TAILOR_RETURN_IF_ERROR(file.write(head));
   TAILOR_RETURN_IF_ERROR(file.write(bin));
+  if (!progress.reached(1.f)) return progress.cancelled();
   return file.commit();
 }
 

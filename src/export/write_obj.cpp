@@ -1,8 +1,8 @@
-// Wavefront OBJ writer: `v` per source vertex (so the reloaded mesh keeps its connectivity), `vt`
-// per split vertex (one per distinct (vertex, uv) pair, in texture repeats, t up), `vn` per source
-// vertex when normals are on, faces `f v/vt[/vn]` (1-based). With a texture, a <stem>.mtl next to
-// the .obj holds one material whose map_Kd is the texture path relative to the .obj's folder.
-// Numbers are written with std::to_chars (shortest text that reads back bit-exact).
+// Wavefront OBJ writer: `v` per source vertex (`v x y z r g b` when the mesh kept colours, COLOR_0) (so the reloaded
+// mesh keeps its connectivity), `vt` per split vertex (one per distinct (vertex, uv) pair, in texture repeats, t up),
+// `vn` per source vertex when normals are on, faces `f v/vt[/vn]` (1-based). With a texture, a <stem>.mtl next to the
+// .obj holds one material whose map_Kd is the texture path relative to the .obj's folder. Numbers are written with
+// std::to_chars (shortest text that reads back bit-exact).
 #include <filesystem>
 
 #include "export/writers.h"
@@ -40,7 +40,11 @@ Status write_obj(const std::string& path, const ExportData& data, const ExportOp
   constexpr size_t kFlushBytes = size_t{1} << 20;
   std::string out;
   out.reserve(kFlushBytes + 4096);
+  // Progress in lines: v and vn per vertex, vt per split vertex, f per face.
+  const size_t lines = mesh.vertex_count() * (data.normals.empty() ? 1 : 2) + split.xref.size() + mesh.face_count();
+  ExportProgress progress(options.progress, lines, path);
   auto flush_if_full = [&]() -> Status {
+    if (!progress.wrote(1)) return progress.cancelled();
     if (out.size() < kFlushBytes) return Status::ok();
     Status s = file.write(out);
     out.clear();
@@ -49,6 +53,9 @@ Status write_obj(const std::string& path, const ExportData& data, const ExportOp
   out += "# written by tailor: ";
   out += std::to_string(mesh.vertex_count()) + " vertices, " + std::to_string(mesh.face_count()) + " faces\n";
   if (textured) out += "mtllib " + mtl_name + "\n";
+  const CornerAttribute* colour = nullptr;  // per source vertex (export_mesh kept it)
+  for (const CornerAttribute& a : data.kept)
+    if (a.name == "COLOR_0" && a.components == 4) colour = &a;
   for (size_t v = 0; v < mesh.vertex_count(); ++v) {
     out += "v ";
     append_float(out, mesh.positions[3 * v]);
@@ -56,6 +63,10 @@ Status write_obj(const std::string& path, const ExportData& data, const ExportOp
     append_float(out, mesh.positions[3 * v + 1]);
     out += ' ';
     append_float(out, mesh.positions[3 * v + 2]);
+    for (size_t k = 0; colour && k < 3; ++k) {
+      out += ' ';
+      append_float(out, colour->values[4 * v + k]);
+    }
     out += '\n';
     TAILOR_RETURN_IF_ERROR(flush_if_full());
   }
@@ -96,6 +107,7 @@ Status write_obj(const std::string& path, const ExportData& data, const ExportOp
     TAILOR_RETURN_IF_ERROR(flush_if_full());
   }
   TAILOR_RETURN_IF_ERROR(file.write(out));
+  if (!progress.reached(1.f)) return progress.cancelled();
   return file.commit();
 }
 

@@ -2,6 +2,7 @@
 // vertices and computes normals once; each writer only serialises and writes atomically.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -15,6 +16,41 @@
 #include "tailor/status.h"
 
 namespace tailor::internal {
+
+//! Export's progress (ExportOptions::progress): the split takes [0, kSplitShare], the writer the
+//! rest, told in bytes written (at most every few MB) or in steps of its own.
+class ExportProgress {
+ public:
+  static constexpr float kSplitShare = 0.2f;
+  ExportProgress(const ProgressCallback& callback, size_t total_bytes, const std::string& path)
+      : callback_(callback), total_(total_bytes), path_(path) {}
+  //! The writer's own share reached, in [0, 1]; false: cancelled.
+  bool reached(float done) const { return !callback_ || callback_(kSplitShare + (1.f - kSplitShare) * done); }
+  //! `bytes` more written; false: cancelled.
+  bool wrote(size_t bytes) {
+    written_ += bytes;
+    if (!callback_ || written_ < next_) return true;
+    next_ = written_ + std::min(size_t{4} << 20, std::max<size_t>(total_ / 100, 1));  // every 1 % or 4 MiB
+    return reached(total_ > 0 ? static_cast<float>(std::min(written_, total_)) / static_cast<float>(total_) : 1.f);
+  }
+  static Status cancelled(const std::string& path) {
+    return Status::error(ErrorCode::kCancelled, path, "export cancelled");
+  }
+  Status cancelled() const { return cancelled(path_); }
+
+ private:
+  const ProgressCallback& callback_;
+  size_t total_ = 0, written_ = 0, next_ = 0;
+  const std::string& path_;
+};
+
+//! The faces of one scene part (Mesh::scene.parts[part]) in the split mesh: faces are sorted by
+//! part and vertices split on it, so each part is a range of split vertices and of indices.
+struct ExportPart {
+  uint32_t part = 0;
+  size_t vertex_begin = 0, vertex_end = 0;  //!< split vertices
+  size_t index_begin = 0, index_end = 0;    //!< into split.indices (global vertex ids)
+};
 
 //! What every writer gets: the source mesh, its vertices split on UV with uvs in texture repeats
 //! (OBJ convention, t up: see export.h), and unit normals per SOURCE vertex (#V by 3, or empty).
@@ -35,7 +71,20 @@ struct ExportData {
   //! #S by 4: unit tangent xyz and handedness w per SPLIT vertex (tangent_frames.cpp); empty unless
   //! the material has a normal map and the mesh has normals.
   std::vector<float> tangents;
+  //! .glb of a glTF scene (Mesh::scene not empty): the parts in order, and the scene they come
+  //! from; empty / null: one part, tailor's own node and material.
+  std::vector<ExportPart> parts;
+  const SceneParts* scene = nullptr;
+  //! The mesh with its faces sorted by part (mesh points here, or attribute_split does).
+  Mesh part_sorted;
 };
+
+//! The nodes, meshes, materials, scene and asset of a .glb: `primitives` holds one primitive per
+//! ExportPart (attributes and indices set) or one in all when data.parts is empty; `root` is
+//! the node that carries the file's transform (up axis, quantization). gltf["materials"] must hold
+//! tailor's material (add_glb_material): input materials get its maps, keeping their own properties.
+void add_glb_scene(nlohmann::json& gltf, const ExportData& data, nlohmann::json root,
+                   std::vector<nlohmann::json> primitives);
 
 //! Per-vertex tangents for the split mesh (ExportData::tangents), from its UVs (split.uvs, t up)
 //! and the unit normals per source vertex.

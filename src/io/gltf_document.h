@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "io/readers.h"
 #include "tailor/status.h"
 
 namespace tailor::internal {
@@ -47,6 +48,8 @@ class GltfDocument {
   Status open(std::span<const char> data, const std::string& name, const std::string& base_dir);
 
   const Json& json() const { return json_; }
+  //! Told the bytes of accessor data decoded so far (every few MB); null: none.
+  void set_progress(ReadProgress* progress) { progress_ = progress; }
   const std::string& name() const { return name_; }
   bool is_binary() const { return binary_; }
 
@@ -84,6 +87,8 @@ class GltfDocument {
   std::vector<std::string> owned_;                         // buffers decoded from data: URIs or read from files
   std::vector<std::vector<unsigned char>> decoded_views_;  // per buffer view: its meshopt-decoded bytes
   std::vector<uint8_t> view_decoded_;                      // per buffer view: 1 once decoded
+  ReadProgress* progress_ = nullptr;
+  size_t decoded_ = 0;  // bytes of accessor data read
 };
 
 }  // namespace tailor::internal

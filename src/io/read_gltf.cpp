@@ -21,6 +21,7 @@
 #include <chrono>
 #include <climits>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <new>
 #include <optional>
@@ -104,11 +105,12 @@ bool local_transform(const Json& node, Matrix& m) {
 struct Instance {
   size_t mesh = 0;
   Matrix world = kIdentity;
+  uint64_t node = UINT64_MAX;  // UINT64_MAX: no scene (every mesh once)
 };
 
 // EXT_mesh_gpu_instancing: one instance per element of the TRANSLATION / ROTATION / SCALE
 // accessors, each placed by world * its TRS.
-Status gpu_instances(GltfDocument& doc, const Json& extension, size_t mesh, const Matrix& world,
+Status gpu_instances(GltfDocument& doc, const Json& extension, size_t mesh, const Matrix& world, uint64_t node,
                      const std::string& where, std::vector<Instance>& instances) {
   const auto attributes = extension.find("attributes");
   if (attributes == extension.end() || !attributes->is_object())
@@ -135,7 +137,7 @@ Status gpu_instances(GltfDocument& doc, const Json& extension, size_t mesh, cons
     for (size_t c = 0; c < 3 && !values[0].empty(); ++c) t[c] = values[0][3 * i + c];
     for (size_t c = 0; c < 4 && !values[1].empty(); ++c) q[c] = values[1][4 * i + c];
     for (size_t c = 0; c < 3 && !values[2].empty(); ++c) s[c] = values[2][3 * i + c];
-    instances.push_back({mesh, multiply(world, trs_matrix(t, q, s))});
+    instances.push_back({mesh, multiply(world, trs_matrix(t, q, s)), node});
   }
   return Status::ok();
 }
@@ -192,9 +194,9 @@ Status scene_instances(GltfDocument& doc, std::vector<Instance>& instances) {
         if (it != extensions->end() && it->is_object()) gpu = &*it;
       }
       if (gpu)
-        TAILOR_RETURN_IF_ERROR(gpu_instances(doc, *gpu, static_cast<size_t>(mesh), world, where, instances));
+        TAILOR_RETURN_IF_ERROR(gpu_instances(doc, *gpu, static_cast<size_t>(mesh), world, index, where, instances));
       else
-        instances.push_back({static_cast<size_t>(mesh), world});
+        instances.push_back({static_cast<size_t>(mesh), world, index});
     }
     const auto children = node->find("children");
     if (children == node->end()) continue;
@@ -452,6 +454,22 @@ void append_kept(const Primitive& p, const Matrix& world, size_t base, size_t fi
     CornerAttribute& out = mesh.corner_attributes[slot];
     const size_t k = size_t(a.components);
     out.values.resize(k * corners, 0.0f);
+    // Copied where nothing turns them (all but normals and tangents, and those under no transform:
+    // most files), else each turned and renormalized: the per-corner loop with a sqrt cost 10 %
+    // of loading a large .glb.
+    if ((a.name != "NORMAL" && a.name != "TANGENT") || world == kIdentity) {
+      const uint32_t* index = mesh.indices.data();
+      const float* values = a.values.data();
+      float* o = out.values.data();
+      if (k == 3) {
+        for (size_t corner = first; corner < corners; ++corner)
+          std::memcpy(&o[3 * corner], &values[3 * (index[corner] - base)], 12);
+      } else {
+        for (size_t corner = first; corner < corners; ++corner)
+          std::memcpy(&o[k * corner], &values[k * (index[corner] - base)], k * sizeof(float));
+      }
+      continue;
+    }
     for (size_t corner = first; corner < corners; ++corner) {
       const float* in = &a.values[k * (mesh.indices[corner] - base)];
       float* o = &out.values[k * corner];
@@ -462,10 +480,6 @@ void append_kept(const Primitive& p, const Matrix& world, size_t base, size_t fi
         const double length = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
         for (int r = 0; r < 3; ++r) o[r] = length > 0 ? static_cast<float>(t[r] / length) : in[r];
         o[3] = static_cast<float>(sign) * (in[3] < 0 ? -1.0f : 1.0f);
-        continue;
-      }
-      if (a.name != "NORMAL") {
-        std::copy_n(in, k, o);
         continue;
       }
       // Column-major: n'_r = sum_j cof[r][j] n_j, with cof stored by columns of the inverse transpose.
@@ -483,9 +497,67 @@ void append_kept(const Primitive& p, const Matrix& world, size_t base, size_t fi
   }
 }
 
-// What the output cannot carry: materials (tailor writes its own), names, extras, attributes
-// other than the kept ones, skins, animations, cameras; and the hierarchy when it was flattened.
-void not_kept(const GltfDocument& doc, size_t instances, std::vector<std::string>& lost) {
+// A name member, or "" when absent or not a string.
+std::string name_of(const Json* object) {
+  if (!object || !object->is_object()) return {};
+  const auto it = object->find("name");
+  return it != object->end() && it->is_string() ? it->get<std::string>() : std::string();
+}
+
+// An extras member as JSON text, or "" when absent.
+std::string extras_of(const Json* object) {
+  if (!object || !object->is_object()) return {};
+  const auto it = object->find("extras");
+  return it != object->end() ? it->dump(-1, ' ', false, Json::error_handler_t::replace) : std::string();
+}
+
+// The properties of material `index` that the output can carry, checked so that what is
+// written back is valid glTF; what is left out (textures, extensions) goes to `lost`.
+std::string kept_material(const Json& material, std::vector<std::string>& lost) {
+  auto note = [&](const char* what) {
+    if (std::find(lost.begin(), lost.end(), what) == lost.end()) lost.emplace_back(what);
+  };
+  auto numbers = [](const Json& j, size_t n) {
+    return j.is_array() && j.size() == n &&
+           std::all_of(j.begin(), j.end(), [](const Json& x) { return x.is_number(); });
+  };
+  Json out = Json::object();
+  if (!material.is_object()) return out.dump();
+  for (const auto& item : material.items()) {
+    const std::string& key = item.key();
+    const Json& v = item.value();
+    if ((key == "name" && v.is_string()) || key == "extras" || (key == "doubleSided" && v.is_boolean()) ||
+        (key == "alphaCutoff" && v.is_number() && v.get<double>() >= 0) ||
+        (key == "alphaMode" && v.is_string() && (v == "OPAQUE" || v == "MASK" || v == "BLEND")) ||
+        (key == "emissiveFactor" && numbers(v, 3))) {
+      out[key] = v;
+    } else if (key == "pbrMetallicRoughness" && v.is_object()) {
+      Json pbr = Json::object();
+      for (const auto& p : v.items()) {
+        if ((p.key() == "baseColorFactor" && numbers(p.value(), 4)) ||
+            ((p.key() == "metallicFactor" || p.key() == "roughnessFactor") && p.value().is_number()))
+          pbr[p.key()] = p.value();
+        else if (p.key().ends_with("Texture"))
+          note("material textures (tailor writes its own)");
+        else if (p.key() == "extras")
+          pbr[p.key()] = p.value();
+        else
+          note("material extensions");
+      }
+      out[key] = pbr;
+    } else if (key.ends_with("Texture")) {
+      note("material textures (tailor writes its own)");
+    } else if (key == "extensions") {
+      note("material extensions");
+    }
+  }
+  return out.dump(-1, ' ', false, Json::error_handler_t::replace);
+}
+
+// What the output cannot carry: material textures and extensions (see kept_material), extras of
+// other objects, attributes other than the kept ones, skins, animations, cameras; the node
+// hierarchy is written flat (one node per mesh instance, in world space).
+void not_kept(const GltfDocument& doc, const std::vector<Instance>& instances, std::vector<std::string>& lost) {
   const Json& json = doc.json();
   auto any = [&](const char* array, auto&& predicate) {
     const auto it = json.find(array);
@@ -493,14 +565,8 @@ void not_kept(const GltfDocument& doc, size_t instances, std::vector<std::string
     return std::any_of(it->begin(), it->end(), predicate);
   };
   auto non_empty = [&](const char* array) { return any(array, [](const Json&) { return true; }); };
-  if (non_empty("materials")) lost.push_back("materials");
-  if (any("nodes", [](const Json& n) { return n.is_object() && n.contains("name"); }) ||
-      any("meshes", [](const Json& m) { return m.is_object() && m.contains("name"); }))
-    lost.push_back("names");
-  if (json.contains("extras") || any("nodes", [](const Json& n) { return n.is_object() && n.contains("extras"); }) ||
-      any("meshes", [](const Json& m) { return m.is_object() && m.contains("extras"); }))
-    lost.push_back("extras");
   std::vector<std::string> attributes;
+  bool primitive_extras = false;
   const auto meshes = json.find("meshes");
   if (meshes != json.end() && meshes->is_array())
     for (const Json& m : *meshes) {
@@ -509,6 +575,7 @@ void not_kept(const GltfDocument& doc, size_t instances, std::vector<std::string
       for (const Json& prim : *primitives) {
         const auto a = prim.is_object() ? prim.find("attributes") : prim.end();
         if (!prim.is_object() || a == prim.end() || !a->is_object()) continue;
+        primitive_extras = primitive_extras || prim.contains("extras") || prim.contains("targets");
         for (const auto& item : a->items())
           if (item.key() != "POSITION" && item.key() != "TEXCOORD_0" && !is_kept_attribute(item.key()) &&
               std::find(attributes.begin(), attributes.end(), item.key()) == attributes.end())
@@ -516,9 +583,13 @@ void not_kept(const GltfDocument& doc, size_t instances, std::vector<std::string
       }
     }
   lost.insert(lost.end(), attributes.begin(), attributes.end());
+  if (primitive_extras) lost.push_back("primitive extras and morph targets");
   for (const char* array : {"skins", "animations", "cameras"})
     if (non_empty(array)) lost.push_back(array);
-  if (instances > 1) lost.push_back("the node hierarchy (one mesh in world space)");
+  const bool moved =
+      std::any_of(instances.begin(), instances.end(), [](const Instance& i) { return i.world != kIdentity; });
+  if (moved || any("nodes", [](const Json& n) { return n.is_object() && n.contains("children"); }))
+    lost.push_back("node transforms and hierarchy (one node per mesh instance, in world space)");
 }
 
 // The encoded images of the first textured material's other maps (read_glb_with_material).
@@ -530,10 +601,11 @@ struct MaterialBytes {
 // the other maps of the same material to `material` (which also keeps TANGENT in the mesh's
 // corner attributes).
 Status parse_gltf(std::span<const char> data, const std::string& name, const std::string& base_dir, Mesh& mesh,
-                  LoadReport& report, std::span<const unsigned char>* texture_bytes,
+                  LoadReport& report, std::span<const unsigned char>* texture_bytes, internal::ReadProgress* progress,
                   MaterialBytes* material = nullptr) {
   GltfDocument doc;
   TAILOR_RETURN_IF_ERROR(doc.open(data, name, base_dir));
+  doc.set_progress(progress);  // in bytes of accessor data (about the file's size, more when compressed)
   report.format = doc.is_binary() ? "glTF binary" : "glTF";
   TAILOR_RETURN_IF_ERROR(check_required_extensions(doc));
   const auto used = doc.json().find("extensionsUsed");
@@ -553,9 +625,30 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
   size_t triangle_primitives = 0, with_uv = 0;
   bool texture_found = false;
   std::vector<uint8_t> incomplete;  // per mesh.corner_attributes: missing on some primitive
+  std::vector<std::string> lost;
+  // Names, extras and materials of what the faces came from (Mesh::scene, Mesh::face_parts).
+  SceneParts& scene = mesh.scene;
+  const Json* asset = doc.json().contains("asset") ? &doc.json()["asset"] : nullptr;
+  scene.asset_extras = extras_of(asset);
+  if (asset && asset->is_object() && asset->contains("copyright") && (*asset)["copyright"].is_string())
+    scene.asset_copyright = (*asset)["copyright"].get<std::string>();
+  {
+    uint64_t scene_index = 0;
+    get_uint(doc.json(), "scene", scene_index);
+    const Json* root = get_element(doc.json(), "scenes", scene_index);
+    scene.scene_name = name_of(root);
+    scene.scene_extras = extras_of(root);
+  }
+  const auto materials_it = doc.json().find("materials");
+  const size_t material_count = materials_it != doc.json().end() && materials_it->is_array() ? materials_it->size() : 0;
+  std::vector<uint32_t> material_slot(material_count, kInvalid);  // input material -> scene.materials
   for (const Instance& instance : instances) {
     const size_t mi = instance.mesh;
     const Json& m = meshes[mi];
+    const Json* node = instance.node == UINT64_MAX ? nullptr : get_element(doc.json(), "nodes", instance.node);
+    const uint32_t instance_id = static_cast<uint32_t>(scene.instances.size());
+    const size_t first_part = scene.parts.size();
+    scene.instances.push_back({name_of(node), extras_of(node), name_of(&m), extras_of(&m)});
     const auto primitives = m.is_object() ? m.find("primitives") : m.end();
     if (!m.is_object() || primitives == m.end() || !primitives->is_array())
       return doc.parse_error("mesh without primitives", "mesh " + std::to_string(mi));
@@ -584,7 +677,19 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
       const size_t nv = p.positions.size() / 3, nf = p.triangles.size() / 3;
       if (mesh.vertex_count() + nv > kMaxVertices || mesh.face_count() + nf > kMaxFaces)
         return Status::error(ErrorCode::kLimit, name, "too many vertices or faces", where);
-      TAILOR_RETURN_IF_ERROR(doc.charge(12 * nv + 36 * nf, where));  // positions, indices, corner UVs
+      TAILOR_RETURN_IF_ERROR(doc.charge(12 * nv + 40 * nf, where));  // positions, indices, corner UVs, parts
+      uint32_t kept_slot = kInvalid;  // the part's material in scene.materials
+      if (p.material < material_count) {
+        if (material_slot[p.material] == kInvalid) {
+          material_slot[p.material] = static_cast<uint32_t>(scene.materials.size());
+          scene.materials.push_back(kept_material((*materials_it)[p.material], lost));
+        }
+        kept_slot = material_slot[p.material];
+      }
+      size_t part = first_part;
+      while (part < scene.parts.size() && scene.parts[part].material != kept_slot) ++part;
+      if (part == scene.parts.size()) scene.parts.push_back({instance_id, kept_slot});
+      mesh.face_parts.resize(mesh.face_count() + nf, static_cast<uint32_t>(part));
       const size_t base = mesh.vertex_count(), first = mesh.indices.size();
       append_instance(p, instance.world, mesh);
       append_kept(p, instance.world, base, first, mesh, incomplete);
@@ -612,13 +717,12 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
                              : std::string("no triangle primitive in the scene"));
   // All or nothing: UVs are only meaningful when every primitive has them; the same for the rest.
   if (with_uv != triangle_primitives) mesh.corner_uvs.clear();
-  std::vector<std::string> lost;
   for (size_t slot = mesh.corner_attributes.size(); slot-- > 0;) {
     if (!incomplete[slot]) continue;
     lost.push_back(mesh.corner_attributes[slot].name + " (not on every primitive)");
     mesh.corner_attributes.erase(mesh.corner_attributes.begin() + static_cast<std::ptrdiff_t>(slot));
   }
-  not_kept(doc, instances.size(), lost);
+  not_kept(doc, instances, lost);
   for (const std::string& item : lost) report.not_kept += (report.not_kept.empty() ? "" : ", ") + item;
   // glTF splits vertices on UV seams; weld them so that seams are edges between faces again.
   report.welded_vertices = weld_identical_positions(mesh);
@@ -635,8 +739,8 @@ std::string folder_of(const std::string& path) {
 namespace internal {
 
 Status read_gltf(std::span<const char> data, const std::string& name, const std::string& base_dir, Mesh& mesh,
-                 LoadReport& report) {
-  return parse_gltf(data, name, base_dir, mesh, report, nullptr);
+                 LoadReport& report, ReadProgress* progress) {
+  return parse_gltf(data, name, base_dir, mesh, report, nullptr, progress);
 }
 
 }  // namespace internal
@@ -656,7 +760,7 @@ Status read_gltf_with_texture(std::span<const char> data, const std::string& nam
   try {
     std::span<const unsigned char> texture_bytes;
     MaterialBytes material_bytes;
-    s = parse_gltf(data, name, base_dir, mesh, r, &texture_bytes, material ? &material_bytes : nullptr);
+    s = parse_gltf(data, name, base_dir, mesh, r, &texture_bytes, nullptr, material ? &material_bytes : nullptr);
     if (s.is_ok()) s = finalize_mesh(name, mesh, r);
     if (s.is_ok() && material) {
       // TANGENT went through the repairs with the other corner attributes; it is not written back.

@@ -177,7 +177,7 @@ namespace {
 
 // read_mesh with the folder where a .gltf's buffer files are (empty: none is opened).
 Status read_mesh_in(std::span<const char> data, MeshFormat format, const std::string& name, const std::string& base_dir,
-                    Mesh& mesh, LoadReport* report) {
+                    Mesh& mesh, LoadReport* report, const ProgressCallback* callback = nullptr) {
   mesh = Mesh{};
   LoadReport local;
   LoadReport& r = report ? *report : local;
@@ -185,20 +185,23 @@ Status read_mesh_in(std::span<const char> data, MeshFormat format, const std::st
   r.file_bytes = data.size();
   if (format == MeshFormat::kUnknown) format = sniff_format(data);
   Status s;
+  internal::ReadProgress progress(callback, data.size());
   // The parsers never throw by design; only an allocation of a (checked, but large) size can.
   try {
     switch (format) {
-      case MeshFormat::kPly: s = internal::read_ply(data, name, mesh, r); break;
-      case MeshFormat::kObj: s = internal::read_obj(data, name, mesh, r); break;
+      case MeshFormat::kPly: s = internal::read_ply(data, name, mesh, r, &progress); break;
+      case MeshFormat::kObj: s = internal::read_obj(data, name, mesh, r, &progress); break;
       case MeshFormat::kOff: s = internal::read_off(data, name, mesh, r); break;
       case MeshFormat::kStl: s = internal::read_stl(data, name, mesh, r); break;
       case MeshFormat::kGlb:
-      case MeshFormat::kGltf: s = internal::read_gltf(data, name, base_dir, mesh, r); break;
+      case MeshFormat::kGltf: s = internal::read_gltf(data, name, base_dir, mesh, r, &progress); break;
       case MeshFormat::kUnknown:
         s = Status::error(ErrorCode::kUnsupported, name, std::string("unknown mesh format (") + kSupported + ")");
         break;
     }
+    if (s.is_ok() && !progress.repairs(0.f)) s = progress.cancelled(name);
     if (s.is_ok()) s = finalize_mesh(name, mesh, r);
+    if (s.is_ok() && !progress.repairs(1.f)) s = progress.cancelled(name);
   } catch (const std::bad_alloc&) {
     s = Status::error(ErrorCode::kLimit, name, "not enough memory to load the mesh");
   } catch (...) {
@@ -218,7 +221,9 @@ Status read_mesh(std::span<const char> data, MeshFormat format, const std::strin
   return read_mesh_in(data, format, name, "", mesh, report);
 }
 
-Status load_mesh(const std::string& path, Mesh& mesh, LoadReport* report) {
+Status load_mesh(const std::string& path, Mesh& mesh, LoadReport* report) { return load_mesh(path, mesh, report, {}); }
+
+Status load_mesh(const std::string& path, Mesh& mesh, LoadReport* report, const ProgressCallback& progress) {
   const auto t0 = std::chrono::steady_clock::now();
   mesh = Mesh{};
   // Mapped, not copied: a read into a fresh buffer cost a quarter of loading a large binary PLY.
@@ -236,7 +241,7 @@ Status load_mesh(const std::string& path, Mesh& mesh, LoadReport* report) {
   LoadReport local;
   LoadReport& r = report ? *report : local;
   const std::filesystem::path folder = std::filesystem::path(path).parent_path();
-  const Status s = read_mesh_in(bytes, format, path, folder.empty() ? "." : folder.string(), mesh, &r);
+  const Status s = read_mesh_in(bytes, format, path, folder.empty() ? "." : folder.string(), mesh, &r, &progress);
   r.load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return s;
 }
@@ -259,6 +264,9 @@ Status finalize_mesh(const std::string& name, Mesh& mesh, LoadReport& report) {
   }
   if (!mesh.seam_faces.empty() && mesh.seam_faces.size() != nf) {
     return Status::error(ErrorCode::kInvalidMesh, name, "seam flags do not match the faces");
+  }
+  if (!mesh.face_parts.empty() && mesh.face_parts.size() != nf) {
+    return Status::error(ErrorCode::kInvalidMesh, name, "face parts do not match the faces");
   }
   for (const CornerAttribute& a : mesh.corner_attributes)
     if (a.components < 1 || a.components > 4 || a.values.size() != nf * 3 * size_t(a.components))
@@ -406,7 +414,7 @@ Status finalize_mesh(const std::string& name, Mesh& mesh, LoadReport& report) {
   // === Compact, keeping corner_uvs and seam_faces in step ======================================
   if (degenerate + duplicates > 0) {
     size_t out = 0;
-    const bool uvs = !mesh.corner_uvs.empty(), seams = !mesh.seam_faces.empty();
+    const bool uvs = !mesh.corner_uvs.empty(), seams = !mesh.seam_faces.empty(), parts = !mesh.face_parts.empty();
     for (size_t f = 0; f < nf; ++f) {
       if (!(flags[f] & kKeep)) {
         const uint32_t a = idx[3 * f], b = idx[3 * f + 1], c = idx[3 * f + 2];
@@ -418,6 +426,7 @@ Status finalize_mesh(const std::string& name, Mesh& mesh, LoadReport& report) {
         std::memmove(&mesh.indices[3 * out], &mesh.indices[3 * f], 3 * sizeof(uint32_t));
         if (uvs) std::memmove(&mesh.corner_uvs[6 * out], &mesh.corner_uvs[6 * f], 6 * sizeof(float));
         if (seams) mesh.seam_faces[out] = mesh.seam_faces[f];
+        if (parts) mesh.face_parts[out] = mesh.face_parts[f];
         for (CornerAttribute& a : mesh.corner_attributes) {
           const size_t k = 3 * size_t(a.components);
           std::memmove(&a.values[k * out], &a.values[k * f], k * sizeof(float));
@@ -428,6 +437,7 @@ Status finalize_mesh(const std::string& name, Mesh& mesh, LoadReport& report) {
     mesh.indices.resize(3 * out);
     if (uvs) mesh.corner_uvs.resize(6 * out);
     if (seams) mesh.seam_faces.resize(out);
+    if (parts) mesh.face_parts.resize(out);
     for (CornerAttribute& a : mesh.corner_attributes) a.values.resize(3 * size_t(a.components) * out);
   }
   report.degenerate_faces += degenerate;

@@ -46,7 +46,8 @@ bool resolve(int64_t raw, size_t count, uint64_t& out) {
 
 }  // namespace
 
-Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report) {
+Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,
+                ReadProgress* progress) {
   report.format = "OBJ";
   TextScanner s(data.data(), data.data() + data.size());
   s.set_hash_comments(true);
@@ -66,6 +67,7 @@ Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh,
   size_t corners_without_vn = 0;
 
   while (!s.at_end()) {
+    if (progress && !progress->at(data.size() - s.remaining())) return progress->cancelled(name);
     const std::string_view w = s.word();
     if (w.empty()) {
       s.next_line();

@@ -439,8 +439,9 @@ bool is_index(double d) { return d >= 0.0 && d < 4294967296.0 && d == std::floor
 template <class Source>
 class BodyReader {
  public:
-  BodyReader(Source& src, const PlyHeader& h, const std::string& name, Mesh& mesh, LoadReport& report)
-      : src_(src), h_(h), name_(name), mesh_(mesh), report_(report) {
+  BodyReader(Source& src, const PlyHeader& h, const std::string& name, Mesh& mesh, LoadReport& report,
+             ReadProgress& progress)
+      : src_(src), h_(h), name_(name), mesh_(mesh), report_(report), progress_(progress), total_(src.remaining()) {
     for (const PlyElement& e : h.elements) {
       if (e.kind == ElementKind::kVertex) vertex_count_ = e.count;
     }
@@ -448,6 +449,7 @@ class BodyReader {
 
   Status run() {
     for (const PlyElement& e : h_.elements) {
+      if (!progress_.at(total_ - src_.remaining())) return progress_.cancelled(name_);
       switch (e.kind) {
         case ElementKind::kVertex: TAILOR_RETURN_IF_ERROR(read_vertices(e)); break;
         case ElementKind::kFace: TAILOR_RETURN_IF_ERROR(read_faces(e)); break;
@@ -541,6 +543,7 @@ class BodyReader {
     if (!have_normals && !have_colours && fast_vertices(e, have_uv)) return Status::ok();
     float* pos = mesh_.positions.data();
     for (uint64_t i = 0; i < e.count; ++i) {
+      if ((i & 0xffff) == 0 && !progress_.at(total_ - src_.remaining())) return progress_.cancelled(name_);
       for (const PlyProperty& p : e.props) {
         if (p.role == Role::kNone) {
           TAILOR_RETURN_IF_ERROR(skip_property(e, i, p));
@@ -633,6 +636,7 @@ class BodyReader {
     uint64_t i = 0;
     if (!have_tc && !have_seam) i = fast_faces(e);
     for (; i < e.count; ++i) {
+      if ((i & 0xffff) == 0 && !progress_.at(total_ - src_.remaining())) return progress_.cancelled(name_);
       poly_.clear();
       tc_.clear();
       uint8_t seam = 0;
@@ -745,6 +749,7 @@ class BodyReader {
   // === Triangle strips ==========================================================================
   Status read_strips(const PlyElement& e) {
     for (uint64_t i = 0; i < e.count; ++i) {
+      if ((i & 0xffff) == 0 && !progress_.at(total_ - src_.remaining())) return progress_.cancelled(name_);
       for (const PlyProperty& p : e.props) {
         if (p.role != Role::kIndices) {
           TAILOR_RETURN_IF_ERROR(skip_property(e, i, p));
@@ -816,6 +821,8 @@ class BodyReader {
   const std::string& name_;
   Mesh& mesh_;
   LoadReport& report_;
+  ReadProgress& progress_;
+  size_t total_ = 0;  // bytes of the body
   uint64_t vertex_count_ = 0;
   std::vector<uint32_t> poly_;
   std::vector<float> tc_;
@@ -862,7 +869,10 @@ Status check_counts(const PlyHeader& h, size_t body_bytes, const std::string& na
 
 }  // namespace
 
-Status read_ply(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report) {
+Status read_ply(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,
+                ReadProgress* progress) {
+  ReadProgress none;
+  ReadProgress& p = progress ? *progress : none;
   const std::string_view text(data.data(), data.size());
   PlyHeader h;
   TAILOR_RETURN_IF_ERROR(parse_header(text, name, h));
@@ -874,26 +884,26 @@ Status read_ply(std::span<const char> data, const std::string& name, Mesh& mesh,
     case PlyFormat::kAscii: {
       report.format = "PLY ascii";
       AsciiSource src(body, end, h.header_lines);
-      return BodyReader<AsciiSource>(src, h, name, mesh, report).run();
+      return BodyReader<AsciiSource>(src, h, name, mesh, report, p).run();
     }
     case PlyFormat::kBinaryLe: {
       report.format = "PLY binary_little_endian";
       if constexpr (std::endian::native == std::endian::little) {
         BinarySource<false> src(body, end);
-        return BodyReader<BinarySource<false>>(src, h, name, mesh, report).run();
+        return BodyReader<BinarySource<false>>(src, h, name, mesh, report, p).run();
       } else {
         BinarySource<true> src(body, end);
-        return BodyReader<BinarySource<true>>(src, h, name, mesh, report).run();
+        return BodyReader<BinarySource<true>>(src, h, name, mesh, report, p).run();
       }
     }
     case PlyFormat::kBinaryBe: {
       report.format = "PLY binary_big_endian";
       if constexpr (std::endian::native == std::endian::big) {
         BinarySource<false> src(body, end);
-        return BodyReader<BinarySource<false>>(src, h, name, mesh, report).run();
+        return BodyReader<BinarySource<false>>(src, h, name, mesh, report, p).run();
       } else {
         BinarySource<true> src(body, end);
-        return BodyReader<BinarySource<true>>(src, h, name, mesh, report).run();
+        return BodyReader<BinarySource<true>>(src, h, name, mesh, report, p).run();
       }
     }
   }

@@ -4,23 +4,62 @@
 // Contract: never read outside `data`, never allocate from an unchecked count, never throw.
 #pragma once
 
+#include <algorithm>
+#include <cstdint>
 #include <span>
 #include <string>
 
 #include "tailor/image.h"
 #include "tailor/mesh.h"
+#include "tailor/progress.h"
 #include "tailor/status.h"
 
 namespace tailor::internal {
 
-Status read_ply(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report);
-Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report);
+//! A reader's progress, as the share of its input parsed, for load_mesh's callback: at() is cheap
+//! enough to call per element, and calls the callback only every kStep units (bytes, or whatever
+//! `total` counts). The parse takes the share [0, kParseShare] of the bar, the repairs the rest.
+class ReadProgress {
+ public:
+  static constexpr float kParseShare = 0.8f;
+  ReadProgress() = default;
+  ReadProgress(const ProgressCallback* callback, size_t total) : callback_(callback), total_(total) {
+    if (callback_ && *callback_) next_ = 0;
+  }
+  //! `done` of `total` parsed; false: the callback cancelled.
+  bool at(size_t done) { return done < next_ || report(done); }
+  //! The repairs' share (after parsing): `done` in [0, 1].
+  bool repairs(float done) const {
+    return !callback_ || !*callback_ || (*callback_)(kParseShare + (1.f - kParseShare) * done);
+  }
+  Status cancelled(const std::string& name) const {
+    return Status::error(ErrorCode::kCancelled, name, "loading cancelled");
+  }
+
+ private:
+  static constexpr size_t kStep = size_t{4} << 20;
+  bool report(size_t done) {
+    next_ = done + (total_ > 100 * kStep ? total_ / 100 : kStep);
+    const float share = total_ > 0 ? static_cast<float>(std::min(done, total_)) / static_cast<float>(total_) : 1.f;
+    return (*callback_)(kParseShare * share);
+  }
+  const ProgressCallback* callback_ = nullptr;
+  size_t total_ = 0;
+  size_t next_ = SIZE_MAX;
+};
+
+//! progress (optional) is told the bytes parsed (PLY: per element and every 64k items of the generic
+//! loops; OBJ: every few MB; glTF: per primitive, in faces); OFF and STL report none.
+Status read_ply(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,
+                ReadProgress* progress = nullptr);
+Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,
+                ReadProgress* progress = nullptr);
 Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report);
 Status read_stl(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report);
 //! glTF 2.0 (.glb or .gltf): the default scene's mesh instances in world space, TEXCOORD_0 into
 //! corner_uvs (read_gltf.cpp). Buffer URIs are looked up in `base_dir` (empty: none is opened).
 Status read_gltf(std::span<const char> data, const std::string& name, const std::string& base_dir, Mesh& mesh,
-                 LoadReport& report);
+                 LoadReport& report, ReadProgress* progress = nullptr);
 
 //! Checks the size an image header claims (width x height, read by stbi_info_from_memory) before
 //! decoding `bytes`: each side within kMaxImageSide, width x height within options.max_pixels, and

@@ -151,12 +151,33 @@ bool mapping_mode_from_name(std::string_view name, MappingMode& mode) {
   return true;
 }
 
+namespace {
+
+// The progress of one named stage of options.stage_progress (empty when that is unset).
+ProgressCallback stage_progress(const StageProgressCallback& stage, const char* name) {
+  return stage ? ProgressCallback([&stage, name](float done) { return stage(name, done); }) : ProgressCallback();
+}
+
+// Calls both (either may be empty); cancelled when either asks.
+ProgressCallback both_progress(ProgressCallback a, ProgressCallback b) {
+  if (!a || !b) return a ? a : b;
+  return ProgressCallback([a, b](float done) { return a(done) && b(done); });
+}
+
+}  // namespace
+
 Status map_texture(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options, TextureMap& map) {
   clear_atlas(map.atlas);
   map.stats = MappingStats{};
   map.metrics = UvMetrics{};
   // === 1. Orientation field: per-face frames, the field and its variation (surface/orientation.cpp) ===
-  TAILOR_RETURN_IF_ERROR(compute_orientation(mesh, topology, options.orientation, map.frames));
+  if (options.stage_progress) {
+    OrientationOptions orientation = options.orientation;
+    orientation.progress = both_progress(orientation.progress, stage_progress(options.stage_progress, "orientation"));
+    TAILOR_RETURN_IF_ERROR(compute_orientation(mesh, topology, orientation, map.frames));
+  } else {
+    TAILOR_RETURN_IF_ERROR(compute_orientation(mesh, topology, options.orientation, map.frames));
+  }
   return internal::map_texture_frames(mesh, topology, options, map);
 }
 
@@ -166,6 +187,11 @@ Status internal::map_texture_frames(const Mesh& mesh, const Topology& topology, 
   map.stats = MappingStats{};
   map.metrics = UvMetrics{};
   const MappingOptions& mapping = options.mapping;
+  // Each stage's own progress (options.stage_progress), beside the growth and closing's shares of
+  // mapping.progress.
+  const StageProgressCallback& stage = options.stage_progress;
+  auto stage_callback = [&stage](const char* name) { return stage_progress(stage, name); };
+  const auto both = both_progress;
   const auto start = std::chrono::steady_clock::now();
   TAILOR_RETURN_IF_ERROR(check_mapping_inputs(mesh, topology, map.frames, mapping));
   const bool thesis = mapping.mode == MappingMode::kThesis;
@@ -181,6 +207,8 @@ Status internal::map_texture_frames(const Mesh& mesh, const Topology& topology, 
   ProgressCallback closing_progress;
   if (close_cracks && mapping.progress)
     closing_progress = [&mapping](float done) { return mapping.progress(kGrowthShare + (1.f - kGrowthShare) * done); };
+  growth_options.progress = both(growth_options.progress, stage_callback("mapping"));
+  closing_progress = both(closing_progress, stage_callback("closing"));
   const internal::MappingInput input{mesh,
                                      topology,
                                      map.frames,
@@ -199,12 +227,14 @@ Status internal::map_texture_frames(const Mesh& mesh, const Topology& topology, 
   // === 3. Seam shortening (mapping/shorten_seams.cpp) ===
   if (status.is_ok() && patches && mapping.shorten_seams)
     stats.faces_reseamed = internal::shorten_seams(input, on_seam, map.atlas);
+  if (status.is_ok() && stage && !stage("mapping", 1.f))  // the growth reports only every few thousand faces
+    status = Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
   // === 4. Crack closing (mapping/close_cracks.cpp) ===
   if (status.is_ok() && close_cracks)
     status = internal::close_cracks(input, closing_progress, map.atlas, stats.cracks_closed);
   // === 5. Relaxation of the angle distortion (mapping/relax_patches.cpp) ===
   if (status.is_ok() && patches && mapping.relax_iterations > 0)
-    status = internal::relax_patches(input, map.atlas, stats.relax_moves);
+    status = internal::relax_patches(input, map.atlas, stats.relax_moves, stage_callback("relaxing"));
   if (!status.is_ok()) {
     clear_atlas(map.atlas);
     map.stats = MappingStats{};
@@ -214,9 +244,12 @@ Status internal::map_texture_frames(const Mesh& mesh, const Topology& topology, 
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   // === 6. Metrics of the result (metrics/uv_metrics.cpp) ===
-  if (options.measure)
+  if (options.measure) {
+    if (stage && !stage("metrics", 0.f)) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
     TAILOR_RETURN_IF_ERROR(
         compute_uv_metrics(mesh, topology, map.atlas.corner_uv, map.atlas.patch, options.metrics, map.metrics));
+    if (stage && !stage("metrics", 1.f)) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
+  }
   return Status::ok();
 }
 

@@ -90,7 +90,8 @@ Status close_cracks(const MappingInput& input, const ProgressCallback& progress,
 //! step): every UV vertex moves except both sides of a seam less than a pixel wide and the corners
 //! of zero-area faces, and only where the faces around it stay within options.max_stretch. moves:
 //! the accepted UV vertex moves. The same result for any thread count; O(F) per iteration.
-Status relax_patches(const MappingInput& input, Atlas& atlas, uint64_t& moves);
+//! progress (optional) gets the share of iterations done after each; false stops (kCancelled).
+Status relax_patches(const MappingInput& input, Atlas& atlas, uint64_t& moves, const ProgressCallback& progress = {});
 
 Status map_thesis(const MappingInput& input, Atlas& atlas, MappingStats& stats);
 

@@ -241,7 +241,7 @@ class Relaxer {
   // threads iterations at most, on `threads` threads (each phase's work is claimed in fixed
   // chunks, and a barrier separates the phases: the result does not depend on the count).
   // Returns the moves taken.
-  uint64_t run(uint32_t iterations, size_t threads) {
+  uint64_t run(uint32_t iterations, size_t threads, const ProgressCallback& progress) {
     const uint32_t phases = static_cast<uint32_t>(colour_start_.size());  // the local step, then each colour
     std::atomic<size_t> next_chunk{0};
     uint32_t phase = 0, iteration = 0;
@@ -256,6 +256,16 @@ class Relaxer {
       const float moved = *std::max_element(largest.begin(), largest.end());
       std::fill(largest.begin(), largest.end(), 0.f);
       done = ++iteration == iterations || moved < kSettledPx;
+      if (!done && progress) {  // on one thread at a time (the barrier's completion)
+        bool go = true;
+        try {
+          go = progress(static_cast<float>(iteration) / static_cast<float>(iterations));
+        } catch (...) {
+          go = false;
+        }
+        cancelled_ = !go;
+        done = !go;
+      }
     };
     std::barrier sync(static_cast<std::ptrdiff_t>(threads), phase_done);
     const auto work = [&](size_t t) {
@@ -297,6 +307,8 @@ class Relaxer {
     return total;
   }
 
+  bool cancelled() const { return cancelled_; }
+
   // Writes the free wedges' positions to their corners.
   void store() const {
     const size_t corners = corner_wedge_.size();
@@ -309,6 +321,7 @@ class Relaxer {
   }
 
  private:
+  bool cancelled_ = false;  // the progress callback said stop
   // The corners at both ends of paired edge e (face f) and o (face g): e runs A -> B, o B -> A.
   struct Sides {
     uint32_t fa, fb, ga, gb;
@@ -451,14 +464,18 @@ class Relaxer {
 
 }  // namespace
 
-Status relax_patches(const MappingInput& input, Atlas& atlas, uint64_t& moves) {
+Status relax_patches(const MappingInput& input, Atlas& atlas, uint64_t& moves, const ProgressCallback& progress) {
   moves = 0;
   if (input.options.relax_iterations == 0) return Status::ok();
+  const Status cancelled = Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
+  if (progress && !progress(0.f)) return cancelled;
   Relaxer relaxer(input, atlas);
   relaxer.build();
   moves = relaxer.run(input.options.relax_iterations,
-                      parallel_threads(input.mesh.face_count(), input.options.threads, kFacesPerRelaxThread));
+                      parallel_threads(input.mesh.face_count(), input.options.threads, kFacesPerRelaxThread), progress);
+  if (relaxer.cancelled()) return cancelled;
   relaxer.store();
+  if (progress && !progress(1.f)) return cancelled;
   return Status::ok();
 }
 

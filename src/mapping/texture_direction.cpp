@@ -36,10 +36,14 @@ std::vector<float> box_reduce(const Image& image, int factor, int& width, int& h
 // (one dominant direction, two axes as in bricks and weaves, three as in hexagonal tiles), each
 // normalised by the total energy: 1 for energy spread evenly over the directions, 0 for stripes.
 // Central differences with wrap-around (textures meant to tile have no border).
-float isotropy_at(const std::vector<float>& g, int width, int height) {
+// progress (may be empty) gets [from, to) as the rows go, every 64 rows.
+float isotropy_at(const std::vector<float>& g, int width, int height, const ProgressCallback& progress = {},
+                  float from = 0.f, float to = 1.f) {
   double total = 0.0;
   std::array<double, 3> re{}, im{};
   for (int y = 0; y < height; ++y) {
+    if (progress && y % 64 == 0)
+      (void)progress(from + (to - from) * static_cast<float>(y) / static_cast<float>(height));
     const float* up = &g[static_cast<size_t>((y + height - 1) % height) * width];
     const float* row = &g[static_cast<size_t>(y) * width];
     const float* down = &g[static_cast<size_t>((y + 1) % height) * width];
@@ -64,7 +68,9 @@ float isotropy_at(const std::vector<float>& g, int width, int height) {
 
 }  // namespace
 
-float texture_isotropy(const Image& texture) {
+float texture_isotropy(const Image& texture) { return texture_isotropy(texture, {}); }
+
+float texture_isotropy(const Image& texture, const ProgressCallback& progress) {
   if (!check_image(texture)) return 1.f;
   float isotropy = 1.f;
   bool measured = false;
@@ -72,7 +78,9 @@ float texture_isotropy(const Image& texture) {
     int width = 0, height = 0;
     if (texture.width / factor < kMinSide || texture.height / factor < kMinSide) continue;
     const std::vector<float> reduced = box_reduce(texture, factor, width, height);
-    isotropy = std::min(isotropy, isotropy_at(reduced, width, height));
+    // The half-size pass has four times the pixels of the quarter-size one.
+    isotropy = std::min(isotropy, factor == 2 ? isotropy_at(reduced, width, height, progress, 0.f, 0.8f)
+                                              : isotropy_at(reduced, width, height, progress, 0.8f, 1.f));
     measured = true;
   }
   if (!measured && texture.width >= 3 && texture.height >= 3) {  // a tiny texture: its own pixels
@@ -86,9 +94,11 @@ bool texture_has_direction(const Image& texture) {
   return texture.empty() || texture_isotropy(texture) < kIsotropicTextureAbove;
 }
 
-float adapt_mapping_to_texture(const Image& texture, MappingOptions& options, bool keep_crack_rings) {
+float adapt_mapping_to_texture(const Image& texture, MappingOptions& options, bool keep_crack_rings,
+                               const ProgressCallback& progress) {
   if (texture.empty()) return -1.f;
-  const float isotropy = texture_isotropy(texture);
+  const float isotropy = texture_isotropy(texture, progress);
+  if (progress) (void)progress(1.f);
   if (isotropy >= kIsotropicTextureAbove) {
     options.field_following = 0.f;
     if (!keep_crack_rings) options.crack_rings = kUndirectedCrackRings;

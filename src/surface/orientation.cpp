@@ -249,6 +249,11 @@ Status compute_orientation_setup(const Mesh& mesh, const Topology& topology, con
     }
   }
 
+  // Progress at the stage's steps (each a pass over the faces): cheap, and enough for a bar.
+  auto reached = [&options](float done) { return !options.progress || options.progress(done); };
+  const Status cancelled = Status::error(ErrorCode::kCancelled, "", "orientation cancelled");
+  if (!reached(0.05f)) return cancelled;
+
   // === Skeleton: a per-face axis, the PCA axes kept as the fallbacks ===
   const size_t threads = internal::parallel_threads(face_count, options.threads);
   std::vector<float> face_axis;  // #F by 3; (0,0,0) where the face has no skeleton edge
@@ -264,6 +269,8 @@ Status compute_orientation_setup(const Mesh& mesh, const Topology& topology, con
         ++frames.skeleton_pca_faces;
     frames.skeleton_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - skeleton_start).count();
   }
+
+  if (!reached(0.1f)) return cancelled;
 
   // === User strokes: a direction and weight per point near them (surface/stroke_field.cpp) ===
   const internal::StrokeField strokes(options.strokes);
@@ -312,10 +319,14 @@ Status compute_orientation_setup(const Mesh& mesh, const Topology& topology, con
     frames.fallback_faces += static_cast<uint32_t>(fallback_count[c]);
   }
 
+  if (!reached(0.5f)) return cancelled;
+
   // === Optional smoothing: Jacobi passes (double-buffered, so the result is order independent) ===
   if (options.smooth_passes > 0) {
     std::vector<float> next(frames.orientation.size());
     for (uint32_t pass = 0; pass < options.smooth_passes; ++pass) {
+      if (!reached(0.5f + 0.2f * static_cast<float>(pass) / static_cast<float>(options.smooth_passes)))
+        return cancelled;
       for (size_t f = 0; f < face_count; ++f) {
         Vec3 sum = load(&frames.orientation[3 * f]);
         if (!degenerate[f]) {
@@ -347,6 +358,7 @@ Status compute_orientation_setup(const Mesh& mesh, const Topology& topology, con
   // of lower id, then each face adds its three in edge order (the same values in the same order
   // as if each face had computed them). Both passes write only their own chunk's half-edges or
   // faces: identical for any thread count.
+  if (!reached(0.7f)) return cancelled;
   std::vector<double> edge_angle;
   internal::reserve_huge(edge_angle, 3 * face_count);
   edge_angle.resize(3 * face_count);
@@ -361,6 +373,7 @@ Status compute_orientation_setup(const Mesh& mesh, const Topology& topology, con
       }
     }
   });
+  if (!reached(0.9f)) return cancelled;
   internal::for_each_chunk(face_count, threads, [&](size_t begin, size_t end, size_t) {
     for (size_t f = begin; f < end; ++f) {
       double sum = 0;
@@ -386,6 +399,7 @@ Status compute_orientation_setup(const Mesh& mesh, const Topology& topology, con
   store(frames.bbox_max.data(), hi);
   frames.unit_scale = static_cast<float>(unit_scale);
   frames.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!reached(1.f)) return cancelled;
   return Status::ok();
 }
 

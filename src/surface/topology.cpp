@@ -47,7 +47,12 @@ uint32_t find_root(uint32_t* parent, uint32_t x) {
 
 }  // namespace
 
-Topology build_topology(const Mesh& mesh) {
+Topology build_topology(const Mesh& mesh) { return build_topology(mesh, {}); }
+
+Topology build_topology(const Mesh& mesh, const ProgressCallback& progress) {
+  auto reached = [&progress](float done) {
+    if (progress) (void)progress(done);
+  };
   const auto start = std::chrono::steady_clock::now();
   Topology t;
   const size_t corner_count = mesh.indices.size();
@@ -82,6 +87,7 @@ Topology build_topology(const Mesh& mesh) {
     }
   }
 
+  reached(0.3f);
   // === Match the uses of each undirected edge (same lower and higher vertex) ===
   // Sorting a vertex's entries puts the uses of one edge next to each other, ordered by edge id,
   // so the pairing does not depend on anything but the mesh. Lists are short (~6 on average):
@@ -107,6 +113,7 @@ Topology build_topology(const Mesh& mesh) {
     }
   }
 
+  reached(0.6f);
   // === Components through paired edges ===
   // Union-find in face order rather than a flood fill: neighbouring faces are mostly near each
   // other in file order, so this pass reads opposite[] sequentially and parent[] with good
@@ -131,6 +138,7 @@ Topology build_topology(const Mesh& mesh) {
     t.face_component[f] = root == f ? t.edge_components++ : t.face_component[root];
   }
 
+  reached(0.85f);
   // === Components of faces sharing a vertex ===
   // Edge components touching at a vertex (bow-ties, fins) are merged with a union-find over the
   // few edge components, labelling each vertex with the first component seen: one pass over the
@@ -156,6 +164,7 @@ Topology build_topology(const Mesh& mesh) {
   t.vertex_components = t.edge_components - merges;
 
   t.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  reached(1.f);
   return t;
 }
 
