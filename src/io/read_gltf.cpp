@@ -678,7 +678,7 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
       if (mesh.vertex_count() + nv > kMaxVertices || mesh.face_count() + nf > kMaxFaces)
         return Status::error(ErrorCode::kLimit, name, "too many vertices or faces", where);
       TAILOR_RETURN_IF_ERROR(doc.charge(12 * nv + 40 * nf, where));  // positions, indices, corner UVs, parts
-      uint32_t kept_slot = kInvalid;  // the part's material in scene.materials
+      uint32_t kept_slot = kInvalid;                                 // the part's material in scene.materials
       if (p.material < material_count) {
         if (material_slot[p.material] == kInvalid) {
           material_slot[p.material] = static_cast<uint32_t>(scene.materials.size());
