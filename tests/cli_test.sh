@@ -278,5 +278,20 @@ cp tests/data/meshes/blobby-3cc.off "$tmp/batch2/blobby-3cc.off"
 expect_error 2 "would both write" -- "$tailor" map tests/data/meshes/blobby-3cc.off "$tmp/batch2/blobby-3cc.off" -o "$tmp/batch3/"
 [[ ! -e $tmp/batch3 ]] && ok || fail "batch made its folder before a usage error"
 
+# --- --strokes: orientation strokes from JSON; the same file gives the same bytes, a bad one one line ---
+printf '{"strokes": [{"points": [[0, 0, 0], [0.2, 0.3, 0.1], [0.3, 0.3, 0.2]], "radius": 0.3}]}\n' >"$tmp/strokes.json"
+"$tailor" map "$mesh" -o "$tmp/plain.glb" -q && "$tailor" map "$mesh" -o "$tmp/s1.glb" --strokes "$tmp/strokes.json" -q &&
+  "$tailor" map "$mesh" -o "$tmp/s2.glb" --strokes "$tmp/strokes.json" -q || fail "map --strokes failed"
+cmp -s "$tmp/s1.glb" "$tmp/s2.glb" && ok || fail "map --strokes: two runs differ"
+cmp -s "$tmp/plain.glb" "$tmp/s1.glb" && fail "map --strokes: the strokes changed nothing" || ok
+printf '{"strokes": [{"points": [[0, 0, 0], [0.2, 0.3]], "radius": 0.3}]}\n' >"$tmp/bad_strokes.json"
+expect_error 1 "bad_strokes.json: a point must be three finite numbers .*strokes\[0\]\.points\[1\]" -- \
+  "$tailor" map "$mesh" -o "$tmp/bs.glb" --strokes "$tmp/bad_strokes.json"
+printf '{"strokes": [{"points": [[0, 0, 0], [1, 1, 1]], "radius": 0}]}\n' >"$tmp/bad_radius.json"
+expect_error 1 "bad_radius.json: .*radius.* > 0" -- "$tailor" map "$mesh" -o "$tmp/bs.glb" --strokes "$tmp/bad_radius.json"
+printf '{"strokes": [' >"$tmp/cut_strokes.json"
+expect_error 1 "cut_strokes.json: not valid JSON \(byte" -- "$tailor" map "$mesh" -o "$tmp/bs.glb" --strokes "$tmp/cut_strokes.json"
+[[ ! -e $tmp/bs.glb ]] && ok || fail "map --strokes with a bad file wrote an output"
+
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]

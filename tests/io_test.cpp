@@ -908,5 +908,48 @@ TEST(Truncation, ObjRoundTripKeepsCornerUvs) {
   EXPECT_EQ(m.corner_uvs, spot.corner_uvs);
 }
 
+TEST(Strokes, JsonRoundTripsBitForBit) {
+  std::vector<OrientationStroke> strokes(2);
+  strokes[0].points = {0.1f, -2.5f, 1e-7f, 3.f, 4.f, 5.f};
+  strokes[0].radius = 0.1f;
+  strokes[1].points = {1.f / 3.f, 2.f / 7.f, -1e20f, 0.f, 0.f, 0.f, 1.f, 1.f, 1.f};
+  strokes[1].radius = 123.456f;
+  std::vector<OrientationStroke> back;
+  const Status s = parse_strokes(strokes_json(strokes), "mem", back);
+  ASSERT_TRUE(s.is_ok()) << s.message();
+  ASSERT_EQ(back.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(back[i].points, strokes[i].points);
+    EXPECT_EQ(back[i].radius, strokes[i].radius);
+  }
+  ASSERT_TRUE(parse_strokes(R"({"strokes": []})", "mem", back).is_ok());
+  EXPECT_TRUE(back.empty());
+}
+
+TEST(Strokes, BadJsonNamesWhereAndLeavesNothing) {
+  std::vector<OrientationStroke> back;
+  auto message = [&](const std::string& text) {
+    back.assign(1, OrientationStroke{});
+    const Status s = parse_strokes(text, "in.json", back);
+    EXPECT_EQ(s.code(), ErrorCode::kParse) << text;
+    EXPECT_TRUE(back.empty()) << text;
+    return s.message();
+  };
+  EXPECT_NE(message(R"({"strokes": [)").find("byte"), std::string::npos);
+  EXPECT_NE(message(R"([1, 2])").find("top level"), std::string::npos);
+  EXPECT_NE(message(R"({"strokes": {}})").find("must be an array"), std::string::npos);
+  EXPECT_NE(message(R"({"strokes": [{"points": [[0,0,0]], "radius": 1}]})").find("strokes[0].points"),
+            std::string::npos);
+  EXPECT_NE(message(R"({"strokes": [{"points": [[0,0,0],[1,1,"a"]], "radius": 1}]})").find("strokes[0].points[1]"),
+            std::string::npos);
+  EXPECT_NE(message(R"({"strokes": [{"points": [[0,0,0],[1,1,1e300]], "radius": 1}]})").find("points[1]"),
+            std::string::npos);
+  EXPECT_NE(message(R"({"strokes": [{"points": [[0,0,0],[1,1,1]], "radius": -1}]})").find("strokes[0].radius"),
+            std::string::npos);
+  EXPECT_NE(message(R"({"strokes": [{"points": [[0,0,0],[1,1,1]], "radius": 1, "x": 2}]})").find("unknown key"),
+            std::string::npos);
+  EXPECT_EQ(load_strokes(test::temp_path("no_such_strokes.json"), back).code(), ErrorCode::kIo);
+}
+
 }  // namespace
 }  // namespace tailor

@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -185,6 +187,120 @@ TEST(Orientation, RejectsBadOptionsAndMismatchedTopology) {
   EXPECT_EQ(compute_orientation(mesh, topology, options, frames).code(), ErrorCode::kInvalidArgument);
   EXPECT_EQ(compute_orientation(mesh, Topology{}, {}, frames).code(), ErrorCode::kInvalidMesh);
   EXPECT_EQ(compute_orientation(Mesh{}, Topology{}, {}, frames).code(), ErrorCode::kInvalidMesh);
+}
+
+// Distance from q to the segment [a, b], in double.
+double segment_distance(const double q[3], const float* a, const float* b) {
+  double d[3], aq[3], len2 = 0, t = 0;
+  for (int c = 0; c < 3; ++c) {
+    d[c] = static_cast<double>(b[c]) - a[c];
+    aq[c] = q[c] - a[c];
+    len2 += d[c] * d[c];
+    t += aq[c] * d[c];
+  }
+  t = std::clamp(t / len2, 0.0, 1.0);
+  double e2 = 0;
+  for (int c = 0; c < 3; ++c) e2 += (aq[c] - t * d[c]) * (aq[c] - t * d[c]);
+  return std::sqrt(e2);
+}
+
+// A stroke between two surface points of the cow: faces on it follow its direction, faces beyond
+// its radius keep the axis field bit for bit.
+TEST(Orientation, StrokeTurnsTheFieldNearItAndLeavesTheRestAlone) {
+  const Mesh mesh = load_test_mesh("spot.obj");
+  const FaceFrames plain = frames_of(mesh);
+  const float* a = &mesh.positions[0];
+  float longest = 0;
+  for (int c = 0; c < 3; ++c) longest = std::max(longest, plain.bbox_max[c] - plain.bbox_min[c]);
+  // The other end: the vertex whose distance from vertex 0 is nearest to a tenth of the mesh,
+  // roughly across the field's axis (a stroke along the axis would change little).
+  size_t other = 1;
+  double best = INFINITY;
+  for (size_t v = 1; v < mesh.vertex_count(); ++v) {
+    const float* p = &mesh.positions[3 * v];
+    const double d[3] = {double(p[0]) - a[0], double(p[1]) - a[1], double(p[2]) - a[2]};
+    const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    const double along = std::abs(d[0] * plain.axis[0] + d[1] * plain.axis[1] + d[2] * plain.axis[2]) / len;
+    const double cost = std::abs(len - 0.1 * longest) / longest + along;
+    if (cost < best) best = cost, other = v;
+  }
+  const float* b = &mesh.positions[3 * other];
+  OrientationStroke stroke;
+  stroke.points = {a[0], a[1], a[2], b[0], b[1], b[2]};
+  stroke.radius = 0.25f * longest;
+  OrientationOptions options;
+  options.strokes = std::span<const OrientationStroke>(&stroke, 1);
+  const FaceFrames stroked = frames_of(mesh, options);
+
+  double t[3], t_len = 0;
+  for (int c = 0; c < 3; ++c) t[c] = double(b[c]) - a[c], t_len += t[c] * t[c];
+  for (double& x : t) x /= std::sqrt(t_len);
+  size_t on = 0, beyond = 0, changed = 0;
+  for (size_t f = 0; f < mesh.face_count(); ++f) {
+    double q[3] = {0, 0, 0};
+    for (int k = 0; k < 3; ++k)
+      for (int c = 0; c < 3; ++c) q[c] += mesh.positions[3 * size_t{mesh.indices[3 * f + k]} + c];
+    for (double& x : q) x /= 3;
+    const double distance = segment_distance(q, a, b);
+    const float* o = &stroked.orientation[3 * f];
+    if (distance >= stroke.radius) {
+      ++beyond;
+      for (int c = 0; c < 3; ++c) ASSERT_EQ(o[c], plain.orientation[3 * f + c]) << "face " << f;
+      for (int c = 0; c < 6; ++c) ASSERT_EQ(stroked.local[6 * f + c], plain.local[6 * f + c]) << "face " << f;
+      continue;
+    }
+    changed += o[0] != plain.orientation[3 * f] || o[1] != plain.orientation[3 * f + 1];
+    if (distance > 0.02 * longest) continue;
+    // The stroke's direction projected onto the face.
+    const float* n = &stroked.normal[3 * f];
+    const double tn = t[0] * n[0] + t[1] * n[1] + t[2] * n[2];
+    if (std::abs(tn) > 0.9) continue;  // the stroke runs into the face: no direction in its plane
+    double p[3], p_len = 0;
+    for (int c = 0; c < 3; ++c) p[c] = t[c] - tn * n[c], p_len += p[c] * p[c];
+    const double cosine = (p[0] * o[0] + p[1] * o[1] + p[2] * o[2]) / std::sqrt(p_len);
+    EXPECT_GT(cosine, std::cos(4.0 * M_PI / 180.0)) << "face " << f << " at " << distance;
+    ++on;
+  }
+  EXPECT_GE(on, 5u);
+  EXPECT_GT(beyond, mesh.face_count() / 2);
+  EXPECT_GT(changed, on);
+}
+
+TEST(Orientation, StrokesAreTheSameForAnyThreadCount) {
+  const Mesh mesh = load_test_mesh("spot.obj");
+  std::vector<OrientationStroke> strokes(2);
+  for (size_t i = 0; i < 2; ++i) {
+    for (size_t v = 0; v < 40; ++v)
+      for (int c = 0; c < 3; ++c) strokes[i].points.push_back(mesh.positions[3 * (v * 37 + i * 11) + c]);
+    strokes[i].radius = 0.2f;
+  }
+  OrientationOptions options;
+  options.strokes = strokes;
+  options.threads = 1;
+  const FaceFrames one = frames_of(mesh, options);
+  options.threads = 3;
+  const FaceFrames three = frames_of(mesh, options);
+  EXPECT_EQ(one.orientation, three.orientation);
+  EXPECT_EQ(one.local, three.local);
+  EXPECT_NE(one.orientation, frames_of(mesh).orientation);
+}
+
+TEST(Orientation, RejectsBadStrokes) {
+  const Mesh mesh = load_test_mesh("spot.obj");
+  const Topology topology = build_topology(mesh);
+  FaceFrames frames;
+  auto code_of = [&](OrientationStroke stroke) {
+    OrientationOptions options;
+    options.strokes = std::span<const OrientationStroke>(&stroke, 1);
+    const Status s = compute_orientation(mesh, topology, options, frames);
+    EXPECT_NE(s.message().find("stroke 0"), std::string::npos) << s.message();
+    return s.code();
+  };
+  EXPECT_EQ(code_of({{0.f, 0.f, 0.f}, 1.f}), ErrorCode::kInvalidArgument);                      // one point
+  EXPECT_EQ(code_of({{0.f, 0.f, 0.f, 1.f, 0.f}, 1.f}), ErrorCode::kInvalidArgument);            // not triples
+  EXPECT_EQ(code_of({{0.f, 0.f, 0.f, 1.f, NAN, 0.f}, 1.f}), ErrorCode::kInvalidArgument);       // not finite
+  EXPECT_EQ(code_of({{0.f, 0.f, 0.f, 1.f, 0.f, 0.f}, 0.f}), ErrorCode::kInvalidArgument);       // radius 0
+  EXPECT_EQ(code_of({{0.f, 0.f, 0.f, 1.f, 0.f, 0.f}, INFINITY}), ErrorCode::kInvalidArgument);  // radius inf
 }
 
 TEST(Orientation, IsDeterministic) {

@@ -56,6 +56,7 @@ struct MapArgs {
   bool crack_rings_given = false;        // --crack-rings on the command line (kept over auto's)
   std::string seed_point;
   std::string seam_faces;
+  std::string strokes;  // --strokes: orientation strokes, JSON (read_strokes.cpp)
   bool stability = false;
   bool quiet = false;
 };
@@ -133,7 +134,13 @@ int run_map(const MapArgs& opt) {
         usage_error("give --texture or --material, not both (the material's colour map is the texture)"));
   if (!opt.material.empty() && ext != ".glb")
     return report_error(usage_error("--material needs a .glb output, got '" + opt.output + "'"));
-  if (Status s = check_outputs(output_paths(opt), {opt.input, opt.texture, opt.seam_faces}); !s) return report_error(s);
+  if (Status s = check_outputs(output_paths(opt), {opt.input, opt.texture, opt.seam_faces, opt.strokes}); !s)
+    return report_error(s);
+  std::vector<OrientationStroke> strokes;  // read first too: a bad file fails before any work
+  if (!opt.strokes.empty()) {
+    if (Status s = load_strokes(opt.strokes, strokes); !s) return report_error(s);
+    options.orientation.strokes = strokes;
+  }
 
   // === Texture and material (read first: a bad map should fail before minutes of work) ===
   MaterialMaps material;
@@ -462,6 +469,7 @@ void register_map(CLI::App& app, Runner& run) {
   add_documented(group, option_doc(kOrientationOptionDocs, "smooth_passes"), orientation.smooth_passes);
   add_documented(group, option_doc(kMappingOptionDocs, "seed_point"), opt->seed_point);
   add_documented(group, option_doc(kMappingOptionDocs, "seam_faces"), opt->seam_faces);
+  add_documented(group, option_doc(kOrientationOptionDocs, "strokes"), opt->strokes);
   add_documented(group, option_doc(kMappingOptionDocs, "symmetry"), mapping.symmetry)->check(CLI::IsMember({1u, 4u}));
   cmd->add_flag("--stability", opt->stability,
                 "Also remove ~10% of the faces, re-map and report how much the remaining UVs moved");

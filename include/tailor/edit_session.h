@@ -30,11 +30,11 @@ namespace tailor {
 //! One edit, every part optional. Applied in this order: options, removed then added seam faces,
 //! strokes (appended to the session's strokes).
 struct EditRequest {
-  std::vector<uint32_t> add_seam_faces;       //!< face ids (input face order) to mark as seam faces
-  std::vector<uint32_t> remove_seam_faces;    //!< face ids to unmark
-  std::vector<OrientationStroke> strokes;     //!< orientation strokes to add
-  std::optional<MapTextureOptions> options;   //!< replaces the pipeline options when set (its spans are
-                                              //!< ignored: seam faces and strokes are the session's)
+  std::vector<uint32_t> add_seam_faces;      //!< face ids (input face order) to mark as seam faces
+  std::vector<uint32_t> remove_seam_faces;   //!< face ids to unmark
+  std::vector<OrientationStroke> strokes;    //!< orientation strokes to add
+  std::optional<MapTextureOptions> options;  //!< replaces the pipeline options when set (its spans are
+                                             //!< ignored: seam faces and strokes are the session's)
 };
 
 //! What an edit, undo, redo or settle did.

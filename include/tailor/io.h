@@ -12,10 +12,12 @@
 
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "tailor/api.h"
 #include "tailor/mesh.h"
+#include "tailor/orientation.h"
 #include "tailor/status.h"
 
 namespace tailor {
@@ -40,6 +42,21 @@ TAILOR_API Status read_mesh(std::span<const char> data, MeshFormat format, const
 //! Face indices refer to the mesh as loaded (after finalize_mesh dropped degenerate faces).
 //! Fails with the line number on a malformed or out-of-range index.
 TAILOR_API Status load_seam_faces(const std::string& path, size_t face_count, std::vector<uint8_t>& seam_faces);
+
+//! Reads orientation strokes (OrientationOptions::strokes) from JSON text of the form
+//! {"strokes": [{"points": [[x, y, z], ...], "radius": r}, ...]} (mesh coordinates; what
+//! `tailor map --strokes` and the edit API read). Fails with kParse naming `name` and where
+//! (byte N, strokes[i].points[k], ...) on invalid JSON, a missing or mistyped key, an unknown key,
+//! fewer than 2 points, a coordinate that is not a finite float or a radius not > 0; `strokes` is
+//! then empty. O(size of the text).
+TAILOR_API Status parse_strokes(std::string_view text, const std::string& name,
+                                std::vector<OrientationStroke>& strokes);
+
+//! parse_strokes on the contents of a file (kIo when it cannot be read).
+TAILOR_API Status load_strokes(const std::string& path, std::vector<OrientationStroke>& strokes);
+
+//! The JSON parse_strokes reads, one line (floats written so that they read back bit for bit).
+TAILOR_API std::string strokes_json(std::span<const OrientationStroke> strokes);
 
 //! Validation and repair shared by all readers (see top of file). Fails on non-finite positions,
 //! out-of-range indices, more than kMaxFaces faces, and meshes with no face left.

@@ -56,9 +56,9 @@ struct OrientationOptions {
   // Normalisation into the unit cube. Leave fixed_unit_scale at 0 to derive it from the mesh's
   // bounding box; stability runs pass the full mesh's values so a cut mesh keeps the same frame.
   std::array<float, 3> fixed_origin{0.f, 0.f, 0.f};  //!< with fixed_unit_scale > 0: bbox minimum, mesh units
-  float fixed_unit_scale = 0.f;  //!< > 0: normalised = (x - origin) * this; 0 = 1 / longest bbox side
-  uint32_t threads = 0;          //!< threads for the per-face frames (0 = one per 100k faces, at most
-                                 //!< the cores and 8); the result is identical for any count
+  float fixed_unit_scale = 0.f;                //!< > 0: normalised = (x - origin) * this; 0 = 1 / longest bbox side
+  uint32_t threads = 0;                        //!< threads for the per-face frames (0 = one per 100k faces, at most
+                                               //!< the cores and 8); the result is identical for any count
   std::span<const OrientationStroke> strokes;  //!< user strokes blended into the field (empty = none)
 };
 
@@ -70,6 +70,9 @@ inline constexpr OptionDoc kOrientationOptionDocs[] = {
      "its nearest curve-skeleton edge, so the texture runs along limbs; CGAL mean curvature flow: 3 s on the "
      "97k-face horse, up to 30 s on scans; holes are closed first, see docs/mapping.md)"},
     {"smooth_passes", "--smooth", "Orientation smoothing passes over face neighbours"},
+    {"strokes", "--strokes",
+     "JSON file of orientation strokes, {\"strokes\": [{\"points\": [[x,y,z], ...], \"radius\": r}]} in mesh "
+     "coordinates (what tailor edit saves): within r of a stroke the field turns to follow it, fully on the curve"},
 };
 
 //! Per-face frames. Shapes: #F by 3 arrays are packed xyz per face.

@@ -14,6 +14,7 @@
 #include <string>
 
 #include "surface/skeleton.h"
+#include "surface/stroke_field.h"
 #include "util/huge_pages.h"
 #include "util/parallel_chunks.h"
 
@@ -86,6 +87,7 @@ Status compute_orientation(const Mesh& mesh, const Topology& topology, const Ori
     return Status::error(ErrorCode::kInvalidArgument, "", "degenerate_cos must be in [0.5, 1]");
   if (!(options.fixed_unit_scale >= 0.f) || !std::isfinite(options.fixed_unit_scale))
     return Status::error(ErrorCode::kInvalidArgument, "", "fixed unit scale must be finite and >= 0");
+  TAILOR_RETURN_IF_ERROR(internal::check_strokes(options.strokes));
   const float* pos = mesh.positions.data();
   const uint32_t* idx = mesh.indices.data();
 
@@ -161,6 +163,9 @@ Status compute_orientation(const Mesh& mesh, const Topology& topology, const Ori
     frames.skeleton_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - skeleton_start).count();
   }
 
+  // === User strokes: a direction and weight per point near them (surface/stroke_field.cpp) ===
+  const internal::StrokeField strokes(options.strokes);
+
   // === Per-face normal, area, orientation ===
   // ~76 bytes per face of fresh memory: on large meshes, faulting it in 4 KiB pages costs more than
   // the arithmetic, so ask for huge pages first.
@@ -196,6 +201,21 @@ Status compute_orientation(const Mesh& mesh, const Topology& topology, const Ori
     frames.anchor[2 * f] = static_cast<float>(dot(p0, o));
     frames.anchor[2 * f + 1] = static_cast<float>(dot(p0, p));
   };
+  // Turns o towards the strokes' direction at the face's centroid by the strokes' weight (a
+  // rotation in the face plane: at weight 1, o is the direction projected onto the face).
+  auto blend_stroke = [&](const internal::StrokeField& field, size_t f, const Vec3& n, Vec3& o) {
+    Vec3 q;
+    for (int k = 0; k < 3; ++k) q = add(q, load(pos + 3 * idx[3 * f + k]));
+    const double centroid[3] = {q.x / 3, q.y / 3, q.z / 3};
+    double d[3];
+    const double w = field.sample(centroid, d);
+    Vec3 t;
+    if (!(w > 0) || !project({d[0], d[1], d[2]}, n, degenerate_cos, t)) return;
+    const Vec3 p = cross(n, o);
+    const double angle = w * std::atan2(dot(t, p), dot(t, o));
+    o = add(mul(o, std::cos(angle)), mul(p, std::sin(angle)));
+    o = mul(o, 1.0 / norm(o));
+  };
   // Faces are independent here: they are cut into fixed chunks shared out among the threads
   // (each writes only its own faces; counters are summed after), so the result is the same
   // bit for bit whatever the thread count.
@@ -221,6 +241,7 @@ Status compute_orientation(const Mesh& mesh, const Topology& topology, const Ori
           ++fallback_faces;
           if (!project(axis2, n, degenerate_cos, o)) o = perpendicular(n);
         }
+        if (!strokes.empty()) blend_stroke(strokes, f, n, o);
       }
       store(&frames.normal[3 * f], n);
       store(&frames.orientation[3 * f], o);
