@@ -51,6 +51,7 @@ struct EditArgs {
   bool crack_rings_given = false;
   std::string seed_point;
   std::string seam_faces;
+  std::string strokes;
 };
 
 // "out/a.glb" + "seam_faces.txt" -> "out/a_seam_faces.txt"
@@ -115,9 +116,14 @@ int run_edit(const EditArgs& opt) {
   if (Status s = check_outputs({{context.glb_path, "--output"},
                                 {context.seam_faces_path, "the seam faces beside --output"},
                                 {context.strokes_path, "the strokes beside --output"}},
-                               {opt.input, opt.texture, opt.seam_faces});
+                               {opt.input, opt.texture, opt.seam_faces, opt.strokes});
       !s)
     return report_error(s);
+  std::vector<OrientationStroke> strokes;
+  if (!opt.strokes.empty()) {
+    if (Status s = load_strokes(opt.strokes, strokes); !s) return report_error(s);
+    options.orientation.strokes = strokes;
+  }
   std::string root;
   if (Status s = find_web_root(opt.web_root, root); !s) return report_error(s);
   if (!std::filesystem::exists(root + "/edit.html"))
@@ -224,6 +230,7 @@ void register_edit(CLI::App& app, Runner& run) {
   cmd->add_option("--texture-size", opt->texture_size, "Texture size in pixels when no --texture is given")
       ->capture_default_str();
   add_documented(cmd, option_doc(kMappingOptionDocs, "seam_faces"), opt->seam_faces);
+  add_documented(cmd, option_doc(kOrientationOptionDocs, "strokes"), opt->strokes);
   add_documented(cmd, option_doc(kExportOptionDocs, "compression"), opt->compress);
   add_documented(cmd, option_doc(kExportOptionDocs, "uv_set"), opt->uv_set)->check(CLI::Range(0, 7));
   add_documented(cmd, option_doc(kExportOptionDocs, "up"), opt->up);

@@ -13,6 +13,7 @@
 
 #include "cli.h"
 #include "tailor/axis_choice.h"
+#include "tailor/io.h"
 #include "tailor/mapping.h"
 #include "tailor/texture_direction.h"
 #include "util/atomic_file.h"
@@ -150,47 +151,43 @@ std::string face_list(const json& j, const char* key, std::vector<uint32_t>& out
   return {};
 }
 
+// The strokes of an edit, read by the library's reader (the messages of `tailor map --strokes`).
 std::string stroke_list(const json& j, std::vector<OrientationStroke>& out) {
   if (!j.is_array()) return "\"strokes\" must be an array";
-  for (const json& s : j) {
-    if (!s.is_object() || !s.contains("points") || !s.contains("radius"))
-      return "each stroke must be {\"points\": [[x, y, z], ...], \"radius\": r}";
-    for (const auto& [key, v] : s.items()) {
-      (void)v;
-      if (key != "points" && key != "radius") return "unknown stroke key '" + key + "'";
-    }
-    OrientationStroke stroke;
-    if (!as_float(s["radius"], stroke.radius) || !(stroke.radius > 0.f)) return "a stroke's radius must be > 0";
-    const json& points = s["points"];
-    if (!points.is_array() || points.size() < 2) return "a stroke needs at least 2 points";
-    stroke.points.reserve(3 * points.size());
-    for (const json& p : points) {
-      if (!p.is_array() || p.size() != 3) return "a stroke's points must be [x, y, z]";
-      for (const json& c : p) {
-        float x = 0.f;
-        if (!as_float(c, x)) return "a stroke's points must be finite numbers";
-        stroke.points.push_back(x);
-      }
-    }
-    out.push_back(std::move(stroke));
-  }
+  if (Status s = parse_strokes(json_text(json{{"strokes", j}}, -1), "strokes", out); !s) return s.message();
   return {};
+}
+
+// A float as the shortest decimal that reads back to it (0.02f is 0.02, not 0.0199999995529...).
+json json_float(float x) {
+  char text[32];
+  const auto [end, error] = std::to_chars(text, text + sizeof text, x);
+  return error == std::errc() ? json(std::strtod(std::string(text, end).c_str(), nullptr)) : json(x);
 }
 
 json options_json(const MapTextureOptions& options) {
   const MappingOptions& m = options.mapping;
-  json j = {{"axis", axis_text(options.orientation)}, {"smooth_passes", options.orientation.smooth_passes},
-            {"mode", mapping_mode_name(m.mode)},      {"scale", m.scale},
-            {"max_stretch", m.max_stretch},           {"field_following", m.field_following},
-            {"min_patch_faces", m.min_patch_faces},   {"hop_age", m.hop_age},
-            {"shorten_seams", m.shorten_seams},       {"close_cracks", m.close_cracks},
-            {"crack_rings", m.crack_rings},           {"relax_iterations", m.relax_iterations},
-            {"threshold_px", m.threshold_px},         {"symmetry", m.symmetry}};
-  j["seed_point"] = m.use_seed_point ? json(m.seed_point) : json(nullptr);
+  json j = {{"axis", axis_text(options.orientation)},
+            {"smooth_passes", options.orientation.smooth_passes},
+            {"mode", mapping_mode_name(m.mode)},
+            {"scale", json_float(m.scale)},
+            {"max_stretch", json_float(m.max_stretch)},
+            {"field_following", json_float(m.field_following)},
+            {"min_patch_faces", m.min_patch_faces},
+            {"hop_age", json_float(m.hop_age)},
+            {"shorten_seams", m.shorten_seams},
+            {"close_cracks", m.close_cracks},
+            {"crack_rings", m.crack_rings},
+            {"relax_iterations", m.relax_iterations},
+            {"threshold_px", json_float(m.threshold_px)},
+            {"symmetry", m.symmetry}};
+  j["seed_point"] = m.use_seed_point
+                        ? json{json_float(m.seed_point[0]), json_float(m.seed_point[1]), json_float(m.seed_point[2])}
+                        : json(nullptr);
   return j;
 }
 
-json strokes_json(const std::vector<OrientationStroke>& strokes) {
+json strokes_array(const std::vector<OrientationStroke>& strokes) {
   json list = json::array();
   for (const OrientationStroke& s : strokes) {
     json points = json::array();
@@ -287,9 +284,13 @@ HttpResponse EditApi::edit(const HttpRequest& request) {
   if (j.is_discarded()) return HttpResponse::error(400, "the body is not JSON");
   if (!j.is_object()) return HttpResponse::error(400, "the body must be a JSON object");
   EditRequest edit;
+  bool join = false;
   for (const auto& [key, v] : j.items()) {
     std::string reason;
-    if (key == "add_seam_faces") {
+    if (key == "join") {
+      if (!v.is_boolean()) reason = "\"join\" must be true or false";
+      join = v.is_boolean() && v.get<bool>();
+    } else if (key == "add_seam_faces") {
       reason = face_list(v, "add_seam_faces", edit.add_seam_faces);
     } else if (key == "remove_seam_faces") {
       reason = face_list(v, "remove_seam_faces", edit.remove_seam_faces);
@@ -304,13 +305,25 @@ HttpResponse EditApi::edit(const HttpRequest& request) {
       reason = apply_options(v, context_, seam_faces, options);
       edit.options = options;
     } else {
-      reason = "unknown key '" + key + "' (add_seam_faces, remove_seam_faces, strokes, options)";
+      reason = "unknown key '" + key + "' (add_seam_faces, remove_seam_faces, strokes, options, join)";
     }
     if (!reason.empty()) return HttpResponse::error(400, reason);
   }
   EditResult result;
-  if (Status s = context_.session->apply(edit, result); !s) {
-    return HttpResponse::error(s.code() == ErrorCode::kInvalidArgument ? 400 : 500, s.message());
+  {
+    const std::lock_guard<std::mutex> lock(edit_mutex_);
+    const uint64_t before = context_.session->version();
+    if (Status s = context_.session->apply(edit, result); !s) {
+      return HttpResponse::error(s.code() == ErrorCode::kInvalidArgument ? 400 : 500, s.message());
+    }
+    if (result.version != before) {  // a session step (an edit that changed nothing makes none)
+      if (join && step_open_ && !undo_steps_.empty())
+        ++undo_steps_.back();
+      else
+        undo_steps_.push_back(1);
+      redo_steps_.clear();
+      step_open_ = true;
+    }
   }
   edited();
   return json_answer(result_json(result));
@@ -318,8 +331,25 @@ HttpResponse EditApi::edit(const HttpRequest& request) {
 
 HttpResponse EditApi::undo_redo(bool redo) {
   EditResult result;
-  const Status s = redo ? context_.session->redo(result) : context_.session->undo(result);
-  if (!s) return HttpResponse::error(s.code() == ErrorCode::kInvalidArgument ? 409 : 500, s.message());
+  {
+    const std::lock_guard<std::mutex> lock(edit_mutex_);
+    std::vector<uint32_t>& from = redo ? redo_steps_ : undo_steps_;
+    std::vector<uint32_t>& to = redo ? undo_steps_ : redo_steps_;
+    if (from.empty()) return HttpResponse::error(409, redo ? "nothing to redo" : "nothing to undo");
+    step_open_ = false;
+    const uint32_t steps = from.back();
+    EditResult one;
+    for (uint32_t i = 0; i < steps; ++i) {
+      const Status s = redo ? context_.session->redo(one) : context_.session->undo(one);
+      if (!s) return HttpResponse::error(s.code() == ErrorCode::kInvalidArgument ? 409 : 500, s.message());
+      result.changed_faces += one.changed_faces;
+      result.ms += one.ms;
+    }
+    result.version = one.version;
+    result.settled = one.settled;
+    from.pop_back();
+    to.push_back(steps);
+  }
   edited();
   return json_answer(result_json(result));
 }
@@ -350,7 +380,7 @@ HttpResponse EditApi::state() const {
             {"settled", settled},
             {"options", options_json(options)},
             {"seam_faces", std::move(marked)},
-            {"strokes", strokes_json(strokes)},
+            {"strokes", strokes_array(strokes)},
             {"output", context_.glb_path},
             {"seam_faces_file", context_.seam_faces_path},
             {"strokes_file", context_.strokes_path}};
@@ -425,7 +455,7 @@ HttpResponse EditApi::save() {
   std::string faces = "# tailor edit: seam faces of " + context_.name + " (tailor map --seam-faces)\n";
   for (size_t f = 0; f < seam_faces.size(); ++f)
     if (seam_faces[f]) faces += std::to_string(f) + "\n";
-  const std::string stroke_text = json_text(json{{"strokes", strokes_json(strokes)}}, 1) + "\n";
+  const std::string stroke_text = strokes_json(strokes) + "\n";
   // The three files land together or not at all.
   internal::FileBatch batch;
   if (Status s = write_mapped_mesh(context_.glb_path, context_.session->mesh(), atlas, context_.output); !s)

@@ -69,6 +69,12 @@ class EditApi {
                         MapTextureOptions& options, uint64_t& version);
 
   EditContext& context_;
+  // Undo steps of the API: a brush stroke is sent as several edits ("join": true after the first)
+  // and undone as one. Each entry counts the session's own steps it spans.
+  std::mutex edit_mutex_;  // edits, undo and redo one at a time, with the step counts
+  std::vector<uint32_t> undo_steps_;
+  std::vector<uint32_t> redo_steps_;
+  bool step_open_ = false;  // the last edit may be joined
   std::string mesh_bytes_;  // GET /api/mesh, built once
   std::mutex settle_mutex_;
   std::condition_variable settle_wake_;

@@ -9,7 +9,8 @@
 //      segment, a backslash or a NUL byte, and checking that the resolved real path (symlinks
 //      followed) still lies inside the root.
 // Everything else gets 404; other methods, and POST to a path without a handler, get 405. A POST
-// must say Content-Length (411 otherwise; at most 16 MiB, 413) and Content-Type: application/json
+// body must come with a Content-Length (411 for chunked ones; at most 16 MiB, 413; none: no body)
+// and every POST with Content-Type: application/json
 // (415), and an Origin header, when sent, must be this server's: a page from another site cannot
 // send such a request without a CORS preflight, which is refused (cross-site request forgery).
 // Not meant for untrusted networks: it listens on the loopback interface only.
