@@ -1,7 +1,7 @@
 // tailor: the whole public API in one include. Link what the headers you use belong to:
 //   tailor::core     mesh.h io.h gltf.h image.h topology.h orientation.h mapping.h axis_choice.h
 //                    atlas.h metrics.h stability.h export.h status.h version.h
-//                    texture_direction.h
+//                    texture_direction.h edit_session.h
 //   tailor::texture  image_ops.h tiling.h (tileable textures, OpenCV inside)
 //   tailor::render   render.h (preview pictures, OSMesa inside)
 // Including a header whose library is not linked is harmless as long as none of its functions is
@@ -12,6 +12,7 @@
 #include "tailor/api.h"
 #include "tailor/atlas.h"
 #include "tailor/axis_choice.h"
+#include "tailor/edit_session.h"
 #include "tailor/export.h"
 #include "tailor/gltf.h"
 #include "tailor/image.h"

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <span>
 
 #include "mapping/face_stretch.h"
 #include "mapping/front_buckets.h"
@@ -71,12 +72,7 @@ class PatchMapper {
   Status run() {
     const Mesh& mesh = in_.mesh;
     const size_t face_count = mesh.face_count();
-    anchor_ = in_.frames.anchor.data();
-    scale_ = in_.options.scale;
-    bound_ = in_.options.max_stretch;
-    max_seed_rotation_ = in_.options.max_seed_rotation_deg * kPi / 180.f;
-    factor_step_ = in_.factor_step;
-    relax_ = 1.f - in_.options.field_following;
+    prepare();
 
     // Fresh multi-megabyte arrays: on huge pages (see huge_pages.h).
     reserve_huge(atlas_.corner_uv, 6 * face_count);
@@ -85,15 +81,107 @@ class PatchMapper {
     fill_records();
     reserve_huge(hint_, mesh.vertex_count());
     hint_.assign(mesh.vertex_count(), VertexHint{kInvalid, 0.f, 0.f});
-    hop_age_ = in_.factor_step < 0 ? in_.options.hop_age : 0.f;
     // Not initialised: a face's entry is written when it is placed, and only placed faces' are read.
     if (hop_age_ > 0.f) hops_.reset(new uint32_t[face_count]);
+
+    // === Grow: one component at a time, patches one after another ===
+    FaceRecord* rec = rec_.get();
+    for (const uint32_t seed : in_.component_seeds) {
+      if (rec[seed].patch != kInvalid) continue;
+      current_ = start_patch(seed);
+      TAILOR_RETURN_IF_ERROR(grow(false));
+    }
+    if (cancelled_) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
+    stats_.patches_before_absorb = static_cast<uint32_t>(patch_size_.size());
+    absorb_small_patches();
+    renumber_patches();
+    return Status::ok();
+  }
+
+  // Grows the faces flagged in `region` again, every other face keeping its UVs and patch (see
+  // regrow_patches in mapping_common.h).
+  Status run_region(std::span<const uint8_t> region) {
+    const Mesh& mesh = in_.mesh;
+    const size_t face_count = mesh.face_count();
+    prepare();
+    uv_ = atlas_.corner_uv.data();
+    fill_records();
+    hint_.assign(mesh.vertex_count(), VertexHint{kInvalid, 0.f, 0.f});
+    if (hop_age_ > 0.f) hops_.reset(new uint32_t[face_count]);
+    // The kept faces are placed as they are, in their patches (ids kept); the first UV each patch
+    // gives a vertex is its hint, as in the growth.
+    FaceRecord* rec = rec_.get();
+    kept_patches_ = atlas_.patch_count;
+    patch_size_.assign(kept_patches_, 0);
+    patch_rotation_.assign(kept_patches_, Rotation{});
+    patch_seed_.assign(kept_patches_, kInvalid);
+    for (uint32_t f = 0; f < face_count; ++f) {
+      if (region[f]) continue;
+      const uint32_t p = atlas_.patch[f];
+      rec[f].patch = p;
+      ++patch_size_[p];
+      if (patch_seed_[p] == kInvalid) patch_seed_[p] = f;
+      if (hop_age_ > 0.f) hops_[f] = 0;
+      for (int k = 0; k < 3; ++k) {
+        VertexHint& hint = hint_[rec[f].vertex[k]];
+        if (hint.patch == kInvalid) hint = VertexHint{p, uv_[6 * f + 2 * k], uv_[6 * f + 2 * k + 1]};
+      }
+    }
+    // The region's faces next to kept ones join the front; a kept patch bordering the region gets
+    // the rotation its face there shows (the growth's patch rotation is not kept).
+    std::vector<uint8_t> rotation_known(kept_patches_, 0);
+    for (uint32_t f = 0; f < face_count; ++f) {
+      if (!region[f]) continue;
+      FaceRecord& r = rec[f];
+      for (const uint32_t g : r.neighbour) {
+        if (g == kInvalid || region[g]) continue;
+        ++r.placed;
+        const uint32_t p = rec[g].patch;
+        if (rotation_known[p]) continue;
+        rotation_known[p] = 1;
+        const float theta = edge_rotation(g, 0, uv_ + 6 * g, uv_ + 6 * g + 2);
+        patch_rotation_[p] = Rotation{std::cos(theta), std::sin(theta)};
+      }
+      if (r.placed > 0) push_front(front_key(r.seam ? kSeam : kWaiting, r.placed, r.variation + hop_age_, f));
+    }
+    current_ = kAnyPatch;
+    TAILOR_RETURN_IF_ERROR(grow(true));
+    // Pieces of the region that touch no kept face (a whole component): from their seed, as the growth.
+    for (const uint32_t seed : in_.component_seeds) {
+      if (!region[seed] || rec[seed].patch != kInvalid) continue;
+      current_ = start_patch(seed);
+      TAILOR_RETURN_IF_ERROR(grow(true));
+    }
+    for (uint32_t f = 0; f < face_count; ++f) {
+      if (!region[f] || rec[f].patch != kInvalid) continue;
+      current_ = start_patch(f);
+      TAILOR_RETURN_IF_ERROR(grow(true));
+    }
+    stats_.patches_before_absorb = static_cast<uint32_t>(patch_size_.size());
+    absorb_small_patches();
+    renumber_region_patches(region);
+    return Status::ok();
+  }
+
+ private:
+  // Options and per-run settings shared by run and run_region.
+  void prepare() {
+    anchor_ = in_.frames.anchor.data();
+    scale_ = in_.options.scale;
+    bound_ = in_.options.max_stretch;
+    max_seed_rotation_ = in_.options.max_seed_rotation_deg * kPi / 180.f;
+    factor_step_ = in_.factor_step;
+    relax_ = 1.f - in_.options.field_following;
+    hop_age_ = in_.factor_step < 0 ? in_.options.hop_age : 0.f;
     queue_.clear();
     patch_rotation_.reserve(256);
     patch_size_.reserve(256);
     patch_seed_.reserve(256);
+  }
 
-    // === Grow: one component at a time, patches one after another ===
+  // Pops the front until it is empty. `any_patch` (the region's growth): a waiting face joins
+  // whichever neighbouring patch fits without a cut, not only the current one.
+  Status grow(bool any_patch) {
     FaceRecord* rec = rec_.get();
     // A front entry is live while it is the face's latest (see front_buckets.h); the popped one's
     // face leaves the front (its front byte is cleared below, not here: the queue may ask about
@@ -101,9 +189,7 @@ class PatchMapper {
     auto live = [rec](uint64_t key) {
       return rec[FrontBuckets::face_of(key)].front == FrontBuckets::bucket_of(key) + 1;
     };
-    for (const uint32_t seed : in_.component_seeds) {
-      if (rec[seed].patch != kInvalid) continue;
-      current_ = start_patch(seed);
+    {
       for (uint64_t key; queue_.pop(live, key);) {
         if (cancelled_) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
         const uint32_t f = FrontBuckets::face_of(key);
@@ -116,7 +202,7 @@ class PatchMapper {
           // First pass: only placements that leave no cut; the others wait, so the front flows
           // around them and cuts are made only where it is otherwise stuck (measured: 10-35%
           // less seam length than cutting at once, e.g. bunny 9.4% -> 8.2% of edge length).
-          if (!try_place(f, current_, false)) {
+          if (!try_place(f, any_patch ? kAnyPatch : current_, false)) {
             ++stats_.deferrals;
             push_front(with_class(key, kDeferred));
           }
@@ -124,7 +210,7 @@ class PatchMapper {
           // Only deferred (and seam) faces wait: the front of the current patch is exhausted.
           // Join it (or, for a face deferred by an earlier patch, the neighbouring patch) with a
           // cut if that fits the bound, else start a new patch there.
-          if (!try_place(f, current_, true) && !try_place(f, kAnyPatch, true)) current_ = start_patch(f);
+          if ((any_patch || !try_place(f, current_, true)) && !try_place(f, kAnyPatch, true)) current_ = start_patch(f);
         } else if (!try_place(f, kAnyPatch)) {
           join_rigidly(f);  // a user seam face: joins a neighbouring patch, the cut runs along it
         }
@@ -139,13 +225,9 @@ class PatchMapper {
       }
     }
     if (cancelled_) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
-    stats_.patches_before_absorb = static_cast<uint32_t>(patch_size_.size());
-    absorb_small_patches();
-    renumber_patches();
     return Status::ok();
   }
 
- private:
   // Copies the inputs into one record per face (sequential passes; the growth then reads one
   // cache line per face instead of one per array).
   void fill_records() {
@@ -652,13 +734,15 @@ class PatchMapper {
     FaceRecord* rec = rec_.get();
     std::vector<uint32_t> largest(in_.topology.edge_components, kInvalid);
     for (uint32_t p = 0; p < patch_count; ++p) {
+      if (patch_seed_[p] == kInvalid) continue;  // a region's former patch, now empty
       uint32_t& l = largest[component[patch_seed_[p]]];
       if (l == kInvalid || patch_size_[p] > patch_size_[l]) l = p;
     }
     std::vector<uint8_t> kept(patch_count, 0);
     bool any_small = false;
     for (uint32_t p = 0; p < patch_count; ++p) {
-      kept[p] = patch_size_[p] >= min_faces || largest[component[patch_seed_[p]]] == p;
+      // The patches of faces outside a regrown region are never touched.
+      kept[p] = p < kept_patches_ || patch_size_[p] >= min_faces || largest[component[patch_seed_[p]]] == p;
       any_small = any_small || !kept[p];
     }
     if (!any_small) return;
@@ -710,6 +794,25 @@ class PatchMapper {
     atlas_.patch_count = next;
   }
 
+  // Region growth: the kept faces' patches keep their ids; the new ones take the ids the region's
+  // former patches left free (lowest first), then ids after the kept ones.
+  void renumber_region_patches(std::span<const uint8_t> region) {
+    std::vector<uint32_t> remap(patch_size_.size(), kInvalid);
+    uint32_t count = 0, free = 0, after = kept_patches_;
+    for (uint32_t p = 0; p < kept_patches_; ++p)
+      if (patch_size_[p] > 0) remap[p] = p, count = p + 1;
+    for (uint32_t p = kept_patches_; p < patch_size_.size(); ++p) {
+      if (patch_size_[p] == 0) continue;
+      while (free < kept_patches_ && patch_size_[free] > 0) ++free;
+      remap[p] = free < kept_patches_ ? free++ : after++;
+      count = std::max(count, remap[p] + 1);
+    }
+    const size_t face_count = in_.mesh.face_count();
+    for (size_t f = 0; f < face_count; ++f)
+      if (region[f]) atlas_.patch[f] = remap[rec_[f].patch];
+    atlas_.patch_count = count;
+  }
+
   const MappingInput& in_;
   MappingStats& stats_;
   Atlas& atlas_;
@@ -731,6 +834,7 @@ class PatchMapper {
   uint64_t placed_count_ = 0;
   bool cancelled_ = false;
   bool absorbing_ = false;
+  uint32_t kept_patches_ = 0;  // run_region: patch ids below this are the kept faces' (never absorbed)
 };
 
 }  // namespace
@@ -739,6 +843,16 @@ Status grow_patches(const MappingInput& input, Atlas& atlas, MappingStats& stats
   on_seam.assign(input.mesh.face_count(), 0);
   PatchMapper mapper(input, atlas, stats, on_seam);
   return mapper.run();
+}
+
+Status regrow_patches(const MappingInput& input, std::span<const uint8_t> region, Atlas& atlas, MappingStats& stats,
+                      std::vector<uint8_t>& on_seam) {
+  on_seam.assign(input.mesh.face_count(), 0);
+  PatchMapper mapper(input, atlas, stats, on_seam);
+  TAILOR_RETURN_IF_ERROR(mapper.run_region(region));
+  // Only the region's faces are where the seam shortening may look (a kept face never moves).
+  for (size_t f = 0; f < on_seam.size(); ++f) on_seam[f] &= region[f];
+  return Status::ok();
 }
 
 }  // namespace tailor::internal

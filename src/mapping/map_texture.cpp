@@ -118,15 +118,6 @@ Status check_mapping_inputs(const Mesh& mesh, const Topology& topology, const Fa
   return Status::ok();
 }
 
-// The growth's age per placed face: the option, or the mode's default (see MappingOptions::factor_step).
-double factor_step_for(const MappingOptions& options, size_t face_count) {
-  const bool thesis = options.mode == MappingMode::kThesis;
-  // Patches mode: negative = the hop rule (hop_age); with hop_age 0, the global counter at 1e-4.
-  if (options.factor_step < 0 && (thesis || options.hop_age == 0.f))
-    return thesis ? 1.0 / static_cast<double>(face_count) : 1e-4;
-  return options.factor_step;
-}
-
 // Cleared, not freed: a caller mapping again reuses the memory (no page faults on 37 MB).
 void clear_atlas(Atlas& atlas) {
   atlas.corner_uv.clear();
@@ -135,6 +126,18 @@ void clear_atlas(Atlas& atlas) {
 }
 
 }  // namespace
+
+namespace internal {
+
+double factor_step_for(const MappingOptions& options, size_t face_count) {
+  const bool thesis = options.mode == MappingMode::kThesis;
+  // Patches mode: negative = the hop rule (hop_age); with hop_age 0, the global counter at 1e-4.
+  if (options.factor_step < 0 && (thesis || options.hop_age == 0.f))
+    return thesis ? 1.0 / static_cast<double>(face_count) : 1e-4;
+  return options.factor_step;
+}
+
+}  // namespace internal
 
 const char* mapping_mode_name(MappingMode mode) { return mode == MappingMode::kThesis ? "thesis" : "patches"; }
 
@@ -152,11 +155,17 @@ Status map_texture(const Mesh& mesh, const Topology& topology, const MapTextureO
   clear_atlas(map.atlas);
   map.stats = MappingStats{};
   map.metrics = UvMetrics{};
-  const MappingOptions& mapping = options.mapping;
-
   // === 1. Orientation field: per-face frames, the field and its variation (surface/orientation.cpp) ===
   TAILOR_RETURN_IF_ERROR(compute_orientation(mesh, topology, options.orientation, map.frames));
+  return internal::map_texture_frames(mesh, topology, options, map);
+}
 
+Status internal::map_texture_frames(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options,
+                                    TextureMap& map) {
+  clear_atlas(map.atlas);
+  map.stats = MappingStats{};
+  map.metrics = UvMetrics{};
+  const MappingOptions& mapping = options.mapping;
   const auto start = std::chrono::steady_clock::now();
   TAILOR_RETURN_IF_ERROR(check_mapping_inputs(mesh, topology, map.frames, mapping));
   const bool thesis = mapping.mode == MappingMode::kThesis;
@@ -176,7 +185,7 @@ Status map_texture(const Mesh& mesh, const Topology& topology, const MapTextureO
                                      topology,
                                      map.frames,
                                      growth_options,
-                                     factor_step_for(mapping, mesh.face_count()),
+                                     internal::factor_step_for(mapping, mesh.face_count()),
                                      component_seed_faces(mesh, topology, map.frames, mapping)};
   MappingStats& stats = map.stats;
   stats.components = static_cast<uint32_t>(input.component_seeds.size());

@@ -6,6 +6,7 @@
 #include <bit>
 #include <cstdint>
 #include <cstring>
+#include <span>
 #include <vector>
 
 #include "tailor/atlas.h"
@@ -47,15 +48,34 @@ struct MappingInput {
   std::vector<uint32_t> component_seeds;  // first face of each component, in processing order
 };
 
+//! Steps 2-6 of map_texture on frames already in map.frames (computed by compute_orientation with
+//! options.orientation): map_texture is compute_orientation then this, so the same bits.
+Status map_texture_frames(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options,
+                          TextureMap& map);
+
+//! The growth's age per placed face: the option, or the mode's default (MappingOptions::factor_step).
+double factor_step_for(const MappingOptions& options, size_t face_count);
+
 //! The growth of the patches mode (step 2 of map_texture): the patch-discovery front, then the
 //! absorption of small patches. on_seam gets #F flags, 1 on every face placed with a seam edge
 //! (and some of their neighbours): where shorten_seams looks.
 Status grow_patches(const MappingInput& input, Atlas& atlas, MappingStats& stats, std::vector<uint8_t>& on_seam);
+//! The growth of grow_patches restricted to the faces flagged in `region` (#F): every other face
+//! keeps its UVs and patch as `atlas` has them (they are the placed faces the region grows from:
+//! the front starts at the region's faces next to them, which join a bordering patch where that
+//! leaves no cut, and new patches start where it does). The new patches take the ids the region's
+//! former patches left free, then ids after the kept ones, so atlas.patch may skip ids; small new
+//! patches are absorbed as in the growth. on_seam: as grow_patches, region faces only.
+Status regrow_patches(const MappingInput& input, std::span<const uint8_t> region, Atlas& atlas, MappingStats& stats,
+                      std::vector<uint8_t>& on_seam);
 //! Re-places faces on seams from their neighbours where that shortens the seams and keeps them
 //! within options.max_stretch (patches mode, step 3, after the growth); drops emptied patches. seam_mark:
 //! #F flags, 1 on every face with a seam edge (others may be 1 too), cleared on return. Returns the
 //! number of moves. Deterministic; O(F) once, then O(faces on seams) per pass, bounded passes.
-uint64_t shorten_seams(const MappingInput& input, std::vector<uint8_t>& seam_mark, Atlas& atlas);
+//! `locked` (empty or #F): faces flagged there never move, and patches are not renumbered (ids
+//! left empty stay unused).
+uint64_t shorten_seams(const MappingInput& input, std::vector<uint8_t>& seam_mark, Atlas& atlas,
+                       std::span<const uint8_t> locked = {});
 
 //! Zips cracks (seam edges between two faces of one patch) shut from their tips, relaxing the UVs
 //! around each zip (ARAP); a zip is kept only if every face it moved stays within

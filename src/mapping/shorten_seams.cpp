@@ -28,7 +28,8 @@ class SeamShortener {
   SeamShortener(const MappingInput& in, Atlas& atlas) : in_(in), atlas_(atlas) {}
 
   //! seam_mark: per face, 1 on every face with a seam edge (others may be 1 too); cleared.
-  uint64_t run(std::vector<uint8_t>& seam_mark) {
+  uint64_t run(std::vector<uint8_t>& seam_mark, std::span<const uint8_t> locked) {
+    locked_ = locked.empty() ? nullptr : locked.data();
     opposite_ = in_.topology.opposite.data();
     uv_ = atlas_.corner_uv.data();
     bound_ = in_.options.max_stretch;
@@ -40,7 +41,7 @@ class SeamShortener {
     patch_size_.assign(atlas_.patch_count, 0);
     for (const uint32_t p : atlas_.patch) ++patch_size_[p];
     const uint64_t moves = move_faces(seam_mark);
-    compact_patches();
+    if (!locked_) compact_patches();
     return moves;
   }
 
@@ -57,6 +58,7 @@ class SeamShortener {
         queued[f] = 0;
         // User seam faces keep the seams the user asked for.
         if (seam_flags_ && seam_flags_[f]) continue;
+        if (locked_ && locked_[f]) continue;
         if (!improve(f)) continue;
         ++moved;
         for (int k = 0; k < 3; ++k) {
@@ -274,6 +276,7 @@ class SeamShortener {
   const uint32_t* opposite_ = nullptr;
   float* uv_ = nullptr;
   const uint8_t* seam_flags_ = nullptr;  // user seam faces, or nullptr
+  const uint8_t* locked_ = nullptr;      // faces that never move, or nullptr
   float bound_ = 0.f, scale_ = 1.f;
   uint32_t min_keep_ = 2;
   std::vector<uint32_t> patch_size_;  // faces per patch, kept up to date by the moves
@@ -281,9 +284,10 @@ class SeamShortener {
 
 }  // namespace
 
-uint64_t shorten_seams(const MappingInput& input, std::vector<uint8_t>& seam_mark, Atlas& atlas) {
+uint64_t shorten_seams(const MappingInput& input, std::vector<uint8_t>& seam_mark, Atlas& atlas,
+                       std::span<const uint8_t> locked) {
   SeamShortener shortener(input, atlas);
-  return shortener.run(seam_mark);
+  return shortener.run(seam_mark, locked);
 }
 
 }  // namespace tailor::internal

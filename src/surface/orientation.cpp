@@ -13,6 +13,7 @@
 #include <functional>
 #include <string>
 
+#include "surface/orientation_setup.h"
 #include "surface/skeleton.h"
 #include "surface/stroke_field.h"
 #include "util/huge_pages.h"
@@ -70,10 +71,111 @@ bool project(const Vec3& a, const Vec3& n, double degenerate_cos, Vec3& o) {
   return true;
 }
 
+// Frames one face: the normal, area and orientation (the axis projected, then the strokes
+// blended in) and, when `corners` is set, the bitangent, corner coordinates and anchor. Used by
+// compute_orientation for every face and by refresh_face_frames for a few: the same arithmetic,
+// so the same bits.
+struct FaceFramer {
+  enum Kind { kNormal, kDegenerate, kFallback };
+  const float* pos;
+  const uint32_t* idx;
+  Vec3 axis, axis2, origin;
+  double unit_scale, degenerate_cos;
+  const float* face_axis;                // #F by 3 skeleton directions, or nullptr
+  const internal::StrokeField* strokes;  // may be empty
+  bool corners;                          // write the corner frame (no smoothing follows)
+  FaceFrames* frames;
+
+  // Corner k of face f in normalised coordinates.
+  Vec3 corner(size_t f, int k) const { return mul(sub(load(pos + 3 * idx[3 * f + k]), origin), unit_scale); }
+
+  // Bitangent, corners in the face frame and anchor, from the stored (float) normal and orientation.
+  void write_corner_frame(size_t f, const Vec3& p0, const Vec3& p1, const Vec3& p2) const {
+    const Vec3 n = load(&frames->normal[3 * f]);
+    const Vec3 o = load(&frames->orientation[3 * f]);
+    const Vec3 p = cross(n, o);  // (o, p, n) right-handed: counter-clockwise stays counter-clockwise
+    store(&frames->bitangent[3 * f], p);
+    float* local = &frames->local[6 * f];
+    const Vec3 d1 = sub(p1, p0), d2 = sub(p2, p0);
+    local[0] = 0.f;
+    local[1] = 0.f;
+    local[2] = static_cast<float>(dot(d1, o));
+    local[3] = static_cast<float>(dot(d1, p));
+    local[4] = static_cast<float>(dot(d2, o));
+    local[5] = static_cast<float>(dot(d2, p));
+    frames->anchor[2 * f] = static_cast<float>(dot(p0, o));
+    frames->anchor[2 * f + 1] = static_cast<float>(dot(p0, p));
+  }
+  void write_corner_frame(size_t f) const { write_corner_frame(f, corner(f, 0), corner(f, 1), corner(f, 2)); }
+
+  // Turns o towards the strokes' direction at the face's centroid by the strokes' weight (a
+  // rotation in the face plane: at weight 1, o is the direction projected onto the face).
+  void blend_stroke(size_t f, const Vec3& n, Vec3& o) const {
+    Vec3 q;
+    for (int k = 0; k < 3; ++k) q = add(q, load(pos + 3 * idx[3 * f + k]));
+    const double centroid[3] = {q.x / 3, q.y / 3, q.z / 3};
+    double d[3];
+    const double w = strokes->sample(centroid, d);
+    Vec3 t;
+    if (!(w > 0) || !project({d[0], d[1], d[2]}, n, degenerate_cos, t)) return;
+    const Vec3 p = cross(n, o);
+    const double angle = w * std::atan2(dot(t, p), dot(t, o));
+    o = add(mul(o, std::cos(angle)), mul(p, std::sin(angle)));
+    o = mul(o, 1.0 / norm(o));
+  }
+
+  Kind frame(size_t f) const {
+    const Vec3 p0 = corner(f, 0), p1 = corner(f, 1), p2 = corner(f, 2);
+    const Vec3 e1 = sub(p1, p0), e2 = sub(p2, p0);
+    Vec3 n = cross(e1, e2);
+    const double twice_area = norm(n);
+    const double longest2 = std::max({dot(e1, e1), dot(e2, e2), dot(sub(p2, p1), sub(p2, p1))});
+    Vec3 o;
+    Kind kind = kNormal;
+    if (!(twice_area > kDegenerateRatio * longest2) || !(longest2 > 0)) {
+      // Zero-area face: any orthonormal frame; o along its longest edge when there is one.
+      kind = kDegenerate;
+      n = perpendicular(axis);
+      if (!project(axis, n, degenerate_cos, o)) o = perpendicular(n);
+    } else {
+      n = mul(n, 1.0 / twice_area);
+      // With a skeleton, its edge is this face's axis and the PCA axes are the fallbacks.
+      const bool own = face_axis && project(load(&face_axis[3 * f]), n, degenerate_cos, o);
+      if (!own && !project(axis, n, degenerate_cos, o)) {
+        kind = kFallback;
+        if (!project(axis2, n, degenerate_cos, o)) o = perpendicular(n);
+      }
+      if (!strokes->empty()) blend_stroke(f, n, o);
+    }
+    store(&frames->normal[3 * f], n);
+    store(&frames->orientation[3 * f], o);
+    frames->area[f] = static_cast<float>(0.5 * twice_area);
+    // Without smoothing the frame is final: finish the face while its corners are in cache.
+    if (corners) write_corner_frame(f, p0, p1, p2);
+    return kind;
+  }
+};
+
+// Sum of the angles between face f's orientation and its edge neighbours' (the variation).
+// Each angle is computed from the half-edge of lower id, as compute_orientation's edge pass does.
+double face_variation(const uint32_t* opposite, const float* orientation, size_t f) {
+  double sum = 0;
+  for (size_t e = 3 * f; e < 3 * f + 3; ++e) {
+    if (opposite[e] == kInvalid) continue;
+    const size_t low = std::min<size_t>(e, opposite[e]), high = std::max<size_t>(e, opposite[e]);
+    const Vec3 o = load(&orientation[3 * (low / 3)]);
+    const Vec3 other = load(&orientation[3 * (high / 3)]);
+    sum += std::acos(std::clamp(dot(o, other), -1.0, 1.0));
+  }
+  return sum;
+}
+
 }  // namespace
 
-Status compute_orientation(const Mesh& mesh, const Topology& topology, const OrientationOptions& options,
-                           FaceFrames& frames) {
+namespace internal {
+
+Status compute_orientation_setup(const Mesh& mesh, const Topology& topology, const OrientationOptions& options,
+                                 FaceFrames& frames, OrientationSetup* setup) {
   const auto start = std::chrono::steady_clock::now();
   frames = FaceFrames{};
   const size_t face_count = mesh.face_count();
@@ -180,80 +282,30 @@ Status compute_orientation(const Mesh& mesh, const Topology& topology, const Ori
   allocate(frames.local, 6 * face_count);
   allocate(frames.variation, face_count);
   allocate(frames.anchor, 2 * face_count);
-  const double degenerate_cos = options.degenerate_cos;
   std::vector<uint8_t> degenerate(face_count, 0);
-  // Corner k of face f in normalised coordinates.
-  auto corner = [&](size_t f, int k) { return mul(sub(load(pos + 3 * idx[3 * f + k]), origin), unit_scale); };
-  // Bitangent, corners in the face frame and anchor, from the stored (float) normal and orientation.
-  auto write_corner_frame = [&](size_t f, const Vec3& p0, const Vec3& p1, const Vec3& p2) {
-    const Vec3 n = load(&frames.normal[3 * f]);
-    const Vec3 o = load(&frames.orientation[3 * f]);
-    const Vec3 p = cross(n, o);  // (o, p, n) right-handed: counter-clockwise stays counter-clockwise
-    store(&frames.bitangent[3 * f], p);
-    float* local = &frames.local[6 * f];
-    const Vec3 d1 = sub(p1, p0), d2 = sub(p2, p0);
-    local[0] = 0.f;
-    local[1] = 0.f;
-    local[2] = static_cast<float>(dot(d1, o));
-    local[3] = static_cast<float>(dot(d1, p));
-    local[4] = static_cast<float>(dot(d2, o));
-    local[5] = static_cast<float>(dot(d2, p));
-    frames.anchor[2 * f] = static_cast<float>(dot(p0, o));
-    frames.anchor[2 * f + 1] = static_cast<float>(dot(p0, p));
-  };
-  // Turns o towards the strokes' direction at the face's centroid by the strokes' weight (a
-  // rotation in the face plane: at weight 1, o is the direction projected onto the face).
-  auto blend_stroke = [&](const internal::StrokeField& field, size_t f, const Vec3& n, Vec3& o) {
-    Vec3 q;
-    for (int k = 0; k < 3; ++k) q = add(q, load(pos + 3 * idx[3 * f + k]));
-    const double centroid[3] = {q.x / 3, q.y / 3, q.z / 3};
-    double d[3];
-    const double w = field.sample(centroid, d);
-    Vec3 t;
-    if (!(w > 0) || !project({d[0], d[1], d[2]}, n, degenerate_cos, t)) return;
-    const Vec3 p = cross(n, o);
-    const double angle = w * std::atan2(dot(t, p), dot(t, o));
-    o = add(mul(o, std::cos(angle)), mul(p, std::sin(angle)));
-    o = mul(o, 1.0 / norm(o));
-  };
+  const FaceFramer framer{pos,
+                          idx,
+                          axis,
+                          axis2,
+                          origin,
+                          unit_scale,
+                          options.degenerate_cos,
+                          face_axis.empty() ? nullptr : face_axis.data(),
+                          &strokes,
+                          options.smooth_passes == 0,
+                          &frames};
   // Faces are independent here: they are cut into fixed chunks shared out among the threads
   // (each writes only its own faces; counters are summed after), so the result is the same
   // bit for bit whatever the thread count.
-  auto frame_faces = [&](size_t begin, size_t end, size_t& degenerate_faces, size_t& fallback_faces) {
-    for (size_t f = begin; f < end; ++f) {
-      const Vec3 p0 = corner(f, 0), p1 = corner(f, 1), p2 = corner(f, 2);
-      const Vec3 e1 = sub(p1, p0), e2 = sub(p2, p0);
-      Vec3 n = cross(e1, e2);
-      const double twice_area = norm(n);
-      const double longest2 = std::max({dot(e1, e1), dot(e2, e2), dot(sub(p2, p1), sub(p2, p1))});
-      Vec3 o;
-      if (!(twice_area > kDegenerateRatio * longest2) || !(longest2 > 0)) {
-        // Zero-area face: any orthonormal frame; o along its longest edge when there is one.
-        degenerate[f] = 1;
-        ++degenerate_faces;
-        n = perpendicular(axis);
-        if (!project(axis, n, degenerate_cos, o)) o = perpendicular(n);
-      } else {
-        n = mul(n, 1.0 / twice_area);
-        // With a skeleton, its edge is this face's axis and the PCA axes are the fallbacks.
-        const bool own = !face_axis.empty() && project(load(&face_axis[3 * f]), n, degenerate_cos, o);
-        if (!own && !project(axis, n, degenerate_cos, o)) {
-          ++fallback_faces;
-          if (!project(axis2, n, degenerate_cos, o)) o = perpendicular(n);
-        }
-        if (!strokes.empty()) blend_stroke(strokes, f, n, o);
-      }
-      store(&frames.normal[3 * f], n);
-      store(&frames.orientation[3 * f], o);
-      frames.area[f] = static_cast<float>(0.5 * twice_area);
-      // Without smoothing the frame is final: finish the face while its corners are in cache.
-      if (options.smooth_passes == 0) write_corner_frame(f, p0, p1, p2);
-    }
-  };
   std::vector<size_t> degenerate_count(internal::chunk_count(face_count), 0),
       fallback_count(internal::chunk_count(face_count), 0);
   internal::for_each_chunk(face_count, threads, [&](size_t begin, size_t end, size_t chunk) {
-    frame_faces(begin, end, degenerate_count[chunk], fallback_count[chunk]);
+    for (size_t f = begin; f < end; ++f) {
+      const FaceFramer::Kind kind = framer.frame(f);
+      degenerate[f] = kind == FaceFramer::kDegenerate;
+      degenerate_count[chunk] += kind == FaceFramer::kDegenerate;
+      fallback_count[chunk] += kind == FaceFramer::kFallback;
+    }
   });
   for (size_t c = 0; c < degenerate_count.size(); ++c) {
     frames.degenerate_faces += static_cast<uint32_t>(degenerate_count[c]);
@@ -287,9 +339,7 @@ Status compute_orientation(const Mesh& mesh, const Topology& topology, const Ori
 
   // === Bitangent, corner coordinates in the face frame, anchor (after smoothing) ===
   if (options.smooth_passes > 0) {
-    for (size_t f = 0; f < face_count; ++f) {
-      write_corner_frame(f, corner(f, 0), corner(f, 1), corner(f, 2));
-    }
+    for (size_t f = 0; f < face_count; ++f) framer.write_corner_frame(f);
   }
 
   // === Variation: sum of angles to the edge neighbours' orientations (the thesis's age) ===
@@ -322,6 +372,13 @@ Status compute_orientation(const Mesh& mesh, const Topology& topology, const Ori
     }
   });
 
+  if (setup) {
+    *setup = OrientationSetup{{axis.x, axis.y, axis.z},
+                              {axis2.x, axis2.y, axis2.z},
+                              {origin.x, origin.y, origin.z},
+                              unit_scale,
+                              std::move(face_axis)};
+  }
   store(frames.axis.data(), axis);
   store(frames.axis2.data(), axis2);
   store(frames.origin.data(), origin);
@@ -330,6 +387,39 @@ Status compute_orientation(const Mesh& mesh, const Topology& topology, const Ori
   frames.unit_scale = static_cast<float>(unit_scale);
   frames.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return Status::ok();
+}
+
+void refresh_face_frames(const Mesh& mesh, const Topology& topology, const OrientationOptions& options,
+                         const OrientationSetup& setup, std::span<const uint32_t> faces, FaceFrames& frames) {
+  const StrokeField strokes(options.strokes);
+  const FaceFramer framer{mesh.positions.data(),
+                          mesh.indices.data(),
+                          {setup.axis[0], setup.axis[1], setup.axis[2]},
+                          {setup.axis2[0], setup.axis2[1], setup.axis2[2]},
+                          {setup.origin[0], setup.origin[1], setup.origin[2]},
+                          setup.unit_scale,
+                          options.degenerate_cos,
+                          setup.face_axis.empty() ? nullptr : setup.face_axis.data(),
+                          &strokes,
+                          true,
+                          &frames};
+  for (const uint32_t f : faces) framer.frame(f);
+  // The variation of every face with an angle that changed (some twice: the same value).
+  const uint32_t* opposite = topology.opposite.data();
+  for (const uint32_t f : faces) {
+    frames.variation[f] = static_cast<float>(face_variation(opposite, frames.orientation.data(), f));
+    for (size_t e = 3 * size_t{f}; e < 3 * size_t{f} + 3; ++e)
+      if (opposite[e] != kInvalid)
+        frames.variation[opposite[e] / 3] =
+            static_cast<float>(face_variation(opposite, frames.orientation.data(), opposite[e] / 3));
+  }
+}
+
+}  // namespace internal
+
+Status compute_orientation(const Mesh& mesh, const Topology& topology, const OrientationOptions& options,
+                           FaceFrames& frames) {
+  return internal::compute_orientation_setup(mesh, topology, options, frames, nullptr);
 }
 
 double mean_neighbour_angle(const Topology& topology, const FaceFrames& frames) {

@@ -1,0 +1,395 @@
+// EditSession (tailor/edit_session.h): the state a user edits, its history and its versions.
+//
+// Locks: edit_mutex serialises the edits (apply, undo, redo) and the publication of a settle;
+// versions_mutex guards the kept UVs of recent versions (corner_uv_repeats). settle() computes
+// its map with neither held, on a copy of the state, and gives up when an edit arrives (the
+// `edits` counter, read by its progress callback), so an edit never waits for a settle.
+#include "tailor/edit_session.h"
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <chrono>
+#include <deque>
+#include <mutex>
+#include <utility>
+
+#include "edit/local_update.h"
+#include "surface/stroke_field.h"
+
+namespace tailor {
+namespace {
+
+// Versions whose UVs corner_uv_repeats still answers, and history states whose atlas is kept so
+// that undo and redo restore them bit for bit (older ones are mapped again).
+constexpr size_t kKeptVersions = 8;
+constexpr size_t kKeptAtlases = 8;
+
+double ms_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+// One applied edit, as what it changed: enough to undo and redo it.
+struct Step {
+  std::vector<uint32_t> flipped;           // faces whose seam flag flipped (ascending)
+  std::vector<OrientationStroke> strokes;  // strokes appended
+  std::optional<MapTextureOptions> options_before, options_after;
+};
+
+// The atlas a history state had when it was last current (settled or not).
+struct KeptAtlas {
+  size_t position = 0;  // steps in effect
+  Atlas atlas;
+  bool settled = false;
+};
+
+// The session's options with the parts it owns cleared: spans (its own seam flags and strokes are
+// set when mapping) and the progress callback.
+MapTextureOptions own_options(const MapTextureOptions& options) {
+  MapTextureOptions o = options;
+  o.mapping.seam_faces = {};
+  o.mapping.progress = nullptr;
+  o.orientation.strokes = {};
+  return o;
+}
+
+// Faces whose UVs or patch differ between two atlases of the same mesh.
+uint32_t count_changed(const Atlas& a, const Atlas& b) {
+  if (a.patch.size() != b.patch.size() || a.corner_uv.size() != b.corner_uv.size())
+    return static_cast<uint32_t>(std::max(a.patch.size(), b.patch.size()));
+  uint32_t changed = 0;
+  for (size_t f = 0; f < a.patch.size(); ++f) {
+    const float* x = &a.corner_uv[6 * f];
+    const float* y = &b.corner_uv[6 * f];
+    bool same = a.patch[f] == b.patch[f];
+    for (int i = 0; i < 6 && same; ++i) same = std::bit_cast<uint32_t>(x[i]) == std::bit_cast<uint32_t>(y[i]);
+    changed += same ? 0u : 1u;
+  }
+  return changed;
+}
+
+}  // namespace
+
+struct EditSession::State {
+  Mesh mesh;
+  Topology topology;
+
+  std::mutex edit_mutex;                   // everything below down to `kept`, and the publication of a settle
+  std::vector<uint8_t> seam;               // #F user seam flags
+  std::vector<OrientationStroke> strokes;  // in the order added
+  MapTextureOptions options;               // own_options()
+  std::vector<Step> steps;                 // the history
+  size_t applied = 0;                      // steps[0, applied) are in effect
+  TextureMap map;                          // the current version's frames and atlas
+  internal::LocalUpdate local;             // what the fast update keeps between edits
+  std::deque<KeptAtlas> kept;              // recent history states' atlases
+
+  std::atomic<uint64_t> version{0};
+  std::atomic<bool> settled{true};
+  std::atomic<uint64_t> edits{0};  // edits begun: a settle in flight gives up when it changes
+
+  mutable std::mutex versions_mutex;
+  std::deque<std::pair<uint64_t, std::vector<float>>> versions;  // recent versions' UVs in repeats
+
+  // The options of a state with its seam flags and strokes set.
+  static MapTextureOptions with_state(const MapTextureOptions& base, const std::vector<uint8_t>& seam_flags,
+                                      const std::vector<OrientationStroke>& stroke_list) {
+    MapTextureOptions o = base;
+    o.mapping.seam_faces = seam_flags;
+    o.orientation.strokes = stroke_list;
+    return o;
+  }
+
+  // Makes the current atlas version v's and keeps its UVs.
+  void publish(uint64_t v, bool is_settled) {
+    const double su = 1.0 / options.metrics.texture_width_px, sv = 1.0 / options.metrics.texture_height_px;
+    const std::vector<float>& px = map.atlas.corner_uv;
+    std::vector<float> repeats(px.size());
+    for (size_t i = 0; i + 1 < px.size(); i += 2) {
+      repeats[i] = static_cast<float>(px[i] * su);
+      repeats[i + 1] = static_cast<float>(px[i + 1] * sv);
+    }
+    {
+      const std::lock_guard<std::mutex> lock(versions_mutex);
+      versions.emplace_back(v, std::move(repeats));
+      while (versions.size() > kKeptVersions) versions.pop_front();
+    }
+    settled.store(is_settled);
+    version.store(v);
+    keep_atlas(is_settled);
+  }
+
+  // Remembers the current atlas for history position `applied` (replacing an older one).
+  void keep_atlas(bool is_settled) {
+    for (auto it = kept.begin(); it != kept.end(); ++it)
+      if (it->position == applied) {
+        kept.erase(it);
+        break;
+      }
+    kept.push_back({applied, map.atlas, is_settled});
+    while (kept.size() > kKeptAtlases) kept.pop_front();
+  }
+
+  // The state moved to history position `applied` by undo or redo: its kept atlas when there is
+  // one (bit for bit what it showed, the frames updated to match), else an update as for an edit.
+  Status move_to_position(const std::vector<uint32_t>& flipped, const std::vector<OrientationStroke>& changed_strokes,
+                          bool options_changed, EditResult& result) {
+    const KeptAtlas* found = nullptr;
+    for (const KeptAtlas& k : kept)
+      if (k.position == applied) found = &k;
+    if (!found) {
+      TAILOR_RETURN_IF_ERROR(update(flipped, changed_strokes, options_changed, result.changed_faces));
+      publish(version.load() + 1, false);
+      return Status::ok();
+    }
+    const MapTextureOptions o = with_state(options, seam, strokes);
+    if (options_changed || !internal::can_update_locally(o, local)) {
+      local.reset();
+      TAILOR_RETURN_IF_ERROR(
+          internal::compute_orientation_setup(mesh, topology, o.orientation, map.frames, &local.setup));
+      local.seeds = component_seed_faces(mesh, topology, map.frames, o.mapping);
+      local.region.assign(mesh.face_count(), 0);
+      local.ring.resize(mesh.face_count());
+      local.ready = true;
+    } else {
+      std::vector<uint32_t> affected;
+      internal::refresh_stroke_frames(mesh, topology, o, changed_strokes, map, local, affected);
+    }
+    result.changed_faces = count_changed(map.atlas, found->atlas);
+    map.atlas = found->atlas;
+    publish(version.load() + 1, found->settled);
+    return Status::ok();
+  }
+
+  // The new state's map after an edit: a local update of the current one where possible, else the
+  // full map. changed: faces whose UVs or patch changed.
+  Status update(const std::vector<uint32_t>& flipped, const std::vector<OrientationStroke>& changed_strokes,
+                bool options_changed, uint32_t& changed) {
+    const MapTextureOptions o = with_state(options, seam, strokes);
+    if (options_changed || !internal::can_update_locally(o, local)) {
+      TextureMap next;
+      TAILOR_RETURN_IF_ERROR(internal::map_keeping_setup(mesh, topology, o, next, local));
+      changed = count_changed(map.atlas, next.atlas);
+      map = std::move(next);
+      return Status::ok();
+    }
+    std::vector<uint32_t> affected;
+    internal::refresh_stroke_frames(mesh, topology, o, changed_strokes, map, local, affected);
+    return internal::update_region(mesh, topology, o, flipped, affected, map, local, changed);
+  }
+};
+
+EditSession::EditSession() : state_(std::make_unique<State>()) {}
+EditSession::~EditSession() = default;
+
+Status EditSession::open(Mesh mesh, const MapTextureOptions& options, std::unique_ptr<EditSession>& session) {
+  session.reset();
+  std::unique_ptr<EditSession> s(new EditSession());
+  State& st = *s->state_;
+  st.mesh = std::move(mesh);
+  st.topology = build_topology(st.mesh);
+  TAILOR_RETURN_IF_ERROR(check_map_options(options));
+  st.options = own_options(options);
+  if (options.mapping.seam_faces.size() == st.mesh.face_count())
+    st.seam.assign(options.mapping.seam_faces.begin(), options.mapping.seam_faces.end());
+  else
+    st.seam.assign(st.mesh.face_count(), 0);
+  st.strokes.assign(options.orientation.strokes.begin(), options.orientation.strokes.end());
+  MapTextureOptions first = State::with_state(st.options, st.seam, st.strokes);
+  first.mapping.progress = options.mapping.progress;
+  TAILOR_RETURN_IF_ERROR(internal::map_keeping_setup(st.mesh, st.topology, first, st.map, st.local));
+  st.publish(0, true);
+  session = std::move(s);
+  return Status::ok();
+}
+
+Status EditSession::apply(const EditRequest& edit, EditResult& result) {
+  const auto start = std::chrono::steady_clock::now();
+  State& st = *state_;
+  st.edits.fetch_add(1);
+  const std::lock_guard<std::mutex> lock(st.edit_mutex);
+  result = EditResult{};
+  // === Checks: nothing changes unless the whole edit is valid ===
+  const size_t face_count = st.mesh.face_count();
+  for (const std::vector<uint32_t>* list : {&edit.remove_seam_faces, &edit.add_seam_faces})
+    for (const uint32_t f : *list)
+      if (f >= face_count)
+        return Status::error(
+            ErrorCode::kInvalidArgument, "",
+            "face " + std::to_string(f) + " out of range (mesh has " + std::to_string(face_count) + " faces)");
+  TAILOR_RETURN_IF_ERROR(internal::check_strokes(edit.strokes));
+  std::optional<MapTextureOptions> new_options;
+  if (edit.options) {
+    TAILOR_RETURN_IF_ERROR(check_map_options(*edit.options));
+    new_options = own_options(*edit.options);
+  }
+
+  // === The step: options, removed then added seam faces, strokes ===
+  Step step;
+  std::vector<uint8_t> seam = st.seam;  // the flags after the edit (a copy: the edit may still fail)
+  for (const uint32_t f : edit.remove_seam_faces) seam[f] = 0;
+  for (const uint32_t f : edit.add_seam_faces) seam[f] = 1;
+  auto note_flip = [&](uint32_t f) {
+    if (seam[f] != st.seam[f]) step.flipped.push_back(f);
+  };
+  for (const uint32_t f : edit.remove_seam_faces) note_flip(f);
+  for (const uint32_t f : edit.add_seam_faces) note_flip(f);
+  std::sort(step.flipped.begin(), step.flipped.end());
+  step.flipped.erase(std::unique(step.flipped.begin(), step.flipped.end()), step.flipped.end());
+  step.strokes = edit.strokes;
+  // New options count as a change (MapTextureOptions has no operator==; the page sends them only
+  // when a control changes): the whole mesh is mapped again.
+  const bool differs = new_options.has_value();
+  if (new_options) {
+    step.options_before = st.options;
+    step.options_after = new_options;
+  }
+  if (step.flipped.empty() && step.strokes.empty() && !differs) {
+    result.version = st.version.load();
+    result.settled = st.settled.load();
+    result.ms = ms_since(start);
+    return Status::ok();
+  }
+
+  // === Update: on failure (options map_texture refuses) the state is put back ===
+  const std::vector<uint8_t> seam_before = std::move(st.seam);
+  const size_t strokes_before = st.strokes.size();
+  const MapTextureOptions options_before = st.options;
+  st.seam = std::move(seam);
+  st.strokes.insert(st.strokes.end(), step.strokes.begin(), step.strokes.end());
+  if (new_options) st.options = *new_options;
+  if (Status s = st.update(step.flipped, step.strokes, differs, result.changed_faces); !s) {
+    // Only the full map can fail (options map_texture refuses): the frames and atlas are intact.
+    st.seam = seam_before;
+    st.strokes.resize(strokes_before);
+    st.options = options_before;
+    return s;
+  }
+  // A new step: the redo branch is dropped with the atlases kept for it.
+  st.steps.resize(st.applied);
+  st.kept.erase(
+      std::remove_if(st.kept.begin(), st.kept.end(), [&](const KeptAtlas& k) { return k.position > st.applied; }),
+      st.kept.end());
+  st.steps.push_back(std::move(step));
+  st.applied = st.steps.size();
+  st.publish(st.version.load() + 1, false);
+  result.version = st.version.load();
+  result.settled = false;
+  result.ms = ms_since(start);
+  return Status::ok();
+}
+
+Status EditSession::undo(EditResult& result) {
+  const auto start = std::chrono::steady_clock::now();
+  State& st = *state_;
+  st.edits.fetch_add(1);
+  const std::lock_guard<std::mutex> lock(st.edit_mutex);
+  result = EditResult{};
+  if (st.applied == 0) return Status::error(ErrorCode::kInvalidArgument, "", "nothing to undo");
+  const Step& step = st.steps[st.applied - 1];
+  for (const uint32_t f : step.flipped) st.seam[f] ^= 1;
+  st.strokes.resize(st.strokes.size() - step.strokes.size());
+  if (step.options_before) st.options = *step.options_before;
+  --st.applied;
+  TAILOR_RETURN_IF_ERROR(st.move_to_position(step.flipped, step.strokes, step.options_before.has_value(), result));
+  result.version = st.version.load();
+  result.settled = st.settled.load();
+  result.ms = ms_since(start);
+  return Status::ok();
+}
+
+Status EditSession::redo(EditResult& result) {
+  const auto start = std::chrono::steady_clock::now();
+  State& st = *state_;
+  st.edits.fetch_add(1);
+  const std::lock_guard<std::mutex> lock(st.edit_mutex);
+  result = EditResult{};
+  if (st.applied == st.steps.size()) return Status::error(ErrorCode::kInvalidArgument, "", "nothing to redo");
+  const Step& step = st.steps[st.applied];
+  for (const uint32_t f : step.flipped) st.seam[f] ^= 1;
+  st.strokes.insert(st.strokes.end(), step.strokes.begin(), step.strokes.end());
+  if (step.options_after) st.options = *step.options_after;
+  ++st.applied;
+  TAILOR_RETURN_IF_ERROR(st.move_to_position(step.flipped, step.strokes, step.options_after.has_value(), result));
+  result.version = st.version.load();
+  result.settled = st.settled.load();
+  result.ms = ms_since(start);
+  return Status::ok();
+}
+
+Status EditSession::settle(EditResult& result) {
+  const auto start = std::chrono::steady_clock::now();
+  State& st = *state_;
+  result = EditResult{};
+  std::vector<uint8_t> seam;
+  std::vector<OrientationStroke> strokes;
+  MapTextureOptions options;
+  uint64_t edits = 0;
+  {
+    const std::lock_guard<std::mutex> lock(st.edit_mutex);
+    result.version = st.version.load();
+    if (st.settled.load()) {
+      result.settled = true;
+      result.ms = ms_since(start);
+      return Status::ok();
+    }
+    seam = st.seam;
+    strokes = st.strokes;
+    options = st.options;
+    edits = st.edits.load();
+  }
+  // The full map without a lock; an edit arriving meanwhile cancels it.
+  TextureMap map;
+  internal::LocalUpdate local;
+  MapTextureOptions o = State::with_state(options, seam, strokes);
+  o.mapping.progress = [&st, edits](float) { return st.edits.load() == edits; };
+  const Status s = internal::map_keeping_setup(st.mesh, st.topology, o, map, local);
+  result.ms = ms_since(start);
+  if (s.code() == ErrorCode::kCancelled) return Status::ok();
+  TAILOR_RETURN_IF_ERROR(s);
+  const std::lock_guard<std::mutex> lock(st.edit_mutex);
+  if (st.edits.load() != edits) {
+    result.version = st.version.load();
+    return Status::ok();
+  }
+  result.changed_faces = count_changed(st.map.atlas, map.atlas);
+  st.map = std::move(map);
+  st.local = std::move(local);
+  if (result.changed_faces == 0) {
+    st.settled.store(true);
+    st.keep_atlas(true);
+  } else {
+    st.publish(st.version.load() + 1, true);
+  }
+  result.version = st.version.load();
+  result.settled = true;
+  result.ms = ms_since(start);
+  return Status::ok();
+}
+
+uint64_t EditSession::version() const { return state_->version.load(); }
+bool EditSession::settled() const { return state_->settled.load(); }
+
+bool EditSession::corner_uv_repeats(uint64_t version, std::vector<float>& out) const {
+  const std::lock_guard<std::mutex> lock(state_->versions_mutex);
+  for (const auto& [v, uv] : state_->versions)
+    if (v == version) {
+      out = uv;
+      return true;
+    }
+  return false;
+}
+
+void EditSession::snapshot(Atlas& atlas, std::vector<uint8_t>& seam_faces, std::vector<OrientationStroke>& strokes,
+                           MapTextureOptions& options) const {
+  State& st = *state_;
+  const std::lock_guard<std::mutex> lock(st.edit_mutex);
+  atlas = st.map.atlas;
+  seam_faces = st.seam;
+  strokes = st.strokes;
+  options = st.options;
+}
+
+const Mesh& EditSession::mesh() const { return state_->mesh; }
+
+}  // namespace tailor
