@@ -26,18 +26,47 @@ const session = {
   info: null, surface: null, mesh: null, shownVersion: -1, serverVersion: -1, settled: true,
   inFlight: 0, pendingAdd: new Set(), pendingRemove: new Set(), lastSend: 0, options: {},
 };
-const timing = { latencies: [], strokeEnd: 0, measuring: 0 };
+// The stroke-to-frame latencies, and the parts of the last update (request, server, UV fetch, page update, draw).
+const timing = { latencies: [], strokeEnd: 0, measuring: 0, last: {}, parts: [] };
 let frames = 0;
-let dirty = true;
 let ready = false;
 
 const container = document.getElementById('view');
-const view = createView(container, () => { dirty = true; pickStale = true; });
+// No multisampling: software WebGL (no GPU) spends most of a frame on it; the shader's lines are smooth anyway.
+const view = createView(container, () => { redrawAll(); pickStale = true; }, { antialias: false });
 const { renderer, scene, camera, controls } = view;
 const material = createSurfaceMaterial();
+// Strokes are drawn over the surface, in their own scene (not picked, not in the frame buffer below).
 const strokeGroup = new THREE.Group();
-strokeGroup.renderOrder = 1;
-scene.add(strokeGroup);
+const strokeScene = new THREE.Scene();
+strokeScene.add(strokeGroup);
+
+// Frames: the surface is drawn into `frame.target` and copied to the screen with the strokes on top.
+// After an edit only the faces it touched are drawn again over the previous frame (same positions,
+// same depths): a frame costs what the edit changed, not the mesh's size, which matters with
+// software WebGL (no GPU), where a full frame of a million faces takes seconds.
+const frame = { target: null, full: true, faces: new Set(), copy: true };
+const patchScene = new THREE.Scene();
+const patchMesh = new THREE.Mesh(new THREE.BufferGeometry(), null);
+patchMesh.frustumCulled = false;
+patchScene.add(patchMesh);
+const copyScene = new THREE.Scene();
+const copyCamera = new THREE.OrthographicCamera(-1, 1, 1, -1, 0, 1);
+const copyMaterial = new THREE.ShaderMaterial({
+  uniforms: { frame: { value: null } },
+  vertexShader: 'void main() { gl_Position = vec4(position.xy, 0.0, 1.0); }',
+  fragmentShader: 'uniform sampler2D frame; void main() { gl_FragColor = texelFetch(frame, ivec2(gl_FragCoord.xy), 0); }',
+  depthTest: false,
+  depthWrite: false,
+});
+{
+  const quad = new THREE.Mesh(new THREE.PlaneGeometry(2, 2), copyMaterial);
+  quad.frustumCulled = false;
+  copyScene.add(quad);
+}
+
+function redrawAll() { frame.full = true; }
+function redrawFaces(faces) { for (const f of faces) frame.faces.add(f); }
 
 function showError(text) {
   const box = document.getElementById('error');
@@ -76,27 +105,76 @@ function setStatus() {
 /** Draws `version` (fetches its UVs) unless a newer one is shown. */
 async function showVersion(version) {
   if (version <= session.shownVersion) return;
-  let buffer;
+  // Only the faces that changed since the version shown (all of them when the server no longer keeps it).
+  const shown = session.shownVersion;
+  timing.last.fetchStart = performance.now();
+  let response;
   try {
-    buffer = await (await api('GET', `/api/uv?version=${version}`)).arrayBuffer();
+    response = await api('GET', `/api/uv?version=${version}&since=${shown}`);
   } catch (e) {
     if (e.status === 404) return;  // no longer kept: a newer version is on its way
     throw e;
   }
-  if (version <= session.shownVersion) return;
-  const changed = session.surface.setUvs(new Float32Array(buffer));
+  const delta = response.headers.get('X-Tailor-Delta') === '1';
+  const buffer = await response.arrayBuffer();
+  if (version <= session.shownVersion || session.shownVersion !== shown) return;
+  const fetched = performance.now();
+  const changed = delta ? session.surface.applyDelta(buffer) : session.surface.setUvs(new Float32Array(buffer));
+  timing.last.fetchMs = fetched - timing.last.fetchStart;
+  timing.last.updateMs = performance.now() - fetched;
+  timing.last.changed = changed;
   session.shownVersion = version;
   updateInfo(changed);
-  dirty = true;
+  redrawFaces(session.surface.lastTouched || []);
   setStatus();
 }
 
-function drawNow() {
-  renderer.render(scene, camera);
+/** Draws what changed (see `frame`); false when nothing did. */
+function draw() {
+  const gl = renderer.getContext();
+  const w = gl.drawingBufferWidth;
+  const h = gl.drawingBufferHeight;
+  if (!frame.target || frame.target.width !== w || frame.target.height !== h) {
+    if (frame.target) frame.target.dispose();
+    frame.target = new THREE.WebGLRenderTarget(w, h, { depthBuffer: true });
+    copyMaterial.uniforms.frame.value = frame.target.texture;
+    frame.full = true;
+  }
+  const faces = frame.faces.size;
+  if (!frame.full && faces === 0 && !frame.copy) return false;
+  renderer.setRenderTarget(frame.target);
+  if (frame.full || faces > session.surface.faces / 4) {
+    renderer.clear();
+    renderer.render(scene, camera);
+  } else if (faces > 0) {
+    patchMesh.geometry.dispose();
+    patchMesh.geometry = session.surface.subsetGeometry([...frame.faces]);
+    patchMesh.material = material;
+    renderer.autoClear = false;
+    renderer.render(patchScene, camera);
+    renderer.autoClear = true;
+  }
+  renderer.setRenderTarget(null);
+  renderer.render(copyScene, copyCamera);
+  if (state.showStrokes && strokeGroup.children.length) {
+    renderer.autoClear = false;
+    renderer.render(strokeScene, camera);
+    renderer.autoClear = true;
+  }
+  frame.full = false;
+  frame.faces.clear();
+  frame.copy = false;
   frames += 1;
-  dirty = false;
+  return true;
+}
+
+/** Draws a frame now and waits for the GPU to finish it (a one-pixel read). */
+function drawNow() {
+  const start = performance.now();
+  draw();
   const gl = renderer.getContext();
   gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));
+  timing.last.drawMs = performance.now() - start;
 }
 
 /** After an edit's answer: draw its version; poll the status until the server settled. */
@@ -162,7 +240,10 @@ async function send(body) {
   session.inFlight += 1;
   session.lastSend = performance.now();
   try {
+    const start = performance.now();
     const result = await (await api('POST', '/api/edit', body)).json();
+    timing.last.editMs = performance.now() - start;
+    timing.last.serverMs = result.ms;
     await edited(result);
   } catch (e) {
     showError(e.message);
@@ -209,7 +290,7 @@ async function refreshState() {
   session.surface.setMarked(flags);
   drawStrokes(info.strokes);
   showOptions(info.options);
-  dirty = true;
+  redrawAll();
 }
 
 function updateInfo(changed) {
@@ -253,7 +334,6 @@ function updatePick() {
   }
   const clear = renderer.getClearColor(new THREE.Color());
   const alpha = renderer.getClearAlpha();
-  strokeGroup.visible = false;
   scene.overrideMaterial = pickMaterial;
   renderer.setRenderTarget(pickTarget);
   renderer.setClearColor(0x000000, 0);
@@ -263,7 +343,6 @@ function updatePick() {
   renderer.setRenderTarget(null);
   renderer.setClearColor(clear, alpha);
   scene.overrideMaterial = null;
-  strokeGroup.visible = state.showStrokes;
   pickStale = false;
 }
 
@@ -337,7 +416,7 @@ function paintAt(event) {
   }
   if (fresh.length) {
     session.surface.markFaces(fresh, mark);
-    dirty = true;
+    redrawFaces(fresh);
     schedulePaint();
   }
 }
@@ -356,7 +435,7 @@ function addStrokePoint(event) {
   if (strokeLine) strokeGroup.remove(strokeLine);
   strokeLine = strokeObject(strokePoints, 0xff6a00);
   strokeGroup.add(strokeLine);
-  dirty = true;
+  frame.copy = true;
 }
 
 function strokeObject(points, color) {
@@ -373,8 +452,7 @@ function drawStrokes(strokes) {
   }
   strokeLine = null;
   for (const s of strokes) strokeGroup.add(strokeObject(s.points.map((p) => new THREE.Vector3(...p)), 0x1f5fd6));
-  strokeGroup.visible = state.showStrokes;
-  dirty = true;
+  frame.copy = true;
 }
 
 function onPointerDown(event) {
@@ -423,6 +501,7 @@ async function finishStroke() {
     if (!session.strokeSent) return;  // the stroke painted nothing new
     drawNow();
     timing.latencies.push(performance.now() - timing.strokeEnd);
+    timing.parts.push({ ...timing.last });
     setStatus();
   } finally {
     timing.measuring -= 1;
@@ -479,8 +558,7 @@ function applyState() {
   updateSurfaceMaterial(material, state, textures);
   document.getElementById('legend').style.display = state.view === 'distortion' ? 'block' : 'none';
   document.getElementById('seam-legend').style.display = state.view === 'seams' ? 'block' : 'none';
-  strokeGroup.visible = state.showStrokes;
-  dirty = true;
+  redrawAll();
 }
 
 function setView(name) {
@@ -600,7 +678,8 @@ async function load() {
   surface.setUvs(new Float32Array(uvBuffer));
   session.shownVersion = session.serverVersion = info.version;
   session.settled = info.settled;
-  if (info.texture) textures.map = prepareTexture(renderer, await new THREE.TextureLoader().loadAsync(info.texture));
+  // 4x anisotropy: the view is redrawn after every edit, and 16x doubles a frame of software WebGL.
+  if (info.texture) textures.map = prepareTexture(renderer, await new THREE.TextureLoader().loadAsync(info.texture), 4);
   textures.blank = new THREE.DataTexture(new Uint8Array([255, 255, 255, 255]), 1, 1);
   textures.blank.needsUpdate = true;
   const mesh = new THREE.Mesh(surface.geometry, material);
@@ -617,10 +696,7 @@ async function load() {
 function animate() {
   requestAnimationFrame(animate);
   controls.update();
-  if (!dirty || !ready) return;
-  dirty = false;
-  renderer.render(scene, camera);
-  frames += 1;
+  if (ready) draw();
 }
 
 window.tailorEdit = {
@@ -636,6 +712,8 @@ window.tailorEdit = {
       !painting && timing.measuring === 0 && session.shownVersion === session.serverVersion;
   },
   get latencies() { return [...timing.latencies]; },
+  /** Per measured stroke: the last request's times (ms): editMs (round trip), serverMs, fetchMs, updateMs, drawMs. */
+  get latencyParts() { return timing.parts.map((p) => ({ ...p })); },
   get markedCount() { return session.surface ? session.surface.marked.reduce((a, b) => a + b, 0) : 0; },
   get seamCounts() { return session.surface.seamCounts(); },
   /** The corner UVs drawn now (a copy). */
@@ -644,6 +722,41 @@ window.tailorEdit = {
   setTool,
   setBrush(px) { const b = document.getElementById('brush'); b.value = String(px); b.dispatchEvent(new Event('input')); },
   pixelStats() { return pixelStats(renderer, scene, camera); },
+  /**
+   * Pixels that differ between the frame on screen (built by partial redraws after edits) and the
+   * same frame drawn in full: 0 when redrawing only the touched faces is exact.
+   */
+  partialFrameError() {
+    const gl = renderer.getContext();
+    const read = () => {
+      const px = new Uint8Array(4 * gl.drawingBufferWidth * gl.drawingBufferHeight);
+      gl.readPixels(0, 0, gl.drawingBufferWidth, gl.drawingBufferHeight, gl.RGBA, gl.UNSIGNED_BYTE, px);
+      return px;
+    };
+    frame.copy = true;
+    draw();
+    const partial = read();
+    redrawAll();
+    draw();
+    const full = read();
+    let differ = 0;
+    for (let i = 0; i < full.length; i += 4) {
+      if (partial[i] !== full[i] || partial[i + 1] !== full[i + 1] || partial[i + 2] !== full[i + 2]) differ += 1;
+    }
+    return differ;
+  },
+  /** Mean time of `n` frames drawn and finished (ms). */
+  timeFrames(n, trivial = false) {
+    if (trivial) scene.overrideMaterial = pickMaterial;
+    const start = performance.now();
+    for (let i = 0; i < n; ++i) {
+      redrawAll();
+      drawNow();
+    }
+    scene.overrideMaterial = null;
+    redrawAll();
+    return (performance.now() - start) / n;
+  },
   undo() { return undoRedo('undo'); },
   redo() { return undoRedo('redo'); },
   save,
@@ -653,5 +766,5 @@ bindPanel();
 setTool('brush');
 animate();
 load()
-  .then(() => { ready = true; dirty = true; })
+  .then(() => { ready = true; redrawAll(); })
   .catch((e) => showError(`cannot load the session: ${e.message}`));

@@ -151,9 +151,8 @@ export class EditSurface {
     const faces = this.faces;
     if (uv.length !== 6 * faces) throw new Error(`expected ${6 * faces} UV values, got ${uv.length}`);
     const bits = new Uint32Array(uv.buffer, uv.byteOffset, uv.length);
-    const first = this.uv === null;
     const changed = [];
-    if (first) {
+    if (this.uv === null) {
       for (let f = 0; f < faces; ++f) changed.push(f);
     } else {
       const old = new Uint32Array(this.uv.buffer, this.uv.byteOffset, this.uv.length);
@@ -163,8 +162,36 @@ export class EditSurface {
             old[i + 4] !== bits[i + 4] || old[i + 5] !== bits[i + 5]) changed.push(f);
       }
     }
-    if (changed.length === 0) return 0;
     this.uv = uv;
+    return this.update(changed);
+  }
+
+  /**
+   * Applies the answer of GET /api/uv?version=N&since=M (the version shown): uint32 count K, K face
+   * ids, 6K floats. Returns the number of faces whose UVs changed.
+   */
+  applyDelta(buffer) {
+    const count = new Uint32Array(buffer, 0, 1)[0];
+    if (buffer.byteLength !== 4 + 28 * count) throw new Error('/api/uv: unexpected size of a delta');
+    const ids = new Uint32Array(buffer, 4, count);
+    const values = new Float32Array(buffer, 4 + 4 * count, 6 * count);
+    const changed = [];
+    for (let i = 0; i < count; ++i) {
+      const f = ids[i];
+      if (f >= this.faces) throw new Error('/api/uv: face id out of range');
+      for (let k = 0; k < 6; ++k) this.uv[6 * f + k] = values[6 * i + k];
+      changed.push(f);
+    }
+    return this.update(changed);
+  }
+
+  /** Rewrites what depends on the UVs of the `changed` faces (this.uv holds the new ones). */
+  update(changed) {
+    const faces = this.faces;
+    const first = this.root[0] < 0;
+    if (changed.length === 0) return 0;
+    const uv = this.uv;
+    const bits = new Uint32Array(uv.buffer, uv.byteOffset, uv.length);
     const touched = new Uint8Array(faces);  // faces whose attributes are rewritten
     const pair = this.pair;
     for (const f of changed) {
@@ -214,7 +241,7 @@ export class EditSurface {
       }
     }
     this.patches = patches;
-    this.writeFaces(touched, changed.length === faces);
+    this.writeFaces(touched, first || changed.length === faces);
     return changed.length;
   }
 
@@ -239,8 +266,10 @@ export class EditSurface {
     const stretchOut = g.getAttribute('stretch');
     const global = this.sumUv > 0 && this.sum3d > 0 ? this.sumUv / this.sum3d : 1;
     const ranges = [];
+    const list = [];
     for (let f = 0; f < this.faces; ++f) {
       if (!touched[f]) continue;
+      list.push(f);
       const last = ranges[ranges.length - 1];
       if (last && f - last[1] < 256) last[1] = f + 1;
       else ranges.push([f, f + 1]);
@@ -262,6 +291,7 @@ export class EditSurface {
         stretchOut.array[corner] = stretch;
       }
     }
+    this.lastTouched = list;
     for (const attribute of [uvOut, seamOut, classOut, patchOut, stretchOut]) {
       attribute.clearUpdateRanges();
       if (!all && ranges.length <= 256) {
@@ -269,6 +299,21 @@ export class EditSurface {
       }
       attribute.needsUpdate = true;
     }
+  }
+
+  /**
+   * A geometry of only `faces`, with their attributes as the full one holds them: the page redraws
+   * just these over the previous frame after an edit (same positions, so the same depths).
+   */
+  subsetGeometry(faces) {
+    const g = new THREE.BufferGeometry();
+    for (const [name, attribute] of Object.entries(this.geometry.attributes)) {
+      const size = 3 * attribute.itemSize;  // values per face
+      const out = new attribute.array.constructor(faces.length * size);
+      for (let i = 0; i < faces.length; ++i) out.set(attribute.array.subarray(faces[i] * size, (faces[i] + 1) * size), i * size);
+      g.setAttribute(name, new THREE.BufferAttribute(out, attribute.itemSize, attribute.normalized));
+    }
+    return g;
   }
 
   /** Sets the marked seam faces (Uint8Array or array of ids with `ids`). */

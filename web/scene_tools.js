@@ -10,8 +10,8 @@ import { kSeamColors } from './surface_material.js';
  * the model. onChange() is called whenever the camera moved (draw a frame then).
  * Returns { renderer, scene, camera, controls, frame(object), resize() }.
  */
-export function createView(container, onChange) {
-  const renderer = new THREE.WebGLRenderer({ antialias: true });
+export function createView(container, onChange, { antialias = true } = {}) {
+  const renderer = new THREE.WebGLRenderer({ antialias });
   renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
   renderer.setSize(container.clientWidth, container.clientHeight);
   // The shader writes display values itself (as the CPU preview does): no output conversion.
@@ -61,14 +61,17 @@ export function createView(container, onChange) {
   return { renderer, scene, camera, controls, frame, resize };
 }
 
-/** Textures are sampled as raw data (no colour-space decoding) and repeat, with mipmaps. */
-export function prepareTexture(renderer, texture) {
+/**
+ * Textures are sampled as raw data (no colour-space decoding) and repeat, with mipmaps and up to
+ * `maxAnisotropy` anisotropic filtering (the device's limit by default).
+ */
+export function prepareTexture(renderer, texture, maxAnisotropy = Infinity) {
   texture.colorSpace = THREE.NoColorSpace;
   texture.wrapS = THREE.RepeatWrapping;
   texture.wrapT = THREE.RepeatWrapping;
   texture.minFilter = THREE.LinearMipmapLinearFilter;
   texture.magFilter = THREE.LinearFilter;
-  texture.anisotropy = renderer.capabilities.getMaxAnisotropy();
+  texture.anisotropy = Math.min(maxAnisotropy, renderer.capabilities.getMaxAnisotropy());
   texture.generateMipmaps = true;
   // glTF's uv has v pointing down the image, like three's textures with flipY off.
   texture.flipY = false;

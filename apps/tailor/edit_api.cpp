@@ -400,7 +400,31 @@ HttpResponse EditApi::uv(const HttpRequest& request) const {
     return HttpResponse::error(404, "version " + std::to_string(version) + " is not kept (only recent ones are)");
   HttpResponse r;
   r.content_type = "application/octet-stream";
-  r.body.assign(reinterpret_cast<const char*>(uvs.data()), 4 * uvs.size());
+  // &since=M: only the faces whose UVs differ from version M (count K, K face ids, 6K floats; header
+  // X-Tailor-Delta: 1); all of them as without it when M is no longer kept.
+  uint64_t since = version;
+  std::vector<float> base;
+  if (query_value(request.query, "since", text)) {
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), since);
+    if (text.empty() || error != std::errc() || end != text.data() + text.size())
+      return HttpResponse::error(400, "since must be an unsigned integer, got '" + text + "'");
+    if (!context_.session->corner_uv_repeats(since, base) || base.size() != uvs.size()) since = version;
+  }
+  if (since != version) {  // `since` is kept: a delta
+    std::vector<uint32_t> faces;
+    for (size_t f = 0; 6 * f < uvs.size(); ++f)
+      if (std::memcmp(&uvs[6 * f], &base[6 * f], 24) != 0) faces.push_back(static_cast<uint32_t>(f));
+    const auto count = static_cast<uint32_t>(faces.size());
+    r.body.resize(4 + 4 * faces.size() + 24 * faces.size());
+    char* out = r.body.data();
+    std::memcpy(out, &count, 4);
+    std::memcpy(out + 4, faces.data(), 4 * faces.size());
+    out += 4 + 4 * faces.size();
+    for (size_t i = 0; i < faces.size(); ++i) std::memcpy(out + 24 * i, &uvs[6 * faces[i]], 24);
+    r.headers.emplace_back("X-Tailor-Delta", "1");
+  } else {
+    r.body.assign(reinterpret_cast<const char*>(uvs.data()), 4 * uvs.size());
+  }
   r.headers.emplace_back("X-Tailor-Version", std::to_string(version));
   return r;
 }

@@ -111,10 +111,18 @@ try {
     await page.evaluate(() => { window.tailorEdit.setView('patches'); window.tailorEdit.setBrush(12); });
     const latencies = [];
     for (let i = 0; i < benchStrokes; ++i) {
-      const y = 0.42 + 0.04 * i;
-      await brushStroke(page, box, 0.38, 0.62, y);
+      // Alternately mark a band and erase it again: every stroke changes as many faces.
+      const erase = i % 2 === 1;
+      await page.evaluate((tool) => window.tailorEdit.setTool(tool), erase ? 'erase' : 'brush');
+      const marked = await page.evaluate(() => window.tailorEdit.markedCount);
+      await brushStroke(page, box, 0.38, 0.62, 0.45);
+      if ((await page.evaluate(() => window.tailorEdit.markedCount)) === marked) throw new Error(`stroke ${i} painted no face`);
       await page.waitForFunction((n) => window.tailorEdit.latencies.length > n, latencies.length, { timeout: kSettleTimeoutMs });
       latencies.push((await page.evaluate(() => window.tailorEdit.latencies)).at(-1));
+      const parts = (await page.evaluate(() => window.tailorEdit.latencyParts)).at(-1);
+      console.log(`stroke ${i}: ${latencies.at(-1).toFixed(0)} ms (last request: ` +
+        Object.entries(parts).filter(([k]) => k.endsWith('Ms')).map(([k, v]) => `${k} ${v.toFixed(0)}`).join(', ') +
+        `, ${parts.changed} faces changed)`);
       await waitSettled(page);
     }
     const sorted = [...latencies].sort((a, b) => a - b);
@@ -144,6 +152,10 @@ try {
     if (!(marked > markedStart)) fail('the brush marked no face');
     if (afterState.seam_faces.length !== marked) fail(`the server holds ${afterState.seam_faces.length} seam faces, the page ${marked}`);
     if (!(afterState.version > v0)) fail('the stroke made no new version');
+    // The frame on screen was built by redrawing the touched faces only: it must equal a full frame.
+    const partialError = await page.evaluate(() => window.tailorEdit.partialFrameError());
+    console.log(`partial redraws: ${partialError} pixels differ from a full frame`);
+    if (partialError !== 0) fail(`the frame built by partial redraws differs from a full frame in ${partialError} pixels`);
     const after = await page.evaluate(() => window.tailorEdit.pixelStats());
     const change = signatureDistance(before, after);
     console.log(`patches view: change after the stroke ${change.toFixed(2)}`);
