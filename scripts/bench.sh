@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # make bench: runs every Google Benchmark of tailor (load, topology, orientation, mapping, export,
-# end to end, tiling; export_as/load_output: PLY and .glb with each --compress, sizes in MB) and
+# end to end, tiling, interactive edits (EditSession::apply against the full map); export_as/load_output:
+# PLY and .glb with each --compress, sizes in MB) and
 # prints one line per benchmark with its throughput counters.
 # Without extra flags it then prints the tiling size table of docs/tiling.md (every shared texture
 # at its size, 2048 and 4096 px: time, peak memory, the five targets; scripts/bench_tile_sizes.sh).

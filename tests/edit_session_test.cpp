@@ -319,8 +319,18 @@ TEST(EditSession, ALocalUpdateKeepsTheFacesBeyondTheEditedPatchesBitForBit) {
   // The seams move onto the marked faces (thesis figure 2.8), already in the fast update.
   const size_t seams_before = seam_edges_at(mesh, topology, before, in_brush);
   const size_t seams_after = seam_edges_at(mesh, topology, after, in_brush);
-  std::printf("brush of %zu faces: %zu seam edges at it before, %zu after the local update; %u faces changed\n",
-              brush.size(), seams_before, seams_after, result.changed_faces);
+  std::vector<uint8_t> flags(mesh.face_count(), 0);
+  for (const uint32_t f : brush) flags[f] = 1;
+  const Atlas settled_atlas = full_map(mesh, flags, {}, default_options());
+  const size_t seams_full = seam_edges_at(mesh, topology, settled_atlas, in_brush);
+  const std::vector<uint8_t> all(mesh.face_count(), 1);
+  std::printf("seam edges in all: %zu before, %zu after the local update, %zu settled\n",
+              seam_edges_at(mesh, topology, before, all), seam_edges_at(mesh, topology, after, all),
+              seam_edges_at(mesh, topology, settled_atlas, all));
+  std::printf(
+      "brush of %zu faces: %zu seam edges at it before, %zu after the local update (%zu settled); %u faces "
+      "changed\n",
+      brush.size(), seams_before, seams_after, seams_full, result.changed_faces);
   EXPECT_GT(seams_after, seams_before);
 
   // Unmarking them again is local too; settling gives the full map of the state.
@@ -368,6 +378,49 @@ TEST(EditSession, AStrokeUpdatesOnlyThePatchesItReaches) {
   expect_valid(mesh, after, options);
   ASSERT_TRUE(session->settle(result).is_ok());
   EXPECT_EQ(current_atlas(*session).corner_uv, full_map(mesh, {}, {stroke}, default_options()).corner_uv);
+}
+
+TEST(EditSession, LocalUpdatesAreTheSameForAnyThreadCount) {
+  const Mesh mesh = test::load_test_mesh("fertility.off");
+  MapTextureOptions one = default_options(), three = default_options();
+  one.mapping.threads = one.orientation.threads = 1;
+  three.mapping.threads = three.orientation.threads = 3;
+  const auto a = open_session(mesh, one);
+  const auto b = open_session(mesh, three);
+  ASSERT_TRUE(a && b);
+  for (uint32_t i = 0; i < 3; ++i) {
+    EditRequest edit;
+    for (uint32_t f = 2000 * i; f < 2000 * i + 50; ++f) edit.add_seam_faces.push_back(f);
+    edit.strokes.push_back(stroke_along(mesh, 2000 * i + 1000, 8));
+    EditResult ra, rb;
+    ASSERT_TRUE(a->apply(edit, ra).is_ok());
+    ASSERT_TRUE(b->apply(edit, rb).is_ok());
+    EXPECT_EQ(ra.changed_faces, rb.changed_faces);
+    EXPECT_EQ(uvs_of(*a, ra.version), uvs_of(*b, rb.version));
+  }
+}
+
+// Beyond the 8 kept atlases, undo updates locally (strokes removed, seam flags flipped back):
+// settled, the state is the full map of what is left.
+TEST(EditSession, UndoingPastTheKeptAtlasesSettlesToTheFullMap) {
+  const Mesh mesh = test::load_test_mesh("spot.obj");
+  const auto session = open_session(mesh, default_options());
+  ASSERT_TRUE(session);
+  EditResult result;
+  for (uint32_t i = 0; i < 11; ++i) {
+    EditRequest edit;
+    for (uint32_t f = 500 * i; f < 500 * i + 30; ++f) edit.add_seam_faces.push_back(f);
+    if (i % 2 == 0) edit.strokes.push_back(stroke_along(mesh, 500 * i + 200, 6));
+    ASSERT_TRUE(session->apply(edit, result).is_ok());
+  }
+  for (int i = 0; i < 9; ++i) ASSERT_TRUE(session->undo(result).is_ok());
+  EXPECT_FALSE(result.settled);
+  ASSERT_TRUE(session->settle(result).is_ok());
+  std::vector<uint8_t> seam(mesh.face_count(), 0);
+  for (uint32_t f = 0; f < 30; ++f) seam[f] = seam[500 + f] = 1;
+  const Atlas expected = full_map(mesh, seam, {stroke_along(mesh, 200, 6)}, default_options());
+  EXPECT_EQ(current_atlas(*session).corner_uv, expected.corner_uv);
+  EXPECT_EQ(current_atlas(*session).patch, expected.patch);
 }
 
 TEST(EditSession, EditsFromSeveralThreadsSettleToTheFullMap) {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "support/fixtures.h"
+#include "surface/orientation_setup.h"
 #include "tailor/io.h"
 #include "tailor/topology.h"
 
@@ -301,6 +302,39 @@ TEST(Orientation, RejectsBadStrokes) {
   EXPECT_EQ(code_of({{0.f, 0.f, 0.f, 1.f, NAN, 0.f}, 1.f}), ErrorCode::kInvalidArgument);       // not finite
   EXPECT_EQ(code_of({{0.f, 0.f, 0.f, 1.f, 0.f, 0.f}, 0.f}), ErrorCode::kInvalidArgument);       // radius 0
   EXPECT_EQ(code_of({{0.f, 0.f, 0.f, 1.f, 0.f, 0.f}, INFINITY}), ErrorCode::kInvalidArgument);  // radius inf
+}
+
+// EditSession's local update recomputes only the faces a stroke reaches: the frames must then be
+// bit for bit those of compute_orientation with the stroke.
+TEST(Orientation, RefreshingTheFacesAStrokeReachesGivesTheFullResult) {
+  const Mesh mesh = load_test_mesh("fertility.off");
+  const Topology topology = build_topology(mesh);
+  OrientationOptions options;
+  FaceFrames frames;
+  internal::OrientationSetup setup;
+  ASSERT_TRUE(internal::compute_orientation_setup(mesh, topology, options, frames, &setup).is_ok());
+  OrientationStroke stroke;
+  for (size_t f = 100; f < 1000; f += 60)
+    for (int c = 0; c < 3; ++c) stroke.points.push_back(mesh.positions[3 * size_t{mesh.indices[3 * f]} + c]);
+  stroke.radius = 0.03f * (frames.bbox_max[0] - frames.bbox_min[0]);
+  options.strokes = std::span<const OrientationStroke>(&stroke, 1);
+  const FaceFrames expected = frames_of(mesh, options);
+  std::vector<uint32_t> changed;
+  for (uint32_t f = 0; f < mesh.face_count(); ++f)
+    if (expected.orientation[3 * f] != frames.orientation[3 * f] ||
+        expected.orientation[3 * f + 1] != frames.orientation[3 * f + 1] ||
+        expected.orientation[3 * f + 2] != frames.orientation[3 * f + 2])
+      changed.push_back(f);
+  ASSERT_GT(changed.size(), 20u);
+  ASSERT_LT(changed.size(), mesh.face_count() * 3 / 4);
+  internal::refresh_face_frames(mesh, topology, options, setup, changed, frames);
+  EXPECT_EQ(frames.normal, expected.normal);
+  EXPECT_EQ(frames.orientation, expected.orientation);
+  EXPECT_EQ(frames.bitangent, expected.bitangent);
+  EXPECT_EQ(frames.area, expected.area);
+  EXPECT_EQ(frames.local, expected.local);
+  EXPECT_EQ(frames.anchor, expected.anchor);
+  EXPECT_EQ(frames.variation, expected.variation);
 }
 
 TEST(Orientation, IsDeterministic) {

@@ -40,6 +40,13 @@ enum class AxisSource {
 //! A curve the user drew on the surface (tailor edit, tailor map --strokes FILE): near it the
 //! orientation field follows the curve's direction, blended into the axis field with a weight
 //! that falls from 1 on the curve to 0 at `radius` (smoothly), so strokes act locally.
+//! Per face (its centroid): each stroke within reach gives the tangent at its nearest point (the
+//! nearest segment's direction, turning towards the next segment's near a shared point) and the
+//! weight w = 1 - smoothstep(distance / radius); several strokes add their tangents times their
+//! weights and the largest weight counts. The face's o is turned in its plane towards that
+//! direction projected onto the face by w times the angle between them (at w = 1, o is the
+//! direction; the sign of the stroke counts: a texture runs the way it was drawn). Blended before
+//! smoothing; without smoothing, faces beyond every radius keep their frames bit for bit.
 struct OrientationStroke {
   std::vector<float> points;  //!< N by 3 (N >= 2): points along the curve, mesh coordinates
   float radius = 0.f;         //!< reach of the stroke, mesh units (> 0)
@@ -106,8 +113,10 @@ struct FaceFrames {
 //! Computes normals, areas, the orientation field, corner positions in each face's frame and the
 //! per-face variation. Inputs: a finalised mesh and its topology (build_topology(mesh)).
 //! Never produces NaN: zero-area faces get an arbitrary orthonormal frame and variation 0 to
-//! themselves. Fails with kInvalidArgument on a zero user axis or smooth_passes > 1000, and with
-//! kInvalidMesh on an empty mesh or a topology of the wrong size. Cost: O(V + F * (1 + passes)).
+//! themselves. Fails with kInvalidArgument on a zero user axis, smooth_passes > 1000 or a bad
+//! stroke (naming it: points not x, y, z triples, fewer than 2, not finite, radius <= 0), and with
+//! kInvalidMesh on an empty mesh or a topology of the wrong size. Cost: O(V + F * (1 + passes)) plus, with
+//! strokes, a uniform grid over their segments and one cell's segments per face.
 //! Deterministic; safe for any mesh that passed finalize_mesh.
 TAILOR_API Status compute_orientation(const Mesh& mesh, const Topology& topology, const OrientationOptions& options,
                                       FaceFrames& frames);

@@ -190,10 +190,13 @@ Status EditSession::open(Mesh mesh, const MapTextureOptions& options, std::uniqu
   st.topology = build_topology(st.mesh);
   TAILOR_RETURN_IF_ERROR(check_map_options(options));
   st.options = own_options(options);
-  if (options.mapping.seam_faces.size() == st.mesh.face_count())
-    st.seam.assign(options.mapping.seam_faces.begin(), options.mapping.seam_faces.end());
-  else
+  if (!options.mapping.seam_faces.empty() && options.mapping.seam_faces.size() != st.mesh.face_count())
+    return Status::error(ErrorCode::kInvalidArgument, "", "seam face flags must hold one entry per face");
+  if (options.mapping.seam_faces.empty())
     st.seam.assign(st.mesh.face_count(), 0);
+  else
+    st.seam.assign(options.mapping.seam_faces.begin(), options.mapping.seam_faces.end());
+  TAILOR_RETURN_IF_ERROR(internal::check_strokes(options.orientation.strokes));
   st.strokes.assign(options.orientation.strokes.begin(), options.orientation.strokes.end());
   MapTextureOptions first = State::with_state(st.options, st.seam, st.strokes);
   first.mapping.progress = options.mapping.progress;

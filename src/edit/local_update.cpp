@@ -18,6 +18,11 @@ namespace {
 // 60-face brush, since its main patch covers most of it.
 constexpr uint32_t kRegionRings = 24;
 
+// Crack closing in the region needs its setup over the whole mesh (wedges, seed distances): 12 ms
+// of CPU at 100k faces, 270 ms at 1.55 M (bench/bench_edit.cpp). Above this many faces the local
+// update leaves the region's cracks to the settle, so that an edit stays near 0.1 s.
+constexpr size_t kMaxClosingFaces = 500000;
+
 }  // namespace
 
 Status map_keeping_setup(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options, TextureMap& map,
@@ -119,16 +124,23 @@ Status update_region(const Mesh& mesh, const Topology& topology, const MapTextur
     old_patch[i] = atlas.patch[faces[i]];
   }
 
-  // === Growth of the region, then its seams shortened (the other faces locked) ===
+  // === Growth of the region, then its seams shortened and its cracks closed (the other faces
+  // locked: they never move, and cracks next to them stay) ===
   const internal::MappingInput input{
       mesh, topology, map.frames, options.mapping, factor_step_for(options.mapping, face_count), local.seeds};
   MappingStats stats;
   Status status = regrow_patches(input, region, atlas, stats, local.on_seam);
-  if (status.is_ok() && options.mapping.shorten_seams) {
-    std::vector<uint8_t>& locked = local.locked;
-    locked.resize(face_count);
-    for (size_t f = 0; f < face_count; ++f) locked[f] = region[f] ^ 1;
-    shorten_seams(input, local.on_seam, atlas, locked);
+  std::vector<uint8_t>& locked = local.locked;
+  locked.resize(face_count);
+  for (size_t f = 0; f < face_count; ++f) locked[f] = region[f] ^ 1;
+  if (status.is_ok() && options.mapping.shorten_seams) shorten_seams(input, local.on_seam, atlas, locked);
+  if (status.is_ok() && options.mapping.close_cracks && face_count <= kMaxClosingFaces) {
+    // One thread: a region's zips are few, starting workers cost more (the result is the same).
+    MappingOptions one_thread = options.mapping;
+    one_thread.threads = 1;
+    const internal::MappingInput closing{mesh, topology, map.frames, one_thread, input.factor_step, local.seeds};
+    uint64_t zipped = 0;
+    status = close_cracks(closing, nullptr, atlas, zipped, locked);
   }
   for (const uint32_t f : faces) region[f] = 0;
   TAILOR_RETURN_IF_ERROR(status);

@@ -5,9 +5,10 @@
 // The region: the patches holding a face whose seam flag flipped or whose orientation changed (a
 // face within reach of a stroke added or removed), plus every patch sharing an edge with those.
 // Its faces are grown again from the faces around it (regrow_patches), then its seams shortened
-// (shorten_seams with the other faces locked). Crack closing and the relaxation are left to the
-// settle: they are what makes the full map slow (70-90% of its time), and they reach across
-// patches. The frames are updated face by face (refresh_face_frames) where strokes changed.
+// and its cracks closed (shorten_seams and close_cracks with the other faces locked: no zip moves
+// them, so cracks next to them stay). The relaxation is left to the settle (its iterations run
+// over the whole mesh). The frames are updated face by face (refresh_face_frames) where strokes
+// changed.
 // Only in the patches mode with symmetry 1 and no field smoothing; otherwise the session maps
 // the whole mesh again.
 #pragma once

@@ -188,10 +188,12 @@ void CrackCloser::close_band(std::vector<uint64_t>& heap, uint32_t band, uint32_
 // (coloured modulo 3) kept the bunny's share but, run colour by colour, lost 55 points on spot;
 // and any Lipschitz bound in space comes from the longest edge, an outlier on scans (the bunny
 // would be one band). docs/mapping.md, section 2.
-Status close_cracks(const MappingInput& input, const ProgressCallback& progress, Atlas& atlas, uint64_t& zipped) {
+Status close_cracks(const MappingInput& input, const ProgressCallback& progress, Atlas& atlas, uint64_t& zipped,
+                    std::span<const uint8_t> locked) {
   zipped = 0;
   const size_t face_count = input.mesh.face_count();
   CrackShared shared;
+  shared.locked = locked.empty() ? nullptr : locked.data();
   const size_t threads = parallel_threads(face_count, input.options.threads, kFacesPerClosingThread);
   std::vector<std::unique_ptr<CrackCloser>> workers;  // one allocation per worker, not per element
   for (size_t t = 0; t < threads; ++t) workers.push_back(std::make_unique<CrackCloser>(input, atlas, shared));

@@ -111,7 +111,8 @@ bool CrackCloser::merge(uint32_t vertex, uint32_t keep, uint32_t drop) {
     const uint32_t corner = vertex_corners_[j];
     const uint32_t w = wedge_[corner];
     if (w != keep && w != drop) continue;
-    inside = inside && atlas_.patch[corner / 3] == patch && !(seam_flags_ && seam_flags_[corner / 3]);
+    inside = inside && atlas_.patch[corner / 3] == patch && !(seam_flags_ && seam_flags_[corner / 3]) &&
+             !(shared_.locked && shared_.locked[corner / 3]);
     if (w != drop) continue;
     wedge_[corner] = keep;
     changed_.push_back(Change{corner, drop});
@@ -199,11 +200,13 @@ void CrackCloser::collect_region(uint32_t patch, int rings) {
   const uint32_t* const face_patch = atlas_.patch.data();
   uint32_t* const face_stamp = face_stamp_.data();
   const uint32_t stamp = stamp_;
+  // Locked faces are left out like other patches' faces: their wedges then stay fixed.
+  const uint8_t* const locked = shared_.locked;
   region_.clear();
   for (const Merge& m : merges_) {
     for (uint32_t i = vertex_start_[m.vertex]; i < vertex_start_[m.vertex + 1]; ++i) {
       const uint32_t f = vertex_corners_[i] / 3;
-      if (face_patch[f] == patch && face_stamp[f] != stamp) {
+      if (face_patch[f] == patch && face_stamp[f] != stamp && !(locked && locked[f])) {
         face_stamp[f] = stamp;
         region_.push_back(f);
       }
@@ -214,7 +217,7 @@ void CrackCloser::collect_region(uint32_t patch, int rings) {
     const auto add = [&](uint32_t o) {
       if (o == kInvalid) return;
       const uint32_t g = o / 3;
-      if (face_stamp[g] == stamp || face_patch[g] != patch) return;
+      if (face_stamp[g] == stamp || face_patch[g] != patch || (locked && locked[g])) return;
       face_stamp[g] = stamp;
       region_.push_back(g);
     };

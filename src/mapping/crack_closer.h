@@ -83,6 +83,7 @@ struct CrackShared {
   std::atomic<uint32_t> stamp{0};         // the last relaxation mark handed out (unique across workers)
   std::atomic<uint64_t> popped{0};        // queue entries taken, all workers
   std::atomic<bool> cancelled{false};
+  const uint8_t* locked = nullptr;  // per face, or nullptr: faces no zip may move (a local update's kept faces)
 };
 
 // A crack closer per worker: zips crack edges one at a time (crack_closer.cpp), and works through
@@ -139,6 +140,7 @@ class CrackCloser {
     const uint32_t f = e / 3, g = o / 3;
     if (atlas_.patch[f] != atlas_.patch[g]) return false;
     if (seam_flags_ && (seam_flags_[f] || seam_flags_[g])) return false;
+    if (shared_.locked && (shared_.locked[f] || shared_.locked[g])) return false;
     const EdgeCorners c = edge_corners(e);
     return wedge_[c.fa] != wedge_[c.ga] || wedge_[c.fb] != wedge_[c.gb];
   }

@@ -82,7 +82,9 @@ uint64_t shorten_seams(const MappingInput& input, std::vector<uint8_t>& seam_mar
 //! options.max_stretch (patches mode, step 4). zipped: the number of zipped vertices.
 //! progress (may be empty) gets the share done; false cancels (kCancelled, atlas half-zipped).
 //! Deterministic; O(F) setup, then O(rings^2) per crack vertex tried.
-Status close_cracks(const MappingInput& input, const ProgressCallback& progress, Atlas& atlas, uint64_t& zipped);
+//! locked (empty or #F): faces no zip moves (their UVs stay bit for bit; cracks next to them stay).
+Status close_cracks(const MappingInput& input, const ProgressCallback& progress, Atlas& atlas, uint64_t& zipped,
+                    std::span<const uint8_t> locked = {});
 
 //! Relaxes the UVs by options.relax_iterations local/global ARAP iterations (patches mode, last
 //! step): every UV vertex moves except both sides of a seam less than a pixel wide and the corners
