@@ -6,8 +6,10 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -199,7 +201,11 @@ int run_edit(const EditArgs& opt) {
   ::sigaction(SIGINT, &action, nullptr);
   ::sigaction(SIGTERM, &action, nullptr);
 
-  std::thread settler([&api] { api.run_settler(g_stop); });
+  std::atomic<bool> settler_done{false};
+  std::thread settler([&api, &settler_done] {
+    api.run_settler(g_stop);
+    settler_done.store(true);
+  });
   // Always printed (also with --quiet): the URL is the point of the command, and scripts read it.
   std::printf("tailor edit: http://127.0.0.1:%d/  (%s, %zu faces mapped in %.2f s; saves to %s; Ctrl-C to stop)\n",
               server.port(), context.name.c_str(), context.session->mesh().face_count(), open_seconds,
@@ -207,8 +213,17 @@ int run_edit(const EditArgs& opt) {
   std::fflush(stdout);
   server.serve(g_stop);
   api.wake();
-  settler.join();
+  // A settle of a large mesh cannot be interrupted (seconds at a million faces): Ctrl-C does not wait
+  // for it. Nothing is being written then (saves run on the server's threads, which have ended).
+  for (int i = 0; i < 50 && !settler_done.load(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
   if (!opt.quiet) std::fprintf(stderr, "tailor edit: stopped\n");
+  if (!settler_done.load()) {
+    std::fflush(stdout);
+    std::error_code ignored;
+    std::filesystem::remove_all(scratch.path, ignored);
+    std::_Exit(kExitOk);
+  }
+  settler.join();
   return kExitOk;
 }
 
