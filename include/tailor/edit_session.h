@@ -13,8 +13,8 @@
 // which is byte for byte what `tailor map --seam-faces F --strokes S` gives with the same options
 // (any thread count). Edits that change the options, and sessions in the thesis mode, with
 // symmetry 4 or with field smoothing, map the whole mesh at each edit instead.
-// Measured (bench/bench_edit.cpp, docs/performance.md): apply about 20 ms of CPU on 100k faces
-// and 120 ms on 1.55 M faces, where the full map takes 0.17-0.3 s and 4.5 s.
+// Measured (bench/bench_edit.cpp, docs/performance.md): apply about 20 ms on 100k faces and
+// 0.1-0.2 s on 1.55 M faces, where the full map takes 0.17-0.3 s and 4.5-8 s.
 // `tailor edit` serves a session over HTTP (docs/edit-api.md).
 //
 // Memory: besides the mesh and one TextureMap, the UVs of the last 8 versions (24 bytes per face
