@@ -224,15 +224,22 @@ async function runPump() {
   while (session.pendingAdd.size || session.pendingRemove.size) {
     const wait = kSendEveryMs - (performance.now() - session.lastSend);
     if (painting && wait > 0) await new Promise((r) => setTimeout(r, wait));
-    const body = {};
-    if (session.pendingAdd.size) body.add_seam_faces = [...session.pendingAdd];
-    if (session.pendingRemove.size) body.remove_seam_faces = [...session.pendingRemove];
-    if (session.strokeSent) body.join = true;
-    session.strokeSent = true;
-    session.pendingAdd.clear();
-    session.pendingRemove.clear();
-    await send(body);
+    await sendPainted();
   }
+}
+
+/** Sends the faces painted and not yet sent, as one edit. */
+async function sendPainted() {
+  const body = {};
+  if (session.pendingAdd.size) body.add_seam_faces = [...session.pendingAdd];
+  if (session.pendingRemove.size) body.remove_seam_faces = [...session.pendingRemove];
+  const first = !session.strokeSent;
+  if (!first) body.join = true;
+  session.strokeSent = true;
+  session.pendingAdd.clear();
+  session.pendingRemove.clear();
+  await send(body);
+  if (first) session.firstAnswered = true;
 }
 
 /** One edit request (every kind: paint, stroke, options). */
@@ -462,6 +469,7 @@ function onPointerDown(event) {
   updatePick();
   painting = true;
   session.strokeSent = false;
+  session.firstAnswered = false;
   if (state.tool === 'stroke') {
     strokePoints = [];
     lastStrokePixel = null;
@@ -497,6 +505,12 @@ function onPointerUp(event) {
 async function finishStroke() {
   timing.measuring += 1;
   try {
+    // The last faces go at once, beside a request still in flight: a stroke only marks or only
+    // unmarks, so the two commute; only the stroke's first request (the one the others join) must
+    // be answered before.
+    if (pump && session.firstAnswered && (session.pendingAdd.size || session.pendingRemove.size)) {
+      await Promise.all([pump, sendPainted()]);
+    }
     while (pump || session.pendingAdd.size || session.pendingRemove.size) await schedulePaint();
     if (!session.strokeSent) return;  // the stroke painted nothing new
     drawNow();
