@@ -402,18 +402,24 @@ HttpResponse EditApi::uv(const HttpRequest& request) const {
   r.content_type = "application/octet-stream";
   // &since=M: only the faces whose UVs differ from version M (count K, K face ids, 6K floats; header
   // X-Tailor-Delta: 1); all of them as without it when M is no longer kept.
-  uint64_t since = version;
-  std::vector<float> base;
+  const std::lock_guard<std::mutex> lock(uv_mutex_);
+  bool delta = false;
+  std::vector<uint32_t> faces;
   if (query_value(request.query, "since", text)) {
+    uint64_t since = 0;
     const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), since);
     if (text.empty() || error != std::errc() || end != text.data() + text.size())
       return HttpResponse::error(400, "since must be an unsigned integer, got '" + text + "'");
-    if (!context_.session->corner_uv_repeats(since, base) || base.size() != uvs.size()) since = version;
+    std::vector<float> copy;
+    const std::vector<float>* base = &uv_last_;  // the version served last: no copy out of the session
+    if (since != uv_version_) base = context_.session->corner_uv_repeats(since, copy) ? &copy : nullptr;
+    if (since != version && base != nullptr && base->size() == uvs.size()) {
+      delta = true;
+      for (size_t f = 0; 6 * f < uvs.size(); ++f)
+        if (std::memcmp(&uvs[6 * f], &(*base)[6 * f], 24) != 0) faces.push_back(static_cast<uint32_t>(f));
+    }
   }
-  if (since != version) {  // `since` is kept: a delta
-    std::vector<uint32_t> faces;
-    for (size_t f = 0; 6 * f < uvs.size(); ++f)
-      if (std::memcmp(&uvs[6 * f], &base[6 * f], 24) != 0) faces.push_back(static_cast<uint32_t>(f));
+  if (delta) {
     const auto count = static_cast<uint32_t>(faces.size());
     r.body.resize(4 + 4 * faces.size() + 24 * faces.size());
     char* out = r.body.data();
@@ -426,6 +432,8 @@ HttpResponse EditApi::uv(const HttpRequest& request) const {
     r.body.assign(reinterpret_cast<const char*>(uvs.data()), 4 * uvs.size());
   }
   r.headers.emplace_back("X-Tailor-Version", std::to_string(version));
+  uv_version_ = version;
+  uv_last_ = std::move(uvs);
   return r;
 }
 

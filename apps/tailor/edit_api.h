@@ -80,6 +80,11 @@ class EditApi {
   std::condition_variable settle_wake_;
   std::chrono::steady_clock::time_point last_edit_{};
   bool settle_pending_ = false;
+  // /api/uv: the UVs of the version served last; the page's next fetch asks for the faces changed
+  // since it, which then costs one copy out of the session instead of two.
+  mutable std::mutex uv_mutex_;
+  mutable uint64_t uv_version_ = UINT64_MAX;
+  mutable std::vector<float> uv_last_;
   std::mutex model_mutex_;  // /api/model.glb: one export at a time, the last one cached
   uint64_t model_version_ = UINT64_MAX;
   std::string model_bytes_;
