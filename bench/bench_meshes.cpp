@@ -131,3 +131,7 @@ const std::string& subdivided_horse_obj_path() {
   static const std::string path = write_once("horse-x16.obj", obj_text);
   return path;
 }
+
+tailor::Status write_subdivided_horse_ply(const std::string& path) {
+  return internal::write_file_atomic(path, binary_ply(subdivided_horse()));
+}

@@ -15,12 +15,16 @@
 #include <string>
 
 #include "tailor/mesh.h"
+#include "tailor/status.h"
 
 //! horse.ply subdivided twice (1,551,456 faces). Aborts the benchmark run if horse.ply is missing.
 const tailor::Mesh& subdivided_horse();
 
 //! subdivided_horse() as binary little-endian PLY (float x y z; uchar int vertex_indices).
 const std::string& subdivided_horse_ply_path();
+
+//! Writes subdivided_horse() as binary PLY to `path` (atomically); for tools outside the benchmarks.
+tailor::Status write_subdivided_horse_ply(const std::string& path);
 
 //! subdivided_horse() as ascii OBJ (`v x y z` with %.9g, `f a b c`).
 const std::string& subdivided_horse_obj_path();

@@ -22,4 +22,7 @@ if (($# == 0)); then
   echo
   echo "bench: tiling sizes (tailor tile under /usr/bin/time -v)"
   bash "$(dirname "$0")/bench_tile_sizes.sh" "$build"
+  echo
+  echo "bench: tailor edit in the browser, end of a brush stroke to its frame (100k and 1.55M faces)"
+  bash "$(dirname "$0")/bench_edit_browser.sh" "$build"
 fi

@@ -139,10 +139,11 @@ else
   grep -qF "viewer in $web;" "$tmp/view.log" && ok || fail "tailor view does not serve $web: $(cat "$tmp/view.log")"
   fetch() { curl -sf --max-time 10 -o "$2" "$url${1#/}"; }
   fetch / "$tmp/index.html" && cmp -s "$tmp/index.html" "$web/index.html" && ok || fail "GET / is not the installed index.html"
-  # Follow the imports from the page's module script, the importmap's way ('three' and 'three/addons/').
+  # Follow the imports from the pages' module scripts (the viewer's and tailor edit's), the importmap's
+  # way ('three' and 'three/addons/').
   declare -A seen=()
-  queue=($(grep -o '<script type="module" src="[^"]*"' "$web/index.html" | sed 's/.*src="//; s/"$//'))
-  [[ ${#queue[@]} -gt 0 ]] && ok || fail "index.html has no module script"
+  queue=($(grep -oh '<script type="module" src="[^"]*"' "$web/index.html" "$web/edit.html" | sed 's/.*src="//; s/"$//'))
+  [[ ${#queue[@]} -gt 1 ]] && ok || fail "index.html or edit.html has no module script"
   while [[ ${#queue[@]} -gt 0 ]]; do
     path=${queue[0]}
     queue=("${queue[@]:1}")

@@ -14,6 +14,8 @@ export const kViews = ['texture', 'patches', 'distortion', 'checker', 'seams'];
 // Line colours of the seams view (display values, unlit): visible seams, invisible seams (the
 // texture continues across them), mesh borders.
 export const kSeamColors = { visible: [0.86, 0.08, 0.08], invisible: [0.05, 0.62, 0.16], border: [0.35, 0.35, 0.38] };
+// tailor edit: the tint of faces marked as seam faces.
+export const kMarkedColor = [1.0, 0.55, 0.0];
 const glslColor = (c) => `vec3(${c.map((x) => x.toFixed(3)).join(', ')})`;
 
 // What the vertex shader hands to the fragment shader (both must declare the same).
@@ -26,6 +28,7 @@ varying vec3 vSeam;
 varying vec3 vSeamClass;
 varying vec3 vPatch;
 varying float vStretch;
+varying float vMarked;
 `;
 
 const vertexShader = /* glsl */ `
@@ -35,6 +38,7 @@ attribute vec3 seamClass;
 attribute vec3 patchColor;
 attribute float stretch;
 attribute vec4 fileTangent;  // the file's TANGENT (xyz, handedness w); zero when it has none
+attribute float marked;      // tailor edit: 1 on the faces the user marked as seam faces (0 when absent)
 ${varyings}
 void main() {
   vNormal = normalize(normalMatrix * normal);
@@ -45,6 +49,7 @@ void main() {
   vSeamClass = seamClass;
   vPatch = patchColor;
   vStretch = stretch;
+  vMarked = marked;
   gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0);
 }
 `;
@@ -80,6 +85,7 @@ uniform float checkerSquares;
 uniform float distortionRange;
 uniform bool wireframe;
 uniform bool showSeams;
+uniform bool showMarked;
 ${varyings}
 // Moreland's cool-to-warm end points, through light grey; t in [-1, 1].
 vec3 coolWarm(float t) {
@@ -166,6 +172,7 @@ void main() {
     color = mix(color, ${glslColor(kSeamColors.invisible)}, edgeLine(seamFlags(1.0), 2.0));
     color = mix(color, ${glslColor(kSeamColors.visible)}, edgeLine(seamFlags(2.0), 2.0));
   }
+  if (showMarked && vMarked > 0.5) color = mix(color, ${glslColor(kMarkedColor)}, 0.5);
   gl_FragColor = vec4(color, 1.0);
 }
 `;
@@ -188,6 +195,7 @@ export function createSurfaceMaterial() {
     distortionRange: { value: 2 },
     wireframe: { value: false },
     showSeams: { value: true },
+    showMarked: { value: false },
   };
   for (let k = 0; k < kMaxVariants; ++k) uniforms[`variant${k}`] = { value: null };
   return new THREE.ShaderMaterial({ uniforms, vertexShader, fragmentShader, side: THREE.DoubleSide });
@@ -219,4 +227,5 @@ export function updateSurfaceMaterial(material, state, textures) {
   u.distortionRange.value = state.distortionRange;
   u.wireframe.value = state.wireframe;
   u.showSeams.value = state.seams;
+  u.showMarked.value = state.showMarked === true;
 }

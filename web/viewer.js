@@ -7,9 +7,9 @@ import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { DRACOLoader } from 'three/addons/loaders/DRACOLoader.js';
 import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
-import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { buildSurface, seamRatios, kDefaultTextureSize } from './mesh_data.js';
 import { createSurfaceMaterial, updateSurfaceMaterial, kMaxVariants, kViews, kSeamColors } from './surface_material.js';
+import { createView, prepareTexture as prepareSceneTexture, pixelStats as scenePixelStats } from './scene_tools.js';
 
 const state = {
   view: 'texture',
@@ -35,28 +35,8 @@ let dirty = true;
 let ready = false;
 
 const container = document.getElementById('view');
-const renderer = new THREE.WebGLRenderer({ antialias: true });
-renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
-renderer.setSize(container.clientWidth, container.clientHeight);
-// The shader writes display values itself (as the CPU preview does): no output conversion.
-renderer.outputColorSpace = THREE.LinearSRGBColorSpace;
-renderer.setClearColor(new THREE.Color(236 / 255, 238 / 255, 242 / 255), 1);
-container.appendChild(renderer.domElement);
-
-const scene = new THREE.Scene();
-const camera = new THREE.PerspectiveCamera(35, container.clientWidth / container.clientHeight, 0.01, 100);
-const controls = new OrbitControls(camera, renderer.domElement);
-controls.enableDamping = true;
-let sceneRadius = 1;
-controls.addEventListener('change', () => {
-  // Keep the depth range tight around the model wherever the camera goes (zooming in past the
-  // initial near plane would cut the model open).
-  const d = camera.position.distanceTo(controls.target);
-  camera.near = Math.max(d - 1.5 * sceneRadius, sceneRadius * 1e-3);
-  camera.far = d + 1.5 * sceneRadius;
-  camera.updateProjectionMatrix();
-  dirty = true;
-});
+const view = createView(container, () => { dirty = true; });
+const { renderer, scene, camera, controls } = view;
 const material = createSurfaceMaterial();
 
 function showError(text) {
@@ -69,19 +49,8 @@ function showError(text) {
 window.addEventListener('error', (e) => showError(`error: ${e.message}`));
 window.addEventListener('unhandledrejection', (e) => showError(`error: ${e.reason && e.reason.message ? e.reason.message : e.reason}`));
 
-/** Textures are sampled as raw data (no colour-space decoding) and repeat, with mipmaps. */
 function prepareTexture(texture) {
-  texture.colorSpace = THREE.NoColorSpace;
-  texture.wrapS = THREE.RepeatWrapping;
-  texture.wrapT = THREE.RepeatWrapping;
-  texture.minFilter = THREE.LinearMipmapLinearFilter;
-  texture.magFilter = THREE.LinearFilter;
-  texture.anisotropy = renderer.capabilities.getMaxAnisotropy();
-  texture.generateMipmaps = true;
-  // glTF's uv has v pointing down the image, like three's textures with flipY off.
-  texture.flipY = false;
-  texture.needsUpdate = true;
-  return texture;
+  return prepareSceneTexture(renderer, texture);
 }
 
 function loadTexture(url) {
@@ -93,27 +62,6 @@ function applyState() {
   document.getElementById('legend').style.display = state.view === 'distortion' ? 'block' : 'none';
   document.getElementById('seam-legend').style.display = state.view === 'seams' ? 'block' : 'none';
   dirty = true;
-}
-
-/** Places the camera at a 3/4 view from above, like `tailor render`, fitting the bounding sphere. */
-function frameCamera(object) {
-  const box = new THREE.Box3().setFromObject(object);
-  const sphere = box.getBoundingSphere(new THREE.Sphere());
-  const radius = sphere.radius > 0 ? sphere.radius : 1;
-  sceneRadius = radius;
-  const fovy = THREE.MathUtils.degToRad(camera.fov);
-  const half = Math.min(fovy / 2, Math.atan(Math.tan(fovy / 2) * camera.aspect));
-  const distance = (radius / Math.sin(half)) * 1.02;
-  const yaw = THREE.MathUtils.degToRad(35);
-  const pitch = THREE.MathUtils.degToRad(25);
-  const dir = new THREE.Vector3(Math.cos(pitch) * Math.sin(yaw), Math.sin(pitch), Math.cos(pitch) * Math.cos(yaw));
-  camera.position.copy(sphere.center).addScaledVector(dir, distance);
-  camera.near = Math.max(distance - radius * 1.5, distance * 1e-3);
-  camera.far = distance + radius * 1.5;
-  camera.updateProjectionMatrix();
-  controls.target.copy(sphere.center);
-  controls.maxDistance = distance * 10;
-  controls.update();
 }
 
 async function load() {
@@ -179,7 +127,7 @@ async function load() {
   if (!hasUv) console.warn(`${config.name}: no texture coordinates; only the patches view is meaningful`);
 
   scene.add(gltf.scene);
-  frameCamera(gltf.scene);
+  view.frame(gltf.scene);
   stats.loadSeconds = (performance.now() - start) / 1000;
   Object.assign(stats, seamRatios(stats.seams));
   const percent = (x) => `${(100 * x).toFixed(2)}%`;
@@ -219,12 +167,7 @@ function bindPanel() {
     if (n >= 1 && n <= kViews.length) setView(kViews[n - 1]);
     if (e.key === 'w') { wireframe.checked = !wireframe.checked; state.wireframe = wireframe.checked; applyState(); }
   });
-  window.addEventListener('resize', () => {
-    camera.aspect = container.clientWidth / container.clientHeight;
-    camera.updateProjectionMatrix();
-    renderer.setSize(container.clientWidth, container.clientHeight);
-    dirty = true;
-  });
+  window.addEventListener('resize', view.resize);
 }
 
 /** Texture repeats per UV unit (the slider is logarithmic, 1/8 .. 8). */
@@ -252,44 +195,8 @@ function animate() {
   frames += 1;
 }
 
-/**
- * Renders now and returns the luminance mean and variance of the canvas, a 100x75 RGB thumbnail
- * (box means, 22500 values) to compare pictures, and the number of pixels close to the seams
- * view's red and green line colours (seamPixels.visible, seamPixels.invisible).
- */
 function pixelStats() {
-  renderer.render(scene, camera);
-  const gl = renderer.getContext();
-  const w = gl.drawingBufferWidth;
-  const h = gl.drawingBufferHeight;
-  const px = new Uint8Array(w * h * 4);
-  gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, px);
-  const tw = 100;
-  const th = 75;
-  const thumb = new Float64Array(tw * th * 3);
-  const counts = new Float64Array(tw * th);
-  let sum = 0;
-  let sum2 = 0;
-  const near = (i, c) => Math.abs(px[i] - 255 * c[0]) < 40 && Math.abs(px[i + 1] - 255 * c[1]) < 40 && Math.abs(px[i + 2] - 255 * c[2]) < 40;
-  const seamPixels = { visible: 0, invisible: 0 };
-  for (let y = 0; y < h; ++y) {
-    const ty = Math.min(th - 1, Math.floor((th * y) / h));
-    for (let x = 0; x < w; ++x) {
-      const i = 4 * (y * w + x);
-      const l = 0.299 * px[i] + 0.587 * px[i + 1] + 0.114 * px[i + 2];
-      sum += l;
-      sum2 += l * l;
-      if (near(i, kSeamColors.visible)) seamPixels.visible += 1;
-      else if (near(i, kSeamColors.invisible)) seamPixels.invisible += 1;
-      const cell = ty * tw + Math.min(tw - 1, Math.floor((tw * x) / w));
-      for (let c = 0; c < 3; ++c) thumb[3 * cell + c] += px[i + c];
-      counts[cell] += 1;
-    }
-  }
-  const n = w * h;
-  const mean = sum / n;
-  const grid = Array.from(thumb, (v, k) => v / counts[Math.floor(k / 3)]);
-  return { width: w, height: h, mean, variance: sum2 / n - mean * mean, grid, seamPixels };
+  return scenePixelStats(renderer, scene, camera);
 }
 
 window.tailorViewer = {

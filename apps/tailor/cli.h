@@ -101,6 +101,11 @@ inline double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+//! The web pages' folder of `tailor view` and `tailor edit`: `given` (--web-root), else the installed
+//! share/tailor/web relative to the executable, else the source tree's web/. Fails with kIo when
+//! none holds index.html, or three.js is not installed there.
+Status find_web_root(const std::string& given, std::string& root);
+
 //! What a subcommand's CLI11 callback sets: the work to run once parsing succeeded.
 using Runner = std::function<int()>;
 
@@ -112,5 +117,6 @@ void register_tile(CLI::App& app, Runner& run);
 void register_eval_tile(CLI::App& app, Runner& run);
 void register_render(CLI::App& app, Runner& run);
 void register_view(CLI::App& app, Runner& run);
+void register_edit(CLI::App& app, Runner& run);
 
 }  // namespace tailor::cli

@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "cli.h"
+#include "map_shared.h"
 #include "tailor/axis_choice.h"
 #include "tailor/export.h"
 #include "tailor/image.h"
@@ -28,19 +29,6 @@ namespace tailor::cli {
 namespace {
 
 Status usage_error(const std::string& what) { return Status::error(ErrorCode::kInvalidArgument, "", what); }
-
-// --axis as the user writes it: pca, x, y, z or X,Y,Z (the inverse of parse_axis).
-std::string axis_text(const OrientationOptions& o) {
-  if (o.axis == AxisSource::kPca) return "pca";
-  if (o.axis == AxisSource::kSkeleton) return "skeleton";
-  const std::array<float, 3>& a = o.user_axis;
-  if (a == std::array<float, 3>{1, 0, 0}) return "x";
-  if (a == std::array<float, 3>{0, 1, 0}) return "y";
-  if (a == std::array<float, 3>{0, 0, 1}) return "z";
-  char text[64];
-  std::snprintf(text, sizeof text, "%g,%g,%g", a[0], a[1], a[2]);
-  return text;
-}
 
 // The command line of `tailor map`. The library's options are bound to their flags in `options`
 // (defaults: the structs' own); those given as text are parsed in run_map.
@@ -72,27 +60,6 @@ struct MapArgs {
   bool stability = false;
   bool quiet = false;
 };
-
-Status parse_axis(const std::string& text, OrientationOptions& o) {
-  if (text == "pca") {
-    o.axis = AxisSource::kPca;
-    return Status::ok();
-  }
-  if (text == "skeleton") {
-    o.axis = AxisSource::kSkeleton;
-    return Status::ok();
-  }
-  o.axis = AxisSource::kUser;
-  if (text == "x")
-    o.user_axis = {1, 0, 0};
-  else if (text == "y")
-    o.user_axis = {0, 1, 0};
-  else if (text == "z")
-    o.user_axis = {0, 0, 1};
-  else if (!parse_vec3(text, o.user_axis))
-    return usage_error("--axis must be pca, skeleton, x, y, z or three numbers X,Y,Z, got '" + text + "'");
-  return Status::ok();
-}
 
 // "out/a.png" + "patches" -> "out/a_patches.png"
 std::string sibling_path(const std::string& path, const std::string& suffix) {
@@ -339,17 +306,18 @@ int run_map(const MapArgs& opt) {
   // Staged together: they land only when all of them were written (nothing on a late failure).
   internal::FileBatch batch;
   const auto export_start = std::chrono::steady_clock::now();
-  ExportOptions export_options;
-  export_options.texture_path = texture_path;
-  export_options.material = std::move(material.textures);
-  export_options.texture_width = tex_w;
-  export_options.texture_height = tex_h;
-  export_options.compression = compression;
-  export_options.uv_set = opt.uv_set;
-  export_options.up = opt.up == "z" ? SceneUp::kZ : SceneUp::kY;
+  const MeshOutput output{texture_path,
+                          std::move(material.textures),
+                          tex_w,
+                          tex_h,
+                          compression,
+                          opt.uv_set,
+                          opt.up == "z" ? SceneUp::kZ : SceneUp::kY};
   Progress exporting("export", opt.quiet);
-  export_options.progress = [&exporting](float f) { return exporting.update(f); };
-  if (Status s = export_mesh(opt.output, mesh, atlas, export_options); !s) return report_error(s);
+  if (Status s =
+          write_mapped_mesh(opt.output, mesh, atlas, output, [&exporting](float f) { return exporting.update(f); });
+      !s)
+    return report_error(s);
   exporting.done();
   run.export_seconds = seconds_since(export_start);
   for (const auto& [path, picture] : pictures) {

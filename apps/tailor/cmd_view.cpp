@@ -54,39 +54,6 @@ std::string extension_of(const std::string& path) {
   return ext;
 }
 
-//! The viewer's files: --web-root, else the installed share/tailor/web relative to the executable
-//! (any prefix: the tree can be moved), else the source tree this binary was built from (a build
-//! tree). web/ next to or above the executable is also tried, for a copied build.
-Status find_web_root(const std::string& given, std::string& root) {
-  std::vector<std::string> candidates;
-  if (!given.empty()) {
-    candidates.push_back(given);
-  } else {
-    std::array<char, 4096> exe{};
-    const ssize_t n = ::readlink("/proc/self/exe", exe.data(), exe.size() - 1);
-    if (n > 0) {
-      const std::string dir = dir_of(std::string(exe.data(), static_cast<size_t>(n)));
-      candidates.push_back(dir + "/" TAILOR_INSTALLED_DATA_DIR "/web");
-      candidates.push_back(dir + "/web");
-      candidates.push_back(dir + "/../web");
-    }
-    candidates.push_back(TAILOR_SOURCE_WEB_DIR);
-  }
-  for (const std::string& dir : candidates) {
-    if (!file_exists(dir + "/index.html")) continue;
-    if (!file_exists(dir + "/node_modules/three/build/three.module.js")) {
-      return Status::error(ErrorCode::kIo, dir, "three.js is not installed", "run 'npm install' in that folder");
-    }
-    // Printed in the startup line: the absolute path, so that one can tell which copy is served.
-    std::error_code error;
-    const std::filesystem::path absolute = std::filesystem::canonical(dir, error);
-    root = error ? dir : absolute.string();
-    return Status::ok();
-  }
-  return Status::error(ErrorCode::kIo, given.empty() ? "" : given, "web viewer files (index.html) not found",
-                       "pass --web-root DIR");
-}
-
 //! Cheap check that `path` is a binary glTF 2.0 file, so a wrong file fails here with one line
 //! rather than in the browser.
 Status check_glb(const std::string& path) {
@@ -185,6 +152,39 @@ int run_view(const ViewArgs& args) {
 }
 
 }  // namespace
+
+//! The viewer's files: --web-root, else the installed share/tailor/web relative to the executable
+//! (any prefix: the tree can be moved), else the source tree this binary was built from (a build
+//! tree). web/ next to or above the executable is also tried, for a copied build.
+Status find_web_root(const std::string& given, std::string& root) {
+  std::vector<std::string> candidates;
+  if (!given.empty()) {
+    candidates.push_back(given);
+  } else {
+    std::array<char, 4096> exe{};
+    const ssize_t n = ::readlink("/proc/self/exe", exe.data(), exe.size() - 1);
+    if (n > 0) {
+      const std::string dir = dir_of(std::string(exe.data(), static_cast<size_t>(n)));
+      candidates.push_back(dir + "/" TAILOR_INSTALLED_DATA_DIR "/web");
+      candidates.push_back(dir + "/web");
+      candidates.push_back(dir + "/../web");
+    }
+    candidates.push_back(TAILOR_SOURCE_WEB_DIR);
+  }
+  for (const std::string& dir : candidates) {
+    if (!file_exists(dir + "/index.html")) continue;
+    if (!file_exists(dir + "/node_modules/three/build/three.module.js")) {
+      return Status::error(ErrorCode::kIo, dir, "three.js is not installed", "run 'npm install' in that folder");
+    }
+    // Printed in the startup line: the absolute path, so that one can tell which copy is served.
+    std::error_code error;
+    const std::filesystem::path absolute = std::filesystem::canonical(dir, error);
+    root = error ? dir : absolute.string();
+    return Status::ok();
+  }
+  return Status::error(ErrorCode::kIo, given.empty() ? "" : given, "web viewer files (index.html) not found",
+                       "pass --web-root DIR");
+}
 
 void register_view(CLI::App& app, Runner& run) {
   auto* cmd = app.add_subcommand("view", "Open a .glb in the web viewer (three.js) served on 127.0.0.1");

@@ -12,6 +12,7 @@
 #include <array>
 #include <cctype>
 #include <cerrno>
+#include <charconv>
 #include <chrono>
 #include <climits>
 #include <cstdio>
@@ -30,9 +31,11 @@ constexpr size_t kMaxHeaderBytes = 16 * 1024;  // a GET from a browser is well u
 constexpr int kPollMillis = 200;               // how often the server and its workers look at the stop flag
 constexpr int kHeaderSeconds = 2;              // a client must send its whole request within this (slow or silent ones
                                    // are dropped: a per-recv timeout would let a trickle hold a worker forever)
-constexpr int kStallSeconds = 30;   // a client that accepts no byte of the answer for this long is dropped
-constexpr size_t kMaxWorkers = 64;  // connections served at once; when full, the oldest one still
-                                    // waiting for its request is dropped; 503 only when none is waiting
+constexpr int kStallSeconds = 30;            // a client that accepts no byte of the answer for this long is dropped
+constexpr size_t kMaxBodyBytes = 16u << 20;  // a POST body (tailor edit: face lists and strokes) at most 16 MiB
+constexpr int kBodySeconds = 30;             // a POST body must arrive within this
+constexpr size_t kMaxWorkers = 64;           // connections served at once; when full, the oldest one still
+                                             // waiting for its request is dropped; 503 only when none is waiting
 
 // Content-Security-Policy of every answer: scripts, styles, images and fetches from this server only.
 // The one inline script, index.html's importmap, is allowed by its SHA-256 (tests/viewer_test.sh
@@ -81,10 +84,31 @@ void send_status(int fd, int code, const char* reason, const std::atomic<bool>& 
   send_all(fd, (head + body).data(), head.size() + body.size(), stop);
 }
 
-std::string header_for(size_t length, const std::string& type) {
-  return "HTTP/1.1 200 OK\r\nContent-Type: " + type + "\r\nContent-Length: " + std::to_string(length) +
-         "\r\nCache-Control: no-cache\r\nX-Content-Type-Options: nosniff\r\nContent-Security-Policy: " +
-         kContentSecurityPolicy + "\r\nConnection: close\r\n\r\n";
+const char* reason_phrase(int code) {
+  switch (code) {
+    case 200: return "OK";
+    case 400: return "Bad Request";
+    case 403: return "Forbidden";
+    case 404: return "Not Found";
+    case 405: return "Method Not Allowed";
+    case 409: return "Conflict";
+    case 411: return "Length Required";
+    case 413: return "Content Too Large";
+    case 415: return "Unsupported Media Type";
+    case 500: return "Internal Server Error";
+    case 503: return "Service Unavailable";
+    default: return "Error";
+  }
+}
+
+std::string header_for(size_t length, const std::string& type, int code = 200,
+                       const std::vector<std::pair<std::string, std::string>>& extra = {}) {
+  std::string head = "HTTP/1.1 " + std::to_string(code) + " " + reason_phrase(code) + "\r\nContent-Type: " + type +
+                     "\r\nContent-Length: " + std::to_string(length) +
+                     "\r\nCache-Control: no-cache\r\nX-Content-Type-Options: nosniff\r\nContent-Security-Policy: " +
+                     kContentSecurityPolicy + "\r\n";
+  for (const auto& [name, value] : extra) head += name + ": " + value + "\r\n";
+  return head + "Connection: close\r\n\r\n";
 }
 
 int hex_value(char c) {
@@ -119,12 +143,61 @@ std::string header_value(const std::string& request, const std::string& name) {
   return {};
 }
 
+// A handler that throws (out of memory) answers 500 instead of ending the process from a worker thread.
+template <class H>
+HttpResponse call_handler(const H& handler, const HttpRequest& request) {
+  try {
+    return handler.handler(request);
+  } catch (const std::exception& e) {
+    return HttpResponse::error(500, std::string("internal error: ") + e.what());
+  }
+}
+
 bool is_regular_file(const std::string& path) {
   struct stat st {};
   return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
 
 }  // namespace
+
+HttpResponse HttpResponse::error(int status, std::string reason) {
+  HttpResponse r;
+  r.status = status;
+  r.content_type = "text/plain; charset=utf-8";
+  for (char& c : reason)
+    if (c == '\n' || c == '\r') c = ' ';
+  r.body = std::move(reason) + "\n";
+  return r;
+}
+
+bool query_value(const std::string& query, const std::string& name, std::string& value) {
+  size_t start = 0;
+  while (start <= query.size()) {
+    const size_t end = std::min(query.find('&', start), query.size());
+    const size_t eq = query.find('=', start);
+    if (eq != std::string::npos && eq < end && query.compare(start, eq - start, name) == 0) {
+      value.clear();
+      for (size_t i = eq + 1; i < end; ++i) {
+        if (query[i] == '%') {
+          if (i + 2 >= end) return false;
+          const int hi = hex_value(query[i + 1]), lo = hex_value(query[i + 2]);
+          if (hi < 0 || lo < 0) return false;
+          value += static_cast<char>(hi * 16 + lo);
+          i += 2;
+        } else {
+          value += query[i] == '+' ? ' ' : query[i];
+        }
+      }
+      return true;
+    }
+    start = end + 1;
+  }
+  return false;
+}
+
+void StaticServer::add_handler(std::string method, std::string url_path, HttpHandler handler) {
+  handlers_.push_back({std::move(method), std::move(url_path), std::move(handler)});
+}
 
 StaticServer::~StaticServer() {
   if (listen_fd_ >= 0) ::close(listen_fd_);
@@ -313,6 +386,20 @@ bool StaticServer::host_allowed(const std::string& host) const {
   return name == "127.0.0.1" || name == "localhost" || name == "[::1]";
 }
 
+bool StaticServer::origin_allowed(const std::string& origin) const {
+  if (origin.empty()) return true;  // curl and scripts send none; browsers send it on every POST
+  const std::string scheme = "http://";
+  if (origin.compare(0, scheme.size(), scheme) != 0) return false;
+  return host_allowed(origin.substr(scheme.size()));
+}
+
+void StaticServer::answer(int client, const HttpResponse& response, bool head_only,
+                          const std::atomic<bool>& stop) const {
+  const std::string head = header_for(response.body.size(), response.content_type, response.status, response.headers);
+  if (send_all(client, head.data(), head.size(), stop) && !head_only)
+    send_all(client, response.body.data(), response.body.size(), stop);
+}
+
 void StaticServer::handle(Connection& conn, const std::atomic<bool>& stop) const {
   const int client = conn.fd;
   std::string request;
@@ -337,10 +424,48 @@ void StaticServer::handle(Connection& conn, const std::atomic<bool>& stop) const
   if (!host_allowed(header_value(request, "host"))) return send_status(client, 403, "Forbidden", stop);
   const std::string method = line.substr(0, sp1);
   const std::string target = line.substr(sp1 + 1, sp2 - sp1 - 1);
-  if (method != "GET" && method != "HEAD") return send_status(client, 405, "Method Not Allowed", stop);
+  if (method != "GET" && method != "HEAD" && method != "POST")
+    return send_status(client, 405, "Method Not Allowed", stop);
   const bool head_only = method == "HEAD";
   const std::string path = safe_request_path(target);
   if (path.empty()) return send_status(client, 403, "Forbidden", stop);
+
+  const Handler* handler = nullptr;
+  for (const Handler& h : handlers_) {
+    if (h.url_path == path && (h.method == method || (h.method == "GET" && head_only))) handler = &h;
+  }
+  if (method == "POST") {
+    if (handler == nullptr) return send_status(client, 405, "Method Not Allowed", stop);
+    if (!origin_allowed(header_value(request, "origin"))) return send_status(client, 403, "Forbidden", stop);
+    const std::string type = header_value(request, "content-type");
+    if (type.compare(0, 16, "application/json") != 0)
+      return answer(client, HttpResponse::error(415, "POST needs Content-Type: application/json"), false, stop);
+    const std::string length_text = header_value(request, "content-length");
+    uint64_t length = 0;
+    const auto [end, error] = std::from_chars(length_text.data(), length_text.data() + length_text.size(), length);
+    // No Content-Length and no Transfer-Encoding: no body (RFC 9112; `curl -X POST` sends neither).
+    // Chunked bodies are refused: the length must be known before anything is read.
+    if ((!length_text.empty() && (error != std::errc() || end != length_text.data() + length_text.size())) ||
+        !header_value(request, "transfer-encoding").empty())
+      return answer(client, HttpResponse::error(411, "POST needs a Content-Length"), false, stop);
+    if (length > kMaxBodyBytes) return answer(client, HttpResponse::error(413, "body over 16 MiB"), false, stop);
+    HttpRequest req{method, path, {}, request.substr(request.find("\r\n\r\n") + 4)};
+    const auto body_deadline = Clock::now() + std::chrono::seconds(kBodySeconds);
+    while (req.body.size() < length) {
+      if (!wait_ready(client, POLLIN, stop, body_deadline)) return;
+      const ssize_t n = ::recv(client, buf.data(), std::min(buf.size(), length - req.body.size()), MSG_DONTWAIT);
+      if (n < 0 && (errno == EINTR || errno == EAGAIN || errno == EWOULDBLOCK)) continue;
+      if (n <= 0) return;
+      req.body.append(buf.data(), static_cast<size_t>(n));
+    }
+    if (req.body.size() > length) req.body.resize(length);
+    return answer(client, call_handler(*handler, req), false, stop);
+  }
+  if (handler != nullptr) {
+    const size_t q = target.find('?');
+    const HttpRequest req{method, path, q == std::string::npos ? std::string() : target.substr(q + 1), {}};
+    return answer(client, call_handler(*handler, req), head_only, stop);
+  }
 
   std::string file;
   for (const Route& r : routes_) {

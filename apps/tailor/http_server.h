@@ -1,18 +1,24 @@
-// A minimal static file server for `tailor view`: HTTP/1.1 GET (and HEAD) only, bound to
-// 127.0.0.1 only, one short-lived connection per request (Connection: close).
+// A minimal file server for `tailor view` and `tailor edit`: HTTP/1.1 GET (and HEAD), and POST to
+// handlers, bound to 127.0.0.1 only, one short-lived connection per request (Connection: close).
 //
 // What it serves, in this order:
-//   1. explicit routes: an URL path mapped to one file on disk, or to bytes held in memory
+//   1. handlers (add_handler): a method and an URL path answered by a callback (tailor edit's API);
+//   2. explicit routes: an URL path mapped to one file on disk, or to bytes held in memory
 //      (the model, its textures, the generated /config.json);
-//   2. files under the web root (index.html for "/"), after refusing any path with a ".."
+//   3. files under the web root (index.html for "/"), after refusing any path with a ".."
 //      segment, a backslash or a NUL byte, and checking that the resolved real path (symlinks
 //      followed) still lies inside the root.
-// Everything else gets 404; other methods get 405. Not meant for untrusted networks: it listens on
-// the loopback interface only.
+// Everything else gets 404; other methods, and POST to a path without a handler, get 405. A POST
+// body must come with a Content-Length (411 for chunked ones; at most 16 MiB, 413; none: no body)
+// and every POST with Content-Type: application/json
+// (415), and an Origin header, when sent, must be this server's: a page from another site cannot
+// send such a request without a CORS preflight, which is refused (cross-site request forgery).
+// Not meant for untrusted networks: it listens on the loopback interface only.
 #pragma once
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -29,6 +35,30 @@ struct Route {
   std::string content_type;  //!< empty: from the extension of url_path
 };
 
+//! A request as a handler sees it.
+struct HttpRequest {
+  std::string method;  //!< "GET", "HEAD" or "POST"
+  std::string path;    //!< decoded, as safe_request_path gives it
+  std::string query;   //!< the raw text after '?', without it ("" when none)
+  std::string body;    //!< POST: the body (Content-Length bytes)
+};
+
+//! A handler's answer. Status codes other than 200 carry a one-line reason as text/plain body.
+struct HttpResponse {
+  int status = 200;
+  std::string content_type = "application/json";
+  std::string body;
+  std::vector<std::pair<std::string, std::string>> headers;  //!< extra headers (name, value)
+
+  //! An error answer: `status` with `reason` (one line) as its text body.
+  static HttpResponse error(int status, std::string reason);
+};
+
+using HttpHandler = std::function<HttpResponse(const HttpRequest&)>;
+
+//! Value of `name` in a query string ("version=3&x=1"), %-decoded; false when absent or malformed.
+bool query_value(const std::string& query, const std::string& name, std::string& value);
+
 class StaticServer {
  public:
   StaticServer() = default;
@@ -40,6 +70,10 @@ class StaticServer {
   //! Fails with kIo when the port is taken or sockets are unavailable, kInvalidArgument for a
   //! port outside 0..65535 or a web root that is not a directory.
   Status start(const std::string& web_root, std::vector<Route> routes, int port);
+
+  //! Answers `method` ("GET" or "POST"; GET handlers also answer HEAD) requests for `url_path` by
+  //! `handler`, called on the connection's thread (handlers run concurrently). Before serve().
+  void add_handler(std::string method, std::string url_path, HttpHandler handler);
 
   //! The port actually bound (after start).
   int port() const { return port_; }
@@ -75,7 +109,15 @@ class StaticServer {
     void close();
   };
 
+  struct Handler {
+    std::string method;
+    std::string url_path;
+    HttpHandler handler;
+  };
+
   bool host_allowed(const std::string& host) const;
+  bool origin_allowed(const std::string& origin) const;
+  void answer(int client, const HttpResponse& response, bool head_only, const std::atomic<bool>& stop) const;
   void handle(Connection& conn, const std::atomic<bool>& stop) const;
   std::string resolve_under_root(const std::string& path) const;
 
@@ -83,6 +125,7 @@ class StaticServer {
   int port_ = 0;
   std::string root_;  // real path of the web root, no trailing '/'
   std::vector<Route> routes_;
+  std::vector<Handler> handlers_;
 };
 
 }  // namespace tailor::cli

@@ -26,6 +26,7 @@ int run_command(int argc, char** argv) {
       "  tailor tile bricks.jpg -o bricks_tile.png                # self-tileable texture\n"
       "  tailor eval bunny.glb                                    # UV quality metrics\n"
       "  tailor info bunny.ply                                    # what a mesh file holds\n"
+      "  tailor edit bunny.ply --texture bricks.png               # paint seams in the browser\n"
       "Run 'tailor <command> --help' for the options of each command.");
 
   Runner run;
@@ -36,6 +37,7 @@ int run_command(int argc, char** argv) {
   register_eval_tile(app, run);
   register_render(app, run);
   register_view(app, run);
+  register_edit(app, run);
 
   try {
     app.parse(argc, argv);

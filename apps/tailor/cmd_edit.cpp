@@ -1,0 +1,301 @@
+// tailor edit: the texturing tool (thesis 2.5 and chapter 4). Maps a mesh as `tailor map` does, opens an
+// EditSession and serves the editing page (web/edit.html) and its API (edit_api.h) on 127.0.0.1 until
+// Ctrl-C. Edits are answered at once by a fast local update; a background thread settles to the full
+// `tailor map` result when the user pauses.
+#include <stdlib.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cli.h"
+#include "edit_api.h"
+#include "http_server.h"
+#include "map_shared.h"
+#include "tailor/axis_choice.h"
+#include "tailor/io.h"
+#include "tailor/mapping.h"
+#include "tailor/texture_direction.h"
+
+namespace tailor::cli {
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+
+extern "C" void on_edit_stop_signal(int) { g_stop.store(true); }
+
+Status usage_error(const std::string& what) { return Status::error(ErrorCode::kInvalidArgument, "", what); }
+
+struct EditArgs {
+  std::string input;
+  std::string output;
+  std::string texture;
+  std::string web_root;
+  int port = 0;
+  bool quiet = false;
+  int texture_size = ExportOptions{}.texture_width;
+  std::string compress = mesh_compression_name(ExportOptions{}.compression);
+  int uv_set = ExportOptions{}.uv_set;
+  std::string up = ExportOptions{}.up == SceneUp::kZ ? "z" : "y";
+  MapTextureOptions options;
+  std::string mode = mapping_mode_name(MappingOptions{}.mode);
+  std::string axis = axis_text(OrientationOptions{});
+  std::string field_following = "auto";
+  bool crack_rings_given = false;
+  std::string seed_point;
+  std::string seam_faces;
+  std::string strokes;
+};
+
+// "out/a.glb" + "seam_faces.txt" -> "out/a_seam_faces.txt"
+std::string beside(const std::string& path, const std::string& suffix) {
+  const std::filesystem::path p(path);
+  return (p.parent_path() / (p.stem().string() + "_" + suffix)).string();
+}
+
+std::string extension_of(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext.empty() ? ext : ext.substr(1);
+}
+
+// A private temporary folder, removed when the command ends.
+struct ScratchDir {
+  std::string path;
+  ~ScratchDir() {
+    if (!path.empty()) {
+      std::error_code ignored;
+      std::filesystem::remove_all(path, ignored);
+    }
+  }
+};
+
+int run_edit(const EditArgs& opt) {
+  EditContext context;
+  context.quiet = opt.quiet;
+  context.input = opt.input;
+  context.name = std::filesystem::path(opt.input).filename().string();
+  context.texture_arg = opt.texture;
+  // === Options, checked before any work, in the order `tailor map` takes them ===
+  context.glb_path = opt.output.empty() ? std::filesystem::path(opt.input).stem().string() + "_edited.glb" : opt.output;
+  if (extension_of(context.glb_path) != "glb")
+    return report_error(usage_error("-o must end in .glb, got '" + context.glb_path + "'"));
+  context.seam_faces_path = beside(context.glb_path, "seam_faces.txt");
+  context.strokes_path = beside(context.glb_path, "strokes.json");
+  MeshOutput& output = context.output;
+  if (!mesh_compression_from_name(opt.compress, output.compression))
+    return report_error(usage_error("--compress must be none, quantize, meshopt or draco, got '" + opt.compress + "'"));
+  if (opt.up != "y" && opt.up != "z") return report_error(usage_error("--up must be y or z, got '" + opt.up + "'"));
+  output.up = opt.up == "z" ? SceneUp::kZ : SceneUp::kY;
+  output.uv_set = opt.uv_set;
+  MapTextureOptions options = opt.options;
+  const bool auto_axis = opt.axis == "auto";
+  if (!auto_axis) {
+    if (Status s = parse_axis(opt.axis, options.orientation); !s) return report_error(s);
+  }
+  MappingOptions& mapping = options.mapping;
+  if (!mapping_mode_from_name(opt.mode, mapping.mode))
+    return report_error(usage_error("--mode must be patches or thesis, got '" + opt.mode + "'"));
+  if (!opt.seed_point.empty()) {
+    if (!parse_vec3(opt.seed_point, mapping.seed_point))
+      return report_error(usage_error("--seed-point must be three numbers X,Y,Z, got '" + opt.seed_point + "'"));
+    mapping.use_seed_point = true;
+  }
+  if (opt.texture_size <= 0) return report_error(usage_error("--texture-size must be positive"));
+  if (Status s = check_map_options(options); !s) return report_error(s);
+  if (opt.field_following != "auto" && !parse_unit_float(opt.field_following, mapping.field_following))
+    return report_error(
+        usage_error("--field-following must be auto or a number in [0, 1], got '" + opt.field_following + "'"));
+  if (Status s = check_outputs({{context.glb_path, "--output"},
+                                {context.seam_faces_path, "the seam faces beside --output"},
+                                {context.strokes_path, "the strokes beside --output"}},
+                               {opt.input, opt.texture, opt.seam_faces, opt.strokes});
+      !s)
+    return report_error(s);
+  std::vector<OrientationStroke> strokes;
+  if (!opt.strokes.empty()) {
+    if (Status s = load_strokes(opt.strokes, strokes); !s) return report_error(s);
+    options.orientation.strokes = strokes;
+  }
+  std::string root;
+  if (Status s = find_web_root(opt.web_root, root); !s) return report_error(s);
+  if (!std::filesystem::exists(root + "/edit.html"))
+    return report_error(Status::error(ErrorCode::kIo, root, "the editing page (edit.html) is missing"));
+
+  // === Texture ===
+  std::vector<Route> routes;
+  if (!opt.texture.empty()) {
+    if (Status s = load_image(opt.texture, context.texture); !s) return report_error(s);
+    context.texture_url = "/files/texture." + extension_of(opt.texture);
+    routes.push_back({context.texture_url, opt.texture, "", ""});
+  }
+  output.texture_path = opt.texture;
+  output.texture_width = !context.texture.empty() ? context.texture.width : opt.texture_size;
+  output.texture_height = !context.texture.empty() ? context.texture.height : opt.texture_size;
+  if (Status s = set_map_texture_size(options, output.texture_width, output.texture_height); !s) return report_error(s);
+  if (opt.field_following == "auto") {
+    const uint32_t rings = mapping.crack_rings;
+    adapt_mapping_to_texture(context.texture, mapping);
+    if (opt.crack_rings_given) mapping.crack_rings = rings;
+  }
+
+  // === Mesh, seam faces, the first full map ===
+  Mesh mesh;
+  LoadReport load;
+  {
+    const ReadingInput reading(opt.input);
+    if (Status s = load_mesh(opt.input, mesh, &load); !s) return report_error(s);
+  }
+  if (load.degenerate_faces || load.duplicate_faces)
+    warn(opt.quiet, opt.input + ": dropped " + std::to_string(load.degenerate_faces + load.duplicate_faces) +
+                        " degenerate or duplicate faces (face ids are those of the loaded mesh)");
+  std::vector<uint8_t> seam_faces;
+  if (!opt.seam_faces.empty()) {
+    if (Status s = load_seam_faces(opt.seam_faces, mesh.face_count(), seam_faces); !s) return report_error(s);
+    mapping.seam_faces = seam_faces;
+  } else if (!mesh.seam_faces.empty()) {
+    seam_faces = mesh.seam_faces;
+    mapping.seam_faces = seam_faces;
+  }
+  context.topology = build_topology(mesh);
+  if (auto_axis) {
+    AxisChoice choice;
+    if (Status s = choose_orientation_axis(mesh, context.topology, options, choice); !s)
+      return report_error(s.with_file(opt.input));
+    options.orientation = orientation_for(choice.best, options.orientation);
+    warn(opt.quiet, std::string("axis auto: ") + axis_candidate_name(choice.best));
+  }
+  const auto start = std::chrono::steady_clock::now();
+  if (Status s = EditSession::open(std::move(mesh), options, context.session); !s)
+    return report_error(s.with_file(opt.input));
+  const double open_seconds = seconds_since(start);
+
+  // === Serve ===
+  ScratchDir scratch;
+  {
+    const char* tmp = std::getenv("TMPDIR");
+    std::string pattern = std::string(tmp != nullptr && *tmp != '\0' ? tmp : "/tmp") + "/tailor-edit-XXXXXX";
+    if (::mkdtemp(pattern.data()) == nullptr)
+      return report_error(Status::error(ErrorCode::kIo, pattern, "cannot create a temporary folder"));
+    scratch.path = pattern;
+    context.scratch_dir = pattern;
+  }
+  routes.push_back({"/", root + "/edit.html", "", ""});
+  StaticServer server;
+  if (Status s = server.start(root, routes, opt.port); !s) return report_error(s);
+  EditApi api(context);
+  api.install(server);
+
+  struct sigaction action {};
+  action.sa_handler = on_edit_stop_signal;
+  sigemptyset(&action.sa_mask);
+  ::sigaction(SIGINT, &action, nullptr);
+  ::sigaction(SIGTERM, &action, nullptr);
+
+  std::atomic<bool> settler_done{false};
+  std::thread settler([&api, &settler_done] {
+    api.run_settler(g_stop);
+    settler_done.store(true);
+  });
+  // Always printed (also with --quiet): the URL is the point of the command, and scripts read it.
+  std::printf("tailor edit: http://127.0.0.1:%d/  (%s, %zu faces mapped in %.2f s; saves to %s; Ctrl-C to stop)\n",
+              server.port(), context.name.c_str(), context.session->mesh().face_count(), open_seconds,
+              context.glb_path.c_str());
+  std::fflush(stdout);
+  server.serve(g_stop);
+  api.wake();
+  // A settle of a large mesh cannot be interrupted (seconds at a million faces): Ctrl-C does not wait
+  // for it. Nothing is being written then (saves run on the server's threads, which have ended).
+  for (int i = 0; i < 50 && !settler_done.load(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  if (!opt.quiet) std::fprintf(stderr, "tailor edit: stopped\n");
+  if (!settler_done.load()) {
+    std::fflush(stdout);
+    std::error_code ignored;
+    std::filesystem::remove_all(scratch.path, ignored);
+    std::_Exit(kExitOk);
+  }
+  settler.join();
+  return kExitOk;
+}
+
+}  // namespace
+
+void register_edit(CLI::App& app, Runner& run) {
+  auto opt = std::make_shared<EditArgs>();
+  MappingOptions& mapping = opt->options.mapping;
+  OrientationOptions& orientation = opt->options.orientation;
+  auto* cmd = app.add_subcommand(
+      "edit", "Texturing tool in the browser: paint seam faces and orientation strokes, see the map update live");
+  cmd->add_option("mesh", opt->input, "Input mesh (.ply .obj .off .stl .glb .gltf), as 'tailor map' reads it")
+      ->required();
+  cmd->add_option("-o,--output", opt->output,
+                  "Where Save writes the textured .glb (default: <mesh name>_edited.glb here); the seam faces "
+                  "go beside it as <name>_seam_faces.txt, the strokes as <name>_strokes.json");
+  cmd->add_option("-t,--texture", opt->texture,
+                  "Texture image (PNG/JPEG), ideally self-tileable (see 'tailor tile'); sets the texture size");
+  cmd->add_option("--texture-size", opt->texture_size, "Texture size in pixels when no --texture is given")
+      ->capture_default_str();
+  add_documented(cmd, option_doc(kMappingOptionDocs, "seam_faces"), opt->seam_faces);
+  add_documented(cmd, option_doc(kOrientationOptionDocs, "strokes"), opt->strokes);
+  add_documented(cmd, option_doc(kExportOptionDocs, "compression"), opt->compress);
+  add_documented(cmd, option_doc(kExportOptionDocs, "uv_set"), opt->uv_set)->check(CLI::Range(0, 7));
+  add_documented(cmd, option_doc(kExportOptionDocs, "up"), opt->up);
+  cmd->add_option("--port", opt->port, "port on 127.0.0.1 (default: a free one)")->check(CLI::Range(0, 65535));
+  cmd->add_option("--web-root", opt->web_root, "folder holding the pages (edit.html, node_modules)");
+  auto* group = cmd->add_option_group("Mapping (as 'tailor map'; the page changes them too)");
+  add_documented(group, option_doc(kMappingOptionDocs, "mode"), opt->mode);
+  add_documented(group, option_doc(kMappingOptionDocs, "scale"), mapping.scale);
+  add_documented(group, option_doc(kMappingOptionDocs, "max_stretch"), mapping.max_stretch);
+  group
+      ->add_option("--field-following", opt->field_following,
+                   std::string(option_doc(kMappingOptionDocs, "field_following").help))
+      ->capture_default_str();
+  add_documented(group, option_doc(kMappingOptionDocs, "min_patch_faces"), mapping.min_patch_faces);
+  add_documented(group, option_doc(kMappingOptionDocs, "hop_age"), mapping.hop_age);
+  add_off_switch(group, option_doc(kMappingOptionDocs, "shorten_seams"), mapping.shorten_seams);
+  add_off_switch(group, option_doc(kMappingOptionDocs, "close_cracks"), mapping.close_cracks);
+  CLI::Option* crack_rings = add_documented(group, option_doc(kMappingOptionDocs, "crack_rings"), mapping.crack_rings)
+                                 ->check(CLI::Range(2u, 64u));
+  add_documented(group, option_doc(kMappingOptionDocs, "relax_iterations"), mapping.relax_iterations)
+      ->check(CLI::Range(0u, 1000u));
+  add_documented(group, option_doc(kMappingOptionDocs, "threshold_px"), mapping.threshold_px);
+  add_documented(group, option_doc(kOrientationOptionDocs, "axis"), opt->axis);
+  add_documented(group, option_doc(kOrientationOptionDocs, "smooth_passes"), orientation.smooth_passes)
+      ->check(CLI::Range(0u, 1000u));
+  add_documented(group, option_doc(kMappingOptionDocs, "seed_point"), opt->seed_point);
+  add_documented(group, option_doc(kMappingOptionDocs, "symmetry"), mapping.symmetry)->check(CLI::IsMember({1u, 4u}));
+  cmd->add_option("--threads", mapping.threads,
+                  "Threads for the orientation, the crack closing and the metrics (0 = one per core, up to 8); "
+                  "the result is the same for any count")
+      ->capture_default_str()
+      ->check(CLI::Range(0u, 64u));
+  cmd->add_flag("-q,--quiet", opt->quiet, "print only the URL and errors");
+  cmd->footer(
+      "Prints http://127.0.0.1:PORT/ : open it in a browser. In the page:\n"
+      "  brush (b) / erase (e): paint seam faces, where the mapping should put its seams; the map is\n"
+      "      redone around the faces as you paint, and settled to the full map when you pause;\n"
+      "  stroke (s): draw a curve on the surface; the texture follows it within the stroke's reach;\n"
+      "  axis, smoothing and the mapping options; views texture, patches, distortion, checker, seams;\n"
+      "  undo / redo (Ctrl-Z / Ctrl-Y); Save writes the .glb, the seam faces and the strokes, and\n"
+      "      prints the 'tailor map' command that replays them to the same bytes.\n"
+      "Right-drag (or orbit mode, o) turns the view, the wheel zooms. Scripts can use the same HTTP API\n"
+      "(docs/edit-api.md).\n"
+      "Examples:\n"
+      "  tailor edit bunny.ply --texture gravel_tile.png -o bunny.glb\n"
+      "  tailor edit horse.ply --axis skeleton --port 8080");
+  cmd->callback([&run, opt, crack_rings] {
+    opt->crack_rings_given = crack_rings->count() > 0;
+    run = [opt] { return run_edit(*opt); };
+  });
+}
+
+}  // namespace tailor::cli
