@@ -346,6 +346,9 @@ Status EditSession::settle(EditResult& result) {
   internal::LocalUpdate local;
   MapTextureOptions o = State::with_state(options, seam, strokes);
   o.mapping.progress = [&st, edits](float) { return st.edits.load() == edits; };
+  // Every stage's progress too (orientation, relaxation, metrics): the relaxation alone takes as long
+  // as the growth on large meshes, and an edit should not wait for it to share the cores.
+  o.stage_progress = [&st, edits](std::string_view, float) { return st.edits.load() == edits; };
   const Status s = internal::map_keeping_setup(st.mesh, st.topology, o, map, local);
   result.ms = ms_since(start);
   if (s.code() == ErrorCode::kCancelled) return Status::ok();
