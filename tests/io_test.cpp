@@ -85,8 +85,7 @@ std::string ascii_ply(const Mesh& m) {
     s += buf;
   }
   for (size_t f = 0; f < m.face_count(); ++f) {
-    std::snprintf(buf, sizeof buf, "3 %u %u %u 0.5 0.5 0.5\n", m.indices[3 * f], m.indices[3 * f + 1],
-                  m.indices[3 * f + 2]);
+    std::snprintf(buf, sizeof buf, "3 %u %u %u\n", m.indices[3 * f], m.indices[3 * f + 1], m.indices[3 * f + 2]);
     s += buf;
   }
   return s;
