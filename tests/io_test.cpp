@@ -951,5 +951,97 @@ TEST(Strokes, BadJsonNamesWhereAndLeavesNothing) {
   EXPECT_EQ(load_strokes(test::temp_path("no_such_strokes.json"), back).code(), ErrorCode::kIo);
 }
 
+// === Load progress for OFF and STL (issue 18 point 5) ===========================================
+
+// Loads `file` with a progress callback: every value in [0, 1], never going back, the last one 1;
+// returns whether one came from the parse itself (strictly inside (0, 0.8), before the repairs).
+bool expect_progress_complete(const std::string& file) {
+  std::vector<float> seen;
+  Mesh mesh;
+  EXPECT_TRUE(load_mesh(file, mesh, nullptr,
+                        [&seen](float f) {
+                          seen.push_back(f);
+                          return true;
+                        })
+                  .is_ok())
+      << file;
+  EXPECT_FALSE(mesh.empty()) << file;
+  if (seen.empty()) {
+    ADD_FAILURE() << file << ": no progress";
+    return false;
+  }
+  bool from_parse = false;
+  for (size_t i = 0; i < seen.size(); ++i) {
+    EXPECT_TRUE(seen[i] >= 0.f && seen[i] <= 1.f) << file << " " << seen[i];
+    if (i > 0) {
+      EXPECT_GE(seen[i], seen[i - 1]) << file;
+    }
+    from_parse = from_parse || (seen[i] > 0.f && seen[i] < 0.8f);
+  }
+  EXPECT_EQ(seen.back(), 1.f) << file;
+  return from_parse;
+}
+
+void expect_cancels(const std::string& file, float at) {
+  Mesh mesh;
+  const Status s = load_mesh(file, mesh, nullptr, [at](float f) { return f < at; });
+  EXPECT_EQ(s.code(), ErrorCode::kCancelled) << file << " at " << at;
+  EXPECT_TRUE(mesh.empty()) << file;
+}
+
+TEST(LoadProgress, OffAndStlReportAndCancel) {
+  for (const char* name : {"fandisk.off", "blobby-3cc.off", "featuretype.stl", "adis16480.stl"}) {
+    expect_progress_complete(mesh_path(name));
+    expect_cancels(mesh_path(name), 0.f);   // in the parse
+    expect_cancels(mesh_path(name), 0.9f);  // in the repairs
+  }
+}
+
+TEST(LoadProgress, LargeOffAndStlReportWhileParsing) {
+  // Files over the reporting step (a few MB): the parse itself reports, and cancelling there stops it.
+  const std::string dir = test::empty_temp_dir("io_test_load_progress");
+  const Mesh horse = load_test_mesh("horse.ply");
+  // Binary STL of the horse (4.8 MB): the welding reports.
+  std::string stl(80, 'x');
+  const uint32_t nf = static_cast<uint32_t>(horse.face_count());
+  stl.append(reinterpret_cast<const char*>(&nf), 4);
+  for (size_t f = 0; f < nf; ++f) {
+    float facet[12] = {};
+    for (int k = 0; k < 3; ++k)
+      std::memcpy(&facet[3 + 3 * k], &horse.positions[3 * size_t{horse.indices[3 * f + k]}], 12);
+    stl.append(reinterpret_cast<const char*>(facet), sizeof(facet));
+    stl.append(2, '\0');
+  }
+  // Ascii STL: adis16480.stl's facets three times over (6.4 MB).
+  std::string ascii;
+  ASSERT_TRUE(internal::read_file(mesh_path("adis16480.stl"), ascii).is_ok());
+  ascii = ascii + "\n" + ascii + "\n" + ascii;  // the file ends without a newline
+  // Ascii OFF of the horse, with face colours (over 4 MB).
+  std::string off = "OFF\n" + std::to_string(horse.vertex_count()) + " " + std::to_string(nf) + " 0\n";
+  char line[96];
+  for (size_t v = 0; v < horse.vertex_count(); ++v) {
+    std::snprintf(line, sizeof(line), "%.9g %.9g %.9g\n", horse.positions[3 * v], horse.positions[3 * v + 1],
+                  horse.positions[3 * v + 2]);
+    off += line;
+  }
+  for (size_t f = 0; f < nf; ++f) {
+    std::snprintf(line, sizeof(line), "3 %u %u %u 0.5 0.5 0.5\n", horse.indices[3 * f], horse.indices[3 * f + 1],
+                  horse.indices[3 * f + 2]);
+    off += line;
+  }
+  ASSERT_GT(off.size(), size_t{4} << 20);
+  const std::vector<std::pair<std::string, std::string>> files = {
+      {dir + "/horse.stl", stl}, {dir + "/adis3.stl", ascii}, {dir + "/horse.off", off}};
+  for (const auto& [path, bytes] : files) {
+    std::ofstream(path, std::ios::binary) << bytes;
+    EXPECT_TRUE(expect_progress_complete(path)) << path;
+    expect_cancels(path, 0.01f);
+  }
+  Mesh mesh;
+  ASSERT_TRUE(load_mesh(dir + "/horse.stl", mesh).is_ok());
+  EXPECT_EQ(mesh.face_count(), horse.face_count());
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace tailor

@@ -32,9 +32,9 @@ TAILOR_API MeshFormat mesh_format_from_path(const std::string& path);
 //! is unknown. Cost: one pass over the file, O(F + V) memory.
 TAILOR_API Status load_mesh(const std::string& path, Mesh& mesh, LoadReport* report = nullptr);
 
-//! load_mesh with progress in [0, 1] (tailor/progress.h): the parse (PLY and OBJ by bytes, glTF by
-//! accessor data decoded; checked every few MB, never per element), then the repairs; false
-//! cancels (kCancelled, the mesh left empty). OFF and STL report only the repairs.
+//! load_mesh with progress in [0, 1] (tailor/progress.h): the parse (PLY, OBJ, OFF and STL by bytes,
+//! glTF by accessor data decoded; reported every few MB, never per element), then the repairs;
+//! false cancels (kCancelled, the mesh left empty).
 TAILOR_API Status load_mesh(const std::string& path, Mesh& mesh, LoadReport* report, const ProgressCallback& progress);
 
 //! Parses a mesh held in memory (used by the fuzzers and the truncation tests).

@@ -191,8 +191,8 @@ Status read_mesh_in(std::span<const char> data, MeshFormat format, const std::st
     switch (format) {
       case MeshFormat::kPly: s = internal::read_ply(data, name, mesh, r, &progress); break;
       case MeshFormat::kObj: s = internal::read_obj(data, name, mesh, r, &progress); break;
-      case MeshFormat::kOff: s = internal::read_off(data, name, mesh, r); break;
-      case MeshFormat::kStl: s = internal::read_stl(data, name, mesh, r); break;
+      case MeshFormat::kOff: s = internal::read_off(data, name, mesh, r, &progress); break;
+      case MeshFormat::kStl: s = internal::read_stl(data, name, mesh, r, &progress); break;
       case MeshFormat::kGlb:
       case MeshFormat::kGltf: s = internal::read_gltf(data, name, base_dir, mesh, r, &progress); break;
       case MeshFormat::kUnknown:

@@ -20,7 +20,8 @@ uint64_t mul_sat(uint64_t a, uint64_t b) { return (a != 0 && b > UINT64_MAX / a)
 
 }  // namespace
 
-Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report) {
+Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,
+                ReadProgress* progress) {
   TextScanner s(data.data(), data.data() + data.size());
   s.set_hash_comments(true);
   s.skip_space();
@@ -88,6 +89,7 @@ Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh,
   reserve_huge(mesh.positions, static_cast<size_t>(3 * nv));
   mesh.positions.resize(static_cast<size_t>(3 * nv));
   for (size_t i = 0; i < nv; ++i) {
+    if (progress && !progress->at(data.size() - s.remaining())) return progress->cancelled(name);
     s.skip_space();
     if (s.at_end())
       return Status::error(ErrorCode::kParse, name, "unexpected end of file in vertex " + std::to_string(i), s.where());
@@ -103,6 +105,7 @@ Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh,
   reserve_huge(mesh.indices, static_cast<size_t>(3 * nf));
   std::vector<uint32_t> poly;
   for (size_t f = 0; f < nf; ++f) {
+    if (progress && !progress->at(data.size() - s.remaining())) return progress->cancelled(name);
     s.skip_space();
     if (s.at_end())
       return Status::error(ErrorCode::kParse, name, "unexpected end of file in face " + std::to_string(f), s.where());

@@ -20,12 +20,18 @@ constexpr size_t kBinaryHeader = 84;
 constexpr size_t kBinaryFacet = 50;  // normal, 3 positions (12 floats), 2 attribute bytes
 
 // Welds corner positions (#corners by 3) into mesh.positions / mesh.indices, in order of first use.
-void weld(const std::vector<float>& corners, Mesh& mesh, LoadReport& report) {
+// progress (binary files, whose copy is instant and whose welding is the work): told the bytes of
+// the facets welded, every 64k corners.
+Status weld(const std::vector<float>& corners, const std::string& name, Mesh& mesh, LoadReport& report,
+            ReadProgress* progress) {
   const size_t nc = corners.size() / 3;
   FlatIdTable table(nc);
   mesh.indices.resize(nc);
   mesh.positions.reserve(corners.size());
   for (size_t c = 0; c < nc; ++c) {
+    if (progress && c % 65536 == 0 && !progress->at(kBinaryHeader + c / 3 * kBinaryFacet)) {
+      return progress->cancelled(name);
+    }
     uint32_t bits[3];
     std::memcpy(bits, &corners[3 * c], 12);
     const uint64_t h = hash_mix((uint64_t{bits[0]} << 32 | bits[1]) ^ hash_mix(bits[2]));
@@ -37,6 +43,7 @@ void weld(const std::vector<float>& corners, Mesh& mesh, LoadReport& report) {
     mesh.indices[c] = id;
   }
   report.welded_vertices = nc - mesh.positions.size() / 3;
+  return Status::ok();
 }
 
 bool starts_with_solid(std::string_view s) {
@@ -64,8 +71,8 @@ Status read_binary(std::span<const char> data, const std::string& name, std::vec
   return Status::ok();
 }
 
-Status read_ascii(std::span<const char> data, const std::string& name, std::vector<float>& corners,
-                  LoadReport& report) {
+Status read_ascii(std::span<const char> data, const std::string& name, std::vector<float>& corners, LoadReport& report,
+                  ReadProgress* progress) {
   report.format = "STL ascii";
   TextScanner s(data.data(), data.data() + data.size());
   std::vector<float> loop;
@@ -80,6 +87,7 @@ Status read_ascii(std::span<const char> data, const std::string& name, std::vect
   };
   auto bad_number = [&]() { return Status::error(ErrorCode::kParse, name, "bad number in ascii STL", s.where()); };
   for (;;) {
+    if (progress && !progress->at(data.size() - s.remaining())) return progress->cancelled(name);
     s.skip_space();
     if (s.at_end()) break;
     const std::string_view w = s.word();
@@ -129,7 +137,8 @@ Status read_ascii(std::span<const char> data, const std::string& name, std::vect
 
 }  // namespace
 
-Status read_stl(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report) {
+Status read_stl(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,
+                ReadProgress* progress) {
   const std::string_view text(data.data(), data.size());
   bool binary = false;
   if (data.size() >= kBinaryHeader) {
@@ -147,9 +156,8 @@ Status read_stl(std::span<const char> data, const std::string& name, Mesh& mesh,
   if (binary)
     TAILOR_RETURN_IF_ERROR(read_binary(data, name, corners, report));
   else
-    TAILOR_RETURN_IF_ERROR(read_ascii(data, name, corners, report));
-  weld(corners, mesh, report);
-  return Status::ok();
+    TAILOR_RETURN_IF_ERROR(read_ascii(data, name, corners, report, progress));
+  return weld(corners, name, mesh, report, binary ? progress : nullptr);
 }
 
 }  // namespace tailor::internal

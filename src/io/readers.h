@@ -49,13 +49,16 @@ class ReadProgress {
 };
 
 //! progress (optional) is told the bytes parsed (PLY: per element and every 64k items of the generic
-//! loops; OBJ: every few MB; glTF: per primitive, in faces); OFF and STL report none.
+//! loops; OBJ, OFF and ascii STL: every few MB; binary STL: the welding, every 64k corners; glTF: per
+//! primitive, in faces).
 Status read_ply(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,
                 ReadProgress* progress = nullptr);
 Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,
                 ReadProgress* progress = nullptr);
-Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report);
-Status read_stl(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report);
+Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,
+                ReadProgress* progress = nullptr);
+Status read_stl(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,
+                ReadProgress* progress = nullptr);
 //! glTF 2.0 (.glb or .gltf): the default scene's mesh instances in world space, TEXCOORD_0 into
 //! corner_uvs (read_gltf.cpp). Buffer URIs are looked up in `base_dir` (empty: none is opened).
 Status read_gltf(std::span<const char> data, const std::string& name, const std::string& base_dir, Mesh& mesh,
