@@ -42,18 +42,11 @@ struct EditArgs {
   std::string web_root;
   int port = 0;
   bool quiet = false;
-  int texture_size = ExportOptions{}.texture_width;
   std::string compress = mesh_compression_name(ExportOptions{}.compression);
   int uv_set = ExportOptions{}.uv_set;
   std::string up = ExportOptions{}.up == SceneUp::kZ ? "z" : "y";
   MapTextureOptions options;
-  std::string mode = mapping_mode_name(MappingOptions{}.mode);
-  std::string axis = axis_text(OrientationOptions{});
-  std::string field_following = "auto";
-  bool crack_rings_given = false;
-  std::string seed_point;
-  std::string seam_faces;
-  std::string strokes;
+  MappingArgs mapping_args;  // the mapping options given as text (map_shared.h)
 };
 
 // "out/a.glb" + "seam_faces.txt" -> "out/a_seam_faces.txt"
@@ -97,33 +90,20 @@ int run_edit(const EditArgs& opt) {
   if (opt.up != "y" && opt.up != "z") return report_error(usage_error("--up must be y or z, got '" + opt.up + "'"));
   output.up = opt.up == "z" ? SceneUp::kZ : SceneUp::kY;
   output.uv_set = opt.uv_set;
+  const MappingArgs& args = opt.mapping_args;
   MapTextureOptions options = opt.options;
-  const bool auto_axis = opt.axis == "auto";
-  if (!auto_axis) {
-    if (Status s = parse_axis(opt.axis, options.orientation); !s) return report_error(s);
-  }
+  if (Status s = apply_mapping_args(args, options); !s) return report_error(s);
+  const bool auto_axis = args.auto_axis();
   MappingOptions& mapping = options.mapping;
-  if (!mapping_mode_from_name(opt.mode, mapping.mode))
-    return report_error(usage_error("--mode must be patches or thesis, got '" + opt.mode + "'"));
-  if (!opt.seed_point.empty()) {
-    if (!parse_vec3(opt.seed_point, mapping.seed_point))
-      return report_error(usage_error("--seed-point must be three numbers X,Y,Z, got '" + opt.seed_point + "'"));
-    mapping.use_seed_point = true;
-  }
-  if (opt.texture_size <= 0) return report_error(usage_error("--texture-size must be positive"));
-  if (Status s = check_map_options(options); !s) return report_error(s);
-  if (opt.field_following != "auto" && !parse_unit_float(opt.field_following, mapping.field_following))
-    return report_error(
-        usage_error("--field-following must be auto or a number in [0, 1], got '" + opt.field_following + "'"));
   if (Status s = check_outputs({{context.glb_path, "--output"},
                                 {context.seam_faces_path, "the seam faces beside --output"},
                                 {context.strokes_path, "the strokes beside --output"}},
-                               {opt.input, opt.texture, opt.seam_faces, opt.strokes});
+                               {opt.input, opt.texture, args.seam_faces, args.strokes});
       !s)
     return report_error(s);
   std::vector<OrientationStroke> strokes;
-  if (!opt.strokes.empty()) {
-    if (Status s = load_strokes(opt.strokes, strokes); !s) return report_error(s);
+  if (!args.strokes.empty()) {
+    if (Status s = load_strokes(args.strokes, strokes); !s) return report_error(s);
     options.orientation.strokes = strokes;
   }
   std::string root;
@@ -139,13 +119,13 @@ int run_edit(const EditArgs& opt) {
     routes.push_back({context.texture_url, opt.texture, "", ""});
   }
   output.texture_path = opt.texture;
-  output.texture_width = !context.texture.empty() ? context.texture.width : opt.texture_size;
-  output.texture_height = !context.texture.empty() ? context.texture.height : opt.texture_size;
+  output.texture_width = !context.texture.empty() ? context.texture.width : args.texture_size;
+  output.texture_height = !context.texture.empty() ? context.texture.height : args.texture_size;
   if (Status s = set_map_texture_size(options, output.texture_width, output.texture_height); !s) return report_error(s);
-  if (opt.field_following == "auto") {
+  if (args.auto_field_following()) {
     const uint32_t rings = mapping.crack_rings;
     adapt_mapping_to_texture(context.texture, mapping);
-    if (opt.crack_rings_given) mapping.crack_rings = rings;
+    if (args.crack_rings_given) mapping.crack_rings = rings;
   }
 
   // === Mesh, seam faces, the first full map ===
@@ -159,8 +139,8 @@ int run_edit(const EditArgs& opt) {
     warn(opt.quiet, opt.input + ": dropped " + std::to_string(load.degenerate_faces + load.duplicate_faces) +
                         " degenerate or duplicate faces (face ids are those of the loaded mesh)");
   std::vector<uint8_t> seam_faces;
-  if (!opt.seam_faces.empty()) {
-    if (Status s = load_seam_faces(opt.seam_faces, mesh.face_count(), seam_faces); !s) return report_error(s);
+  if (!args.seam_faces.empty()) {
+    if (Status s = load_seam_faces(args.seam_faces, mesh.face_count(), seam_faces); !s) return report_error(s);
     mapping.seam_faces = seam_faces;
   } else if (!mesh.seam_faces.empty()) {
     seam_faces = mesh.seam_faces;
@@ -232,7 +212,6 @@ int run_edit(const EditArgs& opt) {
 void register_edit(CLI::App& app, Runner& run) {
   auto opt = std::make_shared<EditArgs>();
   MappingOptions& mapping = opt->options.mapping;
-  OrientationOptions& orientation = opt->options.orientation;
   auto* cmd = app.add_subcommand(
       "edit", "Texturing tool in the browser: paint seam faces and orientation strokes, see the map update live");
   cmd->add_option("mesh", opt->input, "Input mesh (.ply .obj .off .stl .glb .gltf), as 'tailor map' reads it")
@@ -242,37 +221,19 @@ void register_edit(CLI::App& app, Runner& run) {
                   "go beside it as <name>_seam_faces.txt, the strokes as <name>_strokes.json");
   cmd->add_option("-t,--texture", opt->texture,
                   "Texture image (PNG/JPEG), ideally self-tileable (see 'tailor tile'); sets the texture size");
-  cmd->add_option("--texture-size", opt->texture_size, "Texture size in pixels when no --texture is given")
+  cmd->add_option("--texture-size", opt->mapping_args.texture_size, "Texture size in pixels when no --texture is given")
       ->capture_default_str();
-  add_documented(cmd, option_doc(kMappingOptionDocs, "seam_faces"), opt->seam_faces);
-  add_documented(cmd, option_doc(kOrientationOptionDocs, "strokes"), opt->strokes);
+  add_documented(cmd, option_doc(kMappingOptionDocs, "seam_faces"), opt->mapping_args.seam_faces);
+  add_documented(cmd, option_doc(kOrientationOptionDocs, "strokes"), opt->mapping_args.strokes);
   add_documented(cmd, option_doc(kExportOptionDocs, "compression"), opt->compress);
   add_documented(cmd, option_doc(kExportOptionDocs, "uv_set"), opt->uv_set)->check(CLI::Range(0, 7));
   add_documented(cmd, option_doc(kExportOptionDocs, "up"), opt->up);
   cmd->add_option("--port", opt->port, "port on 127.0.0.1 (default: a free one)")->check(CLI::Range(0, 65535));
   cmd->add_option("--web-root", opt->web_root, "folder holding the pages (edit.html, node_modules)");
   auto* group = cmd->add_option_group("Mapping (as 'tailor map'; the page changes them too)");
-  add_documented(group, option_doc(kMappingOptionDocs, "mode"), opt->mode);
-  add_documented(group, option_doc(kMappingOptionDocs, "scale"), mapping.scale);
-  add_documented(group, option_doc(kMappingOptionDocs, "max_stretch"), mapping.max_stretch);
-  group
-      ->add_option("--field-following", opt->field_following,
-                   std::string(option_doc(kMappingOptionDocs, "field_following").help))
-      ->capture_default_str();
-  add_documented(group, option_doc(kMappingOptionDocs, "min_patch_faces"), mapping.min_patch_faces);
-  add_documented(group, option_doc(kMappingOptionDocs, "hop_age"), mapping.hop_age);
-  add_off_switch(group, option_doc(kMappingOptionDocs, "shorten_seams"), mapping.shorten_seams);
-  add_off_switch(group, option_doc(kMappingOptionDocs, "close_cracks"), mapping.close_cracks);
-  CLI::Option* crack_rings = add_documented(group, option_doc(kMappingOptionDocs, "crack_rings"), mapping.crack_rings)
-                                 ->check(CLI::Range(2u, 64u));
-  add_documented(group, option_doc(kMappingOptionDocs, "relax_iterations"), mapping.relax_iterations)
-      ->check(CLI::Range(0u, 1000u));
-  add_documented(group, option_doc(kMappingOptionDocs, "threshold_px"), mapping.threshold_px);
-  add_documented(group, option_doc(kOrientationOptionDocs, "axis"), opt->axis);
-  add_documented(group, option_doc(kOrientationOptionDocs, "smooth_passes"), orientation.smooth_passes)
-      ->check(CLI::Range(0u, 1000u));
-  add_documented(group, option_doc(kMappingOptionDocs, "seed_point"), opt->seed_point);
-  add_documented(group, option_doc(kMappingOptionDocs, "symmetry"), mapping.symmetry)->check(CLI::IsMember({1u, 4u}));
+  const MappingOptionHandles handles = add_mapping_options(group, opt->mapping_args, opt->options, false);
+  handles.smooth->check(CLI::Range(0u, 1000u));  // rejected at parsing here (in `tailor map`, by the orientation)
+  const CLI::Option* crack_rings = handles.crack_rings;
   cmd->add_option("--threads", mapping.threads,
                   "Threads for the orientation, the crack closing and the metrics (0 = one per core, up to 8); "
                   "the result is the same for any count")
@@ -293,7 +254,7 @@ void register_edit(CLI::App& app, Runner& run) {
       "  tailor edit bunny.ply --texture gravel_tile.png -o bunny.glb\n"
       "  tailor edit horse.ply --axis skeleton --port 8080");
   cmd->callback([&run, opt, crack_rings] {
-    opt->crack_rings_given = crack_rings->count() > 0;
+    opt->mapping_args.crack_rings_given = crack_rings->count() > 0;
     run = [opt] { return run_edit(*opt); };
   });
 }

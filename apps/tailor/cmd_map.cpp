@@ -39,7 +39,6 @@ struct MapArgs {
   std::string texture;
   std::string material;            // --material: a folder of PBR maps or a JSON naming them (material.h)
   ImageLoadOptions image_options;  // --max-image-pixels (default: ImageLoadOptions')
-  int texture_size = ExportOptions{}.texture_width;
   std::string compress = mesh_compression_name(ExportOptions{}.compression);
   int uv_set = ExportOptions{}.uv_set;
   std::string up = ExportOptions{}.up == SceneUp::kZ ? "z" : "y";
@@ -50,13 +49,7 @@ struct MapArgs {
   std::string preview;
   bool preview_all = false;
   MapTextureOptions options;
-  std::string mode = mapping_mode_name(MappingOptions{}.mode);
-  std::string axis = axis_text(OrientationOptions{});
-  std::string field_following = "auto";  // or a number in [0, 1]
-  bool crack_rings_given = false;        // --crack-rings on the command line (kept over auto's)
-  std::string seed_point;
-  std::string seam_faces;
-  std::string strokes;  // --strokes: orientation strokes, JSON (read_strokes.cpp)
+  MappingArgs mapping_args;  // the mapping options given as text (map_shared.h)
   bool stability = false;
   bool quiet = false;
 };
@@ -108,24 +101,11 @@ int run_map(const MapArgs& opt) {
     return report_error(usage_error("--tile-size and --texels-per-unit must be positive"));
   if (opt.uv_set != 0 && ext != ".glb")
     return report_error(usage_error("--uv-set needs a .glb output, got '" + opt.output + "'"));
+  const MappingArgs& args = opt.mapping_args;
   MapTextureOptions options = opt.options;
-  const bool auto_axis = opt.axis == "auto";
-  if (!auto_axis) {
-    if (Status s = parse_axis(opt.axis, options.orientation); !s) return report_error(s);
-  }
+  if (Status s = apply_mapping_args(args, options); !s) return report_error(s);
+  const bool auto_axis = args.auto_axis();
   MappingOptions& mapping = options.mapping;
-  if (!mapping_mode_from_name(opt.mode, mapping.mode))
-    return report_error(usage_error("--mode must be patches or thesis, got '" + opt.mode + "'"));
-  if (!opt.seed_point.empty()) {
-    if (!parse_vec3(opt.seed_point, mapping.seed_point))
-      return report_error(usage_error("--seed-point must be three numbers X,Y,Z, got '" + opt.seed_point + "'"));
-    mapping.use_seed_point = true;
-  }
-  if (opt.texture_size <= 0) return report_error(usage_error("--texture-size must be positive"));
-  if (Status s = check_map_options(options); !s) return report_error(s);  // scale, hop age, symmetry
-  if (opt.field_following != "auto" && !parse_unit_float(opt.field_following, mapping.field_following))
-    return report_error(
-        usage_error("--field-following must be auto or a number in [0, 1], got '" + opt.field_following + "'"));
   UpAxis preview_up = RenderOptions{}.up;
   if (!up_axis_from_name(opt.preview_up, preview_up))
     return report_error(usage_error("--preview-up must be x, y, z, -x, -y or -z, got '" + opt.preview_up + "'"));
@@ -134,11 +114,11 @@ int run_map(const MapArgs& opt) {
         usage_error("give --texture or --material, not both (the material's colour map is the texture)"));
   if (!opt.material.empty() && ext != ".glb")
     return report_error(usage_error("--material needs a .glb output, got '" + opt.output + "'"));
-  if (Status s = check_outputs(output_paths(opt), {opt.input, opt.texture, opt.seam_faces, opt.strokes}); !s)
+  if (Status s = check_outputs(output_paths(opt), {opt.input, opt.texture, args.seam_faces, args.strokes}); !s)
     return report_error(s);
   std::vector<OrientationStroke> strokes;  // read first too: a bad file fails before any work
-  if (!opt.strokes.empty()) {
-    if (Status s = load_strokes(opt.strokes, strokes); !s) return report_error(s);
+  if (!args.strokes.empty()) {
+    if (Status s = load_strokes(args.strokes, strokes); !s) return report_error(s);
     options.orientation.strokes = strokes;
   }
 
@@ -155,15 +135,15 @@ int run_map(const MapArgs& opt) {
     if (Status s = load_image(texture_path, texture, opt.image_options); !s) return report_error(s);
   }
   // The UV lattice: the texture's size (a material's: its colour map's, which every map shares).
-  const int tex_w = !texture.empty() ? texture.width : material.width > 0 ? material.width : opt.texture_size;
-  const int tex_h = !texture.empty() ? texture.height : material.height > 0 ? material.height : opt.texture_size;
+  const int tex_w = !texture.empty() ? texture.width : material.width > 0 ? material.width : args.texture_size;
+  const int tex_h = !texture.empty() ? texture.height : material.height > 0 ? material.height : args.texture_size;
   // The lattice period, the metrics' texture size, the threads of every stage.
   if (Status s = set_map_texture_size(options, tex_w, tex_h); !s) return report_error(s);
   // auto: follow the field unless the texture has no direction to follow (texture_direction.h).
   float texture_isotropy = -1.f;
-  if (opt.field_following == "auto") {
+  if (args.auto_field_following()) {
     Progress measuring("texture", opt.quiet);
-    texture_isotropy = adapt_mapping_to_texture(texture, mapping, opt.crack_rings_given,
+    texture_isotropy = adapt_mapping_to_texture(texture, mapping, args.crack_rings_given,
                                                 [&measuring](float f) { return measuring.update(f); });
   }
 
@@ -185,8 +165,8 @@ int run_map(const MapArgs& opt) {
     warn(opt.quiet, opt.input + ": skipped " + std::to_string(load.skipped_primitives) +
                         " point and line primitives (only triangles are mapped)");
   std::vector<uint8_t> seam_faces;
-  if (!opt.seam_faces.empty()) {
-    if (Status s = load_seam_faces(opt.seam_faces, mesh.face_count(), seam_faces); !s) return report_error(s);
+  if (!args.seam_faces.empty()) {
+    if (Status s = load_seam_faces(args.seam_faces, mesh.face_count(), seam_faces); !s) return report_error(s);
     mapping.seam_faces = seam_faces;
   } else if (!mesh.seam_faces.empty()) {
     mapping.seam_faces = mesh.seam_faces;
@@ -228,11 +208,11 @@ int run_map(const MapArgs& opt) {
   run.texture_width = tex_w;
   run.texture_height = tex_h;
   run.texture_isotropy = texture_isotropy;
-  run.field_following_auto = opt.field_following == "auto";
-  run.axis = opt.axis;
+  run.field_following_auto = args.auto_field_following();
+  run.axis = args.axis;
   run.axis_auto = auto_axis;
-  run.seed_point = opt.seed_point;
-  run.seam_faces = opt.seam_faces;
+  run.seed_point = args.seed_point;
+  run.seam_faces = args.seam_faces;
   if (auto_axis) {
     const auto axis_start = std::chrono::steady_clock::now();
     Progress choosing("choosing axis", opt.quiet);
@@ -418,7 +398,6 @@ int run_map_inputs(const MapArgs& args) {
 void register_map(CLI::App& app, Runner& run) {
   auto opt = std::make_shared<MapArgs>();
   MappingOptions& mapping = opt->options.mapping;
-  OrientationOptions& orientation = opt->options.orientation;
   auto* cmd =
       app.add_subcommand("map", "Compute texture coordinates by homogeneous patch discovery and write a textured mesh");
   cmd->add_option("mesh", opt->inputs,
@@ -440,7 +419,7 @@ void register_map(CLI::App& app, Runner& run) {
                   "The colour map sets the texture size; all maps must share it. The .glb gets baseColor, normal "
                   "(+ per-vertex tangents; a DX map's green is flipped), metallicRoughness (G roughness, B "
                   "metallic) and occlusion (R); height is not a glTF map and is left out");
-  cmd->add_option("--texture-size", opt->texture_size, "Texture size in pixels when no --texture is given")
+  cmd->add_option("--texture-size", opt->mapping_args.texture_size, "Texture size in pixels when no --texture is given")
       ->capture_default_str();
   add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), opt->image_options.max_pixels)
       ->check(CLI::PositiveNumber);
@@ -462,28 +441,7 @@ void register_map(CLI::App& app, Runner& run) {
   cmd->add_option("--preview-up", opt->preview_up, std::string(option_doc(kRenderOptionDocs, "up").help))
       ->capture_default_str();
   auto* group = cmd->add_option_group("Mapping");
-  add_documented(group, option_doc(kMappingOptionDocs, "mode"), opt->mode);
-  add_documented(group, option_doc(kMappingOptionDocs, "scale"), mapping.scale);
-  add_documented(group, option_doc(kMappingOptionDocs, "max_stretch"), mapping.max_stretch);
-  group
-      ->add_option("--field-following", opt->field_following,
-                   std::string(option_doc(kMappingOptionDocs, "field_following").help))
-      ->capture_default_str();
-  add_documented(group, option_doc(kMappingOptionDocs, "min_patch_faces"), mapping.min_patch_faces);
-  add_documented(group, option_doc(kMappingOptionDocs, "hop_age"), mapping.hop_age);
-  add_off_switch(group, option_doc(kMappingOptionDocs, "shorten_seams"), mapping.shorten_seams);
-  add_off_switch(group, option_doc(kMappingOptionDocs, "close_cracks"), mapping.close_cracks);
-  CLI::Option* crack_rings = add_documented(group, option_doc(kMappingOptionDocs, "crack_rings"), mapping.crack_rings)
-                                 ->check(CLI::Range(2u, 64u));
-  add_documented(group, option_doc(kMappingOptionDocs, "relax_iterations"), mapping.relax_iterations)
-      ->check(CLI::Range(0u, 1000u));
-  add_documented(group, option_doc(kMappingOptionDocs, "threshold_px"), mapping.threshold_px);
-  add_documented(group, option_doc(kOrientationOptionDocs, "axis"), opt->axis);
-  add_documented(group, option_doc(kOrientationOptionDocs, "smooth_passes"), orientation.smooth_passes);
-  add_documented(group, option_doc(kMappingOptionDocs, "seed_point"), opt->seed_point);
-  add_documented(group, option_doc(kMappingOptionDocs, "seam_faces"), opt->seam_faces);
-  add_documented(group, option_doc(kOrientationOptionDocs, "strokes"), opt->strokes);
-  add_documented(group, option_doc(kMappingOptionDocs, "symmetry"), mapping.symmetry)->check(CLI::IsMember({1u, 4u}));
+  const CLI::Option* crack_rings = add_mapping_options(group, opt->mapping_args, opt->options, true).crack_rings;
   cmd->add_flag("--stability", opt->stability,
                 "Also remove ~10% of the faces, re-map and report how much the remaining UVs moved");
   cmd->add_option("--threads", mapping.threads,
@@ -505,7 +463,7 @@ void register_map(CLI::App& app, Runner& run) {
       "and 32 crack rings, the fewest seams; --field-following 1 keeps the orientation field, and\n"
       "the UVs of a mesh that is edited and re-mapped more stable (docs/mapping.md section 7).");
   cmd->callback([&run, opt, crack_rings] {
-    opt->crack_rings_given = crack_rings->count() > 0;
+    opt->mapping_args.crack_rings_given = crack_rings->count() > 0;
     run = [opt] { return run_map_inputs(*opt); };
   });
 }

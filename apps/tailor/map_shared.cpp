@@ -1,4 +1,5 @@
-// The --axis text and the export step of `tailor map`, shared with `tailor edit` (map_shared.h).
+// The mapping options, the --axis text and the export step of `tailor map`, shared with `tailor edit`
+// (map_shared.h).
 #include "map_shared.h"
 
 #include <array>
@@ -39,6 +40,58 @@ Status parse_axis(const std::string& text, OrientationOptions& o) {
   else if (!parse_vec3(text, o.user_axis))
     return Status::error(ErrorCode::kInvalidArgument, "",
                          "--axis must be pca, skeleton, x, y, z or three numbers X,Y,Z, got '" + text + "'");
+  return Status::ok();
+}
+
+MappingOptionHandles add_mapping_options(CLI::Option_group* group, MappingArgs& args, MapTextureOptions& options,
+                                         bool with_input_files) {
+  MappingOptions& mapping = options.mapping;
+  MappingOptionHandles handles;
+  add_documented(group, option_doc(kMappingOptionDocs, "mode"), args.mode);
+  add_documented(group, option_doc(kMappingOptionDocs, "scale"), mapping.scale);
+  add_documented(group, option_doc(kMappingOptionDocs, "max_stretch"), mapping.max_stretch);
+  group
+      ->add_option("--field-following", args.field_following,
+                   std::string(option_doc(kMappingOptionDocs, "field_following").help))
+      ->capture_default_str();
+  add_documented(group, option_doc(kMappingOptionDocs, "min_patch_faces"), mapping.min_patch_faces);
+  add_documented(group, option_doc(kMappingOptionDocs, "hop_age"), mapping.hop_age);
+  add_off_switch(group, option_doc(kMappingOptionDocs, "shorten_seams"), mapping.shorten_seams);
+  add_off_switch(group, option_doc(kMappingOptionDocs, "close_cracks"), mapping.close_cracks);
+  handles.crack_rings = add_documented(group, option_doc(kMappingOptionDocs, "crack_rings"), mapping.crack_rings)
+                            ->check(CLI::Range(2u, 64u));
+  add_documented(group, option_doc(kMappingOptionDocs, "relax_iterations"), mapping.relax_iterations)
+      ->check(CLI::Range(0u, 1000u));
+  add_documented(group, option_doc(kMappingOptionDocs, "threshold_px"), mapping.threshold_px);
+  add_documented(group, option_doc(kOrientationOptionDocs, "axis"), args.axis);
+  handles.smooth =
+      add_documented(group, option_doc(kOrientationOptionDocs, "smooth_passes"), options.orientation.smooth_passes);
+  add_documented(group, option_doc(kMappingOptionDocs, "seed_point"), args.seed_point);
+  if (with_input_files) {
+    add_documented(group, option_doc(kMappingOptionDocs, "seam_faces"), args.seam_faces);
+    add_documented(group, option_doc(kOrientationOptionDocs, "strokes"), args.strokes);
+  }
+  add_documented(group, option_doc(kMappingOptionDocs, "symmetry"), mapping.symmetry)->check(CLI::IsMember({1u, 4u}));
+  return handles;
+}
+
+Status apply_mapping_args(const MappingArgs& args, MapTextureOptions& options) {
+  const auto usage_error = [](const std::string& what) { return Status::error(ErrorCode::kInvalidArgument, "", what); };
+  if (!args.auto_axis()) {
+    if (Status s = parse_axis(args.axis, options.orientation); !s) return s;
+  }
+  MappingOptions& mapping = options.mapping;
+  if (!mapping_mode_from_name(args.mode, mapping.mode))
+    return usage_error("--mode must be patches or thesis, got '" + args.mode + "'");
+  if (!args.seed_point.empty()) {
+    if (!parse_vec3(args.seed_point, mapping.seed_point))
+      return usage_error("--seed-point must be three numbers X,Y,Z, got '" + args.seed_point + "'");
+    mapping.use_seed_point = true;
+  }
+  if (args.texture_size <= 0) return usage_error("--texture-size must be positive");
+  if (Status s = check_map_options(options); !s) return s;  // scale, hop age, symmetry
+  if (!args.auto_field_following() && !parse_unit_float(args.field_following, mapping.field_following))
+    return usage_error("--field-following must be auto or a number in [0, 1], got '" + args.field_following + "'");
   return Status::ok();
 }
 

@@ -1,15 +1,21 @@
 // What `tailor map` and `tailor edit` share so that an edit saved by the tool and replayed with
-// `tailor map` gives the same bytes: the --axis text, and the export step (texture or material
-// embedding, export_mesh's options).
+// `tailor map` gives the same bytes: the mapping options (their flags and the parsing of those given as
+// text), the --axis text, and the export step (texture or material embedding, export_mesh's options).
 #pragma once
 
 #include <string>
 
 #include "tailor/atlas.h"
 #include "tailor/export.h"
+#include "tailor/mapping.h"
 #include "tailor/mesh.h"
 #include "tailor/orientation.h"
 #include "tailor/status.h"
+
+namespace CLI {
+class Option;
+class Option_group;
+}  // namespace CLI
 
 namespace tailor::cli {
 
@@ -19,6 +25,39 @@ std::string axis_text(const OrientationOptions& o);
 //! Parses --axis (pca, skeleton, x, y, z or three numbers X,Y,Z; not auto, which the commands resolve
 //! by choose_orientation_axis). Fails with kInvalidArgument naming the text.
 Status parse_axis(const std::string& text, OrientationOptions& o);
+
+//! The mapping options of `tailor map` and `tailor edit` given as text (parsed by apply_mapping_args);
+//! the others are bound to their MapTextureOptions fields by add_mapping_options.
+struct MappingArgs {
+  std::string mode = mapping_mode_name(MappingOptions{}.mode);
+  std::string axis = axis_text(OrientationOptions{});  // or auto (resolved by choose_orientation_axis)
+  std::string field_following = "auto";                // or a number in [0, 1]
+  bool crack_rings_given = false;                      // --crack-rings on the command line (kept over auto's)
+  std::string seed_point;
+  std::string seam_faces;                            // --seam-faces: a file of face ids
+  std::string strokes;                               // --strokes: orientation strokes, JSON (read_strokes.cpp)
+  int texture_size = ExportOptions{}.texture_width;  // --texture-size, when no texture gives it
+
+  bool auto_axis() const { return axis == "auto"; }
+  bool auto_field_following() const { return field_following == "auto"; }
+};
+
+//! The options add_mapping_options made that a command refines or reads after parsing.
+struct MappingOptionHandles {
+  CLI::Option* crack_rings = nullptr;  // its count() sets MappingArgs::crack_rings_given
+  CLI::Option* smooth = nullptr;
+};
+
+//! Adds the mapping options (--mode ... --symmetry) to `group`, in the order of --help, bound to `args`
+//! and `options`. `with_input_files`: --seam-faces and --strokes go in the group too (before
+//! --symmetry), as in `tailor map`; `tailor edit` lists them with its files.
+MappingOptionHandles add_mapping_options(CLI::Option_group* group, MappingArgs& args, MapTextureOptions& options,
+                                         bool with_input_files);
+
+//! Parses the options given as text into `options` (an axis of auto is left to the command) and checks
+//! them and the bound ones (check_map_options), in the order the commands report them. Fails with
+//! kInvalidArgument naming the option.
+Status apply_mapping_args(const MappingArgs& args, MapTextureOptions& options);
 
 //! The output side of a mapping, as given on the command line of `tailor map`.
 struct MeshOutput {
