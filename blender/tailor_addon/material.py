@@ -25,15 +25,31 @@ def image_from_pixels(name, pixels):
     return image
 
 
+def _new_node_material(name):
+    """A new node material: (material, its nodes, its links, its Principled BSDF)."""
+    material = bpy.data.materials.new(name)
+    material.use_nodes = True
+    nodes, links = material.node_tree.nodes, material.node_tree.links
+    return material, nodes, links, next(n for n in nodes if n.type == "BSDF_PRINCIPLED")
+
+
+def _give_every_face(obj, material):
+    """Adds material to obj's slots (once) and gives it every face; returns it."""
+    mesh = obj.data
+    if material.name not in mesh.materials:
+        mesh.materials.append(material)
+    index = list(mesh.materials).index(material)
+    mesh.polygons.foreach_set("material_index", np.full(len(mesh.polygons), index, np.int32))
+    mesh.update()
+    return material
+
+
 def assign(obj, image, uv_map="tailor"):
     """Adds (or reuses) the material "tailor <image>" and gives it every face of obj."""
     name = f"tailor {image.name}"
     material = bpy.data.materials.get(name)
     if material is None:
-        material = bpy.data.materials.new(name)
-        material.use_nodes = True
-        nodes, links = material.node_tree.nodes, material.node_tree.links
-        shader = next(n for n in nodes if n.type == "BSDF_PRINCIPLED")
+        material, nodes, links, shader = _new_node_material(name)
         texture = nodes.new("ShaderNodeTexImage")
         texture.image = image
         texture.extension = "REPEAT"
@@ -43,13 +59,7 @@ def assign(obj, image, uv_map="tailor"):
         coordinates.location = (texture.location.x - 220, texture.location.y - 120)
         links.new(coordinates.outputs["UV"], texture.inputs["Vector"])
         links.new(texture.outputs["Color"], shader.inputs["Base Color"])
-    mesh = obj.data
-    if material.name not in mesh.materials:
-        mesh.materials.append(material)
-    index = list(mesh.materials).index(material)
-    mesh.polygons.foreach_set("material_index", np.full(len(mesh.polygons), index, np.int32))
-    mesh.update()
-    return material
+    return _give_every_face(obj, material)
 
 
 # The order the maps are loaded in: the colour map first (its size is the texture size).
@@ -84,10 +94,7 @@ def assign_maps(obj, maps, images, uv_map="tailor"):
     name = f"tailor {folder}"
     material = bpy.data.materials.get(name)
     if material is None:
-        material = bpy.data.materials.new(name)
-        material.use_nodes = True
-        nodes, links = material.node_tree.nodes, material.node_tree.links
-        shader = next(n for n in nodes if n.type == "BSDF_PRINCIPLED")
+        material, nodes, links, shader = _new_node_material(name)
         coordinates = nodes.new("ShaderNodeUVMap")
         coordinates.uv_map = uv_map
         coordinates.location = (shader.location.x - 900, shader.location.y)
@@ -134,10 +141,4 @@ def assign_maps(obj, maps, images, uv_map="tailor"):
                 source = join.outputs["Color"]
             links.new(source, normal_map.inputs["Color"])
             links.new(normal_map.outputs["Normal"], shader.inputs["Normal"])
-    mesh = obj.data
-    if material.name not in mesh.materials:
-        mesh.materials.append(material)
-    index = list(mesh.materials).index(material)
-    mesh.polygons.foreach_set("material_index", np.full(len(mesh.polygons), index, np.int32))
-    mesh.update()
-    return material
+    return _give_every_face(obj, material)
