@@ -366,6 +366,29 @@ TEST(GltfFiles, CommittedCompressedFilesMatchTheirSource) {
   }
 }
 
+// The JSON chunk of a .glb file.
+Json glb_json_of(const std::string& file) {
+  const std::string glb = test::read_all(file);
+  uint32_t json_length = 0;
+  std::memcpy(&json_length, glb.data() + 12, 4);
+  return Json::parse(glb.substr(20, json_length));
+}
+
+// Writes the .glb `file` again to `out` with its JSON chunk replaced by `j` (the BIN chunk kept).
+void write_glb_with_json(const std::string& file, const Json& j, const std::string& out) {
+  const std::string glb = test::read_all(file);
+  uint32_t json_length = 0;
+  std::memcpy(&json_length, glb.data() + 12, 4);
+  std::string text = j.dump();
+  while (text.size() % 4) text += ' ';
+  const std::string bin_chunk = glb.substr(20 + json_length);
+  std::string header_bytes(20, '\0');
+  const uint32_t header[5] = {0x46546C67, 2, static_cast<uint32_t>(20 + text.size() + bin_chunk.size()),
+                              static_cast<uint32_t>(text.size()), 0x4E4F534A};
+  std::memcpy(header_bytes.data(), header, 20);
+  std::ofstream(out, std::ios::binary) << header_bytes + text + bin_chunk;
+}
+
 class GltfTransformTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -431,20 +454,10 @@ TEST_F(GltfTransformTest, MergedAndInstancedScenes) {
   EXPECT_EQ(report.source_faces, 2 * source_.face_count());
 
   // Two nodes over the source's mesh: one where it is, one moved by (3, 0, 0).
-  std::string glb = test::read_all(path("source.glb"));
-  uint32_t json_length = 0;
-  std::memcpy(&json_length, glb.data() + 12, 4);
-  Json j = Json::parse(glb.substr(20, json_length));
+  Json j = glb_json_of(path("source.glb"));
   j["nodes"] = {{{"mesh", 0}}, {{"mesh", 0}, {"translation", {3, 0, 0}}}};
   j["scenes"] = {{{"nodes", {0, 1}}}};
-  std::string text = j.dump();
-  while (text.size() % 4) text += ' ';
-  const std::string bin_chunk = glb.substr(20 + json_length);
-  std::string out(20, '\0');
-  const uint32_t header[5] = {0x46546C67, 2, static_cast<uint32_t>(20 + text.size() + bin_chunk.size()),
-                              static_cast<uint32_t>(text.size()), 0x4E4F534A};
-  std::memcpy(out.data(), header, 20);
-  std::ofstream(path("two.glb"), std::ios::binary) << out + text + bin_chunk;
+  write_glb_with_json(path("source.glb"), j, path("two.glb"));
   transform("instance two.glb instanced.glb --min 2");
   Mesh two, instanced;
   ASSERT_TRUE(load_mesh(path("two.glb"), two).is_ok());
@@ -700,23 +713,12 @@ TEST(GltfKept, ObjColoursAndNormalsReachTheGlb) {
   fs::remove_all(dir);
 }
 
-// The JSON chunk of a .glb file.
-Json glb_json_of(const std::string& file) {
-  const std::string glb = test::read_all(file);
-  uint32_t json_length = 0;
-  std::memcpy(&json_length, glb.data() + 12, 4);
-  return Json::parse(glb.substr(20, json_length));
-}
-
 // The names, extras and materials of a scene made by glTF-Transform reach the output: two
 // instances of one mesh (named nodes with extras), two materials (factors, doubleSided, alphaMode,
 // emissive, extras), the scene's and the asset's extras; plain, meshopt and Draco inputs, every
 // compression on output; each output valid, read back with the same faces per material.
 TEST_F(GltfTransformTest, NamesExtrasAndMaterialsSurviveAMapping) {
-  std::string glb = test::read_all(path("source.glb"));
-  uint32_t json_length = 0;
-  std::memcpy(&json_length, glb.data() + 12, 4);
-  Json j = Json::parse(glb.substr(20, json_length));
+  Json j = glb_json_of(path("source.glb"));
   // The source's one primitive cut in two (its first half of the faces, its second), each with
   // its own material: the indices accessor split by byte offset.
   Json& primitive = j["meshes"][0]["primitives"][0];
@@ -748,14 +750,7 @@ TEST_F(GltfTransformTest, NamesExtrasAndMaterialsSurviveAMapping) {
   j["scenes"] = {{{"nodes", {0, 1}}, {"name", "barn"}, {"extras", {{"season", "spring"}}}}};
   j["asset"]["extras"] = {{"author", "test"}};
   j["asset"]["copyright"] = "CC0";
-  std::string text = j.dump();
-  while (text.size() % 4) text += ' ';
-  const std::string bin_chunk = glb.substr(20 + json_length);
-  std::string out(20, '\0');
-  const uint32_t header[5] = {0x46546C67, 2, static_cast<uint32_t>(20 + text.size() + bin_chunk.size()),
-                              static_cast<uint32_t>(text.size()), 0x4E4F534A};
-  std::memcpy(out.data(), header, 20);
-  std::ofstream(path("scene.glb"), std::ios::binary) << out + text + bin_chunk;
+  write_glb_with_json(path("source.glb"), j, path("scene.glb"));
   transform("meshopt scene.glb scene_meshopt.glb");
   transform("draco scene.glb scene_draco.glb");
 
