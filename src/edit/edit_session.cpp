@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <bit>
 #include <chrono>
 #include <deque>
 #include <mutex>
@@ -58,13 +57,8 @@ uint32_t count_changed(const Atlas& a, const Atlas& b) {
   if (a.patch.size() != b.patch.size() || a.corner_uv.size() != b.corner_uv.size())
     return static_cast<uint32_t>(std::max(a.patch.size(), b.patch.size()));
   uint32_t changed = 0;
-  for (size_t f = 0; f < a.patch.size(); ++f) {
-    const float* x = &a.corner_uv[6 * f];
-    const float* y = &b.corner_uv[6 * f];
-    bool same = a.patch[f] == b.patch[f];
-    for (int i = 0; i < 6 && same; ++i) same = std::bit_cast<uint32_t>(x[i]) == std::bit_cast<uint32_t>(y[i]);
-    changed += same ? 0u : 1u;
-  }
+  for (size_t f = 0; f < a.patch.size(); ++f)
+    changed += internal::same_face_bits(a.patch[f], &a.corner_uv[6 * f], b.patch[f], &b.corner_uv[6 * f]) ? 0u : 1u;
   return changed;
 }
 

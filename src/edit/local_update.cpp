@@ -2,7 +2,6 @@
 #include "edit/local_update.h"
 
 #include <algorithm>
-#include <bit>
 #include <cstring>
 
 #include "mapping/mapping_common.h"
@@ -146,10 +145,8 @@ Status update_region(const Mesh& mesh, const Topology& topology, const MapTextur
   TAILOR_RETURN_IF_ERROR(status);
   for (size_t i = 0; i < faces.size(); ++i) {
     const uint32_t f = faces[i];
-    bool same = atlas.patch[f] == old_patch[i];
-    for (int k = 0; k < 6 && same; ++k)
-      same = std::bit_cast<uint32_t>(atlas.corner_uv[6 * size_t{f} + k]) == std::bit_cast<uint32_t>(old_uv[6 * i + k]);
-    changed_faces += same ? 0u : 1u;
+    changed_faces +=
+        same_face_bits(atlas.patch[f], &atlas.corner_uv[6 * size_t{f}], old_patch[i], &old_uv[6 * i]) ? 0u : 1u;
   }
   return Status::ok();
 }

@@ -13,6 +13,7 @@
 // the whole mesh again.
 #pragma once
 
+#include <bit>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -23,6 +24,15 @@
 #include "tailor/topology.h"
 
 namespace tailor::internal {
+
+//! True when a face has the same patch and bit-identical corner UVs (6 floats) in two atlases: what
+//! EditResult::changed_faces counts the faces that are not.
+inline bool same_face_bits(uint32_t patch_a, const float* uv_a, uint32_t patch_b, const float* uv_b) {
+  if (patch_a != patch_b) return false;
+  for (int k = 0; k < 6; ++k)
+    if (std::bit_cast<uint32_t>(uv_a[k]) != std::bit_cast<uint32_t>(uv_b[k])) return false;
+  return true;
+}
 
 //! What the local update keeps between edits: the orientation's setup and the components' seeds
 //! of the current frames, and scratch arrays reused by every edit.
