@@ -635,8 +635,9 @@ TEST(Mapping, SeveralComponentsEachGetTheirPatches) {
 // Symmetry 4 (issue 14, experimental): an integer-grid map. Seams between faces away from the
 // field's singularities are quarter turns plus whole repeats, so under a 4-fold symmetric tile
 // more seam length is invisible than the growth's (its patches' sides differ by arbitrary
-// rotations). Every face stays within the per-face bound, none is flipped, and the result is the
-// same bytes for any thread count.
+// rotations), and with the lattice coordinates relaxed (grid_relax.h) less of it is visible too.
+// Every face stays within the lattice bound, none is flipped, and the result is the same bytes
+// for any thread count.
 TEST(Mapping, SymmetryFourGivesInvisibleSeams) {
   MetricsOptions quarter_turns;
   quarter_turns.symmetry = 4;
@@ -648,8 +649,9 @@ TEST(Mapping, SymmetryFourGivesInvisibleSeams) {
   };
   Mapped growth, grid1, grid4;
   growth.mesh = grid1.mesh = grid4.mesh = load_test_mesh("fandisk.off");
-  map_mesh(growth);
   MappingOptions options;
+  options.scale = 8000.f;  // ten times the default: the texture repeats ~15 times across the part
+  map_mesh(growth, options);
   options.symmetry = 4;
   options.threads = 1;
   map_mesh(grid1, options);
@@ -657,23 +659,27 @@ TEST(Mapping, SymmetryFourGivesInvisibleSeams) {
   map_mesh(grid4, options);
   EXPECT_EQ(grid1.atlas.corner_uv, grid4.atlas.corner_uv);
   EXPECT_EQ(grid1.atlas.patch, grid4.atlas.patch);
-  EXPECT_EQ(grid1.stats.cracks_closed, 0u);  // the grid map replaces the growth, shortening and closing
-  EXPECT_EQ(grid1.stats.faces_reseamed, 0u);
+  EXPECT_GT(grid1.stats.faces_reseamed, 0u);  // the seam shortening and relaxation follow the grid map
+  EXPECT_GT(grid1.stats.relax_moves, 0u);
   const UvMetrics before = metrics4(growth), after = metrics4(grid1);
   EXPECT_EQ(after.flipped, 0u);
-  // Measured (prototype): 0.0% -> 16.0% of seam length invisible, seams 3.2% -> 7.5% of edge length.
-  EXPECT_GT(after.seam_invisible_ratio, before.seam_invisible_ratio + 0.1);
+  // Measured: invisible share 0.0% -> 70%, visible seams 3.2% -> 1.4% of edge length (before the
+  // relaxation of the lattice coordinates: 31% and 5.4%).
+  EXPECT_GT(after.seam_invisible_ratio, 0.5);
+  EXPECT_LT(after.visible_seam_ratio, 0.6 * before.visible_seam_ratio);
   EXPECT_LT(after.l2_stretch, 1.02);
-  EXPECT_LT(after.linf_stretch, 1.3);
+  EXPECT_LT(after.linf_stretch, 3.0);
   for (size_t f = 0; f < grid1.mesh.face_count(); ++f) {
     if (is_degenerate(grid1.frames, f)) continue;
     const float err = face_stretch_error(std::span<const float, 6>(&grid1.frames.local[6 * f], 6), options.scale,
                                          std::span<const float, 6>(&grid1.atlas.corner_uv[6 * f], 6));
-    ASSERT_LE(err, options.max_stretch + 1e-3f) << "face " << f;
+    ASSERT_LE(err, 4.f * options.max_stretch + 1e-3f) << "face " << f;  // grid_map.h: lattice_max_stretch
   }
-  std::printf("fandisk invisible share: growth %.3f, symmetry 4 %.3f (seams %.4f -> %.4f, visible %.4f -> %.4f)\n",
-              before.seam_invisible_ratio, after.seam_invisible_ratio, before.seam_length_ratio,
-              after.seam_length_ratio, before.visible_seam_ratio, after.visible_seam_ratio);
+  std::printf(
+      "fandisk at scale 8000: invisible share growth %.3f, symmetry 4 %.3f (seams %.4f -> %.4f, visible "
+      "%.4f -> %.4f)\n",
+      before.seam_invisible_ratio, after.seam_invisible_ratio, before.seam_length_ratio, after.seam_length_ratio,
+      before.visible_seam_ratio, after.visible_seam_ratio);
   MappingOptions bad;
   bad.symmetry = 3;
   EXPECT_EQ(map_into(grid1, bad).code(), ErrorCode::kInvalidArgument);

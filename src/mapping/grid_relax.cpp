@@ -1,0 +1,176 @@
+// Relaxation of the lattice coordinates of an integer-grid map (grid_relax.h).
+//
+// Unknowns: per vertex its coordinate U_v in its own chart. A flat face sees its corners through
+// the lattice maps into its first corner's chart, P_k = M_k(U_k), and has the energy
+// A |J - R|^2, J = sum_k P_k g_k^T its Jacobian (g_k the gradient of corner k's barycentric
+// coordinate in the face's frame, pixels), R the rotation nearest to J (local step). The global
+// step puts each vertex where its faces' energies are least with the other corners held (the
+// exact Gauss-Seidel update: P_k |g_k|^2 = R g_k - sum_{j != k} P_j (g_j . g_k), weighted by
+// A |g_k|^2), each face's answer taken back into the vertex's chart through the inverse map.
+// Faces weigh robustly (kRobustScale below), so a mismatch the maps force stays in a few faces.
+// Vertices are coloured so that no two of a colour share a face; a colour's moves are
+// independent, so they run on any number of threads with the same result.
+//
+// This work is based on:
+//   L. Liu, L. Zhang, Y. Xu, C. Gotsman, S. J. Gortler, "A local/global approach to mesh
+//   parameterization", SGP 2008.
+#include "mapping/grid_relax.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "util/parallel_chunks.h"
+
+namespace tailor::internal {
+namespace {
+
+// Successive over-relaxation of the global step.
+constexpr float kOverRelaxation = 1.6f;
+// Robust weights: a face's energy counts 1 / (1 + |J - R|^2 / kRobustScale^2). Where the lattice
+// maps cannot be met isometrically (a strip where the position field's whole-repeat jumps disagree
+// with the surface by a fraction of a repeat), least squares would spread the mismatch over every
+// face around and flip many; the robust weights leave it in the few faces of the strip, which are
+// cut afterwards. Measured over the 16 shared meshes (median visible seam length at scale 800 /
+// 8000, before the seam shortening): 0.2: 6.9 / 4.9 %, 0.3: 6.3 / 3.7 %, 0.5: 5.9 / 2.7 %,
+// 1.0: 5.7 / 2.2 % but Sander L2 up to 1.05 (the issue's bound is 1.02); plain least squares
+// flipped a third of the bunny's faces.
+constexpr float kRobustScale = 0.5f;
+
+}  // namespace
+
+void relax_lattice_coordinates(const GridRelaxInput& in, std::vector<float>& uv) {
+  const size_t nf = in.mesh.face_count(), nv = in.mesh.vertex_count();
+  const uint32_t* idx = in.mesh.indices.data();
+  const float period = in.period;
+  if (in.iterations == 0 || nf == 0) return;
+
+  // Per face: the barycentric gradients (pixels^-1) and the area (pixels^2); 0 = not relaxed.
+  std::vector<float> grad(6 * nf, 0.f), area(nf, 0.f);
+  for_each_chunk(nf, in.threads, [&](size_t begin, size_t end, size_t) {
+    for (size_t f = begin; f < end; ++f) {
+      if (!in.flat[f]) continue;
+      const float* l = &in.frames.local[6 * f];
+      float x[6];
+      for (int i = 0; i < 6; ++i) x[i] = in.scale * l[i];
+      const float twice = (x[2] - x[0]) * (x[5] - x[1]) - (x[3] - x[1]) * (x[4] - x[0]);
+      if (!(twice > 1e-12f)) continue;
+      for (int k = 0; k < 3; ++k) {
+        const int a = (k + 1) % 3, b = (k + 2) % 3;  // g_k = perp(x_b - x_a) / 2A, perp(x, y) = (-y, x)
+        grad[6 * f + 2 * k] = -(x[2 * b + 1] - x[2 * a + 1]) / twice;
+        grad[6 * f + 2 * k + 1] = (x[2 * b] - x[2 * a]) / twice;
+      }
+      area[f] = 0.5f * twice;
+    }
+  });
+
+  // Vertex -> corners of its relaxed faces (CSR).
+  std::vector<uint32_t> start(nv + 1, 0), corners;
+  for (size_t f = 0; f < nf; ++f)
+    if (area[f] > 0.f)
+      for (int k = 0; k < 3; ++k) ++start[idx[3 * f + k] + 1];
+  for (size_t v = 0; v < nv; ++v) start[v + 1] += start[v];
+  corners.resize(start[nv]);
+  {
+    std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+    for (size_t f = 0; f < nf; ++f)
+      if (area[f] > 0.f)
+        for (uint32_t k = 0; k < 3; ++k) corners[fill[idx[3 * f + k]]++] = static_cast<uint32_t>(3 * f + k);
+  }
+
+  // Greedy colouring in vertex order; vertices grouped by colour.
+  std::vector<uint16_t> colour(nv, 0);
+  std::vector<uint8_t> used;
+  uint16_t colours = 1;
+  for (size_t v = 0; v < nv; ++v) {
+    used.assign(colours + 1, 0);
+    for (uint32_t i = start[v]; i < start[v + 1]; ++i) {
+      const uint32_t f = corners[i] / 3;
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t w = idx[3 * f + k];
+        if (w < v) used[colour[w]] = 1;
+      }
+    }
+    uint16_t c = 0;
+    while (used[c]) ++c;
+    colour[v] = c;
+    colours = std::max<uint16_t>(colours, c + 1);
+  }
+  std::vector<uint32_t> colour_start(colours + 1, 0), order(nv);
+  for (size_t v = 0; v < nv; ++v) ++colour_start[colour[v] + 1];
+  for (uint16_t c = 0; c < colours; ++c) colour_start[c + 1] += colour_start[c];
+  {
+    std::vector<uint32_t> fill(colour_start.begin(), colour_start.end() - 1);
+    for (size_t v = 0; v < nv; ++v) order[fill[colour[v]]++] = static_cast<uint32_t>(v);
+  }
+
+  std::vector<float> rotation(2 * nf, 0.f);  // per face (cos, sin) of R
+  std::vector<float> robust(nf, 1.f);        // per face: the robust weight of its energy
+  const auto corner_pos = [&](size_t f, int k, float* out) {
+    apply(in.corner_map[3 * f + k], period, &uv[2 * idx[3 * f + k]], out);
+  };
+  for (uint32_t it = 0; it < in.iterations; ++it) {
+    // Local step: the rotation nearest to each face's Jacobian.
+    for_each_chunk(nf, in.threads, [&](size_t begin, size_t end, size_t) {
+      for (size_t f = begin; f < end; ++f) {
+        if (!(area[f] > 0.f)) continue;
+        float j00 = 0.f, j01 = 0.f, j10 = 0.f, j11 = 0.f;
+        for (int k = 0; k < 3; ++k) {
+          float p[2];
+          corner_pos(f, k, p);
+          const float gx = grad[6 * f + 2 * k], gy = grad[6 * f + 2 * k + 1];
+          j00 += p[0] * gx;
+          j01 += p[0] * gy;
+          j10 += p[1] * gx;
+          j11 += p[1] * gy;
+        }
+        const float c = j00 + j11, s = j10 - j01, n = std::sqrt(c * c + s * s);
+        rotation[2 * f] = n > 0.f ? c / n : 1.f;
+        rotation[2 * f + 1] = n > 0.f ? s / n : 0.f;
+        const float rc = rotation[2 * f], rs = rotation[2 * f + 1];
+        const float e =
+            (j00 - rc) * (j00 - rc) + (j01 + rs) * (j01 + rs) + (j10 - rs) * (j10 - rs) + (j11 - rc) * (j11 - rc);
+        robust[f] = 1.f / (1.f + e / (kRobustScale * kRobustScale));
+      }
+    });
+    // Global step, colour by colour.
+    for (uint16_t col = 0; col < colours; ++col) {
+      const size_t first = colour_start[col], count = colour_start[col + 1] - first;
+      for_each_chunk(count, in.threads, [&](size_t begin, size_t end, size_t) {
+        for (size_t i = first + begin; i < first + end; ++i) {
+          const uint32_t v = order[i];
+          double sx = 0.0, sy = 0.0, sw = 0.0;
+          for (uint32_t c = start[v]; c < start[v + 1]; ++c) {
+            const uint32_t f = corners[c] / 3;
+            const int k = static_cast<int>(corners[c] % 3);
+            const float* g = &grad[6 * f];
+            const float gkx = g[2 * k], gky = g[2 * k + 1];
+            const float gg = gkx * gkx + gky * gky;
+            if (!(gg > 0.f)) continue;
+            const float rc = rotation[2 * f], rs = rotation[2 * f + 1];
+            float tx = rc * gkx - rs * gky, ty = rs * gkx + rc * gky;  // R g_k
+            for (int j = 0; j < 3; ++j) {
+              if (j == k) continue;
+              float p[2];
+              corner_pos(f, j, p);
+              const float d = g[2 * j] * gkx + g[2 * j + 1] * gky;
+              tx -= p[0] * d;
+              ty -= p[1] * d;
+            }
+            float target[2] = {tx / gg, ty / gg}, back[2];
+            apply(inverse(in.corner_map[3 * f + k]), period, target, back);
+            const double w = static_cast<double>(area[f]) * gg * robust[f];
+            sx += w * back[0];
+            sy += w * back[1];
+            sw += w;
+          }
+          if (!(sw > 0.0)) continue;
+          const float mx = static_cast<float>(sx / sw), my = static_cast<float>(sy / sw);
+          uv[2 * v] += kOverRelaxation * (mx - uv[2 * v]);
+          uv[2 * v + 1] += kOverRelaxation * (my - uv[2 * v + 1]);
+        }
+      });
+    }
+  }
+}
+
+}  // namespace tailor::internal
