@@ -32,7 +32,8 @@ struct GridRelaxInput {
 
 //! Moves uv (#V*2, field.uv: per vertex its lattice coordinate in its own chart, pixels) by local/
 //! global ARAP iterations over the flat faces, Gauss-Seidel by vertex colour (no two vertices of a
-//! colour share a face), so the result is the same for any thread count. O(F) per iteration.
+//! colour share a face), so the result is the same for any thread count. O(F) per iteration at
+//! most; vertices that have settled (and their neighbours) are skipped.
 void relax_lattice_coordinates(const GridRelaxInput& input, std::vector<float>& uv);
 
 }  // namespace tailor::internal
