@@ -5,7 +5,11 @@
 // the cut lines it leaves are jagged: teeth (faces with two seam edges) and notches alternate along
 // them. Once every face is placed, a tooth can often take the UVs its two neighbours on the other
 // side give it; the seam then runs along its third edge instead of the two others. This is a local
-// descent on total seam length: each move strictly shortens it, so the pass ends.
+// descent on total seam length: each move strictly shortens it, so the pass ends. With symmetry 4
+// (after the integer-grid map) the length counted is the visible seams' only: a seam whose sides
+// differ by a lattice map (quarter turns plus whole repeats) costs nothing, so invisible seams stay
+// (median invisible share over the shared meshes 6.6 -> 11.7 % at scale 800, 47.6 -> 51.0 % at
+// 8000; visible length within 0.02 points).
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -13,6 +17,7 @@
 
 #include "mapping/face_stretch.h"
 #include "mapping/mapping_common.h"
+#include "tailor/metrics.h"
 
 namespace tailor::internal {
 namespace {
@@ -34,6 +39,9 @@ class SeamShortener {
     uv_ = atlas_.corner_uv.data();
     bound_ = in_.options.max_stretch;
     scale_ = in_.options.scale;
+    lattice_aware_ = in_.options.symmetry == 4;
+    lattice_.symmetry = in_.options.symmetry;
+    lattice_.texture_width_px = lattice_.texture_height_px = in_.options.texture_period_px;
     seam_flags_ = in_.options.seam_faces.empty() ? nullptr : in_.options.seam_faces.data();
     // A move must not shrink its patch under the absorption's minimum (a patch may still vanish
     // when its last face leaves): the shortening never makes tiny or single-face patches.
@@ -102,8 +110,11 @@ class SeamShortener {
     auto seam_at = [&](const float* uv, int k) {
       if (!ends[k][0]) return false;
       const int k1 = kNext[k];
-      return uv[2 * k] != ends[k][0][0] || uv[2 * k + 1] != ends[k][0][1] || uv[2 * k1] != ends[k][1][0] ||
-             uv[2 * k1 + 1] != ends[k][1][1];
+      const bool cut = uv[2 * k] != ends[k][0][0] || uv[2 * k + 1] != ends[k][0][1] || uv[2 * k1] != ends[k][1][0] ||
+                       uv[2 * k1 + 1] != ends[k][1][1];
+      // With symmetry 4 a seam on the lattice costs nothing: only visible seams are shortened.
+      return cut && !(lattice_aware_ && seam_gap_px(uv + 2 * k, uv + 2 * k1, ends[k][0], ends[k][1], lattice_) <
+                                            lattice_.invisible_gap_px);
     };
     const bool seam[3] = {seam_at(own, 0), seam_at(own, 1), seam_at(own, 2)};
     const int seams = seam[0] + seam[1] + seam[2];
@@ -278,6 +289,8 @@ class SeamShortener {
   const uint8_t* seam_flags_ = nullptr;  // user seam faces, or nullptr
   const uint8_t* locked_ = nullptr;      // faces that never move, or nullptr
   float bound_ = 0.f, scale_ = 1.f;
+  bool lattice_aware_ = false;  // symmetry 4: seams on the lattice are free
+  MetricsOptions lattice_;      // the texture period and symmetry, for seam_gap_px
   uint32_t min_keep_ = 2;
   std::vector<uint32_t> patch_size_;  // faces per patch, kept up to date by the moves
 };
