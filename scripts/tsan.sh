@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The threaded stages under ThreadSanitizer: the crack closing (bands of seed distance zipped at
 # once, which must never touch the same vertex), the metrics' and the orientation's chunked
-# passes, and the export's second thread.
+# passes, the integer-grid map's field and relaxation (symmetry 4), and the export's second thread.
 #
 #   scripts/tsan.sh   # make tsan
 #
@@ -18,7 +18,7 @@ export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1"
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTAILOR_TSAN=ON -DTAILOR_BUILD_BENCH=OFF >/dev/null
 cmake --build "$build" -j "$jobs" --target tailor mapping_test metrics_test orientation_test >/dev/null
 
-"$build/mapping_test" --gtest_brief=1 --gtest_filter='Mapping.CrackClosingIsTheSameOnAnyThreadCount:Mapping.RelaxationLowersAngleDistortion:Mapping.ProgressCanCancel'
+"$build/mapping_test" --gtest_brief=1 --gtest_filter='Mapping.CrackClosingIsTheSameOnAnyThreadCount:Mapping.RelaxationLowersAngleDistortion:Mapping.ProgressCanCancel:Mapping.SymmetryFourGivesInvisibleSeams'
 "$build/metrics_test" --gtest_brief=1 --gtest_filter='Metrics.ThreadCountDoesNotChangeAnyFigure'
 "$build/orientation_test" --gtest_brief=1
 tmp="$(mktemp -d "${TMPDIR:-/tmp}/tailor-tsan.XXXXXX")"
