@@ -106,11 +106,13 @@ struct MappingOptions {
   uint32_t min_patch_faces = 16;    //!< patches with fewer faces are absorbed into a neighbouring patch by rigid
                                     //!< unfolding (0 = keep all; isolated components stay whole)
   uint32_t symmetry = 1;            //!< 1: the growth above; 4 (experimental): an integer-grid map in place of
-                                    //!< the growth, seam shortening and crack closing, for a square tile that
-                                    //!< looks the same turned by 90 degrees (4-RoSy and lattice position fields;
-                                    //!< seams that are quarter turns plus whole repeats are invisible, but today
-                                    //!< most seam length is not: docs/mapping.md). Measure it with
-                                    //!< MetricsOptions::symmetry 4 too
+                                    //!< the growth (seam shortening, crack closing and relaxation follow), for a
+                                    //!< square tile that looks the same turned by 90 degrees (4-RoSy and lattice
+                                    //!< position fields, coordinates relaxed with the lattice maps held; seams
+                                    //!< that are quarter turns plus whole repeats are invisible; faces keep their
+                                    //!< lattice chart up to 4x max_stretch). Visible seams 2.1 % of edge length
+                                    //!< when the tile repeats ~15 times across the mesh, 4.5 % at ~1.5 times
+                                    //!< (docs/mapping.md). Measure it with MetricsOptions::symmetry 4 too
   float texture_period_px = 512.f;  //!< symmetry 4: the texture's size in pixels (square), the lattice period
   // kThesis -------------------------------------------------------------------------------------
   float threshold_px = 25.f;       //!< initial absolute error threshold, pixels (thesis: 25 at scale 800)
@@ -158,8 +160,9 @@ inline constexpr OptionDoc kMappingOptionDocs[] = {
      "File of face indices (one per line) where seams should go (PLY 'seam' property also works)"},
     {"symmetry", "--symmetry",
      "1: patch discovery; 4, experimental: an integer-grid map for a square tile that looks the same turned by "
-     "90 degrees (needs a square texture), whose seams are meant to be quarter turns plus whole repeats, "
-     "invisible under such a tile; today most seams stay visible, see docs/mapping.md"},
+     "90 degrees (needs a square texture, e.g. from 'tailor tile --symmetry 4'): seams away from the field's "
+     "cones are quarter turns plus whole repeats, invisible under such a tile. Best when the tile repeats many "
+     "times across the mesh (--scale 8000: 2.1% of edge length visible vs 4.0% with 1); see docs/mapping.md"},
 };
 
 struct MappingStats {
@@ -211,9 +214,9 @@ struct TextureMap {
 
 //! Maps the texture, as `tailor map` does: 1. the orientation field (compute_orientation),
 //! 2. the growth (patches mode: the patch-discovery front; thesis mode: the reference algorithm),
-//! 3. seam shortening and 4. crack closing (patches mode, each unless switched off), 5. the
-//! metrics of the result (compute_uv_metrics, unless options.measure is false). With
-//! mapping.symmetry 4 the integer-grid map (experimental) takes the place of steps 2-4.
+//! 3. seam shortening, 4. crack closing and relaxation (patches mode, each unless switched off),
+//! 5. the metrics of the result (compute_uv_metrics, unless options.measure is false). With
+//! mapping.symmetry 4 the integer-grid map (experimental) takes the place of step 2.
 //! Fills map.atlas: corner_uv (#F*3 by 2, pixels), patch (#F) and patch_count; every face is
 //! placed and every UV is finite. Precondition: topology = build_topology(mesh).
 //! Fails as compute_orientation does, then with kInvalidArgument on bad mapping options (scale <= 0
