@@ -203,7 +203,10 @@ void smooth_orientation(Level& L, uint32_t iterations, size_t threads) {
   }
 }
 
-void smooth_position(Level& L, uint32_t iterations, float scale, float period, float robust, size_t threads) {
+//! Jacobi steps (in parallel, over_relaxation 1) or, with over_relaxation > 1, Gauss-Seidel steps
+//! in vertex order (sequential), each vertex moved over_relaxation times the way to its mean.
+void smooth_position(Level& L, uint32_t iterations, float scale, float period, float robust, size_t threads,
+                     float over_relaxation) {
   const size_t n = L.size();
   // The fields' matching and the offsets are fixed while the positions move: computed once.
   std::vector<int8_t> turns(L.adj.size());
@@ -218,6 +221,8 @@ void smooth_position(Level& L, uint32_t iterations, float scale, float period, f
   });
   std::vector<float> next(L.u.size());
   const float inv_period = 1.f / period;
+  const bool in_place = over_relaxation > 1.f;  // Gauss-Seidel: each vertex sees its neighbours' new values
+  if (in_place) threads = 1;
   for (uint32_t it = 0; it < iterations; ++it) {
     for_each_chunk(n, threads, [&](size_t begin, size_t end, size_t) {
       for (size_t v = begin; v < end; ++v) {
@@ -241,8 +246,13 @@ void smooth_position(Level& L, uint32_t iterations, float scale, float period, f
           sw += wgt;
         }
         const float inv = 1.f / sw;
-        next[2 * v] = wrap(sx * inv, period);
-        next[2 * v + 1] = wrap(sy * inv, period);
+        if (in_place) {
+          L.u[2 * v] = next[2 * v] = wrap(ux + over_relaxation * (sx * inv - ux), period);
+          L.u[2 * v + 1] = next[2 * v + 1] = wrap(uy + over_relaxation * (sy * inv - uy), period);
+        } else {
+          next[2 * v] = wrap(sx * inv, period);
+          next[2 * v + 1] = wrap(sy * inv, period);
+        }
       }
     });
     L.u.swap(next);
@@ -402,8 +412,11 @@ void compute_rosy_field(const Mesh& mesh, const Topology& topology, const FaceFr
         L.u[2 * v + 1] = wrap(pr[1], options.period);
       }
     }
-    smooth_position(L, l == top ? 4 * options.position_iterations : options.position_iterations, options.scale,
-                    options.period, options.robust, l == 0 ? threads : 1);
+    // The coarse levels settle the positions at the scale of the lattice (with the tile repeating
+    // 1.5 times across a mesh, the coarsest levels hold it): Gauss-Seidel, many steps, cheap there.
+    const uint32_t steps = l == 0 ? options.position_iterations : options.coarse_position_iterations;
+    smooth_position(L, l == top ? 4 * steps : steps, options.scale, options.period, options.robust,
+                    l == 0 ? threads : 1, l == 0 ? 1.f : options.coarse_over_relaxation);
   }
   field.position = std::move(F.p);
   field.normal = std::move(F.n);
