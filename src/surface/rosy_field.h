@@ -32,9 +32,12 @@ struct RosyFieldOptions {
   //! (median visible seams over the 16 shared meshes, scale 800 / 8000): 100 Jacobi everywhere 4.48
   //! / 2.05 %; coarse levels 300 Jacobi 3.72 / 1.90 %; 300 Gauss-Seidel over-relaxed 1.6: 3.35 / 1.96
   //! % (1000: 3.13 / 1.85 % for 1.7x the time); then the finest level's 100 -> 25: 3.32 / 1.87 %, and
-  //! the whole map 0.92x the time on the horse.
+  //! the whole map 0.92x the time on the horse. Over-relaxation 1.8 / 1.9: 3.19 / 1.85 %, 3.07 / 1.82 %
+  //! (1.8 kept: the optimum for a Laplacian on a grid 10-100 vertices across, the coarse levels' size,
+  //! is 1.7-1.94, and nearer 2 diverges sooner); 600 steps 3.10 / 1.87 % for 1.4x the time; the
+  //! robust scale 0.02 / 0.1 instead of 0.04: 3.64 / 1.95 %, 3.03 / 2.08 %.
   uint32_t coarse_position_iterations = 300;
-  float coarse_over_relaxation = 1.6f;
+  float coarse_over_relaxation = 1.8f;
   float robust = 0.04f;  //!< position smoothing weighs an edge by 1 / (1 + |r|^2 / (robust |d|^2)), r its
                          //!< residual, d its offset: edges far off are left as cuts (0 = least squares)
   uint32_t threads = 0;  //!< 0 = one per 100k vertices, at most the cores and 8; same result for any count
