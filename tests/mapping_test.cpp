@@ -694,8 +694,8 @@ TEST(Mapping, SymmetryFourGivesInvisibleSeams) {
 }
 
 // The local mixed-integer step of symmetry 4 (grid_cones.h) only moves singularities: the turns
-// around all faces add up as before, paired half-edges keep inverse maps, dislocations merge away
-// and no cone is made.
+// around all faces add up as before, paired half-edges keep inverse maps, cone pairs and
+// dislocations merge away and no cone is made.
 TEST(GridCones, MovesKeepTheTurnsAndMergeDislocations) {
   Mapped m;
   m.mesh = load_test_mesh("fandisk.off");
@@ -734,11 +734,17 @@ TEST(GridCones, MovesKeepTheTurnsAndMergeDislocations) {
     return c;
   };
   const Count before = count();
+  const uint32_t paired = internal::cancel_cone_pairs(m.mesh, m.topology, edge_map);
+  const Count unpaired = count();
+  EXPECT_EQ(unpaired.turns % 4, before.turns % 4);
+  EXPECT_EQ(unpaired.cones + 2 * paired, before.cones);  // a pair closes, or leaves a shift without a turn
   const uint32_t merged = internal::merge_dislocations(m.mesh, m.topology, edge_map);
   const internal::ConeMoves moves = internal::move_cones(m.mesh, m.topology, field.uv, field.period, edge_map);
   const Count after = count();
-  std::printf("fandisk at scale 8000: cones %zu -> %zu, dislocations %zu -> %zu (%u merged), %u cones moved\n",
-              before.cones, after.cones, before.dislocations, after.dislocations, merged, moves.moved);
+  std::printf(
+      "fandisk at scale 8000: cones %zu -> %zu (%u pairs cancelled), dislocations %zu -> %zu (%u merged), %u "
+      "cones moved\n",
+      before.cones, after.cones, paired, before.dislocations, after.dislocations, merged, moves.moved);
   EXPECT_EQ(after.turns % 4, before.turns % 4);
   EXPECT_LE(after.cones, before.cones);
   EXPECT_GT(merged, 0u);

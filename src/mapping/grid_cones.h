@@ -34,6 +34,11 @@ struct ConeMoves {
 ConeMoves move_cones(const Mesh& mesh, const Topology& topology, const std::vector<float>& uv, float period,
                      std::vector<LatticeMap>& edge_map);
 
+//! Cones next to a cone of the opposite turn (noise in the field: a pair within a few faces) hand
+//! their turn to it, and both close (or leave a dislocation, merged next). Returns the pairs.
+//! Deterministic, sequential; O(cones x faces within reach).
+uint32_t cancel_cone_pairs(const Mesh& mesh, const Topology& topology, std::vector<LatticeMap>& edge_map);
+
 //! Faces whose maps compose to a whole-repeat shift (a dislocation, no turn) hand the shift along
 //! the shortest path of faces to the nearest other singular face within a few faces: two
 //! opposite dislocations cancel, one that meets a cone moves the cone's fixed point. Returns the
