@@ -80,24 +80,22 @@ Status map_grid(const MappingInput& input, Atlas& atlas, MappingStats& stats, st
   if (options.progress && !options.progress(0.8f)) return Status::error(ErrorCode::kCancelled, "", "cancelled");
 
   // Per face: the lattice maps of its corners into corner 0's chart and whether they close around
-  // the face (no singularity), from the coordinates as they are.
+  // the face (no singularity).
   std::vector<LatticeMap> corner_map(3 * nf);
   std::vector<uint8_t> flat(nf, 0), good(nf, 0);
   atlas.corner_uv.resize(6 * nf);
   atlas.patch.assign(nf, kInvalid);
   float* uv = atlas.corner_uv.data();
   const size_t threads = parallel_threads(nf, options.threads);
+  // The lattice map of every half-edge (from its end's chart to its start's), rounded from the
+  // fields as they are.
+  std::vector<LatticeMap> edge_map(3 * nf);
   const auto find_maps = [&] {
     for_each_chunk(nf, threads, [&](size_t begin, size_t end, size_t) {
-      for (size_t f = begin; f < end; ++f) {
-        const uint32_t a = idx[3 * f], b = idx[3 * f + 1], c = idx[3 * f + 2];
-        const LatticeMap mb = lattice_map(field, a, b), mc = lattice_map(field, a, c);
-        corner_map[3 * f] = LatticeMap{};
-        corner_map[3 * f + 1] = mb;
-        corner_map[3 * f + 2] = mc;
-        flat[f] = compose(mb, lattice_map(field, b, c)) == mc;
-      }
+      for (size_t e = 3 * begin; e < 3 * end; ++e)
+        edge_map[e] = lattice_map(field, idx[e], idx[e - e % 3 + (e % 3 + 1) % 3]);
     });
+    maps_from_edges(nf, threads, edge_map, corner_map, flat);
   };
   // The coordinates relaxed with the maps held (grid_relax.h), the maps rounded again from the
   // relaxed coordinates (a strip whose whole-repeat jumps the relaxation showed wrong gets the
@@ -114,16 +112,12 @@ Status map_grid(const MappingInput& input, Atlas& atlas, MappingStats& stats, st
   // cones moved: median visible seams 2.24 -> 2.05 % of edge length (14 meshes lower, blobby 1.55
   // -> 0.63 %), invisible share 45 -> 48 %, at scale 800 unchanged (4.45 / 4.49 %); then cone pairs
   // cancelled (after the coarse position levels were settled): 1.85 -> 1.73 %, 3.19 -> 3.16 %.
-  std::vector<LatticeMap> edge_map(3 * nf);
-  for_each_chunk(nf, threads, [&](size_t begin, size_t end, size_t) {
-    for (size_t e = 3 * begin; e < 3 * end; ++e)
-      edge_map[e] = lattice_map(field, idx[e], idx[e - e % 3 + (e % 3 + 1) % 3]);
-  });
+  find_maps();
   const uint32_t paired = cancel_cone_pairs(mesh, topology, edge_map);
-  const uint32_t merged = merge_dislocations(mesh, topology, edge_map) + paired;
+  const uint32_t merged = merge_dislocations(mesh, topology, edge_map);
   const ConeMoves moves = move_cones(mesh, topology, field.uv, period, edge_map);
   maps_from_edges(nf, threads, edge_map, corner_map, flat);
-  if (moves.steps > 0 || merged > 0)
+  if (paired > 0 || merged > 0 || moves.steps > 0)
     relax_lattice_coordinates({mesh, frames, corner_map, flat, scale, period, kRelaxIterations, threads}, field.uv);
   // Per face whether its chart triangle is within the lattice bound.
   const float bound = lattice_max_stretch(options.max_stretch);
