@@ -105,27 +105,31 @@ void relax_lattice_coordinates(const GridRelaxInput& in, std::vector<float>& uv)
         for (uint32_t k = 0; k < 3; ++k) corners[fill[idx[3 * f + k]]++] = static_cast<uint32_t>(3 * f + k);
   }
 
-  // Greedy colouring in vertex order; vertices grouped by colour.
-  std::vector<uint16_t> colour(nv, 0);
-  std::vector<uint8_t> used;
-  uint16_t colours = 1;
+  // Greedy colouring in vertex order; vertices grouped by colour. used[c] == v + 1 marks colour c
+  // as taken by a neighbour of v: the search for a free colour stops within v's corners + 1 steps,
+  // so the colouring is O(corners) on any mesh (a colour count of its own per vertex would not be).
+  std::vector<uint32_t> colour(nv, 0), used(1, 0);
+  uint32_t colours = 1;
   for (size_t v = 0; v < nv; ++v) {
-    used.assign(colours + 1, 0);
+    const uint32_t mark = static_cast<uint32_t>(v + 1);
     for (uint32_t i = start[v]; i < start[v + 1]; ++i) {
       const uint32_t f = corners[i] / 3;
       for (int k = 0; k < 3; ++k) {
         const uint32_t w = idx[3 * f + k];
-        if (w < v) used[colour[w]] = 1;
+        if (w < v) used[colour[w]] = mark;
       }
     }
-    uint16_t c = 0;
-    while (used[c]) ++c;
+    uint32_t c = 0;
+    while (c < colours && used[c] == mark) ++c;
     colour[v] = c;
-    colours = std::max<uint16_t>(colours, c + 1);
+    if (c == colours) {
+      ++colours;
+      used.push_back(0);
+    }
   }
   std::vector<uint32_t> colour_start(colours + 1, 0), order(nv);
   for (size_t v = 0; v < nv; ++v) ++colour_start[colour[v] + 1];
-  for (uint16_t c = 0; c < colours; ++c) colour_start[c + 1] += colour_start[c];
+  for (uint32_t c = 0; c < colours; ++c) colour_start[c + 1] += colour_start[c];
   {
     std::vector<uint32_t> fill(colour_start.begin(), colour_start.end() - 1);
     for (size_t v = 0; v < nv; ++v) order[fill[colour[v]]++] = static_cast<uint32_t>(v);
@@ -177,7 +181,7 @@ void relax_lattice_coordinates(const GridRelaxInput& in, std::vector<float>& uv)
       }
     });
     // Global step, colour by colour.
-    for (uint16_t col = 0; col < colours; ++col) {
+    for (uint32_t col = 0; col < colours; ++col) {
       const size_t first = colour_start[col], count = colour_start[col + 1] - first;
       for_each_chunk(count, in.threads, [&](size_t begin, size_t end, size_t) {
         for (size_t i = first + begin; i < first + end; ++i) {
