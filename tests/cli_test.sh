@@ -145,6 +145,12 @@ expect_error 2 "" -- "$tailor" frobnicate
   "$tailor" map "$mesh" --texture "$texture" -o "$tmp/s4b.glb" --symmetry 4 --threads 4 -q &&
   cmp -s "$tmp/s4a.glb" "$tmp/s4b.glb" && grep -q '"symmetry": 4' "$tmp/s4.json" && ok ||
   fail "map --symmetry 4: differs between 1 and 4 threads, or no symmetry in the stats"
+# ... and says so when the texture is not unchanged by a quarter turn (a square render here; the
+# -q runs above print nothing).
+"$tailor" render "$mesh" --size 64x64 -o "$tmp/square.png" -q &&
+  "$tailor" map "$mesh" --texture "$tmp/square.png" -o "$tmp/s4c.glb" --symmetry 4 2>"$tmp/s4warn.txt" &&
+  grep -q "warning: .*square.png: --symmetry 4 but the texture is not unchanged by a quarter turn" "$tmp/s4warn.txt" &&
+  ok || fail "map --symmetry 4 with a texture a quarter turn changes gave no warning: $(cat "$tmp/s4warn.txt")"
 "$tailor" eval "$tmp/s4a.glb" --symmetry 4 >"$tmp/eval4.txt" 2>&1 && grep -Eq " 0 flipped, .*symmetry 4\)$" "$tmp/eval4.txt" &&
   ok || fail "eval --symmetry 4: $(cat "$tmp/eval4.txt")"
 "$tailor" render "$mesh" --size 64x48 -o "$tmp/wide.png" -q || fail "render of a 64x48 picture failed"

@@ -22,11 +22,16 @@
 #include "tailor/report.h"
 #include "tailor/stability.h"
 #include "tailor/texture_direction.h"
+#include "tailor/tiling.h"
 #include "tailor/topology.h"
 #include "util/atomic_file.h"
 
 namespace tailor::cli {
 namespace {
+
+// The largest difference (levels of 255) between a texture and its quarter turn that still counts
+// as the same tile with --symmetry 4: JPEG compression of a symmetric tile leaves a few levels.
+constexpr int kQuarterTurnNoiseLevels = 12;
 
 Status usage_error(const std::string& what) { return Status::error(ErrorCode::kInvalidArgument, "", what); }
 
@@ -139,6 +144,16 @@ int run_map(const MapArgs& opt) {
   const int tex_h = !texture.empty() ? texture.height : material.height > 0 ? material.height : args.texture_size;
   // The lattice period, the metrics' texture size, the threads of every stage.
   if (Status s = set_map_texture_size(options, tex_w, tex_h); !s) return report_error(s);
+  // Symmetry 4 hides quarter-turn seams only under a tile that a quarter turn leaves unchanged:
+  // say so when the texture is not one (JPEG noise of a few levels is fine). (Where its 4-fold
+  // centre lies is not checked yet: docs/mapping.md, "Symmetry 4", known defect.)
+  if (mapping.symmetry == 4 && !texture.empty()) {
+    const int difference = quarter_turn_difference(texture);
+    if (difference > kQuarterTurnNoiseLevels)
+      warn(opt.quiet, texture_path + ": --symmetry 4 but the texture is not unchanged by a quarter turn (up to " +
+                          std::to_string(difference) +
+                          " levels apart): seams that turn will show; make it with 'tailor tile --symmetry 4'");
+  }
   // auto: follow the field unless the texture has no direction to follow (texture_direction.h).
   float texture_isotropy = -1.f;
   if (args.auto_field_following()) {
