@@ -144,15 +144,21 @@ int run_map(const MapArgs& opt) {
   const int tex_h = !texture.empty() ? texture.height : material.height > 0 ? material.height : args.texture_size;
   // The lattice period, the metrics' texture size, the threads of every stage.
   if (Status s = set_map_texture_size(options, tex_w, tex_h); !s) return report_error(s);
-  // Symmetry 4 hides quarter-turn seams only under a tile that a quarter turn leaves unchanged:
-  // say so when the texture is not one (JPEG noise of a few levels is fine). (Where its 4-fold
-  // centre lies is not checked yet: docs/mapping.md, "Symmetry 4", known defect.)
+  // Symmetry 4 hides quarter-turn seams only under a tile that a quarter turn about its centre or
+  // corner leaves unchanged (the lattice points the map turns it about): say so when the texture is
+  // not one (JPEG noise of a few levels is fine), or turns into itself only about another point.
   if (mapping.symmetry == 4 && !texture.empty()) {
-    const int difference = quarter_turn_difference(texture);
+    int shift_x = 0, shift_y = 0;
+    const int difference = quarter_turn_difference(texture, &shift_x, &shift_y);
     if (difference > kQuarterTurnNoiseLevels)
       warn(opt.quiet, texture_path + ": --symmetry 4 but the texture is not unchanged by a quarter turn (up to " +
                           std::to_string(difference) +
                           " levels apart): seams that turn will show; make it with 'tailor tile --symmetry 4'");
+    else if (shift_x != 0 || shift_y != 0)
+      warn(opt.quiet, texture_path +
+                          ": --symmetry 4 but the texture turns into itself about a point off its centre and corner "
+                          "(a tile from tailor before 2026-11-26?): seams that turn will jump by half a repeat; "
+                          "make it again with 'tailor tile --symmetry 4'");
   }
   // auto: follow the field unless the texture has no direction to follow (texture_direction.h).
   float texture_isotropy = -1.f;

@@ -35,10 +35,10 @@
 // cropped to its centred square) built as a pinwheel of one N/2 x N/2 quadrant (the exemplar
 // square of 3 x 3 places whose histogram is nearest the whole's) and its three quarter turns,
 // whose seams are repaired by the same quilting with every block written into all four rotated
-// places (the rotation centres get one wedge-shaped block each), then shifted by N/4 so that the
-// wrap runs through quadrant interiors: rot90(tile)(x, y) = tile(y, N-1-x) equals
-// tile((x + N/2) % N, y) exactly, i.e. the tile is unchanged by a quarter turn about (N/4, N/4)
-// and (3N/4, 3N/4). Its patch coherence is about 2-2.5 x the exemplar's (see docs/tiling.md).
+// places (the rotation centres get one wedge-shaped block each), the wrap put on the better of
+// the two repaired '+' lines: rot90(tile)(x, y) = tile(y, N-1-x) equals tile(x, y) exactly, i.e.
+// the tile is unchanged by a quarter turn about its centre and corner (where the 4-fold map turns
+// it). Its patch coherence is about 2-2.5 x the exemplar's (see docs/tiling.md).
 //
 // Images follow the layout of image.h (1 to 4 channels; alpha is just a channel, except that the
 // FFT search of 3- and 4-channel images runs on the RGB luminance; the ranking uses all channels).

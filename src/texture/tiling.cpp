@@ -630,11 +630,28 @@ Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int
     }
     rep.blocks += base_blocks;
     if (setup.symmetry == 4) {
-      // The pinwheel's quadrant lines hold the repaired strips and the unrepaired seams through
-      // the rotation centres; shifted by N/4 they lie inside the tile and the wrap runs through
-      // quadrant interiors (exemplar columns and rows). rot90(tile) == tile shifted by (N/2, 0).
+      // The 4-fold centre must stay on the tile's corner or centre: a map that turns the texture
+      // by quarter turns across a seam turns it about a lattice point (docs/mapping.md, "Symmetry
+      // 4"), and about any other point its seams would jump by half a repeat. So the wrap runs
+      // through one of the pinwheel's two '+' lines (shift 0 or N/2), whichever joins its two
+      // sides more like the tile's typical column boundary (the lines are repaired strips; an
+      // earlier N/4 shift ran the wrap through quadrant interiors but put the centre off the
+      // lattice). rot90(tile) == tile.
       const Plane pinwheel = base;
-      const int q = w / 4;
+      std::vector<double> boundary(static_cast<size_t>(w), 0.0);  // summed |difference| across x-1 | x
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+          const float* left = pinwheel.at((x + w - 1) % w, y);
+          const float* right = pinwheel.at(x, y);
+          for (int k = 0; k < ex.channels; ++k) boundary[static_cast<size_t>(x)] += std::abs(left[k] - right[k]);
+        }
+      std::vector<double> sorted = boundary;
+      std::nth_element(sorted.begin(), sorted.begin() + w / 2, sorted.end());
+      const double typical = std::max(sorted[static_cast<size_t>(w / 2)], 1e-9);
+      const auto off = [&](int x) {
+        return std::abs(std::log(std::max(boundary[static_cast<size_t>(x)], 1e-9) / typical));
+      };
+      const int q = off(w / 2) < off(0) ? w / 2 : 0;
       for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
           const float* v = pinwheel.at((x + q) % w, (y + q) % h);
