@@ -29,6 +29,16 @@ namespace fs = std::filesystem;
 using Json = nlohmann::json;
 using test::run_command;
 
+//! An atlas of one patch whose corner k gets the UV (k % period) * step_px in u and v alike: any
+//! UVs will do where a test checks what the export keeps or reports, not the mapping.
+Atlas patterned_atlas(size_t faces, size_t period, float step_px) {
+  Atlas atlas;
+  atlas.corner_uv.resize(6 * faces);
+  for (size_t k = 0; k < atlas.corner_uv.size(); ++k) atlas.corner_uv[k] = static_cast<float>(k % period) * step_px;
+  atlas.patch.assign(faces, 0);
+  return atlas;
+}
+
 // A glTF document built in memory: accessors over one binary buffer.
 struct Builder {
   Json json = {{"asset", {{"version", "2.0"}}}, {"accessors", Json::array()}, {"bufferViews", Json::array()}};
@@ -607,10 +617,7 @@ TEST(GltfKept, NormalsColoursAndOtherUvSetsSurviveAMapping) {
   ASSERT_NE(attribute(mesh, "NORMAL"), nullptr);
 
   // Map into TEXCOORD_1 (any UVs will do): the file's normals, colours and TEXCOORD_0 come back.
-  Atlas atlas;
-  atlas.corner_uv.resize(6 * mesh.face_count());
-  for (size_t k = 0; k < atlas.corner_uv.size(); ++k) atlas.corner_uv[k] = float(k % 7) * 64;
-  atlas.patch.assign(mesh.face_count(), 0);
+  const Atlas atlas = patterned_atlas(mesh.face_count(), 7, 64.f);
   const std::string dir = test::empty_temp_dir("gltf_kept");
   for (MeshCompression method : {MeshCompression::kNone, MeshCompression::kMeshopt, MeshCompression::kDraco}) {
     SCOPED_TRACE(mesh_compression_name(method));
@@ -762,10 +769,7 @@ TEST_F(GltfTransformTest, NamesExtrasAndMaterialsSurviveAMapping) {
     EXPECT_EQ(report.not_kept.find("names"), std::string::npos) << report.not_kept;
     EXPECT_EQ(report.not_kept.find("materials,"), std::string::npos) << report.not_kept;
     ASSERT_EQ(mesh.scene.parts.size(), 4u) << input;  // 2 instances x 2 materials
-    Atlas atlas;
-    atlas.corner_uv.resize(6 * mesh.face_count());
-    for (size_t k = 0; k < atlas.corner_uv.size(); ++k) atlas.corner_uv[k] = float(k % 11) * 32;
-    atlas.patch.assign(mesh.face_count(), 0);
+    Atlas atlas = patterned_atlas(mesh.face_count(), 11, 32.f);
     for (MeshCompression method :
          {MeshCompression::kNone, MeshCompression::kQuantize, MeshCompression::kMeshopt, MeshCompression::kDraco}) {
       SCOPED_TRACE(std::string(input) + " -> " + mesh_compression_name(method));
@@ -844,10 +848,7 @@ TEST(GltfKept, PlyAndObjColoursRoundTrip) {
     ASSERT_TRUE(load_mesh(dir + "/" + input, mesh).is_ok()) << input;
     const CornerAttribute* colour = attribute(mesh, "COLOR_0");
     ASSERT_NE(colour, nullptr) << input;
-    Atlas atlas;
-    atlas.corner_uv.assign(6 * mesh.face_count(), 0.f);
-    for (size_t k = 0; k < atlas.corner_uv.size(); ++k) atlas.corner_uv[k] = float(k % 5) * 100;
-    atlas.patch.assign(mesh.face_count(), 0);
+    const Atlas atlas = patterned_atlas(mesh.face_count(), 5, 100.f);
     for (const char* output : {"out.ply", "out.obj", "out.glb"}) {
       SCOPED_TRACE(std::string(input) + " -> " + output);
       ASSERT_TRUE(export_mesh(dir + "/" + output, mesh, atlas, ExportOptions{}).is_ok());
@@ -964,10 +965,7 @@ TEST(Progress, LoadingReportsAndCancels) {
   // The same mesh as PLY (generic ascii loop), OBJ, .glb (plain and Draco).
   const std::string dir = test::empty_temp_dir("progress_load");
   const Mesh source = test::load_test_mesh("horse.ply");
-  Atlas atlas;
-  atlas.corner_uv.assign(6 * source.face_count(), 0.f);
-  for (size_t k = 0; k < atlas.corner_uv.size(); ++k) atlas.corner_uv[k] = float(k % 13) * 16;
-  atlas.patch.assign(source.face_count(), 0);
+  const Atlas atlas = patterned_atlas(source.face_count(), 13, 16.f);
   ASSERT_TRUE(export_mesh(dir + "/h.obj", source, atlas, ExportOptions{}).is_ok());
   ASSERT_TRUE(export_mesh(dir + "/h.glb", source, atlas, ExportOptions{}).is_ok());
   ExportOptions draco;
@@ -991,10 +989,7 @@ TEST(Progress, LoadingReportsAndCancels) {
 TEST(Progress, ExportReportsAndCancelsWritingNothing) {
   const std::string dir = test::empty_temp_dir("progress_export");
   const Mesh mesh = test::load_test_mesh("spot.obj");
-  Atlas atlas;
-  atlas.corner_uv.assign(6 * mesh.face_count(), 0.f);
-  for (size_t k = 0; k < atlas.corner_uv.size(); ++k) atlas.corner_uv[k] = float(k % 9) * 40;
-  atlas.patch.assign(mesh.face_count(), 0);
+  const Atlas atlas = patterned_atlas(mesh.face_count(), 9, 40.f);
   for (MeshCompression method :
        {MeshCompression::kNone, MeshCompression::kQuantize, MeshCompression::kMeshopt, MeshCompression::kDraco}) {
     SCOPED_TRACE(mesh_compression_name(method));
