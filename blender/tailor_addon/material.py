@@ -33,6 +33,24 @@ def _new_node_material(name):
     return material, nodes, links, next(n for n in nodes if n.type == "BSDF_PRINCIPLED")
 
 
+def _uv_node(nodes, uv_map, location):
+    """A UV Map node reading uv_map."""
+    coordinates = nodes.new("ShaderNodeUVMap")
+    coordinates.uv_map = uv_map
+    coordinates.location = location
+    return coordinates
+
+
+def _image_node(nodes, links, image, coordinates, location):
+    """An Image Texture node of image, repeating, sampled at the UV Map node coordinates."""
+    texture = nodes.new("ShaderNodeTexImage")
+    texture.image = image
+    texture.extension = "REPEAT"
+    texture.location = location
+    links.new(coordinates.outputs["UV"], texture.inputs["Vector"])
+    return texture
+
+
 def _give_every_face(obj, material):
     """Adds material to obj's slots (once) and gives it every face; returns it."""
     mesh = obj.data
@@ -50,14 +68,9 @@ def assign(obj, image, uv_map="tailor"):
     material = bpy.data.materials.get(name)
     if material is None:
         material, nodes, links, shader = _new_node_material(name)
-        texture = nodes.new("ShaderNodeTexImage")
-        texture.image = image
-        texture.extension = "REPEAT"
-        texture.location = (shader.location.x - 320, shader.location.y)
-        coordinates = nodes.new("ShaderNodeUVMap")
-        coordinates.uv_map = uv_map
-        coordinates.location = (texture.location.x - 220, texture.location.y - 120)
-        links.new(coordinates.outputs["UV"], texture.inputs["Vector"])
+        x, y = shader.location.x, shader.location.y
+        coordinates = _uv_node(nodes, uv_map, (x - 540, y - 120))
+        texture = _image_node(nodes, links, image, coordinates, (x - 320, y))
         links.new(texture.outputs["Color"], shader.inputs["Base Color"])
     return _give_every_face(obj, material)
 
@@ -95,18 +108,12 @@ def assign_maps(obj, maps, images, uv_map="tailor"):
     material = bpy.data.materials.get(name)
     if material is None:
         material, nodes, links, shader = _new_node_material(name)
-        coordinates = nodes.new("ShaderNodeUVMap")
-        coordinates.uv_map = uv_map
-        coordinates.location = (shader.location.x - 900, shader.location.y)
+        coordinates = _uv_node(nodes, uv_map, (shader.location.x - 900, shader.location.y))
         textures = {}
         for row, (role, image) in enumerate(images.items()):
-            texture = nodes.new("ShaderNodeTexImage")
-            texture.image = image
-            texture.extension = "REPEAT"
-            texture.label = role
-            texture.location = (shader.location.x - 620, shader.location.y - 280 * row)
-            links.new(coordinates.outputs["UV"], texture.inputs["Vector"])
-            textures[role] = texture
+            location = (shader.location.x - 620, shader.location.y - 280 * row)
+            textures[role] = _image_node(nodes, links, image, coordinates, location)
+            textures[role].label = role
         colour = textures["color"].outputs["Color"] if "color" in textures else None
         if "occlusion" in textures and colour is not None:  # the Principled BSDF has no occlusion input
             multiply = nodes.new("ShaderNodeMixRGB")
