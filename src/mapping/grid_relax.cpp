@@ -18,6 +18,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "util/parallel_chunks.h"
 
@@ -36,11 +37,17 @@ constexpr float kOverRelaxation = 1.6f;
 // flipped a third of the bunny's faces.
 constexpr float kRobustScale = 0.5f;
 
-// A vertex that moved less than this (|du| + |dv|, pixels) in a sweep has settled: it and its
-// neighbours are left alone until one of them moves again. On the 1.55 M-face horse_x16 the
-// relaxation's 80 sweeps take 2.0 s instead of 12 s (visible seams 0.96 -> 1.04 % of edge length);
-// the medians over the shared meshes stay within 0.01 points.
-constexpr float kSettledPx = 0.05f;
+// A vertex that moved less than this share of its faces' mean side (|du| + |dv|) in a sweep has
+// settled: it and its neighbours are left alone until one of them moves again. Relative to the
+// faces, so the work and the strain left do not depend on the scale: a fixed 0.05 px left every
+// vertex of the horse active at scale 8000 and was loose on fine meshes (horse_x16's faces are
+// 0.65 px wide at scale 800). Measured against 0.05 px (medians over the 16 shared meshes, visible
+// seams at 800 / 8000): 3.22 / 1.77 -> 3.24 / 1.80 % of edge length; horse 1.2x the time at 800,
+// 0.64x at 8000; horse_x16 0.885 -> 0.822 % for 1.4x the time at 800, the same at 8000. Looser
+// settles are faster and worse: 0.015: 3.32 / 1.82 %, 0.02: 3.36 / 1.90 %; tighter ones with more
+// sweeps better and slower: 0.002 and 60 sweeps a round: 2.89 / 1.62 % for 2.6x the time (the
+// relaxation's convergence, not the maps, is what these figures follow).
+constexpr float kSettledShare = 0.01f;
 
 // The quarter turns of rosy_field.h's rotate_quarter as matrices (x' = a x + b y, y' = c x + d y):
 // the same values without a branch per corner (the turns are as good as random).
@@ -105,6 +112,17 @@ void relax_lattice_coordinates(const GridRelaxInput& in, std::vector<float>& uv)
         for (uint32_t k = 0; k < 3; ++k) corners[fill[idx[3 * f + k]]++] = static_cast<uint32_t>(3 * f + k);
   }
 
+  // Per vertex the move below which it has settled (pixels).
+  std::vector<float> settled(nv, 0.f);
+  for_each_chunk(nv, in.threads, [&](size_t begin, size_t end, size_t) {
+    for (size_t v = begin; v < end; ++v) {
+      float side = 0.f;
+      for (uint32_t c = start[v]; c < start[v + 1]; ++c) side += std::sqrt(area[corners[c] / 3]);
+      const uint32_t n = start[v + 1] - start[v];
+      settled[v] = n > 0 ? kSettledShare * side / static_cast<float>(n) : 0.f;
+    }
+  });
+
   // Greedy colouring in vertex order; vertices grouped by colour. used[c] == v + 1 marks colour c
   // as taken by a neighbour of v: the search for a free colour stops within v's corners + 1 steps,
   // so the colouring is O(corners) on any mesh (a colour count of its own per vertex would not be).
@@ -141,18 +159,26 @@ void relax_lattice_coordinates(const GridRelaxInput& in, std::vector<float>& uv)
     map_point(in.corner_map[3 * f + k], period, &uv[2 * idx[3 * f + k]], out);
   };
   // Activity: a vertex is moved again only while a vertex of one of its faces moved by more than
-  // kSettledPx in the last sweep (at first every vertex); a face is fitted again only then too.
-  std::vector<uint8_t> moved(nv, 1), face_active(nf, 1), vertex_active(nv, 1);
+  // its settled share in the last sweep (at first every vertex, or those input.moving names); a
+  // face is fitted again only then too (at first every face: the rotations start from nothing).
+  const bool warm = in.moving && in.moving->size() == nv;
+  std::vector<uint8_t> own_moved;
+  if (!warm) own_moved.assign(nv, 1);
+  std::vector<uint8_t>& moved = warm ? *in.moving : own_moved;
+  std::vector<uint8_t> face_active(nf, 1), vertex_active(nv, 1);
   for (uint32_t it = 0; it < in.iterations; ++it) {
-    if (it > 0) {
+    if (it > 0 || warm) {
       for_each_chunk(nf, in.threads, [&](size_t begin, size_t end, size_t) {
         for (size_t f = begin; f < end; ++f)
-          face_active[f] = moved[idx[3 * f]] | moved[idx[3 * f + 1]] | moved[idx[3 * f + 2]];
+          face_active[f] = it == 0 || (moved[idx[3 * f]] | moved[idx[3 * f + 1]] | moved[idx[3 * f + 2]]);
       });
       for_each_chunk(nv, in.threads, [&](size_t begin, size_t end, size_t) {
         for (size_t v = begin; v < end; ++v) {
           uint8_t active = 0;
-          for (uint32_t c = start[v]; c < start[v + 1] && !active; ++c) active = face_active[corners[c] / 3];
+          for (uint32_t c = start[v]; c < start[v + 1] && !active; ++c) {
+            const uint32_t* t = &idx[corners[c] - corners[c] % 3];
+            active = moved[t[0]] | moved[t[1]] | moved[t[2]];
+          }
           vertex_active[v] = active;
         }
       });
@@ -218,11 +244,12 @@ void relax_lattice_coordinates(const GridRelaxInput& in, std::vector<float>& uv)
           const float dx = kOverRelaxation * (mx - uv[2 * v]), dy = kOverRelaxation * (my - uv[2 * v + 1]);
           uv[2 * v] += dx;
           uv[2 * v + 1] += dy;
-          moved[v] = std::abs(dx) + std::abs(dy) > kSettledPx;
+          moved[v] = std::abs(dx) + std::abs(dy) > settled[v];
         }
       });
     }
   }
+  if (in.moving && !warm) *in.moving = std::move(own_moved);
 }
 
 }  // namespace tailor::internal

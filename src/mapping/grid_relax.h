@@ -28,12 +28,17 @@ struct GridRelaxInput {
   float period = 512.f;                       //!< lattice period, pixels
   uint32_t iterations = 30;
   size_t threads = 1;
+  //! #V, in and out: 1 where a vertex is still moving (it and its neighbours start active; set it
+  //! for the vertices of faces whose maps changed); on return, the vertices that moved in the last
+  //! sweep. Null or empty: every vertex starts active.
+  std::vector<uint8_t>* moving = nullptr;
 };
 
 //! Moves uv (#V*2, field.uv: per vertex its lattice coordinate in its own chart, pixels) by local/
 //! global ARAP iterations over the flat faces, Gauss-Seidel by vertex colour (no two vertices of a
 //! colour share a face), so the result is the same for any thread count. O(F) per iteration at
-//! most; vertices that have settled (and their neighbours) are skipped.
+//! most; vertices that have settled (and their neighbours) are skipped; with input.moving only those
+//! still moving and their neighbours start.
 void relax_lattice_coordinates(const GridRelaxInput& input, std::vector<float>& uv);
 
 }  // namespace tailor::internal

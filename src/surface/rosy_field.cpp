@@ -219,10 +219,10 @@ void smooth_position(Level& L, uint32_t iterations, float scale, float period, f
         turns[i] = static_cast<int8_t>(k);
       }
   });
-  std::vector<float> next(L.u.size());
   const float inv_period = 1.f / period;
   const bool in_place = over_relaxation > 1.f;  // Gauss-Seidel: each vertex sees its neighbours' new values
   if (in_place) threads = 1;
+  std::vector<float> next(in_place ? 0 : L.u.size());  // Jacobi's second buffer
   for (uint32_t it = 0; it < iterations; ++it) {
     for_each_chunk(n, threads, [&](size_t begin, size_t end, size_t) {
       for (size_t v = begin; v < end; ++v) {
@@ -247,15 +247,15 @@ void smooth_position(Level& L, uint32_t iterations, float scale, float period, f
         }
         const float inv = 1.f / sw;
         if (in_place) {
-          L.u[2 * v] = next[2 * v] = wrap(ux + over_relaxation * (sx * inv - ux), period);
-          L.u[2 * v + 1] = next[2 * v + 1] = wrap(uy + over_relaxation * (sy * inv - uy), period);
+          L.u[2 * v] = wrap(ux + over_relaxation * (sx * inv - ux), period);
+          L.u[2 * v + 1] = wrap(uy + over_relaxation * (sy * inv - uy), period);
         } else {
           next[2 * v] = wrap(sx * inv, period);
           next[2 * v + 1] = wrap(sy * inv, period);
         }
       }
     });
-    L.u.swap(next);
+    if (!in_place) L.u.swap(next);
   }
 }
 
