@@ -16,6 +16,7 @@
 #include "tailor/export.h"
 #include "tailor/image.h"
 #include "tailor/io.h"
+#include "tailor/tiling.h"
 
 namespace tailor {
 namespace {
@@ -319,8 +320,9 @@ TEST(RenderPreview, UpAxisStandsAZUpPillarUpright) {
 }
 
 // Planar UVs from the mesh's x and y: `repeats` texture repeats across its bounding box; faces whose
-// centroid lies right of the box's middle get `shift` (repeats) added, which cuts the mesh there.
-std::vector<float> planar_uvs(const Mesh& mesh, float repeats, float shift_u, float shift_v) {
+// centroid lies right of the box's middle get their UVs turned by `quarter_turns` x 90 degrees about
+// the UV origin and `shift` (repeats) added, which cuts the mesh there.
+std::vector<float> planar_uvs(const Mesh& mesh, float repeats, float shift_u, float shift_v, int quarter_turns = 0) {
   float lo[2] = {1e30f, 1e30f}, hi[2] = {-1e30f, -1e30f};
   for (size_t v = 0; v < mesh.vertex_count(); ++v)
     for (size_t k = 0; k < 2; ++k) {
@@ -334,8 +336,14 @@ std::vector<float> planar_uvs(const Mesh& mesh, float repeats, float shift_u, fl
     for (size_t k = 0; k < 3; ++k) cx += mesh.positions[3 * size_t{mesh.indices[3 * f + k]}] / 3;
     for (size_t k = 0; k < 3; ++k) {
       const float* p = &mesh.positions[3 * size_t{mesh.indices[3 * f + k]}];
-      uv[6 * f + 2 * k] = (p[0] - lo[0]) / size * repeats + (cx > middle ? shift_u : 0.0f);
-      uv[6 * f + 2 * k + 1] = (p[1] - lo[1]) / size * repeats + (cx > middle ? shift_v : 0.0f);
+      float u = (p[0] - lo[0]) / size * repeats, v = (p[1] - lo[1]) / size * repeats;
+      if (cx > middle) {
+        for (int t = 0; t < quarter_turns; ++t) u = -std::exchange(v, u);  // (u, v) -> (-v, u)
+        u += shift_u;
+        v += shift_v;
+      }
+      uv[6 * f + 2 * k] = u;
+      uv[6 * f + 2 * k + 1] = v;
     }
   }
   return uv;
@@ -417,6 +425,49 @@ TEST(RenderPreview, InvisibleSeamsDoNotJumpInPixelsAndVisibleOnesDo) {
   const double along_fraction = mean_gradient(c, cut);
   EXPECT_NEAR(along_whole, along_uncut, 0.05 * along_uncut + 0.1);
   EXPECT_GT(along_fraction, 1.5 * along_uncut) << along_fraction << " vs " << along_uncut;
+}
+
+// The same for symmetry 4 (issue 14, point 4): spot's right half turned by a quarter turn plus
+// whole repeats. Under the gravel tile made 4-fold by make_tileable (unchanged by a quarter turn
+// about its corner) it renders as the uncut mesh and the seams view (seam_symmetry 4) draws the
+// cut green; under the plain gravel tile the same cut is red and the texture jumps across it.
+TEST(RenderPreview, QuarterTurnSeamsDoNotJumpUnderAFourFoldTile) {
+  const Mesh mesh = load_test_mesh("spot.obj");
+  Image gravel, plain, four_fold;
+  ASSERT_TRUE(load_image(kData + "textures/gravel-gray-512.png", gravel).is_ok());
+  TileOptions tiling;
+  ASSERT_TRUE(make_tileable(gravel, tiling, plain).is_ok());
+  tiling.symmetry = 4;
+  ASSERT_TRUE(make_tileable(gravel, tiling, four_fold).is_ok());
+  const std::vector<float> uncut = planar_uvs(mesh, 0.4f, 0, 0);
+  const std::vector<float> turned = planar_uvs(mesh, 0.4f, 2, -1, 1);
+  RenderOptions seams = small(PreviewView::kSeams);
+  seams.width = 640;
+  seams.height = 480;
+  const auto green = [](const Image& img) { return pixels_near(img, {20, 170, 60}); };
+  const auto red = [](const Image& img) { return pixels_near(img, {225, 30, 30}); };
+  const Image seams_plain = render_uv(mesh, turned, &four_fold, seams);  // seam_symmetry 1: a turn is visible
+  seams.seam_symmetry = 4;
+  const Image seams_four_fold = render_uv(mesh, turned, &four_fold, seams);
+  const std::vector<uint8_t> cut = red(seams_plain);
+  EXPECT_GT(count(cut), 100u);
+  EXPECT_EQ(count(green(seams_plain)), 0u);
+  EXPECT_GT(count(green(seams_four_fold)), 100u);
+  EXPECT_EQ(count(red(seams_four_fold)), 0u);
+
+  RenderOptions texture = seams;
+  texture.view = PreviewView::kTexture;
+  const Image a = render_uv(mesh, uncut, &four_fold, texture);
+  const Image b = render_uv(mesh, turned, &four_fold, texture);
+  EXPECT_LT(mean_abs_difference(a, b), 0.05);  // the quarter-turn cut renders as no cut at all
+  const double along_uncut = mean_gradient(a, cut), along_turned = mean_gradient(b, cut);
+  EXPECT_NEAR(along_turned, along_uncut, 0.05 * along_uncut + 0.1);
+  const Image c = render_uv(mesh, uncut, &plain, texture);
+  const Image d = render_uv(mesh, turned, &plain, texture);
+  EXPECT_GT(mean_abs_difference(c, d), 1.0);  // the plain tile turned shows other texels
+  const double along_plain = mean_gradient(c, cut), along_plain_turned = mean_gradient(d, cut);
+  // Measured 1.47x (the whole-repeat test's fractional shift: over 1.5x); the 4-fold tile within 5 %.
+  EXPECT_GT(along_plain_turned, 1.3 * along_plain) << along_plain_turned << " vs " << along_plain;
 }
 
 // === Material: normal and occlusion maps (PreviewMaterial) ======================================
