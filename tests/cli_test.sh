@@ -157,6 +157,11 @@ expect_error 2 "" -- "$tailor" frobnicate
 expect_error 2 "symmetry 4 needs a square texture, got 64x48" -- "$tailor" map "$mesh" --texture "$tmp/wide.png" -o "$tmp/x.glb" --symmetry 4
 [[ ! -e $tmp/x.glb ]] && ok || fail "map --symmetry 4 with a non-square texture wrote its output"
 expect_error 2 "symmetry" -- "$tailor" eval "$tmp/a.glb" --symmetry 3
+# render --view seams --symmetry 4 draws quarter-turn seams green: another picture than with 1.
+"$tailor" render "$tmp/s4a.glb" --view seams --size 320x240 -o "$tmp/seams1.png" -q &&
+  "$tailor" render "$tmp/s4a.glb" --view seams --size 320x240 --symmetry 4 -o "$tmp/seams4.png" -q &&
+  ! cmp -s "$tmp/seams1.png" "$tmp/seams4.png" && ok || fail "render --symmetry 4 drew the seams as with 1"
+expect_error 2 "symmetry" -- "$tailor" render "$tmp/s4a.glb" --view seams --symmetry 2 -o "$tmp/seams2.png"
 # render --normal-map: an RGB map shades the texture view (a different picture), a grey one is refused.
 "$tailor" render "$tmp/s4a.glb" --size 64x48 -o "$tmp/plain.png" -q &&
   "$tailor" render "$tmp/s4a.glb" --size 64x48 --normal-map "$tmp/wide.png" -o "$tmp/bumpy.png" -q &&

@@ -121,12 +121,15 @@ void register_render(CLI::App& app, Runner& run) {
   add_documented(cmd, option_doc(kRenderOptionDocs, "yaw_degrees"), args->options.yaw_degrees);
   add_documented(cmd, option_doc(kRenderOptionDocs, "pitch_degrees"), args->options.pitch_degrees);
   add_documented(cmd, option_doc(kRenderOptionDocs, "checker_squares"), args->options.checker_squares);
+  add_documented(cmd, option_doc(kRenderOptionDocs, "seam_symmetry"), args->options.seam_symmetry)
+      ->check(CLI::IsMember({1u, 4u}));
   cmd->add_flag("-q,--quiet", args->quiet, "print nothing but errors");
   cmd->footer(
       "Examples:\n"
       "  tailor render spot.glb -o spot.png\n"
       "  tailor render spot.glb -o spot_patches.png --view patches --size 800x600\n"
       "  tailor render spot.glb -o spot_checker.png --view checker --checker 16\n"
+      "  tailor render spot4.glb -o spot4_seams.png --view seams --symmetry 4   # from 'tailor map --symmetry 4'\n"
       "A .glb written by 'tailor map --material' is shaded with its normal map (tangent space, the file's\n"
       "TANGENT) and occlusion map.");
   cmd->callback([&run, args] { run = [args] { return run_render(*args); }; });

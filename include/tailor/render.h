@@ -90,6 +90,9 @@ inline constexpr OptionDoc kRenderOptionDocs[] = {
     {"yaw_degrees", "--yaw", "camera azimuth in degrees around the up axis"},
     {"pitch_degrees", "--pitch", "camera elevation in degrees"},
     {"checker_squares", "--checker", "checker squares per texture repeat"},
+    {"seam_symmetry", "--symmetry",
+     "seams view: 1, or 4 for a map from 'tailor map --symmetry 4' (a seam whose sides differ by a quarter turn "
+     "plus whole repeats is drawn invisible, green; needs a square texture)"},
 };
 
 //! What the texture view shades with besides the base colour: glTF's material maps, all optional.
