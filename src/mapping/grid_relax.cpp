@@ -39,15 +39,18 @@ constexpr float kRobustScale = 0.5f;
 
 // A vertex that moved less than this share of its faces' mean side (|du| + |dv|) in a sweep has
 // settled: it and its neighbours are left alone until one of them moves again. Relative to the
-// faces, so the work and the strain left do not depend on the scale: a fixed 0.05 px left every
-// vertex of the horse active at scale 8000 and was loose on fine meshes (horse_x16's faces are
-// 0.65 px wide at scale 800). Measured against 0.05 px (medians over the 16 shared meshes, visible
-// seams at 800 / 8000): 3.22 / 1.77 -> 3.24 / 1.80 % of edge length; horse 1.2x the time at 800,
-// 0.64x at 8000; horse_x16 0.885 -> 0.822 % for 1.4x the time at 800, the same at 8000. Looser
-// settles are faster and worse: 0.015: 3.32 / 1.82 %, 0.02: 3.36 / 1.90 %; tighter ones with more
-// sweeps better and slower: 0.002 and 60 sweeps a round: 2.89 / 1.62 % for 2.6x the time (the
-// relaxation's convergence, not the maps, is what these figures follow).
+// faces, so the work and the strain left do not depend on the scale: a fixed 0.05 px alone left
+// every vertex of the horse active at scale 8000 (faces ten times wider in pixels than at 800).
+// Measured against 0.05 px alone (medians over the 16 shared meshes, visible seams at 800 / 8000):
+// 3.22 / 1.77 -> 3.27 / 1.80 % of edge length, the horse in 0.98x / 0.59x the time. Looser settles
+// are faster and worse (1.5 %: 3.32 / 1.82 %, 2 %: 3.36 / 1.90 %), tighter ones with more sweeps
+// better and slower (0.2 % and 60 sweeps a round: 2.89 / 1.62 % for 2.6x the time): the figures
+// follow the relaxation's convergence (docs/mapping.md section 7, tenth session).
 constexpr float kSettledShare = 0.01f;
+// ... or less than this many pixels (a twentieth of a texel), whichever is larger: finer moves do
+// not show in the texture, and on meshes whose faces are a pixel or less wide (horse_x16 at scale
+// 800: 0.65 px) the share alone took 1.4x the time for 0.885 -> 0.822 % visible seams.
+constexpr float kSettledPx = 0.05f;
 
 // The quarter turns of rosy_field.h's rotate_quarter as matrices (x' = a x + b y, y' = c x + d y):
 // the same values without a branch per corner (the turns are as good as random).
@@ -119,7 +122,7 @@ void relax_lattice_coordinates(const GridRelaxInput& in, std::vector<float>& uv)
       float side = 0.f;
       for (uint32_t c = start[v]; c < start[v + 1]; ++c) side += std::sqrt(area[corners[c] / 3]);
       const uint32_t n = start[v + 1] - start[v];
-      settled[v] = n > 0 ? kSettledShare * side / static_cast<float>(n) : 0.f;
+      settled[v] = std::max(kSettledPx, n > 0 ? kSettledShare * side / static_cast<float>(n) : 0.f);
     }
   });
 
