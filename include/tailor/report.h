@@ -136,7 +136,7 @@ struct TileRun {
 //! Each metric's worst value over the tiles: wrap ratios farthest from 1, the largest worst seam,
 //! histogram L1 and patch coherence, the smallest gradient ratio; the other fields from the first
 //! tile. Precondition: at least one tile.
-TileMetrics worst_tile_metrics(std::span<const TileQuality> tiles);
+TAILOR_API TileMetrics worst_tile_metrics(std::span<const TileQuality> tiles);
 
 //! The JSON of `tailor tile --json`: the settings, the report, each tile's metrics and verdict,
 //! targets_met of the worst.

@@ -239,8 +239,11 @@ Status AtomicFileWriter::write(std::span<const char> bytes) {
 Status AtomicFileWriter::commit() {
   if (!error_.is_ok()) return error_;
   if (!file_) return fail(EBADF);
-  // The first failure's errno: fclose sets its own (or none) after a failed fflush.
+  // The first failure's errno: fclose sets its own (or none) after a failed fflush. The bytes reach
+  // the disk (fsync) before the rename makes them the target: after a power cut the target is the
+  // old file or the whole new one, never a renamed empty one.
   int write_error = std::fflush(file_) == 0 ? 0 : (errno != 0 ? errno : EIO);
+  if (write_error == 0 && fsync(fileno(file_)) != 0 && errno != EINVAL && errno != EROFS) write_error = errno;
   if (std::fclose(file_) != 0 && write_error == 0) write_error = errno != 0 ? errno : EIO;
   file_ = nullptr;
   if (write_error != 0) return fail(write_error);
