@@ -112,7 +112,7 @@ Status map_grid(const MappingInput& input, Atlas& atlas, MappingStats& stats, st
     for (size_t f = 0; f < nf; ++f) {
       bool changed = flat[f] != previous_flat[f];
       for (size_t k = 0; k < 3; ++k) changed |= !(corner_map[3 * f + k] == previous_map[3 * f + k]);
-      if (changed)
+      if (changed && !moving.empty())  // empty: the relaxation has not run, every vertex starts
         for (size_t k = 0; k < 3; ++k) moving[idx[3 * f + k]] = 1;
     }
   };
