@@ -691,6 +691,16 @@ TEST(Mapping, SymmetryFourGivesInvisibleSeams) {
   bad.mode = MappingMode::kPatches;
   bad.texture_period_px = 0.f;
   EXPECT_EQ(map_into(grid1, bad).code(), ErrorCode::kInvalidArgument);
+  // Faces a few millionths of the texture wide (scale 0.01: fandisk within 0.01 px) are refused,
+  // not mapped with flipped faces (the lattice coordinates are floats modulo the period).
+  bad.texture_period_px = 512.f;
+  bad.scale = 0.01f;
+  const Status tiny = map_into(grid1, bad);
+  EXPECT_EQ(tiny.code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(tiny.message().find("symmetry 4 needs faces at least"), std::string::npos) << tiny.message();
+  bad.scale = 10.f;  // faces ~0.1 px: mapped, none flipped
+  ASSERT_TRUE(map_into(grid1, bad).is_ok());
+  EXPECT_EQ(metrics4(grid1).flipped, 0u);
 }
 
 // The local mixed-integer step of symmetry 4 (grid_cones.h) only moves singularities: the turns

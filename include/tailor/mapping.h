@@ -222,7 +222,8 @@ struct TextureMap {
 //! Fails as compute_orientation does, then with kInvalidArgument on bad mapping options (scale <= 0
 //! or non-finite, max_stretch, field_following, hop_age, crack_rings, max_seed_rotation_deg or
 //! factor_step out of range, seam_faces of the wrong size, a non-finite seed point, symmetry not 1
-//! or 4, symmetry 4 outside the patches mode or with texture_period_px < 1), kInvalidMesh
+//! or 4, symmetry 4 outside the patches mode, with texture_period_px < 1 or with faces narrower
+//! on average than 2^-18 of the period at this scale: floats modulo the period), kInvalidMesh
 //! when the topology does not match the mesh, kCancelled when the progress callback returns false
 //! (the atlas is then empty), and as compute_uv_metrics does.
 //! Cost: the orientation and the metrics O(F); the growth O(F log front) time; the crack closing
