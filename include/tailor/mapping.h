@@ -110,8 +110,8 @@ struct MappingOptions {
                                     //!< square tile that looks the same turned by 90 degrees (4-RoSy and lattice
                                     //!< position fields, coordinates relaxed with the lattice maps held; seams
                                     //!< that are quarter turns plus whole repeats are invisible; faces keep their
-                                    //!< lattice chart up to 4x max_stretch). Visible seams 1.6 % of edge length
-                                    //!< when the tile repeats ~15 times across the mesh, 2.9 % at ~1.5 times
+                                    //!< lattice chart up to 6x max_stretch). Visible seams 1.5 % of edge length
+                                    //!< when the tile repeats ~15 times across the mesh, 2.85 % at ~1.5 times
                                     //!< (docs/mapping.md). Measure it with MetricsOptions::symmetry 4 too
   float texture_period_px = 512.f;  //!< symmetry 4: the texture's size in pixels (square), the lattice period
   // kThesis -------------------------------------------------------------------------------------
@@ -162,7 +162,7 @@ inline constexpr OptionDoc kMappingOptionDocs[] = {
      "1: patch discovery; 4, experimental: an integer-grid map for a square tile that looks the same turned by "
      "90 degrees (needs a square texture, e.g. from 'tailor tile --symmetry 4'): seams away from the field's "
      "cones are quarter turns plus whole repeats, invisible under such a tile. Best when the tile repeats many "
-     "times across the mesh (--scale 8000: 1.6% of edge length visible vs 4.0% with 1); see docs/mapping.md"},
+     "times across the mesh (--scale 8000: 1.5% of edge length visible vs 4.0% with 1); see docs/mapping.md"},
 };
 
 struct MappingStats {

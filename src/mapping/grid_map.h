@@ -24,11 +24,13 @@
 namespace tailor::internal {
 
 //! The per-face bound of a face that keeps its lattice chart: looser than max_stretch, because
-//! cutting such a face makes visible seams and stretching it does not. 4x max_stretch (singular
-//! values within [1/2, 2] by default): over the 16 shared meshes the median visible seam length
-//! goes 6.6 -> 6.3 % at scale 800 and 5.4 -> 3.7 % at 8000 against max_stretch itself, Sander
-//! Linf <= 2 and L2 <= 1.02; 8x gave 6.3 / 3.4 % with Linf up to 3 and L2 1.019.
-inline float lattice_max_stretch(float max_stretch) { return 4.f * max_stretch; }
+//! cutting such a face makes visible seams and stretching it does not. 6x max_stretch (singular
+//! values within [1/2.5, 2.5] by default, within the Sander Linf <= 3; map_grid keeps L2
+//! within its budget by cutting the most squashed faces). Medians over the 16 shared meshes,
+//! visible seams at scale 800 / 8000 (over-relaxation 1.9, L2 budget): 4x: 2.88 / 1.60 %, Linf
+//! <= 1.99; 5x: 2.88 / 1.53 %, 2.24; 6x: 2.85 / 1.46 %, 2.49; 7x: 2.84 / 1.44 %, 2.73; 8x: 2.83 /
+//! 1.41 %, 2.99 (too near 3). Before the L2 budget, 8x put L2 past 1.02.
+inline float lattice_max_stretch(float max_stretch) { return 6.f * max_stretch; }
 
 //! Fills atlas.corner_uv, atlas.patch and patch_count (symmetry 4), and on_seam (#F, where the
 //! seam shortening looks: every face). Deterministic for any options.threads. O(V) per field
