@@ -37,10 +37,6 @@ void fixed_point(const LatticeMap& m, float period, float p[2]) {
   p[1] = (a * ty - c * tx) / det;
 }
 
-}  // namespace
-
-namespace {
-
 // Breadth-first search state, reused from one start face to the next.
 struct Search {
   std::vector<uint32_t> stamp, from, queue;  // per face: last search that reached it, the half-edge it came by
