@@ -23,6 +23,9 @@ namespace {
 // 2.25 % for 20 % less mapping time (the relaxation is most of it on large meshes).
 constexpr uint32_t kRelaxRounds = 3;
 constexpr uint32_t kRelaxIterations = 20;
+// Faces per thread of the relaxation: its 80 sweeps make it worth a thread from far fewer faces
+// than a single pass over them (util/parallel_chunks.h's 100k).
+constexpr size_t kRelaxFacesPerThread = 20000;
 
 //! Places face g from its placed neighbour across g's edge `k` (corners k, k+1 take the
 //! neighbour's UVs at those vertices: ua, ub), the third corner by the similarity that maps g's
@@ -209,12 +212,14 @@ Status map_grid(const MappingInput& input, Atlas& atlas, MappingStats& stats, st
         for (size_t k = 0; k < 3; ++k) moving[idx[3 * f + k]] = 1;
     }
   };
-  const GridRelaxInput relax{mesh, frames, corner_map, flat, scale, period, kRelaxIterations, threads, &moving};
+  const LatticeRelaxation relaxation(mesh, frames, scale, period,
+                                     parallel_threads(nf, options.threads, kRelaxFacesPerThread));
+  const auto relax = [&] { relaxation.run(corner_map, flat, kRelaxIterations, &moving, field.uv); };
   for (uint32_t round = 0; round < kRelaxRounds; ++round) {
     if (round > 0) remember();
     find_maps();
     if (round > 0) mark_changed();
-    relax_lattice_coordinates(relax, field.uv);
+    relax();
     if (options.progress && !options.progress(0.8f + 0.15f * static_cast<float>(round + 1) / kRelaxRounds))
       return Status::error(ErrorCode::kCancelled, "", "cancelled");
   }
@@ -231,7 +236,7 @@ Status map_grid(const MappingInput& input, Atlas& atlas, MappingStats& stats, st
   move_cones(mesh, topology, field.uv, period, edge_map);
   maps_from_edges(nf, threads, edge_map, corner_map, flat);
   mark_changed();
-  relax_lattice_coordinates(relax, field.uv);
+  relax();
   // Per face whether its chart triangle is within the lattice bound, and its part of Sander's L2.
   const float bound = lattice_max_stretch(options.max_stretch);
   std::vector<float> area_3d(nf, 0.f), area_uv(nf, 0.f), l2_term(nf, 1.f);

@@ -8,8 +8,9 @@
 // exact Gauss-Seidel update: P_k |g_k|^2 = R g_k - sum_{j != k} P_j (g_j . g_k), weighted by
 // A |g_k|^2), each face's answer taken back into the vertex's chart through the inverse map.
 // Faces weigh robustly (kRobustScale below), so a mismatch the maps force stays in a few faces.
-// Vertices are coloured so that no two of a colour share a face; a colour's moves are
-// independent, so they run on any number of threads with the same result.
+// The vertices move in blocks of consecutive vertices (in the order the faces name them), one
+// after the other within a block; the blocks are coloured so that no two of a colour share a face,
+// so a colour's blocks move independently, on any number of threads with the same result.
 //
 // This work is based on:
 //   L. Liu, L. Zhang, Y. Xu, C. Gotsman, S. J. Gortler, "A local/global approach to mesh
@@ -57,44 +58,46 @@ constexpr float kSettledShare = 0.01f;
 // 800: 0.65 px) the share alone took 1.4x the time for 0.885 -> 0.822 % visible seams.
 constexpr float kSettledPx = 0.05f;
 
-// The quarter turns of rosy_field.h's rotate_quarter as matrices (x' = a x + b y, y' = c x + d y):
-// the same values without a branch per corner (the turns are as good as random).
-struct Turn {
-  float a, b, c, d;
-};
-constexpr Turn kTurn[4] = {{1.f, 0.f, 0.f, 1.f}, {0.f, 1.f, -1.f, 0.f}, {-1.f, 0.f, 0.f, -1.f}, {0.f, -1.f, 1.f, 0.f}};
+// Vertices per block of the Gauss-Seidel sweep (consecutive in the sweep order), and blocks per
+// parallel chunk: a block's faces' data spans a few pages; a chunk is enough work for a thread.
+constexpr size_t kBlock = 256;
+constexpr size_t kBlocksPerChunk = 4;
 
-//! apply(m, period, in, out) of rosy_field.h.
+//! apply(m, period, in, out) of rosy_field.h, the turn as a product (kQuarterTurn).
 inline void map_point(const LatticeMap& m, float period, const float* in, float* out) {
-  const Turn& t = kTurn[m.r & 3];
-  out[0] = t.a * in[0] + t.b * in[1] + period * static_cast<float>(m.tx);
-  out[1] = t.c * in[0] + t.d * in[1] + period * static_cast<float>(m.ty);
+  const float* t = kQuarterTurn[m.r & 3];
+  out[0] = t[0] * in[0] + t[1] * in[1] + period * static_cast<float>(m.tx);
+  out[1] = t[2] * in[0] + t[3] * in[1] + period * static_cast<float>(m.ty);
 }
 
 //! The inverse map: the turn transposed after the shift taken off.
 inline void unmap_point(const LatticeMap& m, float period, const float* in, float* out) {
-  const Turn& t = kTurn[m.r & 3];
+  const float* t = kQuarterTurn[m.r & 3];
   const float x = in[0] - period * static_cast<float>(m.tx), y = in[1] - period * static_cast<float>(m.ty);
-  out[0] = t.a * x + t.c * y;
-  out[1] = t.b * x + t.d * y;
+  out[0] = t[0] * x + t[2] * y;
+  out[1] = t[1] * x + t[3] * y;
 }
 
 }  // namespace
 
-void relax_lattice_coordinates(const GridRelaxInput& in, std::vector<float>& uv) {
-  const size_t nf = in.mesh.face_count(), nv = in.mesh.vertex_count();
-  const uint32_t* idx = in.mesh.indices.data();
-  const float period = in.period;
-  if (in.iterations == 0 || nf == 0) return;
-
-  // Per face: the barycentric gradients (pixels^-1) and the area (pixels^2); 0 = not relaxed.
-  std::vector<float> grad(6 * nf, 0.f), area(nf, 0.f);
-  for_each_chunk(nf, in.threads, [&](size_t begin, size_t end, size_t) {
+LatticeRelaxation::LatticeRelaxation(const Mesh& mesh, const FaceFrames& frames, float scale, float period,
+                                     size_t threads)
+    : idx_(mesh.indices.data()),
+      face_count_(mesh.face_count()),
+      vertex_count_(mesh.vertex_count()),
+      period_(period),
+      threads_(threads) {
+  const size_t nf = face_count_, nv = vertex_count_;
+  const uint32_t* idx = idx_;
+  // Per face: the barycentric gradients (pixels^-1) and the area (pixels^2); 0 = degenerate.
+  std::vector<float>& grad = grad_;
+  std::vector<float> area(nf, 0.f);
+  grad.assign(6 * nf, 0.f);
+  for_each_chunk(nf, threads, [&](size_t begin, size_t end, size_t) {
     for (size_t f = begin; f < end; ++f) {
-      if (!in.flat[f]) continue;
-      const float* l = &in.frames.local[6 * f];
+      const float* l = &frames.local[6 * f];
       float x[6];
-      for (int i = 0; i < 6; ++i) x[i] = in.scale * l[i];
+      for (int i = 0; i < 6; ++i) x[i] = scale * l[i];
       const float twice = (x[2] - x[0]) * (x[5] - x[1]) - (x[3] - x[1]) * (x[4] - x[0]);
       if (!(twice > 1e-12f)) continue;
       for (int k = 0; k < 3; ++k) {
@@ -106,23 +109,64 @@ void relax_lattice_coordinates(const GridRelaxInput& in, std::vector<float>& uv)
     }
   });
 
-  // Vertex -> corners of its relaxed faces (CSR).
-  std::vector<uint32_t> start(nv + 1, 0), corners;
+  // The sweep's order of the vertices: as the faces first name them, so that consecutive vertices
+  // in it have their faces near each other in the face arrays (the vertex indices of a file need
+  // not follow its faces: on the horse, the sweep in index order waited on memory for its faces'
+  // maps). Vertices no face names come last. Below, per-vertex arrays but uv and `moving` are in
+  // this order.
+  std::vector<uint32_t>& sweep = sweep_order_;
+  std::vector<uint32_t> rank(nv, kInvalid);
+  sweep.reserve(nv);
+  for (size_t c = 0; c < 3 * nf; ++c)
+    if (rank[idx[c]] == kInvalid) {
+      rank[idx[c]] = static_cast<uint32_t>(sweep.size());
+      sweep.push_back(idx[c]);
+    }
+  for (size_t v = 0; v < nv; ++v)
+    if (rank[v] == kInvalid) {
+      rank[v] = static_cast<uint32_t>(sweep.size());
+      sweep.push_back(static_cast<uint32_t>(v));
+    }
+
+  // Vertex (in sweep order) -> corners of its non-degenerate faces (CSR).
+  std::vector<uint32_t>&start = start_, &corners = corners_;
+  start.assign(nv + 1, 0);
   for (size_t f = 0; f < nf; ++f)
     if (area[f] > 0.f)
-      for (int k = 0; k < 3; ++k) ++start[idx[3 * f + k] + 1];
+      for (int k = 0; k < 3; ++k) ++start[rank[idx[3 * f + k]] + 1];
   for (size_t v = 0; v < nv; ++v) start[v + 1] += start[v];
   corners.resize(start[nv]);
   {
     std::vector<uint32_t> fill(start.begin(), start.end() - 1);
     for (size_t f = 0; f < nf; ++f)
       if (area[f] > 0.f)
-        for (uint32_t k = 0; k < 3; ++k) corners[fill[idx[3 * f + k]]++] = static_cast<uint32_t>(3 * f + k);
+        for (uint32_t k = 0; k < 3; ++k) corners[fill[rank[idx[3 * f + k]]]++] = static_cast<uint32_t>(3 * f + k);
   }
 
+  // Per corner, in the vertices' order: what the global step needs of its face but the positions,
+  // g_k / |g_k|^2, (g_j . g_k) / |g_k|^2 for the next and previous corner j, and the weight
+  // A |g_k|^2, read in order instead of gathered from the face's gradients in every sweep.
+  std::vector<float>& term = term_;
+  term.resize(5 * corners.size());
+  for_each_chunk(nv, threads, [&](size_t begin, size_t end, size_t) {
+    for (size_t c = start[begin]; c < start[end]; ++c) {
+      const uint32_t f = corners[c] / 3, k = corners[c] % 3;
+      const float* g = &grad[6 * f];
+      const float gx = g[2 * k], gy = g[2 * k + 1], gg = gx * gx + gy * gy;
+      const uint32_t j1 = (k + 1) % 3, j2 = (k + 2) % 3;
+      float* t = &term[5 * c];
+      t[0] = gx / gg;
+      t[1] = gy / gg;
+      t[2] = (g[2 * j1] * gx + g[2 * j1 + 1] * gy) / gg;
+      t[3] = (g[2 * j2] * gx + g[2 * j2 + 1] * gy) / gg;
+      t[4] = area[f] * gg;
+    }
+  });
+
   // Per vertex the move below which it has settled (pixels).
-  std::vector<float> settled(nv, 0.f);
-  for_each_chunk(nv, in.threads, [&](size_t begin, size_t end, size_t) {
+  std::vector<float>& settled = settled_;
+  settled.assign(nv, 0.f);
+  for_each_chunk(nv, threads, [&](size_t begin, size_t end, size_t) {
     for (size_t v = begin; v < end; ++v) {
       float side = 0.f;
       for (uint32_t c = start[v]; c < start[v + 1]; ++c) side += std::sqrt(area[corners[c] / 3]);
@@ -131,70 +175,131 @@ void relax_lattice_coordinates(const GridRelaxInput& in, std::vector<float>& uv)
     }
   });
 
-  // Greedy colouring in vertex order; vertices grouped by colour. used[c] == v + 1 marks colour c
-  // as taken by a neighbour of v: the search for a free colour stops within v's corners + 1 steps,
-  // so the colouring is O(corners) on any mesh (a colour count of its own per vertex would not be).
-  std::vector<uint32_t> colour(nv, 0), used(1, 0);
-  uint32_t colours = 1;
-  for (size_t v = 0; v < nv; ++v) {
-    const uint32_t mark = static_cast<uint32_t>(v + 1);
-    for (uint32_t i = start[v]; i < start[v + 1]; ++i) {
-      const uint32_t f = corners[i] / 3;
-      for (int k = 0; k < 3; ++k) {
-        const uint32_t w = idx[3 * f + k];
-        if (w < v) used[colour[w]] = mark;
+  // Blocks of kBlock consecutive vertices in sweep order, coloured so that no two blocks of a
+  // colour share a face: a colour's blocks move independently (any number of threads, the same
+  // result), and a block's vertices move one after the other, so that a sweep reads its faces'
+  // data nearly in order (a colouring by vertex read it at random and waited on memory).
+  const size_t blocks = (nv + kBlock - 1) / kBlock;
+  std::vector<uint64_t> touching;  // (block, neighbouring block) pairs
+  for (size_t f = 0; f < nf; ++f) {
+    if (!(area[f] > 0.f)) continue;
+    for (int k = 0; k < 3; ++k)
+      for (int j = 0; j < 3; ++j) {
+        const uint64_t a = rank[idx[3 * f + k]] / kBlock, b = rank[idx[3 * f + j]] / kBlock;
+        if (a != b) touching.push_back((a << 32) | b);
       }
+  }
+  std::sort(touching.begin(), touching.end());
+  touching.erase(std::unique(touching.begin(), touching.end()), touching.end());
+  // Greedy colouring in block order. used[c] == b + 1 marks colour c as taken by a neighbour of b:
+  // the search for a free colour stops within b's neighbours + 1 steps, so the colouring is
+  // O(pairs) on any mesh (a badly ordered one gets many colours, not wrong ones).
+  std::vector<uint32_t> colour(blocks, 0), used(1, 0);
+  uint32_t colours = 1;
+  for (size_t b = 0, i = 0; b < blocks; ++b) {
+    const uint32_t mark = static_cast<uint32_t>(b + 1);
+    for (; i < touching.size() && (touching[i] >> 32) == b; ++i) {
+      const uint32_t w = static_cast<uint32_t>(touching[i]);
+      if (w < b) used[colour[w]] = mark;
     }
     uint32_t c = 0;
     while (c < colours && used[c] == mark) ++c;
-    colour[v] = c;
+    colour[b] = c;
     if (c == colours) {
       ++colours;
       used.push_back(0);
     }
   }
-  std::vector<uint32_t> colour_start(colours + 1, 0), order(nv);
-  for (size_t v = 0; v < nv; ++v) ++colour_start[colour[v] + 1];
+  touching = {};
+  std::vector<uint32_t>&colour_start = colour_start_, &order = order_;
+  colour_start.assign(colours + 1, 0);
+  order.resize(blocks);
+  for (size_t b = 0; b < blocks; ++b) ++colour_start[colour[b] + 1];
   for (uint32_t c = 0; c < colours; ++c) colour_start[c + 1] += colour_start[c];
   {
     std::vector<uint32_t> fill(colour_start.begin(), colour_start.end() - 1);
-    for (size_t v = 0; v < nv; ++v) order[fill[colour[v]]++] = static_cast<uint32_t>(v);
+    for (size_t b = 0; b < blocks; ++b) order[fill[colour[b]]++] = static_cast<uint32_t>(b);
   }
+}
 
+void LatticeRelaxation::run(const std::vector<LatticeMap>& corner_map, const std::vector<uint8_t>& flat,
+                            uint32_t iterations, std::vector<uint8_t>* moving, std::vector<float>& uv) const {
+  const size_t nf = face_count_, nv = vertex_count_;
+  if (iterations == 0 || nf == 0) return;
+  const uint32_t* idx = idx_;
+  const float period = period_;
+  const std::vector<float>&grad = grad_, &term = term_, &settled = settled_;
+  const std::vector<uint32_t>&start = start_, &corners = corners_, &sweep = sweep_order_;
+  const std::vector<uint32_t>&colour_start = colour_start_, &order = order_;
+  const uint32_t colours = static_cast<uint32_t>(colour_start.size() - 1);
   std::vector<float> rotation(2 * nf, 0.f);  // per face (cos, sin) of R
-  std::vector<float> robust(nf, 1.f);        // per face: the robust weight of its energy
+  std::vector<float> robust(nf, 0.f);        // per face: the robust weight of its energy; 0 = not relaxed
   const auto corner_pos = [&](size_t f, int k, float* out) {
-    map_point(in.corner_map[3 * f + k], period, &uv[2 * idx[3 * f + k]], out);
+    map_point(corner_map[3 * f + k], period, &uv[2 * idx[3 * f + k]], out);
   };
   // Activity: a vertex is moved again only while a vertex of one of its faces moved by more than
   // its settled share in the last sweep (at first every vertex, or those input.moving names); a
   // face is fitted again only then too (at first every face: the rotations start from nothing).
-  const bool warm = in.moving && in.moving->size() == nv;
+  const bool warm = moving && moving->size() == nv;
   std::vector<uint8_t> own_moved;
   if (!warm) own_moved.assign(nv, 1);
-  std::vector<uint8_t>& moved = warm ? *in.moving : own_moved;
+  std::vector<uint8_t>& moved = warm ? *moving : own_moved;
   std::vector<uint8_t> face_active(nf, 1), vertex_active(nv, 1);
-  for (uint32_t it = 0; it < in.iterations; ++it) {
+  // The vertex's exact Gauss-Seidel update, over-relaxed.
+  const auto move = [&](size_t p) {
+    const uint32_t v = sweep[p];
+    moved[v] = 0;
+    if (!vertex_active[p]) return;
+    double sx = 0.0, sy = 0.0, sw = 0.0;
+    for (uint32_t c = start[p]; c < start[p + 1]; ++c) {
+      const uint32_t f = corners[c] / 3, k = corners[c] % 3;
+      const float* t = &term[5 * c];
+      const float rc = rotation[2 * f], rs = rotation[2 * f + 1];
+      float p1[2], p2[2];
+      corner_pos(f, static_cast<int>((k + 1) % 3), p1);
+      corner_pos(f, static_cast<int>((k + 2) % 3), p2);
+      // P_k = R g_k / |g_k|^2 - sum_{j != k} P_j (g_j . g_k) / |g_k|^2
+      float target[2] = {rc * t[0] - rs * t[1] - t[2] * p1[0] - t[3] * p2[0],
+                         rs * t[0] + rc * t[1] - t[2] * p1[1] - t[3] * p2[1]};
+      float back[2];
+      unmap_point(corner_map[corners[c]], period, target, back);
+      const double w = static_cast<double>(t[4] * robust[f]);
+      sx += w * back[0];
+      sy += w * back[1];
+      sw += w;
+    }
+    if (!(sw > 0.0)) return;
+    const float mx = static_cast<float>(sx / sw), my = static_cast<float>(sy / sw);
+    const float dx = kOverRelaxation * (mx - uv[2 * v]), dy = kOverRelaxation * (my - uv[2 * v + 1]);
+    uv[2 * v] += dx;
+    uv[2 * v + 1] += dy;
+    moved[v] = std::abs(dx) + std::abs(dy) > settled[p];
+  };
+  for (uint32_t it = 0; it < iterations; ++it) {
     if (it > 0 || warm) {
-      for_each_chunk(nf, in.threads, [&](size_t begin, size_t end, size_t) {
+      for_each_chunk(nf, threads_, [&](size_t begin, size_t end, size_t) {
         for (size_t f = begin; f < end; ++f)
           face_active[f] = it == 0 || (moved[idx[3 * f]] | moved[idx[3 * f + 1]] | moved[idx[3 * f + 2]]);
       });
-      for_each_chunk(nv, in.threads, [&](size_t begin, size_t end, size_t) {
-        for (size_t v = begin; v < end; ++v) {
+      for_each_chunk(nv, threads_, [&](size_t begin, size_t end, size_t) {
+        for (size_t p = begin; p < end; ++p) {
           uint8_t active = 0;
-          for (uint32_t c = start[v]; c < start[v + 1] && !active; ++c) {
+          for (uint32_t c = start[p]; c < start[p + 1] && !active; ++c) {
             const uint32_t* t = &idx[corners[c] - corners[c] % 3];
             active = moved[t[0]] | moved[t[1]] | moved[t[2]];
           }
-          vertex_active[v] = active;
+          vertex_active[p] = active;
         }
       });
     }
     // Local step: the rotation nearest to each face's Jacobian.
-    for_each_chunk(nf, in.threads, [&](size_t begin, size_t end, size_t) {
+    for_each_chunk(nf, threads_, [&](size_t begin, size_t end, size_t) {
       for (size_t f = begin; f < end; ++f) {
-        if (!(area[f] > 0.f) || !face_active[f]) continue;
+        if (!face_active[f]) continue;
+        if (!flat[f]) {  // no chart to relax (a singularity): its corners take no part
+          robust[f] = 0.f;
+          continue;
+        }
         float j00 = 0.f, j01 = 0.f, j10 = 0.f, j11 = 0.f;
         for (int k = 0; k < 3; ++k) {
           float p[2];
@@ -206,58 +311,29 @@ void relax_lattice_coordinates(const GridRelaxInput& in, std::vector<float>& uv)
           j11 += p[1] * gy;
         }
         const float c = j00 + j11, s = j10 - j01, n = std::sqrt(c * c + s * s);
-        rotation[2 * f] = n > 0.f ? c / n : 1.f;
-        rotation[2 * f + 1] = n > 0.f ? s / n : 0.f;
-        const float rc = rotation[2 * f], rs = rotation[2 * f + 1];
+        const float inv_n = n > 0.f ? 1.f / n : 0.f;
+        const float rc = n > 0.f ? c * inv_n : 1.f, rs = s * inv_n;
+        rotation[2 * f] = rc;
+        rotation[2 * f + 1] = rs;
         const float e =
             (j00 - rc) * (j00 - rc) + (j01 + rs) * (j01 + rs) + (j10 - rs) * (j10 - rs) + (j11 - rc) * (j11 - rc);
-        robust[f] = 1.f / (1.f + e / (kRobustScale * kRobustScale));
+        constexpr float kRobust2 = kRobustScale * kRobustScale;
+        robust[f] = kRobust2 / (kRobust2 + e);  // 1 / (1 + e / scale^2) in one division
       }
     });
-    // Global step, colour by colour.
+    // Global step, colour by colour, block by block.
     for (uint32_t col = 0; col < colours; ++col) {
       const size_t first = colour_start[col], count = colour_start[col + 1] - first;
-      for_each_chunk(count, in.threads, [&](size_t begin, size_t end, size_t) {
-        for (size_t i = first + begin; i < first + end; ++i) {
-          const uint32_t v = order[i];
-          moved[v] = 0;
-          if (!vertex_active[v]) continue;
-          double sx = 0.0, sy = 0.0, sw = 0.0;
-          for (uint32_t c = start[v]; c < start[v + 1]; ++c) {
-            const uint32_t f = corners[c] / 3;
-            const int k = static_cast<int>(corners[c] % 3);
-            const float* g = &grad[6 * f];
-            const float gkx = g[2 * k], gky = g[2 * k + 1];
-            const float gg = gkx * gkx + gky * gky;
-            if (!(gg > 0.f)) continue;
-            const float rc = rotation[2 * f], rs = rotation[2 * f + 1];
-            float tx = rc * gkx - rs * gky, ty = rs * gkx + rc * gky;  // R g_k
-            for (int j = 0; j < 3; ++j) {
-              if (j == k) continue;
-              float p[2];
-              corner_pos(f, j, p);
-              const float d = g[2 * j] * gkx + g[2 * j + 1] * gky;
-              tx -= p[0] * d;
-              ty -= p[1] * d;
-            }
-            float target[2] = {tx / gg, ty / gg}, back[2];
-            unmap_point(in.corner_map[3 * f + k], period, target, back);
-            const double w = static_cast<double>(area[f]) * gg * robust[f];
-            sx += w * back[0];
-            sy += w * back[1];
-            sw += w;
-          }
-          if (!(sw > 0.0)) continue;
-          const float mx = static_cast<float>(sx / sw), my = static_cast<float>(sy / sw);
-          const float dx = kOverRelaxation * (mx - uv[2 * v]), dy = kOverRelaxation * (my - uv[2 * v + 1]);
-          uv[2 * v] += dx;
-          uv[2 * v + 1] += dy;
-          moved[v] = std::abs(dx) + std::abs(dy) > settled[v];
-        }
-      });
+      for_each_chunk(
+          count, threads_,
+          [&](size_t begin, size_t end, size_t) {
+            for (size_t i = first + begin; i < first + end; ++i)
+              for (size_t p = size_t{order[i]} * kBlock, last = std::min(nv, p + kBlock); p < last; ++p) move(p);
+          },
+          kBlocksPerChunk);
     }
   }
-  if (in.moving && !warm) *in.moving = std::move(own_moved);
+  if (moving && !warm) *moving = std::move(own_moved);
 }
 
 }  // namespace tailor::internal

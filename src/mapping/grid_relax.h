@@ -19,26 +19,38 @@
 
 namespace tailor::internal {
 
-struct GridRelaxInput {
-  const Mesh& mesh;
-  const FaceFrames& frames;
-  const std::vector<LatticeMap>& corner_map;  //!< #F*3: corner k's chart -> corner 0's chart
-  const std::vector<uint8_t>& flat;           //!< #F: 1 where the maps close around the face
-  float scale = 800.f;                        //!< pixels per normalised unit
-  float period = 512.f;                       //!< lattice period, pixels
-  uint32_t iterations = 30;
-  size_t threads = 1;
-  //! #V, in and out: 1 where a vertex is still moving (it and its neighbours start active; set it
-  //! for the vertices of faces whose maps changed); on return, the vertices that moved in the last
-  //! sweep. Null or empty: every vertex starts active.
-  std::vector<uint8_t>* moving = nullptr;
-};
+//! The relaxation of one mesh at one scale: built once (the faces' gradients and areas, each
+//! vertex's corners, the blocks and their colours), run for each round of lattice maps.
+class LatticeRelaxation {
+ public:
+  //! threads: for the parallel loops (the same result for any count).
+  LatticeRelaxation(const Mesh& mesh, const FaceFrames& frames, float scale, float period, size_t threads);
 
-//! Moves uv (#V*2, field.uv: per vertex its lattice coordinate in its own chart, pixels) by local/
-//! global ARAP iterations over the flat faces, Gauss-Seidel by vertex colour (no two vertices of a
-//! colour share a face), so the result is the same for any thread count. O(F) per iteration at
-//! most; vertices that have settled (and their neighbours) are skipped; with input.moving only those
-//! still moving and their neighbours start.
-void relax_lattice_coordinates(const GridRelaxInput& input, std::vector<float>& uv);
+  //! Moves uv (#V*2, field.uv: per vertex its lattice coordinate in its own chart, pixels) by
+  //! `iterations` local/global ARAP iterations over the faces `flat` names (#F: 1 where the
+  //! lattice maps close around the face), each corner seen through corner_map (#F*3: corner k's
+  //! chart -> corner 0's chart). Gauss-Seidel by blocks of vertices in index order, the blocks by
+  //! colour (no two blocks of a colour share a face), so the result is the same for any thread
+  //! count. O(F) per iteration at most; vertices that have settled (and their neighbours) are
+  //! skipped. moving (#V, in and out; may be null or empty): 1 where a vertex is still moving (it
+  //! and its neighbours start active; set it for the vertices of faces whose maps changed); on
+  //! return, the vertices that moved in the last sweep. Null or empty: every vertex starts active.
+  void run(const std::vector<LatticeMap>& corner_map, const std::vector<uint8_t>& flat, uint32_t iterations,
+           std::vector<uint8_t>* moving, std::vector<float>& uv) const;
+
+ private:
+  const uint32_t* idx_;
+  size_t face_count_, vertex_count_;
+  float period_;
+  size_t threads_;
+  std::vector<float> grad_;             // #F*6: barycentric gradients (pixels^-1); 0 for a degenerate face
+  std::vector<uint32_t> sweep_order_;   // #V: the vertices in the order of the sweeps
+  std::vector<uint32_t> start_;         // #V+1, in sweep order: CSR of each vertex's corners of non-degenerate faces
+  std::vector<uint32_t> corners_;       // corner indices 3f + k
+  std::vector<float> term_;             // 5 per corner (see grid_relax.cpp)
+  std::vector<float> settled_;          // #V, in sweep order: the move below which a vertex has settled (pixels)
+  std::vector<uint32_t> colour_start_;  // blocks by colour: order_[colour_start_[c] .. colour_start_[c + 1])
+  std::vector<uint32_t> order_;
+};
 
 }  // namespace tailor::internal

@@ -9,12 +9,19 @@
 
 #include <algorithm>
 #include <cmath>
-#include <unordered_map>
 
+#include "util/flat_hash.h"
 #include "util/parallel_chunks.h"
 
 namespace tailor::internal {
 namespace {
+
+// The smoothing sweeps run many times over each level: worth a thread from fewer vertices than a
+// single pass (util/parallel_chunks.h's 100k), and in smaller chunks than its default so that two
+// threads share a level of 50k vertices evenly (no sums are taken: any chunking gives the same
+// bytes).
+constexpr size_t kVerticesPerThread = 20000;
+constexpr size_t kSweepChunk = 4096;
 
 struct V3 {
   float x = 0, y = 0, z = 0;
@@ -89,8 +96,24 @@ inline void edge_offset(const Level& L, size_t v, const Level& M, size_t w, floa
   d[1] = scale * dot(delta, e2);
 }
 
+// std::round and std::floor are library calls on the x86-64 baseline (no SSE4.1), and the position
+// smoothing makes two rounds per edge and sweep (a fifth of a 4-fold map's time). round_nearest
+// adds and takes away 1.5 * 2^23, which leaves x rounded to the nearest integer (ties to even) for
+// |x| < 2^22, without a branch that mispredicts (the lattice coordinates are within a few periods
+// of 0; beyond, and for NaN, the library). round_down truncates and corrects.
+inline float round_nearest(float x) {
+  constexpr float kShift = 12582912.f;  // 1.5 * 2^23: the sum's last bit is the units
+  if (!(std::abs(x) < 4194304.f)) return std::round(x);
+  return (x + kShift) - kShift;
+}
+inline float round_down(float x) {
+  if (!(std::abs(x) < 4194304.f)) return std::floor(x);
+  const float t = static_cast<float>(static_cast<int32_t>(x));
+  return x < t ? t - 1.f : t;
+}
+
 inline float wrap(float x, float period) {
-  const float y = x - period * std::floor(x / period);
+  const float y = x - period * round_down(x / period);
   return y >= period ? 0.f : y;  // rounding can give exactly period
 }
 
@@ -105,14 +128,25 @@ inline void predict(const Level& L, size_t v, const Level& M, size_t w, float sc
   out[1] = y - d[1];
 }
 
+//! The adjacency of `count` vertices from (p << 32 | q) pairs, each row sorted, without repeats.
+//! Bucketed by row first, then each short row sorted: a sort of all pairs took a tenth of the
+//! field's time.
 void build_csr(size_t count, std::vector<uint64_t>& pairs, Level& L) {
-  std::sort(pairs.begin(), pairs.end());
-  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  std::vector<uint32_t> fill(count + 1, 0), row(pairs.size());
+  for (const uint64_t pq : pairs) ++fill[(pq >> 32) + 1];
+  for (size_t i = 0; i < count; ++i) fill[i + 1] += fill[i];
+  const std::vector<uint32_t> bucket(fill.begin(), fill.end());
+  for (const uint64_t pq : pairs) row[fill[pq >> 32]++] = static_cast<uint32_t>(pq);
+  pairs = {};
   L.start.assign(count + 1, 0);
-  L.adj.resize(pairs.size());
-  for (const uint64_t pq : pairs) ++L.start[(pq >> 32) + 1];
-  for (size_t i = 0; i < count; ++i) L.start[i + 1] += L.start[i];
-  for (size_t i = 0; i < pairs.size(); ++i) L.adj[i] = static_cast<uint32_t>(pairs[i]);
+  L.adj.clear();
+  L.adj.reserve(row.size());
+  for (size_t v = 0; v < count; ++v) {
+    const auto first = row.begin() + bucket[v], last = row.begin() + bucket[v + 1];
+    std::sort(first, last);
+    L.adj.insert(L.adj.end(), first, std::unique(first, last));
+    L.start[v + 1] = static_cast<uint32_t>(L.adj.size());
+  }
 }
 
 //! Clusters level L into a coarser level by a voxel grid of side `cell` and the normal's axis.
@@ -120,8 +154,8 @@ Level coarsen(Level& L, float cell) {
   Level C;
   const size_t n = L.size();
   L.parent.assign(n, 0);
-  std::unordered_map<uint64_t, uint32_t> cluster;
-  cluster.reserve(n / 2);
+  FlatIdTable cluster(n);
+  std::vector<uint64_t> cluster_key;
   std::vector<uint32_t> members;
   for (size_t v = 0; v < n; ++v) {
     const V3 p = load3(L.p, v), nv = load3(L.n, v);
@@ -131,10 +165,14 @@ Level coarsen(Level& L, float cell) {
     const float ax = std::abs(nv.x), ay = std::abs(nv.y), az = std::abs(nv.z);
     const uint64_t bin = ax >= ay && ax >= az ? (nv.x < 0) : ay >= az ? 2u + (nv.y < 0) : 4u + (nv.z < 0);
     const uint64_t key = (cell_of(p.x) << 43) | (cell_of(p.y) << 23) | (cell_of(p.z) << 3) | bin;
-    const auto [it, inserted] = cluster.try_emplace(key, static_cast<uint32_t>(members.size()));
-    if (inserted) members.push_back(0);
-    L.parent[v] = it->second;
-    ++members[it->second];
+    const uint32_t id = cluster.find_or_insert(hash_mix(key), static_cast<uint32_t>(members.size()),
+                                               [&](uint32_t s) { return cluster_key[s] == key; });
+    if (id == members.size()) {
+      members.push_back(0);
+      cluster_key.push_back(key);
+    }
+    L.parent[v] = id;
+    ++members[id];
   }
   const size_t m = members.size();
   C.p.assign(3 * m, 0.f);
@@ -179,26 +217,29 @@ void smooth_orientation(Level& L, uint32_t iterations, size_t threads) {
   const size_t n = L.size();
   std::vector<float> next(L.q.size());
   for (uint32_t it = 0; it < iterations; ++it) {
-    for_each_chunk(n, threads, [&](size_t begin, size_t end, size_t) {
-      for (size_t v = begin; v < end; ++v) {
-        const V3 qv = load3(L.q, v);
-        if (L.start[v] == L.start[v + 1]) {
-          store3(next, v, L.fixed[v] ? load3(L.c, v) : qv);
-          continue;
-        }
-        V3 acc = qv;
-        if (L.fixed[v]) {  // a soft pull towards the feature, as strong as all neighbours together
-          int k;
-          acc = acc + match(acc, load3(L.n, v), load3(L.c, v), k) * static_cast<float>(L.start[v + 1] - L.start[v]);
-        }
-        for (uint32_t i = L.start[v]; i < L.start[v + 1]; ++i) {
-          const uint32_t w = L.adj[i];
-          int k;
-          acc = acc + match(acc, load3(L.n, w), load3(L.q, w), k);
-        }
-        store3(next, v, tangent(acc, load3(L.n, v), qv));
-      }
-    });
+    for_each_chunk(
+        n, threads,
+        [&](size_t begin, size_t end, size_t) {
+          for (size_t v = begin; v < end; ++v) {
+            const V3 qv = load3(L.q, v);
+            if (L.start[v] == L.start[v + 1]) {
+              store3(next, v, L.fixed[v] ? load3(L.c, v) : qv);
+              continue;
+            }
+            V3 acc = qv;
+            if (L.fixed[v]) {  // a soft pull towards the feature, as strong as all neighbours together
+              int k;
+              acc = acc + match(acc, load3(L.n, v), load3(L.c, v), k) * static_cast<float>(L.start[v + 1] - L.start[v]);
+            }
+            for (uint32_t i = L.start[v]; i < L.start[v + 1]; ++i) {
+              const uint32_t w = L.adj[i];
+              int k;
+              acc = acc + match(acc, load3(L.n, w), load3(L.q, w), k);
+            }
+            store3(next, v, tangent(acc, load3(L.n, v), qv));
+          }
+        },
+        kSweepChunk);
     L.q.swap(next);
   }
 }
@@ -210,51 +251,58 @@ void smooth_position(Level& L, uint32_t iterations, float scale, float period, f
   const size_t n = L.size();
   // The fields' matching and the offsets are fixed while the positions move: computed once.
   std::vector<int8_t> turns(L.adj.size());
-  std::vector<float> offset(2 * L.adj.size());
-  for_each_chunk(n, threads, [&](size_t begin, size_t end, size_t) {
-    for (size_t v = begin; v < end; ++v)
-      for (uint32_t i = L.start[v]; i < L.start[v + 1]; ++i) {
-        int k;
-        edge_offset(L, v, L, L.adj[i], scale, k, &offset[2 * i]);
-        turns[i] = static_cast<int8_t>(k);
-      }
-  });
+  std::vector<float> offset(2 * L.adj.size()), scale2(L.adj.size());  // scale2: the robust s^2 below
+  for_each_chunk(
+      n, threads,
+      [&](size_t begin, size_t end, size_t) {
+        for (size_t v = begin; v < end; ++v)
+          for (uint32_t i = L.start[v]; i < L.start[v + 1]; ++i) {
+            int k;
+            edge_offset(L, v, L, L.adj[i], scale, k, &offset[2 * i]);
+            turns[i] = static_cast<int8_t>(k & 3);
+            scale2[i] = robust * (offset[2 * i] * offset[2 * i] + offset[2 * i + 1] * offset[2 * i + 1]) + 1e-6f;
+          }
+      },
+      kSweepChunk);
   const float inv_period = 1.f / period;
   const bool in_place = over_relaxation > 1.f;  // Gauss-Seidel: each vertex sees its neighbours' new values
   if (in_place) threads = 1;
   std::vector<float> next(in_place ? 0 : L.u.size());  // Jacobi's second buffer
   for (uint32_t it = 0; it < iterations; ++it) {
-    for_each_chunk(n, threads, [&](size_t begin, size_t end, size_t) {
-      for (size_t v = begin; v < end; ++v) {
-        const float ux = L.u[2 * v], uy = L.u[2 * v + 1];
-        float sx = ux, sy = uy, sw = 1.f;
-        for (uint32_t i = L.start[v]; i < L.start[v + 1]; ++i) {
-          const uint32_t w = L.adj[i];
-          float x, y;
-          rotate_quarter(turns[i], L.u[2 * w], L.u[2 * w + 1], x, y);
-          x -= offset[2 * i];
-          y -= offset[2 * i + 1];
-          x += period * std::round((ux - x) * inv_period);
-          y += period * std::round((uy - y) * inv_period);
-          // Robust weight: an edge far off its offset is left to become a cut (a visible seam
-          // from a cone) instead of stretching everything around it.
-          const float rx = x - ux, ry = y - uy;
-          const float s2 = robust * (offset[2 * i] * offset[2 * i] + offset[2 * i + 1] * offset[2 * i + 1]) + 1e-6f;
-          const float wgt = robust > 0.f ? 1.f / (1.f + (rx * rx + ry * ry) / s2) : 1.f;
-          sx += wgt * x;
-          sy += wgt * y;
-          sw += wgt;
-        }
-        const float inv = 1.f / sw;
-        if (in_place) {
-          L.u[2 * v] = wrap(ux + over_relaxation * (sx * inv - ux), period);
-          L.u[2 * v + 1] = wrap(uy + over_relaxation * (sy * inv - uy), period);
-        } else {
-          next[2 * v] = wrap(sx * inv, period);
-          next[2 * v + 1] = wrap(sy * inv, period);
-        }
-      }
-    });
+    for_each_chunk(
+        n, threads,
+        [&](size_t begin, size_t end, size_t) {
+          for (size_t v = begin; v < end; ++v) {
+            const float ux = L.u[2 * v], uy = L.u[2 * v + 1];
+            float sx = ux, sy = uy, sw = 1.f;
+            for (uint32_t i = L.start[v]; i < L.start[v + 1]; ++i) {
+              const uint32_t w = L.adj[i];
+              const float* t = kQuarterTurn[turns[i]];
+              const float a = L.u[2 * w], b = L.u[2 * w + 1];
+              float x = t[0] * a + t[1] * b - offset[2 * i];
+              float y = t[2] * a + t[3] * b - offset[2 * i + 1];
+              x += period * round_nearest((ux - x) * inv_period);
+              y += period * round_nearest((uy - y) * inv_period);
+              // Robust weight: an edge far off its offset is left to become a cut (a visible seam
+              // from a cone) instead of stretching everything around it.
+              // 1 / (1 + r^2 / s^2) as one division (the sweep's slowest instruction).
+              const float rx = x - ux, ry = y - uy;
+              const float wgt = robust > 0.f ? scale2[i] / (scale2[i] + (rx * rx + ry * ry)) : 1.f;
+              sx += wgt * x;
+              sy += wgt * y;
+              sw += wgt;
+            }
+            const float inv = 1.f / sw;
+            if (in_place) {
+              L.u[2 * v] = wrap(ux + over_relaxation * (sx * inv - ux), period);
+              L.u[2 * v + 1] = wrap(uy + over_relaxation * (sy * inv - uy), period);
+            } else {
+              next[2 * v] = wrap(sx * inv, period);
+              next[2 * v + 1] = wrap(sy * inv, period);
+            }
+          }
+        },
+        kSweepChunk);
     if (!in_place) L.u.swap(next);
   }
 }
@@ -383,7 +431,7 @@ void compute_rosy_field(const Mesh& mesh, const Topology& topology, const FaceFr
     levels.push_back(std::move(coarse));
     cell *= 2.f;
   }
-  const size_t threads = parallel_threads(nv, options.threads);
+  const size_t threads = parallel_threads(nv, options.threads, kVerticesPerThread);
   const size_t top = levels.size() - 1;
   // Orientation, coarse to fine.
   for (size_t l = top + 1; l-- > 0;) {
@@ -395,8 +443,10 @@ void compute_rosy_field(const Mesh& mesh, const Topology& topology, const FaceFr
         store3(L.q, v, tangent(load3(P.q, L.parent[v]), nn, load3(L.q, v)));
       }
     }
-    smooth_orientation(L, l == top ? 4 * options.orientation_iterations : options.orientation_iterations,
-                       l == 0 ? threads : 1);
+    const uint32_t iterations =
+        std::min(options.orientation_iterations, options.fine_orientation_iterations << std::min<size_t>(l, 8));
+    smooth_orientation(L, l == top ? 4 * options.orientation_iterations : iterations,
+                       parallel_threads(L.size(), options.threads, kVerticesPerThread));
   }
   // Positions, coarse to fine.
   for (size_t l = top + 1; l-- > 0;) {

@@ -26,24 +26,24 @@ inline size_t parallel_threads(size_t n, size_t requested, size_t per_thread = 1
   return std::clamp<size_t>(std::min(cores, n / per_thread), 1, 8);
 }
 
-//! Number of chunks for n elements.
-inline size_t chunk_count(size_t n) { return (n + kParallelChunk - 1) / kParallelChunk; }
+//! Number of chunks of `chunk` elements for n elements.
+inline size_t chunk_count(size_t n, size_t chunk = kParallelChunk) { return (n + chunk - 1) / chunk; }
 
-//! Calls body(begin, end, chunk) for every chunk of [0, n), on up to `threads` threads (each takes
+//! Calls body(begin, end, chunk) for every chunk of [0, n) (`chunk_size` elements; the last one
+//! shorter), on up to `threads` threads (each takes
 //! the next chunk not yet taken; fewer when the system refuses a thread). body must only write
 //! state owned by its chunk or its elements. An exception from body (any thread) is rethrown here
 //! once every thread has stopped.
 template <class Body>
-void for_each_chunk(size_t n, size_t threads, Body body) {
-  const size_t chunks = chunk_count(n);
+void for_each_chunk(size_t n, size_t threads, Body body, size_t chunk_size = kParallelChunk) {
+  const size_t chunks = chunk_count(n, chunk_size);
   threads = std::clamp<size_t>(threads, 1, std::max<size_t>(chunks, 1));
   std::atomic<size_t> next{0};
   std::exception_ptr failure;  // the first exception of any thread, rethrown on the calling one
   std::mutex failure_mutex;
   auto run = [&] {
     try {
-      for (size_t c; (c = next.fetch_add(1)) < chunks;)
-        body(c * kParallelChunk, std::min(n, (c + 1) * kParallelChunk), c);
+      for (size_t c; (c = next.fetch_add(1)) < chunks;) body(c * chunk_size, std::min(n, (c + 1) * chunk_size), c);
     } catch (...) {
       const std::lock_guard<std::mutex> lock(failure_mutex);
       if (!failure) failure = std::current_exception();
