@@ -21,6 +21,7 @@
 #include <cmath>
 #include <utility>
 
+#include "util/block_sweep.h"
 #include "util/parallel_chunks.h"
 
 namespace tailor::internal {
@@ -57,11 +58,6 @@ constexpr float kSettledShare = 0.01f;
 // not show in the texture, and on meshes whose faces are a pixel or less wide (horse_x16 at scale
 // 800: 0.65 px) the share alone took 1.4x the time for 0.885 -> 0.822 % visible seams.
 constexpr float kSettledPx = 0.05f;
-
-// Vertices per block of the Gauss-Seidel sweep (consecutive in the sweep order), and blocks per
-// parallel chunk: a block's faces' data spans a few pages; a chunk is enough work for a thread.
-constexpr size_t kBlock = 256;
-constexpr size_t kBlocksPerChunk = 4;
 
 //! apply(m, period, in, out) of rosy_field.h, the turn as a product (kQuarterTurn).
 inline void map_point(const LatticeMap& m, float period, const float* in, float* out) {
@@ -175,51 +171,13 @@ LatticeRelaxation::LatticeRelaxation(const Mesh& mesh, const FaceFrames& frames,
     }
   });
 
-  // Blocks of kBlock consecutive vertices in sweep order, coloured so that no two blocks of a
-  // colour share a face: a colour's blocks move independently (any number of threads, the same
-  // result), and a block's vertices move one after the other, so that a sweep reads its faces'
-  // data nearly in order (a colouring by vertex read it at random and waited on memory).
-  const size_t blocks = (nv + kBlock - 1) / kBlock;
-  std::vector<uint64_t> touching;  // (block, neighbouring block) pairs
+  // The Gauss-Seidel sweep by coloured blocks of vertices in sweep order (util/block_sweep.h).
+  std::vector<uint64_t> touching;
   for (size_t f = 0; f < nf; ++f) {
     if (!(area[f] > 0.f)) continue;
-    for (int k = 0; k < 3; ++k)
-      for (int j = 0; j < 3; ++j) {
-        const uint64_t a = rank[idx[3 * f + k]] / kBlock, b = rank[idx[3 * f + j]] / kBlock;
-        if (a != b) touching.push_back((a << 32) | b);
-      }
+    for (int k = 0; k < 3; ++k) BlockSweep::couple(rank[idx[3 * f + k]], rank[idx[3 * f + (k + 1) % 3]], touching);
   }
-  std::sort(touching.begin(), touching.end());
-  touching.erase(std::unique(touching.begin(), touching.end()), touching.end());
-  // Greedy colouring in block order. used[c] == b + 1 marks colour c as taken by a neighbour of b:
-  // the search for a free colour stops within b's neighbours + 1 steps, so the colouring is
-  // O(pairs) on any mesh (a badly ordered one gets many colours, not wrong ones).
-  std::vector<uint32_t> colour(blocks, 0), used(1, 0);
-  uint32_t colours = 1;
-  for (size_t b = 0, i = 0; b < blocks; ++b) {
-    const uint32_t mark = static_cast<uint32_t>(b + 1);
-    for (; i < touching.size() && (touching[i] >> 32) == b; ++i) {
-      const uint32_t w = static_cast<uint32_t>(touching[i]);
-      if (w < b) used[colour[w]] = mark;
-    }
-    uint32_t c = 0;
-    while (c < colours && used[c] == mark) ++c;
-    colour[b] = c;
-    if (c == colours) {
-      ++colours;
-      used.push_back(0);
-    }
-  }
-  touching = {};
-  std::vector<uint32_t>&colour_start = colour_start_, &order = order_;
-  colour_start.assign(colours + 1, 0);
-  order.resize(blocks);
-  for (size_t b = 0; b < blocks; ++b) ++colour_start[colour[b] + 1];
-  for (uint32_t c = 0; c < colours; ++c) colour_start[c + 1] += colour_start[c];
-  {
-    std::vector<uint32_t> fill(colour_start.begin(), colour_start.end() - 1);
-    for (size_t b = 0; b < blocks; ++b) order[fill[colour[b]]++] = static_cast<uint32_t>(b);
-  }
+  blocks_ = BlockSweep(nv, std::move(touching));
 }
 
 void LatticeRelaxation::run(const std::vector<LatticeMap>& corner_map, const std::vector<uint8_t>& flat,
@@ -230,8 +188,6 @@ void LatticeRelaxation::run(const std::vector<LatticeMap>& corner_map, const std
   const float period = period_;
   const std::vector<float>&grad = grad_, &term = term_, &settled = settled_;
   const std::vector<uint32_t>&start = start_, &corners = corners_, &sweep = sweep_order_;
-  const std::vector<uint32_t>&colour_start = colour_start_, &order = order_;
-  const uint32_t colours = static_cast<uint32_t>(colour_start.size() - 1);
   std::vector<float> rotation(2 * nf, 0.f);  // per face (cos, sin) of R
   std::vector<float> robust(nf, 0.f);        // per face: the robust weight of its energy; 0 = not relaxed
   const auto corner_pos = [&](size_t f, int k, float* out) {
@@ -321,17 +277,8 @@ void LatticeRelaxation::run(const std::vector<LatticeMap>& corner_map, const std
         robust[f] = kRobust2 / (kRobust2 + e);  // 1 / (1 + e / scale^2) in one division
       }
     });
-    // Global step, colour by colour, block by block.
-    for (uint32_t col = 0; col < colours; ++col) {
-      const size_t first = colour_start[col], count = colour_start[col + 1] - first;
-      for_each_chunk(
-          count, threads_,
-          [&](size_t begin, size_t end, size_t) {
-            for (size_t i = first + begin; i < first + end; ++i)
-              for (size_t p = size_t{order[i]} * kBlock, last = std::min(nv, p + kBlock); p < last; ++p) move(p);
-          },
-          kBlocksPerChunk);
-    }
+    // Global step, block by block.
+    blocks_.sweep(threads_, move);
   }
   if (moving && !warm) *moving = std::move(own_moved);
 }

@@ -16,6 +16,7 @@
 #include "surface/rosy_field.h"
 #include "tailor/mesh.h"
 #include "tailor/orientation.h"
+#include "util/block_sweep.h"
 
 namespace tailor::internal {
 
@@ -43,14 +44,13 @@ class LatticeRelaxation {
   size_t face_count_, vertex_count_;
   float period_;
   size_t threads_;
-  std::vector<float> grad_;             // #F*6: barycentric gradients (pixels^-1); 0 for a degenerate face
-  std::vector<uint32_t> sweep_order_;   // #V: the vertices in the order of the sweeps
-  std::vector<uint32_t> start_;         // #V+1, in sweep order: CSR of each vertex's corners of non-degenerate faces
-  std::vector<uint32_t> corners_;       // corner indices 3f + k
-  std::vector<float> term_;             // 5 per corner (see grid_relax.cpp)
-  std::vector<float> settled_;          // #V, in sweep order: the move below which a vertex has settled (pixels)
-  std::vector<uint32_t> colour_start_;  // blocks by colour: order_[colour_start_[c] .. colour_start_[c + 1])
-  std::vector<uint32_t> order_;
+  std::vector<float> grad_;            // #F*6: barycentric gradients (pixels^-1); 0 for a degenerate face
+  std::vector<uint32_t> sweep_order_;  // #V: the vertices in the order of the sweeps
+  std::vector<uint32_t> start_;        // #V+1, in sweep order: CSR of each vertex's corners of non-degenerate faces
+  std::vector<uint32_t> corners_;      // corner indices 3f + k
+  std::vector<float> term_;            // 5 per corner (see grid_relax.cpp)
+  std::vector<float> settled_;         // #V, in sweep order: the move below which a vertex has settled (pixels)
+  BlockSweep blocks_;                  // the Gauss-Seidel sweep's blocks of vertices (sweep order)
 };
 
 }  // namespace tailor::internal

@@ -3,13 +3,14 @@
 // Design after Instant Meshes (Jakob et al. 2015), written from its paper's description: the
 // hierarchy here clusters vertices by a voxel grid whose cell doubles per level (and by the
 // dominant axis of the normal, so that the two sides of a thin part stay apart), and every
-// smoothing step is a Jacobi step (new values from old ones only), so threads do not change the
-// result.
+// smoothing step is a Jacobi step (new values from old ones only) or a Gauss-Seidel step by
+// coloured blocks (the coarse position levels), so threads do not change the result.
 #include "surface/rosy_field.h"
 
 #include <algorithm>
 #include <cmath>
 
+#include "util/block_sweep.h"
 #include "util/flat_hash.h"
 #include "util/parallel_chunks.h"
 
@@ -244,8 +245,9 @@ void smooth_orientation(Level& L, uint32_t iterations, size_t threads) {
   }
 }
 
-//! Jacobi steps (in parallel, over_relaxation 1) or, with over_relaxation > 1, Gauss-Seidel steps
-//! in vertex order (sequential), each vertex moved over_relaxation times the way to its mean.
+//! Jacobi steps (over_relaxation 1) or, with over_relaxation > 1, Gauss-Seidel steps by coloured
+//! blocks of vertices (util/block_sweep.h), each vertex moved over_relaxation times the way to its
+//! mean; both on `threads` threads, the same bytes for any count.
 void smooth_position(Level& L, uint32_t iterations, float scale, float period, float robust, size_t threads,
                      float over_relaxation) {
   const size_t n = L.size();
@@ -265,45 +267,53 @@ void smooth_position(Level& L, uint32_t iterations, float scale, float period, f
       },
       kSweepChunk);
   const float inv_period = 1.f / period;
-  const bool in_place = over_relaxation > 1.f;  // Gauss-Seidel: each vertex sees its neighbours' new values
-  if (in_place) threads = 1;
+  const bool in_place = over_relaxation > 1.f;         // Gauss-Seidel: each vertex sees its neighbours' new values
   std::vector<float> next(in_place ? 0 : L.u.size());  // Jacobi's second buffer
+  const auto update = [&](size_t v) {
+    const float ux = L.u[2 * v], uy = L.u[2 * v + 1];
+    float sx = ux, sy = uy, sw = 1.f;
+    for (uint32_t i = L.start[v]; i < L.start[v + 1]; ++i) {
+      const uint32_t w = L.adj[i];
+      const float* t = kQuarterTurn[turns[i]];
+      const float a = L.u[2 * w], b = L.u[2 * w + 1];
+      float x = t[0] * a + t[1] * b - offset[2 * i];
+      float y = t[2] * a + t[3] * b - offset[2 * i + 1];
+      x += period * round_nearest((ux - x) * inv_period);
+      y += period * round_nearest((uy - y) * inv_period);
+      // Robust weight: an edge far off its offset is left to become a cut (a visible seam from a
+      // cone) instead of stretching everything around it. 1 / (1 + r^2 / s^2) as one division (the
+      // sweep's slowest instruction).
+      const float rx = x - ux, ry = y - uy;
+      const float wgt = robust > 0.f ? scale2[i] / (scale2[i] + (rx * rx + ry * ry)) : 1.f;
+      sx += wgt * x;
+      sy += wgt * y;
+      sw += wgt;
+    }
+    const float inv = 1.f / sw;
+    if (in_place) {
+      L.u[2 * v] = wrap(ux + over_relaxation * (sx * inv - ux), period);
+      L.u[2 * v + 1] = wrap(uy + over_relaxation * (sy * inv - uy), period);
+    } else {
+      next[2 * v] = wrap(sx * inv, period);
+      next[2 * v + 1] = wrap(sy * inv, period);
+    }
+  };
+  if (in_place) {  // by coloured blocks of vertices (util/block_sweep.h)
+    std::vector<uint64_t> pairs;
+    for (size_t v = 0; v < n; ++v)
+      for (uint32_t i = L.start[v]; i < L.start[v + 1]; ++i) BlockSweep::couple(v, L.adj[i], pairs);
+    const BlockSweep blocks(n, std::move(pairs));
+    for (uint32_t it = 0; it < iterations; ++it) blocks.sweep(threads, update);
+    return;
+  }
   for (uint32_t it = 0; it < iterations; ++it) {
     for_each_chunk(
         n, threads,
         [&](size_t begin, size_t end, size_t) {
-          for (size_t v = begin; v < end; ++v) {
-            const float ux = L.u[2 * v], uy = L.u[2 * v + 1];
-            float sx = ux, sy = uy, sw = 1.f;
-            for (uint32_t i = L.start[v]; i < L.start[v + 1]; ++i) {
-              const uint32_t w = L.adj[i];
-              const float* t = kQuarterTurn[turns[i]];
-              const float a = L.u[2 * w], b = L.u[2 * w + 1];
-              float x = t[0] * a + t[1] * b - offset[2 * i];
-              float y = t[2] * a + t[3] * b - offset[2 * i + 1];
-              x += period * round_nearest((ux - x) * inv_period);
-              y += period * round_nearest((uy - y) * inv_period);
-              // Robust weight: an edge far off its offset is left to become a cut (a visible seam
-              // from a cone) instead of stretching everything around it.
-              // 1 / (1 + r^2 / s^2) as one division (the sweep's slowest instruction).
-              const float rx = x - ux, ry = y - uy;
-              const float wgt = robust > 0.f ? scale2[i] / (scale2[i] + (rx * rx + ry * ry)) : 1.f;
-              sx += wgt * x;
-              sy += wgt * y;
-              sw += wgt;
-            }
-            const float inv = 1.f / sw;
-            if (in_place) {
-              L.u[2 * v] = wrap(ux + over_relaxation * (sx * inv - ux), period);
-              L.u[2 * v + 1] = wrap(uy + over_relaxation * (sy * inv - uy), period);
-            } else {
-              next[2 * v] = wrap(sx * inv, period);
-              next[2 * v + 1] = wrap(sy * inv, period);
-            }
-          }
+          for (size_t v = begin; v < end; ++v) update(v);
         },
         kSweepChunk);
-    if (!in_place) L.u.swap(next);
+    L.u.swap(next);
   }
 }
 
@@ -431,7 +441,6 @@ void compute_rosy_field(const Mesh& mesh, const Topology& topology, const FaceFr
     levels.push_back(std::move(coarse));
     cell *= 2.f;
   }
-  const size_t threads = parallel_threads(nv, options.threads, kVerticesPerThread);
   const size_t top = levels.size() - 1;
   // Orientation, coarse to fine.
   for (size_t l = top + 1; l-- > 0;) {
@@ -466,7 +475,8 @@ void compute_rosy_field(const Mesh& mesh, const Topology& topology, const FaceFr
     // 1.5 times across a mesh, the coarsest levels hold it): Gauss-Seidel, many steps, cheap there.
     const uint32_t steps = l == 0 ? options.position_iterations : options.coarse_position_iterations;
     smooth_position(L, l == top ? 4 * steps : steps, options.scale, options.period, options.robust,
-                    l == 0 ? threads : 1, l == 0 ? 1.f : options.coarse_over_relaxation);
+                    parallel_threads(L.size(), options.threads, kVerticesPerThread),
+                    l == 0 ? 1.f : options.coarse_over_relaxation);
   }
   field.position = std::move(F.p);
   field.normal = std::move(F.n);
