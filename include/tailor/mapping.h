@@ -111,7 +111,7 @@ struct MappingOptions {
                                     //!< position fields, coordinates relaxed with the lattice maps held; seams
                                     //!< that are quarter turns plus whole repeats are invisible; faces keep their
                                     //!< lattice chart up to 6x max_stretch). Visible seams 1.5 % of edge length
-                                    //!< when the tile repeats ~15 times across the mesh, 2.85 % at ~1.5 times
+                                    //!< when the tile repeats ~15 times across the mesh, 2.8 % at ~1.5 times
                                     //!< (docs/mapping.md). Measure it with MetricsOptions::symmetry 4 too
   float texture_period_px = 512.f;  //!< symmetry 4: the texture's size in pixels (square), the lattice period
   // kThesis -------------------------------------------------------------------------------------
