@@ -297,6 +297,7 @@ void bind_map(py::module_& m) {
         result->texture_height = height;
         result->texture = run.texture;
         result->material = material_path;
+        result->symmetry = mapping.symmetry;
         ProgressBridge bridge(progress);
         const auto report_progress = bridge.function();
         Status status;

@@ -28,6 +28,7 @@ void bind_save(py::module_& m) {
         options.texture_path = texture.is_none() ? result.texture : path_of(texture);
         options.texture_width = result.texture_width;
         options.texture_height = result.texture_height;
+        options.symmetry = result.symmetry;
         Status status;
         {
           const py::gil_scoped_release release;

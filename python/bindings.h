@@ -36,6 +36,7 @@ struct PyResult {
   int texture_height = 0;
   std::string texture;            //!< the texture file given to map (a material's colour map), empty when none
   std::string material;           //!< the material (folder or JSON) given to map, empty when none
+  uint32_t symmetry = 1;          //!< map's symmetry: 4 is recorded in a .glb (ExportOptions::symmetry)
   std::vector<float> corner_uvs;  //!< #F*3*2, texture repeats, exactly as export writes them
   py::object stats;               //!< dict: the JSON of `tailor map --stats`
   double library_seconds = 0;     //!< wall time inside the library's calls (the benchmark's baseline)

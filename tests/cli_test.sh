@@ -153,14 +153,32 @@ expect_error 2 "" -- "$tailor" frobnicate
   ok || fail "map --symmetry 4 with a texture a quarter turn changes gave no warning: $(cat "$tmp/s4warn.txt")"
 "$tailor" eval "$tmp/s4a.glb" --symmetry 4 >"$tmp/eval4.txt" 2>&1 && grep -Eq " 0 flipped, .*symmetry 4\)$" "$tmp/eval4.txt" &&
   ok || fail "eval --symmetry 4: $(cat "$tmp/eval4.txt")"
+# The .glb of a 4-fold map says so (its material's extras): eval measures it as the map did without
+# being told, --symmetry 1 overrides, and a default map's .glb is measured with 1.
+"$tailor" eval "$tmp/s4a.glb" >"$tmp/eval4d.txt" 2>&1 && cmp -s "$tmp/eval4.txt" "$tmp/eval4d.txt" &&
+  "$tailor" eval "$tmp/s4a.glb" --json -q | grep -q '"symmetry": 4' &&
+  "$tailor" eval "$tmp/s4a.glb" --json -q >"$tmp/eval4d.json" &&
+  python3 -c "import json, sys; a = json.load(open(sys.argv[1]))['metrics']['visible_seam_ratio']; \
+b = json.load(open(sys.argv[2]))['visible_seam_ratio']; sys.exit(0 if abs(a - b) < 1e-4 else 1)" \
+    "$tmp/s4.json" "$tmp/eval4d.json" &&
+  "$tailor" eval "$tmp/s4a.glb" --symmetry 1 --json -q | grep -q '"symmetry": 1' &&
+  "$tailor" eval "$tmp/a.glb" --json -q | grep -q '"symmetry": 1' &&
+  ok || fail "eval of a 4-fold map's .glb did not measure it with symmetry 4 by itself: $(cat "$tmp/eval4d.txt")"
+# ... and a new map of that .glb without --symmetry 4 does not keep the input's record.
+"$tailor" map "$tmp/s4a.glb" --texture "$texture" -o "$tmp/s4r.glb" -q &&
+  "$tailor" eval "$tmp/s4r.glb" --json -q | grep -q '"symmetry": 1' &&
+  ok || fail "a map of a 4-fold map's .glb kept its symmetry record"
 "$tailor" render "$mesh" --size 64x48 -o "$tmp/wide.png" -q || fail "render of a 64x48 picture failed"
 expect_error 2 "symmetry 4 needs a square texture, got 64x48" -- "$tailor" map "$mesh" --texture "$tmp/wide.png" -o "$tmp/x.glb" --symmetry 4
 [[ ! -e $tmp/x.glb ]] && ok || fail "map --symmetry 4 with a non-square texture wrote its output"
 expect_error 2 "symmetry" -- "$tailor" eval "$tmp/a.glb" --symmetry 3
-# render --view seams --symmetry 4 draws quarter-turn seams green: another picture than with 1.
-"$tailor" render "$tmp/s4a.glb" --view seams --size 320x240 -o "$tmp/seams1.png" -q &&
+# render --view seams --symmetry 4 draws quarter-turn seams green: another picture than with 1; a
+# 4-fold map's .glb is drawn so without the option.
+"$tailor" render "$tmp/s4a.glb" --view seams --size 320x240 --symmetry 1 -o "$tmp/seams1.png" -q &&
   "$tailor" render "$tmp/s4a.glb" --view seams --size 320x240 --symmetry 4 -o "$tmp/seams4.png" -q &&
-  ! cmp -s "$tmp/seams1.png" "$tmp/seams4.png" && ok || fail "render --symmetry 4 drew the seams as with 1"
+  "$tailor" render "$tmp/s4a.glb" --view seams --size 320x240 -o "$tmp/seams4d.png" -q &&
+  ! cmp -s "$tmp/seams1.png" "$tmp/seams4.png" && cmp -s "$tmp/seams4.png" "$tmp/seams4d.png" &&
+  ok || fail "render --symmetry 4 drew the seams as with 1, or a 4-fold map's .glb not as with 4"
 expect_error 2 "symmetry" -- "$tailor" render "$tmp/s4a.glb" --view seams --symmetry 2 -o "$tmp/seams2.png"
 # render --normal-map: an RGB map shades the texture view (a different picture), a grey one is refused.
 "$tailor" render "$tmp/s4a.glb" --size 64x48 -o "$tmp/plain.png" -q &&

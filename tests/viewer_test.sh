@@ -143,6 +143,19 @@ timeout 120 node web/test/viewer_browser_test.mjs "$url" --eval "$tmp/horse_eval
   || fail "browser test of the seams view (horse) failed"
 stop_server
 
+# --- 8b. a 4-fold map (tailor map --symmetry 4): its .glb says so, and the viewer counts quarter-turn
+# seams as invisible as eval does (its figures against eval's, which reads the same record) ---------
+timeout 60 "$tailor" tile tests/data/textures/vistex-tile04-128.png --symmetry 4 -o "$tmp/tile4.png" -q \
+  || fail "tailor tile --symmetry 4 failed"
+timeout 60 "$tailor" map examples/spot.obj --texture "$tmp/tile4.png" --symmetry 4 -o "$tmp/spot4.glb" -q \
+  || fail "tailor map --symmetry 4 failed"
+timeout 60 "$tailor" eval "$tmp/spot4.glb" --json -q >"$tmp/spot4_eval.json" || fail "tailor eval of the 4-fold .glb failed"
+grep -q '"symmetry": 4' "$tmp/spot4_eval.json" || fail "eval did not read the 4-fold map's record"
+start_server "$tmp/spot4.glb"
+timeout 120 node web/test/viewer_browser_test.mjs "$url" --eval "$tmp/spot4_eval.json" --expect-invisible \
+  || fail "browser test of the seams view (4-fold map) failed"
+stop_server
+
 # --- 9. compressed outputs (three.js's meshopt and Draco decoders, WebAssembly under the CSP) -------
 for method in meshopt draco; do
   timeout 60 "$tailor" map examples/spot.obj --texture examples/gravel.png --compress "$method" \

@@ -295,6 +295,7 @@ async function refreshState() {
   const flags = new Uint8Array(session.surface.faces);
   for (const f of info.seam_faces) flags[f] = 1;
   session.surface.setMarked(flags);
+  session.surface.setSymmetry(info.options?.symmetry);
   drawStrokes(info.strokes);
   showOptions(info.options);
   redrawAll();
@@ -687,7 +688,7 @@ async function load() {
     api('GET', `/api/uv?version=${info.version}`).then((r) => r.arrayBuffer()),
   ]);
   session.mesh = parseMesh(meshBuffer);
-  const surface = new EditSurface(session.mesh, info.texture_width, info.texture_height);
+  const surface = new EditSurface(session.mesh, info.texture_width, info.texture_height, info.options?.symmetry);
   session.surface = surface;
   surface.setUvs(new Float32Array(uvBuffer));
   session.shownVersion = session.serverVersion = info.version;

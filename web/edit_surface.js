@@ -7,7 +7,7 @@
 // the patches (faces joined across edges whose two sides have the same UVs, as derive_patches in
 // metrics.h; a patch's colour follows its lowest face, so untouched patches keep their colours).
 import * as THREE from 'three';
-import { edgeRings, patchColor, kSeamNone, kSeamInvisible, kSeamVisible, kSeamBorder } from './mesh_data.js';
+import { edgeRings, patchColor, seamGap, kSeamNone, kSeamInvisible, kSeamVisible, kSeamBorder } from './mesh_data.js';
 
 const next = (e) => (e % 3 === 2 ? e - 2 : e + 1);
 
@@ -18,11 +18,6 @@ function findRoot(parent, x) {
     x = parent[x];
   }
   return x;
-}
-
-/** std::round: halves away from zero, as mesh_data.js and uv_metrics.cpp. */
-function roundHalfAway(x) {
-  return x < 0 ? -Math.round(-x) : Math.round(x);
 }
 
 /**
@@ -43,14 +38,18 @@ export function parseMesh(buffer) {
 }
 
 export class EditSurface {
-  /** mesh: parseMesh()'s result; textureWidth, textureHeight: pixels per repeat (seam gaps). */
-  constructor(mesh, textureWidth, textureHeight) {
+  /**
+   * mesh: parseMesh()'s result; textureWidth, textureHeight: pixels per repeat (seam gaps);
+   * symmetry: 4 for a 4-fold map (quarter-turn seams invisible, seamGap), else 1.
+   */
+  constructor(mesh, textureWidth, textureHeight, symmetry = 1) {
     const { position, index, faces, vertices } = mesh;
     this.faces = faces;
     this.index = index;
     this.position = position;
     this.width = textureWidth;
     this.height = textureHeight;
+    this.symmetry = symmetry === 4 && textureWidth === textureHeight ? 4 : 1;
     // Edge pairs: the other use of an undirected edge used exactly twice, in opposite directions.
     const ring = edgeRings(index, null, vertices);
     const pair = new Int32Array(3 * faces).fill(-1);
@@ -134,13 +133,10 @@ export class EditSurface {
     const uv = this.uv, w = this.width, h = this.height;
     const fa = 2 * e, fb = 2 * next(e), ga = 2 * next(o), gb = 2 * o;
     const px = (i, s) => Math.fround(uv[i] * s);
-    const dau = px(fa, w) - px(ga, w), dav = px(fa + 1, h) - px(ga + 1, h);
-    const dbu = px(fb, w) - px(gb, w), dbv = px(fb + 1, h) - px(gb + 1, h);
-    if (dau === 0 && dav === 0 && dbu === 0 && dbv === 0) return kSeamNone;
-    const ku = w * roundHalfAway((0.5 * (dau + dbu)) / w);
-    const kv = h * roundHalfAway((0.5 * (dav + dbv)) / h);
-    const gap = Math.sqrt(Math.max((dau - ku) ** 2 + (dav - kv) ** 2, (dbu - ku) ** 2 + (dbv - kv) ** 2));
-    return gap < 1 ? kSeamInvisible : kSeamVisible;
+    const fau = px(fa, w), fav = px(fa + 1, h), fbu = px(fb, w), fbv = px(fb + 1, h);
+    const gau = px(ga, w), gav = px(ga + 1, h), gbu = px(gb, w), gbv = px(gb + 1, h);
+    if (fau === gau && fav === gav && fbu === gbu && fbv === gbv) return kSeamNone;
+    return seamGap(fau, fav, fbu, fbv, gau, gav, gbu, gbv, w, h, this.symmetry) < 1 ? kSeamInvisible : kSeamVisible;
   }
 
   /**
@@ -183,6 +179,17 @@ export class EditSurface {
       changed.push(f);
     }
     return this.update(changed);
+  }
+
+  /** Sets the map's symmetry (4: quarter-turn seams invisible) and classifies every seam again. */
+  setSymmetry(symmetry) {
+    const s = symmetry === 4 && this.width === this.height ? 4 : 1;
+    if (s === this.symmetry) return;
+    this.symmetry = s;
+    if (this.uv === null) return;
+    const changed = [];
+    for (let f = 0; f < this.faces; ++f) changed.push(f);
+    this.update(changed);
   }
 
   /** Rewrites what depends on the UVs of the `changed` faces (this.uv holds the new ones). */

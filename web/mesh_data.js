@@ -176,9 +176,35 @@ function roundHalfAway(x) {
 }
 
 /**
+ * The lattice gap (pixels) of a seam edge a -> b between faces f and g, as seam_gap_px in
+ * uv_metrics.cpp: with d = uv_f - uv_g at each end and k the whole repeats nearest to their mean,
+ * max over the ends of |d - k|; with symmetry 4 the least over g's UVs turned by 0, 90, 180 and
+ * 270 degrees (a square tile that a quarter turn leaves unchanged). UVs in pixels, w x h the
+ * texture.
+ */
+export function seamGap(fau, fav, fbu, fbv, gau, gav, gbu, gbv, w, h, symmetry = 1) {
+  let best = Infinity;
+  for (let rot = 0; rot < (symmetry === 4 ? 4 : 1); ++rot) {
+    // g's side turned `rot` quarter turns counter-clockwise: (x, y) -> (-y, x).
+    let au = gau, av = gav, bu = gbu, bv = gbv;
+    for (let r = 0; r < rot; ++r) {
+      [au, av] = [-av, au];
+      [bu, bv] = [-bv, bu];
+    }
+    const dau = fau - au, dav = fav - av, dbu = fbu - bu, dbv = fbv - bv;
+    const ku = w * roundHalfAway((0.5 * (dau + dbu)) / w);
+    const kv = h * roundHalfAway((0.5 * (dav + dbv)) / h);
+    const gap = Math.sqrt(Math.max((dau - ku) ** 2 + (dav - kv) ** 2, (dbu - ku) ** 2 + (dbv - kv) ** 2));
+    best = Math.min(best, gap);
+  }
+  return best;
+}
+
+/**
  * Seam classes of the mesh welded by position, as `tailor eval` computes them (uv_metrics.cpp).
  * index: corners (3 per face) into the split mesh; position: 3 floats per vertex; uv: 2 floats per
- * vertex in texture repeats, or null; width, height: the texture size in pixels.
+ * vertex in texture repeats, or null; width, height: the texture size in pixels; symmetry: 1, or 4
+ * for a 4-fold map (seamGap).
  * An undirected edge of the welded mesh used by exactly two faces running it in opposite directions
  * is paired; every other use is a border. A paired edge is a seam when its faces disagree on the UV
  * of an end; its lattice gap (pixels) is max over the ends a, b of |d - k|, with d = uv_f - uv_g
@@ -188,7 +214,7 @@ function roundHalfAway(x) {
  * once); seamLength, invisibleLength, visibleLength; seamEdges, invisibleEdges: counts }.
  * Typed arrays only: O(F).
  */
-export function seamClasses(index, position, uv, width = kDefaultTextureSize, height = kDefaultTextureSize) {
+export function seamClasses(index, position, uv, width = kDefaultTextureSize, height = kDefaultTextureSize, symmetry = 1) {
   const edges = index.length;
   const weld = weldByPosition(position);
   // UVs in pixels rounded to float, as eval's corner_uv (identical UVs stay identical).
@@ -231,13 +257,8 @@ export function seamClasses(index, position, uv, width = kDefaultTextureSize, he
     const fa = 2 * index[e], fb = 2 * index[eNext];
     const ga = 2 * index[o % 3 === 2 ? o - 2 : o + 1], gb = 2 * index[o];
     if (uvPx[fa] === uvPx[ga] && uvPx[fa + 1] === uvPx[ga + 1] && uvPx[fb] === uvPx[gb] && uvPx[fb + 1] === uvPx[gb + 1]) continue;
-    const dau = uvPx[fa] - uvPx[ga], dav = uvPx[fa + 1] - uvPx[ga + 1];
-    const dbu = uvPx[fb] - uvPx[gb], dbv = uvPx[fb + 1] - uvPx[gb + 1];
-    const ku = width * roundHalfAway((0.5 * (dau + dbu)) / width);
-    const kv = height * roundHalfAway((0.5 * (dav + dbv)) / height);
-    const gapA = (dau - ku) * (dau - ku) + (dav - kv) * (dav - kv);
-    const gapB = (dbu - ku) * (dbu - ku) + (dbv - kv) * (dbv - kv);
-    const gap = Math.sqrt(Math.max(gapA, gapB));
+    const gap = seamGap(uvPx[fa], uvPx[fa + 1], uvPx[fb], uvPx[fb + 1], uvPx[ga], uvPx[ga + 1], uvPx[gb], uvPx[gb + 1],
+      width, height, symmetry);
     seamEdges += 1;
     seamLength += length;
     if (gap < 1) {
@@ -328,10 +349,10 @@ function floatArray(attribute) {
 /**
  * Builds the viewer geometry from an (indexed or not) BufferGeometry with position, optional
  * normal, uv and tangent; textureWidth, textureHeight: the embedded texture's size in pixels (eval's default
- * 512 without one), for the seam classes. Returns { geometry, faces, patches, seamEdges, hasUv,
+ * 512 without one), for the seam classes, and symmetry (4: a 4-fold map, seamGap). Returns { geometry, faces, patches, seamEdges, hasUv,
  * seams } with seams = seamClasses()'s sums (no per-edge array).
  */
-export function buildSurface(source, { textureWidth = kDefaultTextureSize, textureHeight = kDefaultTextureSize } = {}) {
+export function buildSurface(source, { textureWidth = kDefaultTextureSize, textureHeight = kDefaultTextureSize, symmetry = 1 } = {}) {
   const position = floatArray(source.getAttribute('position'));
   const vertexCount = source.getAttribute('position').count;
   let index = source.index ? source.index.array : null;
@@ -348,7 +369,7 @@ export function buildSurface(source, { textureWidth = kDefaultTextureSize, textu
   const faces = index.length / 3;
   const { seam, patch, count } = edgesAndPatches(index);
   const stretch = faceStretch(index, position, uv);
-  const { seamClass, ...seams } = seamClasses(index, position, uv, textureWidth, textureHeight);
+  const { seamClass, ...seams } = seamClasses(index, position, uv, textureWidth, textureHeight, symmetry);
 
   const n = 3 * faces;
   const outPos = new Float32Array(3 * n);

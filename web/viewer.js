@@ -96,7 +96,10 @@ async function load() {
     const textureWidth = image && image.width > 0 ? image.width : kDefaultTextureSize;
     const textureHeight = image && image.height > 0 ? image.height : kDefaultTextureSize;
     const analysisStart = performance.now();
-    const surface = buildSurface(mesh.geometry, { textureWidth, textureHeight });
+    // A 4-fold map (`tailor map --symmetry 4`) says so in its material's extras (three.js's userData):
+    // quarter-turn seams are invisible under its tile, as `tailor eval` counts them.
+    const symmetry = mesh.material?.userData?.tailor?.symmetry === 4 && textureWidth === textureHeight ? 4 : 1;
+    const surface = buildSurface(mesh.geometry, { textureWidth, textureHeight, symmetry });
     stats.analysisSeconds += (performance.now() - analysisStart) / 1000;
     mesh.geometry.dispose();
     mesh.geometry = surface.geometry;

@@ -27,6 +27,7 @@ struct EvalOptions {
   bool stability = false;
   std::string seed_point;
   uint32_t symmetry = MetricsOptions{}.symmetry;
+  bool symmetry_given = false;  // else a .glb's record of a 4-fold map (LoadReport::texture_symmetry) decides
   StabilityOptions stability_options;
 };
 
@@ -94,7 +95,9 @@ int run_eval(const EvalOptions& opt) {
     height = report.texture_height;
     size_source = "embedded texture";
   }
-  if (opt.symmetry == 4 && width != height)
+  // A 4-fold map says so in its .glb (tailor map --symmetry 4): measured as the map was.
+  const uint32_t symmetry = opt.symmetry_given ? opt.symmetry : glb ? report.texture_symmetry : opt.symmetry;
+  if (symmetry == 4 && width != height)
     return report_error(Status::error(
         ErrorCode::kInvalidArgument, "",
         "--symmetry 4 needs a square texture, got " + std::to_string(width) + "x" + std::to_string(height)));
@@ -108,7 +111,7 @@ int run_eval(const EvalOptions& opt) {
   const Topology topology = build_topology(mesh);
   UvMetrics m;
   MetricsOptions options{static_cast<float>(width), static_cast<float>(height)};
-  options.symmetry = opt.symmetry;
+  options.symmetry = symmetry;
   const Status metrics_status = compute_uv_metrics(mesh, topology, uv_px, {}, options, m);
   if (!metrics_status) return report_error(metrics_status.with_file(opt.input));
   const double seconds = seconds_since(start);
@@ -127,7 +130,7 @@ int run_eval(const EvalOptions& opt) {
   run.texture_width = width;
   run.texture_height = height;
   run.texture_size_from = size_source;
-  run.symmetry = opt.symmetry;
+  run.symmetry = symmetry;
   run.metrics = m;
   run.boundary_edges = topology.boundary_edges;
   run.nonmanifold_edges = topology.nonmanifold_edges;
@@ -151,7 +154,10 @@ void register_eval(CLI::App& app, Runner& run) {
       ->check(CLI::Range(1, 1 << 16));
   add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), opt->image_options.max_pixels)
       ->check(CLI::PositiveNumber);
-  add_documented(cmd, option_doc(kMetricsOptionDocs, "symmetry"), opt->symmetry)->check(CLI::IsMember({1u, 4u}));
+  add_documented(cmd, option_doc(kMetricsOptionDocs, "symmetry"), opt->symmetry)
+      ->check(CLI::IsMember({1u, 4u}))
+      ->description(std::string(option_doc(kMetricsOptionDocs, "symmetry").help) +
+                    "; default: 4 for a .glb from tailor map --symmetry 4 (its material says so), else 1");
   cmd->add_flag("--json", opt->json, "Print the full report as a JSON object");
   cmd->add_flag("-q,--quiet", opt->quiet, "Print nothing but the result and errors");
   cmd->add_flag("--stability", opt->stability,
@@ -166,9 +172,12 @@ void register_eval(CLI::App& app, Runner& run) {
       "(coefficient of variation of UV/3D area ratio, 0 ideal), L2/Linf stretch (Sander 2001, 1 ideal),\n"
       "median angle distortion, seam gap (px, modulo the texture) and share of invisible seams.\n"
       "Example:\n  tailor eval bunny.glb\n  tailor eval spot.obj --texture-size 1024 --json\n"
-      "  tailor eval bunny_grid.glb --symmetry 4   (a map made with tailor map --symmetry 4)\n"
+      "  tailor eval bunny_grid.obj --symmetry 4   (a map made with tailor map --symmetry 4; a .glb says so itself)\n"
       "  tailor eval bunny.ply --stability --seed-point 0,0.1,0\n");
-  cmd->callback([&run, opt] { run = [opt] { return run_eval(*opt); }; });
+  cmd->callback([&run, opt, cmd] {
+    opt->symmetry_given = cmd->count("--symmetry") > 0;
+    run = [opt] { return run_eval(*opt); };
+  });
 }
 
 }  // namespace tailor::cli

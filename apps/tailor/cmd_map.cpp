@@ -313,7 +313,8 @@ int run_map(const MapArgs& opt) {
                           tex_h,
                           compression,
                           opt.uv_set,
-                          opt.up == "z" ? SceneUp::kZ : SceneUp::kY};
+                          opt.up == "z" ? SceneUp::kZ : SceneUp::kY,
+                          mapping.symmetry};
   Progress exporting("export", opt.quiet);
   if (Status s =
           write_mapped_mesh(opt.output, mesh, atlas, output, [&exporting](float f) { return exporting.update(f); });

@@ -27,6 +27,7 @@ struct RenderArgs {
   std::string size = std::to_string(RenderOptions{}.width) + "x" + std::to_string(RenderOptions{}.height);
   std::string up = up_axis_name(RenderOptions{}.up);
   bool quiet = false;
+  bool symmetry_given = false;  // else a .glb's record of a 4-fold map (LoadReport::texture_symmetry) decides
 };
 
 //! "WIDTHxHEIGHT" -> width, height; false when malformed.
@@ -58,14 +59,16 @@ int run_render(const RenderArgs& args) {
   Mesh mesh;
   Image texture;
   GltfMaterialMaps maps;  // a .glb's normal and occlusion maps, and its tangents
+  LoadReport report;
   Status status = [&] {
     const ReadingInput reading(args.input);
     const MeshFormat format = mesh_format_from_path(args.input);
     return format == MeshFormat::kGlb || format == MeshFormat::kGltf
-               ? read_glb_with_material(args.input, mesh, &texture, args.no_material ? nullptr : &maps)
-               : load_mesh(args.input, mesh);
+               ? read_glb_with_material(args.input, mesh, &texture, args.no_material ? nullptr : &maps, &report)
+               : load_mesh(args.input, mesh, &report);
   }();
   if (!status) return report_error(status.with_file(args.input));
+  if (!args.symmetry_given) options.seam_symmetry = report.texture_symmetry;  // a 4-fold map's .glb says so
   if (!args.texture.empty()) {
     status = load_image(args.texture, texture);
     if (!status) return report_error(status.with_file(args.texture));
@@ -122,17 +125,22 @@ void register_render(CLI::App& app, Runner& run) {
   add_documented(cmd, option_doc(kRenderOptionDocs, "pitch_degrees"), args->options.pitch_degrees);
   add_documented(cmd, option_doc(kRenderOptionDocs, "checker_squares"), args->options.checker_squares);
   add_documented(cmd, option_doc(kRenderOptionDocs, "seam_symmetry"), args->options.seam_symmetry)
-      ->check(CLI::IsMember({1u, 4u}));
+      ->check(CLI::IsMember({1u, 4u}))
+      ->description(std::string(option_doc(kRenderOptionDocs, "seam_symmetry").help) +
+                    "; default: 4 for a .glb from tailor map --symmetry 4 (its material says so), else 1");
   cmd->add_flag("-q,--quiet", args->quiet, "print nothing but errors");
   cmd->footer(
       "Examples:\n"
       "  tailor render spot.glb -o spot.png\n"
       "  tailor render spot.glb -o spot_patches.png --view patches --size 800x600\n"
       "  tailor render spot.glb -o spot_checker.png --view checker --checker 16\n"
-      "  tailor render spot4.glb -o spot4_seams.png --view seams --symmetry 4   # from 'tailor map --symmetry 4'\n"
+      "  tailor render spot4.obj -o spot4_seams.png --view seams --symmetry 4   # a 4-fold map (a .glb says so)\n"
       "A .glb written by 'tailor map --material' is shaded with its normal map (tangent space, the file's\n"
       "TANGENT) and occlusion map.");
-  cmd->callback([&run, args] { run = [args] { return run_render(*args); }; });
+  cmd->callback([&run, args, cmd] {
+    args->symmetry_given = cmd->count("--symmetry") > 0;
+    run = [args] { return run_render(*args); };
+  });
 }
 
 }  // namespace tailor::cli

@@ -447,7 +447,9 @@ HttpResponse EditApi::model() {
   if (before != model_version_) {
     context_.session->snapshot(atlas, seam_faces, strokes, options);
     const std::string path = context_.scratch_dir + "/model.glb";
-    if (Status s = write_mapped_mesh(path, context_.session->mesh(), atlas, context_.output); !s)
+    MeshOutput output = context_.output;
+    output.symmetry = options.mapping.symmetry;
+    if (Status s = write_mapped_mesh(path, context_.session->mesh(), atlas, output); !s)
       return HttpResponse::error(500, s.message());
     if (Status s = read_file(path, model_bytes_); !s) return HttpResponse::error(500, s.message());
     std::remove(path.c_str());
@@ -490,7 +492,9 @@ HttpResponse EditApi::save() {
   const std::string stroke_text = strokes_json(strokes) + "\n";
   // The three files land together or not at all.
   internal::FileBatch batch;
-  if (Status s = write_mapped_mesh(context_.glb_path, context_.session->mesh(), atlas, context_.output); !s)
+  MeshOutput output = context_.output;
+  output.symmetry = options.mapping.symmetry;
+  if (Status s = write_mapped_mesh(context_.glb_path, context_.session->mesh(), atlas, output); !s)
     return HttpResponse::error(500, s.message());
   if (Status s = internal::write_file_atomic(context_.seam_faces_path, faces); !s)
     return HttpResponse::error(500, s.message());

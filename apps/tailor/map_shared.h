@@ -68,6 +68,7 @@ struct MeshOutput {
   MeshCompression compression = MeshCompression::kNone;
   int uv_set = 0;
   SceneUp up = SceneUp::kY;
+  uint32_t symmetry = 1;  //!< the map's (MappingOptions::symmetry): 4 is recorded in the .glb (ExportOptions)
 };
 
 //! Writes `mesh` with the UVs of `atlas` to `path` (export_mesh; atomic, staged in an active FileBatch),

@@ -83,6 +83,9 @@ struct ExportOptions {
   int uv_set = 0;             //!< .glb: the mapped UVs go to TEXCOORD_<uv_set> (0..7); the file's other sets are kept
   SceneUp up = SceneUp::kY;   //!< .glb: kZ turns the scene Y-up as glTF wants (-90 degrees about x, on the node)
   MaterialTextures material;  //!< .glb: normal, metallic-roughness and occlusion maps (kInvalidArgument otherwise)
+  uint32_t symmetry = 1;      //!< .glb: 4 records in the material ("extras": {"tailor": {"symmetry": 4}}) that
+                              //!< the map is 4-fold (MappingOptions::symmetry), so that eval, render and the
+                              //!< viewer count quarter-turn seams as invisible without being told
   ProgressCallback progress;  //!< optional: the vertex split, then the bytes written (every few MB) or the
                               //!< codec's steps; false cancels (kCancelled, nothing written)
 };

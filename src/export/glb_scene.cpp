@@ -37,6 +37,15 @@ Json merged_material(const std::string& kept, const Json& own) {
   const Json& pbr = own["pbrMetallicRoughness"];
   for (const char* key : {"baseColorTexture", "metallicRoughnessTexture"})
     if (pbr.contains(key)) m["pbrMetallicRoughness"][key] = pbr[key];
+  // tailor's record of a 4-fold map (add_glb_material) is this map's, not the input's.
+  if (m.contains("extras") && m["extras"].is_object()) {
+    m["extras"].erase("tailor");
+    if (m["extras"].empty()) m.erase("extras");
+  }
+  if (own.contains("extras") && own["extras"].contains("tailor")) {
+    if (!m.contains("extras")) m["extras"] = Json::object();
+    m["extras"]["tailor"] = own["extras"]["tailor"];
+  }
   return m;
 }
 

@@ -78,7 +78,7 @@ size_t add_view(nlohmann::json& views, size_t offset, size_t length, int target)
 
 void add_glb_material(nlohmann::json& gltf, nlohmann::json& views, size_t blob_offset, std::string& blob,
                       const std::string& base_color, const std::string& mime_type, const MaterialTextures& material,
-                      int uv_set) {
+                      int uv_set, uint32_t symmetry) {
   nlohmann::json pbr = {{"metallicFactor", 0.0}, {"roughnessFactor", 1.0}};
   nlohmann::json out = {{"name", "tailor"}};
   nlohmann::json images = nlohmann::json::array(), textures = nlohmann::json::array();
@@ -110,6 +110,7 @@ void add_glb_material(nlohmann::json& gltf, nlohmann::json& views, size_t blob_o
     gltf["textures"] = textures;
   }
   out["pbrMetallicRoughness"] = pbr;
+  if (symmetry == 4) out["extras"] = {{"tailor", {{"symmetry", 4}}}};
   gltf["materials"] = {out};
 }
 
@@ -193,7 +194,8 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
   if (options.up == SceneUp::kZ) node["rotation"] = {-kHalfSqrt2, 0.0, 0.0, kHalfSqrt2};
   nlohmann::json gltf;
   std::string images;  // the material's images, after the indices
-  add_glb_material(gltf, views, bin_size, images, texture_bytes, mime_type, options.material, data.uv_set);
+  add_glb_material(gltf, views, bin_size, images, texture_bytes, mime_type, options.material, data.uv_set,
+                   options.symmetry);
   add_glb_scene(gltf, data, node, std::move(primitives));
   texture_bytes = {};
   if (images.size() > std::numeric_limits<uint32_t>::max() - bin_size)

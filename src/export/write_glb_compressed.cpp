@@ -498,7 +498,8 @@ Status write_glb_compressed(const std::string& path, const ExportData& data, con
   nlohmann::json gltf = {{"extensionsUsed", used}, {"extensionsRequired", used}};
   pad_to_4(bin);
   std::string images;
-  add_glb_material(gltf, views, bin.size(), images, texture_bytes, mime_type, options.material, data.uv_set);
+  add_glb_material(gltf, views, bin.size(), images, texture_bytes, mime_type, options.material, data.uv_set,
+                   options.symmetry);
   add_glb_scene(gltf, data, node, std::move(primitives));
   bin += images;
   if (buffers.empty()) buffers.push_back(nullptr);

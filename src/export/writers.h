@@ -104,10 +104,11 @@ std::string relative_path(const std::string& target, const std::filesystem::path
 //! The material every .glb gets (named "tailor", not metallic, fully rough) and its images: the
 //! base colour `base_color` (PNG/JPEG bytes of type mime_type, may be empty) and the maps of
 //! `material`, appended to `blob` (each 4-byte aligned), which the caller places at byte
-//! blob_offset of buffer 0; a REPEAT sampler; textures read through TEXCOORD_<uv_set>.
+//! blob_offset of buffer 0; a REPEAT sampler; textures read through TEXCOORD_<uv_set>; with
+//! symmetry 4, the extras that say the map is 4-fold (ExportOptions::symmetry).
 void add_glb_material(nlohmann::json& gltf, nlohmann::json& views, size_t blob_offset, std::string& blob,
                       const std::string& base_color, const std::string& mime_type, const MaterialTextures& material,
-                      int uv_set);
+                      int uv_set, uint32_t symmetry);
 
 Status write_glb(const std::string& path, const ExportData& data, const ExportOptions& options);
 //! .glb with options.compression (quantize, meshopt or draco): the arrays are built in memory.

@@ -357,6 +357,19 @@ void find_texture(GltfDocument& doc, uint64_t material, const char* key, std::sp
   bytes = view_bytes;
 }
 
+// 4 where a material's extras say its map is 4-fold ({"tailor": {"symmetry": 4}}, written by
+// tailor map --symmetry 4), else 1; anything else there is ignored.
+uint32_t material_symmetry(GltfDocument& doc, uint64_t material) {
+  const Json* m = get_element(doc.json(), "materials", material);
+  if (!m || !m->is_object()) return 1;
+  const auto extras = m->find("extras");
+  if (extras == m->end() || !extras->is_object()) return 1;
+  const auto tailor = extras->find("tailor");
+  uint64_t symmetry = 1;
+  if (tailor == extras->end() || !tailor->is_object() || !get_uint(*tailor, "symmetry", symmetry)) return 1;
+  return symmetry == 4 ? 4 : 1;
+}
+
 Status decode_texture(std::span<const unsigned char> bytes, const std::string& name, Image& image) {
   image = Image{};
   if (bytes.size() > size_t{INT_MAX})
@@ -699,6 +712,7 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
       if (texture_bytes && !texture_found && p.material != UINT64_MAX) {
         find_texture(doc, p.material, "baseColorTexture", *texture_bytes);
         texture_found = !texture_bytes->empty();
+        if (texture_found) report.texture_symmetry = material_symmetry(doc, p.material);
         if (material) {
           find_texture(doc, p.material, "normalTexture", material->normal);
           find_texture(doc, p.material, "occlusionTexture", material->occlusion);

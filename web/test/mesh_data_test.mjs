@@ -128,6 +128,30 @@ const diagonalClass = (shift, shift5, width = 512, height = 512) => {
   assert.equal(diagonalClass([1, 0], [0, 0]).seamClass[2], kSeamVisible);
 }
 {
+  // Symmetry 4 (a 4-fold map under a tile a quarter turn leaves unchanged): face 1's UVs turned a
+  // quarter turn and shifted by whole repeats is an invisible seam then, a visible one without; a
+  // turn plus a fraction of a repeat stays visible.
+  const turned = (k, fraction) => {
+    const { index, position, uv } = square([0, 0]);
+    // Face 1 (vertices 3, 4, 5): (x, y) -> (y, -x) + k, which a quarter turn counter-clockwise,
+    // (x, y) -> (-y, x), takes back to face 0's UVs plus whole repeats.
+    for (const v of [3, 4, 5]) {
+      const x = uv[2 * v], y = uv[2 * v + 1];
+      uv[2 * v] = y + k[0] + fraction;
+      uv[2 * v + 1] = -x + k[1];
+    }
+    return (symmetry) => seamClasses(index, position, uv, 512, 512, symmetry).seamClass[2];
+  };
+  for (const k of [[0, 0], [1, -2], [-3, 4]]) {
+    assert.equal(turned(k, 0)(1), kSeamVisible, `turn + ${k}, symmetry 1`);
+    assert.equal(turned(k, 0)(4), kSeamInvisible, `turn + ${k}, symmetry 4`);
+    assert.equal(turned(k, 0.3)(4), kSeamVisible, `turn + ${k} + 0.3, symmetry 4`);
+  }
+  // A shift alone stays invisible with symmetry 4.
+  const { index, position, uv } = square([2, -1]);
+  assert.equal(seamClasses(index, position, uv, 512, 512, 4).seamClass[2], kSeamInvisible);
+}
+{
   // A third face on the diagonal (non-manifold) or a flipped face 1 (inconsistent orientation):
   // unpaired, so borders, as in tailor's topology.
   const { index, position, uv } = square([0.3, 0]);
@@ -213,6 +237,7 @@ if (tailor) {
       const position = new Float32Array(9 * faces.length);
       const uv = new Float32Array(6 * faces.length);
       let obj = points.map((p) => `v ${p.join(' ')}\n`).join('');
+      const faceTurn = faces.map(() => (random(3) === 0 ? random(4) : 0));
       faces.forEach((face, f) => {
         const faceShift = shifts[random(shifts.length)];
         face.forEach((v, k) => {
@@ -220,20 +245,29 @@ if (tailor) {
           const shift = random(5) === 0 ? shifts[random(shifts.length)] : faceShift;
           index[c] = c;
           position.set(points[v], 3 * c);
-          uv[2 * c] = points[v][0] / 10 + shift[0];
-          uv[2 * c + 1] = points[v][1] / 10 + shift[1];
+          // Odd trials turn some faces' UVs by quarter turns (tailor map --symmetry 4's seams).
+          const turns = trial % 2 ? faceTurn[f] : 0;
+          let [x, y] = [points[v][0] / 10, points[v][1] / 10];
+          for (let r = 0; r < turns; ++r) [x, y] = [y, -x];
+          uv[2 * c] = x + shift[0];
+          uv[2 * c + 1] = y + shift[1];
           obj += `vt ${uv[2 * c]} ${uv[2 * c + 1]}\n`;
         });
       });
       obj += faces.map((face, f) => `f ${face.map((v, k) => `${v + 1}/${3 * f + k + 1}`).join(' ')}\n`).join('');
       const file = path.join(dir, 'grid.obj');
       fs.writeFileSync(file, obj);
-      const grid = JSON.parse(execFileSync(tailor, ['eval', file, '--json', '-q'], { encoding: 'utf8' }));
-      const g = seamClasses(index, position, uv, grid.texture_width, grid.texture_height);
-      const gr = seamRatios(g);
-      assert.equal(g.seamEdges, grid.seam_edges, `grid ${trial}: seam edges`);
-      assert.ok(Math.abs(gr.visibleSeamRatio - grid.visible_seam_ratio) < 1e-9, `grid ${trial}: visible_seam_ratio`);
-      assert.ok(Math.abs(gr.seamInvisibleRatio - grid.seam_invisible_ratio) < 1e-9, `grid ${trial}: seam_invisible_ratio`);
+      // With symmetry 4 too (UVs turned by quarter turns on some faces below).
+      for (const symmetry of trial % 2 ? [1, 4] : [1]) {
+        const grid = JSON.parse(
+          execFileSync(tailor, ['eval', file, '--json', '-q', '--symmetry', `${symmetry}`], { encoding: 'utf8' }));
+        const g = seamClasses(index, position, uv, grid.texture_width, grid.texture_height, symmetry);
+        const gr = seamRatios(g);
+        const what = `grid ${trial}, symmetry ${symmetry}`;
+        assert.equal(g.seamEdges, grid.seam_edges, `${what}: seam edges`);
+        assert.ok(Math.abs(gr.visibleSeamRatio - grid.visible_seam_ratio) < 1e-9, `${what}: visible_seam_ratio`);
+        assert.ok(Math.abs(gr.seamInvisibleRatio - grid.seam_invisible_ratio) < 1e-9, `${what}: seam_invisible_ratio`);
+      }
     }
   } finally {
     fs.rmSync(dir, { recursive: true, force: true });
