@@ -21,7 +21,8 @@
 namespace tailor::internal {
 
 //! The relaxation of one mesh at one scale: built once (the faces' gradients and areas, each
-//! vertex's corners, the blocks and their colours), run for each round of lattice maps.
+//! vertex's corners, the blocks and their colours), run for each round of lattice maps. It keeps a
+//! pointer to the mesh's indices: the mesh must outlive it.
 class LatticeRelaxation {
  public:
   //! threads: for the parallel loops (the same result for any count).
@@ -48,7 +49,7 @@ class LatticeRelaxation {
   std::vector<uint32_t> sweep_order_;  // #V: the vertices in the order of the sweeps
   std::vector<uint32_t> start_;        // #V+1, in sweep order: CSR of each vertex's corners of non-degenerate faces
   std::vector<uint32_t> corners_;      // corner indices 3f + k
-  std::vector<float> term_;            // 5 per corner (see grid_relax.cpp)
+  std::vector<float> area_;            // #F: area (pixels^2); 0 for a degenerate face
   std::vector<float> settled_;         // #V, in sweep order: the move below which a vertex has settled (pixels)
   BlockSweep blocks_;                  // the Gauss-Seidel sweep's blocks of vertices (sweep order)
 };
