@@ -180,6 +180,13 @@ expect_error 2 "symmetry" -- "$tailor" eval "$tmp/a.glb" --symmetry 3
   ! cmp -s "$tmp/seams1.png" "$tmp/seams4.png" && cmp -s "$tmp/seams4.png" "$tmp/seams4d.png" &&
   ok || fail "render --symmetry 4 drew the seams as with 1, or a 4-fold map's .glb not as with 4"
 expect_error 2 "symmetry" -- "$tailor" render "$tmp/s4a.glb" --view seams --symmetry 2 -o "$tmp/seams2.png"
+# render --max-image-pixels applies to the .glb's embedded images and to --texture (checked from the
+# header, nothing written).
+expect_error 1 "embedded texture: image too large: .* the limit is 100 px" -- "$tailor" render "$tmp/s4a.glb" \
+  --max-image-pixels 100 -o "$tmp/limit.png"
+expect_error 1 "image too large: .* the limit is 100 px" -- "$tailor" render "$mesh" --texture "$texture" \
+  --max-image-pixels 100 -o "$tmp/limit.png"
+[[ ! -e $tmp/limit.png ]] && ok || fail "render over --max-image-pixels wrote its output"
 # render --normal-map: an RGB map shades the texture view (a different picture), a grey one is refused.
 "$tailor" render "$tmp/s4a.glb" --size 64x48 -o "$tmp/plain.png" -q &&
   "$tailor" render "$tmp/s4a.glb" --size 64x48 --normal-map "$tmp/wide.png" -o "$tmp/bumpy.png" -q &&

@@ -96,7 +96,7 @@ int run_eval(const EvalOptions& opt) {
     size_source = "embedded texture";
   }
   // A 4-fold map says so in its .glb (tailor map --symmetry 4): measured as the map was.
-  const uint32_t symmetry = opt.symmetry_given ? opt.symmetry : glb ? report.texture_symmetry : opt.symmetry;
+  const uint32_t symmetry = glb && !opt.symmetry_given ? report.texture_symmetry : opt.symmetry;
   if (symmetry == 4 && width != height)
     return report_error(Status::error(
         ErrorCode::kInvalidArgument, "",

@@ -22,6 +22,7 @@ struct RenderArgs {
   std::string texture;
   std::string normal_map;
   bool no_material = false;
+  ImageLoadOptions image_options;  // --max-image-pixels: the .glb's images, --texture, --normal-map
   RenderOptions options;
   std::string view = preview_view_name(RenderOptions{}.view);
   std::string size = std::to_string(RenderOptions{}.width) + "x" + std::to_string(RenderOptions{}.height);
@@ -64,17 +65,18 @@ int run_render(const RenderArgs& args) {
     const ReadingInput reading(args.input);
     const MeshFormat format = mesh_format_from_path(args.input);
     return format == MeshFormat::kGlb || format == MeshFormat::kGltf
-               ? read_glb_with_material(args.input, mesh, &texture, args.no_material ? nullptr : &maps, &report)
+               ? read_glb_with_material(args.input, mesh, &texture, args.no_material ? nullptr : &maps, &report,
+                                        args.image_options)
                : load_mesh(args.input, mesh, &report);
   }();
   if (!status) return report_error(status.with_file(args.input));
   if (!args.symmetry_given) options.seam_symmetry = report.texture_symmetry;  // a 4-fold map's .glb says so
   if (!args.texture.empty()) {
-    status = load_image(args.texture, texture);
+    status = load_image(args.texture, texture, args.image_options);
     if (!status) return report_error(status.with_file(args.texture));
   }
   if (!args.normal_map.empty()) {  // replaces the file's; tangents then come from the UVs
-    status = load_image(args.normal_map, maps.normal);
+    status = load_image(args.normal_map, maps.normal, args.image_options);
     if (!status) return report_error(status.with_file(args.normal_map));
     if (maps.normal.channels < 3)
       return report_error(Status::error(ErrorCode::kInvalidImage, args.normal_map, "a normal map needs RGB channels"));
@@ -128,6 +130,8 @@ void register_render(CLI::App& app, Runner& run) {
       ->check(CLI::IsMember({1u, 4u}))
       ->description(std::string(option_doc(kRenderOptionDocs, "seam_symmetry").help) +
                     "; default: 4 for a .glb from tailor map --symmetry 4 (its material says so), else 1");
+  add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), args->image_options.max_pixels)
+      ->check(CLI::PositiveNumber);
   cmd->add_flag("-q,--quiet", args->quiet, "print nothing but errors");
   cmd->footer(
       "Examples:\n"

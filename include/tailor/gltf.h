@@ -44,8 +44,10 @@ namespace tailor {
 //! decodes the base colour texture of the first textured material (PNG or JPEG) into it (left
 //! empty when there is none). report may be null. Fails with kIo, kParse (not a glb, bad chunk,
 //! bad accessor), kUnsupported (no triangle primitive, a required extension, a URI outside the folder),
-//! kInvalidMesh, kInvalidImage (texture present but undecodable). Cost: O(file size).
-TAILOR_API Status read_glb_file(const std::string& path, Mesh& mesh, Image* texture, LoadReport* report = nullptr);
+//! kInvalidMesh, kInvalidImage (texture present but undecodable, or larger than image_options
+//! allow: checked from its header before decoding). Cost: O(file size).
+TAILOR_API Status read_glb_file(const std::string& path, Mesh& mesh, Image* texture, LoadReport* report = nullptr,
+                                const ImageLoadOptions& image_options = {});
 
 //! The maps of a glTF material beside its base colour, and the tangents its normal map needs: what a
 //! preview shades with (render.h PreviewMaterial).
@@ -62,10 +64,11 @@ struct GltfMaterialMaps {
 //! kept in mesh.corner_attributes (a new mapping would make it wrong). Same errors; a map that
 //! cannot be decoded is kInvalidImage.
 TAILOR_API Status read_glb_with_material(const std::string& path, Mesh& mesh, Image* texture,
-                                         GltfMaterialMaps* material, LoadReport* report = nullptr);
+                                         GltfMaterialMaps* material, LoadReport* report = nullptr,
+                                         const ImageLoadOptions& image_options = {});
 
 //! Same from memory (.glb, or .gltf whose buffers are data: URIs); `name` is used in error messages only.
 TAILOR_API Status read_glb_memory(std::span<const char> data, const std::string& name, Mesh& mesh, Image* texture,
-                                  LoadReport* report = nullptr);
+                                  LoadReport* report = nullptr, const ImageLoadOptions& image_options = {});
 
 }  // namespace tailor

@@ -370,7 +370,8 @@ uint32_t material_symmetry(GltfDocument& doc, uint64_t material) {
   return symmetry == 4 ? 4 : 1;
 }
 
-Status decode_texture(std::span<const unsigned char> bytes, const std::string& name, Image& image) {
+Status decode_texture(std::span<const unsigned char> bytes, const std::string& name, const ImageLoadOptions& options,
+                      Image& image) {
   image = Image{};
   if (bytes.size() > size_t{INT_MAX})
     return Status::error(ErrorCode::kInvalidImage, name, "embedded texture too large");
@@ -378,7 +379,7 @@ Status decode_texture(std::span<const unsigned char> bytes, const std::string& n
   int width = 0, height = 0, channels = 0;
   if (!stbi_info_from_memory(bytes.data(), length, &width, &height, &channels))
     return Status::error(ErrorCode::kInvalidImage, name, "embedded texture cannot be decoded");
-  if (Status s = internal::check_image_header(bytes, width, height, ImageLoadOptions{}, name); !s)
+  if (Status s = internal::check_image_header(bytes, width, height, options, name); !s)
     return Status::error(ErrorCode::kInvalidImage, name, "embedded texture: " + s.what(), s.where());
   unsigned char* pixels = stbi_load_from_memory(bytes.data(), length, &width, &height, &channels, 0);
   if (!pixels) return Status::error(ErrorCode::kInvalidImage, name, "embedded texture cannot be decoded");
@@ -762,7 +763,8 @@ Status read_gltf(std::span<const char> data, const std::string& name, const std:
 namespace {
 
 Status read_gltf_with_texture(std::span<const char> data, const std::string& name, const std::string& base_dir,
-                              Mesh& mesh, Image* texture, LoadReport* report, GltfMaterialMaps* material = nullptr) {
+                              Mesh& mesh, Image* texture, LoadReport* report, GltfMaterialMaps* material,
+                              const ImageLoadOptions& image_options) {
   mesh = Mesh{};
   if (texture) *texture = Image{};
   if (material) *material = GltfMaterialMaps{};
@@ -789,7 +791,7 @@ Status read_gltf_with_texture(std::span<const char> data, const std::string& nam
           {material_bytes.occlusion, &material->occlusion},
           {material_bytes.metallic_roughness, &material->metallic_roughness}};
       for (const auto& [bytes, image] : maps)
-        if (s.is_ok() && !bytes.empty()) s = decode_texture(bytes, name, *image);
+        if (s.is_ok() && !bytes.empty()) s = decode_texture(bytes, name, image_options, *image);
     }
     int width = 0, height = 0, channels = 0;  // the texture's size from its header only
     if (s.is_ok() && !texture_bytes.empty() && texture_bytes.size() <= size_t{INT_MAX} &&
@@ -799,7 +801,8 @@ Status read_gltf_with_texture(std::span<const char> data, const std::string& nam
       r.texture_width = width;
       r.texture_height = height;
     }
-    if (s.is_ok() && texture && !texture_bytes.empty()) s = decode_texture(texture_bytes, name, *texture);
+    if (s.is_ok() && texture && !texture_bytes.empty())
+      s = decode_texture(texture_bytes, name, image_options, *texture);
   } catch (const std::bad_alloc&) {
     s = Status::error(ErrorCode::kLimit, name, "not enough memory to load the mesh");
   } catch (...) {
@@ -817,16 +820,17 @@ Status read_gltf_with_texture(std::span<const char> data, const std::string& nam
 }  // namespace
 
 Status read_glb_memory(std::span<const char> data, const std::string& name, Mesh& mesh, Image* texture,
-                       LoadReport* report) {
-  return read_gltf_with_texture(data, name, "", mesh, texture, report);
+                       LoadReport* report, const ImageLoadOptions& image_options) {
+  return read_gltf_with_texture(data, name, "", mesh, texture, report, nullptr, image_options);
 }
 
-Status read_glb_file(const std::string& path, Mesh& mesh, Image* texture, LoadReport* report) {
-  return read_glb_with_material(path, mesh, texture, nullptr, report);
+Status read_glb_file(const std::string& path, Mesh& mesh, Image* texture, LoadReport* report,
+                     const ImageLoadOptions& image_options) {
+  return read_glb_with_material(path, mesh, texture, nullptr, report, image_options);
 }
 
 Status read_glb_with_material(const std::string& path, Mesh& mesh, Image* texture, GltfMaterialMaps* material,
-                              LoadReport* report) {
+                              LoadReport* report, const ImageLoadOptions& image_options) {
   const auto start = std::chrono::steady_clock::now();
   mesh = Mesh{};
   if (material) *material = GltfMaterialMaps{};
@@ -834,7 +838,7 @@ Status read_glb_with_material(const std::string& path, Mesh& mesh, Image* textur
   TAILOR_RETURN_IF_ERROR(internal::read_file(path, bytes));
   LoadReport local;
   LoadReport& r = report ? *report : local;
-  const Status s = read_gltf_with_texture(bytes, path, folder_of(path), mesh, texture, &r, material);
+  const Status s = read_gltf_with_texture(bytes, path, folder_of(path), mesh, texture, &r, material, image_options);
   r.load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return s;
 }
