@@ -49,7 +49,7 @@ export class EditSurface {
     this.position = position;
     this.width = textureWidth;
     this.height = textureHeight;
-    this.symmetry = symmetry === 4 && textureWidth === textureHeight ? 4 : 1;
+    this.symmetry = 1;  // setSymmetry(symmetry) below, once this.uv exists (null: nothing to classify yet)
     // Edge pairs: the other use of an undirected edge used exactly twice, in opposite directions.
     const ring = edgeRings(index, null, vertices);
     const pair = new Int32Array(3 * faces).fill(-1);
@@ -78,6 +78,7 @@ export class EditSurface {
     this.areaUv = new Float64Array(faces);
     this.sumUv = 0;
     this.uv = null;                                // Float32Array(6F), corner UVs in repeats
+    this.setSymmetry(symmetry);
     this.same = new Uint8Array(3 * faces);         // per edge: paired and the same UVs on both sides
     this.seamClass = new Uint8Array(3 * faces);    // per edge: kSeam*
     this.root = new Int32Array(faces).fill(-1);    // per face: lowest face of its patch

@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <array>
 #include <chrono>
+#include <cstdint>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -61,6 +62,16 @@ Status check_outputs(const std::vector<OutputPath>& outputs, const std::vector<s
 template <class T>
 CLI::Option* add_documented(CLI::App* app, const OptionDoc& doc, T& field) {
   return app->add_option(std::string(doc.flag), field, std::string(doc.help))->capture_default_str();
+}
+
+//! Adds --symmetry (1 or 4) of eval and render, documented by `doc`: when it is not given, a .glb
+//! from tailor map --symmetry 4 decides (LoadReport::texture_symmetry; the caller reads
+//! count("--symmetry")).
+inline CLI::Option* add_symmetry_option(CLI::App* app, const OptionDoc& doc, uint32_t& field) {
+  return add_documented(app, doc, field)
+      ->check(CLI::IsMember({1u, 4u}))
+      ->description(std::string(doc.help) +
+                    "; default: 4 for a .glb from tailor map --symmetry 4 (its material says so), else 1");
 }
 
 //! Adds the switch `doc` names ("--no-..."), which turns `field` (on by default) off.

@@ -154,10 +154,7 @@ void register_eval(CLI::App& app, Runner& run) {
       ->check(CLI::Range(1, 1 << 16));
   add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), opt->image_options.max_pixels)
       ->check(CLI::PositiveNumber);
-  add_documented(cmd, option_doc(kMetricsOptionDocs, "symmetry"), opt->symmetry)
-      ->check(CLI::IsMember({1u, 4u}))
-      ->description(std::string(option_doc(kMetricsOptionDocs, "symmetry").help) +
-                    "; default: 4 for a .glb from tailor map --symmetry 4 (its material says so), else 1");
+  add_symmetry_option(cmd, option_doc(kMetricsOptionDocs, "symmetry"), opt->symmetry);
   cmd->add_flag("--json", opt->json, "Print the full report as a JSON object");
   cmd->add_flag("-q,--quiet", opt->quiet, "Print nothing but the result and errors");
   cmd->add_flag("--stability", opt->stability,

@@ -126,10 +126,7 @@ void register_render(CLI::App& app, Runner& run) {
   add_documented(cmd, option_doc(kRenderOptionDocs, "yaw_degrees"), args->options.yaw_degrees);
   add_documented(cmd, option_doc(kRenderOptionDocs, "pitch_degrees"), args->options.pitch_degrees);
   add_documented(cmd, option_doc(kRenderOptionDocs, "checker_squares"), args->options.checker_squares);
-  add_documented(cmd, option_doc(kRenderOptionDocs, "seam_symmetry"), args->options.seam_symmetry)
-      ->check(CLI::IsMember({1u, 4u}))
-      ->description(std::string(option_doc(kRenderOptionDocs, "seam_symmetry").help) +
-                    "; default: 4 for a .glb from tailor map --symmetry 4 (its material says so), else 1");
+  add_symmetry_option(cmd, option_doc(kRenderOptionDocs, "seam_symmetry"), args->options.seam_symmetry);
   add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), args->image_options.max_pixels)
       ->check(CLI::PositiveNumber);
   cmd->add_flag("-q,--quiet", args->quiet, "print nothing but errors");
