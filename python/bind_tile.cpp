@@ -45,7 +45,7 @@ void bind_tile(py::module_& m) {
   m.def(
       "tile",
       [](const py::object& image_or_path, int block, int overlap, uint64_t seed, bool fit_period, int symmetry,
-         bool report, const py::object& progress) -> py::object {
+         bool same_size, bool report, const py::object& progress) -> py::object {
         Image exemplar;
         TileRun run;
         if (py::isinstance<py::array>(image_or_path)) {
@@ -65,6 +65,7 @@ void bind_tile(py::module_& m) {
         options.seed = seed;
         options.fit_period = fit_period;
         options.symmetry = symmetry;
+        options.same_size = same_size;
         ProgressBridge bridge(progress);
         options.progress = bridge.function();
         run.input_width = exemplar.width;
@@ -92,14 +93,16 @@ void bind_tile(py::module_& m) {
         return py::make_tuple(tile, json_to_dict(tile_report_json(run)));
       },
       py::arg("image"), py::arg("block") = d.block, py::arg("overlap") = d.overlap, py::arg("seed") = d.seed,
-      py::arg("fit_period") = d.fit_period, py::arg("symmetry") = d.symmetry, py::arg("report") = false,
-      py::arg("progress") = py::none(),
-      R"(tile(image, block=32, overlap=0, seed=1, fit_period=False, symmetry=1, report=False, progress=None)
+      py::arg("fit_period") = d.fit_period, py::arg("symmetry") = d.symmetry, py::arg("same_size") = d.same_size,
+      py::arg("report") = false, py::arg("progress") = py::none(),
+      R"(tile(image, block=32, overlap=0, seed=1, fit_period=False, symmetry=1, same_size=False, report=False,
+     progress=None)
 
 Makes a texture self-tileable (quadrant swap + image quilting), as `tailor tile`. image: a uint8
 array (H, W) or (H, W, C) with C in 1..4, or an image file path. Returns the tile as a uint8 array
 (H', W', C); with report=True, (tile, dict) where the dict is `tailor tile --json`'s report
-(metrics against the input). The same seed gives the same tile. The GIL is released while it
+(metrics against the input). symmetry=4 gives a tile twice the input's (square) side, or its side
+with same_size=True. The same seed gives the same tile. The GIL is released while it
 works; progress works as in map().)");
 }
 

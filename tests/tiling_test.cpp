@@ -385,29 +385,34 @@ TileOptions quarter_turn_options() {
 
 // rot90(tile)(x, y) = tile(y, N - 1 - x) equals tile(x, y), sample for sample: the 4-fold centre is
 // on the tile's centre (or corner), a lattice point of the map (docs/mapping.md, "Symmetry 4").
+// The tile is twice the exemplar's (square) side, or its side with same_size.
 TEST(QuarterTurn, InvarianceIsExactOnEveryExemplar) {
-  for (const char* file : kExemplars) {
-    SCOPED_TRACE(file);
-    const Image ex = load(file);
-    Image tile;
-    TileReport report;
-    ASSERT_TRUE(make_tileable(ex, quarter_turn_options(), tile, &report).is_ok());
-    const int n = tile.width;
-    ASSERT_EQ(tile.height, n);
-    EXPECT_EQ(n, std::min(ex.width, ex.height) / 4 * 4);
-    EXPECT_EQ(tile.channels, ex.channels);
-    size_t differing = 0;
-    for (int y = 0; y < n; ++y)
-      for (int x = 0; x < n; ++x)
-        if (!same_pixel(tile, y, n - 1 - x, tile, x, y)) ++differing;
-    EXPECT_EQ(differing, 0u);
-    int sx = -1, sy = -1;
-    EXPECT_EQ(quarter_turn_difference(tile, &sx, &sy), 0);
-    EXPECT_EQ(sx, 0);
-    EXPECT_EQ(sy, 0);
-    EXPECT_EQ(report.quarter_turn_difference, 0);
-    EXPECT_EQ(report.symmetry, 4);
-  }
+  for (const char* file : kExemplars)
+    for (const bool same_size : {false, true}) {
+      SCOPED_TRACE(std::string(file) + (same_size ? " same_size" : ""));
+      const Image ex = load(file);
+      Image tile;
+      TileReport report;
+      TileOptions options = quarter_turn_options();
+      options.same_size = same_size;
+      ASSERT_TRUE(make_tileable(ex, options, tile, &report).is_ok());
+      const int n = tile.width;
+      ASSERT_EQ(tile.height, n);
+      EXPECT_EQ(n, std::min(ex.width, ex.height) / 4 * 4 * (same_size ? 1 : 2));
+      EXPECT_EQ(report.width, n);
+      EXPECT_EQ(tile.channels, ex.channels);
+      size_t differing = 0;
+      for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x)
+          if (!same_pixel(tile, y, n - 1 - x, tile, x, y)) ++differing;
+      EXPECT_EQ(differing, 0u);
+      int sx = -1, sy = -1;
+      EXPECT_EQ(quarter_turn_difference(tile, &sx, &sy), 0);
+      EXPECT_EQ(sx, 0);
+      EXPECT_EQ(sy, 0);
+      EXPECT_EQ(report.quarter_turn_difference, 0);
+      EXPECT_EQ(report.symmetry, 4);
+    }
   // A plain tile is not quarter-turn symmetric, and a non-square image has no figure.
   const Image sand = load("vistex-sand05-128.png");
   Image plain;
@@ -416,12 +421,14 @@ TEST(QuarterTurn, InvarianceIsExactOnEveryExemplar) {
   EXPECT_EQ(quarter_turn_difference(stripes(64, 40, 8)), -1);
 }
 
-// Four of the five targets hold on the stochastic shared photos; patch coherence (measured, like
-// the exemplar's baseline, against the exemplar's four quarter turns) is 2.2-2.3 x the
-// exemplar's: the known shortfall of this version (docs/tiling.md), bounded here so that it
-// cannot get worse unnoticed.
-TEST(QuarterTurn, TargetsOnGravelAndSand) {
-  for (const char* file : {"gravel-gray-512.png", "vistex-sand05-128.png"}) {
+// Four of the five targets hold on the stochastic shared photos, all five on fabric and water;
+// patch coherence (measured, like the exemplar's baseline, against the exemplar's four quarter
+// turns) is 1.1-1.4 x the exemplar's on the others: the known shortfall (docs/tiling.md), bounded
+// here so that it cannot get worse unnoticed. With same_size (quadrants of a quarter of the photo,
+// twice the seam length per pixel) it is 2.2-2.5 x.
+TEST(QuarterTurn, TargetsOnStochasticPhotos) {
+  for (const char* file :
+       {"gravel-gray-512.png", "vistex-sand05-128.png", "vistex-fabric02-128.png", "water-caustics-300.jpg"}) {
     SCOPED_TRACE(file);
     const Image ex = load(file);
     Image tile;
@@ -430,8 +437,44 @@ TEST(QuarterTurn, TargetsOnGravelAndSand) {
     ASSERT_TRUE(tile_metrics(tile, &ex, m).is_ok());
     EXPECT_EQ(m.quarter_turn_difference, 0);
     EXPECT_TRUE(m.coherence_with_turns);
-    expect_target_figures(m, 2.5);
+    const bool all_met =
+        std::string(file) == "vistex-fabric02-128.png" || std::string(file) == "water-caustics-300.jpg";
+    expect_target_figures(m, all_met ? 1.0 : 1.3);
+    EXPECT_EQ(meets_tile_targets(m), all_met);
   }
+  const Image sand = load("vistex-sand05-128.png");
+  TileOptions same = quarter_turn_options();
+  same.same_size = true;
+  Image tile;
+  ASSERT_TRUE(make_tileable(sand, same, tile).is_ok());
+  TileMetrics m;
+  ASSERT_TRUE(tile_metrics(tile, &sand, m).is_ok());
+  EXPECT_GT(m.patch_coherence, 1.5 * m.exemplar_patch_coherence);  // why it is not the default
+  EXPECT_LE(m.patch_coherence, 2.6 * m.exemplar_patch_coherence);
+}
+
+// A tile twice the exemplar's size is sampled at the exemplar's patch stride (at a stride above
+// 1 PatchMatch finds the cut patches' matches less well): a 2 x 2 repeat of a tile reads the tile's
+// own coherence, where it read about twice it when the stride followed the tile's size.
+TEST(TileMetricsTest, CoherenceDoesNotDependOnTheTilesSize) {
+  const Image ex = load("gravel-gray-512.png");
+  Image tile;
+  ASSERT_TRUE(make_tileable(ex, TileOptions{}, tile).is_ok());
+  Image twice;
+  twice.width = 2 * tile.width;
+  twice.height = 2 * tile.height;
+  twice.channels = tile.channels;
+  twice.pixels.resize(static_cast<size_t>(twice.width) * twice.height * twice.channels);
+  for (int y = 0; y < twice.height; ++y)
+    for (int x = 0; x < twice.width; ++x)
+      for (int c = 0; c < tile.channels; ++c)
+        twice.pixels[(static_cast<size_t>(y) * twice.width + x) * tile.channels + c] =
+            tile.pixels[(static_cast<size_t>(y % tile.height) * tile.width + x % tile.width) * tile.channels + c];
+  TileMetrics one, two;
+  ASSERT_TRUE(tile_metrics(tile, &ex, one).is_ok());
+  ASSERT_TRUE(tile_metrics(twice, &ex, two).is_ok());
+  EXPECT_NEAR(two.patch_coherence, one.patch_coherence, 0.1 * one.patch_coherence);
+  EXPECT_DOUBLE_EQ(two.exemplar_patch_coherence, one.exemplar_patch_coherence);
 }
 
 TEST(QuarterTurn, DeterministicAndDirectionalTexturesWarn) {
@@ -457,8 +500,8 @@ TEST(QuarterTurn, DeterministicAndDirectionalTexturesWarn) {
 
   // Non-square exemplar: cropped (with a warning) to its centred square, side a multiple of 4.
   ASSERT_TRUE(make_tileable(stripes(150, 90, 10), quarter_turn_options(), a, &report).is_ok());
-  EXPECT_EQ(a.width, 88);
-  EXPECT_EQ(a.height, 88);
+  EXPECT_EQ(a.width, 176);
+  EXPECT_EQ(a.height, 176);
   EXPECT_EQ(quarter_turn_difference(a), 0);
 }
 
@@ -472,6 +515,9 @@ TEST(QuarterTurn, VariantsFitPeriodAndOtherOrdersAreErrors) {
   EXPECT_EQ(make_tileable(sand, o, tile).code(), ErrorCode::kInvalidArgument);
   o = TileOptions{};
   o.symmetry = 3;
+  EXPECT_EQ(make_tileable(sand, o, tile).code(), ErrorCode::kInvalidArgument);
+  o = TileOptions{};
+  o.same_size = true;  // only with symmetry 4
   EXPECT_EQ(make_tileable(sand, o, tile).code(), ErrorCode::kInvalidArgument);
   EXPECT_TRUE(make_tile_variants(sand, quarter_turn_options(), 1, tiles).is_ok());
 }
@@ -553,6 +599,10 @@ TEST(TileCli, SymmetryFourReportsTheQuarterTurnAndRefusesVariants) {
   const nlohmann::json j = nlohmann::json::parse(jf, nullptr, false);
   ASSERT_FALSE(j.is_discarded());
   EXPECT_EQ(j["symmetry"], 4);
+  EXPECT_EQ(j["width"], 256);  // twice the input's side
+  Image written;
+  ASSERT_TRUE(load_image(out, written).is_ok());
+  EXPECT_EQ(written.width, 256);
   EXPECT_EQ(j["quarter_turn_difference"], 0);
   EXPECT_EQ(j["quarter_turn_exact"], true);
   EXPECT_EQ(j["tiles"][0]["quarter_turn_symmetric"], true);
@@ -566,9 +616,16 @@ TEST(TileCli, SymmetryFourReportsTheQuarterTurnAndRefusesVariants) {
   EXPECT_GT(m["quarter_turn_difference"].get<int>(), 0);
   EXPECT_EQ(m["quarter_turn_symmetric"], false);
 
-  for (const std::string& bad :
-       {std::string("--variants 2"), std::string("--fit-period"), std::string("--symmetry 2")}) {
-    const std::string args = bad == "--symmetry 2" ? bad : "--symmetry 4 " + bad;
+  const CliRun same =
+      run_cli("tile " + kData + "vistex-sand05-128.png -o " + dir + "/same.png --symmetry 4 --same-size -q");
+  ASSERT_EQ(same.code, 0) << same.err;
+  ASSERT_TRUE(load_image(dir + "/same.png", written).is_ok());
+  EXPECT_EQ(written.width, 128);
+  EXPECT_EQ(quarter_turn_difference(written), 0);
+
+  for (const std::string& bad : {std::string("--variants 2"), std::string("--fit-period"), std::string("--symmetry 2"),
+                                 std::string("--same-size")}) {
+    const std::string args = bad == "--symmetry 2" || bad == "--same-size" ? bad : "--symmetry 4 " + bad;
     const CliRun u = run_cli("tile " + kData + "vistex-sand05-128.png -o " + dir + "/u.png " + args);
     EXPECT_EQ(u.code, 2) << args << ": " << u.err;
     EXPECT_EQ(std::count(u.err.begin(), u.err.end(), '\n'), 1) << u.err;

@@ -402,6 +402,8 @@ void register_tile(CLI::App& app, Runner& run) {
   cmd->add_flag(std::string(fit_period.flag), options.fit_period, std::string(fit_period.help));
   add_off_switch(cmd, option_doc(kTileOptionDocs, "auto_period"), options.auto_period);
   add_documented(cmd, option_doc(kTileOptionDocs, "symmetry"), options.symmetry)->check(CLI::IsMember({1, 4}));
+  const OptionDoc& same_size = option_doc(kTileOptionDocs, "same_size");
+  cmd->add_flag(std::string(same_size.flag), options.same_size, std::string(same_size.help));
   add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), opt->image_options.max_pixels)
       ->check(CLI::PositiveNumber);
   cmd->add_option("--json", opt->json, "Write the metrics and settings as JSON to this file");
@@ -410,7 +412,8 @@ void register_tile(CLI::App& app, Runner& run) {
       "Examples:\n"
       "  tailor tile bricks.jpg -o bricks_tile.png\n"
       "  tailor tile bricks.jpg -o bricks.png --fit-period --variants 4   # bricks_0..3.png + bricks.json\n"
-      "  tailor tile gravel.png -o gravel_tile.png --symmetry 4         # also unchanged by a quarter turn\n"
+      "  tailor tile gravel.png -o gravel_tile.png --symmetry 4         # also unchanged by a quarter turn (2x the "
+      "side)\n"
       "  tailor tile --set color.png normal.png rough.png --normal-map normal.png -o tiled/   # one cut for all\n"
       "  tailor eval-tile bricks_tile.png bricks.jpg                     # check the result");
   cmd->callback([&run, opt] {
@@ -434,6 +437,8 @@ void register_tile(CLI::App& app, Runner& run) {
       if (o.symmetry == 4 && o.fit_period)
         return report_error(
             Status::error(ErrorCode::kInvalidArgument, "", "--symmetry 4 cannot be combined with --fit-period"));
+      if (o.same_size && o.symmetry != 4)
+        return report_error(Status::error(ErrorCode::kInvalidArgument, "", "--same-size needs --symmetry 4"));
       return run_tile(*opt);
     };
   });

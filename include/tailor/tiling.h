@@ -31,14 +31,17 @@
 // that a regular pattern ends in phase (thesis 3.1: 10 px stripes in 55 px -> 60 px).
 //
 // With symmetry = 4 the tile is also unchanged by a quarter turn up to a shift: a square N x N
-// tile (N = the exemplar's smaller side rounded down to a multiple of 4; a non-square exemplar is
-// cropped to its centred square) built as a pinwheel of one N/2 x N/2 quadrant (the exemplar
-// square of 3 x 3 places whose histogram is nearest the whole's) and its three quarter turns,
-// whose seams are repaired by the same quilting with every block written into all four rotated
-// places (the rotation centres get one wedge-shaped block each), the wrap put on the better of
-// the two repaired '+' lines: rot90(tile)(x, y) = tile(y, N-1-x) equals tile(x, y) exactly, i.e.
+// tile (S = the exemplar's smaller side rounded down to a multiple of 4, a non-square exemplar
+// cropped to its centred square; N = 2S up to 4096 px, else, or with same_size, N = S) built as a
+// pinwheel of one N/2 x N/2 quadrant (the whole exemplar, or with N = S the exemplar square of 3 x 3
+// places whose histogram is nearest the whole's) and its three quarter turns, whose seams are
+// repaired by the same quilting, drawing blocks from the exemplar's four turns and writing every
+// block into all four rotated places (the rotation centres get one wedge-shaped block each), the
+// wrap put on the better of the two repaired '+' lines (a retry with the smooth-block penalty when
+// its ratio misses [0.8, 1.2]): rot90(tile)(x, y) = tile(y, N-1-x) equals tile(x, y) exactly, i.e.
 // the tile is unchanged by a quarter turn about its centre and corner (where the 4-fold map turns
-// it). Its patch coherence is about 2-2.5 x the exemplar's (see docs/tiling.md).
+// it). Its patch coherence is about 1.1-1.2 x the exemplar's with N = 2S, 2-2.5 x with N = S (see
+// docs/tiling.md).
 //
 // Images follow the layout of image.h (1 to 4 channels; alpha is just a channel, except that the
 // FFT search of 3- and 4-channel images runs on the RGB luminance; the ranking uses all channels).
@@ -80,7 +83,9 @@ struct TileOptions {
                      //!< also make the period-fitted tile and keep it unless it misses a target the plain one meets
   int symmetry = 1;  //!< 1: plain tile; 4: also unchanged by a quarter turn (square output, one tile,
                      //!< no fit_period; see make_tileable)
-  TileProgress progress;  //!< optional progress callback (may be empty)
+  bool same_size = false;  //!< symmetry 4: a tile of the input's (cropped) side, each quadrant a quarter
+                           //!< of it, instead of twice the side with the whole input in each quadrant
+  TileProgress progress;   //!< optional progress callback (may be empty)
 };
 
 //! Flags and help of the TileOptions a user sets (option_doc.h).
@@ -95,7 +100,11 @@ inline constexpr OptionDoc kTileOptionDocs[] = {
     {"symmetry", "--symmetry",
      "1 or 4: 4 makes a square tile that is also unchanged by a quarter turn (rot90(tile) == tile), for "
      "stochastic textures (gravel, sand, bark, moss); directional ones (bricks, planks, grain) cannot look "
-     "the same turned and get a warning. Not with --variants or --fit-period"},
+     "the same turned and get a warning. The tile is twice the input's side (its square crop), each quadrant "
+     "the whole input turned. Not with --variants or --fit-period"},
+    {"same_size", "--same-size",
+     "With --symmetry 4: a tile of the input's side, each quadrant a quarter of it (more seams per pixel: "
+     "patch coherence about 2x worse than the default's twice-the-side tile)"},
 };
 
 //! Texel period found by autocorrelation (thesis 3.1), per axis.
@@ -110,7 +119,7 @@ struct PeriodEstimate {
 
 //! What make_tileable did, for reports and the variants' JSON.
 struct TileReport {
-  int width = 0;  //!< output size (differs from the input only with fit_period)
+  int width = 0;  //!< output size (differs from the input with fit_period, and with symmetry 4: twice its side)
   int height = 0;
   int block = 0;            //!< block side actually used (px)
   int overlap = 0;          //!< overlap actually used (px)

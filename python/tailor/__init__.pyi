@@ -89,6 +89,7 @@ def tile(
     seed: int = 1,
     fit_period: bool = False,
     symmetry: Literal[1, 4] = 1,
+    same_size: bool = False,
     report: Literal[False] = False,
     progress: Optional[_Progress] = None,
 ) -> npt.NDArray[np.uint8]: ...
@@ -100,6 +101,7 @@ def tile(
     seed: int = 1,
     fit_period: bool = False,
     symmetry: Literal[1, 4] = 1,
+    same_size: bool = False,
     *,
     report: Literal[True],
     progress: Optional[_Progress] = None,

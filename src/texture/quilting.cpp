@@ -46,11 +46,24 @@ void Quilter::place(int bx, int by, int bw, int bh, const Exclusion& exclusion) 
   // Choose the exemplar block among those within the tolerance of the best SSD.
   const int nx = search_.positions_x(bw);
   const int ny = search_.positions_y(bh);
+  const int searched_turns = turn_search_ ? 4 : 1;  // candidate i: turn i / (nx ny), position i % (nx ny)
+  const int per_turn = nx * ny;
   int chosen = 0;
+  turn_ = 0;
   if (!any_known) {
-    chosen = static_cast<int>(rng_.below(static_cast<uint32_t>(nx * ny)));
+    chosen = static_cast<int>(rng_.below(static_cast<uint32_t>(per_turn * searched_turns)));
+  } else if (turn_search_) {
+    // The exemplar's four quarter turns are searched as one candidate set: a seam between two
+    // turned copies is repaired from blocks that match both without a turn in the middle.
+    ssd_.resize(static_cast<size_t>(per_turn) * 4);
+    for (int k = 0; k < 4; ++k) {
+      (*turn_search_)[static_cast<size_t>(k)].search(bw, bh, templ_, mask_, turn_ssd_);
+      std::copy(turn_ssd_.begin(), turn_ssd_.end(), ssd_.begin() + static_cast<std::ptrdiff_t>(k) * per_turn);
+    }
   } else {
     search_.search(bw, bh, templ_, mask_, ssd_);
+  }
+  if (any_known) {
     float energy = 0.0f;
     for (size_t i = 0; i < templ_.size(); ++i) energy += mask_[i / channels] * templ_[i] * templ_[i];
     select_candidates(nx, ny, energy, exclusion);
@@ -72,7 +85,8 @@ void Quilter::place(int bx, int by, int bw, int bh, const Exclusion& exclusion) 
       costs_.resize(k);
       double best_cost = std::numeric_limits<double>::max();
       for (size_t i = 0; i < k; ++i) {
-        const int cx = candidates_[i] % nx, cy = candidates_[i] / nx;
+        turn_ = candidates_[i] / per_turn;
+        const int cx = candidates_[i] % per_turn % nx, cy = candidates_[i] % per_turn / nx;
         compute_error(cx, cy);
         take_new_.assign(area, 1);
         for (int side = 0; side < 4; ++side) cut_side(side);
@@ -102,8 +116,9 @@ void Quilter::place(int bx, int by, int bw, int bh, const Exclusion& exclusion) 
       cut_cost_ += costs_[pick];
     }
   }
-  const int px = chosen % nx;
-  const int py = chosen / nx;
+  turn_ = chosen / per_turn;
+  const int px = chosen % per_turn % nx;
+  const int py = chosen % per_turn / nx;
   if (record_) record_->push_back({bx, by, bw, bh, px, py});
 
   // Boundary cuts on every side whose overlap strip holds known pixels.
@@ -119,16 +134,16 @@ void Quilter::place(int bx, int by, int bw, int bh, const Exclusion& exclusion) 
       const size_t ci = static_cast<size_t>(cy) * canvas_.width + cx;
       if (locked_[ci]) continue;
       if (take_new_[i] || mask_[i] == 0.0f) {
-        const float* e = ex_.at(px + x, py + y);
+        const float* e = block_plane().at(px + x, py + y);
         std::copy(e, e + channels, canvas_.at(cx, cy));
-        if (source_) (*source_)[ci] = (py + y) * ex_.width + px + x;
+        if (source_) (*source_)[ci] = turn_offset() + (py + y) * ex_.width + px + x;
         if (turns_) {
           // The three images under r(x, y) = (N - 1 - y, x); the source turns with them:
           // turns[k + 1](S - 1 - sy, sx) = turns[k](sx, sy) for the S x S exemplar.
           const int n = canvas_.width, s = ex_.width;
           const int32_t plane = s * s;
           int rx = cx, ry = cy;
-          int32_t src = (py + y) * ex_.width + px + x;
+          int32_t src = turn_offset() + (py + y) * ex_.width + px + x;
           for (int turn = 1; turn < 4; ++turn) {
             const int nx2 = n - 1 - ry;
             ry = rx;
@@ -206,21 +221,22 @@ void Quilter::select_candidates(int nx, int ny, float energy, const Exclusion& e
     }
     ranked_.resize(std::min(ranked_.size(), top));
   } else {
+    // The exclusion names upright exemplar positions (variants; no turned search there).
+    const int per_turn = nx * ny, count = static_cast<int>(ssd_.size());
+    auto excluded = [&](int i) { return i < per_turn && exclusion.contains(i % nx, i / nx); };
     float best = std::numeric_limits<float>::max();
-    for (int y = 0; y < ny; ++y)
-      for (int x = 0; x < nx; ++x)
-        if (!exclusion.contains(x, y)) best = std::min(best, ssd_[static_cast<size_t>(y) * nx + x]);
+    for (int i = 0; i < count; ++i)
+      if (!excluded(i)) best = std::min(best, ssd_[static_cast<size_t>(i)]);
     const bool use_exclusion = best < std::numeric_limits<float>::max();
     if (!use_exclusion)
       for (float v : ssd_) best = std::min(best, v);
     const float threshold = threshold_of(best);
-    for (int y = 0; y < ny; ++y)
-      for (int x = 0; x < nx; ++x) {
-        if (use_exclusion && exclusion.contains(x, y)) continue;
-        const std::pair<float, int> entry{ssd_[static_cast<size_t>(y) * nx + x], y * nx + x};
-        if (entry.first <= threshold) candidates_.push_back(entry.second);
-        if (top > 0) keep_lowest(entry, top);
-      }
+    for (int i = 0; i < count; ++i) {
+      if (use_exclusion && excluded(i)) continue;
+      const std::pair<float, int> entry{ssd_[static_cast<size_t>(i)], i};
+      if (entry.first <= threshold) candidates_.push_back(entry.second);
+      if (top > 0) keep_lowest(entry, top);
+    }
   }
   if (candidates_.size() < top) {
     candidates_.clear();
@@ -235,7 +251,7 @@ void Quilter::compute_error(int px, int py) {
     for (int x = 0; x < bw_; ++x) {
       const size_t i = static_cast<size_t>(y) * bw_ + x;
       if (mask_[i] == 0.0f) continue;
-      const float* e = ex_.at(px + x, py + y);
+      const float* e = block_plane().at(px + x, py + y);
       float sum = 0.0f;
       for (int c = 0; c < channels; ++c) {
         const float d = templ_[i * channels + c] - e[c];
@@ -251,9 +267,10 @@ double Quilter::block_gradient(int px, int py) const {
   double sum = 0.0;
   for (int y = 0; y + 1 < bh_; ++y)
     for (int x = 0; x + 1 < bw_; ++x) {
-      const float* a = ex_.at(px + x, py + y);
-      const float* r = ex_.at(px + x + 1, py + y);
-      const float* d = ex_.at(px + x, py + y + 1);
+      const Plane& plane = block_plane();
+      const float* a = plane.at(px + x, py + y);
+      const float* r = plane.at(px + x + 1, py + y);
+      const float* d = plane.at(px + x, py + y + 1);
       for (int c = 0; c < channels; ++c) sum += std::abs(a[c] - r[c]) + std::abs(a[c] - d[c]);
     }
   return sum / (static_cast<double>(bw_ - 1) * (bh_ - 1) * channels);
@@ -282,7 +299,7 @@ double Quilter::profile_deficit(int bx, int by, int px, int py) const {
     const int cy = Plane::mod(by + y, canvas_.height);
     const size_t i = static_cast<size_t>(y) * bw_ + x;
     if (!locked_[static_cast<size_t>(cy) * canvas_.width + cx] && (take_new_[i] || mask_[i] == 0.0f))
-      return ex_.at(px + x, py + y);
+      return block_plane().at(px + x, py + y);
     return canvas_.at(cx, cy);
   };
   double deficit = 0.0, total = 0.0;
@@ -332,9 +349,9 @@ double Quilter::patch_cost(int bx, int by, int px, int py, double factor_a, doub
       const bool in_block = x >= 0 && y >= 0 && x < bw_ && y < bh_;
       const size_t bi = in_block ? static_cast<size_t>(y) * bw_ + x : 0;
       if (in_block && !locked_[ci] && (take_new_[bi] || mask_[bi] == 0.0f)) {
-        const float* e = ex_.at(px + x, py + y);
+        const float* e = block_plane().at(px + x, py + y);
         std::copy(e, e + channels, &region_val_[r * channels]);
-        region_src_[r] = (py + y) * ex_.width + px + x;
+        region_src_[r] = turn_offset() + (py + y) * ex_.width + px + x;
         region_known_[r] = 1;
       } else {
         const float* e = canvas_.at(cx, cy);

@@ -85,7 +85,12 @@ class Quilter {
   //! exemplar); a source index is then k * (exemplar pixels) + the pixel's index in turns[k], so
   //! the patch cost sees rotated copies as copies. The caller keeps blocks from overlapping their
   //! own images.
-  void set_quarter_turns(const std::vector<Plane>* turns) { turns_ = turns; }
+  //! With `searches` (one SsdSearch per turn, initialised on turns[k]), blocks are drawn from all
+  //! four turns, not only from the upright exemplar.
+  void set_quarter_turns(const std::vector<Plane>* turns, std::vector<SsdSearch>* searches = nullptr) {
+    turns_ = turns;
+    turn_search_ = searches;
+  }
 
   //! Appends every placement to `record` (may be null).
   void set_record(std::vector<Placement>* record) { record_ = record; }
@@ -160,6 +165,12 @@ class Quilter {
   int skip_first_ = 0, skip_count_ = 0;
   std::vector<uint8_t> strong_rows_, strong_cols_;
   const std::vector<Plane>* turns_ = nullptr;
+  std::vector<SsdSearch>* turn_search_ = nullptr;
+  std::vector<float> turn_ssd_;
+  int turn_ = 0;  // quarter turn of the block being tried or placed (0 without a turned search)
+  //! The exemplar turn the current block is read from, and its offset in source indices.
+  const Plane& block_plane() const { return turn_search_ ? (*turns_)[static_cast<size_t>(turn_)] : ex_; }
+  int32_t turn_offset() const { return turn_ * ex_.width * ex_.height; }
   std::vector<Placement>* record_ = nullptr;
 };
 

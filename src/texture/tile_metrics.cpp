@@ -6,7 +6,8 @@
 //   patch-coherence metric: random init, propagation, random search with halving radius).
 //
 // Patch coherence is evaluated on a fixed grid of tile patches (stride 1 up to 128 x 128, then the
-// smallest stride giving <= 16384 patches) so that a 512 px image costs ~0.1 s; the generator is
+// smallest stride giving <= 16384 patches over the smaller of tile and exemplar, at most 4 x 16384
+// over the tile) so that a 512 px image costs ~0.1 s; the generator is
 // seeded with a constant, so the value is deterministic. Everything works on the 8-bit samples
 // in place (no float copies) and the exact-copy pass streams over the exemplar with a rolling
 // hash, so a 4096 px pair costs about 1 s and 100 MB (float planes and a sorted table of every
@@ -36,6 +37,7 @@ Plane view(const Image& image) { return {image.width, image.height, image.channe
 
 constexpr int kPatch = 7;
 constexpr int kMaxPatches = 16384;
+constexpr int kMaxGridGrowth = 4;  // a tile larger than its exemplar: up to this many times the patches
 constexpr int kIterations = 6;
 constexpr int kSamplesPerRadius = 1;  // random samples per search radius
 constexpr int kBins = 64;
@@ -155,6 +157,13 @@ double variance(const Plane& p) {
 //! its samples).
 void nearest_patch_costs(const Plane& source, const Plane& target, std::vector<float>& cost);
 
+//! The smallest stride whose grid over a w x h image holds at most `limit` patches.
+int patch_stride(int w, int h, int limit) {
+  int stride = 1;
+  while ((((w + stride - 1) / stride) * ((h + stride - 1) / stride)) > limit) ++stride;
+  return stride;
+}
+
 //! The mean per-sample squared distance of nearest_patch_costs; with `turns`, the nearest over
 //! the target and its three quarter turns.
 double mean_nearest_patch_distance(const Plane& source, const Plane& target, bool turns = false) {
@@ -196,8 +205,14 @@ void nearest_patch_costs(const Plane& source, const Plane& target, std::vector<f
       std::copy(s, s + c, &padded[(static_cast<size_t>(y) * pw + x) * c]);
     }
   const int tx = target.width - kPatch + 1, ty = target.height - kPatch + 1;
-  int stride = 1;
-  while ((((w + stride - 1) / stride) * ((h + stride - 1) / stride)) > kMaxPatches) ++stride;
+  // The stride of the smaller image: at a stride above 1 PatchMatch's propagation between grid
+  // neighbours helps less and the estimate of a patch across a cut rises (a 2 x 2 repeat of a
+  // 512 px tile read 2x the tile's coherence at stride 8), so a tile larger than its exemplar
+  // (symmetry 4: twice the side) is sampled as finely as the exemplar's own baseline, up to
+  // kMaxPatches x kMaxGridGrowth patches.
+  const int stride =
+      std::max(std::min(patch_stride(w, h, kMaxPatches), patch_stride(target.width, target.height, kMaxPatches)),
+               patch_stride(w, h, kMaxPatches * kMaxGridGrowth));
   const int gx = (w + stride - 1) / stride, gy = (h + stride - 1) / stride;
   const int ox = std::max(0, w - (kPatch - 1) - (gx - 1) * stride);
   const int oy = std::max(0, h - (kPatch - 1) - (gy - 1) * stride);

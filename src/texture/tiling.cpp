@@ -48,7 +48,15 @@ constexpr int kMinCandidates = 8;  // a tolerance set smaller than this is toppe
 constexpr int kProfileCandidates = 16;     // the same where the straight-boundary profile is checked
 constexpr int kAttemptPixels = 320 * 320;  // best of (this / pixels) attempts, at most kMaxAttempts
 constexpr int kMaxAttempts = 4;
-constexpr double kDirectional = 0.5;  // symmetry 4 warns above this orientation_anisotropy()
+constexpr double kDirectional = 0.5;               // symmetry 4 warns above this orientation_anisotropy()
+constexpr double kWrapLow = 0.8, kWrapHigh = 1.2;  // the wrap-ratio target (meets_tile_targets)
+constexpr unsigned kQuarterTurnRedraws = 4;        // symmetry 4: draws after the retry while a target misses
+// Symmetry 4 makes a tile twice the exemplar's side up to this side, the exemplar's own side beyond
+// it, and draws blocks from the exemplar's four turns up to kMaxTurnedSearchSide (each turn is
+// one more FFT search per block: at 1024 px 3.5 s -> 12.7 s; full-size blocks, no planning on a
+// reduced copy as for plain tiles).
+constexpr int kMaxDoubledSide = 2048;
+constexpr int kMaxTurnedSearchSide = 512;
 
 //! Square image cut out of `in`.
 Image crop(const Image& in, int x0, int y0, int w, int h) {
@@ -96,6 +104,7 @@ struct Setup {
   int fold_x = 0;  // px added by fit_period extension: its fold seam lies fold_x px before the wrap
   int fold_y = 0;
   int symmetry = 1;  // 4: quarter-turn tile (exemplar cropped to its centred square, even side)
+  int quadrant = 0;  // symmetry 4: side M of the exemplar square each quadrant holds (tile side 2M)
 };
 
 void choose_shift(const Plane& ex, int& shift_x, int& shift_y);
@@ -147,6 +156,8 @@ Status prepare(const Image& input, const TileOptions& options, Setup& setup, Til
   if (options.symmetry == 4 && options.fit_period)
     return Status::error(ErrorCode::kInvalidArgument, "", "--symmetry 4 cannot be combined with --fit-period",
                          "a quarter-turn tile is square; a period fitted along x and y would not survive the turn");
+  if (options.same_size && options.symmetry != 4)
+    return Status::error(ErrorCode::kInvalidArgument, "", "--same-size needs --symmetry 4");
   Image work = input;
   report.symmetry = options.symmetry;
   setup.symmetry = options.symmetry;
@@ -172,6 +183,17 @@ Status prepare(const Image& input, const TileOptions& options, Setup& setup, Til
   }
   report.width = work.width;
   report.height = work.height;
+  if (options.symmetry == 4) {
+    // Each quadrant holds the whole exemplar (tile side 2N): the tile then has a plain tile's seam
+    // length per pixel and the exemplar's histogram; with quadrants of N/2 (same_size), twice the
+    // seam length per pixel and a quarter of the photo (docs/tiling.md).
+    const bool doubled = !options.same_size && 2 * work.width <= kMaxDoubledSide;
+    if (!options.same_size && !doubled)
+      report.warnings.push_back("tile kept at " + std::to_string(work.width) + " px: twice the side would exceed " +
+                                std::to_string(kMaxDoubledSide) + " px (as with --same-size)");
+    setup.quadrant = doubled ? work.width : work.width / 2;
+    report.width = report.height = 2 * setup.quadrant;
+  }
   int block = options.block;
   const int max_block = std::min(work.width, work.height) / 4;
   if (block > max_block) {
@@ -282,6 +304,34 @@ double worst_seam_ratio(const Plane& p, bool include_wrap) {
   return worst;
 }
 
+//! Where a quarter-turn tile's wrap goes (symmetry 4): the 4-fold centre must stay on the tile's
+//! corner or centre (a map that turns the texture by quarter turns across a seam turns it about a
+//! lattice point, docs/mapping.md "Symmetry 4"; about any other point its seams would jump by half a
+//! repeat), so the wrap runs through one of the pinwheel's two '+' lines: shift 0 or N/2, whichever
+//! joins its two sides more like the tile's median column boundary. Returns the shift and, in
+//! `wrap`, that line's difference over the median (the wrap ratio; rows are the turned columns).
+int quarter_turn_wrap(const Plane& pinwheel, double& wrap) {
+  const int n = pinwheel.width;
+  std::vector<double> boundary(static_cast<size_t>(n), 0.0);  // summed |difference| across x-1 | x
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      const float* left = pinwheel.at((x + n - 1) % n, y);
+      const float* right = pinwheel.at(x, y);
+      for (int k = 0; k < pinwheel.channels; ++k) boundary[static_cast<size_t>(x)] += std::abs(left[k] - right[k]);
+    }
+  // The wrap line's difference over the median of the other lines, as tile_metrics measures it.
+  const auto ratio = [&](int x) {
+    std::vector<double> others = boundary;
+    others.erase(others.begin() + x);
+    std::nth_element(others.begin(), others.begin() + static_cast<std::ptrdiff_t>(others.size() / 2), others.end());
+    return std::max(boundary[static_cast<size_t>(x)], 1e-9) / std::max(others[others.size() / 2], 1e-9);
+  };
+  const double at_zero = ratio(0), at_half = ratio(n / 2);
+  const int q = std::abs(std::log(at_half)) < std::abs(std::log(at_zero)) ? n / 2 : 0;
+  wrap = q == 0 ? at_zero : at_half;
+  return q;
+}
+
 //! How one attempt at the base tile chooses its blocks.
 struct CrossPlan {
   uint64_t stream = 0;            // random stream (mix_seed(seed, stream))
@@ -373,20 +423,23 @@ Status quilt_cross(const Setup& setup, const TileOptions& options, const CrossPl
   return Status::ok();
 }
 
-//! Quarter-turn tile (symmetry 4) on the square N x N exemplar, M = N / 2: the canvas starts as a
-//! pinwheel of the exemplar's centred M x M square Q (Q in the top-left quadrant, its images under
-//! r(x, y) = (N - 1 - y, x) in the others), so it is unchanged by r and has seams on the lines
-//! x, y = M (the centre '+') and x, y = 0 (the wrap '+'). Zones of `margin` px around them are
-//! unknown and quilted with the arm blocks of quilt_cross, each block written into its four
-//! places (Quilter::set_quarter_turns). Up to the turn, there are two seams: segment A (x = M,
-//! y in [0, M): between the 2-fold point (M, 0) and the centre) and segment B (x = 0, y in [0, M):
+//! Quarter-turn tile (symmetry 4) of side N = 2M from the square S x S exemplar, M = setup.quadrant
+//! (S, or S / 2 with same_size): the canvas starts as a pinwheel of an M x M exemplar square Q (Q in
+//! the top-left quadrant, its images under r(x, y) = (N - 1 - y, x) in the others), so it is
+//! unchanged by r and has seams on the lines x, y = M (the centre '+') and x, y = 0 (the wrap '+').
+//! Zones of `margin` px around them are unknown and quilted with the arm blocks of quilt_cross,
+//! drawn from the exemplar's four turns and each written into its four places
+//! (Quilter::set_quarter_turns). Up to the turn, there are two seams: segment A (x = M, y in
+//! [0, M): between the 2-fold point (M, 0) and the centre) and segment B (x = 0, y in [0, M):
 //! between the corner and the 2-fold point (0, M)); the centre and the corner, where a block
 //! would overlap its own images, get one quarter block each (its images are the other three
 //! quarters). The result is made exact by rebuilding it from its top-left quadrant.
 Status quilt_pinwheel(const Setup& setup, const TileOptions& options, const CrossPlan& plan, SsdSearch& search,
-                      const std::vector<Plane>& turns, Plane& canvas, int& placed, double& cut_cost) {
+                      const std::vector<Plane>& turns, std::vector<SsdSearch>& turn_search, Plane& canvas, int& placed,
+                      double& cut_cost) {
   const Plane& ex = setup.exemplar;
-  const int n = ex.width, m = n / 2, c = ex.channels;
+  const int es = ex.width, c = ex.channels;
+  const int m = setup.quadrant, n = 2 * m;
   const int b = std::max(8, setup.block / kArmDivisor);
   const int ov = std::clamp(setup.overlap / kArmDivisor, 1, b / 2 - 1);
   const int margin = b - 2 * ov;    // unknown zone across each line
@@ -397,13 +450,15 @@ Status quilt_pinwheel(const Setup& setup, const TileOptions& options, const Cros
   const int reach = half + 2 * ov;
   const int quarter = std::max(b, reach + ov);
   if (quarter > m / 2) return Status::error(ErrorCode::kInvalidArgument, "", "block too large for --symmetry 4");
-  canvas = ex;
+  canvas.width = canvas.height = n;
+  canvas.channels = c;
+  canvas.px.assign(static_cast<size_t>(n) * n * c, 0.0f);
   std::vector<int32_t> source(static_cast<size_t>(n) * n, -1);
   std::vector<uint8_t> known(static_cast<size_t>(n) * n, 1), locked(static_cast<size_t>(n) * n, 0);
-  const int32_t plane = n * n;
-  // Q = exemplar [qx, qx + m) x [qy, qy + m): of 3 x 3 places, the one whose 64-bin histogram
-  // (all channels) is nearest the exemplar's (a non-stationary photo: its centre alone can be
-  // lighter or darker than the whole).
+  const int32_t plane = es * es;
+  // Q = exemplar [qx, qx + m) x [qy, qy + m): the whole exemplar, or (m < es) of 3 x 3 places the
+  // one whose 64-bin histogram (all channels) is nearest the exemplar's (a non-stationary photo:
+  // its centre alone can be lighter or darker than the whole).
   auto histogram = [&](int x0, int y0, int size) {
     std::vector<double> h(static_cast<size_t>(64 * c), 0.0);
     for (int y = y0; y < y0 + size; ++y)
@@ -413,12 +468,12 @@ Status quilt_pinwheel(const Setup& setup, const TileOptions& options, const Cros
               1.0 / (static_cast<double>(size) * size);
     return h;
   };
-  const std::vector<double> whole = histogram(0, 0, n);
-  int qx = (n - m) / 2, qy = (n - m) / 2;
+  const std::vector<double> whole = histogram(0, 0, es);
+  int qx = (es - m) / 2, qy = (es - m) / 2;
   double best_l1 = std::numeric_limits<double>::max();
   for (int j = 0; j <= 2; ++j)
     for (int i = 0; i <= 2; ++i) {
-      const int x0 = i * (n - m) / 2, y0 = j * (n - m) / 2;
+      const int x0 = i * (es - m) / 2, y0 = j * (es - m) / 2;
       const std::vector<double> h = histogram(x0, y0, m);
       double l1 = 0.0;
       for (size_t k = 0; k < h.size(); ++k) l1 += std::abs(h[k] - whole[k]);
@@ -431,7 +486,7 @@ Status quilt_pinwheel(const Setup& setup, const TileOptions& options, const Cros
   for (int y = 0; y < m; ++y)
     for (int x = 0; x < m; ++x) {
       int rx = x, ry = y;
-      int32_t src = (qy + y) * n + qx + x;
+      int32_t src = (qy + y) * es + qx + x;
       const float* e = ex.at(qx + x, qy + y);
       for (int turn = 0; turn < 4; ++turn) {
         std::copy(e, e + c, canvas.at(rx, ry));
@@ -439,8 +494,8 @@ Status quilt_pinwheel(const Setup& setup, const TileOptions& options, const Cros
         const int nx2 = n - 1 - ry;
         ry = rx;
         rx = nx2;
-        const int32_t k = src / plane, sx = src % plane % n, sy = src % plane / n;
-        src = ((k + 1) % 4) * plane + sx * n + (n - 1 - sy);
+        const int32_t k = src / plane, sx = src % plane % es, sy = src % plane / es;
+        src = ((k + 1) % 4) * plane + sx * es + (es - 1 - sy);
       }
     }
   auto in_zone = [&](int v) { return Plane::mod(v - (m - half), n) < margin || Plane::mod(v + half, n) < margin; };
@@ -453,7 +508,7 @@ Status quilt_pinwheel(const Setup& setup, const TileOptions& options, const Cros
   SplitMix64 rng(mix_seed(options.seed, plan.stream));
   Quilter quilter(ex, search, canvas, known, locked, ov, options.tolerance, rng, &source, kCandidatePool,
                   plan.gradient_penalty);
-  quilter.set_quarter_turns(&turns);
+  quilter.set_quarter_turns(&turns, turn_search.empty() ? nullptr : &turn_search);
   quilter.set_min_candidates(plan.min_candidates);
   // The 2-fold point (M, 0) gets a block of 2 quarter x 2 quarter, so chain A starts below it.
   const int a0 = quarter - ov;
@@ -581,9 +636,15 @@ Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int
     const double target = std::max(exemplar_worst, kSeamFloor);
     std::vector<CrossPlan> plans;
     std::vector<Plane> turns;
+    std::vector<SsdSearch> turn_search;
     if (setup.symmetry == 4) {
       turns.push_back(ex);
       for (int k = 1; k < 4; ++k) turns.push_back(turn_plane(turns.back()));
+      if (ex.width <= kMaxTurnedSearchSide) {
+        turn_search.resize(4);
+        for (int k = 0; k < 4; ++k)
+          turn_search[static_cast<size_t>(k)].init(turns[static_cast<size_t>(k)], all_channels);
+      }
     }
     if (exemplar_worst > kStrongEdge && setup.symmetry == 1) {
       plans.push_back({0, kSmoothPenalty, 0, 1, 2});
@@ -594,11 +655,14 @@ Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int
         plans.push_back({a == 0 ? 0u : 1000u + static_cast<unsigned>(a), 0.0, kMinCandidates, 0, 0});
       plans.push_back({0, kRetryPenalty, kMinCandidates, 0, 0});
     }
+    const size_t retry_plan = exemplar_worst > kStrongEdge && setup.symmetry == 1 ? 1 : plans.size() - 1;
+    // A quarter-turn wrap that is too sharp is not helped by the smooth-block penalty: other draws.
+    if (setup.symmetry == 4)
+      for (unsigned k = 1; k <= kQuarterTurnRedraws; ++k) plans.push_back({2000u + k, 0.0, kMinCandidates, 0, 0});
     Plane base;
     int base_blocks = 0;
     double base_worst = 0.0, base_cost = 0.0;
     bool base_meets = false;
-    const size_t retry_plan = exemplar_worst > kStrongEdge && setup.symmetry == 1 ? 1 : plans.size() - 1;
     for (size_t i = 0; i < plans.size(); ++i) {
       // Later plans of strong-edge exemplars, and the smooth-penalty retry, run only if needed.
       if (i >= retry_plan && base_meets) break;
@@ -610,12 +674,23 @@ Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int
       double cost = 0.0;
       SessionRecord record;
       if (setup.symmetry == 4)
-        TAILOR_RETURN_IF_ERROR(quilt_pinwheel(setup, plan_options, plans[i], search, turns, canvas, blocks, cost));
+        TAILOR_RETURN_IF_ERROR(
+            quilt_pinwheel(setup, plan_options, plans[i], search, turns, turn_search, canvas, blocks, cost));
       else
         TAILOR_RETURN_IF_ERROR(
             quilt_cross(setup, plan_options, plans[i], search, canvas, blocks, cost, tile_plan ? &record : nullptr));
-      const double worst = worst_seam_ratio(canvas, true);
-      const bool meets = worst <= target * kSeamHeadroom;
+      double worst = worst_seam_ratio(canvas, true);
+      bool meets = worst <= target * kSeamHeadroom;
+      if (setup.symmetry == 4) {
+        // The wrap runs through a repaired line, which smooth blocks can leave too smooth (the
+        // smooth-block penalty of the retry helps) or too sharp: its ratio is a target too, and
+        // `worst` becomes how far both miss (the smaller, the better).
+        double wrap = 1.0;
+        quarter_turn_wrap(canvas, wrap);
+        meets = meets && wrap >= kWrapLow && wrap <= kWrapHigh;
+        worst = std::max(0.0, worst / (target * kSeamHeadroom) - 1.0) + std::max(0.0, kWrapLow / wrap - 1.0) +
+                std::max(0.0, wrap / kWrapHigh - 1.0);
+      }
       // Meeting the seam target first, then the lower cut cost (or, both missing, the lower worst seam).
       const bool better =
           i == 0 || (meets && !base_meets) || (meets == base_meets && (meets ? cost < base_cost : worst < base_worst));
@@ -630,31 +705,15 @@ Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int
     }
     rep.blocks += base_blocks;
     if (setup.symmetry == 4) {
-      // The 4-fold centre must stay on the tile's corner or centre: a map that turns the texture
-      // by quarter turns across a seam turns it about a lattice point (docs/mapping.md, "Symmetry
-      // 4"), and about any other point its seams would jump by half a repeat. So the wrap runs
-      // through one of the pinwheel's two '+' lines (shift 0 or N/2), whichever joins its two
-      // sides more like the tile's typical column boundary (the lines are repaired strips; an
-      // earlier N/4 shift ran the wrap through quadrant interiors but put the centre off the
-      // lattice). rot90(tile) == tile.
+      // The wrap through one of the '+' lines (quarter_turn_wrap; an earlier N/4 shift ran it
+      // through quadrant interiors but put the 4-fold centre off the lattice). rot90(tile) == tile.
+      double wrap = 1.0;
+      const int q = quarter_turn_wrap(base, wrap);
       const Plane pinwheel = base;
-      std::vector<double> boundary(static_cast<size_t>(w), 0.0);  // summed |difference| across x-1 | x
-      for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-          const float* left = pinwheel.at((x + w - 1) % w, y);
-          const float* right = pinwheel.at(x, y);
-          for (int k = 0; k < ex.channels; ++k) boundary[static_cast<size_t>(x)] += std::abs(left[k] - right[k]);
-        }
-      std::vector<double> sorted = boundary;
-      std::nth_element(sorted.begin(), sorted.begin() + w / 2, sorted.end());
-      const double typical = std::max(sorted[static_cast<size_t>(w / 2)], 1e-9);
-      const auto off = [&](int x) {
-        return std::abs(std::log(std::max(boundary[static_cast<size_t>(x)], 1e-9) / typical));
-      };
-      const int q = off(w / 2) < off(0) ? w / 2 : 0;
-      for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-          const float* v = pinwheel.at((x + q) % w, (y + q) % h);
+      const int tw = base.width;
+      for (int y = 0; y < tw; ++y)
+        for (int x = 0; x < tw; ++x) {
+          const float* v = pinwheel.at((x + q) % tw, (y + q) % tw);
           std::copy(v, v + ex.channels, base.at(x, y));
         }
       rep.shift_x = rep.shift_y = q;

@@ -105,6 +105,14 @@ def test_tile_from_array_and_file(tmp_path, tailor_binary):
         tailor.tile(grey.astype(np.float32))
     with pytest.raises(tailor.Error):
         tailor.tile(np.zeros((8, 8, 3), np.uint8))  # too small to tile
+    # A quarter-turn tile is twice the input's side, or its side with same_size.
+    small = np.ascontiguousarray(tile[:128, :128])
+    turned = tailor.tile(small, symmetry=4)
+    assert turned.shape == (256, 256, small.shape[2])
+    assert np.array_equal(np.rot90(turned), turned)
+    assert tailor.tile(small, symmetry=4, same_size=True).shape == small.shape
+    with pytest.raises(tailor.Error, match="same-size"):
+        tailor.tile(small, same_size=True)
 
 
 def test_maps_in_parallel_threads_give_the_sequential_bits():
