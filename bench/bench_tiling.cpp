@@ -1,8 +1,8 @@
 // Self-tileable textures: time of make_tileable for 128, 512 and 1024 px exemplars (grey and
-// RGB; grey also with symmetry 4), of the variants and of the quality metrics. Target: < 1 s for 512 x 512 RGB on one core.
-// Each benchmark reports the process's peak resident memory so far (getrusage ru_maxrss) as the
-// counter peak_rss_mb. Exemplars come from the shared data folder (TAILOR_SHARED_DATA); the
-// 512 and 1024 px RGB ones are the 300 px water photo resampled (bicubic) to that size.
+// RGB; grey also with symmetry 4), of the variants and of the quality metrics. Target: < 1 s for 512 x 512 RGB on one
+// core. Each benchmark reports the process's peak resident memory so far (getrusage ru_maxrss) as the counter
+// peak_rss_mb. Exemplars come from the shared data folder (TAILOR_SHARED_DATA); the 512 and 1024 px RGB ones are the
+// 300 px water photo resampled (bicubic) to that size.
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
 

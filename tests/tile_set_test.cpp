@@ -180,6 +180,16 @@ TEST(TileSet, SixteenBitMapsStaySixteenBit) {
   ASSERT_TRUE(load_image16(dir + "/t16.png", tiled).is_ok());
   EXPECT_EQ(tiled.bits, 16);
   EXPECT_EQ(tiled.width, 512);
+  // The quarter-turn tile is 8-bit only: a clear usage error (it said "not available for map
+  // sets" of a single image), nothing written.
+  std::string err;
+  EXPECT_EQ(
+      test::run_command(std::string(TAILOR_BINARY) + " tile " + dir + "/h16.png -o " + dir + "/q16.png --symmetry 4",
+                        out, &err),
+      2);
+  EXPECT_NE(err.find("h16.png: --symmetry 4 needs an 8-bit image, this PNG has 16 bits per sample"), std::string::npos)
+      << err;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/q16.png"));
   // An 8-bit PNG stays 8-bit.
   Image16 eight;
   ASSERT_TRUE(load_image16(kData + "gravel-gray-512.png", eight).is_ok());

@@ -115,6 +115,10 @@ int run_tile(const TileCliOptions& opt) {
   {
     Image16 deep;
     if (Status s = load_image16(opt.input, deep, opt.image_options); !s) return report_error(s);
+    if (deep.bits == 16 && opt.options.symmetry == 4)  // the quarter-turn pinwheel is quilted in 8 bits only
+      return report_error(Status::error(ErrorCode::kInvalidArgument, opt.input,
+                                        "--symmetry 4 needs an 8-bit image, this PNG has 16 bits per sample",
+                                        "save it with 8 bits per sample first"));
     if (deep.bits == 16) return run_tile16(opt, deep);
     exemplar = to_image8(deep);
   }
