@@ -180,6 +180,15 @@ expect_error 2 "symmetry" -- "$tailor" eval "$tmp/a.glb" --symmetry 3
   ! cmp -s "$tmp/seams1.png" "$tmp/seams4.png" && cmp -s "$tmp/seams4.png" "$tmp/seams4d.png" &&
   ok || fail "render --symmetry 4 drew the seams as with 1, or a 4-fold map's .glb not as with 4"
 expect_error 2 "symmetry" -- "$tailor" render "$tmp/s4a.glb" --view seams --symmetry 2 -o "$tmp/seams2.png"
+# With --texture, the seams are drawn as visible under that texture: the map's own gravel (not
+# quarter-turn symmetric) as with 1, whatever the .glb's record; a 4-fold tile of its size as with 4.
+"$tailor" tile "$texture" -o "$tmp/gravel_q.png" --symmetry 4 --same-size -q &&
+  "$tailor" render "$tmp/s4a.glb" --view seams --size 320x240 --texture "$texture" -o "$tmp/seams_t.png" -q &&
+  cmp -s "$tmp/seams1.png" "$tmp/seams_t.png" &&
+  "$tailor" render "$tmp/s4a.glb" --view seams --size 320x240 --texture "$tmp/gravel_q.png" -o "$tmp/seams_q.png" -q &&
+  "$tailor" render "$tmp/s4a.glb" --view seams --size 320x240 --texture "$tmp/gravel_q.png" --symmetry 4 \
+    -o "$tmp/seams_q4.png" -q && cmp -s "$tmp/seams_q.png" "$tmp/seams_q4.png" && ! cmp -s "$tmp/seams_q.png" "$tmp/seams_t.png" &&
+  ok || fail "render --texture OTHER drew the seams by the .glb's record instead of that texture's symmetry"
 # render --max-image-pixels applies to the .glb's embedded images and to --texture (checked from the
 # header, nothing written).
 expect_error 1 "embedded texture: image too large: .* the limit is 100 px" -- "$tailor" render "$tmp/s4a.glb" \

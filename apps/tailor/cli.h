@@ -67,12 +67,18 @@ CLI::Option* add_documented(CLI::App* app, const OptionDoc& doc, T& field) {
 //! Adds --symmetry (1 or 4) of eval and render, documented by `doc`: when it is not given, a .glb
 //! from tailor map --symmetry 4 decides (LoadReport::texture_symmetry; the caller reads
 //! count("--symmetry")).
-inline CLI::Option* add_symmetry_option(CLI::App* app, const OptionDoc& doc, uint32_t& field) {
+inline CLI::Option* add_symmetry_option(CLI::App* app, const OptionDoc& doc, uint32_t& field,
+                                        const std::string& more_default = "") {
   return add_documented(app, doc, field)
       ->check(CLI::IsMember({1u, 4u}))
       ->description(std::string(doc.help) +
-                    "; default: 4 for a .glb from tailor map --symmetry 4 (its material says so), else 1");
+                    "; default: 4 for a .glb from tailor map --symmetry 4 (its material says so)" + more_default +
+                    ", else 1");
 }
+
+//! The largest difference (levels of 255) between a texture and its quarter turn that still counts
+//! as the same tile with --symmetry 4: JPEG compression of a symmetric tile leaves a few levels.
+constexpr int kQuarterTurnNoiseLevels = 12;
 
 //! Adds the switch `doc` names ("--no-..."), which turns `field` (on by default) off.
 inline CLI::Option* add_off_switch(CLI::App* app, const OptionDoc& doc, bool& field) {

@@ -29,10 +29,6 @@
 namespace tailor::cli {
 namespace {
 
-// The largest difference (levels of 255) between a texture and its quarter turn that still counts
-// as the same tile with --symmetry 4: JPEG compression of a symmetric tile leaves a few levels.
-constexpr int kQuarterTurnNoiseLevels = 12;
-
 Status usage_error(const std::string& what) { return Status::error(ErrorCode::kInvalidArgument, "", what); }
 
 // The command line of `tailor map`. The library's options are bound to their flags in `options`

@@ -10,6 +10,7 @@
 #include "tailor/image.h"
 #include "tailor/io.h"
 #include "tailor/render.h"
+#include "tailor/tiling.h"
 
 namespace tailor::cli {
 namespace {
@@ -74,6 +75,14 @@ int run_render(const RenderArgs& args) {
   if (!args.texture.empty()) {
     status = load_image(args.texture, texture, args.image_options);
     if (!status) return report_error(status.with_file(args.texture));
+    // The seams view shows what is visible under the texture drawn: another texture than the
+    // map's has its own symmetry (4 when a quarter turn about its centre leaves it unchanged).
+    if (!args.symmetry_given) {
+      int shift_x = 0, shift_y = 0;
+      const int difference = quarter_turn_difference(texture, &shift_x, &shift_y);
+      options.seam_symmetry =
+          difference >= 0 && difference <= kQuarterTurnNoiseLevels && shift_x == 0 && shift_y == 0 ? 4 : 1;
+    }
   }
   if (!args.normal_map.empty()) {  // replaces the file's; tangents then come from the UVs
     status = load_image(args.normal_map, maps.normal, args.image_options);
@@ -126,7 +135,8 @@ void register_render(CLI::App& app, Runner& run) {
   add_documented(cmd, option_doc(kRenderOptionDocs, "yaw_degrees"), args->options.yaw_degrees);
   add_documented(cmd, option_doc(kRenderOptionDocs, "pitch_degrees"), args->options.pitch_degrees);
   add_documented(cmd, option_doc(kRenderOptionDocs, "checker_squares"), args->options.checker_squares);
-  add_symmetry_option(cmd, option_doc(kRenderOptionDocs, "seam_symmetry"), args->options.seam_symmetry);
+  add_symmetry_option(cmd, option_doc(kRenderOptionDocs, "seam_symmetry"), args->options.seam_symmetry,
+                      "; with --texture, 4 when that texture is unchanged by a quarter turn");
   add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), args->image_options.max_pixels)
       ->check(CLI::PositiveNumber);
   cmd->add_flag("-q,--quiet", args->quiet, "print nothing but errors");
