@@ -593,6 +593,78 @@ TEST(Mapping, ProgressCanCancel) {
   EXPECT_TRUE(m.atlas.patch.empty());
 }
 
+// Meshes made to break the mapping (the adversarial test files, a random triangle soup, needles,
+// a non-manifold fan, sheets at 1e-12 and 1e12 units) map in every mode with every face placed
+// and every UV finite, or fail with a message (symmetry 4 refuses faces far below a pixel).
+TEST(Mapping, AdversarialMeshesGetFiniteUvsInEveryMode) {
+  std::vector<std::pair<std::string, Mesh>> meshes;
+  for (const auto& entry : std::filesystem::directory_iterator(std::string(TAILOR_TEST_DATA) + "/meshes/adversarial")) {
+    Mesh mesh;
+    if (load_mesh(entry.path().string(), mesh).is_ok()) meshes.emplace_back(entry.path().filename().string(), mesh);
+  }
+  std::sort(meshes.begin(), meshes.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  uint64_t state = 12345;  // a fixed linear congruential stream: the same meshes on every platform
+  auto uniform = [&state](float lo, float hi) {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return lo + (hi - lo) * static_cast<float>(state >> 40) / static_cast<float>(1ull << 24);
+  };
+  auto add = [&meshes](const std::string& name, Mesh mesh) {
+    LoadReport report;
+    if (finalize_mesh(name, mesh, report).is_ok()) meshes.emplace_back(name, std::move(mesh));
+  };
+  Mesh soup;
+  for (int i = 0; i < 3 * 60; ++i) soup.positions.push_back(uniform(-1.0f, 1.0f));
+  for (int f = 0; f < 150; ++f)
+    for (int k = 0; k < 3; ++k) soup.indices.push_back(static_cast<uint32_t>(uniform(0.0f, 59.99f)));
+  add("soup", soup);
+  Mesh fan;
+  fan.positions = {0, 0, 0};
+  const int spokes = 40;
+  for (int i = 0; i < spokes; ++i)
+    fan.positions.insert(fan.positions.end(), {std::cos(0.157f * static_cast<float>(i)),
+                                               std::sin(0.157f * static_cast<float>(i)), uniform(-1.0f, 1.0f)});
+  for (uint32_t i = 0; i < spokes; ++i) {
+    fan.indices.insert(fan.indices.end(), {0, 1 + i, 1 + (i + 1) % spokes});
+    if (i % 3 == 0) fan.indices.insert(fan.indices.end(), {0, 1 + i, 1 + (i + 2) % spokes});  // a second sheet
+  }
+  add("fan", fan);
+  for (const float scale : {1e-12f, 1e12f}) {
+    Mesh sheet = grid(12, 9, Diagonal::kRising);
+    for (size_t i = 0; i < sheet.positions.size(); ++i)
+      sheet.positions[i] = (i % 3 == 2 ? uniform(0.0f, 3.0f) : sheet.positions[i]) * scale;
+    add("sheet x" + std::to_string(scale), sheet);
+  }
+  Mesh needles = grid(20, 4, Diagonal::kFalling);
+  for (size_t i = 0; i < needles.positions.size(); i += 3) needles.positions[i] *= 1e4f;
+  add("needles", needles);
+  ASSERT_GE(meshes.size(), 10u);
+
+  for (const auto& [name, mesh] : meshes) {
+    const Topology topology = build_topology(mesh);
+    for (int mode = 0; mode < 4; ++mode) {
+      SCOPED_TRACE(name + " mode " + std::to_string(mode));
+      MapTextureOptions options;
+      ASSERT_TRUE(set_map_texture_size(options, 512, 512).is_ok());
+      if (mode == 1) options.mapping.symmetry = 4;
+      if (mode == 2) options.mapping.mode = MappingMode::kThesis;
+      if (mode == 3) options.mapping.field_following = 0.0f;
+      TextureMap map;
+      const Status s = map_texture(mesh, topology, options, map);
+      if (!s.is_ok()) {
+        EXPECT_EQ(mode, 1) << s.message();
+        EXPECT_FALSE(s.what().empty());
+        continue;
+      }
+      ASSERT_EQ(map.atlas.corner_uv.size(), 6 * mesh.face_count());
+      ASSERT_EQ(map.atlas.patch.size(), mesh.face_count());
+      EXPECT_TRUE(std::all_of(map.atlas.corner_uv.begin(), map.atlas.corner_uv.end(),
+                              [](float v) { return std::isfinite(v); }));
+      EXPECT_TRUE(std::all_of(map.atlas.patch.begin(), map.atlas.patch.end(),
+                              [&](uint32_t p) { return p < map.atlas.patch_count; }));
+    }
+  }
+}
+
 TEST(Mapping, RejectsBadOptionsAndMismatchedInputs) {
   Mapped m;
   m.mesh = grid(3, 3, Diagonal::kRising);
