@@ -124,7 +124,7 @@ def map_with_cli(path, request):
                    "--scale", repr(request.scale * side), "--axis", request.axis,
                    "--max-stretch", repr(o["max_stretch"]), "--field-following", str(o["field_following"]),
                    "--relax-iterations", str(o["relax_iterations"]), "--threads", str(o["threads"]),
-                   "--stats", os.path.join(tmp, "stats.json")]
+                   "--symmetry", str(o.get("symmetry", 1)), "--stats", os.path.join(tmp, "stats.json")]
         if not o["close_cracks"]:
             command.append("--no-crack-closing")
         if o.get("texture"):  # its size is the texture size; 'auto' measures it
@@ -144,12 +144,13 @@ def map_with_cli(path, request):
     return np.array(uvs, np.float32), stats
 
 
-def make_tileable(kind, tool, image_path, out_png):
-    """Writes a self-tileable version of image_path to out_png (PNG)."""
+def make_tileable(kind, tool, image_path, out_png, symmetry=1):
+    """Writes a self-tileable version of image_path to out_png (PNG); symmetry 4: also unchanged by a
+    quarter turn (twice the image's side)."""
     if kind == "cli":
-        _run([tool, "tile", image_path, "-o", out_png, "-q"])
+        _run([tool, "tile", image_path, "-o", out_png, "-q", "--symmetry", str(symmetry)])
         return None
-    return tool.tile(image_path)  # (H, W, C) uint8: the caller makes a Blender image of it
+    return tool.tile(image_path, symmetry=symmetry)  # (H, W, C) uint8: the caller makes a Blender image of it
 
 
 def write_png(path, pixels):

@@ -51,6 +51,12 @@ class TAILOR_OT_texture_map(bpy.types.Operator):
         default=True)
     relax_iterations: bpy.props.IntProperty(
         name="Relaxation", description="Iterations of the final ARAP relaxation (0: off)", default=10, min=0, max=1000)
+    quarter_turns: bpy.props.BoolProperty(
+        name="Quarter-turn seams",
+        description="Experimental (tailor map --symmetry 4): an integer-grid map whose seams are quarter turns plus "
+                    "whole repeats, invisible under a square tile that a quarter turn leaves unchanged; with Make "
+                    "tileable the tile is made so (twice the image's side). Best with many repeats per object",
+        default=False)
     threads: bpy.props.IntProperty(
         name="Threads", description="0: automatic; the result is the same for any count", default=0, min=0, max=64)
     assign_material: bpy.props.BoolProperty(
@@ -81,7 +87,7 @@ class TAILOR_OT_texture_map(bpy.types.Operator):
         box = layout.box()
         box.label(text="Mapping")
         for name in ("axis", "use_seams", "max_stretch", "auto_field_following", "field_following", "close_cracks",
-                     "relax_iterations", "threads"):
+                     "relax_iterations", "quarter_turns", "threads"):
             box.prop(self, name)
         box = layout.box()
         box.label(text="Material")
@@ -140,7 +146,7 @@ class TAILOR_OT_texture_map(bpy.types.Operator):
         automatic = self.auto_field_following and texture_file is not None
         options = {"max_stretch": self.max_stretch, "field_following": "auto" if automatic else self.field_following,
                    "close_cracks": self.close_cracks, "relax_iterations": self.relax_iterations,
-                   "threads": self.threads, "texture": texture_file}
+                   "threads": self.threads, "texture": texture_file, "symmetry": 4 if self.quarter_turns else 1}
         wm = context.window_manager
         mapped, failed = 0, []
         for i, obj in enumerate(objects):
@@ -177,7 +183,8 @@ class TAILOR_OT_texture_map(bpy.types.Operator):
             obj["tailor"] = {"backend": kind, "faces_seam": stats["mapping"]["faces_seam"],
                              "patches": metrics["patches"], "flipped": metrics["flipped"],
                              "seam_length_ratio": metrics["seam_length_ratio"], "tile_size": self.tile_size,
-                             "field_following": stats["options"]["field_following"]}
+                             "field_following": stats["options"]["field_following"],
+                             "symmetry": options["symmetry"], "visible_seam_ratio": metrics["visible_seam_ratio"]}
             if image is not None:
                 material.assign(obj, image)
             elif maps is not None:
@@ -199,7 +206,7 @@ class TAILOR_OT_texture_map(bpy.types.Operator):
         if not self.make_tileable:
             return bpy.data.images.load(path, check_existing=True), path
         out = os.path.join(tmp, os.path.splitext(name)[0] + "_tile.png")
-        pixels = backend.make_tileable(kind, tool, path, out)
+        pixels = backend.make_tileable(kind, tool, path, out, 4 if self.quarter_turns else 1)
         if pixels is not None:
             backend.write_png(out, pixels)
             return material.image_from_pixels(os.path.splitext(name)[0] + "_tile", pixels), out

@@ -4,7 +4,7 @@ Installs and enables the add-on from its zip, imports a mesh, marks seams, runs 
 the module backend and the command backend, and checks the UV map "tailor": every loop finite, no
 flipped triangle, the marked seams handed to tailor, one texel density on objects of two sizes,
 the material (an image, or a PBR material folder wired into the Principled BSDF), the automatic
-field following on textures without direction, errors as reports, and the UVs after saving and
+field following on textures without direction, quarter-turn seams under a 4-fold tile, errors as reports, and the UVs after saving and
 reloading the .blend."""
 import os
 import shutil
@@ -219,6 +219,25 @@ def main():
         check(finite and flipped == 0 and abs(density / 16.0 - 1) < 0.1,
               f"material ({kind}): finite, 0 flipped, 16 repeats^2/unit^2 from the colour map's size ({density})")
     check_material_nodes(small.data.materials[-1])
+    preferences.backend = "MODULE" if KIND == "module" else "CLI"
+
+    # --- quarter-turn seams (tailor map --symmetry 4) under a 4-fold tile made here, both backends ---
+    for kind in ([KIND, "cli"] if KIND == "module" else ["cli"]):
+        preferences.backend = "MODULE" if kind == "module" else "CLI"
+        select_only(small)
+        result = bpy.ops.uv.tailor_texture_map(tile_size=0.25, assign_material=True, image_path=IMAGE,
+                                               make_tileable=True, quarter_turns=True)
+        check(result == {"FINISHED"} and small["tailor"]["backend"] == kind, f"quarter turns ({kind}) finished")
+        check(small["tailor"]["symmetry"] == 4, f"quarter turns ({kind}): mapped with symmetry 4")
+        finite, flipped, density = uv_figures(small)
+        check(finite and flipped == 0 and abs(density / 16.0 - 1) < 0.1,
+              f"quarter turns ({kind}): finite, 0 flipped, 16 repeats^2/unit^2 ({density})")
+        image = [n.image for n in small.data.materials[-1].node_tree.nodes if n.type == "TEX_IMAGE"][0]
+        check(tuple(image.size) == (1024, 1024), f"quarter turns ({kind}): the tile is twice gravel's side ({image.size[:]})")
+        pixels = np.empty(4 * image.size[0] * image.size[1], np.float32)
+        image.pixels.foreach_get(pixels)
+        pixels = pixels.reshape(image.size[1], image.size[0], 4)
+        check(np.array_equal(np.rot90(pixels), pixels), f"quarter turns ({kind}): the tile is unchanged by a quarter turn")
     preferences.backend = "MODULE" if KIND == "module" else "CLI"
 
     # --- errors are reports, never a crash ---
