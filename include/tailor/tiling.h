@@ -100,8 +100,8 @@ inline constexpr OptionDoc kTileOptionDocs[] = {
     {"symmetry", "--symmetry",
      "1 or 4: 4 makes a square tile that is also unchanged by a quarter turn (rot90(tile) == tile), for "
      "stochastic textures (gravel, sand, bark, moss); directional ones (bricks, planks, grain) cannot look "
-     "the same turned and get a warning. The tile is twice the input's side (its square crop), each quadrant "
-     "the whole input turned. Not with --variants or --fit-period"},
+     "the same turned and get a warning. The tile is twice the input's side (its square crop; inputs over "
+     "1024 px keep their side), each quadrant the whole input turned. Not with --variants or --fit-period"},
     {"same_size", "--same-size",
      "With --symmetry 4: a tile of the input's side, each quadrant a quarter of it (more seams per pixel: "
      "patch coherence about 2x worse than the default's twice-the-side tile)"},
