@@ -265,9 +265,9 @@ void Quilter::compute_error(int px, int py) {
 double Quilter::block_gradient(int px, int py) const {
   const int channels = canvas_.channels;
   double sum = 0.0;
+  const Plane& plane = block_plane();
   for (int y = 0; y + 1 < bh_; ++y)
     for (int x = 0; x + 1 < bw_; ++x) {
-      const Plane& plane = block_plane();
       const float* a = plane.at(px + x, py + y);
       const float* r = plane.at(px + x + 1, py + y);
       const float* d = plane.at(px + x, py + y + 1);
