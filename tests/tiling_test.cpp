@@ -505,6 +505,23 @@ TEST(QuarterTurn, DeterministicAndDirectionalTexturesWarn) {
   EXPECT_EQ(quarter_turn_difference(a), 0);
 }
 
+// Photos over 1024 px keep their side (a tile twice as wide would be over 2048 px: its quilting
+// runs at full size), with a warning that says so.
+TEST(QuarterTurn, LargePhotosKeepTheirSide) {
+  Image large;
+  ASSERT_TRUE(resize_image(load("vistex-sand05-128.png"), 1032, 1032, large).is_ok());
+  Image tile;
+  TileReport report;
+  TileOptions options = quarter_turn_options();
+  options.block = 128;  // fewer full-size FFT searches: a short test
+  ASSERT_TRUE(make_tileable(large, options, tile, &report).is_ok());
+  EXPECT_EQ(tile.width, 1032);
+  EXPECT_EQ(report.width, 1032);
+  EXPECT_EQ(quarter_turn_difference(tile), 0);
+  ASSERT_FALSE(report.warnings.empty());
+  EXPECT_NE(report.warnings.back().find("tile kept at 1032 px"), std::string::npos) << report.warnings.back();
+}
+
 TEST(QuarterTurn, VariantsFitPeriodAndOtherOrdersAreErrors) {
   const Image sand = load("vistex-sand05-128.png");
   std::vector<Image> tiles;
