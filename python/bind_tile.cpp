@@ -1,7 +1,12 @@
 // tailor.tile: make_tileable on a numpy image or an image file, as `tailor tile` (report=True adds
-// the JSON of `tailor tile --json`).
+// the JSON of `tailor tile --json`); tailor.tile_set: the maps of a material with one cut, as
+// `tailor tile --set`.
+#include <algorithm>
 #include <chrono>
 #include <cstring>
+#include <filesystem>
+#include <string>
+#include <vector>
 
 #include "bindings.h"
 #include "tailor/image.h"
@@ -104,6 +109,67 @@ array (H, W) or (H, W, C) with C in 1..4, or an image file path. Returns the til
 (metrics against the input). symmetry=4 gives a tile twice the input's (square) side, or its side
 with same_size=True. The same seed gives the same tile. The GIL is released while it
 works; progress works as in map().)");
+}
+
+void bind_tile_set(py::module_& m) {
+  const TileOptions d;
+  m.def(
+      "tile_set",
+      [](const std::vector<py::object>& map_paths, const py::object& output, const std::vector<py::object>& normal_maps,
+         int block, int overlap, uint64_t seed, const py::object& progress) -> std::vector<std::string> {
+        std::vector<std::string> paths, normals, written;
+        for (const py::object& p : map_paths) paths.push_back(path_of(p));
+        for (const py::object& p : normal_maps) normals.push_back(path_of(p));
+        const std::string folder = path_of(output);
+        if (paths.empty()) raise_error("tile_set needs at least one map");
+        for (const std::string& n : normals)
+          if (std::find(paths.begin(), paths.end(), n) == paths.end())
+            raise_status(Status::error(ErrorCode::kInvalidArgument, n, "normal_maps must name maps of the set"));
+        // Each output is the input's file name with the extension .png, inside `output`.
+        for (const std::string& in : paths) {
+          const size_t slash = in.find_last_of('/');
+          std::string name = slash == std::string::npos ? in : in.substr(slash + 1);
+          const size_t dot = name.find_last_of('.');
+          if (dot != std::string::npos && dot > 0) name = name.substr(0, dot);
+          const std::string out = folder + "/" + name + ".png";
+          if (std::find(written.begin(), written.end(), out) != written.end())
+            raise_status(Status::error(ErrorCode::kInvalidArgument, in,
+                                       "two maps of the set would be written to the same file name", out));
+          written.push_back(out);
+        }
+        std::vector<TileMap> maps(paths.size());
+        TileOptions options;
+        options.block = block;
+        options.overlap = overlap;
+        options.seed = seed;
+        ProgressBridge bridge(progress);
+        options.progress = bridge.function();
+        Status status;
+        std::vector<std::vector<Image16>> tiles;
+        {
+          const py::gil_scoped_release release;
+          for (size_t i = 0; i < paths.size() && status; ++i) {
+            status = load_image16(paths[i], maps[i].image).with_file(paths[i]);
+            maps[i].normal = std::find(normals.begin(), normals.end(), paths[i]) != normals.end();
+          }
+          if (status) status = make_tileable_set(maps, options, 1, tiles).with_file(paths[0]);
+          if (status && !std::filesystem::is_directory(folder) && !std::filesystem::create_directories(folder))
+            status = Status::error(ErrorCode::kIo, folder, "cannot create the output folder");
+          for (size_t i = 0; i < written.size() && status; ++i) status = write_png16(written[i], tiles[0][i]);
+        }
+        bridge.finish(status);
+        return written;
+      },
+      py::arg("maps"), py::arg("output"), py::arg("normal_maps") = std::vector<py::object>{},
+      py::arg("block") = d.block, py::arg("overlap") = d.overlap, py::arg("seed") = d.seed,
+      py::arg("progress") = py::none(),
+      R"(tile_set(maps, output, normal_maps=(), block=32, overlap=0, seed=1, progress=None) -> list
+
+Makes the maps of one material (colour, normal, roughness, height... image files of one size)
+self-tileable with one cut for all, as `tailor tile --set MAPS --normal-map N -o OUTPUT/`: each is
+written into the folder `output` (created if missing) under its own name as .png, 8 or 16 bits as
+its input; returns the written paths in the order of `maps`. normal_maps: the maps (the same paths)
+that are normal maps, blended as vectors.)");
 }
 
 }  // namespace tailor::python

@@ -94,6 +94,7 @@ void bind_errors(py::module_& m);
 void bind_mesh(py::module_& m);
 void bind_map(py::module_& m);
 void bind_tile(py::module_& m);
+void bind_tile_set(py::module_& m);
 void bind_eval(py::module_& m);
 void bind_save(py::module_& m);
 

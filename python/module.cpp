@@ -12,6 +12,7 @@ PYBIND11_MODULE(_tailor, m) {
   tp::bind_mesh(m);
   tp::bind_map(m);
   tp::bind_tile(m);
+  tp::bind_tile_set(m);
   tp::bind_eval(m);
   tp::bind_save(m);
 }

@@ -153,6 +153,18 @@ def make_tileable(kind, tool, image_path, out_png, symmetry=1):
     return tool.tile(image_path, symmetry=symmetry)  # (H, W, C) uint8: the caller makes a Blender image of it
 
 
+def make_tileable_set(kind, tool, map_paths, normal_paths, out_folder):
+    """Writes the maps of one material, made self-tileable with one cut for all, into out_folder
+    under their own names (.png), as `tailor tile --set`."""
+    if kind == "cli":
+        command = [tool, "tile", "--set", *map_paths, "-o", out_folder + os.sep, "-q"]
+        for path in normal_paths:
+            command += ["--normal-map", path]
+        _run(command)
+    else:
+        tool.tile_set(list(map_paths), out_folder, normal_maps=list(normal_paths))
+
+
 def write_png(path, pixels):
     """An 8-bit PNG of a uint8 (H, W[, C]) array, rows top first (the tile the module made, so that
     the mapping can measure it as the command does)."""

@@ -70,7 +70,9 @@ class TAILOR_OT_texture_map(bpy.types.Operator):
                     "*_metallic, *_ao (as tailor map --material)",
         subtype="DIR_PATH", default="")
     make_tileable: bpy.props.BoolProperty(
-        name="Make tileable", description="Make the image self-tileable with tailor first (packed into the .blend)",
+        name="Make tileable",
+        description="Make the image, or the material folder's maps with one cut for all, self-tileable with tailor "
+                    "first (packed into the .blend)",
         default=False)
 
     @classmethod
@@ -96,9 +98,7 @@ class TAILOR_OT_texture_map(bpy.types.Operator):
         row.enabled = self.assign_material
         row.prop(self, "image_path")
         row.prop(self, "material_path")
-        tileable = row.row()
-        tileable.enabled = not self.material_path
-        tileable.prop(self, "make_tileable")
+        row.prop(self, "make_tileable")
 
     def invoke(self, context, event):
         return context.window_manager.invoke_props_dialog(self, width=380)
@@ -136,7 +136,12 @@ class TAILOR_OT_texture_map(bpy.types.Operator):
         texture_width = texture_height = self.texture_size
         if self.assign_material and self.material_path:
             maps = material_files.find_maps(bpy.path.abspath(self.material_path))
+            if self.make_tileable:
+                maps = self.tile_maps(kind, tool, maps, tmp)
             images = material.load_maps(maps)
+            if self.make_tileable:  # the tiles live in tmp: into the .blend with them
+                for tile in images.values():
+                    tile.pack()
             texture_width, texture_height = images[next(iter(images))].size
             texture_file = maps["color"][0] if "color" in maps else None  # decides 'auto', as --material does
         elif self.assign_material:
@@ -196,6 +201,19 @@ class TAILOR_OT_texture_map(bpy.types.Operator):
         self.report({"INFO"}, f"tailor: mapped {mapped} object(s) with the {kind} backend" +
                     (f"; failed: {', '.join(failed)}" if failed else ""))
         return {"FINISHED"}
+
+    def tile_maps(self, kind, tool, maps, tmp):
+        """The material folder's maps made self-tileable together (tailor tile --set), in tmp under
+        their own names, so that the roles (and a DirectX normal map) are found as before."""
+        if self.quarter_turns:
+            raise RuntimeError("Quarter-turn seams need a 4-fold tile, which tailor makes from single images only, "
+                               "not from a material folder: use an image, or turn Make tileable off")
+        folder = os.path.basename(os.path.normpath(bpy.path.abspath(self.material_path)))
+        out = os.path.join(tmp, folder + "_tile")
+        paths = [path for path, _ in maps.values()]
+        normals = [path for role, (path, _) in maps.items() if role == "normal"]
+        backend.make_tileable_set(kind, tool, paths, normals, out)
+        return material_files.find_maps(out)
 
     def load_image(self, kind, tool, tmp):
         """The Blender image and the file the mapping measures (the tile, when made here, in tmp)."""

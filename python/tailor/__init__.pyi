@@ -1,6 +1,6 @@
 # Type stubs of the tailor module (the C++ extension tailor._tailor); docstrings: help(tailor.map).
 import os
-from typing import Callable, Literal, Optional, Sequence, Tuple, Union, overload
+from typing import Callable, List, Literal, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -106,6 +106,15 @@ def tile(
     report: Literal[True],
     progress: Optional[_Progress] = None,
 ) -> Tuple[npt.NDArray[np.uint8], dict]: ...
+def tile_set(
+    maps: Sequence[_Path],
+    output: _Path,
+    normal_maps: Sequence[_Path] = (),
+    block: int = 32,
+    overlap: int = 0,
+    seed: int = 1,
+    progress: Optional[_Progress] = None,
+) -> List[str]: ...
 def evaluate(
     mesh: Mesh,
     corner_uvs: npt.ArrayLike,

@@ -219,6 +219,38 @@ def main():
         check(finite and flipped == 0 and abs(density / 16.0 - 1) < 0.1,
               f"material ({kind}): finite, 0 flipped, 16 repeats^2/unit^2 from the colour map's size ({density})")
     check_material_nodes(small.data.materials[-1])
+    # Make tileable on a material folder: its maps tiled with one cut (tailor tile --set), packed.
+    for kind in ([KIND, "cli"] if KIND == "module" else ["cli"]):
+        preferences.backend = "MODULE" if kind == "module" else "CLI"
+        select_only(small)
+        result = bpy.ops.uv.tailor_texture_map(tile_size=0.25, assign_material=True, material_path=folder,
+                                               make_tileable=True)
+        check(result == {"FINISHED"} and small["tailor"]["backend"] == kind, f"tileable material ({kind}) finished")
+        tiled = small.data.materials[-1]
+        check(tiled.name == "tailor gravel_material_tile", f"tileable material ({kind}): named so ({tiled.name})")
+        textures = {n.label: n.image for n in tiled.node_tree.nodes if n.type == "TEX_IMAGE"}
+        check(sorted(textures) == ["color", "normal", "occlusion", "roughness"] and
+              all(i.packed_file is not None for i in textures.values()),
+              f"tileable material ({kind}): four maps, all packed: {sorted(textures)}")
+        # The colour map now continues across its wrap (the source does not): mean difference across
+        # the wrap over the mean difference between neighbouring columns.
+        colour = np.empty(4 * 512 * 512, np.float32)
+        textures["color"].pixels.foreach_get(colour)
+        colour = colour.reshape(512, 512, 4)[:, :, 0]
+        source = bpy.data.images.load(IMAGE)
+        original = np.empty(4 * 512 * 512, np.float32)
+        source.pixels.foreach_get(original)
+        original = original.reshape(512, 512, 4)[:, :, 0]
+        wrap = np.abs(colour[:, 0] - colour[:, -1]).mean() / np.abs(np.diff(colour, axis=1)).mean()
+        raw = np.abs(original[:, 0] - original[:, -1]).mean() / np.abs(np.diff(original, axis=1)).mean()
+        check(wrap < 1.3 < raw, f"tileable material ({kind}): the colour map wraps (ratio {wrap:.2f}, source {raw:.2f})")
+    select_only(small)
+    try:
+        bpy.ops.uv.tailor_texture_map(assign_material=True, material_path=folder, make_tileable=True,
+                                      quarter_turns=True)
+        check(False, "quarter turns with a material folder to make tileable is an error")
+    except RuntimeError as error:
+        check("single images only" in str(error), f"error report: {error}")
     preferences.backend = "MODULE" if KIND == "module" else "CLI"
 
     # --- quarter-turn seams (tailor map --symmetry 4) under a 4-fold tile made here, both backends ---

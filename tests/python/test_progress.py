@@ -1,5 +1,6 @@
 """Progress, cancelling, Ctrl-C and the GIL: a long map leaves other Python threads running."""
 import _thread
+import os
 import threading
 import time
 
@@ -113,6 +114,24 @@ def test_tile_from_array_and_file(tmp_path, tailor_binary):
     assert tailor.tile(small, symmetry=4, same_size=True).shape == small.shape
     with pytest.raises(tailor.Error, match="same-size"):
         tailor.tile(small, same_size=True)
+
+
+def test_tile_set_writes_the_maps_as_the_cli_does(tmp_path, tailor_binary):
+    from conftest import run_cli
+
+    textures = str(GRAVEL.parent.parent / "tests" / "data" / "textures") + os.sep
+    sand, bark = textures + "vistex-sand05-128.png", textures + "vistex-bark11-128.png"
+    written = tailor.tile_set([sand, bark], tmp_path / "py", normal_maps=[bark])
+    assert [os.path.basename(p) for p in written] == ["vistex-sand05-128.png", "vistex-bark11-128.png"]
+    code, _, err = run_cli(tailor_binary, "tile", "--set", sand, bark, "--normal-map", bark, "-o", tmp_path / "cli", "-q")
+    assert code == 0, err
+    for name in ("vistex-sand05-128.png", "vistex-bark11-128.png"):
+        assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes(), name
+    with pytest.raises(tailor.Error, match="same size"):
+        tailor.tile_set([sand, textures + "water-caustics-300.jpg"], tmp_path / "bad")
+    assert not (tmp_path / "bad").exists()
+    with pytest.raises(tailor.Error, match="normal_maps"):
+        tailor.tile_set([sand], tmp_path / "bad", normal_maps=[bark])
 
 
 def test_maps_in_parallel_threads_give_the_sequential_bits():
