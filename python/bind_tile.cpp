@@ -125,13 +125,9 @@ void bind_tile_set(py::module_& m) {
         for (const std::string& n : normals)
           if (std::find(paths.begin(), paths.end(), n) == paths.end())
             raise_status(Status::error(ErrorCode::kInvalidArgument, n, "normal_maps must name maps of the set"));
-        // Each output is the input's file name with the extension .png, inside `output`.
+        // Each output is named as `tailor tile --set` names it, inside `output`.
         for (const std::string& in : paths) {
-          const size_t slash = in.find_last_of('/');
-          std::string name = slash == std::string::npos ? in : in.substr(slash + 1);
-          const size_t dot = name.find_last_of('.');
-          if (dot != std::string::npos && dot > 0) name = name.substr(0, dot);
-          const std::string out = folder + "/" + name + ".png";
+          const std::string out = folder + "/" + tile_set_file_name(in);
           if (std::find(written.begin(), written.end(), out) != written.end())
             raise_status(Status::error(ErrorCode::kInvalidArgument, in,
                                        "two maps of the set would be written to the same file name", out));

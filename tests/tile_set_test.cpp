@@ -196,6 +196,14 @@ TEST(TileSet, SixteenBitMapsStaySixteenBit) {
   EXPECT_EQ(eight.bits, 8);
 }
 
+// The output name of a set's map, shared by `tailor tile --set` and tailor.tile_set.
+TEST(TileSet, OutputFileNames) {
+  EXPECT_EQ(tile_set_file_name("maps/bark_color.jpg"), "bark_color.png");
+  EXPECT_EQ(tile_set_file_name("/a/b/x.y.png"), "x.y.png");
+  EXPECT_EQ(tile_set_file_name("noext"), "noext.png");
+  EXPECT_EQ(tile_set_file_name(".hidden"), ".hidden.png");
+}
+
 TEST(TileSet, AlphaIsKept) {
   const Image rgb = load("vistex-fabric02-128.png");
   Image rgba;

@@ -186,14 +186,6 @@ std::string dir_name(const std::string& path) {
   return slash == std::string::npos ? "." : path.substr(0, slash);
 }
 
-//! The set's output name: the input's file name, extension replaced by .png.
-std::string png_name(const std::string& path) {
-  std::string name = base_name(path);
-  const size_t dot = name.find_last_of('.');
-  if (dot != std::string::npos && dot > 0) name = name.substr(0, dot);
-  return name + ".png";
-}
-
 //! --material JSON: {"maps": [{"file": "color.png"}, {"file": "normal.png", "normal": true}, ...],
 //! "normal_convention": "gl"}; files relative to the JSON's folder. Fills opt.set / normal_maps.
 Status read_material(TileCliOptions& opt) {
@@ -244,7 +236,7 @@ int run_tile_set(TileCliOptions opt) {
   // Output names (inside OUTDIR), checked before any work.
   std::vector<std::string> names;
   for (const std::string& in : opt.set) {
-    const std::string name = png_name(in);
+    const std::string name = tile_set_file_name(in);
     if (std::find(names.begin(), names.end(), name) != names.end())
       return report_error(Status::error(ErrorCode::kInvalidArgument, in,
                                         "two maps of the set would be written to the same file name",

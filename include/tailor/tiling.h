@@ -173,6 +173,10 @@ struct TileMap {
 TAILOR_API Status make_tileable_set(const std::vector<TileMap>& maps, const TileOptions& options, int count,
                                     std::vector<std::vector<Image16>>& tiles, TileReport* report = nullptr);
 
+//! The file name a tiled map of a set is written under (`tailor tile --set`, tailor.tile_set): the
+//! input's file name, its extension replaced by .png ("maps/bark_color.jpg" -> "bark_color.png").
+TAILOR_API std::string tile_set_file_name(const std::string& input_path);
+
 //! Images whose larger side exceeds this are tiled coarse-to-fine: the quilting plan is found on
 //! a copy reduced to kPlanSide px (the larger side; the block, overlap and search are those of a
 //! kPlanSide px image), then replayed at full size with each block's source refined within

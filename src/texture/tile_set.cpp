@@ -370,6 +370,14 @@ Status make_tile_variants(const Image& exemplar, const TileOptions& options, int
       [](const std::vector<Image>& out) -> const Image& { return out[0]; });
 }
 
+std::string tile_set_file_name(const std::string& input_path) {
+  const size_t slash = input_path.find_last_of('/');
+  std::string name = slash == std::string::npos ? input_path : input_path.substr(slash + 1);
+  const size_t dot = name.find_last_of('.');
+  if (dot != std::string::npos && dot > 0) name = name.substr(0, dot);
+  return name + ".png";
+}
+
 Status make_tileable_set(const std::vector<TileMap>& maps, const TileOptions& options, int count,
                          std::vector<std::vector<Image16>>& tiles, TileReport* report) {
   // auto_period is decided between the plans on the guide (plan_and_replay).
