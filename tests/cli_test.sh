@@ -164,6 +164,13 @@ b = json.load(open(sys.argv[2]))['visible_seam_ratio']; sys.exit(0 if abs(a - b)
   "$tailor" eval "$tmp/s4a.glb" --symmetry 1 --json -q | grep -q '"symmetry": 1' &&
   "$tailor" eval "$tmp/a.glb" --json -q | grep -q '"symmetry": 1' &&
   ok || fail "eval of a 4-fold map's .glb did not measure it with symmetry 4 by itself: $(cat "$tmp/eval4d.txt")"
+# ... also without a texture (the record is the material's, the texture size given to eval).
+"$tailor" map "$mesh" -o "$tmp/s4n.glb" --symmetry 4 --stats "$tmp/s4n.json" -q &&
+  "$tailor" eval "$tmp/s4n.glb" --json -q >"$tmp/eval4n.json" && grep -q '"symmetry": 4' "$tmp/eval4n.json" &&
+  python3 -c "import json, sys; a = json.load(open(sys.argv[1]))['metrics']['visible_seam_ratio']; \
+b = json.load(open(sys.argv[2]))['visible_seam_ratio']; sys.exit(0 if abs(a - b) < 1e-4 else 1)" \
+    "$tmp/s4n.json" "$tmp/eval4n.json" &&
+  ok || fail "eval of a textureless 4-fold map's .glb did not measure it with symmetry 4"
 # ... and a new map of that .glb without --symmetry 4 does not keep the input's record.
 "$tailor" map "$tmp/s4a.glb" --texture "$texture" -o "$tmp/s4r.glb" -q &&
   "$tailor" eval "$tmp/s4r.glb" --json -q | grep -q '"symmetry": 1' &&

@@ -85,8 +85,9 @@ struct LoadReport {
                                      //!< "material textures, TANGENT"; empty when nothing is lost
   int texture_width = 0;             //!< glb: the embedded base colour texture's size, read from its header
   int texture_height = 0;            //!< without decoding it (0: no texture, or a header stb cannot read)
-  uint32_t texture_symmetry = 1;     //!< glb: 4 where that texture's material says the map is 4-fold (written by
-                                     //!< tailor map --symmetry 4: ExportOptions::symmetry), else 1
+  uint32_t texture_symmetry = 1;     //!< glb: 4 where that texture's material (without a texture, the first
+                                     //!< primitive's) says the map is 4-fold (written by tailor map
+                                     //!< --symmetry 4: ExportOptions::symmetry), else 1
   double load_seconds = 0.0;
 };
 

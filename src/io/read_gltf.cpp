@@ -638,6 +638,7 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
   std::vector<std::optional<std::vector<Primitive>>> decoded(meshes.size());
   size_t triangle_primitives = 0, with_uv = 0;
   bool texture_found = false;
+  bool symmetry_read = false;       // report.texture_symmetry: of the first material, until a texture's
   std::vector<uint8_t> incomplete;  // per mesh.corner_attributes: missing on some primitive
   std::vector<std::string> lost;
   // Names, extras and materials of what the faces came from (Mesh::scene, Mesh::face_parts).
@@ -710,6 +711,11 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
       ++triangle_primitives;
       with_uv += !p.uv.empty();
       report.source_faces += p.source_faces;
+      // A 4-fold map's record is in its material: the textured one's, or without a texture the first.
+      if (!symmetry_read && p.material != UINT64_MAX) {
+        report.texture_symmetry = material_symmetry(doc, p.material);
+        symmetry_read = true;
+      }
       if (texture_bytes && !texture_found && p.material != UINT64_MAX) {
         find_texture(doc, p.material, "baseColorTexture", *texture_bytes);
         texture_found = !texture_bytes->empty();
