@@ -151,6 +151,11 @@ expect_error 2 "" -- "$tailor" frobnicate
   "$tailor" map "$mesh" --texture "$tmp/square.png" -o "$tmp/s4c.glb" --symmetry 4 2>"$tmp/s4warn.txt" &&
   grep -q "warning: .*square.png: --symmetry 4 but the texture is not unchanged by a quarter turn" "$tmp/s4warn.txt" &&
   ok || fail "map --symmetry 4 with a texture a quarter turn changes gave no warning: $(cat "$tmp/s4warn.txt")"
+# ... and when the tile repeats less than once across the mesh (not with the 64 px render above).
+"$tailor" map "$mesh" -o "$tmp/s4few.glb" --symmetry 4 --texture-size 1024 2>"$tmp/s4few.txt" &&
+  grep -q "warning: --symmetry 4: the 1024 px texture repeats 0.78 times across the mesh" "$tmp/s4few.txt" &&
+  ! grep -q "repeats .* times across" "$tmp/s4warn.txt" &&
+  ok || fail "map --symmetry 4 with a texture repeating less than once gave no warning: $(cat "$tmp/s4few.txt")"
 "$tailor" eval "$tmp/s4a.glb" --symmetry 4 >"$tmp/eval4.txt" 2>&1 && grep -Eq " 0 flipped, .*symmetry 4\)$" "$tmp/eval4.txt" &&
   ok || fail "eval --symmetry 4: $(cat "$tmp/eval4.txt")"
 # The .glb of a 4-fold map says so (its material's extras): eval measures it as the map did without

@@ -13,6 +13,7 @@
 
 #include "mapping/grid_cones.h"
 #include "mapping/grid_map.h"
+#include "mapping/mapping_common.h"
 #include "support/fixtures.h"
 #include "surface/rosy_field.h"
 #include "tailor/axis_choice.h"
@@ -402,6 +403,49 @@ TEST(Mapping, RelaxationLowersAngleDistortion) {
   EXPECT_EQ(relaxed.seam_edges, unrelaxed.seam_edges);
   EXPECT_LT(relaxed.l2_stretch, unrelaxed.l2_stretch);
   EXPECT_LT(relaxed.stretch, unrelaxed.stretch);
+}
+
+// The relaxation holds every seam that is invisible on the texture's lattice, with the lattice's
+// width and height apart (texture_period_px, texture_period_v_px): spot mapped without it, its
+// half x > 0 shifted by three repeats of a 8 x 4 px texture in v (12 px, which a square 8 px
+// lattice would see 4 px off), then relaxed: the cut's corners stay where they are, the rest moves.
+TEST(Mapping, RelaxationHoldsSeamsOnANonSquareLattice) {
+  Mapped m;
+  m.mesh = load_test_mesh("spot.obj");
+  MappingOptions options;
+  options.relax_iterations = 0;
+  map_mesh(m, options);
+  // The cut's edges that were seamless: their sides then differ by the shift alone.
+  std::vector<uint8_t> was_seamless(m.topology.opposite.size());
+  for (uint32_t e = 0; e < was_seamless.size(); ++e) was_seamless[e] = !is_seam_edge(m, e);
+  const size_t face_count = m.mesh.face_count();
+  std::vector<uint8_t> right(face_count, 0);
+  for (size_t f = 0; f < face_count; ++f) {
+    float x = 0.f;
+    for (int k = 0; k < 3; ++k) x += m.mesh.positions[3 * m.mesh.indices[3 * f + k]];
+    if (x <= 0.f) continue;
+    right[f] = 1;
+    for (int k = 0; k < 3; ++k) m.atlas.corner_uv[6 * f + 2 * k + 1] += 12.f;
+  }
+  const std::vector<float> shifted = m.atlas.corner_uv;
+  options.relax_iterations = 10;
+  options.texture_period_px = 8.f;
+  options.texture_period_v_px = 4.f;
+  const internal::MappingInput input{m.mesh, m.topology, m.frames, options, 0.0, {}};
+  uint64_t moves = 0;
+  ASSERT_TRUE(internal::relax_patches(input, m.atlas, moves).is_ok());
+  EXPECT_GT(moves, face_count);
+  size_t cut = 0;
+  for (uint32_t e = 0; e < m.topology.opposite.size(); ++e) {
+    const uint32_t o = m.topology.opposite[e];
+    if (o == kInvalid || right[e / 3] == right[o / 3] || !was_seamless[e]) continue;
+    ++cut;
+    for (const uint32_t c : {e, 3 * (e / 3) + (e % 3 + 1) % 3}) {
+      EXPECT_EQ(m.atlas.corner_uv[2 * c], shifted[2 * c]) << "edge " << e;
+      EXPECT_EQ(m.atlas.corner_uv[2 * c + 1], shifted[2 * c + 1]) << "edge " << e;
+    }
+  }
+  EXPECT_GT(cut, 100u);
 }
 
 TEST(Mapping, SeedPointChoosesTheFirstPatch) {

@@ -113,7 +113,11 @@ struct MappingOptions {
                                     //!< lattice chart up to 6x max_stretch). Visible seams 1.5 % of edge length
                                     //!< when the tile repeats ~15 times across the mesh, 2.8 % at ~1.5 times
                                     //!< (docs/mapping.md). Measure it with MetricsOptions::symmetry 4 too
-  float texture_period_px = 512.f;  //!< symmetry 4: the texture's size in pixels (square), the lattice period
+  float texture_period_px = 512.f;  //!< the texture's width in pixels, the lattice period in u (symmetry 4: its
+                                    //!< square side): the relaxation holds seams whose sides differ by whole
+                                    //!< repeats (invisible), and with symmetry 4 the seam shortening counts
+                                    //!< only the visible seams
+  float texture_period_v_px = 0.f;  //!< the texture's height in pixels, the period in v (0: texture_period_px)
   // kThesis -------------------------------------------------------------------------------------
   float threshold_px = 25.f;       //!< initial absolute error threshold, pixels (thesis: 25 at scale 800)
   float threshold_step_px = 10.f;  //!< added when every waiting face exceeds the threshold (thesis: 10)

@@ -28,6 +28,7 @@ Status set_map_texture_size(MapTextureOptions& options, int texture_width, int t
     return usage_error("--symmetry 4 needs a square texture, got " + std::to_string(texture_width) + "x" +
                        std::to_string(texture_height));
   mapping.texture_period_px = static_cast<float>(texture_width);
+  mapping.texture_period_v_px = static_cast<float>(texture_height);
   options.metrics.symmetry = mapping.symmetry;
   options.metrics.texture_width_px = static_cast<float>(texture_width);
   options.metrics.texture_height_px = static_cast<float>(texture_height);

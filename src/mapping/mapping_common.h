@@ -12,6 +12,7 @@
 #include "tailor/atlas.h"
 #include "tailor/mapping.h"
 #include "tailor/mesh.h"
+#include "tailor/metrics.h"
 #include "tailor/orientation.h"
 #include "tailor/topology.h"
 
@@ -47,6 +48,17 @@ struct MappingInput {
   double factor_step;                     // resolved for the mode; < 0 in kPatches = the hop rule
   std::vector<uint32_t> component_seeds;  // first face of each component, in processing order
 };
+
+//! The texture's lattice as the metrics measure seams on it (docs/metrics.md): its width and height
+//! (MappingOptions::texture_period_px, texture_period_v_px) and symmetry.
+inline MetricsOptions lattice_of(const MappingOptions& options) {
+  MetricsOptions lattice;
+  lattice.symmetry = options.symmetry;
+  lattice.texture_width_px = options.texture_period_px;
+  lattice.texture_height_px =
+      options.texture_period_v_px > 0.f ? options.texture_period_v_px : options.texture_period_px;
+  return lattice;
+}
 
 //! Steps 2-6 of map_texture on frames already in map.frames (computed by compute_orientation with
 //! options.orientation): map_texture is compute_orientation then this, so the same bits.

@@ -103,8 +103,7 @@ class Relaxer {
         bound_(in.options.max_stretch),
         high_(1.f + bound_),
         low_(1.f / (1.f + bound_)) {
-    lattice_.texture_width_px = lattice_.texture_height_px = in.options.texture_period_px;
-    lattice_.symmetry = in.options.symmetry;  // quarter turns too with symmetry 4
+    lattice_ = lattice_of(in.options);  // quarter turns too with symmetry 4
   }
 
   // Wedges, the free ones' colours and terms, per face its frame.

@@ -39,9 +39,8 @@ class SeamShortener {
     uv_ = atlas_.corner_uv.data();
     bound_ = in_.options.max_stretch;
     scale_ = in_.options.scale;
+    lattice_ = lattice_of(in_.options);
     lattice_aware_ = in_.options.symmetry == 4;
-    lattice_.symmetry = in_.options.symmetry;
-    lattice_.texture_width_px = lattice_.texture_height_px = in_.options.texture_period_px;
     seam_flags_ = in_.options.seam_faces.empty() ? nullptr : in_.options.seam_faces.data();
     // A move must not shrink its patch under the absorption's minimum (a patch may still vanish
     // when its last face leaves): the shortening never makes tiny or single-face patches.
@@ -112,7 +111,10 @@ class SeamShortener {
       const int k1 = kNext[k];
       const bool cut = uv[2 * k] != ends[k][0][0] || uv[2 * k + 1] != ends[k][0][1] || uv[2 * k1] != ends[k][1][0] ||
                        uv[2 * k1 + 1] != ends[k][1][1];
-      // With symmetry 4 a seam on the lattice costs nothing: only visible seams are shortened.
+      // With symmetry 4 a seam on the lattice costs nothing: only visible seams are shortened. Not
+      // with symmetry 1: there the invisible seams are mostly cracks under a pixel wide, and
+      // shortening them too gives fewer visible seams and dangling ends (measured: 3.91 against 3.95 %
+      // visible, 136 against 142 ends, medians over the shared meshes, gravel tile).
       return cut && !(lattice_aware_ && seam_gap_px(uv + 2 * k, uv + 2 * k1, ends[k][0], ends[k][1], lattice_) <
                                             lattice_.invisible_gap_px);
     };
@@ -290,7 +292,7 @@ class SeamShortener {
   const uint8_t* locked_ = nullptr;      // faces that never move, or nullptr
   float bound_ = 0.f, scale_ = 1.f;
   bool lattice_aware_ = false;  // symmetry 4: seams on the lattice are free
-  MetricsOptions lattice_;      // the texture period and symmetry, for seam_gap_px
+  MetricsOptions lattice_;      // the texture's periods and symmetry, for seam_gap_px
   uint32_t min_keep_ = 2;
   std::vector<uint32_t> patch_size_;  // faces per patch, kept up to date by the moves
 };
