@@ -12,6 +12,7 @@
 #include "tailor/axis_choice.h"
 #include "tailor/export.h"
 #include "tailor/image.h"
+#include "tailor/map_warnings.h"
 #include "tailor/mapping.h"
 #include "tailor/material.h"
 #include "tailor/report.h"
@@ -279,6 +280,10 @@ void bind_map(py::module_& m) {
         if (field_following_auto)
           run.texture_isotropy = adapt_mapping_to_texture(image, mapping, !crack_rings.is_none());
         if (Status s = set_map_texture_size(options, width, height); !s) raise_status(s);
+        // Symmetry 4 under a texture that is not a 4-fold tile, or repeating less than once: what
+        // `tailor map` prints, as UserWarning (an error where the warnings filter says so).
+        for (const std::string& line : map_warnings(mesh.mesh, options, image, run.texture))
+          if (PyErr_WarnEx(PyExc_UserWarning, line.c_str(), 1) != 0) throw py::error_already_set();
         std::vector<uint8_t> seams;
         if (!seam_faces.is_none()) {
           const py::array seam_array = py::array::ensure(seam_faces);

@@ -76,10 +76,6 @@ inline CLI::Option* add_symmetry_option(CLI::App* app, const OptionDoc& doc, uin
                     ", else 1");
 }
 
-//! The largest difference (levels of 255) between a texture and its quarter turn that still counts
-//! as the same tile with --symmetry 4: JPEG compression of a symmetric tile leaves a few levels.
-constexpr int kQuarterTurnNoiseLevels = 12;
-
 //! Adds the switch `doc` names ("--no-..."), which turns `field` (on by default) off.
 inline CLI::Option* add_off_switch(CLI::App* app, const OptionDoc& doc, bool& field) {
   return app->add_flag_callback(

@@ -14,6 +14,7 @@
 #include "tailor/export.h"
 #include "tailor/image.h"
 #include "tailor/io.h"
+#include "tailor/map_warnings.h"
 #include "tailor/mapping.h"
 #include "tailor/material.h"
 #include "tailor/metrics.h"
@@ -22,7 +23,6 @@
 #include "tailor/report.h"
 #include "tailor/stability.h"
 #include "tailor/texture_direction.h"
-#include "tailor/tiling.h"
 #include "tailor/topology.h"
 #include "util/atomic_file.h"
 
@@ -140,22 +140,6 @@ int run_map(const MapArgs& opt) {
   const int tex_h = !texture.empty() ? texture.height : material.height > 0 ? material.height : args.texture_size;
   // The lattice period, the metrics' texture size, the threads of every stage.
   if (Status s = set_map_texture_size(options, tex_w, tex_h); !s) return report_error(s);
-  // Symmetry 4 hides quarter-turn seams only under a tile that a quarter turn about its centre or
-  // corner leaves unchanged (the lattice points the map turns it about): say so when the texture is
-  // not one (JPEG noise of a few levels is fine), or turns into itself only about another point.
-  if (mapping.symmetry == 4 && !texture.empty()) {
-    int shift_x = 0, shift_y = 0;
-    const int difference = quarter_turn_difference(texture, &shift_x, &shift_y);
-    if (difference > kQuarterTurnNoiseLevels)
-      warn(opt.quiet, texture_path + ": --symmetry 4 but the texture is not unchanged by a quarter turn (up to " +
-                          std::to_string(difference) +
-                          " levels apart): seams that turn will show; make it with 'tailor tile --symmetry 4'");
-    else if (shift_x != 0 || shift_y != 0)
-      warn(opt.quiet, texture_path +
-                          ": --symmetry 4 but the texture turns into itself about a point off its centre and corner "
-                          "(a tile from tailor before 2026-11-26?): seams that turn will jump by half a repeat; "
-                          "make it again with 'tailor tile --symmetry 4'");
-  }
   // auto: follow the field unless the texture has no direction to follow (texture_direction.h).
   float texture_isotropy = -1.f;
   if (args.auto_field_following()) {
@@ -216,18 +200,8 @@ int run_map(const MapArgs& opt) {
                                       " pixels per mesh size, outside 0.001 to 1e7"));
     mapping.scale = static_cast<float>(scale);
   }
-  // The 4-fold seams land on the lattice less often the fewer lattice points the mesh spans (cones
-  // go to lattice points: docs/mapping.md, 3.5 % visible seams at 0.8 repeats, 2.9 % at 1.6, 1.5 %
-  // at 16): below one repeat across the mesh, say how to get more.
-  if (mapping.symmetry == 4 && mapping.scale < static_cast<float>(tex_w)) {
-    char line[320];
-    std::snprintf(line, sizeof line,
-                  "--symmetry 4: the %d px texture repeats %.2f times across the mesh; quarter-turn seams land on "
-                  "the lattice less often the fewer the repeats (a larger --scale, or a tile made with 'tailor tile "
-                  "--symmetry 4 --same-size', repeats more)",
-                  tex_w, static_cast<double>(mapping.scale) / tex_w);
-    warn(opt.quiet, line);
-  }
+  // Symmetry 4: a texture that is not a 4-fold tile, or repeats less than once across the mesh.
+  for (const std::string& line : map_warnings(mesh, options, texture, texture_path)) warn(opt.quiet, line);
   MapRun run;  // the report: what was asked, then what each step found
   run.texels_per_unit = texels_per_unit;
   run.up = opt.up;

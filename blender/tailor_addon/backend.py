@@ -6,6 +6,7 @@ import struct
 import subprocess
 import sys
 import tempfile
+import warnings
 import zlib
 
 import numpy as np
@@ -66,7 +67,8 @@ class MapRequest:
 
 
 def map_with_module(tailor, request, progress):
-    """Corner UVs (F, 3, 2) and the stats dict, by the module (GIL released; progress(fraction))."""
+    """Corner UVs (F, 3, 2), the stats dict and the warnings (sentences) of tailor.map, by the module
+    (GIL released; progress(fraction))."""
     mesh = tailor.Mesh(request.positions, request.faces)
     if mesh.face_count != len(request.faces):
         raise RuntimeError(f"{len(request.faces) - mesh.face_count} degenerate faces")
@@ -74,9 +76,11 @@ def map_with_module(tailor, request, progress):
     options = dict(request.options)
     if options.get("texture") is None:
         options.pop("texture", None)
-    result = tailor.map(mesh, texture_size=request.texture_size, scale=request.scale, axis=request.axis,
-                        seam_faces=seams, progress=progress, unit_scale=1.0, **options)
-    return np.array(result.corner_uvs), result.stats
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = tailor.map(mesh, texture_size=request.texture_size, scale=request.scale, axis=request.axis,
+                            seam_faces=seams, progress=progress, unit_scale=1.0, **options)
+    return np.array(result.corner_uvs), result.stats, [str(w.message) for w in caught]
 
 
 def write_ply(path, positions, faces):
@@ -104,14 +108,18 @@ def read_split_ply(path):
 
 
 def _run(command):
+    """Runs the tool; its warnings (the sentences after 'tailor: warning: '), or the error it ends on."""
     done = subprocess.run(command, capture_output=True, text=True)
     if done.returncode != 0:
         lines = done.stderr.strip().splitlines() or [f"exit code {done.returncode}"]
         raise RuntimeError(lines[-1].removeprefix("tailor: error: "))
+    prefix = "tailor: warning: "
+    return [line[len(prefix):] for line in done.stderr.splitlines() if line.startswith(prefix)]
 
 
 def map_with_cli(path, request):
-    """The same through `tailor map` (no live progress). The CLI normalises the mesh into the unit
+    """The same through `tailor map` (no live progress; without -q for its warnings, which it prints
+    only when asked to talk: its progress bars need a terminal). The CLI normalises the mesh into the unit
     cube, so its --scale is the module's times the longest side of the bounding box: the same
     density (the texture's offset differs)."""
     used = request.positions[np.unique(request.faces)]
@@ -120,7 +128,7 @@ def map_with_cli(path, request):
     with tempfile.TemporaryDirectory(prefix="tailor-blender-") as tmp:
         mesh_in, mesh_out = os.path.join(tmp, "in.ply"), os.path.join(tmp, "out.ply")
         write_ply(mesh_in, request.positions, request.faces)
-        command = [path, "map", mesh_in, "-o", mesh_out, "-q", "--texture-size", str(request.texture_size),
+        command = [path, "map", mesh_in, "-o", mesh_out, "--texture-size", str(request.texture_size),
                    "--scale", repr(request.scale * side), "--axis", request.axis,
                    "--max-stretch", repr(o["max_stretch"]), "--field-following", str(o["field_following"]),
                    "--relax-iterations", str(o["relax_iterations"]), "--threads", str(o["threads"]),
@@ -133,7 +141,7 @@ def map_with_cli(path, request):
             seam_file = os.path.join(tmp, "seams.txt")
             np.savetxt(seam_file, np.flatnonzero(request.seam_faces), fmt="%d")
             command += ["--seam-faces", seam_file]
-        _run(command)
+        warned = _run(command)
         import json
 
         with open(os.path.join(tmp, "stats.json")) as f:
@@ -141,7 +149,7 @@ def map_with_cli(path, request):
         uvs = read_split_ply(mesh_out)
     if len(uvs) != len(request.faces):
         raise RuntimeError(f"{len(request.faces) - len(uvs)} degenerate faces")
-    return np.array(uvs, np.float32), stats
+    return np.array(uvs, np.float32), stats, warned
 
 
 def make_tileable(kind, tool, image_path, out_png, symmetry=1):

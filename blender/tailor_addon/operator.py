@@ -171,9 +171,9 @@ class TAILOR_OT_texture_map(bpy.types.Operator):
                 request = backend.MapRequest(triangles.positions, triangles.faces, triangles.seam_faces,
                                              texture_width, self.tile_size, self.axis, options)
                 if kind == "module":
-                    uvs, stats = backend.map_with_module(tool, request, progress)
+                    uvs, stats, warned = backend.map_with_module(tool, request, progress)
                 else:
-                    uvs, stats = backend.map_with_cli(tool, request)
+                    uvs, stats, warned = backend.map_with_cli(tool, request)
             except KeyboardInterrupt:
                 self.report({"WARNING"}, "tailor: cancelled")
                 return {"CANCELLED"}
@@ -189,7 +189,10 @@ class TAILOR_OT_texture_map(bpy.types.Operator):
                              "patches": metrics["patches"], "flipped": metrics["flipped"],
                              "seam_length_ratio": metrics["seam_length_ratio"], "tile_size": self.tile_size,
                              "field_following": stats["options"]["field_following"],
-                             "symmetry": options["symmetry"], "visible_seam_ratio": metrics["visible_seam_ratio"]}
+                             "symmetry": options["symmetry"], "visible_seam_ratio": metrics["visible_seam_ratio"],
+                             "warnings": "\n".join(warned)}
+            for line in warned:  # what tailor map would print: a 4-fold map under too few repeats...
+                self.report({"WARNING"}, f"tailor: {obj.name}: {line}")
             if image is not None:
                 material.assign(obj, image)
             elif maps is not None:

@@ -193,6 +193,10 @@ inline constexpr int kPlanSide = 512;
 //! The shift found is returned in shift_x / shift_y when not null. -1 for a non-square or invalid
 //! image. O(N).
 TAILOR_API int quarter_turn_difference(const Image& tile, int* shift_x = nullptr, int* shift_y = nullptr);
+//! The largest quarter_turn_difference that still counts as the same tile with symmetry 4 (`tailor
+//! map`'s warning, `tailor render`'s seams view): JPEG compression of a symmetric tile leaves a few
+//! levels.
+inline constexpr int kQuarterTurnNoiseLevels = 12;
 
 //! How directional an image is, in [0, 1]: the coherence of its structure tensor summed over the
 //! image, |sum w e^{2i theta}| / sum w over the luminance gradients (weight w = squared gradient

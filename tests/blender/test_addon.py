@@ -270,6 +270,12 @@ def main():
         image.pixels.foreach_get(pixels)
         pixels = pixels.reshape(image.size[1], image.size[0], 4)
         check(np.array_equal(np.rot90(pixels), pixels), f"quarter turns ({kind}): the tile is unchanged by a quarter turn")
+        check(small["tailor"]["warnings"] == "", f"quarter turns ({kind}): no warning ({small['tailor']['warnings']})")
+        # A tile larger than the object: the warning of tailor map, as a report and on the object.
+        result = bpy.ops.uv.tailor_texture_map(tile_size=50.0, assign_material=True, image_path=IMAGE,
+                                               make_tileable=True, quarter_turns=True)
+        check(result == {"FINISHED"} and "times across the mesh; quarter-turn seams" in small["tailor"]["warnings"],
+              f"quarter turns ({kind}), one repeat for many objects: warned ({small['tailor']['warnings']})")
     preferences.backend = "MODULE" if KIND == "module" else "CLI"
 
     # --- errors are reports, never a crash ---

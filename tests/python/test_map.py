@@ -1,5 +1,6 @@
 """tailor.map, save and evaluate: identity with the tailor command, options, errors."""
 import json
+import warnings
 
 import numpy as np
 import pytest
@@ -152,3 +153,23 @@ def test_map_docstring_carries_the_cli_help(tailor_binary):
     _, help_text, _ = run_cli(tailor_binary, "map", "--help")
     for flag in ("--max-stretch", "--hop-age", "--crack-rings", "--relax-iterations", "--symmetry", "--smooth"):
         assert flag in help_text and flag in tailor.map.__doc__, flag
+
+
+def test_symmetry_4_warns_as_the_cli(tmp_path, tailor_binary):
+    mesh = tailor.load(SPOT)
+    # A 1024 px texture at 800 px per mesh size repeats 0.78 times: the command's warning, as UserWarning.
+    with pytest.warns(UserWarning, match="the 1024 px texture repeats 0.78 times across the mesh") as caught:
+        tailor.map(mesh, symmetry=4, texture_size=1024, relax_iterations=0)
+    code, _, err = run_cli(tailor_binary, "map", SPOT, "-o", tmp_path / "x.glb", "--symmetry", "4", "--texture-size",
+                           "1024", "--relax-iterations", "0")
+    assert code == 0 and f"tailor: warning: {caught[0].message}" in err
+    # The gravel photo's tile is not unchanged by a quarter turn.
+    with pytest.warns(UserWarning, match="gravel.png: --symmetry 4 but the texture is not unchanged by a quarter turn"):
+        tailor.map(mesh, symmetry=4, texture=GRAVEL, relax_iterations=0)
+    # A warnings filter that makes them errors stops the map with the warning.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(UserWarning, match="repeats 0.78 times"):
+            tailor.map(mesh, symmetry=4, texture_size=1024)
+        tailor.map(mesh, symmetry=4, relax_iterations=0)  # 512 px, 1.56 repeats, no texture: nothing to say
+        tailor.map(mesh, texture_size=1024, relax_iterations=0)  # symmetry 1: nothing to say

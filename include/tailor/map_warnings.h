@@ -1,0 +1,26 @@
+// What a user should hear before a map runs under a texture, shared by `tailor map`, the Python
+// module (as UserWarning) and through it the Blender add-on, so all three say the same.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "tailor/api.h"
+#include "tailor/image.h"
+#include "tailor/mapping.h"
+#include "tailor/mesh.h"
+
+namespace tailor {
+
+//! The warnings of mapping `mesh` with `options` under `texture` (may be empty: not looked at),
+//! one sentence each, empty when there is nothing to say. With symmetry 4: the texture is not
+//! unchanged by a quarter turn (quarter_turn_difference over kQuarterTurnNoiseLevels), or turns
+//! into itself only about a point off its centre and corner (quarter-turn seams would show or jump
+//! by half a repeat); the texture repeats less than once across the mesh's longest side (quarter-
+//! turn seams land on the lattice less often the fewer the repeats). Sentences about the texture
+//! start with texture_name. Call with the options complete (set_map_texture_size, the final
+//! scale and orientation.fixed_unit_scale). O(V + texture pixels).
+TAILOR_API std::vector<std::string> map_warnings(const Mesh& mesh, const MapTextureOptions& options,
+                                                 const Image& texture, const std::string& texture_name);
+
+}  // namespace tailor
