@@ -522,6 +522,36 @@ TEST(QuarterTurn, LargePhotosKeepTheirSide) {
   EXPECT_NE(report.warnings.back().find("tile kept at 1032 px"), std::string::npos) << report.warnings.back();
 }
 
+// Photos above kPlanMaxSide are quilted on a kPlanSide px copy and read at full size from its
+// source map: the tile keeps the photo's own pixel-level detail (here gravel upsampled to 1024 px
+// with per-pixel noise on top, which the reduced tile scaled up would lose: gradient ratio 0.55,
+// worst seam 1.90, coherence 11x the exemplar's), is exactly unchanged by a quarter turn, and
+// meets the tiling targets.
+TEST(QuarterTurn, LargePhotosArePlannedOnAReducedCopyAtFullDetail) {
+  Image large;
+  ASSERT_TRUE(resize_image(load("gravel-gray-512.png"), 1024, 1024, large).is_ok());
+  uint32_t state = 12345u;
+  for (uint8_t& v : large.pixels) {
+    state = state * 1664525u + 1013904223u;
+    v = static_cast<uint8_t>(std::clamp(static_cast<int>(v) + static_cast<int>(state >> 27) - 16, 0, 255));
+  }
+  Image tile;
+  TileReport report;
+  ASSERT_TRUE(make_tileable(large, quarter_turn_options(), tile, &report).is_ok());
+  EXPECT_EQ(tile.width, 2048);
+  EXPECT_EQ(quarter_turn_difference(tile), 0);
+  TileMetrics m;
+  ASSERT_TRUE(tile_metrics(tile, &large, m).is_ok());
+  std::string failed;
+  EXPECT_TRUE(meets_tile_targets(m, &failed)) << failed;
+  EXPECT_GT(m.gradient_ratio, 0.95);
+  std::printf(
+      "1024 px noisy gravel, 4-fold: wrap %.2f, worst seam %.2f, hist %.3f, gradient %.3f, coherence %.4f "
+      "(exemplar %.4f)\n",
+      m.wrap_ratio_x, m.worst_seam_ratio, m.histogram_l1, m.gradient_ratio, m.patch_coherence,
+      m.exemplar_patch_coherence);
+}
+
 TEST(QuarterTurn, VariantsFitPeriodAndOtherOrdersAreErrors) {
   const Image sand = load("vistex-sand05-128.png");
   std::vector<Image> tiles;

@@ -32,7 +32,7 @@
 //
 // With symmetry = 4 the tile is also unchanged by a quarter turn up to a shift: a square N x N
 // tile (S = the exemplar's smaller side rounded down to a multiple of 4, a non-square exemplar
-// cropped to its centred square; N = 2S up to 4096 px, else, or with same_size, N = S) built as a
+// cropped to its centred square; N = 2S up to 2048 px, else, or with same_size, N = S) built as a
 // pinwheel of one N/2 x N/2 quadrant (the whole exemplar, or with N = S the exemplar square of 3 x 3
 // places whose histogram is nearest the whole's) and its three quarter turns, whose seams are
 // repaired by the same quilting, drawing blocks from the exemplar's four turns and writing every
@@ -41,7 +41,9 @@
 // its ratio misses [0.8, 1.2]): rot90(tile)(x, y) = tile(y, N-1-x) equals tile(x, y) exactly, i.e.
 // the tile is unchanged by a quarter turn about its centre and corner (where the 4-fold map turns
 // it). Its patch coherence is about 1.1-1.2 x the exemplar's with N = 2S, 2-2.5 x with N = S (see
-// docs/tiling.md).
+// docs/tiling.md). Exemplars above kPlanMaxSide are quilted so on a kPlanSide px copy and the tile
+// is read at full size from that tile's source map (each block at the photo's own resolution,
+// cross-fades of the scale factor's width across the cuts): a 4096 px photo in ~1.5 s.
 //
 // Images follow the layout of image.h (1 to 4 channels; alpha is just a channel, except that the
 // FFT search of 3- and 4-channel images runs on the RGB luminance; the ranking uses all channels).

@@ -53,8 +53,9 @@ constexpr double kWrapLow = 0.8, kWrapHigh = 1.2;  // the wrap-ratio target (mee
 constexpr unsigned kQuarterTurnRedraws = 4;        // symmetry 4: draws after the retry while a target misses
 // Symmetry 4 makes a tile twice the exemplar's side up to this side, the exemplar's own side beyond
 // it, and draws blocks from the exemplar's four turns up to kMaxTurnedSearchSide (each turn is
-// one more FFT search per block: at 1024 px 3.5 s -> 12.7 s; full-size blocks, no planning on a
-// reduced copy as for plain tiles).
+// one more FFT search per block: at 1024 px 3.5 s -> 12.7 s). Exemplars above kPlanMaxSide are
+// quilted on a kPlanSide px copy and read at full size from its source map
+// (tile_from_reduced_sources), so the turned search always runs.
 constexpr int kMaxDoubledSide = 2048;
 constexpr int kMaxTurnedSearchSide = 512;
 
@@ -436,7 +437,7 @@ Status quilt_cross(const Setup& setup, const TileOptions& options, const CrossPl
 //! quarters). The result is made exact by rebuilding it from its top-left quadrant.
 Status quilt_pinwheel(const Setup& setup, const TileOptions& options, const CrossPlan& plan, SsdSearch& search,
                       const std::vector<Plane>& turns, std::vector<SsdSearch>& turn_search, Plane& canvas, int& placed,
-                      double& cut_cost) {
+                      double& cut_cost, std::vector<int32_t>& source_out) {
   const Plane& ex = setup.exemplar;
   const int es = ex.width, c = ex.channels;
   const int m = setup.quadrant, n = 2 * m;
@@ -568,7 +569,88 @@ Status quilt_pinwheel(const Setup& setup, const TileOptions& options, const Cros
     }
   placed += quilter.placed();
   cut_cost = quilter.cut_cost();
+  source_out = std::move(source);
   return Status::ok();
+}
+
+//! The quarter-turn tile of a large exemplar (side S over kPlanMaxSide), read at full size from
+//! the source map of the tile quilted on its reduced copy (`source`: per pixel of the n x n
+//! reduced tile, turn t * plane + y_t * s + x_t in the reduced exemplar's t-th quarter turn, side
+//! s; before the wrap's roll; its top-left quadrant is the authority, as for the pixels). Within a
+//! block the offset between a tile pixel and its source is constant, so a reduced pixel x with
+//! source x_t puts the full exemplar's pixel X + round((x_t - x) * S / s) (of its t-th turn) at
+//! full-size X. Each full-size pixel blends what the four reduced pixels nearest to it put there,
+//! with bilinear weights: inside a block the four agree and the full exemplar's pixel comes out
+//! unchanged; across a cut the two blocks cross-fade over S / s px instead of stepping along the
+//! reduced cut. The top-left quadrant is read so and the others are its quarter turns about the
+//! centre (the tile is exactly 4-fold). O(N^2).
+Plane tile_from_reduced_sources(const Plane& full, const std::vector<int32_t>& source, int n, int s, int big_n) {
+  const int S = full.width, c = full.channels, m = big_n / 2, half_n = n / 2;
+  const double k = static_cast<double>(S) / s;
+  const int32_t plane = s * s;
+  // The reduced map made exactly 4-fold from its top-left quadrant (a turn of the canvas, r(x, y) =
+  // (n - 1 - y, x), takes a source to the next turn: (x_t, y_t) -> (s - 1 - y_t, x_t)).
+  std::vector<int32_t> map(static_cast<size_t>(n) * n, -1);
+  for (int y = 0; y < half_n; ++y)
+    for (int x = 0; x < half_n; ++x) {
+      int32_t src = source[static_cast<size_t>(y) * n + x];
+      if (src < 0) src = y * s + x;  // a pixel no block wrote (none is expected): its own place, upright
+      int rx = x, ry = y;
+      for (int turn = 0; turn < 4; ++turn) {
+        map[static_cast<size_t>(ry) * n + rx] = src;
+        const int nx = n - 1 - ry;
+        ry = rx;
+        rx = nx;
+        const int32_t t = src / plane, sx = src % plane % s, sy = src % plane / s;
+        src = ((t + 1) % 4) * plane + sx * s + (s - 1 - sy);
+      }
+    }
+  // Full exemplar pixel that reduced pixel (cx, cy) (unwrapped) puts at full-size (x, y).
+  auto sample = [&](int cx, int cy, int x, int y) {
+    const int32_t src = map[static_cast<size_t>(Plane::mod(cy, n)) * n + Plane::mod(cx, n)];
+    const int t = src / plane, sx = src % plane % s, sy = src % plane / s;
+    int u = std::clamp(x + static_cast<int>(std::lround((sx - cx) * k)), 0, S - 1);
+    int v = std::clamp(y + static_cast<int>(std::lround((sy - cy) * k)), 0, S - 1);
+    // (u, v) in the t-th turn; undoing one turn maps (u, v) back to (v, S - 1 - u).
+    for (int turn = 0; turn < t; ++turn) {
+      const int a = v, b = S - 1 - u;
+      u = a;
+      v = b;
+    }
+    return full.at(u, v);
+  };
+  Plane out;
+  out.width = out.height = big_n;
+  out.channels = c;
+  out.px.assign(static_cast<size_t>(big_n) * big_n * c, 0.0f);
+  std::vector<float> value(static_cast<size_t>(c));
+  for (int y = 0; y < m; ++y) {
+    const double yc = (y + 0.5) / k - 0.5;
+    const int y0 = static_cast<int>(std::floor(yc));
+    const float fy = static_cast<float>(yc - y0);
+    for (int x = 0; x < m; ++x) {
+      const double xc = (x + 0.5) / k - 0.5;
+      const int x0 = static_cast<int>(std::floor(xc));
+      const float fx = static_cast<float>(xc - x0);
+      const float* p00 = sample(x0, y0, x, y);
+      const float* p10 = sample(x0 + 1, y0, x, y);
+      const float* p01 = sample(x0, y0 + 1, x, y);
+      const float* p11 = sample(x0 + 1, y0 + 1, x, y);
+      for (int ch = 0; ch < c; ++ch)
+        value[static_cast<size_t>(ch)] =
+            p00 == p10 && p00 == p01 && p00 == p11
+                ? p00[ch]
+                : (1.f - fy) * ((1.f - fx) * p00[ch] + fx * p10[ch]) + fy * ((1.f - fx) * p01[ch] + fx * p11[ch]);
+      int tx = x, ty = y;
+      for (int turn = 0; turn < 4; ++turn) {
+        std::copy(value.begin(), value.end(), out.at(tx, ty));
+        const int nx = big_n - 1 - ty;
+        ty = tx;
+        tx = nx;
+      }
+    }
+  }
+  return out;
 }
 
 }  // namespace
@@ -603,6 +685,24 @@ Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int
   try {
     Setup setup;
     TAILOR_RETURN_IF_ERROR(prepare(exemplar, options, setup, rep));
+    // Symmetry 4 above kPlanMaxSide: quilted on a kPlanSide px copy, then read at full size from
+    // that tile's source map (tile_from_reduced_sources). Quilting at full size searched the whole
+    // photo for every block: a 2048 px photo took 14-30 s, a 4096 px one over 10 minutes.
+    Plane full;
+    int full_tile = 0;
+    if (setup.symmetry == 4 && setup.exemplar.width > kPlanMaxSide) {
+      full = std::move(setup.exemplar);
+      full_tile = 2 * setup.quadrant;
+      Image reduced;
+      TAILOR_RETURN_IF_ERROR(resize_image(plane_to_image(full), kPlanSide, kPlanSide, reduced));
+      TileOptions reduced_options = options;
+      reduced_options.same_size = setup.quadrant != full.width;  // quadrants of the full tile's kind
+      TileReport plan_report;
+      TAILOR_RETURN_IF_ERROR(prepare(reduced, reduced_options, setup, plan_report));
+      rep.block = setup.block;
+      rep.overlap = setup.overlap;
+      rep.border = setup.overlap;
+    }
     const Plane& ex = setup.exemplar;
     const int w = ex.width, h = ex.height, b = setup.block, ov = setup.overlap;
     SsdSearch search;
@@ -673,10 +773,14 @@ Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int
       int blocks = 0;
       double cost = 0.0;
       SessionRecord record;
-      if (setup.symmetry == 4)
+      std::vector<int32_t> source;
+      if (setup.symmetry == 4) {
         TAILOR_RETURN_IF_ERROR(
-            quilt_pinwheel(setup, plan_options, plans[i], search, turns, turn_search, canvas, blocks, cost));
-      else
+            quilt_pinwheel(setup, plan_options, plans[i], search, turns, turn_search, canvas, blocks, cost, source));
+        // A planned tile is judged as it will be written, at full size (its wrap and worst seam
+        // differ from the reduced tile's: water at 1024 px met its wrap on no reduced attempt).
+        if (full_tile > 0) canvas = tile_from_reduced_sources(full, source, canvas.width, ex.width, full_tile);
+      } else
         TAILOR_RETURN_IF_ERROR(
             quilt_cross(setup, plan_options, plans[i], search, canvas, blocks, cost, tile_plan ? &record : nullptr));
       double worst = worst_seam_ratio(canvas, true);
