@@ -424,6 +424,14 @@ Status quilt_cross(const Setup& setup, const TileOptions& options, const CrossPl
   return Status::ok();
 }
 
+//! A source-map entry (turn t * side^2 + y_t * side + x_t, in the exemplar's t-th quarter turn)
+//! for the pixel's image under the canvas's quarter turn r(x, y) = (n - 1 - y, x): the same
+//! exemplar pixel seen in the next turn, (x_t, y_t) -> (side - 1 - y_t, x_t).
+int32_t next_turn_source(int32_t src, int side) {
+  const int32_t plane = side * side, t = src / plane, x = src % plane % side, y = src % plane / side;
+  return ((t + 1) % 4) * plane + x * side + (side - 1 - y);
+}
+
 //! Quarter-turn tile (symmetry 4) of side N = 2M from the square S x S exemplar, M = setup.quadrant
 //! (S, or S / 2 with same_size): the canvas starts as a pinwheel of an M x M exemplar square Q (Q in
 //! the top-left quadrant, its images under r(x, y) = (N - 1 - y, x) in the others), so it is
@@ -456,7 +464,6 @@ Status quilt_pinwheel(const Setup& setup, const TileOptions& options, const Cros
   canvas.px.assign(static_cast<size_t>(n) * n * c, 0.0f);
   std::vector<int32_t> source(static_cast<size_t>(n) * n, -1);
   std::vector<uint8_t> known(static_cast<size_t>(n) * n, 1), locked(static_cast<size_t>(n) * n, 0);
-  const int32_t plane = es * es;
   // Q = exemplar [qx, qx + m) x [qy, qy + m): the whole exemplar, or (m < es) of 3 x 3 places the
   // one whose 64-bin histogram (all channels) is nearest the exemplar's (a non-stationary photo:
   // its centre alone can be lighter or darker than the whole).
@@ -495,8 +502,7 @@ Status quilt_pinwheel(const Setup& setup, const TileOptions& options, const Cros
         const int nx2 = n - 1 - ry;
         ry = rx;
         rx = nx2;
-        const int32_t k = src / plane, sx = src % plane % es, sy = src % plane / es;
-        src = ((k + 1) % 4) * plane + sx * es + (es - 1 - sy);
+        src = next_turn_source(src, es);
       }
     }
   auto in_zone = [&](int v) { return Plane::mod(v - (m - half), n) < margin || Plane::mod(v + half, n) < margin; };
@@ -601,8 +607,7 @@ Plane tile_from_reduced_sources(const Plane& full, const std::vector<int32_t>& s
         const int nx = n - 1 - ry;
         ry = rx;
         rx = nx;
-        const int32_t t = src / plane, sx = src % plane % s, sy = src % plane / s;
-        src = ((t + 1) % 4) * plane + sx * s + (s - 1 - sy);
+        src = next_turn_source(src, s);
       }
     }
   // Full exemplar pixel that reduced pixel (cx, cy) (unwrapped) puts at full-size (x, y).
