@@ -53,10 +53,8 @@ namespace {
 
 using namespace skeleton_types;
 
-constexpr double kEdgeLengthFactor = 2.0;
-constexpr size_t kFlowEdges = 300000;           // 200k faces; the horse (146k edges) goes in whole
-constexpr double kQualitySpeedTradeoff = 0.05;  // CGAL's default 0.1: the speed of the flow (see below)  // the flow's
-                                                // shortest edge, in CGAL's defaults (see below)
+constexpr double kEdgeLengthFactor = 2.0;  // times the flow's shortest edge in CGAL's defaults (see below)
+constexpr size_t kFlowEdges = 300000;      // 200k faces; the horse (146k edges) goes in whole
 
 // Closes every border cycle of `sm` with a fan around its centroid; returns the number closed.
 uint32_t close_holes(SurfaceMesh& sm) {
