@@ -10,6 +10,7 @@
 
 #include "bindings.h"
 #include "tailor/image.h"
+#include "tailor/material.h"
 #include "tailor/report.h"
 #include "tailor/tiling.h"
 
@@ -116,7 +117,8 @@ void bind_tile_set(py::module_& m) {
   m.def(
       "tile_set",
       [](const std::vector<py::object>& map_paths, const py::object& output, const std::vector<py::object>& normal_maps,
-         int block, int overlap, uint64_t seed, const py::object& progress) -> std::vector<std::string> {
+         int block, int overlap, uint64_t seed, int symmetry, bool same_size,
+         const py::object& progress) -> std::vector<std::string> {
         std::vector<std::string> paths, normals, written;
         for (const py::object& p : map_paths) paths.push_back(path_of(p));
         for (const py::object& p : normal_maps) normals.push_back(path_of(p));
@@ -138,6 +140,8 @@ void bind_tile_set(py::module_& m) {
         options.block = block;
         options.overlap = overlap;
         options.seed = seed;
+        options.symmetry = symmetry;
+        options.same_size = same_size;
         ProgressBridge bridge(progress);
         options.progress = bridge.function();
         Status status;
@@ -147,6 +151,9 @@ void bind_tile_set(py::module_& m) {
           for (size_t i = 0; i < paths.size() && status; ++i) {
             status = load_image16(paths[i], maps[i].image).with_file(paths[i]);
             maps[i].normal = std::find(normals.begin(), normals.end(), paths[i]) != normals.end();
+            bool dx_name = false;  // a *_normal_dx map turns the other way round with symmetry 4
+            material_role_from_name(paths[i], &dx_name);
+            maps[i].directx = maps[i].normal && dx_name;
           }
           if (status) status = make_tileable_set(maps, options, 1, tiles).with_file(paths[0]);
           if (status && !std::filesystem::is_directory(folder) && !std::filesystem::create_directories(folder))
@@ -158,14 +165,15 @@ void bind_tile_set(py::module_& m) {
       },
       py::arg("maps"), py::arg("output"), py::arg("normal_maps") = std::vector<py::object>{},
       py::arg("block") = d.block, py::arg("overlap") = d.overlap, py::arg("seed") = d.seed,
-      py::arg("progress") = py::none(),
-      R"(tile_set(maps, output, normal_maps=(), block=32, overlap=0, seed=1, progress=None) -> list
+      py::arg("symmetry") = d.symmetry, py::arg("same_size") = d.same_size, py::arg("progress") = py::none(),
+      R"(tile_set(maps, output, normal_maps=(), block=32, overlap=0, seed=1, symmetry=1, same_size=False, progress=None) -> list
 
 Makes the maps of one material (colour, normal, roughness, height... image files of one size)
 self-tileable with one cut for all, as `tailor tile --set MAPS --normal-map N -o OUTPUT/`: each is
 written into the folder `output` (created if missing) under its own name as .png, 8 or 16 bits as
 its input; returns the written paths in the order of `maps`. normal_maps: the maps (the same paths)
-that are normal maps, blended as vectors.)");
+that are normal maps, blended as vectors. symmetry=4 (`--symmetry 4`): one quarter-turn tile for
+all, normal maps turned with their content; same_size as in tile().)");
 }
 
 }  // namespace tailor::python

@@ -14,6 +14,7 @@
 
 #include "cli.h"
 #include "tailor/image.h"
+#include "tailor/material.h"
 #include "tailor/report.h"
 #include "tailor/tiling.h"
 #include "util/atomic_file.h"
@@ -115,10 +116,6 @@ int run_tile(const TileCliOptions& opt) {
   {
     Image16 deep;
     if (Status s = load_image16(opt.input, deep, opt.image_options); !s) return report_error(s);
-    if (deep.bits == 16 && opt.options.symmetry == 4)  // the quarter-turn pinwheel is quilted in 8 bits only
-      return report_error(Status::error(ErrorCode::kInvalidArgument, opt.input,
-                                        "--symmetry 4 needs an 8-bit image, this PNG has 16 bits per sample",
-                                        "save it with 8 bits per sample first"));
     if (deep.bits == 16) return run_tile16(opt, deep);
     exemplar = to_image8(deep);
   }
@@ -261,6 +258,10 @@ int run_tile_set(TileCliOptions opt) {
   for (size_t m = 0; m < opt.set.size(); ++m) {
     if (Status s = load_image16(opt.set[m], maps[m].image, opt.image_options); !s) return report_error(s);
     maps[m].normal = std::find(opt.normal_maps.begin(), opt.normal_maps.end(), opt.set[m]) != opt.normal_maps.end();
+    // DirectX normal maps (their +y down) turn the other way round with --symmetry 4.
+    bool dx_name = false;
+    material_role_from_name(opt.set[m], &dx_name);
+    maps[m].directx = maps[m].normal && (opt.normal_convention == "dx" || dx_name);
     if (maps[m].image.width != maps[0].image.width || maps[m].image.height != maps[0].image.height)
       return report_error(
           Status::error(ErrorCode::kInvalidImage, opt.set[m], "every map of a set must have the same size",
@@ -421,9 +422,6 @@ void register_tile(CLI::App& app, Runner& run) {
                                           "give one input image, or --set MAPS..., or --material JSON"));
       if (!opt->normal_maps.empty() && opt->set.empty())
         return report_error(Status::error(ErrorCode::kInvalidArgument, "", "--normal-map needs --set"));
-      if (is_set && o.symmetry == 4)
-        return report_error(
-            Status::error(ErrorCode::kInvalidArgument, "", "--symmetry 4 is not available for map sets"));
       if (o.overlap != 0 && o.overlap > o.block / 2 - 1)
         return report_error(Status::error(ErrorCode::kInvalidArgument, "", "--overlap must be at most block/2 - 1",
                                           "block " + std::to_string(o.block)));

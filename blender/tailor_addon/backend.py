@@ -161,16 +161,17 @@ def make_tileable(kind, tool, image_path, out_png, symmetry=1):
     return tool.tile(image_path, symmetry=symmetry)  # (H, W, C) uint8: the caller makes a Blender image of it
 
 
-def make_tileable_set(kind, tool, map_paths, normal_paths, out_folder):
+def make_tileable_set(kind, tool, map_paths, normal_paths, out_folder, symmetry=1):
     """Writes the maps of one material, made self-tileable with one cut for all, into out_folder
-    under their own names (.png), as `tailor tile --set`."""
+    under their own names (.png), as `tailor tile --set`; symmetry 4: one quarter-turn tile for all
+    (twice the maps' side, normal maps turned with their content)."""
     if kind == "cli":
-        command = [tool, "tile", "--set", *map_paths, "-o", out_folder + os.sep, "-q"]
+        command = [tool, "tile", "--set", *map_paths, "-o", out_folder + os.sep, "-q", "--symmetry", str(symmetry)]
         for path in normal_paths:
             command += ["--normal-map", path]
         _run(command)
     else:
-        tool.tile_set(list(map_paths), out_folder, normal_maps=list(normal_paths))
+        tool.tile_set(list(map_paths), out_folder, normal_maps=list(normal_paths), symmetry=symmetry)
 
 
 def write_png(path, pixels):

@@ -102,11 +102,16 @@ def load_maps(maps):
 
 def assign_maps(obj, maps, images, uv_map="tailor"):
     """Adds (or reuses) the material "tailor <folder>" wired from the maps and gives it every face
-    of obj. A DirectX normal map (*_normal_dx) has its green flipped (Blender wants OpenGL's)."""
+    of obj. A DirectX normal map (*_normal_dx) has its green flipped (Blender wants OpenGL's). A
+    reused material shows these images (the maps of a folder made tileable again are new images)."""
     folder = os.path.basename(os.path.dirname(next(iter(maps.values()))[0]))
     name = f"tailor {folder}"
     material = bpy.data.materials.get(name)
-    if material is None:
+    if material is not None:
+        for node in material.node_tree.nodes:
+            if node.type == "TEX_IMAGE" and node.label in images:
+                node.image = images[node.label]
+    else:
         material, nodes, links, shader = _new_node_material(name)
         coordinates = _uv_node(nodes, uv_map, (shader.location.x - 900, shader.location.y))
         textures = {}

@@ -207,15 +207,13 @@ class TAILOR_OT_texture_map(bpy.types.Operator):
 
     def tile_maps(self, kind, tool, maps, tmp):
         """The material folder's maps made self-tileable together (tailor tile --set), in tmp under
-        their own names, so that the roles (and a DirectX normal map) are found as before."""
-        if self.quarter_turns:
-            raise RuntimeError("Quarter-turn seams need a 4-fold tile, which tailor makes from single images only, "
-                               "not from a material folder: use an image, or turn Make tileable off")
+        their own names, so that the roles (and a DirectX normal map) are found as before; with
+        Quarter-turn seams one 4-fold tile for all (normal maps turned with their content)."""
         folder = os.path.basename(os.path.normpath(bpy.path.abspath(self.material_path)))
-        out = os.path.join(tmp, folder + "_tile")
+        out = os.path.join(tmp, folder + ("_tile4" if self.quarter_turns else "_tile"))
         paths = [path for path, _ in maps.values()]
         normals = [path for role, (path, _) in maps.items() if role == "normal"]
-        backend.make_tileable_set(kind, tool, paths, normals, out)
+        backend.make_tileable_set(kind, tool, paths, normals, out, 4 if self.quarter_turns else 1)
         return material_files.find_maps(out)
 
     def load_image(self, kind, tool, tmp):

@@ -103,7 +103,8 @@ inline constexpr OptionDoc kTileOptionDocs[] = {
      "1 or 4: 4 makes a square tile that is also unchanged by a quarter turn (rot90(tile) == tile), for "
      "stochastic textures (gravel, sand, bark, moss); directional ones (bricks, planks, grain) cannot look "
      "the same turned and get a warning. The tile is twice the input's side (its square crop; inputs over "
-     "1024 px keep their side), each quadrant the whole input turned. Not with --variants or --fit-period"},
+     "1024 px keep their side), each quadrant the whole input turned; with --set every map through one cut, "
+     "normal maps turned with their content. Not with --variants or --fit-period"},
     {"same_size", "--same-size",
      "With --symmetry 4: a tile of the input's side, each quadrant a quarter of it (more seams per pixel: "
      "patch coherence about 2x worse than the default's twice-the-side tile)"},
@@ -158,8 +159,10 @@ TAILOR_API Status make_tile_variants(const Image& exemplar, const TileOptions& o
 
 //! One map of a material set (make_tileable_set).
 struct TileMap {
-  Image16 image;        //!< 8- or 16-bit, 1 to 4 channels (alpha is a channel like any other)
-  bool normal = false;  //!< a normal map: blended as unit vectors (the first three channels), renormalised
+  Image16 image;         //!< 8- or 16-bit, 1 to 4 channels (alpha is a channel like any other)
+  bool normal = false;   //!< a normal map: blended as unit vectors (the first three channels), renormalised
+  bool directx = false;  //!< a normal map whose +y points down the image (DirectX; glTF's points up): with
+                         //!< symmetry 4 its vectors turn the other way round
 };
 
 //! Makes a set of registered maps (colour, normal, roughness, height...) self-tileable together:
@@ -169,9 +172,12 @@ struct TileMap {
 //! tiles[k][m] is variant k (as make_tile_variants) of map m, with its bit depth and channels.
 //! Within max(1, scale / 2) px of a cut (scale: full size / plan size, see kPlanMaxSide) the
 //! sources of both sides are blended: scalar maps per channel, normal maps as vectors; every
-//! output normal is renormalised. Small sets are planned at full size (scale 1, 1 px feather). Fails with
-//! kInvalidArgument for an empty set, maps of different sizes (saying which), symmetry 4, or what make_tile_variants
-//! refuses.
+//! output normal is renormalised. Small sets are planned at full size (scale 1, 1 px feather). With
+//! symmetry 4 one quarter-turn tile is quilted on the guide (make_tileable's, on a kPlanSide px
+//! copy above kPlanMaxSide) and every map is read through its source map at full size, normal
+//! maps turned with their content (+x right, +y up, as glTF) and renormalised. Fails with
+//! kInvalidArgument for an empty set, maps of different sizes (saying which), or what
+//! make_tile_variants refuses.
 TAILOR_API Status make_tileable_set(const std::vector<TileMap>& maps, const TileOptions& options, int count,
                                     std::vector<std::vector<Image16>>& tiles, TileReport* report = nullptr);
 

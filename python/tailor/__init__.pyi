@@ -113,6 +113,8 @@ def tile_set(
     block: int = 32,
     overlap: int = 0,
     seed: int = 1,
+    symmetry: Literal[1, 4] = 1,
+    same_size: bool = False,
     progress: Optional[_Progress] = None,
 ) -> List[str]: ...
 def evaluate(

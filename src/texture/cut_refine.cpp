@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 #include <vector>
 
 namespace tailor::internal {
@@ -278,6 +279,128 @@ void compose(const T* in, int width, int height, int channels, int max_value, Bl
       }
     }
 }
+
+template <typename T>
+void read_quarter_turn(const T* in, int width, int channels, double max_value, bool normal, bool y_down,
+                       const QuarterTurnPlan& plan, std::vector<T>& out) {
+  const int S = plan.full_side, c = channels, n = plan.n, s = plan.s, big_n = plan.tile_side, m = big_n / 2;
+  const int half_n = n / 2;
+  const bool vectors = normal && c >= 3;
+  const double k = static_cast<double>(S) / s;
+  const int32_t plane = s * s;
+  // The quilted map made exactly 4-fold from its top-left quadrant (the authority, as for pixels).
+  std::vector<int32_t> map(static_cast<size_t>(n) * n, -1);
+  for (int y = 0; y < half_n; ++y)
+    for (int x = 0; x < half_n; ++x) {
+      int32_t src = plan.source[static_cast<size_t>(y) * n + x];
+      if (src < 0) src = y * s + x;  // a pixel no block wrote (none is expected): its own place, upright
+      int rx = x, ry = y;
+      for (int turn = 0; turn < 4; ++turn) {
+        map[static_cast<size_t>(ry) * n + rx] = src;
+        const int nx = n - 1 - ry;
+        ry = rx;
+        rx = nx;
+        src = next_turn_source(src, s);
+      }
+    }
+  // The map's sample that quilted pixel (cx, cy) (unwrapped) puts at full-size (x, y), and the
+  // quarter turns of its content.
+  auto sample = [&](int cx, int cy, int x, int y, int& turns) {
+    const int32_t src = map[static_cast<size_t>(Plane::mod(cy, n)) * n + Plane::mod(cx, n)];
+    const int t = src / plane, sx = src % plane % s, sy = src % plane / s;
+    int u = std::clamp(x + static_cast<int>(std::lround((sx - cx) * k)), 0, S - 1);
+    int v = std::clamp(y + static_cast<int>(std::lround((sy - cy) * k)), 0, S - 1);
+    // (u, v) in the t-th turn; undoing one turn maps (u, v) back to (v, S - 1 - u).
+    for (int turn = 0; turn < t; ++turn) {
+      const int a = v, b = S - 1 - u;
+      u = a;
+      v = b;
+    }
+    turns = t;
+    return in + (static_cast<size_t>(plan.crop_y + v) * width + plan.crop_x + u) * c;
+  };
+  const double half = max_value / 2.0;
+  const double flip = y_down ? -1.0 : 1.0;
+  auto turn_vector = [flip](double& x, double& y, int turns) {  // r: (x, y) -> (y, -x) with +y up
+    for (int i = 0; i < turns; ++i) {
+      const double a = flip * y, b = -flip * x;
+      x = a;
+      y = b;
+    }
+  };
+  std::vector<float> pinwheel(static_cast<size_t>(big_n) * big_n * c);
+  std::vector<double> value(static_cast<size_t>(c));
+  for (int y = 0; y < m; ++y) {
+    const double yc = (y + 0.5) / k - 0.5;
+    const int y0 = static_cast<int>(std::floor(yc));
+    const double fy = yc - y0;
+    for (int x = 0; x < m; ++x) {
+      const double xc = (x + 0.5) / k - 0.5;
+      const int x0 = static_cast<int>(std::floor(xc));
+      const double fx = xc - x0;
+      int turns[4];
+      const T* p[4] = {sample(x0, y0, x, y, turns[0]), sample(x0 + 1, y0, x, y, turns[1]),
+                       sample(x0, y0 + 1, x, y, turns[2]), sample(x0 + 1, y0 + 1, x, y, turns[3])};
+      const double weight[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
+      const bool one = p[0] == p[1] && p[0] == p[2] && p[0] == p[3];
+      std::fill(value.begin(), value.end(), 0.0);
+      for (int q = 0; q < (one ? 1 : 4); ++q) {
+        const double w = one ? 1.0 : weight[q];
+        for (int ch = 0; ch < c; ++ch) value[static_cast<size_t>(ch)] += w * static_cast<double>(p[q][ch]);
+        if (vectors) {  // the vector part again, turned with its block's content
+          double nx = p[q][0] / half - 1.0, ny = p[q][1] / half - 1.0;
+          turn_vector(nx, ny, turns[q]);
+          value[0] += w * ((nx + 1.0) * half - static_cast<double>(p[q][0]));
+          value[1] += w * ((ny + 1.0) * half - static_cast<double>(p[q][1]));
+        }
+      }
+      int tx = x, ty = y;
+      for (int turn = 0; turn < 4; ++turn) {
+        float* o = &pinwheel[(static_cast<size_t>(ty) * big_n + tx) * c];
+        for (int ch = 0; ch < c; ++ch) o[ch] = static_cast<float>(value[static_cast<size_t>(ch)]);
+        if (vectors) {  // renormalised, and turned with the quadrant
+          double nx = value[0] / half - 1.0, ny = value[1] / half - 1.0, nz = value[2] / half - 1.0;
+          turn_vector(nx, ny, turn);
+          const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
+          if (len < 1e-9) {
+            nx = ny = 0.0;
+            nz = 1.0;
+          } else {
+            nx /= len;
+            ny /= len;
+            nz /= len;
+          }
+          o[0] = static_cast<float>((nx + 1.0) * half);
+          o[1] = static_cast<float>((ny + 1.0) * half);
+          o[2] = static_cast<float>((nz + 1.0) * half);
+        }
+        const int nx = big_n - 1 - ty;
+        ty = tx;
+        tx = nx;
+      }
+    }
+  }
+  // The wrap's roll; samples rounded into T (floats as they are).
+  out.resize(pinwheel.size());
+  for (int y = 0; y < big_n; ++y)
+    for (int x = 0; x < big_n; ++x) {
+      const float* v = &pinwheel[(static_cast<size_t>((y + plan.roll) % big_n) * big_n + (x + plan.roll) % big_n) * c];
+      T* o = &out[(static_cast<size_t>(y) * big_n + x) * c];
+      for (int ch = 0; ch < c; ++ch) {
+        if constexpr (std::is_floating_point_v<T>)
+          o[ch] = static_cast<T>(v[ch]);
+        else
+          o[ch] = static_cast<T>(std::lround(std::clamp(static_cast<double>(v[ch]), 0.0, max_value)));
+      }
+    }
+}
+
+template void read_quarter_turn<float>(const float*, int, int, double, bool, bool, const QuarterTurnPlan&,
+                                       std::vector<float>&);
+template void read_quarter_turn<uint8_t>(const uint8_t*, int, int, double, bool, bool, const QuarterTurnPlan&,
+                                         std::vector<uint8_t>&);
+template void read_quarter_turn<uint16_t>(const uint16_t*, int, int, double, bool, bool, const QuarterTurnPlan&,
+                                          std::vector<uint16_t>&);
 
 template void compose<uint8_t>(const uint8_t*, int, int, int, int, BlendKind, const std::vector<int32_t>&, int,
                                std::vector<uint8_t>&);

@@ -92,10 +92,47 @@ template <typename T>
 void compose(const T* in, int width, int height, int channels, int max_value, BlendKind kind,
              const std::vector<int32_t>& source, int feather, std::vector<T>& out);
 
+//! A quarter-turn tile (symmetry 4) as quilted on a guide, for reading any registered map at full
+//! size (read_quarter_turn): per pixel of the n x n quilted tile (before the wrap's roll) its
+//! source, turn t * s^2 + y_t * s + x_t in the t-th quarter turn of the s x s exemplar it was
+//! quilted from (the guide's reduced copy above kPlanMaxSide, else the guide); the full square
+//! exemplar (side full_side, at crop_x, crop_y in the input), the tile's side and the wrap's roll.
+struct QuarterTurnPlan {
+  std::vector<int32_t> source;
+  int n = 0, s = 0;
+  int full_side = 0, crop_x = 0, crop_y = 0;
+  int tile_side = 0;
+  int roll = 0;  //!< tile(x, y) = pinwheel((x + roll) % N, (y + roll) % N)
+};
+
+//! A source-map entry's image under the canvas's quarter turn r(x, y) = (n - 1 - y, x): the same
+//! exemplar pixel in the next turn, (x_t, y_t) -> (side - 1 - y_t, x_t).
+inline int32_t next_turn_source(int32_t src, int side) {
+  const int32_t plane = side * side, t = src / plane, x = src % plane % side, y = src % plane / side;
+  return ((t + 1) % 4) * plane + x * side + (side - 1 - y);
+}
+
+//! The quarter-turn tile of one map (samples T in [0, max_value], interleaved, `width` wide, at
+//! least the plan's square) read at full size through `plan` into out (tile_side^2 x channels).
+//! Within a block the offset between a tile pixel and its source is constant, so a quilted pixel x
+//! with source x_t puts the full map's pixel X + round((x_t - x) * S / s) (of its t-th turn) at
+//! full-size X. Each full-size pixel blends what the four quilted pixels nearest to it put there,
+//! with bilinear weights: inside a block the four agree and the map's pixel comes out unchanged;
+//! across a cut the two blocks cross-fade over S / s px instead of stepping along the quilted cut.
+//! The top-left quadrant is read so and the others are its quarter turns (the tile is exactly
+//! 4-fold), then rolled. normal: the first three channels are a tangent-space normal (+x right,
+//! +y up as glTF, or down with y_down as DirectX), turned with the content (a quarter turn r takes
+//! (x, y) to (y, -x), with y_down to (-y, x)), blended as vectors and renormalised. O(N^2).
+template <typename T>
+void read_quarter_turn(const T* in, int width, int channels, double max_value, bool normal, bool y_down,
+                       const QuarterTurnPlan& plan, std::vector<T>& out);
+
 //! The quilting of tiling.cpp (make_tile_variants for images up to kPlanMaxSide) on `exemplar`,
 //! recording its plan in `plan` (may be null). all_channels: the block search uses every channel
 //! (a map set's guide) rather than a colour image's luminance.
+//! With symmetry 4, quarter_plan (may be null) receives the tile's QuarterTurnPlan.
 Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int count, bool all_channels,
-                          std::vector<Image>& tiles, TileReport* report, TilePlan* plan);
+                          std::vector<Image>& tiles, TileReport* report, TilePlan* plan,
+                          QuarterTurnPlan* quarter_plan = nullptr);
 
 }  // namespace tailor::internal

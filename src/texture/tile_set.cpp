@@ -240,8 +240,6 @@ Status tile_set_once(const std::vector<TileMap>& maps, const TileOptions& option
                      std::vector<std::vector<Image16>>& tiles, TileReport* report) {
   tiles.clear();
   if (maps.empty()) return Status::error(ErrorCode::kInvalidArgument, "", "a map set needs at least one map");
-  if (options.symmetry != 1)
-    return Status::error(ErrorCode::kInvalidArgument, "", "--symmetry 4 is not available for map sets");
   for (size_t m = 0; m < maps.size(); ++m) {
     const Image16& a = maps[m].image;
     if ((a.bits != 8 && a.bits != 16) || a.channels < 1 || a.channels > 4 || a.width < 1 || a.height < 1 ||
@@ -291,6 +289,25 @@ Status tile_set_once(const std::vector<TileMap>& maps, const TileOptions& option
           guide.pixels[i * gc + k] = static_cast<uint8_t>(
               std::lround(std::clamp(sum[static_cast<size_t>(k)] / shares[static_cast<size_t>(k)], 0.0, 255.0)));
       }
+    }
+    if (options.symmetry == 4) {
+      // One quarter-turn tile quilted on the guide, every map read through it at full size (normal
+      // maps turned with their content).
+      std::vector<Image> guide_tiles;
+      internal::QuarterTurnPlan plan;
+      TAILOR_RETURN_IF_ERROR(
+          internal::plan_tile_variants(guide, options, count, all_channels, guide_tiles, &rep, nullptr, &plan));
+      tiles.assign(1, std::vector<Image16>(maps.size()));
+      for (size_t m = 0; m < maps.size(); ++m) {
+        const Image16& a = maps[m].image;
+        Image16& t = tiles[0][m];
+        t.width = t.height = plan.tile_side;
+        t.channels = a.channels;
+        t.bits = a.bits;
+        internal::read_quarter_turn(a.pixels.data(), a.width, a.channels, a.bits == 16 ? 65535.0 : 255.0,
+                                    maps[m].normal, maps[m].directx, plan, t.pixels);
+      }
+      return Status::ok();
     }
     Replayed r;
     TAILOR_RETURN_IF_ERROR(plan_and_replay(guide, all_channels, options, count, rep, r));

@@ -424,14 +424,6 @@ Status quilt_cross(const Setup& setup, const TileOptions& options, const CrossPl
   return Status::ok();
 }
 
-//! A source-map entry (turn t * side^2 + y_t * side + x_t, in the exemplar's t-th quarter turn)
-//! for the pixel's image under the canvas's quarter turn r(x, y) = (n - 1 - y, x): the same
-//! exemplar pixel seen in the next turn, (x_t, y_t) -> (side - 1 - y_t, x_t).
-int32_t next_turn_source(int32_t src, int side) {
-  const int32_t plane = side * side, t = src / plane, x = src % plane % side, y = src % plane / side;
-  return ((t + 1) % 4) * plane + x * side + (side - 1 - y);
-}
-
 //! Quarter-turn tile (symmetry 4) of side N = 2M from the square S x S exemplar, M = setup.quadrant
 //! (S, or S / 2 with same_size): the canvas starts as a pinwheel of an M x M exemplar square Q (Q in
 //! the top-left quadrant, its images under r(x, y) = (N - 1 - y, x) in the others), so it is
@@ -502,7 +494,7 @@ Status quilt_pinwheel(const Setup& setup, const TileOptions& options, const Cros
         const int nx2 = n - 1 - ry;
         ry = rx;
         rx = nx2;
-        src = next_turn_source(src, es);
+        src = internal::next_turn_source(src, es);
       }
     }
   auto in_zone = [&](int v) { return Plane::mod(v - (m - half), n) < margin || Plane::mod(v + half, n) < margin; };
@@ -579,82 +571,18 @@ Status quilt_pinwheel(const Setup& setup, const TileOptions& options, const Cros
   return Status::ok();
 }
 
-//! The quarter-turn tile of a large exemplar (side S over kPlanMaxSide), read at full size from
-//! the source map of the tile quilted on its reduced copy (`source`: per pixel of the n x n
-//! reduced tile, turn t * plane + y_t * s + x_t in the reduced exemplar's t-th quarter turn, side
-//! s; before the wrap's roll; its top-left quadrant is the authority, as for the pixels). Within a
-//! block the offset between a tile pixel and its source is constant, so a reduced pixel x with
-//! source x_t puts the full exemplar's pixel X + round((x_t - x) * S / s) (of its t-th turn) at
-//! full-size X. Each full-size pixel blends what the four reduced pixels nearest to it put there,
-//! with bilinear weights: inside a block the four agree and the full exemplar's pixel comes out
-//! unchanged; across a cut the two blocks cross-fade over S / s px instead of stepping along the
-//! reduced cut. The top-left quadrant is read so and the others are its quarter turns about the
-//! centre (the tile is exactly 4-fold). O(N^2).
+//! The pinwheel's full-size readout on a float plane (the guide's own tile, judged per attempt).
 Plane tile_from_reduced_sources(const Plane& full, const std::vector<int32_t>& source, int n, int s, int big_n) {
-  const int S = full.width, c = full.channels, m = big_n / 2, half_n = n / 2;
-  const double k = static_cast<double>(S) / s;
-  const int32_t plane = s * s;
-  // The reduced map made exactly 4-fold from its top-left quadrant (a turn of the canvas, r(x, y) =
-  // (n - 1 - y, x), takes a source to the next turn: (x_t, y_t) -> (s - 1 - y_t, x_t)).
-  std::vector<int32_t> map(static_cast<size_t>(n) * n, -1);
-  for (int y = 0; y < half_n; ++y)
-    for (int x = 0; x < half_n; ++x) {
-      int32_t src = source[static_cast<size_t>(y) * n + x];
-      if (src < 0) src = y * s + x;  // a pixel no block wrote (none is expected): its own place, upright
-      int rx = x, ry = y;
-      for (int turn = 0; turn < 4; ++turn) {
-        map[static_cast<size_t>(ry) * n + rx] = src;
-        const int nx = n - 1 - ry;
-        ry = rx;
-        rx = nx;
-        src = next_turn_source(src, s);
-      }
-    }
-  // Full exemplar pixel that reduced pixel (cx, cy) (unwrapped) puts at full-size (x, y).
-  auto sample = [&](int cx, int cy, int x, int y) {
-    const int32_t src = map[static_cast<size_t>(Plane::mod(cy, n)) * n + Plane::mod(cx, n)];
-    const int t = src / plane, sx = src % plane % s, sy = src % plane / s;
-    int u = std::clamp(x + static_cast<int>(std::lround((sx - cx) * k)), 0, S - 1);
-    int v = std::clamp(y + static_cast<int>(std::lround((sy - cy) * k)), 0, S - 1);
-    // (u, v) in the t-th turn; undoing one turn maps (u, v) back to (v, S - 1 - u).
-    for (int turn = 0; turn < t; ++turn) {
-      const int a = v, b = S - 1 - u;
-      u = a;
-      v = b;
-    }
-    return full.at(u, v);
-  };
+  internal::QuarterTurnPlan plan;
+  plan.source = source;
+  plan.n = n;
+  plan.s = s;
+  plan.full_side = full.width;
+  plan.tile_side = big_n;
   Plane out;
   out.width = out.height = big_n;
-  out.channels = c;
-  out.px.assign(static_cast<size_t>(big_n) * big_n * c, 0.0f);
-  std::vector<float> value(static_cast<size_t>(c));
-  for (int y = 0; y < m; ++y) {
-    const double yc = (y + 0.5) / k - 0.5;
-    const int y0 = static_cast<int>(std::floor(yc));
-    const float fy = static_cast<float>(yc - y0);
-    for (int x = 0; x < m; ++x) {
-      const double xc = (x + 0.5) / k - 0.5;
-      const int x0 = static_cast<int>(std::floor(xc));
-      const float fx = static_cast<float>(xc - x0);
-      const float* p00 = sample(x0, y0, x, y);
-      const float* p10 = sample(x0 + 1, y0, x, y);
-      const float* p01 = sample(x0, y0 + 1, x, y);
-      const float* p11 = sample(x0 + 1, y0 + 1, x, y);
-      for (int ch = 0; ch < c; ++ch)
-        value[static_cast<size_t>(ch)] =
-            p00 == p10 && p00 == p01 && p00 == p11
-                ? p00[ch]
-                : (1.f - fy) * ((1.f - fx) * p00[ch] + fx * p10[ch]) + fy * ((1.f - fx) * p01[ch] + fx * p11[ch]);
-      int tx = x, ty = y;
-      for (int turn = 0; turn < 4; ++turn) {
-        std::copy(value.begin(), value.end(), out.at(tx, ty));
-        const int nx = big_n - 1 - ty;
-        ty = tx;
-        tx = nx;
-      }
-    }
-  }
+  out.channels = full.channels;
+  internal::read_quarter_turn(full.px.data(), full.width, full.channels, 255.0, false, false, plan, out.px);
   return out;
 }
 
@@ -675,7 +603,8 @@ Image swap_quadrants(const Image& image) {
 namespace internal {
 
 Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int count, bool all_channels,
-                          std::vector<Image>& tiles, TileReport* report, TilePlan* tile_plan) {
+                          std::vector<Image>& tiles, TileReport* report, TilePlan* tile_plan,
+                          QuarterTurnPlan* quarter_plan) {
   tiles.clear();
   if (count < 1 || count > 64)
     return Status::error(ErrorCode::kInvalidArgument, "", "variant count must be in [1, 64]",
@@ -765,6 +694,8 @@ Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int
     if (setup.symmetry == 4)
       for (unsigned k = 1; k <= kQuarterTurnRedraws; ++k) plans.push_back({2000u + k, 0.0, kMinCandidates, 0, 0});
     Plane base;
+    std::vector<int32_t> base_source;  // symmetry 4: the chosen tile's source map (QuarterTurnPlan)
+    int base_source_side = 0;
     int base_blocks = 0;
     double base_worst = 0.0, base_cost = 0.0;
     bool base_meets = false;
@@ -779,9 +710,11 @@ Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int
       double cost = 0.0;
       SessionRecord record;
       std::vector<int32_t> source;
+      int source_side = 0;
       if (setup.symmetry == 4) {
         TAILOR_RETURN_IF_ERROR(
             quilt_pinwheel(setup, plan_options, plans[i], search, turns, turn_search, canvas, blocks, cost, source));
+        source_side = canvas.width;
         // A planned tile is judged as it will be written, at full size (its wrap and worst seam
         // differ from the reduced tile's: water at 1024 px met its wrap on no reduced attempt).
         if (full_tile > 0) canvas = tile_from_reduced_sources(full, source, canvas.width, ex.width, full_tile);
@@ -805,6 +738,8 @@ Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int
           i == 0 || (meets && !base_meets) || (meets == base_meets && (meets ? cost < base_cost : worst < base_worst));
       if (better) {
         base = std::move(canvas);
+        base_source = std::move(source);
+        base_source_side = source_side;
         base_blocks = blocks;
         base_worst = worst;
         base_cost = cost;
@@ -826,6 +761,18 @@ Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int
           std::copy(v, v + ex.channels, base.at(x, y));
         }
       rep.shift_x = rep.shift_y = q;
+      if (quarter_plan) {
+        // The square prepare() cut out of the exemplar: its side, centred.
+        const int side = std::min(exemplar.width, exemplar.height) & ~3;
+        quarter_plan->source = std::move(base_source);
+        quarter_plan->n = base_source_side;
+        quarter_plan->s = ex.width;
+        quarter_plan->full_side = full_tile > 0 ? full.width : ex.width;
+        quarter_plan->crop_x = (exemplar.width - side) / 2;
+        quarter_plan->crop_y = (exemplar.height - side) / 2;
+        quarter_plan->tile_side = tw;
+        quarter_plan->roll = q;
+      }
     }
     tiles.push_back(plane_to_image(base));
     if (setup.symmetry == 4) {

@@ -244,13 +244,24 @@ def main():
         wrap = np.abs(colour[:, 0] - colour[:, -1]).mean() / np.abs(np.diff(colour, axis=1)).mean()
         raw = np.abs(original[:, 0] - original[:, -1]).mean() / np.abs(np.diff(original, axis=1)).mean()
         check(wrap < 1.3 < raw, f"tileable material ({kind}): the colour map wraps (ratio {wrap:.2f}, source {raw:.2f})")
-    select_only(small)
-    try:
-        bpy.ops.uv.tailor_texture_map(assign_material=True, material_path=folder, make_tileable=True,
-                                      quarter_turns=True)
-        check(False, "quarter turns with a material folder to make tileable is an error")
-    except RuntimeError as error:
-        check("single images only" in str(error), f"error report: {error}")
+    # A material folder made tileable with quarter turns: one 4-fold tile for all its maps.
+    for kind in ([KIND, "cli"] if KIND == "module" else ["cli"]):
+        preferences.backend = "MODULE" if kind == "module" else "CLI"
+        select_only(small)
+        result = bpy.ops.uv.tailor_texture_map(tile_size=0.25, assign_material=True, material_path=folder,
+                                               make_tileable=True, quarter_turns=True)
+        check(result == {"FINISHED"} and small["tailor"]["symmetry"] == 4, f"4-fold material ({kind}) finished")
+        tiled = small.data.materials[-1]
+        check(tiled.name == "tailor gravel_material_tile4", f"4-fold material ({kind}): named so ({tiled.name})")
+        textures = {n.label: n.image for n in tiled.node_tree.nodes if n.type == "TEX_IMAGE"}
+        check(sorted(textures) == ["color", "normal", "occlusion", "roughness"] and
+              all(i.packed_file is not None and tuple(i.size) == (1024, 1024) for i in textures.values()),
+              f"4-fold material ({kind}): four maps of 1024 px, all packed "
+              f"({ {k: (tuple(i.size), i.packed_file is not None) for k, i in textures.items()} })")
+        colour = np.empty(4 * 1024 * 1024, np.float32)
+        textures["color"].pixels.foreach_get(colour)
+        colour = colour.reshape(1024, 1024, 4)
+        check(np.array_equal(np.rot90(colour), colour), f"4-fold material ({kind}): the colour map is unchanged by a quarter turn")
     preferences.backend = "MODULE" if KIND == "module" else "CLI"
 
     # --- quarter-turn seams (tailor map --symmetry 4) under a 4-fold tile made here, both backends ---

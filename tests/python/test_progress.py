@@ -1,6 +1,7 @@
 """Progress, cancelling, Ctrl-C and the GIL: a long map leaves other Python threads running."""
 import _thread
 import os
+import struct
 import threading
 import time
 
@@ -132,6 +133,15 @@ def test_tile_set_writes_the_maps_as_the_cli_does(tmp_path, tailor_binary):
     assert not (tmp_path / "bad").exists()
     with pytest.raises(tailor.Error, match="normal_maps"):
         tailor.tile_set([sand], tmp_path / "bad", normal_maps=[bark])
+    # With symmetry 4: one quarter-turn tile for both, the command's bytes; the tiles twice the side.
+    tailor.tile_set([sand, bark], tmp_path / "py4", normal_maps=[bark], symmetry=4)
+    code, _, err = run_cli(tailor_binary, "tile", "--set", sand, bark, "--normal-map", bark, "-o", tmp_path / "cli4",
+                           "-q", "--symmetry", "4")
+    assert code == 0, err
+    for name in ("vistex-sand05-128.png", "vistex-bark11-128.png"):
+        assert (tmp_path / "py4" / name).read_bytes() == (tmp_path / "cli4" / name).read_bytes(), name
+    header = (tmp_path / "py4" / "vistex-sand05-128.png").read_bytes()[16:24]  # the PNG's IHDR width, height
+    assert struct.unpack(">II", header) == (256, 256)
 
 
 def test_maps_in_parallel_threads_give_the_sequential_bits():
