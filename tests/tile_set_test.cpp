@@ -213,7 +213,9 @@ TEST(TileSet, SixteenBitMapsStaySixteenBit) {
 // with it). Without turning the normals they would point 90 degrees off in three quarters. A
 // DirectX normal map (+y down the image) turns the other way round.
 TEST(TileSet, QuarterTurnSetsTurnTheirNormalMaps) {
-  for (const auto& [side, dx] : {std::pair{512, false}, std::pair{800, false}, std::pair{512, true}}) {
+  for (const std::pair<int, bool>& run : {std::pair{512, false}, std::pair{800, false}, std::pair{512, true}}) {
+    const int side = run.first;
+    const bool dx = run.second;  // not structured bindings: clang 14 cannot capture those in lambdas
     Image grey;
     ASSERT_TRUE(resize_image(load("gravel-gray-512.png"), side, side, grey).is_ok());
     // Height: the photo smoothed (a 5 x 5 box twice), so its normals vary slowly.
