@@ -177,6 +177,21 @@ void CutRefiner::place(const Placement& p, int overlap, int radius) {
   }
 }
 
+namespace {
+// (x, y, z) scaled to unit length; a null vector becomes (0, 0, 1), the flat normal.
+void unit_or_up(double& x, double& y, double& z) {
+  const double len = std::sqrt(x * x + y * y + z * z);
+  if (len < 1e-9) {
+    x = y = 0.0;
+    z = 1.0;
+  } else {
+    x /= len;
+    y /= len;
+    z /= len;
+  }
+}
+}  // namespace
+
 template <typename T>
 void compose(const T* in, int width, int height, int channels, int max_value, BlendKind kind,
              const std::vector<int32_t>& source, int feather, std::vector<T>& out) {
@@ -186,15 +201,7 @@ void compose(const T* in, int width, int height, int channels, int max_value, Bl
   const double half = max_value / 2.0;
   // Writes the vector (x, y, z) in [-1, 1] renormalised (a null vector becomes (0, 0, 1)).
   auto put_normal = [&](double nx, double ny, double nz, T* o) {
-    const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
-    if (len < 1e-9) {
-      nx = ny = 0.0;
-      nz = 1.0;
-    } else {
-      nx /= len;
-      ny /= len;
-      nz /= len;
-    }
+    unit_or_up(nx, ny, nz);
     o[0] = static_cast<T>(std::lround(std::clamp((nx + 1.0) * half, 0.0, static_cast<double>(max_value))));
     o[1] = static_cast<T>(std::lround(std::clamp((ny + 1.0) * half, 0.0, static_cast<double>(max_value))));
     o[2] = static_cast<T>(std::lround(std::clamp((nz + 1.0) * half, 0.0, static_cast<double>(max_value))));
@@ -361,15 +368,7 @@ void read_quarter_turn(const T* in, int width, int channels, double max_value, b
         if (vectors) {  // renormalised, and turned with the quadrant
           double nx = value[0] / half - 1.0, ny = value[1] / half - 1.0, nz = value[2] / half - 1.0;
           turn_vector(nx, ny, turn);
-          const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
-          if (len < 1e-9) {
-            nx = ny = 0.0;
-            nz = 1.0;
-          } else {
-            nx /= len;
-            ny /= len;
-            nz /= len;
-          }
+          unit_or_up(nx, ny, nz);
           o[0] = static_cast<float>((nx + 1.0) * half);
           o[1] = static_cast<float>((ny + 1.0) * half);
           o[2] = static_cast<float>((nz + 1.0) * half);
