@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <exception>
 #include <limits>
 
@@ -571,18 +572,20 @@ Status quilt_pinwheel(const Setup& setup, const TileOptions& options, const Cros
   return Status::ok();
 }
 
-//! The pinwheel's full-size readout on a float plane (the guide's own tile, judged per attempt).
-Plane tile_from_reduced_sources(const Plane& full, const std::vector<int32_t>& source, int n, int s, int big_n) {
+//! The pinwheel read at full size from the 8-bit exemplar, as a float plane (judged per attempt).
+Plane tile_from_reduced_sources(const Image& full, const std::vector<int32_t>& source, int n, int s, int big_n) {
   internal::QuarterTurnPlan plan;
   plan.source = source;
   plan.n = n;
   plan.s = s;
   plan.full_side = full.width;
   plan.tile_side = big_n;
+  std::vector<uint8_t> samples;
+  internal::read_quarter_turn(full.pixels.data(), full.width, full.channels, 255.0, false, false, plan, samples);
   Plane out;
   out.width = out.height = big_n;
   out.channels = full.channels;
-  internal::read_quarter_turn(full.px.data(), full.width, full.channels, 255.0, false, false, plan, out.px);
+  out.px.assign(samples.begin(), samples.end());
   return out;
 }
 
@@ -622,13 +625,13 @@ Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int
     // Symmetry 4 above kPlanMaxSide: quilted on a kPlanSide px copy, then read at full size from
     // that tile's source map (tile_from_reduced_sources). Quilting at full size searched the whole
     // photo for every block: a 2048 px photo took 14-30 s, a 4096 px one over 10 minutes.
-    Plane full;
+    Image full;  // 8 bits: a float copy of an 8192 px photo is 0.8 GB
     int full_tile = 0;
     if (setup.symmetry == 4 && setup.exemplar.width > kPlanMaxSide) {
-      full = std::move(setup.exemplar);
+      full = plane_to_image(setup.exemplar);
       full_tile = 2 * setup.quadrant;
       Image reduced;
-      TAILOR_RETURN_IF_ERROR(resize_image(plane_to_image(full), kPlanSide, kPlanSide, reduced));
+      TAILOR_RETURN_IF_ERROR(resize_image(full, kPlanSide, kPlanSide, reduced));
       TileOptions reduced_options = options;
       reduced_options.same_size = setup.quadrant != full.width;  // quadrants of the full tile's kind
       TileReport plan_report;
@@ -737,7 +740,7 @@ Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int
       const bool better =
           i == 0 || (meets && !base_meets) || (meets == base_meets && (meets ? cost < base_cost : worst < base_worst));
       if (better) {
-        base = std::move(canvas);
+        if (full_tile == 0) base = std::move(canvas);  // a planned tile is read again from its sources below
         base_source = std::move(source);
         base_source_side = source_side;
         base_blocks = blocks;
@@ -748,18 +751,22 @@ Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int
       }
     }
     rep.blocks += base_blocks;
+    // One full-size tile alive at a time: the planned attempts' tiles were only judged.
+    if (full_tile > 0) base = tile_from_reduced_sources(full, base_source, base_source_side, ex.width, full_tile);
     if (setup.symmetry == 4) {
       // The wrap through one of the '+' lines (quarter_turn_wrap; an earlier N/4 shift ran it
       // through quadrant interiors but put the 4-fold centre off the lattice). rot90(tile) == tile.
       double wrap = 1.0;
       const int q = quarter_turn_wrap(base, wrap);
-      const Plane pinwheel = base;
+      // tile(x, y) = pinwheel((x + q) % N, (y + q) % N), in place: rows, then within each row.
       const int tw = base.width;
-      for (int y = 0; y < tw; ++y)
-        for (int x = 0; x < tw; ++x) {
-          const float* v = pinwheel.at((x + q) % tw, (y + q) % tw);
-          std::copy(v, v + ex.channels, base.at(x, y));
-        }
+      const size_t row = static_cast<size_t>(tw) * base.channels;
+      std::rotate(base.px.begin(), base.px.begin() + static_cast<std::ptrdiff_t>(q * row), base.px.end());
+      for (int y = 0; y < tw; ++y) {
+        const auto start = base.px.begin() + static_cast<std::ptrdiff_t>(y * row);
+        std::rotate(start, start + static_cast<std::ptrdiff_t>(q) * base.channels,
+                    start + static_cast<std::ptrdiff_t>(row));
+      }
       rep.shift_x = rep.shift_y = q;
       if (quarter_plan) {
         // The square prepare() cut out of the exemplar: its side, centred.
