@@ -107,6 +107,8 @@ struct Setup {
   int fold_y = 0;
   int symmetry = 1;  // 4: quarter-turn tile (exemplar cropped to its centred square, even side)
   int quadrant = 0;  // symmetry 4: side M of the exemplar square each quadrant holds (tile side 2M)
+  int crop_x = 0;    // symmetry 4: where the exemplar square starts in the input
+  int crop_y = 0;
 };
 
 void choose_shift(const Plane& ex, int& shift_x, int& shift_y);
@@ -174,7 +176,9 @@ Status prepare(const Image& input, const TileOptions& options, Setup& setup, Til
     if (side != input.width || side != input.height) {
       report.warnings.push_back("cropped to the centred " + std::to_string(side) + "x" + std::to_string(side) +
                                 " square for --symmetry 4");
-      work = crop(input, (input.width - side) / 2, (input.height - side) / 2, side, side);
+      setup.crop_x = (input.width - side) / 2;
+      setup.crop_y = (input.height - side) / 2;
+      work = crop(input, setup.crop_x, setup.crop_y, side, side);
     }
   }
   if (options.fit_period) {
@@ -572,14 +576,10 @@ Status quilt_pinwheel(const Setup& setup, const TileOptions& options, const Cros
   return Status::ok();
 }
 
-//! The pinwheel read at full size from the 8-bit exemplar, as a float plane (judged per attempt).
-Plane tile_from_reduced_sources(const Image& full, const std::vector<int32_t>& source, int n, int s, int big_n) {
-  internal::QuarterTurnPlan plan;
-  plan.source = source;
-  plan.n = n;
-  plan.s = s;
-  plan.full_side = full.width;
-  plan.tile_side = big_n;
+//! The pinwheel read at full size from the 8-bit square exemplar through `plan` (its geometry and
+//! a quilted tile's sources), as a float plane (judged per attempt).
+Plane tile_from_reduced_sources(const Image& full, const internal::QuarterTurnPlan& plan) {
+  const int big_n = plan.tile_side;
   std::vector<uint8_t> samples;
   internal::read_quarter_turn(full.pixels.data(), full.width, full.channels, 255.0, false, false, plan, samples);
   Plane out;
@@ -626,10 +626,15 @@ Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int
     // that tile's source map (tile_from_reduced_sources). Quilting at full size searched the whole
     // photo for every block: a 2048 px photo took 14-30 s, a 4096 px one over 10 minutes.
     Image full;  // 8 bits: a float copy of an 8192 px photo is 0.8 GB
-    int full_tile = 0;
-    if (setup.symmetry == 4 && setup.exemplar.width > kPlanMaxSide) {
+    // Symmetry 4: how the quilted tile's sources map onto the (full-size) exemplar square; `full`
+    // is that square already, the input's crop is added for quarter_plan.
+    QuarterTurnPlan geometry;
+    geometry.full_side = setup.exemplar.width;
+    geometry.tile_side = 2 * setup.quadrant;
+    const int crop_x = setup.crop_x, crop_y = setup.crop_y;
+    const bool planned = setup.symmetry == 4 && setup.exemplar.width > kPlanMaxSide;
+    if (planned) {
       full = plane_to_image(setup.exemplar);
-      full_tile = 2 * setup.quadrant;
       Image reduced;
       TAILOR_RETURN_IF_ERROR(resize_image(full, kPlanSide, kPlanSide, reduced));
       TileOptions reduced_options = options;
@@ -642,6 +647,8 @@ Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int
     }
     const Plane& ex = setup.exemplar;
     const int w = ex.width, h = ex.height, b = setup.block, ov = setup.overlap;
+    geometry.n = 2 * setup.quadrant;  // the quilted tile, on the reduced copy when planned
+    geometry.s = ex.width;
     SsdSearch search;
     search.init(ex, all_channels);
     if (tile_plan) {
@@ -698,7 +705,6 @@ Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int
       for (unsigned k = 1; k <= kQuarterTurnRedraws; ++k) plans.push_back({2000u + k, 0.0, kMinCandidates, 0, 0});
     Plane base;
     std::vector<int32_t> base_source;  // symmetry 4: the chosen tile's source map (QuarterTurnPlan)
-    int base_source_side = 0;
     int base_blocks = 0;
     double base_worst = 0.0, base_cost = 0.0;
     bool base_meets = false;
@@ -713,14 +719,16 @@ Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int
       double cost = 0.0;
       SessionRecord record;
       std::vector<int32_t> source;
-      int source_side = 0;
       if (setup.symmetry == 4) {
         TAILOR_RETURN_IF_ERROR(
             quilt_pinwheel(setup, plan_options, plans[i], search, turns, turn_search, canvas, blocks, cost, source));
-        source_side = canvas.width;
         // A planned tile is judged as it will be written, at full size (its wrap and worst seam
         // differ from the reduced tile's: water at 1024 px met its wrap on no reduced attempt).
-        if (full_tile > 0) canvas = tile_from_reduced_sources(full, source, canvas.width, ex.width, full_tile);
+        if (planned) {
+          geometry.source.swap(source);
+          canvas = tile_from_reduced_sources(full, geometry);
+          geometry.source.swap(source);
+        }
       } else
         TAILOR_RETURN_IF_ERROR(
             quilt_cross(setup, plan_options, plans[i], search, canvas, blocks, cost, tile_plan ? &record : nullptr));
@@ -740,9 +748,8 @@ Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int
       const bool better =
           i == 0 || (meets && !base_meets) || (meets == base_meets && (meets ? cost < base_cost : worst < base_worst));
       if (better) {
-        if (full_tile == 0) base = std::move(canvas);  // a planned tile is read again from its sources below
+        if (!planned) base = std::move(canvas);  // a planned tile is read again from its sources below
         base_source = std::move(source);
-        base_source_side = source_side;
         base_blocks = blocks;
         base_worst = worst;
         base_cost = cost;
@@ -752,7 +759,8 @@ Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int
     }
     rep.blocks += base_blocks;
     // One full-size tile alive at a time: the planned attempts' tiles were only judged.
-    if (full_tile > 0) base = tile_from_reduced_sources(full, base_source, base_source_side, ex.width, full_tile);
+    geometry.source = std::move(base_source);
+    if (planned) base = tile_from_reduced_sources(full, geometry);
     if (setup.symmetry == 4) {
       // The wrap through one of the '+' lines (quarter_turn_wrap; an earlier N/4 shift ran it
       // through quadrant interiors but put the 4-fold centre off the lattice). rot90(tile) == tile.
@@ -769,16 +777,10 @@ Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int
       }
       rep.shift_x = rep.shift_y = q;
       if (quarter_plan) {
-        // The square prepare() cut out of the exemplar: its side, centred.
-        const int side = std::min(exemplar.width, exemplar.height) & ~3;
-        quarter_plan->source = std::move(base_source);
-        quarter_plan->n = base_source_side;
-        quarter_plan->s = ex.width;
-        quarter_plan->full_side = full_tile > 0 ? full.width : ex.width;
-        quarter_plan->crop_x = (exemplar.width - side) / 2;
-        quarter_plan->crop_y = (exemplar.height - side) / 2;
-        quarter_plan->tile_side = tw;
-        quarter_plan->roll = q;
+        geometry.roll = q;
+        geometry.crop_x = crop_x;
+        geometry.crop_y = crop_y;
+        *quarter_plan = std::move(geometry);
       }
     }
     tiles.push_back(plane_to_image(base));
