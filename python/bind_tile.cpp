@@ -37,6 +37,17 @@ Image image_from_array(const py::array& array) {
   return image;
 }
 
+// The options tile() and tile_set() share, as `tailor tile` takes them.
+TileOptions tile_options(int block, int overlap, uint64_t seed, int symmetry, bool same_size) {
+  TileOptions options;
+  options.block = block;
+  options.overlap = overlap;
+  options.seed = seed;
+  options.symmetry = symmetry;
+  options.same_size = same_size;
+  return options;
+}
+
 py::array array_from_image(Image&& image) {
   auto* owned = new Image(std::move(image));
   py::capsule owner(owned, [](void* p) { delete static_cast<Image*>(p); });
@@ -65,13 +76,8 @@ void bind_tile(py::module_& m) {
           }
           if (!s) raise_status(s);
         }
-        TileOptions options;
-        options.block = block;
-        options.overlap = overlap;
-        options.seed = seed;
+        TileOptions options = tile_options(block, overlap, seed, symmetry, same_size);
         options.fit_period = fit_period;
-        options.symmetry = symmetry;
-        options.same_size = same_size;
         ProgressBridge bridge(progress);
         options.progress = bridge.function();
         run.input_width = exemplar.width;
@@ -136,12 +142,7 @@ void bind_tile_set(py::module_& m) {
           written.push_back(out);
         }
         std::vector<TileMap> maps(paths.size());
-        TileOptions options;
-        options.block = block;
-        options.overlap = overlap;
-        options.seed = seed;
-        options.symmetry = symmetry;
-        options.same_size = same_size;
+        TileOptions options = tile_options(block, overlap, seed, symmetry, same_size);
         ProgressBridge bridge(progress);
         options.progress = bridge.function();
         Status status;
