@@ -60,7 +60,10 @@ expect_error 2 "$tailor" edit examples/spot.obj -o examples/spot.obj
 
 # --- 2. the API -------------------------------------------------------------------------------------
 start_server() {
-  "$tailor" edit "$@" >"$tmp/edit.log" 2>&1 &
+  # The log is emptied here, not by the background redirection: that one runs in the child, so the
+  # first grep below could still read the previous server's address.
+  : >"$tmp/edit.log"
+  "$tailor" edit "$@" >>"$tmp/edit.log" 2>&1 &
   server_pid=$!
   url=""
   for _ in $(seq 1 300); do

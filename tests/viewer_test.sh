@@ -77,7 +77,10 @@ case "$err" in "tailor: error: "*) ;; *) fail "unexpected error line from view: 
 
 # Starts `tailor view ARGS...` in the background and sets $url once it printed its address.
 start_server() {
-  "$tailor" view "$@" >"$tmp/view.log" 2>&1 &
+  # The log is emptied here, not by the background redirection: that one runs in the child, so the
+  # first grep below could still read the previous server's address.
+  : >"$tmp/view.log"
+  "$tailor" view "$@" >>"$tmp/view.log" 2>&1 &
   server_pid=$!
   url=""
   for _ in $(seq 1 100); do
