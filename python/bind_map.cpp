@@ -110,7 +110,9 @@ const std::string& map_docstring() {
         "texture_size: pixels of one texture repeat (--texture-size); texture=PATH sets it from the image (--texture)\n"
         "material: a PBR material instead of texture (--material): a folder of maps named *_color, *_normal,\n"
         "  *_roughness, *_metallic, *_ao, *_height..., or a JSON naming them; its colour map (else its first\n"
-        "  map) sets the texture size and field_following 'auto'; tailor.save embeds it in a .glb\n"
+        "  map) sets the texture size and field_following 'auto'; tailor.save embeds it in a .glb; the\n"
+        "  quarter-turn tiles of `tailor tile --set --symmetry 4` (its material.json) are mapped with symmetry 4\n"
+        "symmetry: None (default) = 1, or the material's 4 as above; 1 or 4 as --symmetry\n"
         "axis: 'pca', 'x', 'y', 'z', 'auto' or three numbers\n"
         "seam_faces: face indices or an (F,) bool mask of faces where seams should go; None: the file's\n"
         "threads: 0 = automatic (--threads); the result is the same for any count\n"
@@ -185,7 +187,7 @@ void bind_map(py::module_& m) {
          uint32_t threads, const py::object& progress, const py::object& texture, const std::string& mode,
          float max_stretch, const py::object& field_following, uint32_t min_patch_faces, float hop_age,
          bool shorten_seams, bool close_cracks, const py::object& crack_rings, uint32_t relax_iterations,
-         float threshold, const py::object& seed_point, uint32_t symmetry, float unit_scale, uint32_t smooth,
+         float threshold, const py::object& seed_point, const py::object& symmetry, float unit_scale, uint32_t smooth,
          const py::object& material) {
         // === Options, checked before any work (the CLI's checks and messages) ===
         MapTextureOptions options;
@@ -221,7 +223,16 @@ void bind_map(py::module_& m) {
         if (!crack_rings.is_none()) mapping.crack_rings = crack_rings.cast<uint32_t>();  // else as auto decides
         mapping.relax_iterations = relax_iterations;
         mapping.threshold_px = threshold;
-        mapping.symmetry = symmetry;
+        if (!symmetry.is_none()) {
+          int value = 0;
+          try {
+            value = symmetry.cast<int>();
+          } catch (const py::cast_error&) {
+          }
+          if (value != 1 && value != 4)
+            raise_error("--symmetry: " + py::str(symmetry).cast<std::string>() + " not in {1,4}");
+          mapping.symmetry = static_cast<uint32_t>(value);
+        }
         if (threads > 64) raise_error("--threads: value " + std::to_string(threads) + " not in range [0 - 64]");
         mapping.threads = threads;
         if (!seed_point.is_none()) {
@@ -262,6 +273,8 @@ void bind_map(py::module_& m) {
           if (!s) raise_status(s);
           for (const std::string& note : maps.notes) PyErr_WarnEx(PyExc_UserWarning, note.c_str(), 1);
           run.texture = maps.color;
+          // Quarter-turn tiles (`tailor tile --set --symmetry 4`) are mapped for them unless told.
+          if (maps.symmetry == 4 && symmetry.is_none() && mapping.mode == MappingMode::kPatches) mapping.symmetry = 4;
           width = maps.width;
           height = maps.height;
         } else if (!texture.is_none()) {
@@ -356,7 +369,7 @@ void bind_map(py::module_& m) {
       py::arg("hop_age") = md.hop_age, py::arg("shorten_seams") = md.shorten_seams,
       py::arg("close_cracks") = md.close_cracks, py::arg("crack_rings") = py::none(),
       py::arg("relax_iterations") = md.relax_iterations, py::arg("threshold") = md.threshold_px,
-      py::arg("seed_point") = py::none(), py::arg("symmetry") = md.symmetry,
+      py::arg("seed_point") = py::none(), py::arg("symmetry") = py::none(),
       py::arg("unit_scale") = OrientationOptions{}.fixed_unit_scale,
       py::arg("smooth") = OrientationOptions{}.smooth_passes, py::arg("material") = py::none(),
       map_docstring().c_str());

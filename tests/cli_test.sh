@@ -180,6 +180,25 @@ b = json.load(open(sys.argv[2]))['visible_seam_ratio']; sys.exit(0 if abs(a - b)
 "$tailor" map "$tmp/s4a.glb" --texture "$texture" -o "$tmp/s4r.glb" -q &&
   "$tailor" eval "$tmp/s4r.glb" --json -q | grep -q '"symmetry": 1' &&
   ok || fail "a map of a 4-fold map's .glb kept its symmetry record"
+# A set of quarter-turn tiles records it (material.json), and a map of the set is a 4-fold map
+# without being told (the folder or its material.json); --symmetry 1 maps it as plain tiles; a
+# record that is not 1 or 4 is an error naming the file.
+mkdir -p "$tmp/set_in" && cp tests/data/textures/vistex-sand05-128.png "$tmp/set_in/sand_color.png" &&
+  cp tests/data/textures/vistex-bark11-128.png "$tmp/set_in/sand_normal.png" &&
+  "$tailor" tile --set "$tmp/set_in/sand_color.png" "$tmp/set_in/sand_normal.png" \
+    --normal-map "$tmp/set_in/sand_normal.png" --symmetry 4 --same-size -o "$tmp/set4/" -q &&
+  grep -q '"symmetry": 4' "$tmp/set4/material.json" &&
+  "$tailor" map "$mesh" --material "$tmp/set4" -o "$tmp/m4.glb" 2>"$tmp/m4.txt" &&
+  grep -q "^symmetry 4: $tmp/set4 records quarter-turn tiles" "$tmp/m4.txt" &&
+  "$tailor" eval "$tmp/m4.glb" --json -q | grep -q '"symmetry": 4' &&
+  "$tailor" map "$mesh" --material "$tmp/set4/material.json" -o "$tmp/m4j.glb" -q &&
+  "$tailor" eval "$tmp/m4j.glb" --json -q | grep -q '"symmetry": 4' &&
+  "$tailor" map "$mesh" --material "$tmp/set4" --symmetry 1 -o "$tmp/m1.glb" 2>"$tmp/m1.txt" &&
+  ! grep -q "quarter-turn tiles" "$tmp/m1.txt" && "$tailor" eval "$tmp/m1.glb" --json -q | grep -q '"symmetry": 1' &&
+  ok || fail "a map of a 4-fold material set is not a 4-fold map by itself: $(cat "$tmp/m4.txt" "$tmp/m1.txt")"
+sed 's/"symmetry": 4/"symmetry": 3/' "$tmp/set4/material.json" >"$tmp/set4/bad.json"
+expect_error 2 "bad.json: \"symmetry\" must be 1 or 4" -- "$tailor" map "$mesh" --material "$tmp/set4/bad.json" -o "$tmp/x.glb"
+[[ ! -e $tmp/x.glb ]] && ok || fail "map of a material with a bad symmetry record wrote its output"
 "$tailor" render "$mesh" --size 64x48 -o "$tmp/wide.png" -q || fail "render of a 64x48 picture failed"
 expect_error 2 "symmetry 4 needs a square texture, got 64x48" -- "$tailor" map "$mesh" --texture "$tmp/wide.png" -o "$tmp/x.glb" --symmetry 4
 [[ ! -e $tmp/x.glb ]] && ok || fail "map --symmetry 4 with a non-square texture wrote its output"

@@ -130,6 +130,13 @@ int run_map(const MapArgs& opt) {
     if (Status s = load_material(opt.material, material, opt.image_options); !s) return report_error(s);
     for (const std::string& note : material.notes) warn(opt.quiet, note);
     texture_path = material.color;
+    // A set of quarter-turn tiles (`tailor tile --set --symmetry 4`) is mapped for them unless told.
+    if (material.symmetry == 4 && !args.symmetry_given && mapping.mode == MappingMode::kPatches) {
+      mapping.symmetry = 4;
+      if (!opt.quiet)
+        std::fprintf(stderr, "symmetry 4: %s records quarter-turn tiles (--symmetry 1 maps them as plain tiles)\n",
+                     opt.material.c_str());
+    }
   }
   Image texture;
   if (!texture_path.empty()) {
@@ -422,7 +429,8 @@ void register_map(CLI::App& app, Runner& run) {
                   "\"a.png\", \"normal\": \"b.png\", ...}, or OUTDIR/material.json of 'tailor tile --set'). "
                   "The colour map sets the texture size; all maps must share it. The .glb gets baseColor, normal "
                   "(+ per-vertex tangents; a DX map's green is flipped), metallicRoughness (G roughness, B "
-                  "metallic) and occlusion (R); height is not a glTF map and is left out");
+                  "metallic) and occlusion (R); height is not a glTF map and is left out. The quarter-turn tiles "
+                  "of 'tailor tile --set --symmetry 4' are mapped with --symmetry 4 unless --symmetry says otherwise");
   cmd->add_option("--texture-size", opt->mapping_args.texture_size, "Texture size in pixels when no --texture is given")
       ->capture_default_str();
   add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), opt->image_options.max_pixels)
@@ -445,7 +453,8 @@ void register_map(CLI::App& app, Runner& run) {
   cmd->add_option("--preview-up", opt->preview_up, std::string(option_doc(kRenderOptionDocs, "up").help))
       ->capture_default_str();
   auto* group = cmd->add_option_group("Mapping");
-  const CLI::Option* crack_rings = add_mapping_options(group, opt->mapping_args, opt->options, true).crack_rings;
+  const MappingOptionHandles handles = add_mapping_options(group, opt->mapping_args, opt->options, true);
+  const CLI::Option *crack_rings = handles.crack_rings, *symmetry = handles.symmetry;
   cmd->add_flag("--stability", opt->stability,
                 "Also remove ~10% of the faces, re-map and report how much the remaining UVs moved");
   cmd->add_option("--threads", mapping.threads,
@@ -466,8 +475,9 @@ void register_map(CLI::App& app, Runner& run) {
       "texture without a direction (gravel, grass; its isotropy is in the --stats) with rigid unfolding\n"
       "and 32 crack rings, the fewest seams; --field-following 1 keeps the orientation field, and\n"
       "the UVs of a mesh that is edited and re-mapped more stable (docs/mapping.md section 7).");
-  cmd->callback([&run, opt, crack_rings] {
+  cmd->callback([&run, opt, crack_rings, symmetry] {
     opt->mapping_args.crack_rings_given = crack_rings->count() > 0;
+    opt->mapping_args.symmetry_given = symmetry->count() > 0;
     run = [opt] { return run_map_inputs(*opt); };
   });
 }

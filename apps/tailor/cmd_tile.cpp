@@ -301,6 +301,7 @@ int run_tile_set(TileCliOptions opt) {
     internal::FileBatch batch;
     nlohmann::json material;
     material["normal_convention"] = opt.normal_convention;
+    material["symmetry"] = options.symmetry;  // 4: `tailor map --material` maps with --symmetry 4
     material["maps"] = nlohmann::json::array();
     for (size_t m = 0; m < maps.size(); ++m) {
       nlohmann::json entry;

@@ -71,7 +71,8 @@ MappingOptionHandles add_mapping_options(CLI::Option_group* group, MappingArgs& 
     add_documented(group, option_doc(kMappingOptionDocs, "seam_faces"), args.seam_faces);
     add_documented(group, option_doc(kOrientationOptionDocs, "strokes"), args.strokes);
   }
-  add_documented(group, option_doc(kMappingOptionDocs, "symmetry"), mapping.symmetry)->check(CLI::IsMember({1u, 4u}));
+  handles.symmetry = add_documented(group, option_doc(kMappingOptionDocs, "symmetry"), mapping.symmetry)
+                         ->check(CLI::IsMember({1u, 4u}));
   return handles;
 }
 

@@ -33,6 +33,7 @@ struct MappingArgs {
   std::string axis = axis_text(OrientationOptions{});  // or auto (resolved by choose_orientation_axis)
   std::string field_following = "auto";                // or a number in [0, 1]
   bool crack_rings_given = false;                      // --crack-rings on the command line (kept over auto's)
+  bool symmetry_given = false;                         // --symmetry on the command line (kept over a material's)
   std::string seed_point;
   std::string seam_faces;                            // --seam-faces: a file of face ids
   std::string strokes;                               // --strokes: orientation strokes, JSON (read_strokes.cpp)
@@ -46,6 +47,7 @@ struct MappingArgs {
 struct MappingOptionHandles {
   CLI::Option* crack_rings = nullptr;  // its count() sets MappingArgs::crack_rings_given
   CLI::Option* smooth = nullptr;
+  CLI::Option* symmetry = nullptr;  // its count() sets MappingArgs::symmetry_given
 };
 
 //! Adds the mapping options (--mode ... --symmetry) to `group`, in the order of --help, bound to `args`

@@ -32,6 +32,10 @@ struct MaterialMaps {
   Image occlusion_image;      //!< the occlusion map, one 8-bit channel: for previews; or empty
   std::vector<std::string> files;  //!< every map read, "role: path", for reports
   std::vector<std::string> notes;  //!< one-line warnings (height map not embedded, ...)
+  //! What the material JSON (or a folder's material.json) records as "symmetry": 4 for the
+  //! quarter-turn tiles of `tailor tile --set --symmetry 4`, which `tailor map` and tailor.map then
+  //! map with symmetry 4 unless told otherwise; 1 for plain tiles; 0 when it says nothing.
+  int symmetry = 0;
 };
 
 //! Reads a material: a folder (its .png/.jpg/.jpeg files with a recognised suffix; others ignored) or
@@ -39,8 +43,10 @@ struct MaterialMaps {
 //! material.json of `tailor tile --set` ({"maps": [{"file": ..., "normal": true}, ...]}: roles from
 //! "role"/"type" or the file names). Paths are relative to the JSON's folder. A DX normal map
 //! (normal_convention "dx" or a _dx/_directx suffix) has its green channel flipped. 16-bit maps
-//! stay 16-bit. Fails (kInvalidArgument, one line naming the file) when no map is recognised, two
-//! files claim one role, maps differ in size; kIo / kInvalidImage for unreadable files.
+//! stay 16-bit. A "symmetry" of 1 or 4 in the JSON, or in a folder's material.json, fills
+//! MaterialMaps::symmetry. Fails (kInvalidArgument, one line naming the file) when no map is
+//! recognised, two files claim one role, maps differ in size, a symmetry is not 1 or 4; kIo /
+//! kInvalidImage for unreadable files.
 TAILOR_API Status load_material(const std::string& dir_or_json, MaterialMaps& out,
                                 const ImageLoadOptions& options = {});
 

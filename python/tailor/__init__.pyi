@@ -76,7 +76,7 @@ def map(
     relax_iterations: int = 10,
     threshold: float = 25.0,
     seed_point: Optional[Sequence[float]] = None,
-    symmetry: Literal[1, 4] = 1,
+    symmetry: Optional[Literal[1, 4]] = None,
     unit_scale: float = 0.0,
     smooth: int = 0,
     material: Optional[_Path] = None,

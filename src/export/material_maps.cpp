@@ -86,6 +86,21 @@ MaterialRole material_role_from_name(const std::string& file_name, bool* directx
   return MaterialRole::kNone;
 }
 
+namespace {
+
+//! The "symmetry" a material JSON records (`tailor tile --set` writes 1 or 4), into `symmetry`;
+//! left as it is when the JSON has none.
+Status read_symmetry(const nlohmann::json& j, const std::string& file, int& symmetry) {
+  if (!j.contains("symmetry")) return Status::ok();
+  const nlohmann::json& value = j["symmetry"];
+  if (!value.is_number_integer() || (value.get<int>() != 1 && value.get<int>() != 4))
+    return Status::error(ErrorCode::kInvalidArgument, file, "\"symmetry\" must be 1 or 4", value.dump());
+  symmetry = value.get<int>();
+  return Status::ok();
+}
+
+}  // namespace
+
 Status load_material(const std::string& dir_or_json, MaterialMaps& out, const ImageLoadOptions& options) {
   out = {};
   namespace fs = std::filesystem;
@@ -109,6 +124,15 @@ Status load_material(const std::string& dir_or_json, MaterialMaps& out, const Im
         names.push_back(e.path().filename().string());
     }
     if (ec) return Status::error(ErrorCode::kIo, dir_or_json, "cannot list the folder");
+    // The folder of `tailor tile --set`: its material.json says whether the maps are quarter-turn
+    // tiles (the maps themselves are found by name, as in any folder).
+    const std::string record = dir_or_json + "/material.json";
+    if (std::ifstream in{record}) {
+      std::stringstream text;
+      text << in.rdbuf();
+      const nlohmann::json j = nlohmann::json::parse(text.str(), nullptr, false);
+      if (!j.is_discarded() && j.is_object()) TAILOR_RETURN_IF_ERROR(read_symmetry(j, record, out.symmetry));
+    }
     std::sort(names.begin(), names.end());  // deterministic whatever the listing order
     for (const std::string& name : names) {
       bool dx = false;
@@ -135,6 +159,7 @@ Status load_material(const std::string& dir_or_json, MaterialMaps& out, const Im
         return Status::error(ErrorCode::kInvalidArgument, dir_or_json, "normal_convention must be \"gl\" or \"dx\"");
       directx = c == "dx";
     }
+    TAILOR_RETURN_IF_ERROR(read_symmetry(j, dir_or_json, out.symmetry));
     if (j.contains("maps") && j["maps"].is_array()) {  // tailor tile --set's material.json
       for (size_t i = 0; i < j["maps"].size(); ++i) {
         const nlohmann::json& m = j["maps"][i];
@@ -154,7 +179,9 @@ Status load_material(const std::string& dir_or_json, MaterialMaps& out, const Im
       }
     } else {
       for (const auto& [key, value] : j.items()) {
-        if (key == "normal_convention" || key == "width" || (key == "height" && !value.is_string())) continue;
+        if (key == "normal_convention" || key == "symmetry" || key == "width" ||
+            (key == "height" && !value.is_string()))
+          continue;
         bool dx = false;
         const MaterialRole role = role_from_word(key, &dx);
         if (role == MaterialRole::kNone || !value.is_string())

@@ -173,3 +173,22 @@ def test_symmetry_4_warns_as_the_cli(tmp_path, tailor_binary):
             tailor.map(mesh, symmetry=4, texture_size=1024)
         tailor.map(mesh, symmetry=4, relax_iterations=0)  # 512 px, 1.56 repeats, no texture: nothing to say
         tailor.map(mesh, texture_size=1024, relax_iterations=0)  # symmetry 1: nothing to say
+
+
+def test_a_set_of_quarter_turn_tiles_is_mapped_with_symmetry_4(tmp_path, tailor_binary):
+    import shutil
+
+    textures = DATA / "textures"
+    (tmp_path / "in").mkdir()
+    shutil.copy(textures / "vistex-sand05-128.png", tmp_path / "in" / "sand_color.png")
+    shutil.copy(textures / "vistex-bark11-128.png", tmp_path / "in" / "sand_normal.png")
+    code, _, err = run_cli(tailor_binary, "tile", "--set", tmp_path / "in" / "sand_color.png",
+                           tmp_path / "in" / "sand_normal.png", "--normal-map", tmp_path / "in" / "sand_normal.png",
+                           "--symmetry", "4", "--same-size", "-o", str(tmp_path / "set4") + "/", "-q")
+    assert code == 0, err
+    mesh = tailor.load(SPOT)
+    # The record (material.json) decides unless symmetry= is given, as `tailor map --material`.
+    assert tailor.map(mesh, material=tmp_path / "set4", relax_iterations=0).stats["options"]["symmetry"] == 4
+    assert tailor.map(mesh, material=tmp_path / "set4", symmetry=1, relax_iterations=0).stats["options"]["symmetry"] == 1
+    with pytest.raises(tailor.Error, match="--symmetry: 3 not in"):
+        tailor.map(mesh, symmetry=3)
