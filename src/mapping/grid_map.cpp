@@ -229,6 +229,8 @@ Status map_grid(const MappingInput& input, Atlas& atlas, MappingStats& stats, st
   // cones moved: median visible seams 2.24 -> 2.05 % of edge length (14 meshes lower, blobby 1.55
   // -> 0.63 %), invisible share 45 -> 48 %, at scale 800 unchanged (4.45 / 4.49 %); then cone pairs
   // cancelled (after the coarse position levels were settled): 1.85 -> 1.73 %, 3.19 -> 3.16 %.
+  // Cones held on their nearest vertex (an integer-grid map's cone) and dislocations relaxed over a
+  // band of faces were both worse (1.47 -> 1.55 and 1.53-1.57 % at 8000; docs/mapping.md section 7).
   remember();
   find_maps();
   cancel_cone_pairs(mesh, topology, edge_map);
