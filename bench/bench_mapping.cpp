@@ -11,10 +11,13 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <array>
+#include <chrono>
 #include <filesystem>
 #include <map>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "bench_meshes.h"
@@ -117,6 +120,59 @@ void BM_Mapping(benchmark::State& state, const std::string& key, const tailor::M
   if (options.mode == tailor::MappingMode::kThesis) state.counters["thr_px"] = stats.final_threshold_px;
 }
 
+// Thread scaling: the whole map_texture (orientation, mapping; no metrics) on horse_x16 with
+// state.range(0) threads, and whether its UVs are bit-identical to the 1-thread run's (the
+// project's determinism rule; the 1-thread row runs first and keeps its UVs per mode). The
+// stages' shares of the last run, from the last progress report of each (orientation, mapping:
+// the growth or the grid map and the seam shortening, closing, relaxing), show which of them keep
+// the others waiting.
+void BM_MappingThreads(benchmark::State& state, const std::string& key, const std::string& mode,
+                       tailor::MappingOptions options) {
+  const Prepared& p = prepared(key);
+  if (!p.ok) {
+    state.SkipWithError(p.error.c_str());
+    return;
+  }
+  static std::map<std::string, std::vector<float>> one_thread_uv;  // per mode
+  options.threads = static_cast<uint32_t>(state.range(0));
+  tailor::MapTextureOptions pipeline;
+  pipeline.mapping = options;
+  pipeline.orientation.threads = options.threads;
+  pipeline.measure = false;
+  using Clock = std::chrono::steady_clock;
+  const std::array<std::string_view, 4> stages = {"orientation", "mapping", "closing", "relaxing"};
+  std::array<Clock::time_point, 4> last_report{};
+  pipeline.stage_progress = [&](std::string_view stage, float) {
+    for (size_t s = 0; s < stages.size(); ++s)
+      if (stage == stages[s]) last_report[s] = Clock::now();
+    return true;
+  };
+  tailor::TextureMap map;
+  Clock::time_point start, end;
+  for (auto _ : state) {
+    last_report = {};
+    start = Clock::now();
+    if (!tailor::map_texture(p.mesh, p.topology, pipeline, map).is_ok()) {
+      state.SkipWithError("mapping failed");
+      return;
+    }
+    end = Clock::now();
+    benchmark::DoNotOptimize(map.atlas.corner_uv.data());
+  }
+  Clock::time_point previous = start;
+  for (size_t s = 0; s < stages.size(); ++s) {
+    const Clock::time_point until = s + 1 == stages.size() ? end : last_report[s];
+    if (until == Clock::time_point{}) continue;  // a stage this mode has not (closing with symmetry 4 has)
+    state.counters[std::string(stages[s]) + "_s"] = std::chrono::duration<double>(until - previous).count();
+    previous = until;
+  }
+  if (options.threads == 1) one_thread_uv[mode] = map.atlas.corner_uv;
+  const auto reference = one_thread_uv.find(mode);
+  state.counters["threads"] = options.threads;
+  state.counters["same_bits"] = reference != one_thread_uv.end() && reference->second == map.atlas.corner_uv;
+  set_faces_rate(state, p.mesh.face_count());
+}
+
 // Registers one orientation and nine mapping benchmarks per mesh at static initialisation:
 // patches mode with a texture that has a direction, or none (default options, and ten times the
 // texture scale), with a texture without direction (`tailor map`'s default for gravel, grass:
@@ -185,6 +241,22 @@ void BM_Mapping(benchmark::State& state, const std::string& key, const tailor::M
         ->MinTime(0.2)
         ->UseManualTime();
   }
+  // Thread scaling on the large mesh: the texture-aware default for an isotropic tile (undirected),
+  // field following, and the 4-fold map, 1 to 16 threads.
+  for (const auto& [mode, options] :
+       {std::pair{std::string("undirected"), undirected}, std::pair{std::string("patches"), patches},
+        std::pair{std::string("symmetry4"), fourfold}})
+    benchmark::RegisterBenchmark(("MappingThreads/" + mode + "/horse_x16").c_str(), BM_MappingThreads, "horse_x16",
+                                 mode, options)
+        ->ArgName("threads")
+        ->Arg(1)
+        ->Arg(2)
+        ->Arg(4)
+        ->Arg(8)
+        ->Arg(16)
+        ->Unit(benchmark::kMillisecond)
+        ->MinTime(0.2)
+        ->UseRealTime();
   return true;
 }();
 
