@@ -88,6 +88,16 @@ MaterialRole material_role_from_name(const std::string& file_name, bool* directx
 
 namespace {
 
+//! The JSON in the file at `path` (discarded when it does not parse); false when it cannot be opened.
+bool read_json(const std::string& path, nlohmann::json& out) {
+  std::ifstream in(path);
+  if (!in) return false;
+  std::stringstream text;
+  text << in.rdbuf();
+  out = nlohmann::json::parse(text.str(), nullptr, false);
+  return true;
+}
+
 //! The "symmetry" a material JSON records (`tailor tile --set` writes 1 or 4), into `symmetry`;
 //! left as it is when the JSON has none.
 Status read_symmetry(const nlohmann::json& j, const std::string& file, int& symmetry) {
@@ -127,12 +137,9 @@ Status load_material(const std::string& dir_or_json, MaterialMaps& out, const Im
     // The folder of `tailor tile --set`: its material.json says whether the maps are quarter-turn
     // tiles (the maps themselves are found by name, as in any folder).
     const std::string record = dir_or_json + "/material.json";
-    if (std::ifstream in{record}) {
-      std::stringstream text;
-      text << in.rdbuf();
-      const nlohmann::json j = nlohmann::json::parse(text.str(), nullptr, false);
-      if (!j.is_discarded() && j.is_object()) TAILOR_RETURN_IF_ERROR(read_symmetry(j, record, out.symmetry));
-    }
+    nlohmann::json j;
+    if (read_json(record, j) && !j.is_discarded() && j.is_object())
+      TAILOR_RETURN_IF_ERROR(read_symmetry(j, record, out.symmetry));
     std::sort(names.begin(), names.end());  // deterministic whatever the listing order
     for (const std::string& name : names) {
       bool dx = false;
@@ -140,11 +147,9 @@ Status load_material(const std::string& dir_or_json, MaterialMaps& out, const Im
       if (role != MaterialRole::kNone) TAILOR_RETURN_IF_ERROR(claim(role, dir_or_json + "/" + name, dx));
     }
   } else {
-    std::ifstream in(dir_or_json);
-    if (!in) return Status::error(ErrorCode::kIo, dir_or_json, "cannot open the material (a folder of maps or a JSON)");
-    std::stringstream text;
-    text << in.rdbuf();
-    const nlohmann::json j = nlohmann::json::parse(text.str(), nullptr, false);
+    nlohmann::json j;
+    if (!read_json(dir_or_json, j))
+      return Status::error(ErrorCode::kIo, dir_or_json, "cannot open the material (a folder of maps or a JSON)");
     if (j.is_discarded() || !j.is_object())
       return Status::error(
           ErrorCode::kInvalidArgument, dir_or_json,
