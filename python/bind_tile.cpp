@@ -160,6 +160,20 @@ void bind_tile_set(py::module_& m) {
           if (status && !std::filesystem::is_directory(folder) && !std::filesystem::create_directories(folder))
             status = Status::error(ErrorCode::kIo, folder, "cannot create the output folder");
           for (size_t i = 0; i < written.size() && status; ++i) status = write_png16(written[i], tiles[0][i]);
+          if (status) {  // material.json, as the command writes it (tailor.map(material=folder) reads it)
+            TileSetRecord record;
+            record.symmetry = options.symmetry;
+            record.width = tiles[0][0].width;
+            record.height = tiles[0][0].height;
+            for (size_t i = 0; i < paths.size(); ++i)
+              record.maps.push_back({tile_set_file_name(paths[i]),
+                                     paths[i],
+                                     maps[i].normal,
+                                     maps[i].image.bits,
+                                     maps[i].image.channels,
+                                     {}});
+            status = write_tile_set_record(folder, record);
+          }
         }
         bridge.finish(status);
         return written;
@@ -172,9 +186,11 @@ void bind_tile_set(py::module_& m) {
 Makes the maps of one material (colour, normal, roughness, height... image files of one size)
 self-tileable with one cut for all, as `tailor tile --set MAPS --normal-map N -o OUTPUT/`: each is
 written into the folder `output` (created if missing) under its own name as .png, 8 or 16 bits as
-its input; returns the written paths in the order of `maps`. normal_maps: the maps (the same paths)
-that are normal maps, blended as vectors. symmetry=4 (`--symmetry 4`): one quarter-turn tile for
-all, normal maps turned with their content; same_size as in tile().)");
+its input, with the command's material.json beside them; returns the written maps' paths in the
+order of `maps`. normal_maps: the maps (the same paths) that are normal maps, blended as vectors.
+symmetry=4 (`--symmetry 4`): one quarter-turn tile for all, normal maps turned with their content,
+recorded in material.json so that map(material=output/material.json) maps with symmetry 4;
+same_size as in tile().)");
 }
 
 }  // namespace tailor::python

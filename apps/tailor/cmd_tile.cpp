@@ -299,25 +299,21 @@ int run_tile_set(TileCliOptions opt) {
   // before the folder is.
   const Status written = [&]() -> Status {
     internal::FileBatch batch;
-    nlohmann::json material;
-    material["normal_convention"] = opt.normal_convention;
-    material["symmetry"] = options.symmetry;  // 4: `tailor map --material` maps with --symmetry 4
-    material["maps"] = nlohmann::json::array();
+    TileSetRecord record;
+    record.normal_convention = opt.normal_convention;
+    record.symmetry = options.symmetry;
+    record.width = run.report.width;
+    record.height = run.report.height;
     for (size_t m = 0; m < maps.size(); ++m) {
-      nlohmann::json entry;
-      entry["file"] = names[m];
-      entry["source"] = opt.set[m];
-      entry["normal"] = maps[m].normal;
-      entry["bits"] = maps[m].image.bits;
-      entry["channels"] = maps[m].image.channels;
-      if (opt.variants > 1) {
-        entry["variants"] = nlohmann::json::array();
-        for (int k = 0; k < opt.variants; ++k) entry["variants"].push_back(base_name(file_of(m, k)));
-      }
-      material["maps"].push_back(entry);
+      TileSetRecord::Map& entry = record.maps.emplace_back();
+      entry.file = names[m];
+      entry.source = opt.set[m];
+      entry.normal = maps[m].normal;
+      entry.bits = maps[m].image.bits;
+      entry.channels = maps[m].image.channels;
+      if (opt.variants > 1)
+        for (int k = 0; k < opt.variants; ++k) entry.variants.push_back(base_name(file_of(m, k)));
     }
-    material["width"] = run.report.width;
-    material["height"] = run.report.height;
     for (int k = 0; k < opt.variants; ++k)
       for (size_t m = 0; m < maps.size(); ++m) {
         const std::string path = file_of(m, k);
@@ -326,7 +322,7 @@ int run_tile_set(TileCliOptions opt) {
         q.file = path;
         run.tiles.push_back(q);
       }
-    if (Status s = internal::write_file_atomic(outdir + "/material.json", material.dump(2) + "\n"); !s) return s;
+    if (Status s = write_tile_set_record(outdir, record); !s) return s;
     if (!opt.quiet || !opt.json.empty()) {
       // Metrics of every output map against its input (8-bit reductions of 16-bit maps).
       bool all_met = true;

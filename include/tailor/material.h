@@ -50,4 +50,23 @@ struct MaterialMaps {
 TAILOR_API Status load_material(const std::string& dir_or_json, MaterialMaps& out,
                                 const ImageLoadOptions& options = {});
 
+//! What the material.json of a tiled set records (`tailor tile --set`, tailor.tile_set), which
+//! load_material reads back.
+struct TileSetRecord {
+  struct Map {
+    std::string file;                   //!< its tile's file name in the folder (tile_set_file_name)
+    std::string source;                 //!< the input it was tiled from, as given
+    bool normal = false;                //!< a normal map
+    int bits = 8, channels = 0;         //!< the input's (the tile keeps them)
+    std::vector<std::string> variants;  //!< the variants' file names in order; empty for one tile
+  };
+  std::vector<Map> maps;
+  std::string normal_convention = "gl";  //!< "gl" or "dx"
+  int symmetry = 1;                      //!< 4: quarter-turn tiles, mapped with symmetry 4 (load_material)
+  int width = 0, height = 0;             //!< the tiles' size
+};
+
+//! Writes folder/material.json for `record` (atomically; staged in an active internal::FileBatch).
+TAILOR_API Status write_tile_set_record(const std::string& folder, const TileSetRecord& record);
+
 }  // namespace tailor

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "tailor/material.h"
+#include "util/atomic_file.h"
 
 namespace tailor {
 namespace {
@@ -290,6 +291,26 @@ Status load_material(const std::string& dir_or_json, MaterialMaps& out, const Im
     out.textures.orm_occlusion = ao;
   }
   return Status::ok();
+}
+
+Status write_tile_set_record(const std::string& folder, const TileSetRecord& record) {
+  nlohmann::json material;
+  material["normal_convention"] = record.normal_convention;
+  material["symmetry"] = record.symmetry;  // 4: `tailor map --material` maps with --symmetry 4
+  material["maps"] = nlohmann::json::array();
+  for (const TileSetRecord::Map& map : record.maps) {
+    nlohmann::json entry;
+    entry["file"] = map.file;
+    entry["source"] = map.source;
+    entry["normal"] = map.normal;
+    entry["bits"] = map.bits;
+    entry["channels"] = map.channels;
+    if (!map.variants.empty()) entry["variants"] = map.variants;
+    material["maps"].push_back(entry);
+  }
+  material["width"] = record.width;
+  material["height"] = record.height;
+  return internal::write_file_atomic(folder + "/material.json", material.dump(2) + "\n");
 }
 
 }  // namespace tailor

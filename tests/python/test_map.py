@@ -190,5 +190,9 @@ def test_a_set_of_quarter_turn_tiles_is_mapped_with_symmetry_4(tmp_path, tailor_
     # The record (material.json) decides unless symmetry= is given, as `tailor map --material`.
     assert tailor.map(mesh, material=tmp_path / "set4", relax_iterations=0).stats["options"]["symmetry"] == 4
     assert tailor.map(mesh, material=tmp_path / "set4", symmetry=1, relax_iterations=0).stats["options"]["symmetry"] == 1
+    # ... also a set tiled by tailor.tile_set (it writes the same material.json).
+    tailor.tile_set([tmp_path / "in" / "sand_color.png", tmp_path / "in" / "sand_normal.png"], tmp_path / "py4",
+                    normal_maps=[tmp_path / "in" / "sand_normal.png"], symmetry=4, same_size=True)
+    assert tailor.map(mesh, material=tmp_path / "py4", relax_iterations=0).stats["options"]["symmetry"] == 4
     with pytest.raises(tailor.Error, match="--symmetry: 3 not in"):
         tailor.map(mesh, symmetry=3)

@@ -1,5 +1,6 @@
 """Progress, cancelling, Ctrl-C and the GIL: a long map leaves other Python threads running."""
 import _thread
+import json
 import os
 import struct
 import threading
@@ -126,7 +127,7 @@ def test_tile_set_writes_the_maps_as_the_cli_does(tmp_path, tailor_binary):
     assert [os.path.basename(p) for p in written] == ["vistex-sand05-128.png", "vistex-bark11-128.png"]
     code, _, err = run_cli(tailor_binary, "tile", "--set", sand, bark, "--normal-map", bark, "-o", tmp_path / "cli", "-q")
     assert code == 0, err
-    for name in ("vistex-sand05-128.png", "vistex-bark11-128.png"):
+    for name in ("vistex-sand05-128.png", "vistex-bark11-128.png", "material.json"):
         assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes(), name
     with pytest.raises(tailor.Error, match="same size"):
         tailor.tile_set([sand, textures + "water-caustics-300.jpg"], tmp_path / "bad")
@@ -138,8 +139,9 @@ def test_tile_set_writes_the_maps_as_the_cli_does(tmp_path, tailor_binary):
     code, _, err = run_cli(tailor_binary, "tile", "--set", sand, bark, "--normal-map", bark, "-o", tmp_path / "cli4",
                            "-q", "--symmetry", "4")
     assert code == 0, err
-    for name in ("vistex-sand05-128.png", "vistex-bark11-128.png"):
+    for name in ("vistex-sand05-128.png", "vistex-bark11-128.png", "material.json"):
         assert (tmp_path / "py4" / name).read_bytes() == (tmp_path / "cli4" / name).read_bytes(), name
+    assert json.loads((tmp_path / "py4" / "material.json").read_text())["symmetry"] == 4
     header = (tmp_path / "py4" / "vistex-sand05-128.png").read_bytes()[16:24]  # the PNG's IHDR width, height
     assert struct.unpack(">II", header) == (256, 256)
 
