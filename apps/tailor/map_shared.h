@@ -32,6 +32,8 @@ struct MappingArgs {
   std::string mode = mapping_mode_name(MappingOptions{}.mode);
   std::string axis = axis_text(OrientationOptions{});  // or auto (resolved by choose_orientation_axis)
   std::string field_following = "auto";                // or a number in [0, 1]
+  std::string chunks = "auto";                         // --chunks auto|on|off
+  std::string chunk_cell = "auto";                     // --chunk-cell: a power-of-two exponent, or auto
   bool crack_rings_given = false;                      // --crack-rings on the command line (kept over auto's)
   bool symmetry_given = false;                         // --symmetry on the command line (kept over a material's)
   std::string seed_point;

@@ -43,6 +43,7 @@
 
 #include "tailor/api.h"
 #include "tailor/atlas.h"
+#include "tailor/chunks.h"
 #include "tailor/mesh.h"
 #include "tailor/metrics.h"
 #include "tailor/option_doc.h"
@@ -189,7 +190,14 @@ struct MappingStats {
   uint64_t relax_moves = 0;            //!< kPatches: UV vertex moves the relaxation kept (relax_iterations)
   uint64_t faces_seam = 0;             //!< faces flagged in seam_faces
   uint64_t inverted_accepted = 0;      //!< kThesis: faces accepted with a non-positive UV area (always 0 in kPatches)
-  double seconds = 0.0;                //!< wall time of the growth, seam shortening and crack closing (steps 2-4)
+  double seconds = 0.0;                //!< wall time of the growth, seam shortening and crack closing (steps 2-4);
+                                       //!< chunked: of the whole per-chunk pipeline (orientation included)
+  // The chunked engine (tailor/chunks.h); chunks = 0 when the mesh was mapped whole.
+  uint32_t chunks = 0;         //!< chunks mapped
+  double chunk_cell_size = 0;  //!< the chunk grid's cell side, world units (a power of two)
+  double texels_per_unit = 0;  //!< texture pixels per world unit every chunk was mapped at
+  double locality_radius = 0;  //!< world units: corners farther than this from every edited face keep
+                               //!< their UVs bit for bit when the mesh is mapped again (ChunkPlan)
 };
 
 //! Seed face of every edge component: the face whose centroid is nearest to the seed point (the
@@ -202,6 +210,7 @@ struct MapTextureOptions {
   OrientationOptions orientation;  //!< step 1, the orientation field
   MappingOptions mapping;          //!< steps 2-4: growth, seam shortening, crack closing (and the progress)
   MetricsOptions metrics;          //!< step 5 (the texture size, for the seam gap)
+  ChunkOptions chunks;             //!< the chunked engine: whether and how the mesh is cut into chunks
   bool measure = true;             //!< false skips step 5 (TextureMap::metrics stays empty)
   //! Optional, beside mapping.progress: each stage's own progress ("orientation", "mapping" (the
   //! growth and seam shortening), "closing", "relaxing", "metrics"); return false to cancel.

@@ -166,10 +166,34 @@ ProgressCallback both_progress(ProgressCallback a, ProgressCallback b) {
 
 }  // namespace
 
+namespace {
+
+// Step 6, the metrics of the result (metrics/uv_metrics.cpp), unless options.measure is off.
+Status measure_atlas(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options, TextureMap& map) {
+  if (!options.measure) return Status::ok();
+  const StageProgressCallback& stage = options.stage_progress;
+  if (stage && !stage("metrics", 0.f)) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
+  TAILOR_RETURN_IF_ERROR(
+      compute_uv_metrics(mesh, topology, map.atlas.corner_uv, map.atlas.patch, options.metrics, map.metrics));
+  if (stage && !stage("metrics", 1.f)) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
+  return Status::ok();
+}
+
+}  // namespace
+
 Status map_texture(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options, TextureMap& map) {
   clear_atlas(map.atlas);
   map.stats = MappingStats{};
   map.metrics = UvMetrics{};
+  // === 0. Chunks: a large mesh is cut by the world-space chunk rule and every chunk runs steps
+  //        1-5 on its own, in parallel (mapping/map_chunks.cpp, tailor/chunks.h) ===
+  TAILOR_RETURN_IF_ERROR(check_chunk_options(options.chunks));
+  if (uses_chunks(options.chunks, mesh.face_count())) {
+    if (topology.opposite.size() != 3 * mesh.face_count())
+      return Status::error(ErrorCode::kInvalidMesh, "", "topology does not match the mesh");
+    TAILOR_RETURN_IF_ERROR(internal::map_chunks(mesh, options, map));
+    return measure_atlas(mesh, topology, options, map);
+  }
   // === 1. Orientation field: per-face frames, the field and its variation (surface/orientation.cpp) ===
   if (options.stage_progress) {
     OrientationOptions orientation = options.orientation;
@@ -245,13 +269,7 @@ Status internal::map_texture_frames(const Mesh& mesh, const Topology& topology, 
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   // === 6. Metrics of the result (metrics/uv_metrics.cpp) ===
-  if (options.measure) {
-    if (stage && !stage("metrics", 0.f)) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
-    TAILOR_RETURN_IF_ERROR(
-        compute_uv_metrics(mesh, topology, map.atlas.corner_uv, map.atlas.patch, options.metrics, map.metrics));
-    if (stage && !stage("metrics", 1.f)) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
-  }
-  return Status::ok();
+  return measure_atlas(mesh, topology, options, map);
 }
 
 }  // namespace tailor

@@ -65,6 +65,16 @@ inline MetricsOptions lattice_of(const MappingOptions& options) {
 Status map_texture_frames(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options,
                           TextureMap& map);
 
+//! The chunked engine (map_chunks.cpp): steps 1-4 of map_texture on each chunk of the chunk rule
+//! (ChunkPlan), in parallel, written back to the mesh's corners; map.frames stays empty and
+//! map.stats holds the chunks' counters summed and the chunk grid's figures.
+Status map_chunks(const Mesh& mesh, const MapTextureOptions& options, TextureMap& map);
+
+//! The texel density the chunks are mapped at, texture pixels per world unit: options.mapping.scale
+//! times the fixed normalisation when one is given, else per the longest side of the referenced
+//! vertices' bounding box rounded to a power of two (0 for a mesh without extent).
+double chunk_texels_per_unit(const Mesh& mesh, const MapTextureOptions& options);
+
 //! The growth's age per placed face: the option, or the mode's default (MappingOptions::factor_step).
 double factor_step_for(const MappingOptions& options, size_t face_count);
 

@@ -70,16 +70,30 @@ std::string stability_report_json(const std::string& file, const StabilityReport
   j["within_1px_ratio"] = r.within_1px_ratio;
   j["patches_full"] = r.patches_full;
   j["patches_cut"] = r.patches_cut;
+  j["order_identical_ratio"] = r.order_identical_ratio;
+  j["locality_radius"] = r.locality_radius;
+  j["corners_beyond_radius"] = r.corners_beyond_radius;
+  j["identical_beyond_radius_ratio"] = r.identical_beyond_radius_ratio;
   j["seconds"] = r.seconds;
   return internal::json_text(j);
 }
 
 std::string stability_summary(const std::string& file, const StabilityReport& r) {
-  return format_text(
+  std::string text;
+  if (r.order_identical_ratio >= 0)
+    text += format_text("%s: stability: another face, vertex and corner order: %.1f%% of corners bit-identical\n",
+                        file.c_str(), 100.0 * r.order_identical_ratio);
+  text += format_text(
       "%s: stability: removed %zu of %zu faces, surviving corners moved %.3f px on average (max %.2f px), "
       "%.1f%% bit-identical, %.1f%% within 1 px; patches %u -> %u (%.0f ms)\n",
       file.c_str(), r.removed_faces, r.faces, r.mean_difference_px, r.max_difference_px, 100.0 * r.identical_ratio,
       100.0 * r.within_1px_ratio, r.patches_full, r.patches_cut, r.seconds * 1e3);
+  if (r.identical_beyond_radius_ratio >= 0)
+    text += format_text(
+        "%s: stability: %.1f%% of the %zu surviving corners farther than %g units from the cut are "
+        "bit-identical\n",
+        file.c_str(), 100.0 * r.identical_beyond_radius_ratio, r.corners_beyond_radius, r.locality_radius);
+  return text;
 }
 
 }  // namespace tailor

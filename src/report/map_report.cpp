@@ -78,7 +78,11 @@ std::string map_report_json(const MapRun& run) {
                   {"cracks_closed", stats.cracks_closed},
                   {"relax_moves", stats.relax_moves},
                   {"faces_seam", stats.faces_seam},
-                  {"inverted_accepted", stats.inverted_accepted}};
+                  {"inverted_accepted", stats.inverted_accepted},
+                  {"chunks", stats.chunks},
+                  {"chunk_cell_size", stats.chunk_cell_size},
+                  {"texels_per_unit", stats.texels_per_unit},
+                  {"locality_radius", stats.locality_radius}};
   j["metrics"] = {{"patches", metrics.patches},
                   {"single_face_patches", metrics.single_face_patches},
                   {"stretch", metrics.stretch},
@@ -98,9 +102,16 @@ std::string map_report_json(const MapRun& run) {
                   {"uv_scale", metrics.uv_scale}};
   if (run.stability) {
     const StabilityReport& s = *run.stability;
-    j["stability"] = {{"removed_faces", s.removed_faces},           {"compared_corners", s.compared_corners},
-                      {"mean_difference_px", s.mean_difference_px}, {"max_difference_px", s.max_difference_px},
-                      {"identical_ratio", s.identical_ratio},       {"within_1px_ratio", s.within_1px_ratio}};
+    j["stability"] = {{"removed_faces", s.removed_faces},
+                      {"compared_corners", s.compared_corners},
+                      {"mean_difference_px", s.mean_difference_px},
+                      {"max_difference_px", s.max_difference_px},
+                      {"identical_ratio", s.identical_ratio},
+                      {"within_1px_ratio", s.within_1px_ratio},
+                      {"order_identical_ratio", s.order_identical_ratio},
+                      {"locality_radius", s.locality_radius},
+                      {"corners_beyond_radius", s.corners_beyond_radius},
+                      {"identical_beyond_radius_ratio", s.identical_beyond_radius_ratio}};
   }
   j["time_ms"] = {{"load", ms(run.load.load_seconds)},
                   {"topology", ms(run.topology_seconds)},
@@ -129,6 +140,11 @@ std::string map_summary(const MapRun& run) {
       run.options.metrics.symmetry == 4 ? " up to quarter turns" : "", m.visible_dangling_ends,
       ms(run.load.load_seconds), ms(run.topology_seconds), axis_choice.c_str(), ms(run.orientation_seconds),
       ms(run.mapping.seconds), ms(run.export_seconds), run.output.c_str());
+  if (run.mapping.chunks > 0)
+    text += format_text(
+        "chunks: %u of side %g world units, mapped at %g texels per unit; corners farther than %g units from "
+        "an edit keep their UVs\n",
+        run.mapping.chunks, run.mapping.chunk_cell_size, run.mapping.texels_per_unit, run.mapping.locality_radius);
   if (run.stability) {
     const StabilityReport& s = *run.stability;
     text += format_text(
@@ -136,6 +152,12 @@ std::string map_summary(const MapRun& run) {
         "%.1f%% bit-identical, %.1f%% within 1 px\n",
         s.removed_faces, s.mean_difference_px, s.max_difference_px, 100.0 * s.identical_ratio,
         100.0 * s.within_1px_ratio);
+    if (s.order_identical_ratio >= 0)
+      text += format_text("stability: another face, vertex and corner order: %.1f%% of corners bit-identical\n",
+                          100.0 * s.order_identical_ratio);
+    if (s.identical_beyond_radius_ratio >= 0)
+      text += format_text("stability: %.1f%% of the corners farther than %g units from the cut bit-identical\n",
+                          100.0 * s.identical_beyond_radius_ratio, s.locality_radius);
   }
   return text;
 }

@@ -1,0 +1,84 @@
+// tailor: the chunked engine's rule (DESIGN.md section 8, docs/ARCHITECTURE.md "The chunked engine").
+//
+// A large mesh is cut into chunks by a grid anchored at the world origin whose cell side is a
+// power of two in world units: a face belongs to the cell that holds its centroid. The cell side
+// comes from the median edge length, rounded to a power of two, so neither the file's order, the
+// bounding box nor the thread count moves a chunk border, and a local edit moves none either.
+// map_texture maps each chunk on its own (in parallel) from its own geometry only: the same chunk
+// gives the same UVs bit for bit whatever else is loaded and in whatever order its faces, vertices
+// and corners come.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "tailor/api.h"
+#include "tailor/mesh.h"
+#include "tailor/option_doc.h"
+#include "tailor/status.h"
+
+namespace tailor {
+
+//! Whether map_texture cuts the mesh into chunks.
+enum class ChunkMode : uint8_t {
+  kAuto,  //!< chunks from ChunkOptions::min_faces faces on (smaller meshes are one chunk, mapped whole)
+  kOn,    //!< always chunks (a small mesh may still fall into one cell)
+  kOff,   //!< never: the whole mesh is one chunk, as its own bounding box and principal axis say
+};
+
+//! Sentinel of ChunkOptions::cell_exponent: derive it from the mesh's median edge length.
+inline constexpr int kAutoCellExponent = -1000;
+
+struct ChunkOptions {
+  ChunkMode mode = ChunkMode::kAuto;
+  uint32_t min_faces = uint32_t{1} << 17;  //!< kAuto: meshes with fewer faces are mapped whole (one chunk)
+  int cell_exponent = kAutoCellExponent;   //!< cell side 2^cell_exponent world units (-60..60), or auto
+  float cell_edges = 256.f;                //!< auto: the cell side is about this many median edges (rounded to a
+                                           //!< power of two): ~50k-200k faces per full cell (8..4096)
+};
+
+//! Flags and help of the ChunkOptions a user sets (option_doc.h).
+inline constexpr OptionDoc kChunkOptionDocs[] = {
+    {"mode", "--chunks",
+     "auto: meshes from 131072 faces on are cut into chunks by a world-space grid (a power-of-two cell of about "
+     "256 median edges), mapped in parallel, each from its own geometry: the same surface in any file order maps "
+     "to the same UVs, and an edit changes only the chunks it touches; smaller meshes are mapped whole. on: always "
+     "chunks; off: never (one mapping of the whole mesh, one thread for its growth)"},
+    {"cell_exponent", "--chunk-cell",
+     "the chunk grid's cell side as a power of two of world units (e.g. 4 = 16 units); default: from the median "
+     "edge length"},
+};
+
+//! The chunks of one mesh: a CSR list of face ids per chunk, chunks in the order of their cells
+//! (z, then y, then x), faces of a chunk in file order (map_texture sorts them spatially).
+struct ChunkPlan {
+  int cell_exponent = 0;                      //!< cell side = 2^cell_exponent world units
+  double cell_size = 0;                       //!< 2^cell_exponent
+  double median_edge = 0;                     //!< median edge length of the mesh (world units) the cell came from
+  double longest_edge = 0;                    //!< longest edge (world units): faces reach that far beyond their cell
+  std::vector<std::array<int32_t, 3>> cells;  //!< per chunk: its cell's integer coordinates
+  std::vector<uint32_t> chunk_start;          //!< #chunks + 1: offsets into faces
+  std::vector<uint32_t> faces;                //!< #F: face ids grouped by chunk
+  size_t chunk_count() const { return cells.size(); }
+  //! Every corner farther than this from an edited face keeps its UVs bit for bit: the cell's
+  //! diagonal plus a face's reach beyond its cell on both sides.
+  double locality_radius() const { return cell_size * 1.7320508075688772 + 2.0 * longest_edge; }
+};
+
+//! Checks the options (mode, cell_exponent in -60..60 or auto, cell_edges in 8..4096). O(1).
+TAILOR_API Status check_chunk_options(const ChunkOptions& options);
+
+//! True when map_texture with these options cuts this mesh into chunks (kOn, or kAuto and at least
+//! min_faces faces). O(1).
+TAILOR_API bool uses_chunks(const ChunkOptions& options, size_t face_count);
+
+//! The chunk rule: the cell side (the option, or 2^round(log2(cell_edges * median edge length))),
+//! then each face's cell from its centroid. Fails with kInvalidArgument on bad options and
+//! kInvalidMesh when the mesh has no face, no edge of positive length, or cells beyond 2^20 per
+//! axis (a mesh spanning more than a million cells: give a larger cell). O(F) time (the median by
+//! selection), 12 bytes per face while it runs and 4 in the result.
+TAILOR_API Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& plan);
+
+}  // namespace tailor

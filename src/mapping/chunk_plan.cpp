@@ -1,0 +1,174 @@
+// The chunk rule (tailor/chunks.h): a world grid anchored at the origin, cell side a power of two
+// from the median edge length, a face in the cell of its centroid. Everything here is a function
+// of the geometry alone: the median is order-free, the cell of a face depends on its own corners.
+#include <algorithm>
+#include <cmath>
+
+#include "tailor/chunks.h"
+
+namespace tailor {
+
+Status check_chunk_options(const ChunkOptions& options) {
+  if (options.mode != ChunkMode::kAuto && options.mode != ChunkMode::kOn && options.mode != ChunkMode::kOff)
+    return Status::error(ErrorCode::kInvalidArgument, "", "chunk mode must be auto, on or off");
+  if (options.cell_exponent != kAutoCellExponent && (options.cell_exponent < -60 || options.cell_exponent > 60))
+    return Status::error(ErrorCode::kInvalidArgument, "", "chunk cell exponent must be in -60..60");
+  if (!(options.cell_edges >= 8.f && options.cell_edges <= 4096.f))
+    return Status::error(ErrorCode::kInvalidArgument, "", "chunk cell edges must be in 8..4096");
+  return Status::ok();
+}
+
+bool uses_chunks(const ChunkOptions& options, size_t face_count) {
+  return options.mode == ChunkMode::kOn || (options.mode == ChunkMode::kAuto && face_count >= options.min_faces);
+}
+
+namespace {
+
+// Cells per axis either side of the origin: cell coordinates pack into 21 bits each.
+constexpr double kMaxCell = double{1 << 20};
+
+// The face's centroid as three times it, in doubles, the three terms added smallest first so that
+// the corners' order cannot change a rounding.
+inline void centroid3(const Mesh& mesh, size_t f, double out[3]) {
+  const float* p = mesh.positions.data();
+  const uint32_t* idx = mesh.indices.data() + 3 * f;
+  for (int k = 0; k < 3; ++k) {
+    double a = p[3 * size_t{idx[0]} + k], b = p[3 * size_t{idx[1]} + k], c = p[3 * size_t{idx[2]} + k];
+    if (a > b) std::swap(a, b);
+    if (b > c) std::swap(b, c);
+    if (a > b) std::swap(a, b);
+    out[k] = (a + b) + c;
+  }
+}
+
+// A set of cell keys (open addressing, linear probing): the distinct cells are few (one per ~100k
+// faces), so this stays in cache where sorting every face's key would not.
+class CellTable {
+ public:
+  static constexpr uint64_t kEmpty = ~uint64_t{0};
+  void insert(uint64_t key) {
+    if (2 * (size_ + 1) > keys_.size()) grow();
+    size_t i = slot(key);
+    while (keys_[i] != kEmpty && keys_[i] != key) i = (i + 1) & (keys_.size() - 1);
+    if (keys_[i] == kEmpty) {
+      keys_[i] = key;
+      ++size_;
+    }
+  }
+  //! The value stored for a key that was inserted.
+  uint32_t value(uint64_t key) const {
+    size_t i = slot(key);
+    while (keys_[i] != key) i = (i + 1) & (keys_.size() - 1);
+    return values_[i];
+  }
+  std::vector<uint64_t> keys() const {
+    std::vector<uint64_t> out;
+    out.reserve(size_);
+    for (const uint64_t k : keys_)
+      if (k != kEmpty) out.push_back(k);
+    return out;
+  }
+  void set_value(uint64_t key, uint32_t value) {
+    size_t i = slot(key);
+    while (keys_[i] != key) i = (i + 1) & (keys_.size() - 1);
+    values_[i] = value;
+  }
+
+ private:
+  size_t slot(uint64_t key) const { return (key * 0x9E3779B97F4A7C15ull >> 17) & (keys_.size() - 1); }
+  void grow() {
+    std::vector<uint64_t> old = keys_.empty() ? std::vector<uint64_t>() : keys();
+    keys_.assign(std::max<size_t>(64, 2 * keys_.size()), kEmpty);
+    values_.assign(keys_.size(), 0);
+    size_ = 0;
+    for (const uint64_t k : old) insert(k);
+  }
+  std::vector<uint64_t> keys_;
+  std::vector<uint32_t> values_;
+  size_t size_ = 0;
+};
+
+}  // namespace
+
+Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& plan) {
+  TAILOR_RETURN_IF_ERROR(check_chunk_options(options));
+  const size_t face_count = mesh.face_count();
+  if (face_count == 0) return Status::error(ErrorCode::kInvalidMesh, "", "mesh has no face");
+  const float* p = mesh.positions.data();
+  const uint32_t* idx = mesh.indices.data();
+
+  // Edge lengths: each face's three (an interior edge counts twice, which leaves the median where
+  // it is on a closed surface and shifts it by a hair on an open one).
+  std::vector<float> lengths(3 * face_count);
+  float longest = 0.f;
+  for (size_t f = 0; f < face_count; ++f)
+    for (int k = 0; k < 3; ++k) {
+      const float* a = p + 3 * size_t{idx[3 * f + k]};
+      const float* b = p + 3 * size_t{idx[3 * f + (k + 1) % 3]};
+      const double dx = double{a[0]} - b[0], dy = double{a[1]} - b[1], dz = double{a[2]} - b[2];
+      const float l = static_cast<float>(std::sqrt(dx * dx + dy * dy + dz * dz));
+      lengths[3 * f + static_cast<size_t>(k)] = l;
+      longest = std::max(longest, l);
+    }
+  auto middle = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
+  std::nth_element(lengths.begin(), middle, lengths.end());
+  const double median = *middle;
+  std::vector<float>().swap(lengths);
+  plan.median_edge = median;
+  plan.longest_edge = longest;
+
+  int exponent = options.cell_exponent;
+  if (exponent == kAutoCellExponent) {
+    if (!(median > 0.0) || !std::isfinite(median))
+      return Status::error(ErrorCode::kInvalidMesh, "", "no edge of positive length to size the chunks by");
+    exponent = static_cast<int>(std::lround(std::log2(double{options.cell_edges} * median)));
+    exponent = std::clamp(exponent, -60, 60);
+  }
+  plan.cell_exponent = exponent;
+  plan.cell_size = std::ldexp(1.0, exponent);
+  const double inverse3 = std::ldexp(1.0, -exponent) / 3.0;
+
+  // Each face's cell, packed in 63 bits (21 per axis, offset to be unsigned): x fastest.
+  std::vector<uint64_t> key(face_count);
+  for (size_t f = 0; f < face_count; ++f) {
+    double c[3];
+    centroid3(mesh, f, c);
+    uint64_t packed = 0;
+    for (int k = 2; k >= 0; --k) {
+      const double cell = std::floor(c[k] * inverse3);
+      if (!(cell >= -kMaxCell && cell < kMaxCell))
+        return Status::error(ErrorCode::kInvalidMesh, "",
+                             "the mesh spans more than 2^21 chunk cells along an axis: give a larger chunk cell");
+      packed = (packed << 21) | static_cast<uint64_t>(cell + kMaxCell);
+    }
+    key[f] = packed;
+  }
+  // The distinct cells, in key order (z, y, x).
+  CellTable table;
+  for (size_t f = 0; f < face_count; ++f) table.insert(key[f]);
+  std::vector<uint64_t> cells = table.keys();
+  std::sort(cells.begin(), cells.end());
+  const size_t chunks = cells.size();
+  for (size_t c = 0; c < chunks; ++c) table.set_value(cells[c], static_cast<uint32_t>(c));
+  plan.cells.resize(chunks);
+  for (size_t c = 0; c < chunks; ++c)
+    for (int k = 0; k < 3; ++k)
+      plan.cells[c][static_cast<size_t>(k)] = static_cast<int32_t>(
+          static_cast<int64_t>((cells[c] >> (21 * k)) & ((uint64_t{1} << 21) - 1)) - static_cast<int64_t>(kMaxCell));
+  // Faces grouped by chunk (a counting sort, file order within a chunk).
+  std::vector<uint32_t> chunk_of(face_count);
+  plan.chunk_start.assign(chunks + 1, 0);
+  for (size_t f = 0; f < face_count; ++f) {
+    const uint32_t c = table.value(key[f]);
+    chunk_of[f] = c;
+    ++plan.chunk_start[c + 1];
+  }
+  std::vector<uint64_t>().swap(key);
+  for (size_t c = 0; c < chunks; ++c) plan.chunk_start[c + 1] += plan.chunk_start[c];
+  plan.faces.resize(face_count);
+  std::vector<uint32_t> fill(plan.chunk_start.begin(), plan.chunk_start.end() - 1);
+  for (size_t f = 0; f < face_count; ++f) plan.faces[fill[chunk_of[f]]++] = static_cast<uint32_t>(f);
+  return Status::ok();
+}
+
+}  // namespace tailor

@@ -1,0 +1,164 @@
+// The chunked engine (tailor/chunks.h): the chunk rule, and map_texture on chunks: the same UVs for
+// the same surface in any order and for any thread count, edits that stay local, quality kept.
+#include "tailor/chunks.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <tuple>
+
+#include "support/fixtures.h"
+#include "tailor/mapping.h"
+#include "tailor/stability.h"
+#include "tailor/topology.h"
+
+namespace tailor {
+namespace {
+
+using test::load_test_mesh;
+
+// Chunk options that cut a test mesh (tens of thousands of faces) into a handful of chunks.
+MapTextureOptions chunked(int cell_exponent) {
+  MapTextureOptions options;
+  options.chunks.mode = ChunkMode::kOn;
+  options.chunks.cell_exponent = cell_exponent;
+  return options;
+}
+
+// The cell exponent that gives the mesh `cells_across` cells along its longest side.
+int exponent_for(const Mesh& mesh, double cells_across) {
+  float lo = INFINITY, hi = -INFINITY;
+  for (size_t v = 0; v < mesh.vertex_count(); ++v)
+    for (size_t k = 0; k < 3; ++k) {
+      lo = std::min(lo, mesh.positions[3 * v + k]);
+      hi = std::max(hi, mesh.positions[3 * v + k]);
+    }
+  return static_cast<int>(std::floor(std::log2((double{hi} - lo) / cells_across)));
+}
+
+TEST(ChunkPlan, EveryFaceIsInTheCellOfItsCentroid) {
+  const Mesh mesh = load_test_mesh("fertility.off");
+  ChunkOptions options;
+  options.mode = ChunkMode::kOn;
+  options.cell_exponent = exponent_for(mesh, 3);
+  ChunkPlan plan;
+  ASSERT_TRUE(plan_chunks(mesh, options, plan).is_ok());
+  EXPECT_EQ(plan.cell_size, std::ldexp(1.0, options.cell_exponent));
+  ASSERT_GT(plan.chunk_count(), 3u);
+  ASSERT_EQ(plan.chunk_start.back(), mesh.face_count());
+  std::vector<int> seen(mesh.face_count(), 0);
+  for (size_t c = 0; c < plan.chunk_count(); ++c) {
+    ASSERT_LT(plan.chunk_start[c], plan.chunk_start[c + 1]) << "an empty chunk";
+    if (c > 0) {  // z, then y, then x
+      const auto& a = plan.cells[c - 1];
+      const auto& b = plan.cells[c];
+      EXPECT_LT(std::make_tuple(a[2], a[1], a[0]), std::make_tuple(b[2], b[1], b[0])) << "cells out of order";
+    }
+    for (uint32_t i = plan.chunk_start[c]; i < plan.chunk_start[c + 1]; ++i) {
+      const uint32_t f = plan.faces[i];
+      ++seen[f];
+      for (size_t k = 0; k < 3; ++k) {
+        double centroid = 0;
+        for (size_t j = 0; j < 3; ++j) centroid += mesh.positions[3 * size_t{mesh.indices[3 * f + j]} + k];
+        centroid /= 3.0;
+        EXPECT_GE(centroid, plan.cells[c][k] * plan.cell_size - 1e-9);
+        EXPECT_LE(centroid, (plan.cells[c][k] + 1) * plan.cell_size + 1e-9);
+      }
+    }
+  }
+  EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), static_cast<std::ptrdiff_t>(mesh.face_count()));
+  // The automatic cell: a power of two near cell_edges median edges, whatever the mesh's position.
+  ChunkOptions automatic;
+  ASSERT_TRUE(plan_chunks(mesh, automatic, plan).is_ok());
+  EXPECT_GE(plan.cell_size, automatic.cell_edges * plan.median_edge / std::sqrt(2.0));
+  EXPECT_LE(plan.cell_size, automatic.cell_edges * plan.median_edge * std::sqrt(2.0));
+  EXPECT_GT(plan.locality_radius(), plan.cell_size);
+}
+
+TEST(ChunkPlan, RejectsBadOptionsAndHugeSpans) {
+  const Mesh mesh = load_test_mesh("spot.obj");
+  ChunkPlan plan;
+  ChunkOptions bad;
+  bad.cell_exponent = 61;
+  EXPECT_EQ(plan_chunks(mesh, bad, plan).code(), ErrorCode::kInvalidArgument);
+  bad = ChunkOptions{};
+  bad.cell_edges = 2.f;
+  EXPECT_EQ(plan_chunks(mesh, bad, plan).code(), ErrorCode::kInvalidArgument);
+  ChunkOptions tiny;
+  tiny.cell_exponent = -40;  // far more than 2^21 cells across the mesh
+  EXPECT_EQ(plan_chunks(mesh, tiny, plan).code(), ErrorCode::kInvalidMesh);
+  EXPECT_EQ(plan_chunks(Mesh{}, ChunkOptions{}, plan).code(), ErrorCode::kInvalidMesh);
+  EXPECT_TRUE(uses_chunks(ChunkOptions{}, ChunkOptions{}.min_faces));
+  EXPECT_FALSE(uses_chunks(ChunkOptions{}, ChunkOptions{}.min_faces - 1));
+}
+
+TEST(ChunkedMapping, SameSurfaceInAnotherOrderMapsToTheSameBits) {
+  for (const char* name : {"fertility.off", "horse.ply", "fandisk.off", "blobby-3cc.off"}) {
+    const Mesh mesh = load_test_mesh(name);
+    const MapTextureOptions options = chunked(exponent_for(mesh, 2.5));
+    StabilityReport report;
+    ASSERT_TRUE(measure_stability(mesh, options, report).is_ok()) << name;
+    EXPECT_EQ(report.order_identical_ratio, 1.0) << name;
+    EXPECT_LT(report.identical_ratio, 1.0) << name;  // the cut's own chunks change
+    // Everything beyond the locality radius keeps its bits (on the scans: the CAD part's longest
+    // edges make the radius span the part).
+    if (std::string(name) == "fandisk.off" || std::string(name) == "blobby-3cc.off") continue;
+    EXPECT_GT(report.corners_beyond_radius, 0u) << name;
+    EXPECT_EQ(report.identical_beyond_radius_ratio, 1.0) << name;
+  }
+  // Mapped whole, the same surface in another order does not keep its bits (the reason for chunks).
+  const Mesh fertility = load_test_mesh("fertility.off");
+  MapTextureOptions whole;
+  whole.chunks.mode = ChunkMode::kOff;
+  StabilityReport report;
+  ASSERT_TRUE(measure_stability(fertility, whole, report).is_ok());
+  EXPECT_LT(report.order_identical_ratio, 0.5);
+}
+
+TEST(ChunkedMapping, SameBitsForAnyThreadCountAndQualityKept) {
+  const Mesh mesh = load_test_mesh("horse.ply");
+  const Topology topology = build_topology(mesh);
+  MapTextureOptions options = chunked(exponent_for(mesh, 3));
+  options.mapping.threads = 1;
+  TextureMap one;
+  ASSERT_TRUE(map_texture(mesh, topology, options, one).is_ok());
+  EXPECT_GT(one.stats.chunks, 4u);
+  EXPECT_GT(one.stats.texels_per_unit, 0.0);
+  EXPECT_EQ(one.stats.texels_per_unit, std::exp2(std::round(std::log2(one.stats.texels_per_unit))));
+  ASSERT_EQ(one.atlas.corner_uv.size(), 6 * mesh.face_count());
+  for (const float x : one.atlas.corner_uv) ASSERT_TRUE(std::isfinite(x));
+  for (const uint32_t p : one.atlas.patch) ASSERT_LT(p, one.atlas.patch_count);
+  EXPECT_EQ(one.metrics.flipped, 0u);
+  EXPECT_LE(one.metrics.l2_stretch, 1.02);
+  EXPECT_LE(one.metrics.linf_stretch, 3.0);
+  for (const uint32_t threads : {2u, 3u}) {
+    options.mapping.threads = threads;
+    TextureMap other;
+    ASSERT_TRUE(map_texture(mesh, topology, options, other).is_ok());
+    ASSERT_EQ(other.atlas.corner_uv.size(), one.atlas.corner_uv.size());
+    EXPECT_EQ(std::memcmp(other.atlas.corner_uv.data(), one.atlas.corner_uv.data(),
+                          one.atlas.corner_uv.size() * sizeof(float)),
+              0)
+        << threads << " threads";
+    EXPECT_EQ(other.atlas.patch, one.atlas.patch);
+  }
+}
+
+TEST(ChunkedMapping, CancelsAndRefusesWhatNeedsTheWholeMesh) {
+  const Mesh mesh = load_test_mesh("fandisk.off");
+  const Topology topology = build_topology(mesh);
+  MapTextureOptions options = chunked(exponent_for(mesh, 2));
+  options.mapping.progress = [](float done) { return done < 0.3f; };
+  TextureMap map;
+  EXPECT_EQ(map_texture(mesh, topology, options, map).code(), ErrorCode::kCancelled);
+  EXPECT_TRUE(map.atlas.corner_uv.empty());
+  MapTextureOptions skeleton = chunked(exponent_for(mesh, 2));
+  skeleton.orientation.axis = AxisSource::kSkeleton;
+  EXPECT_EQ(map_texture(mesh, topology, skeleton, map).code(), ErrorCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace tailor
