@@ -73,16 +73,19 @@ void BM_Orientation(benchmark::State& state, const std::string& key) {
   set_faces_rate(state, p.mesh.face_count());
 }
 
-void BM_Mapping(benchmark::State& state, const std::string& key, const tailor::MappingOptions& options) {
+void BM_Mapping(benchmark::State& state, const std::string& key, const tailor::MappingOptions& options,
+                tailor::ChunkMode chunks) {
   const Prepared& p = prepared(key);
   if (!p.ok) {
     state.SkipWithError(p.error.c_str());
     return;
   }
   // map_texture without its metrics; timed: the growth, seam shortening and crack closing (the
-  // orientation is BM_Orientation's).
+  // orientation is BM_Orientation's); chunked (ChunkMode::kOn): every chunk's whole pipeline, its
+  // orientation included.
   tailor::MapTextureOptions pipeline;
   pipeline.mapping = options;
+  pipeline.chunks.mode = chunks;
   pipeline.measure = false;
   tailor::TextureMap map;
   const tailor::Atlas& atlas = map.atlas;
@@ -118,6 +121,7 @@ void BM_Mapping(benchmark::State& state, const std::string& key, const tailor::M
   state.counters["L2"] = m.l2_stretch;
   state.counters["Linf"] = m.linf_stretch;
   if (options.mode == tailor::MappingMode::kThesis) state.counters["thr_px"] = stats.final_threshold_px;
+  state.counters["chunks"] = stats.chunks;
 }
 
 // Thread scaling: the whole map_texture (orientation, mapping; no metrics) on horse_x16 with
@@ -127,7 +131,7 @@ void BM_Mapping(benchmark::State& state, const std::string& key, const tailor::M
 // the growth or the grid map and the seam shortening, closing, relaxing), show which of them keep
 // the others waiting.
 void BM_MappingThreads(benchmark::State& state, const std::string& key, const std::string& mode,
-                       tailor::MappingOptions options) {
+                       tailor::MappingOptions options, tailor::ChunkMode chunks) {
   const Prepared& p = prepared(key);
   if (!p.ok) {
     state.SkipWithError(p.error.c_str());
@@ -138,6 +142,7 @@ void BM_MappingThreads(benchmark::State& state, const std::string& key, const st
   tailor::MapTextureOptions pipeline;
   pipeline.mapping = options;
   pipeline.orientation.threads = options.threads;
+  pipeline.chunks.mode = chunks;
   pipeline.measure = false;
   using Clock = std::chrono::steady_clock;
   const std::array<std::string_view, 4> stages = {"orientation", "mapping", "closing", "relaxing"};
@@ -166,8 +171,9 @@ void BM_MappingThreads(benchmark::State& state, const std::string& key, const st
     state.counters[std::string(stages[s]) + "_s"] = std::chrono::duration<double>(until - previous).count();
     previous = until;
   }
-  if (options.threads == 1) one_thread_uv[mode] = map.atlas.corner_uv;
-  const auto reference = one_thread_uv.find(mode);
+  const std::string run = mode + (chunks == tailor::ChunkMode::kOff ? "" : "/chunked");
+  if (options.threads == 1) one_thread_uv[run] = map.atlas.corner_uv;
+  const auto reference = one_thread_uv.find(run);
   state.counters["threads"] = options.threads;
   state.counters["same_bits"] = reference != one_thread_uv.end() && reference->second == map.atlas.corner_uv;
   set_faces_rate(state, p.mesh.face_count());
@@ -208,55 +214,73 @@ void BM_MappingThreads(benchmark::State& state, const std::string& key, const st
         ->Unit(benchmark::kMillisecond)
         ->MinTime(0.2)
         ->UseRealTime();
-    benchmark::RegisterBenchmark(("Mapping/patches/" + name).c_str(), BM_Mapping, key, patches)
+    benchmark::RegisterBenchmark(("Mapping/patches/" + name).c_str(), BM_Mapping, key, patches, tailor::ChunkMode::kOff)
         ->Unit(benchmark::kMillisecond)
         ->MinTime(0.2)
         ->UseManualTime();
-    benchmark::RegisterBenchmark(("Mapping/patches-x10/" + name).c_str(), BM_Mapping, key, patches_x10)
+    benchmark::RegisterBenchmark(("Mapping/patches-x10/" + name).c_str(), BM_Mapping, key, patches_x10,
+                                 tailor::ChunkMode::kOff)
         ->Unit(benchmark::kMillisecond)
         ->MinTime(0.2)
         ->UseManualTime();
-    benchmark::RegisterBenchmark(("Mapping/symmetry4/" + name).c_str(), BM_Mapping, key, fourfold)
+    benchmark::RegisterBenchmark(("Mapping/symmetry4/" + name).c_str(), BM_Mapping, key, fourfold,
+                                 tailor::ChunkMode::kOff)
         ->Unit(benchmark::kMillisecond)
         ->MinTime(0.2)
         ->UseManualTime();
-    benchmark::RegisterBenchmark(("Mapping/symmetry4-x10/" + name).c_str(), BM_Mapping, key, fourfold_x10)
+    benchmark::RegisterBenchmark(("Mapping/symmetry4-x10/" + name).c_str(), BM_Mapping, key, fourfold_x10,
+                                 tailor::ChunkMode::kOff)
         ->Unit(benchmark::kMillisecond)
         ->MinTime(0.2)
         ->UseManualTime();
-    benchmark::RegisterBenchmark(("Mapping/growth/" + name).c_str(), BM_Mapping, key, growth)
+    benchmark::RegisterBenchmark(("Mapping/growth/" + name).c_str(), BM_Mapping, key, growth, tailor::ChunkMode::kOff)
         ->Unit(benchmark::kMillisecond)
         ->MinTime(0.2)
         ->UseManualTime();
-    benchmark::RegisterBenchmark(("Mapping/undirected/" + name).c_str(), BM_Mapping, key, undirected)
+    benchmark::RegisterBenchmark(("Mapping/undirected/" + name).c_str(), BM_Mapping, key, undirected,
+                                 tailor::ChunkMode::kOff)
         ->Unit(benchmark::kMillisecond)
         ->MinTime(0.2)
         ->UseManualTime();
-    benchmark::RegisterBenchmark(("Mapping/undirected-x10/" + name).c_str(), BM_Mapping, key, undirected_x10)
+    benchmark::RegisterBenchmark(("Mapping/undirected-x10/" + name).c_str(), BM_Mapping, key, undirected_x10,
+                                 tailor::ChunkMode::kOff)
         ->Unit(benchmark::kMillisecond)
         ->MinTime(0.2)
         ->UseManualTime();
-    benchmark::RegisterBenchmark(("Mapping/thesis/" + name).c_str(), BM_Mapping, key, thesis)
+    benchmark::RegisterBenchmark(("Mapping/thesis/" + name).c_str(), BM_Mapping, key, thesis, tailor::ChunkMode::kOff)
         ->Unit(benchmark::kMillisecond)
         ->MinTime(0.2)
         ->UseManualTime();
+    // The same, cut into chunks by the chunk rule (its automatic cell; the mesh spans up to a few
+    // cells): what the chunk borders cost beside the one-chunk rows above.
+    for (const auto& [mode, options] :
+         {std::pair{std::string("patches"), patches}, std::pair{std::string("patches-x10"), patches_x10},
+          std::pair{std::string("undirected"), undirected}, std::pair{std::string("undirected-x10"), undirected_x10}})
+      benchmark::RegisterBenchmark(("Mapping/" + mode + "-chunked/" + name).c_str(), BM_Mapping, key, options,
+                                   tailor::ChunkMode::kOn)
+          ->Unit(benchmark::kMillisecond)
+          ->MinTime(0.2)
+          ->UseManualTime();
   }
   // Thread scaling on the large mesh: the texture-aware default for an isotropic tile (undirected),
-  // field following, and the 4-fold map, 1 to 16 threads.
+  // field following, and the 4-fold map, 1 to 16 threads; mapped whole and by chunks (the default
+  // from 131072 faces on).
   for (const auto& [mode, options] :
        {std::pair{std::string("undirected"), undirected}, std::pair{std::string("patches"), patches},
         std::pair{std::string("symmetry4"), fourfold}})
-    benchmark::RegisterBenchmark(("MappingThreads/" + mode + "/horse_x16").c_str(), BM_MappingThreads, "horse_x16",
-                                 mode, options)
-        ->ArgName("threads")
-        ->Arg(1)
-        ->Arg(2)
-        ->Arg(4)
-        ->Arg(8)
-        ->Arg(16)
-        ->Unit(benchmark::kMillisecond)
-        ->MinTime(0.2)
-        ->UseRealTime();
+    for (const tailor::ChunkMode chunks : {tailor::ChunkMode::kOff, tailor::ChunkMode::kOn})
+      benchmark::RegisterBenchmark(
+          ("MappingThreads/" + mode + (chunks == tailor::ChunkMode::kOn ? "-chunked" : "") + "/horse_x16").c_str(),
+          BM_MappingThreads, "horse_x16", mode, options, chunks)
+          ->ArgName("threads")
+          ->Arg(1)
+          ->Arg(2)
+          ->Arg(4)
+          ->Arg(8)
+          ->Arg(16)
+          ->Unit(benchmark::kMillisecond)
+          ->MinTime(0.2)
+          ->UseRealTime();
   return true;
 }();
 

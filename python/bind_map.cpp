@@ -122,7 +122,9 @@ const std::string& map_docstring() {
         "field_following: 'auto' (default) as the CLI: 0 with 32 crack rings when texture= has no direction\n"
         "  (gravel, grass), else 1; crack_rings: None = 16, or auto's choice\n"
         "unit_scale: 0 normalises the mesh into the unit cube (as the CLI); > 0 uses coordinates times unit_scale,\n"
-        "  so with unit_scale=1, scale is pixels per mesh unit: one texel density on every mesh (no CLI flag)\n\n"
+        "  so with unit_scale=1, scale is pixels per mesh unit: one texel density on every mesh (no CLI flag)\n"
+        "chunks: 'auto', 'on' or 'off' (--chunks); chunk_cell: None = auto, or the cell side's power of two\n"
+        "  (--chunk-cell)\n\n"
         "The options with the CLI's help (tailor map --help):\n";
     auto add = [&doc](std::span<const OptionDoc> docs) {
       for (const OptionDoc& d : docs) {
@@ -136,6 +138,9 @@ const std::string& map_docstring() {
     };
     add(kMappingOptionDocs);
     add(kOrientationOptionDocs);
+    for (const OptionDoc& d : kChunkOptionDocs)
+      doc += "  " + std::string(d.flag) + " (" + (d.field == std::string_view("mode") ? "chunks" : "chunk_cell") +
+             "): " + std::string(d.help) + "\n";
     return doc;
   }();
   return text;
@@ -188,7 +193,7 @@ void bind_map(py::module_& m) {
          float max_stretch, const py::object& field_following, uint32_t min_patch_faces, float hop_age,
          bool shorten_seams, bool close_cracks, const py::object& crack_rings, uint32_t relax_iterations,
          float threshold, const py::object& seed_point, const py::object& symmetry, float unit_scale, uint32_t smooth,
-         const py::object& material) {
+         const py::object& material, const std::string& chunks, const py::object& chunk_cell) {
         // === Options, checked before any work (the CLI's checks and messages) ===
         MapTextureOptions options;
         MappingOptions& mapping = options.mapping;
@@ -251,6 +256,19 @@ void bind_map(py::module_& m) {
         }
         if (!(unit_scale >= 0.f && unit_scale <= 1e30f)) raise_error("unit_scale must be 0 or a positive number");
         options.orientation.fixed_unit_scale = unit_scale;  // about the origin (fixed_origin stays 0, 0, 0)
+        if (chunks == "auto")
+          options.chunks.mode = ChunkMode::kAuto;
+        else if (chunks == "on")
+          options.chunks.mode = ChunkMode::kOn;
+        else if (chunks == "off")
+          options.chunks.mode = ChunkMode::kOff;
+        else
+          raise_error("chunks must be 'auto', 'on' or 'off', got '" + chunks + "'");
+        if (!chunk_cell.is_none()) {
+          const int e = chunk_cell.cast<int>();
+          if (e < -60 || e > 60) raise_error("chunk_cell must be None or a whole number in -60..60");
+          options.chunks.cell_exponent = e;
+        }
         if (smooth > 1000) raise_error("--smooth: value " + std::to_string(smooth) + " not in range [0 - 1000]");
         options.orientation.smooth_passes = smooth;
         if (texture_size <= 0) raise_error("--texture-size must be positive");
@@ -372,6 +390,7 @@ void bind_map(py::module_& m) {
       py::arg("seed_point") = py::none(), py::arg("symmetry") = py::none(),
       py::arg("unit_scale") = OrientationOptions{}.fixed_unit_scale,
       py::arg("smooth") = OrientationOptions{}.smooth_passes, py::arg("material") = py::none(),
+      py::arg("chunks") = "auto", py::arg("chunk_cell") = py::none(),
       map_docstring().c_str());
 }
 

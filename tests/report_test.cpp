@@ -82,9 +82,11 @@ TEST(Report, FileNamesThatAreNotUtf8DoNotBreakTheJson) {
   EXPECT_EQ(j.size(), 31u);
   EXPECT_EQ(eval_summary(run).find("bad\xff.obj: 0 faces"), 0u);
   const nlohmann::json s = nlohmann::json::parse(stability_report_json(run.file, StabilityReport{}));
-  EXPECT_EQ(keys(s), (std::vector<std::string>{"compared_corners", "faces", "file", "identical_ratio",
-                                               "max_difference_px", "mean_difference_px", "patches_cut", "patches_full",
-                                               "removed_faces", "seconds", "within_1px_ratio"}));
+  EXPECT_EQ(keys(s),
+            (std::vector<std::string>{"compared_corners", "corners_beyond_radius", "faces", "file",
+                                      "identical_beyond_radius_ratio", "identical_ratio", "locality_radius",
+                                      "max_difference_px", "mean_difference_px", "order_identical_ratio", "patches_cut",
+                                      "patches_full", "removed_faces", "seconds", "within_1px_ratio"}));
 }
 
 TEST(Report, TileReportsTheWorstVariant) {

@@ -80,6 +80,8 @@ def map(
     unit_scale: float = 0.0,
     smooth: int = 0,
     material: Optional[_Path] = None,
+    chunks: Literal["auto", "on", "off"] = "auto",
+    chunk_cell: Optional[int] = None,
 ) -> Result: ...
 @overload
 def tile(

@@ -248,11 +248,33 @@ Status map_chunks(const Mesh& mesh, const MapTextureOptions& options, TextureMap
   std::vector<MappingStats> chunk_stats(chunks);
   std::vector<Status> chunk_status(chunks, Status::ok());
   std::atomic<size_t> next{0};
-  std::atomic<bool> failed{false};
-  std::mutex report_mutex;  // progress callbacks are called by one worker at a time
-  size_t faces_done = 0;
+  std::atomic<bool> failed{false};     // stop taking chunks: a chunk failed or the caller cancelled
+  std::atomic<bool> cancelled{false};  // the caller cancelled
+  std::mutex report_mutex;             // progress callbacks are called by one worker at a time
+  size_t faces_done = 0;               // faces of the chunks mapped so far (under report_mutex)
+  float reported = 0.f;                // the largest share reported (reports never go back)
   const StageProgressCallback& stage = options.stage_progress;
   const ProgressCallback& progress = options.mapping.progress;
+  // Reports the share of faces mapped, `partial` of them in a chunk still being mapped; false
+  // (and everything stops) when the caller cancels. A worker that finds another one reporting
+  // goes on without waiting, unless `last` (its chunk's end, which must be counted).
+  auto report = [&](size_t partial, size_t finished, bool last) {
+    if (failed.load(std::memory_order_relaxed)) return false;
+    if (!stage && !progress && !finished) return true;
+    std::unique_lock<std::mutex> lock(report_mutex, std::defer_lock);
+    if (last)
+      lock.lock();
+    else if (!lock.try_lock())
+      return true;
+    faces_done += finished;
+    reported = std::max(reported, static_cast<float>(faces_done + partial) / static_cast<float>(face_count));
+    if ((stage && !stage("mapping", reported)) || (progress && !progress(reported))) {
+      cancelled.store(true);
+      failed.store(true);
+      return false;
+    }
+    return true;
+  };
 
   auto work = [&] {
     ChunkWorker w;
@@ -264,7 +286,10 @@ Status map_chunks(const Mesh& mesh, const MapTextureOptions& options, TextureMap
       o.chunks.mode = ChunkMode::kOff;
       o.measure = false;
       o.stage_progress = nullptr;
-      o.mapping.progress = nullptr;
+      const size_t chunk_faces = w.faces.size();
+      o.mapping.progress = [&report, chunk_faces](float done) {
+        return report(static_cast<size_t>(done * static_cast<float>(chunk_faces)), 0, false);
+      };
       o.orientation.progress = nullptr;
       o.mapping.threads = inner_threads;
       o.orientation.threads = inner_threads;
@@ -292,14 +317,7 @@ Status map_chunks(const Mesh& mesh, const MapTextureOptions& options, TextureMap
       }
       chunk_patches[c] = w.map.atlas.patch_count;
       chunk_stats[c] = w.map.stats;
-      const std::lock_guard<std::mutex> lock(report_mutex);
-      faces_done += w.faces.size();
-      const float done = static_cast<float>(faces_done) / static_cast<float>(face_count);
-      if ((stage && !stage("mapping", done)) || (progress && !progress(done))) {
-        chunk_status[c] = Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
-        failed.store(true);
-        return;
-      }
+      if (!report(0, chunk_faces, true)) return;
     }
   };
   {
@@ -311,12 +329,18 @@ Status map_chunks(const Mesh& mesh, const MapTextureOptions& options, TextureMap
     work();
     for (std::thread& t : workers) t.join();
   }
-  for (size_t c = 0; c < chunks; ++c)
-    if (!chunk_status[c]) {
-      map.atlas.corner_uv.clear();
-      map.atlas.patch.clear();
-      return chunk_status[c];
-    }
+  // A chunk's own error first (the first in cell order), else the caller's cancelling (which the
+  // chunks still running saw as theirs).
+  Status failure = Status::ok();
+  for (size_t c = 0; c < chunks && failure.is_ok(); ++c)
+    if (!chunk_status[c] && chunk_status[c].code() != ErrorCode::kCancelled) failure = chunk_status[c];
+  if (failure.is_ok() && (cancelled.load() || failed.load()))
+    failure = Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
+  if (!failure.is_ok()) {
+    map.atlas.corner_uv.clear();
+    map.atlas.patch.clear();
+    return failure;
+  }
   // Patch ids: each chunk's after those of the chunks before it (in cell order).
   std::vector<uint32_t> first_patch(chunks + 1, 0);
   for (size_t c = 0; c < chunks; ++c) first_patch[c + 1] = first_patch[c] + chunk_patches[c];

@@ -22,6 +22,8 @@ def without_times(stats):
         (DATA / "meshes" / "fandisk.off", dict(axis="auto", texture_size=256), ["--axis", "auto", "--texture-size", "256"]),
         (DATA / "meshes" / "horse.ply", dict(axis=(0, 1, 0), scale=400, threads=2, close_cracks=False, smooth=2),
          ["--axis", "0,1,0", "--scale", "400", "--threads", "2", "--no-crack-closing", "--smooth", "2"]),
+        (DATA / "meshes" / "horse.ply", dict(chunks="on", chunk_cell=-4, threads=2),
+         ["--chunks", "on", "--chunk-cell", "-4", "--threads", "2"]),
     ],
 )
 def test_map_is_bit_identical_to_the_cli(tmp_path, tailor_binary, mesh_path, options, cli_options):
