@@ -15,4 +15,5 @@ PYBIND11_MODULE(_tailor, m) {
   tp::bind_tile_set(m);
   tp::bind_eval(m);
   tp::bind_save(m);
+  tp::bind_chunks(m);
 }

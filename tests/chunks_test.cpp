@@ -11,6 +11,7 @@
 #include <tuple>
 
 #include "support/fixtures.h"
+#include "tailor/chunked_mapper.h"
 #include "tailor/mapping.h"
 #include "tailor/stability.h"
 #include "tailor/topology.h"
@@ -158,6 +159,76 @@ TEST(ChunkedMapping, CancelsAndRefusesWhatNeedsTheWholeMesh) {
   MapTextureOptions skeleton = chunked(exponent_for(mesh, 2));
   skeleton.orientation.axis = AxisSource::kSkeleton;
   EXPECT_EQ(map_texture(mesh, topology, skeleton, map).code(), ErrorCode::kInvalidArgument);
+}
+
+// The faces of `result` as a mesh of their own (vertices renumbered, in another order than the
+// source's), with face i = result.faces[i].
+Mesh chunk_faces(const Mesh& mesh, const ChunkResult& result) {
+  Mesh out;
+  std::vector<uint32_t> id(mesh.vertex_count(), kInvalid);
+  for (const uint32_t f : result.faces)
+    for (size_t k = 0; k < 3; ++k) {
+      const uint32_t v = mesh.indices[3 * size_t{f} + k];
+      if (id[v] == kInvalid) {
+        id[v] = static_cast<uint32_t>(out.vertex_count());
+        out.positions.insert(out.positions.end(), mesh.positions.begin() + 3 * static_cast<std::ptrdiff_t>(v),
+                             mesh.positions.begin() + 3 * static_cast<std::ptrdiff_t>(v) + 3);
+      }
+      out.indices.push_back(id[v]);
+    }
+  return out;
+}
+
+TEST(ChunkedMapper, AChunkAloneMapsAsInsideTheMeshAndReplacingItTouchesNoOther) {
+  const Mesh mesh = load_test_mesh("horse.ply");
+  const int exponent = exponent_for(mesh, 3);
+  ChunkedMapper whole(MapTextureOptions{}, exponent, 4096.0);
+  ASSERT_TRUE(whole.check().is_ok());
+  std::vector<ChunkCell> cells;
+  ASSERT_TRUE(whole.set_mesh(mesh, &cells).is_ok());
+  ASSERT_GT(cells.size(), 4u);
+  EXPECT_EQ(whole.cells(), cells);
+  size_t faces = 0;
+  for (const ChunkCell& c : cells) faces += whole.chunk(c)->faces.size();
+  EXPECT_EQ(faces, mesh.face_count());
+  // The largest chunk, mapped alone from a mesh of its own faces (another vertex order): the
+  // same bits as inside the whole mesh.
+  const ChunkCell big = *std::max_element(cells.begin(), cells.end(), [&](const ChunkCell& a, const ChunkCell& b) {
+    return whole.chunk(a)->faces.size() < whole.chunk(b)->faces.size();
+  });
+  const ChunkResult inside = *whole.chunk(big);
+  const Mesh alone = chunk_faces(mesh, inside);
+  ChunkedMapper streamed(MapTextureOptions{}, exponent, 4096.0);
+  ASSERT_TRUE(streamed.set_chunk(big, alone).is_ok());
+  const ChunkResult* mapped = streamed.chunk(big);
+  ASSERT_NE(mapped, nullptr);
+  EXPECT_EQ(mapped->corner_uv, inside.corner_uv);
+  EXPECT_EQ(mapped->patch, inside.patch);
+  EXPECT_EQ(mapped->patch_count, inside.patch_count);
+  // Replacing it (a tenth of its faces removed) changes it and no other chunk.
+  std::vector<std::vector<float>> before;
+  for (const ChunkCell& c : cells) before.push_back(whole.chunk(c)->corner_uv);
+  Mesh edited = alone;
+  edited.indices.resize(3 * (alone.face_count() - alone.face_count() / 10));
+  ASSERT_TRUE(whole.set_chunk(big, edited).is_ok());
+  for (size_t i = 0; i < cells.size(); ++i) {
+    if (cells[i] == big)
+      EXPECT_NE(whole.chunk(cells[i])->corner_uv, before[i]);
+    else
+      EXPECT_EQ(whole.chunk(cells[i])->corner_uv, before[i]);
+  }
+  // Faces of another cell are refused, and the chunk keeps what it had.
+  const ChunkCell other = cells[0] == big ? cells[1] : cells[0];
+  const Status wrong = whole.set_chunk(other, edited);
+  EXPECT_EQ(wrong.code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(wrong.message().find("outside the chunk's cell"), std::string::npos) << wrong.message();
+  EXPECT_EQ(whole.chunk(other)->corner_uv, before[cells[0] == big ? 1 : 0]);
+  EXPECT_TRUE(whole.remove_chunk(big));
+  EXPECT_FALSE(whole.remove_chunk(big));
+  EXPECT_EQ(whole.chunk(big), nullptr);
+  EXPECT_EQ(whole.cells().size(), cells.size() - 1);
+  EXPECT_EQ(ChunkedMapper(MapTextureOptions{}, exponent, 0.0).check().code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(ChunkedMapper(MapTextureOptions{}, 70, 1.0).set_mesh(mesh).code(), ErrorCode::kInvalidArgument);
 }
 
 }  // namespace

@@ -12,6 +12,8 @@
 #include "tailor/api.h"
 #include "tailor/atlas.h"
 #include "tailor/axis_choice.h"
+#include "tailor/chunked_mapper.h"
+#include "tailor/chunks.h"
 #include "tailor/edit_session.h"
 #include "tailor/export.h"
 #include "tailor/gltf.h"

@@ -10,6 +10,6 @@ textures.
 Every call releases the GIL while the C++ library works; errors raise tailor.Error (a ValueError)
 with the message the tailor command prints. See docs/python.md.
 """
-from ._tailor import Error, Mesh, Result, __version__, evaluate, load, map, material_role, save, tile, tile_set
+from ._tailor import ChunkedMapper, Error, Mesh, Result, __version__, evaluate, load, map, material_role, save, tile, tile_set
 
-__all__ = ["Error", "Mesh", "Result", "evaluate", "load", "map", "material_role", "save", "tile", "tile_set", "__version__"]
+__all__ = ["ChunkedMapper", "Error", "Mesh", "Result", "evaluate", "load", "map", "material_role", "save", "tile", "tile_set", "__version__"]

@@ -2,14 +2,10 @@
 // every chunk is mapped by the whole pipeline (map_texture on the chunk alone) on the next free
 // worker thread, and its UVs and patches are written back to the mesh's corners.
 //
-// Why each chunk is rebuilt in a canonical form: the mapping's every tie (front keys, seed
-// distances, sums over vertices) is broken by ids, so the same surface in another file order
-// would map differently. A chunk's faces are sorted by the Morton key of their centroid (then by
-// their corners' coordinates), each face starts at its lexicographically smallest corner, and the
-// vertices are numbered by first use: the chunk's mesh, and so its UVs, are a function of its
-// geometry and connectivity alone. Its frame (origin, unit) is its cell's, its texel density is
-// one number for the whole mesh (a power of two unless the caller fixed it), so nothing outside
-// the chunk reaches in.
+// Each chunk is mapped in canonical form (chunk_mesh.h), so its UVs are a function of its geometry
+// and connectivity alone. Its frame (origin, unit) is its cell's, its texel density is one number
+// for the whole mesh (a power of two unless the caller fixed it), so nothing outside the chunk
+// reaches in.
 #include <algorithm>
 #include <atomic>
 #include <bit>
@@ -20,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "mapping/chunk_mesh.h"
 #include "mapping/mapping_common.h"
 #include "tailor/chunks.h"
 #include "tailor/mapping.h"
@@ -27,142 +24,6 @@
 
 namespace tailor::internal {
 namespace {
-
-// Spreads the low 21 bits of x to every third bit (Morton interleave).
-inline uint64_t spread3(uint64_t x) {
-  x &= 0x1FFFFF;
-  x = (x | x << 32) & 0x1F00000000FFFFull;
-  x = (x | x << 16) & 0x1F0000FF0000FFull;
-  x = (x | x << 8) & 0x100F00F00F00F00Full;
-  x = (x | x << 4) & 0x10C30C30C30C30C3ull;
-  x = (x | x << 2) & 0x1249249249249249ull;
-  return x;
-}
-
-// Lexicographic order of two points (x, then y, then z).
-inline bool point_less(const float* a, const float* b) {
-  if (a[0] != b[0]) return a[0] < b[0];
-  if (a[1] != b[1]) return a[1] < b[1];
-  return a[2] < b[2];
-}
-
-// One face of a chunk in canonical form: its sort key, its global id, the corner it starts at.
-struct ChunkFace {
-  uint64_t morton;
-  uint32_t face;
-  uint32_t rotation;
-};
-
-// Global vertex id -> chunk vertex id, for one chunk at a time (open addressing, cleared by
-// stamping: no per-chunk reallocation once it has grown to the largest chunk).
-class VertexTable {
- public:
-  void reset(size_t expected) {
-    size_t want = 64;
-    while (want < 2 * expected) want *= 2;
-    if (want > keys_.size()) {
-      keys_.assign(want, 0);
-      values_.assign(want, 0);
-      stamps_.assign(want, 0);
-      stamp_ = 0;
-    }
-    if (++stamp_ == 0) {  // wrapped: clear the stamps once
-      std::fill(stamps_.begin(), stamps_.end(), 0u);
-      stamp_ = 1;
-    }
-  }
-  // The chunk id of global vertex v, `next` (then incremented) when v is new.
-  uint32_t find_or_add(uint32_t v, uint32_t& next, bool& added) {
-    const size_t mask = keys_.size() - 1;
-    size_t i = (uint64_t{v} * 0x9E3779B97F4A7C15ull >> 20) & mask;
-    while (stamps_[i] == stamp_) {
-      if (keys_[i] == v) {
-        added = false;
-        return values_[i];
-      }
-      i = (i + 1) & mask;
-    }
-    stamps_[i] = stamp_;
-    keys_[i] = v;
-    values_[i] = next;
-    added = true;
-    return next++;
-  }
-
- private:
-  std::vector<uint32_t> keys_, values_, stamps_;
-  uint32_t stamp_ = 0;
-};
-
-// What one worker reuses from chunk to chunk.
-struct ChunkWorker {
-  std::vector<ChunkFace> faces;
-  VertexTable vertices;
-  Mesh mesh;
-  std::vector<uint8_t> seam_flags;
-  TextureMap map;
-};
-
-// Builds the canonical mesh of chunk `c` into w.mesh (and w.faces: chunk face i is global face
-// w.faces[i].face starting at its corner w.faces[i].rotation).
-void build_chunk_mesh(const Mesh& mesh, const ChunkPlan& plan, size_t c, std::span<const uint8_t> seam_faces,
-                      ChunkWorker& w) {
-  const float* pos = mesh.positions.data();
-  const uint32_t* idx = mesh.indices.data();
-  const uint32_t begin = plan.chunk_start[c], end = plan.chunk_start[c + 1];
-  const double inverse = 1.0 / plan.cell_size;
-  const std::array<int32_t, 3>& cell = plan.cells[c];
-  w.faces.resize(end - begin);
-  for (uint32_t i = begin; i < end; ++i) {
-    const uint32_t f = plan.faces[i];
-    const float* p[3] = {pos + 3 * size_t{idx[3 * f]}, pos + 3 * size_t{idx[3 * f + 1]},
-                         pos + 3 * size_t{idx[3 * f + 2]}};
-    uint32_t r = 0;
-    if (point_less(p[1], p[r])) r = 1;
-    if (point_less(p[2], p[r])) r = 2;
-    uint64_t morton = 0;
-    for (int k = 0; k < 3; ++k) {
-      double a = p[0][k], b = p[1][k], d = p[2][k];  // summed smallest first, as the chunk rule does
-      if (a > b) std::swap(a, b);
-      if (b > d) std::swap(b, d);
-      if (a > b) std::swap(a, b);
-      const double t = ((a + b) + d) / 3.0 * inverse - cell[static_cast<size_t>(k)];
-      const double q = std::clamp(std::floor(t * double{1 << 21}), 0.0, double{(1 << 21) - 1});
-      morton |= spread3(static_cast<uint64_t>(q)) << k;
-    }
-    w.faces[i - begin] = ChunkFace{morton, f, r};
-  }
-  auto corner = [&](const ChunkFace& face, uint32_t k) {
-    return pos + 3 * size_t{idx[3 * size_t{face.face} + (face.rotation + k) % 3]};
-  };
-  std::sort(w.faces.begin(), w.faces.end(), [&](const ChunkFace& a, const ChunkFace& b) {
-    if (a.morton != b.morton) return a.morton < b.morton;
-    for (uint32_t k = 0; k < 3; ++k) {
-      const float *pa = corner(a, k), *pb = corner(b, k);
-      if (point_less(pa, pb)) return true;
-      if (point_less(pb, pa)) return false;
-    }
-    return a.face < b.face;  // the same triangle twice: indistinguishable anyway
-  });
-  const size_t n = w.faces.size();
-  w.vertices.reset(3 * n);
-  w.mesh.indices.resize(3 * n);
-  w.mesh.positions.clear();
-  w.mesh.positions.reserve(3 * n);
-  const bool seams = !seam_faces.empty();
-  w.seam_flags.resize(seams ? n : 0);
-  uint32_t next = 0;
-  for (size_t i = 0; i < n; ++i) {
-    const ChunkFace& face = w.faces[i];
-    for (uint32_t k = 0; k < 3; ++k) {
-      const uint32_t v = idx[3 * size_t{face.face} + (face.rotation + k) % 3];
-      bool added = false;
-      w.mesh.indices[3 * i + k] = w.vertices.find_or_add(v, next, added);
-      if (added) w.mesh.positions.insert(w.mesh.positions.end(), pos + 3 * size_t{v}, pos + 3 * size_t{v} + 3);
-    }
-    if (seams) w.seam_flags[i] = seam_faces[face.face];
-  }
-}
 
 void add_stats(const MappingStats& s, MappingStats& total) {
   total.patches += s.patches;
@@ -185,6 +46,29 @@ void add_stats(const MappingStats& s, MappingStats& total) {
 }
 
 }  // namespace
+
+Status map_chunk(const MapTextureOptions& options, const std::array<int32_t, 3>& cell, double cell_size,
+                 double texels_per_unit, uint32_t threads, ProgressCallback progress, ChunkWorker& w) {
+  const double chunk_scale = texels_per_unit * cell_size;
+  if (!(chunk_scale >= 1e-3 && chunk_scale <= 1e7))
+    return Status::error(ErrorCode::kInvalidArgument, "",
+                         "the texel density gives " + std::to_string(chunk_scale) +
+                             " pixels per chunk cell, outside 0.001 to 1e7: give another chunk cell or scale");
+  const Topology topology = build_topology(w.mesh);
+  MapTextureOptions o = options;
+  o.chunks.mode = ChunkMode::kOff;
+  o.measure = false;
+  o.stage_progress = nullptr;
+  o.mapping.progress = std::move(progress);
+  o.orientation.progress = nullptr;
+  o.mapping.threads = threads;
+  o.orientation.threads = threads;
+  o.orientation.fixed_unit_scale = static_cast<float>(1.0 / cell_size);
+  for (size_t k = 0; k < 3; ++k) o.orientation.fixed_origin[k] = static_cast<float>(cell[k] * cell_size);
+  o.mapping.scale = static_cast<float>(chunk_scale);
+  o.mapping.seam_faces = w.seam_flags;
+  return map_texture(w.mesh, topology, o, w.map);
+}
 
 double chunk_texels_per_unit(const Mesh& mesh, const MapTextureOptions& options) {
   if (options.orientation.fixed_unit_scale > 0.f)
@@ -221,8 +105,7 @@ Status map_chunks(const Mesh& mesh, const MapTextureOptions& options, TextureMap
   ChunkPlan plan;
   TAILOR_RETURN_IF_ERROR(plan_chunks(mesh, options.chunks, plan));
   const double texels_per_unit = chunk_texels_per_unit(mesh, options);
-  const double chunk_scale = texels_per_unit * plan.cell_size;
-  if (!(chunk_scale >= 1e-3 && chunk_scale <= 1e7))
+  if (const double chunk_scale = texels_per_unit * plan.cell_size; !(chunk_scale >= 1e-3 && chunk_scale <= 1e7))
     return Status::error(ErrorCode::kInvalidArgument, "",
                          "the texel density gives " + std::to_string(chunk_scale) +
                              " pixels per chunk cell, outside 0.001 to 1e7: give another chunk cell or scale");
@@ -280,25 +163,16 @@ Status map_chunks(const Mesh& mesh, const MapTextureOptions& options, TextureMap
     ChunkWorker w;
     for (size_t i; !failed.load(std::memory_order_relaxed) && (i = next.fetch_add(1)) < chunks;) {
       const uint32_t c = order[i];
-      build_chunk_mesh(mesh, plan, c, options.mapping.seam_faces, w);
-      const Topology topology = build_topology(w.mesh);
-      MapTextureOptions o = options;
-      o.chunks.mode = ChunkMode::kOff;
-      o.measure = false;
-      o.stage_progress = nullptr;
+      const std::span<const uint32_t> faces(plan.faces.data() + plan.chunk_start[c],
+                                            plan.chunk_start[c + 1] - plan.chunk_start[c]);
+      build_chunk_mesh(mesh, faces, plan.cells[c], plan.cell_size, options.mapping.seam_faces, w);
       const size_t chunk_faces = w.faces.size();
-      o.mapping.progress = [&report, chunk_faces](float done) {
-        return report(static_cast<size_t>(done * static_cast<float>(chunk_faces)), 0, false);
-      };
-      o.orientation.progress = nullptr;
-      o.mapping.threads = inner_threads;
-      o.orientation.threads = inner_threads;
-      o.orientation.fixed_unit_scale = static_cast<float>(1.0 / plan.cell_size);
-      for (size_t k = 0; k < 3; ++k)
-        o.orientation.fixed_origin[k] = static_cast<float>(plan.cells[c][k] * plan.cell_size);
-      o.mapping.scale = static_cast<float>(chunk_scale);
-      o.mapping.seam_faces = w.seam_flags;
-      Status s = map_texture(w.mesh, topology, o, w.map);
+      const Status s = map_chunk(
+          options, plan.cells[c], plan.cell_size, texels_per_unit, inner_threads,
+          [&report, chunk_faces](float done) {
+            return report(static_cast<size_t>(done * static_cast<float>(chunk_faces)), 0, false);
+          },
+          w);
       if (!s) {
         chunk_status[c] = s;
         failed.store(true);

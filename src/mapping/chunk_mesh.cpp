@@ -1,0 +1,119 @@
+// One chunk in canonical form (chunk_mesh.h).
+#include "mapping/chunk_mesh.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace tailor::internal {
+namespace {
+
+// Spreads the low 21 bits of x to every third bit (Morton interleave).
+inline uint64_t spread3(uint64_t x) {
+  x &= 0x1FFFFF;
+  x = (x | x << 32) & 0x1F00000000FFFFull;
+  x = (x | x << 16) & 0x1F0000FF0000FFull;
+  x = (x | x << 8) & 0x100F00F00F00F00Full;
+  x = (x | x << 4) & 0x10C30C30C30C30C3ull;
+  x = (x | x << 2) & 0x1249249249249249ull;
+  return x;
+}
+
+// Lexicographic order of two points (x, then y, then z).
+inline bool point_less(const float* a, const float* b) {
+  if (a[0] != b[0]) return a[0] < b[0];
+  if (a[1] != b[1]) return a[1] < b[1];
+  return a[2] < b[2];
+}
+
+}  // namespace
+
+void VertexTable::reset(size_t expected) {
+  size_t want = 64;
+  while (want < 2 * expected) want *= 2;
+  if (want > keys_.size()) {
+    keys_.assign(want, 0);
+    values_.assign(want, 0);
+    stamps_.assign(want, 0);
+    stamp_ = 0;
+  }
+  if (++stamp_ == 0) {  // wrapped: clear the stamps once
+    std::fill(stamps_.begin(), stamps_.end(), 0u);
+    stamp_ = 1;
+  }
+}
+
+uint32_t VertexTable::find_or_add(uint32_t v, uint32_t& next, bool& added) {
+  const size_t mask = keys_.size() - 1;
+  size_t i = (uint64_t{v} * 0x9E3779B97F4A7C15ull >> 20) & mask;
+  while (stamps_[i] == stamp_) {
+    if (keys_[i] == v) {
+      added = false;
+      return values_[i];
+    }
+    i = (i + 1) & mask;
+  }
+  stamps_[i] = stamp_;
+  keys_[i] = v;
+  values_[i] = next;
+  added = true;
+  return next++;
+}
+
+void build_chunk_mesh(const Mesh& mesh, std::span<const uint32_t> faces, const std::array<int32_t, 3>& cell,
+                      double cell_size, std::span<const uint8_t> seam_faces, ChunkWorker& w) {
+  const float* pos = mesh.positions.data();
+  const uint32_t* idx = mesh.indices.data();
+  const double inverse = 1.0 / cell_size;
+  w.faces.resize(faces.size());
+  for (size_t i = 0; i < faces.size(); ++i) {
+    const uint32_t f = faces[i];
+    const float* p[3] = {pos + 3 * size_t{idx[3 * f]}, pos + 3 * size_t{idx[3 * f + 1]},
+                         pos + 3 * size_t{idx[3 * f + 2]}};
+    uint32_t r = 0;
+    if (point_less(p[1], p[r])) r = 1;
+    if (point_less(p[2], p[r])) r = 2;
+    uint64_t morton = 0;
+    for (int k = 0; k < 3; ++k) {
+      double a = p[0][k], b = p[1][k], d = p[2][k];  // summed smallest first, as the chunk rule does
+      if (a > b) std::swap(a, b);
+      if (b > d) std::swap(b, d);
+      if (a > b) std::swap(a, b);
+      const double t = ((a + b) + d) / 3.0 * inverse - cell[static_cast<size_t>(k)];
+      const double q = std::clamp(std::floor(t * double{1 << 21}), 0.0, double{(1 << 21) - 1});
+      morton |= spread3(static_cast<uint64_t>(q)) << k;
+    }
+    w.faces[i] = ChunkFace{morton, f, r};
+  }
+  auto corner = [&](const ChunkFace& face, uint32_t k) {
+    return pos + 3 * size_t{idx[3 * size_t{face.face} + (face.rotation + k) % 3]};
+  };
+  std::sort(w.faces.begin(), w.faces.end(), [&](const ChunkFace& a, const ChunkFace& b) {
+    if (a.morton != b.morton) return a.morton < b.morton;
+    for (uint32_t k = 0; k < 3; ++k) {
+      const float *pa = corner(a, k), *pb = corner(b, k);
+      if (point_less(pa, pb)) return true;
+      if (point_less(pb, pa)) return false;
+    }
+    return a.face < b.face;  // the same triangle twice: indistinguishable anyway
+  });
+  const size_t n = w.faces.size();
+  w.vertices.reset(3 * n);
+  w.mesh.indices.resize(3 * n);
+  w.mesh.positions.clear();
+  w.mesh.positions.reserve(3 * n);
+  const bool seams = !seam_faces.empty();
+  w.seam_flags.resize(seams ? n : 0);
+  uint32_t next = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const ChunkFace& face = w.faces[i];
+    for (uint32_t k = 0; k < 3; ++k) {
+      const uint32_t v = idx[3 * size_t{face.face} + (face.rotation + k) % 3];
+      bool added = false;
+      w.mesh.indices[3 * i + k] = w.vertices.find_or_add(v, next, added);
+      if (added) w.mesh.positions.insert(w.mesh.positions.end(), pos + 3 * size_t{v}, pos + 3 * size_t{v} + 3);
+    }
+    if (seams) w.seam_flags[i] = seam_faces[face.face];
+  }
+}
+
+}  // namespace tailor::internal

@@ -1,0 +1,61 @@
+// One chunk in canonical form (map_chunks.cpp maps it): its faces sorted by the Morton key of
+// their centroid in the cell (then by their corners' coordinates), each face starting at its
+// lexicographically smallest corner, its vertices numbered by first use. The mapping breaks every
+// tie by ids (front keys, seed distances, sums over vertices), so a chunk's UVs are then a
+// function of its geometry and connectivity alone, whatever order the file had.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "tailor/chunks.h"
+#include "tailor/mapping.h"
+#include "tailor/mesh.h"
+
+namespace tailor::internal {
+
+//! One face of a chunk in canonical form: its sort key, its id in the source mesh, the corner it
+//! starts at (chunk corner k is source corner (rotation + k) % 3).
+struct ChunkFace {
+  uint64_t morton;
+  uint32_t face;
+  uint32_t rotation;
+};
+
+//! Source vertex id -> chunk vertex id, for one chunk at a time (open addressing, cleared by
+//! stamping: no reallocation once it has grown to the largest chunk).
+class VertexTable {
+ public:
+  void reset(size_t expected);
+  //! The chunk id of source vertex v; `next` (then incremented) when v is new, with added = true.
+  uint32_t find_or_add(uint32_t v, uint32_t& next, bool& added);
+
+ private:
+  std::vector<uint32_t> keys_, values_, stamps_;
+  uint32_t stamp_ = 0;
+};
+
+//! What one worker reuses from chunk to chunk.
+struct ChunkWorker {
+  std::vector<ChunkFace> faces;  //!< the chunk's faces in canonical order
+  VertexTable vertices;
+  Mesh mesh;  //!< the chunk's canonical mesh
+  std::vector<uint8_t> seam_flags;
+  TextureMap map;  //!< the chunk's mapping, in canonical order
+};
+
+//! Builds the canonical mesh of the faces `faces` of `mesh` (their centroids in `cell`, whose side
+//! is cell_size) into w.mesh, w.faces and w.seam_flags (when seam_faces is not empty).
+void build_chunk_mesh(const Mesh& mesh, std::span<const uint32_t> faces, const std::array<int32_t, 3>& cell,
+                      double cell_size, std::span<const uint8_t> seam_faces, ChunkWorker& w);
+
+//! Maps the chunk built in w (build_chunk_mesh) by map_texture with `options` (no metrics): its
+//! frame is its cell's (origin at the cell's corner, unit the cell side), its density
+//! texels_per_unit, `threads` for its own stages, `progress` its share (optional). Results in w.map,
+//! in w's canonical order. Defined in map_chunks.cpp.
+Status map_chunk(const MapTextureOptions& options, const std::array<int32_t, 3>& cell, double cell_size,
+                 double texels_per_unit, uint32_t threads, ProgressCallback progress, ChunkWorker& w);
+
+}  // namespace tailor::internal

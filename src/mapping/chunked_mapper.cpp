@@ -1,0 +1,162 @@
+// ChunkedMapper (tailor/chunked_mapper.h): the chunked engine's chunks kept one by one. set_chunk
+// maps one chunk as map_chunks does inside a whole mesh (chunk_mesh.h, map_chunk); set_mesh runs
+// map_chunks and keeps each chunk's share.
+#include "tailor/chunked_mapper.h"
+
+#include <algorithm>
+#include <cmath>
+#include <span>
+#include <tuple>
+
+#include "mapping/chunk_mesh.h"
+#include "mapping/mapping_common.h"
+
+namespace tailor {
+namespace {
+
+uint64_t pack(const ChunkCell& cell) {
+  uint64_t key = 0;
+  for (int k = 2; k >= 0; --k) key = (key << 21) | (static_cast<uint64_t>(cell[static_cast<size_t>(k)]) & 0x1FFFFF);
+  return key;
+}
+
+bool cell_less(const ChunkCell& a, const ChunkCell& b) {
+  return std::tie(a[2], a[1], a[0]) < std::tie(b[2], b[1], b[0]);
+}
+
+}  // namespace
+
+ChunkedMapper::ChunkedMapper(const MapTextureOptions& options, int cell_exponent, double texels_per_unit)
+    : options_(options),
+      cell_exponent_(cell_exponent),
+      cell_size_(std::ldexp(1.0, std::clamp(cell_exponent, -60, 60))),
+      // The density as the whole-mesh path carries it (MappingOptions::scale is a float).
+      texels_per_unit_(static_cast<double>(static_cast<float>(texels_per_unit))) {
+  options_.stage_progress = nullptr;
+  options_.mapping.progress = nullptr;
+  options_.orientation.progress = nullptr;
+  options_.measure = false;
+  options_.mapping.seam_faces = {};
+}
+
+Status ChunkedMapper::check() const {
+  if (cell_exponent_ < -60 || cell_exponent_ > 60)
+    return Status::error(ErrorCode::kInvalidArgument, "", "chunk cell exponent must be in -60..60");
+  const double per_cell = texels_per_unit_ * cell_size_;
+  if (!(texels_per_unit_ > 0) || !std::isfinite(texels_per_unit_) || !(per_cell >= 1e-3 && per_cell <= 1e7))
+    return Status::error(ErrorCode::kInvalidArgument, "",
+                         "texels per unit must be positive and give 0.001 to 1e7 pixels per chunk cell");
+  if (options_.orientation.axis == AxisSource::kSkeleton)
+    return Status::error(ErrorCode::kInvalidArgument, "", "the skeleton axis needs the whole mesh, not chunks");
+  return check_map_options(options_);
+}
+
+Status ChunkedMapper::set_chunk(const ChunkCell& cell, const Mesh& faces) {
+  TAILOR_RETURN_IF_ERROR(check());
+  if (faces.empty()) return Status::error(ErrorCode::kInvalidMesh, "", "a chunk needs at least one face");
+  if (!faces.seam_faces.empty() && faces.seam_faces.size() != faces.face_count())
+    return Status::error(ErrorCode::kInvalidMesh, "", "seam face flags must hold one entry per face");
+  // The rule's own test: the plan of these faces alone must be this one cell.
+  ChunkOptions rule;
+  rule.mode = ChunkMode::kOn;
+  rule.cell_exponent = cell_exponent_;
+  ChunkPlan plan;
+  TAILOR_RETURN_IF_ERROR(plan_chunks(faces, rule, plan));
+  if (plan.chunk_count() != 1 || plan.cells[0] != cell) {
+    const auto outside =
+        std::find_if(plan.cells.begin(), plan.cells.end(), [&](const ChunkCell& c) { return c != cell; });
+    const size_t c = static_cast<size_t>(outside - plan.cells.begin());
+    return Status::error(
+        ErrorCode::kInvalidArgument, "",
+        "face " + std::to_string(plan.faces[plan.chunk_start[c]]) + " has its centroid outside the chunk's cell",
+        "cell " + std::to_string(cell[0]) + "," + std::to_string(cell[1]) + "," + std::to_string(cell[2]));
+  }
+  internal::ChunkWorker w;
+  internal::build_chunk_mesh(faces, plan.faces, cell, cell_size_, faces.seam_faces, w);
+  TAILOR_RETURN_IF_ERROR(
+      internal::map_chunk(options_, cell, cell_size_, texels_per_unit_, options_.mapping.threads, {}, w));
+  // Back to the faces' own order and corners.
+  ChunkResult result;
+  const size_t n = faces.face_count();
+  result.faces.resize(n);
+  for (size_t f = 0; f < n; ++f) result.faces[f] = static_cast<uint32_t>(f);
+  result.corner_uv.resize(6 * n);
+  result.patch.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const internal::ChunkFace& face = w.faces[i];
+    for (uint32_t k = 0; k < 3; ++k) {
+      const size_t corner = 3 * size_t{face.face} + (face.rotation + k) % 3;
+      result.corner_uv[2 * corner] = w.map.atlas.corner_uv[6 * i + 2 * k];
+      result.corner_uv[2 * corner + 1] = w.map.atlas.corner_uv[6 * i + 2 * k + 1];
+    }
+    result.patch[face.face] = w.map.atlas.patch[i];
+  }
+  result.patch_count = w.map.atlas.patch_count;
+  result.stats = w.map.stats;
+  chunks_[pack(cell)] = std::move(result);
+  return Status::ok();
+}
+
+Status ChunkedMapper::set_mesh(const Mesh& mesh, std::vector<ChunkCell>* cells) {
+  TAILOR_RETURN_IF_ERROR(check());
+  if (!mesh.seam_faces.empty() && mesh.seam_faces.size() != mesh.face_count())
+    return Status::error(ErrorCode::kInvalidMesh, "", "seam face flags must hold one entry per face");
+  MapTextureOptions o = options_;
+  o.chunks.mode = ChunkMode::kOn;
+  o.chunks.cell_exponent = cell_exponent_;
+  o.mapping.scale = static_cast<float>(texels_per_unit_);  // with unit 1: pixels per world unit
+  o.orientation.fixed_unit_scale = 1.f;
+  o.mapping.seam_faces = mesh.seam_faces;
+  TextureMap map;
+  TAILOR_RETURN_IF_ERROR(internal::map_chunks(mesh, o, map));
+  ChunkPlan plan;
+  TAILOR_RETURN_IF_ERROR(plan_chunks(mesh, o.chunks, plan));
+  if (cells) cells->clear();
+  for (size_t c = 0; c < plan.chunk_count(); ++c) {
+    const std::span<const uint32_t> faces(plan.faces.data() + plan.chunk_start[c],
+                                          plan.chunk_start[c + 1] - plan.chunk_start[c]);
+    ChunkResult result;
+    result.faces.assign(faces.begin(), faces.end());
+    result.corner_uv.reserve(6 * faces.size());
+    result.patch.reserve(faces.size());
+    uint32_t first = kInvalid, last = 0;  // a chunk's patches are consecutive ids (map_chunks)
+    for (const uint32_t f : faces) {
+      first = std::min(first, map.atlas.patch[f]);
+      last = std::max(last, map.atlas.patch[f]);
+    }
+    for (const uint32_t f : faces) {
+      const auto uv = map.atlas.corner_uv.begin() + static_cast<std::ptrdiff_t>(6 * size_t{f});
+      result.corner_uv.insert(result.corner_uv.end(), uv, uv + 6);
+      result.patch.push_back(map.atlas.patch[f] - first);
+    }
+    result.patch_count = last - first + 1;
+    chunks_[pack(plan.cells[c])] = std::move(result);
+    if (cells) cells->push_back(plan.cells[c]);
+  }
+  return Status::ok();
+}
+
+bool ChunkedMapper::remove_chunk(const ChunkCell& cell) { return chunks_.erase(pack(cell)) > 0; }
+
+const ChunkResult* ChunkedMapper::chunk(const ChunkCell& cell) const {
+  const auto it = chunks_.find(pack(cell));
+  return it == chunks_.end() ? nullptr : &it->second;
+}
+
+std::vector<ChunkCell> ChunkedMapper::cells() const {
+  std::vector<ChunkCell> out;
+  out.reserve(chunks_.size());
+  for (const auto& [key, result] : chunks_) {
+    ChunkCell cell;
+    for (size_t k = 0; k < 3; ++k) {
+      const uint64_t bits = (key >> (21 * k)) & 0x1FFFFF;
+      cell[k] = static_cast<int32_t>(bits >= (uint64_t{1} << 20) ? static_cast<int64_t>(bits) - (int64_t{1} << 21)
+                                                                 : static_cast<int64_t>(bits));
+    }
+    out.push_back(cell);
+  }
+  std::sort(out.begin(), out.end(), cell_less);
+  return out;
+}
+
+}  // namespace tailor

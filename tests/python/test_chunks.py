@@ -1,0 +1,35 @@
+"""tailor.ChunkedMapper: chunks mapped one by one are the bits of the whole mesh's chunked map."""
+import numpy as np
+import pytest
+
+import tailor
+from conftest import DATA
+
+
+def test_a_chunk_set_alone_matches_the_mesh_and_the_cli_density():
+    mesh = tailor.load(DATA / "meshes" / "horse.ply")
+    mapper = tailor.ChunkedMapper(-4, 4096.0, threads=2)
+    cells = mapper.set_mesh(mesh)
+    assert len(cells) > 4 and mapper.cells() == cells
+    assert mapper.cell_size == 2.0 ** -4 and mapper.texels_per_unit == 4096.0
+    assert sum(len(mapper.chunk(c)["faces"]) for c in cells) == mesh.face_count
+    # One chunk's faces as a mesh of their own, mapped alone: the same bits.
+    cell = max(cells, key=lambda c: len(mapper.chunk(c)["faces"]))
+    inside = mapper.chunk(cell)
+    faces = mesh.faces[inside["faces"]]
+    used, compact = np.unique(faces, return_inverse=True)
+    part = tailor.Mesh(mesh.positions[used], compact.reshape(-1, 3).astype(np.uint32))
+    alone = tailor.ChunkedMapper(-4, 4096.0)
+    alone.set_chunk(cell, part)
+    assert np.array_equal(alone.chunk(cell)["corner_uvs"], inside["corner_uvs"])
+    assert alone.chunk(cell)["patch_count"] == inside["patch_count"]
+    # Faces of another cell are refused; removing a chunk leaves the others.
+    other = next(c for c in cells if c != cell)
+    with pytest.raises(tailor.Error, match="outside the chunk's cell"):
+        alone.set_chunk(other, part)
+    before = mapper.chunk(other)["corner_uvs"].copy()
+    assert mapper.remove_chunk(cell) and not mapper.remove_chunk(cell)
+    assert mapper.chunk(cell) is None
+    assert np.array_equal(mapper.chunk(other)["corner_uvs"], before)
+    with pytest.raises(tailor.Error, match="texels per unit"):
+        tailor.ChunkedMapper(-4, 0.0)
