@@ -40,11 +40,34 @@ void VertexTable::reset(size_t expected) {
     std::fill(stamps_.begin(), stamps_.end(), 0u);
     stamp_ = 1;
   }
+  size_ = 0;
+}
+
+void VertexTable::grow() {
+  std::vector<uint32_t> keys, values;
+  for (size_t i = 0; i < keys_.size(); ++i)
+    if (stamps_[i] == stamp_) {
+      keys.push_back(keys_[i]);
+      values.push_back(values_[i]);
+    }
+  keys_.assign(2 * keys_.size(), 0);
+  values_.assign(keys_.size(), 0);
+  stamps_.assign(keys_.size(), 0);
+  stamp_ = 1;
+  const size_t mask = keys_.size() - 1;
+  for (size_t j = 0; j < keys.size(); ++j) {
+    size_t i = slot(keys[j], mask);
+    while (stamps_[i] == stamp_) i = (i + 1) & mask;
+    stamps_[i] = stamp_;
+    keys_[i] = keys[j];
+    values_[i] = values[j];
+  }
 }
 
 uint32_t VertexTable::find_or_add(uint32_t v, uint32_t& next, bool& added) {
+  if (2 * (size_ + 1) > keys_.size()) grow();
   const size_t mask = keys_.size() - 1;
-  size_t i = (uint64_t{v} * 0x9E3779B97F4A7C15ull >> 20) & mask;
+  size_t i = slot(v, mask);
   while (stamps_[i] == stamp_) {
     if (keys_[i] == v) {
       added = false;
@@ -56,6 +79,7 @@ uint32_t VertexTable::find_or_add(uint32_t v, uint32_t& next, bool& added) {
   keys_[i] = v;
   values_[i] = next;
   added = true;
+  ++size_;
   return next++;
 }
 
@@ -97,7 +121,7 @@ void build_chunk_mesh(const Mesh& mesh, std::span<const uint32_t> faces, const s
     return a.face < b.face;  // the same triangle twice: indistinguishable anyway
   });
   const size_t n = w.faces.size();
-  w.vertices.reset(3 * n);
+  w.vertices.reset(n / 2 + 16);  // a surface has about half as many vertices as faces; grows when not
   w.mesh.indices.resize(3 * n);
   w.mesh.positions.clear();
   w.mesh.positions.reserve(3 * n);

@@ -28,13 +28,17 @@ struct ChunkFace {
 //! stamping: no reallocation once it has grown to the largest chunk).
 class VertexTable {
  public:
+  //! Empties the table for about `expected` vertices (it grows past them when needed).
   void reset(size_t expected);
   //! The chunk id of source vertex v; `next` (then incremented) when v is new, with added = true.
   uint32_t find_or_add(uint32_t v, uint32_t& next, bool& added);
 
  private:
+  static size_t slot(uint32_t v, size_t mask) { return (uint64_t{v} * 0x9E3779B97F4A7C15ull >> 20) & mask; }
+  void grow();
   std::vector<uint32_t> keys_, values_, stamps_;
   uint32_t stamp_ = 0;
+  size_t size_ = 0;
 };
 
 //! What one worker reuses from chunk to chunk.
