@@ -67,6 +67,18 @@ grep -Eq '"cracks_closed": [1-9][0-9]*' "$tmp/a.json" && ok || fail "stats: no c
 "$tailor" eval tests/data/meshes/fertility.off --stability --json >"$tmp/stab.json" 2>&1 &&
   grep -q '"removed_faces"' "$tmp/stab.json" && ok || fail "eval --stability: $(cat "$tmp/stab.json")"
 expect_error 1 "no texture coordinates" -- "$tailor" eval tests/data/meshes/fandisk.off
+# Chunks: the same surface in another order keeps every UV bit, and so does everything beyond the
+# locality radius of a cut (the horse in cells of 1/16 unit: a dozen chunks).
+"$tailor" eval tests/data/meshes/horse.ply --stability --chunks on --chunk-cell -4 >"$tmp/chunks.txt" 2>&1 &&
+  grep -q "another face, vertex and corner order: 100.0% of corners bit-identical" "$tmp/chunks.txt" &&
+  grep -Eq "100.0% of the [0-9]+ surviving corners farther than" "$tmp/chunks.txt" && ok ||
+  fail "eval --stability --chunks on: $(cat "$tmp/chunks.txt")"
+"$tailor" map tests/data/meshes/horse.ply -o "$tmp/chunks.glb" --chunks on --chunk-cell -4 --stats "$tmp/chunks.json" \
+  >"$tmp/chunks_map.txt" 2>&1 && grep -Eq '"chunks": [0-9]{2}' "$tmp/chunks.json" &&
+  grep -q '"locality_radius"' "$tmp/chunks.json" && grep -q "^chunks: " "$tmp/chunks_map.txt" && ok ||
+  fail "map --chunks on: $(cat "$tmp/chunks_map.txt")"
+expect_error 2 "--chunks must be auto, on or off, got 'maybe'" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --chunks maybe
+expect_error 2 "--chunk-cell must be auto or a whole number in -60..60" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --chunk-cell 1.5
 
 # --- bad input: clear one-line errors, exit 1, nothing written ---
 printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n' >"$tmp/truncated.ply"

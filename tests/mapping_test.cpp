@@ -202,12 +202,17 @@ MappingOptions map_with_and_without(const char* name, bool MappingOptions::*step
 TEST(Mapping, SeamShorteningShortensSeamsWithinTheBound) {
   for (const char* name : {"horse.ply", "spot.obj"}) {
     Mapped shortened, kept;
-    const MappingOptions options = map_with_and_without(name, &MappingOptions::shorten_seams, shortened, kept);
+    // The shortening's own effect on the growth's seams (the crack closing after it zips most of
+    // what is left either way).
+    MappingOptions growth;
+    growth.close_cracks = false;
+    growth.relax_iterations = 0;
+    const MappingOptions options = map_with_and_without(name, &MappingOptions::shorten_seams, shortened, kept, growth);
     EXPECT_GT(shortened.stats.faces_reseamed, 0u) << name;
     EXPECT_EQ(kept.stats.faces_reseamed, 0u) << name;
     expect_valid_patches_atlas(shortened, options, std::string(name) + " shortened");
     const UvMetrics with = metrics_of(shortened), without = metrics_of(kept);
-    // Measured: horse 7.8% -> 7.0%, spot 12.7% -> 11.4% of edge length; assert at least 5% less.
+    // At least 5% less seam length than the growth left.
     EXPECT_LT(with.seam_length_ratio, 0.95 * without.seam_length_ratio) << name;
     EXPECT_LT(with.seam_edges, without.seam_edges) << name;
     EXPECT_LE(with.patches, without.patches) << name;

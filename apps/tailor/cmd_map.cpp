@@ -256,6 +256,11 @@ int run_map(const MapArgs& opt) {
   const Atlas& atlas = map.atlas;
   run.options = options;
   add_map_results(mesh, load, topology, map, run);
+  if (map.stats.chunks > 0 && mesh.face_count() / map.stats.chunks < 1000)
+    warn(opt.quiet, opt.input + ": " + std::to_string(map.stats.chunks) + " chunks of " +
+                        std::to_string(mesh.face_count() / map.stats.chunks) +
+                        " faces on average: every chunk border is a seam; a larger --chunk-cell keeps more of the "
+                        "surface in one piece");
   topology = Topology{};  // 16 bytes per face nothing after the metrics reads: freed before the export
 
   // === Stability (optional: two more mappings) ===
@@ -458,10 +463,12 @@ void register_map(CLI::App& app, Runner& run) {
   const MappingOptionHandles handles = add_mapping_options(group, opt->mapping_args, opt->options, true);
   const CLI::Option *crack_rings = handles.crack_rings, *symmetry = handles.symmetry;
   cmd->add_flag("--stability", opt->stability,
-                "Also remove ~10% of the faces, re-map and report how much the remaining UVs moved");
+                "Also map the mesh again in another file order, and with ~10% of its faces removed (fresh runs, "
+                "as tailor eval --stability), and report how many UVs kept their bits and how far the others moved");
   cmd->add_option("--threads", mapping.threads,
-                  "Threads for the orientation, the crack closing and the metrics (0 = one per core, up to 8, "
-                  "where the mesh is large enough); the output is the same for any count")
+                  "Threads: chunks (--chunks) are mapped one per thread (0 = one per core); a mesh mapped whole uses "
+                  "them for its orientation, crack closing and metrics (0 = one per core, up to 8, where the mesh is "
+                  "large enough); the output is the same for any count")
       ->capture_default_str()
       ->check(CLI::Range(0u, 64u));
   cmd->add_flag("-q,--quiet", opt->quiet, "Print nothing but errors");

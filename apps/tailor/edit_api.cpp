@@ -238,7 +238,8 @@ std::string replay_command(const EditContext& c, const MapTextureOptions& option
          std::to_string(m.min_patch_faces) + " --hop-age " + number(m.hop_age) + " --crack-rings " +
          std::to_string(m.crack_rings) + " --relax-iterations " + std::to_string(m.relax_iterations) + " --threshold " +
          number(m.threshold_px) + " --axis " + shell_word(axis_text(options.orientation)) + " --smooth " +
-         std::to_string(options.orientation.smooth_passes) + " --symmetry " + std::to_string(m.symmetry);
+         std::to_string(options.orientation.smooth_passes) + " --symmetry " + std::to_string(m.symmetry) +
+         " --chunks off";
   if (m.use_seed_point)
     cmd += " --seed-point " + number(m.seed_point[0]) + "," + number(m.seed_point[1]) + "," + number(m.seed_point[2]);
   if (!m.shorten_seams) cmd += " --no-seam-shortening";

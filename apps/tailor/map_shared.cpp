@@ -44,6 +44,28 @@ Status parse_axis(const std::string& text, OrientationOptions& o) {
   return Status::ok();
 }
 
+Status parse_chunk_args(const std::string& mode, const std::string& cell, ChunkOptions& chunks) {
+  const auto usage_error = [](const std::string& what) { return Status::error(ErrorCode::kInvalidArgument, "", what); };
+  if (mode == "auto")
+    chunks.mode = ChunkMode::kAuto;
+  else if (mode == "on")
+    chunks.mode = ChunkMode::kOn;
+  else if (mode == "off")
+    chunks.mode = ChunkMode::kOff;
+  else
+    return usage_error("--chunks must be auto, on or off, got '" + mode + "'");
+  if (cell != "auto") {
+    char* end = nullptr;
+    const long e = std::strtol(cell.c_str(), &end, 10);
+    if (cell.empty() || *end != '\0' || e < -60 || e > 60)
+      return usage_error(
+          "--chunk-cell must be auto or a whole number in -60..60 (the cell side is 2^N world units), got '" + cell +
+          "'");
+    chunks.cell_exponent = static_cast<int>(e);
+  }
+  return Status::ok();
+}
+
 MappingOptionHandles add_mapping_options(CLI::Option_group* group, MappingArgs& args, MapTextureOptions& options,
                                          bool with_input_files) {
   MappingOptions& mapping = options.mapping;
@@ -93,24 +115,7 @@ Status apply_mapping_args(const MappingArgs& args, MapTextureOptions& options) {
     mapping.use_seed_point = true;
   }
   if (args.texture_size <= 0) return usage_error("--texture-size must be positive");
-  if (args.chunks == "auto")
-    options.chunks.mode = ChunkMode::kAuto;
-  else if (args.chunks == "on")
-    options.chunks.mode = ChunkMode::kOn;
-  else if (args.chunks == "off")
-    options.chunks.mode = ChunkMode::kOff;
-  else
-    return usage_error("--chunks must be auto, on or off, got '" + args.chunks + "'");
-  if (args.chunk_cell != "auto") {
-    char* end = nullptr;
-    const long e = std::strtol(args.chunk_cell.c_str(), &end, 10);
-    if (args.chunk_cell.empty() || *end != '\0' || e < -60 || e > 60)
-      return usage_error(
-          "--chunk-cell must be auto or a whole number in -60..60 (the cell side is 2^N world units), "
-          "got '" +
-          args.chunk_cell + "'");
-    options.chunks.cell_exponent = static_cast<int>(e);
-  }
+  if (Status s = parse_chunk_args(args.chunks, args.chunk_cell, options.chunks); !s) return s;
   if (Status s = check_map_options(options); !s) return s;  // scale, hop age, symmetry
   if (!args.auto_field_following() && !parse_unit_float(args.field_following, mapping.field_following))
     return usage_error("--field-following must be auto or a number in [0, 1], got '" + args.field_following + "'");

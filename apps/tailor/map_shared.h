@@ -61,6 +61,9 @@ MappingOptionHandles add_mapping_options(CLI::Option_group* group, MappingArgs& 
 //! Parses the options given as text into `options` (an axis of auto is left to the command) and checks
 //! them and the bound ones (check_map_options), in the order the commands report them. Fails with
 //! kInvalidArgument naming the option.
+//! Parses --chunks (auto, on, off) and --chunk-cell (auto or a whole number in -60..60) into `chunks`.
+Status parse_chunk_args(const std::string& mode, const std::string& cell, ChunkOptions& chunks);
+
 Status apply_mapping_args(const MappingArgs& args, MapTextureOptions& options);
 
 //! The output side of a mapping, as given on the command line of `tailor map`.

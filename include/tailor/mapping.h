@@ -100,10 +100,9 @@ struct MappingOptions {
                                        //!< 1000): median angle distortion 6.5 -> 1.9 degrees on the shared meshes for
                                        //!< ~20% more mapping time; patches and seam edges unchanged, invisible seams
                                        //!< (< 1 px) untouched, every moved face within max_stretch (docs/mapping.md)
-  uint32_t threads =
-      0;  //!< threads of the crack closing, the relaxation and symmetry 4's fields (0 = one per 10k / 20k
-          //!< faces, at most the cores and 8); the result is identical for any count
-          //!< (the growth is sequential)
+  uint32_t threads = 0;  //!< threads: chunked, one chunk per thread (0 = one per core); whole, those of the crack
+                         //!< closing, the relaxation and symmetry 4's fields (0 = one per 10k / 20k faces, at most the
+                         //!< cores and 8; the growth is sequential); the result is identical for any count
   uint32_t min_patch_faces = 16;    //!< patches with fewer faces are absorbed into a neighbouring patch by rigid
                                     //!< unfolding (0 = keep all; isolated components stay whole)
   uint32_t symmetry = 1;            //!< 1: the growth above; 4 (experimental): an integer-grid map in place of
@@ -225,7 +224,12 @@ struct TextureMap {
   UvMetrics metrics;   //!< step 5: quality of the atlas (metrics.seconds: its time)
 };
 
-//! Maps the texture, as `tailor map` does: 1. the orientation field (compute_orientation),
+//! Maps the texture, as `tailor map` does: 0. from options.chunks.min_faces faces on (kAuto), the
+//! mesh is cut into chunks by the chunk rule (tailor/chunks.h) and each chunk runs steps 1-4 on its
+//! own, in parallel (map.frames then stays empty; map.stats sums the chunks and reports the grid);
+//! a smaller mesh is one piece. Either way the mesh is rebuilt in a canonical order first, so the
+//! same surface in any order of faces, vertices and corners maps to the same UV bits.
+//! 1. the orientation field (compute_orientation),
 //! 2. the growth (patches mode: the patch-discovery front; thesis mode: the reference algorithm),
 //! 3. seam shortening, 4. crack closing and relaxation (patches mode, each unless switched off),
 //! 5. the metrics of the result (compute_uv_metrics, unless options.measure is false). With

@@ -29,8 +29,12 @@ Status map_keeping_setup(const Mesh& mesh, const Topology& topology, const MapTe
   local.ready = false;
   MapTextureOptions o = options;
   o.measure = false;  // the session shows no metrics (the atlas does not depend on them)
+  // The full map is map_texture's (the whole mesh in canonical order, as `tailor map --chunks off`
+  // gives it: the local updates work at the whole mesh's texel density); the frames and the setup
+  // the local updates need are then computed in the session's own order.
+  o.chunks.mode = ChunkMode::kOff;
+  TAILOR_RETURN_IF_ERROR(map_texture(mesh, topology, o, map));
   TAILOR_RETURN_IF_ERROR(compute_orientation_setup(mesh, topology, o.orientation, map.frames, &local.setup));
-  TAILOR_RETURN_IF_ERROR(map_texture_frames(mesh, topology, o, map));
   local.seeds = component_seed_faces(mesh, topology, map.frames, o.mapping);
   local.region.assign(mesh.face_count(), 0);
   local.ring.resize(mesh.face_count());

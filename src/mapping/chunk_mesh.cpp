@@ -83,11 +83,11 @@ uint32_t VertexTable::find_or_add(uint32_t v, uint32_t& next, bool& added) {
   return next++;
 }
 
-void build_chunk_mesh(const Mesh& mesh, std::span<const uint32_t> faces, const std::array<int32_t, 3>& cell,
-                      double cell_size, std::span<const uint8_t> seam_faces, ChunkWorker& w) {
+void build_chunk_mesh(const Mesh& mesh, std::span<const uint32_t> faces, const std::array<double, 3>& origin,
+                      double size, std::span<const uint8_t> seam_faces, ChunkWorker& w) {
   const float* pos = mesh.positions.data();
   const uint32_t* idx = mesh.indices.data();
-  const double inverse = 1.0 / cell_size;
+  const double inverse = 1.0 / size;
   w.faces.resize(faces.size());
   for (size_t i = 0; i < faces.size(); ++i) {
     const uint32_t f = faces[i];
@@ -102,7 +102,7 @@ void build_chunk_mesh(const Mesh& mesh, std::span<const uint32_t> faces, const s
       if (a > b) std::swap(a, b);
       if (b > d) std::swap(b, d);
       if (a > b) std::swap(a, b);
-      const double t = ((a + b) + d) / 3.0 * inverse - cell[static_cast<size_t>(k)];
+      const double t = (((a + b) + d) / 3.0 - origin[static_cast<size_t>(k)]) * inverse;
       const double q = std::clamp(std::floor(t * double{1 << 21}), 0.0, double{(1 << 21) - 1});
       morton |= spread3(static_cast<uint64_t>(q)) << k;
     }

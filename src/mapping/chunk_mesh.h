@@ -50,10 +50,23 @@ struct ChunkWorker {
   TextureMap map;  //!< the chunk's mapping, in canonical order
 };
 
-//! Builds the canonical mesh of the faces `faces` of `mesh` (their centroids in `cell`, whose side
-//! is cell_size) into w.mesh, w.faces and w.seam_flags (when seam_faces is not empty).
-void build_chunk_mesh(const Mesh& mesh, std::span<const uint32_t> faces, const std::array<int32_t, 3>& cell,
-                      double cell_size, std::span<const uint8_t> seam_faces, ChunkWorker& w);
+//! Builds the canonical mesh of the faces `faces` of `mesh` into w.mesh, w.faces and w.seam_flags
+//! (when seam_faces is not empty). Their centroids lie in the cube of side `size` at `origin` (a
+//! chunk's cell, or the whole mesh's bounding box): the Morton keys are taken there.
+void build_chunk_mesh(const Mesh& mesh, std::span<const uint32_t> faces, const std::array<double, 3>& origin,
+                      double size, std::span<const uint8_t> seam_faces, ChunkWorker& w);
+
+//! The origin of a chunk's cell, world units.
+inline std::array<double, 3> cell_origin(const std::array<int32_t, 3>& cell, double cell_size) {
+  return {cell[0] * cell_size, cell[1] * cell_size, cell[2] * cell_size};
+}
+
+//! Maps a whole mesh (not cut into chunks) in canonical form, so that the same surface in any
+//! file order gets the same UVs: build_chunk_mesh over its bounding box, map_texture on that (its
+//! own normalisation, as the mesh's), then the atlas and the frames back to the mesh's faces and
+//! corners (a rotated face's local corners re-expressed from its own corner 0). Defined in
+//! map_chunks.cpp.
+Status map_whole_canonical(const Mesh& mesh, const MapTextureOptions& options, TextureMap& map);
 
 //! Maps the chunk built in w (build_chunk_mesh) by map_texture with `options` (no metrics): its
 //! frame is its cell's (origin at the cell's corner, unit the cell side), its density

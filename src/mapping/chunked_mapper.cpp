@@ -72,7 +72,8 @@ Status ChunkedMapper::set_chunk(const ChunkCell& cell, const Mesh& faces) {
         "cell " + std::to_string(cell[0]) + "," + std::to_string(cell[1]) + "," + std::to_string(cell[2]));
   }
   internal::ChunkWorker w;
-  internal::build_chunk_mesh(faces, plan.faces, cell, cell_size_, faces.seam_faces, w);
+  internal::build_chunk_mesh(faces, plan.faces, internal::cell_origin(cell, cell_size_), cell_size_, faces.seam_faces,
+                             w);
   TAILOR_RETURN_IF_ERROR(
       internal::map_chunk(options_, cell, cell_size_, texels_per_unit_, options_.mapping.threads, {}, w));
   // Back to the faces' own order and corners.

@@ -67,7 +67,100 @@ Status map_chunk(const MapTextureOptions& options, const std::array<int32_t, 3>&
   for (size_t k = 0; k < 3; ++k) o.orientation.fixed_origin[k] = static_cast<float>(cell[k] * cell_size);
   o.mapping.scale = static_cast<float>(chunk_scale);
   o.mapping.seam_faces = w.seam_flags;
-  return map_texture(w.mesh, topology, o, w.map);
+  return map_texture_in_order(w.mesh, topology, o, w.map);
+}
+
+Status map_whole_canonical(const Mesh& mesh, const MapTextureOptions& options, TextureMap& map) {
+  const size_t face_count = mesh.face_count();
+  if (face_count == 0) return Status::error(ErrorCode::kInvalidMesh, "", "mesh has no face");
+  if (!options.mapping.seam_faces.empty() && options.mapping.seam_faces.size() != face_count)
+    return Status::error(ErrorCode::kInvalidArgument, "", "seam face flags must hold one entry per face");
+  // The Morton keys over a cube that an edit rarely moves: the caller's fixed frame, else a
+  // power-of-two cube on the world grid of that size that holds the bounding box (it moves only
+  // when the box crosses a power of two), so that an edit leaves the other faces' order as it was.
+  std::array<double, 3> origin;
+  double side;
+  if (options.orientation.fixed_unit_scale > 0.f) {
+    side = 1.0 / options.orientation.fixed_unit_scale;
+    for (size_t k = 0; k < 3; ++k) origin[k] = options.orientation.fixed_origin[k];
+  } else {
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    for (const uint32_t v : mesh.indices)
+      for (size_t k = 0; k < 3; ++k) {
+        lo[k] = std::min(lo[k], double{mesh.positions[3 * size_t{v} + k]});
+        hi[k] = std::max(hi[k], double{mesh.positions[3 * size_t{v} + k]});
+      }
+    const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+    const double grid = extent > 0 && std::isfinite(extent) ? std::exp2(std::ceil(std::log2(extent))) : 1.0;
+    for (size_t k = 0; k < 3; ++k) origin[k] = std::isfinite(lo[k]) ? std::floor(lo[k] / grid) * grid : 0.0;
+    side = 2 * grid;
+  }
+  std::vector<uint32_t> all(face_count);
+  for (size_t f = 0; f < face_count; ++f) all[f] = static_cast<uint32_t>(f);
+  ChunkWorker w;
+  build_chunk_mesh(mesh, all, origin, side, options.mapping.seam_faces, w);
+  std::vector<uint32_t>().swap(all);
+  {
+    const Topology topology = build_topology(w.mesh);
+    MapTextureOptions o = options;
+    o.mapping.seam_faces = w.seam_flags;
+    o.measure = false;  // map_texture measures the result on the mesh as given
+    TAILOR_RETURN_IF_ERROR(map_texture_in_order(w.mesh, topology, o, w.map));
+  }
+  // Back to the mesh's faces and corners: chunk corner k of face i is corner (rotation + k) % 3 of
+  // face w.faces[i].face.
+  map.atlas.corner_uv.resize(6 * face_count);
+  map.atlas.patch.resize(face_count);
+  map.atlas.patch_count = w.map.atlas.patch_count;
+  const FaceFrames& in = w.map.frames;
+  FaceFrames& out = map.frames;
+  out = FaceFrames{};
+  out.normal.resize(3 * face_count);
+  out.orientation.resize(3 * face_count);
+  out.bitangent.resize(3 * face_count);
+  out.area.resize(face_count);
+  out.local.resize(6 * face_count);
+  out.variation.resize(face_count);
+  out.anchor.resize(2 * face_count);
+  for (size_t i = 0; i < face_count; ++i) {
+    const uint32_t f = w.faces[i].face, r = w.faces[i].rotation;
+    for (uint32_t k = 0; k < 3; ++k) {
+      const size_t corner = 3 * size_t{f} + (r + k) % 3;
+      map.atlas.corner_uv[2 * corner] = w.map.atlas.corner_uv[6 * i + 2 * k];
+      map.atlas.corner_uv[2 * corner + 1] = w.map.atlas.corner_uv[6 * i + 2 * k + 1];
+    }
+    map.atlas.patch[f] = w.map.atlas.patch[i];
+    std::copy_n(&in.normal[3 * i], 3, &out.normal[3 * size_t{f}]);
+    std::copy_n(&in.orientation[3 * i], 3, &out.orientation[3 * size_t{f}]);
+    std::copy_n(&in.bitangent[3 * i], 3, &out.bitangent[3 * size_t{f}]);
+    out.area[f] = in.area[i];
+    out.variation[f] = in.variation[i];
+    // The face's corners from its own corner 0 (chunk corner k0); exact when it was not rotated.
+    const uint32_t k0 = (3 - r) % 3;
+    const float* l = &in.local[6 * i];
+    for (uint32_t j = 0; j < 3; ++j) {
+      const uint32_t k = (j + 3 - r) % 3;
+      out.local[6 * size_t{f} + 2 * j] = r == 0 ? l[2 * k] : l[2 * k] - l[2 * k0];
+      out.local[6 * size_t{f} + 2 * j + 1] = r == 0 ? l[2 * k + 1] : l[2 * k + 1] - l[2 * k0 + 1];
+    }
+    out.anchor[2 * size_t{f}] = r == 0 ? in.anchor[2 * i] : in.anchor[2 * i] + l[2 * k0];
+    out.anchor[2 * size_t{f} + 1] = r == 0 ? in.anchor[2 * i + 1] : in.anchor[2 * i + 1] + l[2 * k0 + 1];
+  }
+  out.axis = in.axis;
+  out.axis2 = in.axis2;
+  out.origin = in.origin;
+  out.bbox_min = in.bbox_min;
+  out.bbox_max = in.bbox_max;
+  out.unit_scale = in.unit_scale;
+  out.degenerate_faces = in.degenerate_faces;
+  out.fallback_faces = in.fallback_faces;
+  out.skeleton_edges = in.skeleton_edges;
+  out.skeleton_closed_holes = in.skeleton_closed_holes;
+  out.skeleton_pca_faces = in.skeleton_pca_faces;
+  out.skeleton_seconds = in.skeleton_seconds;
+  out.seconds = in.seconds;
+  map.stats = w.map.stats;
+  return Status::ok();
 }
 
 double chunk_texels_per_unit(const Mesh& mesh, const MapTextureOptions& options) {
@@ -165,7 +258,8 @@ Status map_chunks(const Mesh& mesh, const MapTextureOptions& options, TextureMap
       const uint32_t c = order[i];
       const std::span<const uint32_t> faces(plan.faces.data() + plan.chunk_start[c],
                                             plan.chunk_start[c + 1] - plan.chunk_start[c]);
-      build_chunk_mesh(mesh, faces, plan.cells[c], plan.cell_size, options.mapping.seam_faces, w);
+      build_chunk_mesh(mesh, faces, cell_origin(plan.cells[c], plan.cell_size), plan.cell_size,
+                       options.mapping.seam_faces, w);
       const size_t chunk_faces = w.faces.size();
       const Status s = map_chunk(
           options, plan.cells[c], plan.cell_size, texels_per_unit, inner_threads,

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <limits>
 
+#include "mapping/chunk_mesh.h"
 #include "mapping/face_stretch.h"
 #include "mapping/grid_map.h"
 #include "mapping/mapping_common.h"
@@ -194,6 +195,19 @@ Status map_texture(const Mesh& mesh, const Topology& topology, const MapTextureO
     TAILOR_RETURN_IF_ERROR(internal::map_chunks(mesh, options, map));
     return measure_atlas(mesh, topology, options, map);
   }
+  // Smaller meshes: steps 1-5 on the whole mesh rebuilt in canonical order, so that the file's
+  // order of faces, vertices and corners does not change a bit (mapping/map_chunks.cpp)
+  if (topology.opposite.size() != 3 * mesh.face_count())
+    return Status::error(ErrorCode::kInvalidMesh, "", "topology does not match the mesh");
+  TAILOR_RETURN_IF_ERROR(internal::map_whole_canonical(mesh, options, map));
+  return measure_atlas(mesh, topology, options, map);
+}
+
+Status internal::map_texture_in_order(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options,
+                                      TextureMap& map) {
+  clear_atlas(map.atlas);
+  map.stats = MappingStats{};
+  map.metrics = UvMetrics{};
   // === 1. Orientation field: per-face frames, the field and its variation (surface/orientation.cpp) ===
   if (options.stage_progress) {
     OrientationOptions orientation = options.orientation;

@@ -60,6 +60,12 @@ inline MetricsOptions lattice_of(const MappingOptions& options) {
   return lattice;
 }
 
+//! Steps 1-6 of map_texture on the mesh in the order given (the faces' and vertices' ids break the
+//! mapping's ties): the orientation into map.frames, then map_texture_frames. map_texture runs it on
+//! a canonical copy of the mesh or of each chunk (chunk_mesh.h).
+Status map_texture_in_order(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options,
+                            TextureMap& map);
+
 //! Steps 2-6 of map_texture on frames already in map.frames (computed by compute_orientation with
 //! options.orientation): map_texture is compute_orientation then this, so the same bits.
 Status map_texture_frames(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options,
