@@ -390,8 +390,7 @@ void bind_map(py::module_& m) {
       py::arg("seed_point") = py::none(), py::arg("symmetry") = py::none(),
       py::arg("unit_scale") = OrientationOptions{}.fixed_unit_scale,
       py::arg("smooth") = OrientationOptions{}.smooth_passes, py::arg("material") = py::none(),
-      py::arg("chunks") = "auto", py::arg("chunk_cell") = py::none(),
-      map_docstring().c_str());
+      py::arg("chunks") = "auto", py::arg("chunk_cell") = py::none(), map_docstring().c_str());
 }
 
 }  // namespace tailor::python

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The threaded stages under ThreadSanitizer: the crack closing (bands of seed distance zipped at
 # once, which must never touch the same vertex), the metrics' and the orientation's chunked
-# passes, the integer-grid map's field and relaxation (symmetry 4), and the export's second thread.
+# passes, the integer-grid map's field and relaxation (symmetry 4), the export's second thread,
+# and the chunked engine (one chunk per thread, progress from every worker).
 #
 #   scripts/tsan.sh   # make tsan
 #
@@ -16,15 +17,18 @@ jobs="${JOBS:-2}"
 export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1"
 
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTAILOR_TSAN=ON -DTAILOR_BUILD_BENCH=OFF >/dev/null
-cmake --build "$build" -j "$jobs" --target tailor mapping_test metrics_test orientation_test >/dev/null
+cmake --build "$build" -j "$jobs" --target tailor mapping_test metrics_test orientation_test chunks_test >/dev/null
 
 "$build/mapping_test" --gtest_brief=1 --gtest_filter='Mapping.CrackClosingIsTheSameOnAnyThreadCount:Mapping.RelaxationLowersAngleDistortion:Mapping.ProgressCanCancel:Mapping.SymmetryFourGivesInvisibleSeams'
 "$build/metrics_test" --gtest_brief=1 --gtest_filter='Metrics.ThreadCountDoesNotChangeAnyFigure'
 "$build/orientation_test" --gtest_brief=1
+"$build/chunks_test" --gtest_brief=1 --gtest_filter='ChunkedMapping.SameBitsForAnyThreadCountAndQualityKept:ChunkedMapping.CancelsAndRefusesWhatNeedsTheWholeMesh'
 tmp="$(mktemp -d "${TMPDIR:-/tmp}/tailor-tsan.XXXXXX")"
 trap 'rm -rf "$tmp"' EXIT
 for mesh in horse.ply fertility.off blobby-3cc.off; do
   "$build/tailor" map "$root/tests/data/meshes/$mesh" -o "$tmp/out.glb" --threads 4 --quiet
   echo "tsan: map $mesh with 4 threads ok"
 done
+"$build/tailor" map "$root/tests/data/meshes/horse.ply" -o "$tmp/out.glb" --chunks on --chunk-cell -4 --threads 4 --quiet
+echo "tsan: map horse.ply in chunks with 4 threads ok"
 echo "tsan: no data race"
