@@ -115,8 +115,9 @@ inline double seconds_since(std::chrono::steady_clock::time_point start) {
 }
 
 //! The web pages' folder of `tailor view` and `tailor edit`: `given` (--web-root), else the installed
-//! share/tailor/web relative to the executable, else the source tree's web/. Fails with kIo when
-//! none holds index.html, or three.js is not installed there.
+//! share/tailor/web relative to the executable, else web/ beside or above it (a build tree's link to
+//! the source tree's web/). Fails with kIo when none holds index.html, or three.js is not installed
+//! there.
 Status find_web_root(const std::string& given, std::string& root);
 
 //! What a subcommand's CLI11 callback sets: the work to run once parsing succeeded.
