@@ -37,8 +37,17 @@ done
 # --- info on a real mesh: exact counts from MANIFEST.md ---
 "$tailor" info "$mesh" --json >"$tmp/info.json" || fail "info failed"
 grep -q '"faces": 5856' "$tmp/info.json" && grep -q '"vertices": 2930' "$tmp/info.json" &&
-  grep -q '"components": 1' "$tmp/info.json" && grep -q '"boundary_edges": 0' "$tmp/info.json" && ok ||
+  grep -q '"components": 1' "$tmp/info.json" && grep -q '"boundary_edges": 0' "$tmp/info.json" &&
+  grep -q '"nonmanifold_vertices": 0' "$tmp/info.json" && ok ||
   fail "info counts wrong: $(cat "$tmp/info.json")"
+# Non-manifold vertices: two triangles touching at one vertex (a bow tie), and a fin (three faces
+# on one edge: both its ends).
+printf 'v 0 0 0\nv 1 0 0\nv 0.5 1 0\nv 0 2 0\nv 1 2 0\nf 1 2 3\nf 3 4 5\n' >"$tmp/bowtie.obj"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n' >"$tmp/fin.obj"
+"$tailor" info "$tmp/bowtie.obj" >"$tmp/bowtie.txt" && grep -q "^  non-manifold vertices  1 " "$tmp/bowtie.txt" && ok ||
+  fail "info bowtie.obj: $(cat "$tmp/bowtie.txt")"
+"$tailor" info "$tmp/fin.obj" --json >"$tmp/fin.json" && grep -q '"nonmanifold_vertices": 2' "$tmp/fin.json" &&
+  grep -q '"nonmanifold_edges": 1' "$tmp/fin.json" && ok || fail "info fin.obj: $(cat "$tmp/fin.json")"
 
 # --- map: summary line, outputs, stats; determinism (bit-identical files) ---
 "$tailor" map "$mesh" --texture "$texture" -o "$tmp/a.glb" --stats "$tmp/a.json" >"$tmp/map.txt" 2>&1 ||
@@ -67,6 +76,10 @@ grep -Eq '"cracks_closed": [1-9][0-9]*' "$tmp/a.json" && ok || fail "stats: no c
 "$tailor" eval tests/data/meshes/fertility.off --stability --json >"$tmp/stab.json" 2>&1 &&
   grep -q '"removed_faces"' "$tmp/stab.json" && ok || fail "eval --stability: $(cat "$tmp/stab.json")"
 expect_error 1 "no texture coordinates" -- "$tailor" eval tests/data/meshes/fandisk.off
+# One of a thing is singular in the summary: "1 face, 1 patch".
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 0.1 0\nvt 0 0.1\nf 1/1 2/2 3/3\n' >"$tmp/one.obj"
+"$tailor" eval "$tmp/one.obj" >"$tmp/one.txt" 2>&1 && grep -q "one.obj: 1 face, 1 patch (" "$tmp/one.txt" && ok ||
+  fail "eval of one triangle: $(cat "$tmp/one.txt")"
 
 # --- bad input: clear one-line errors, exit 1, nothing written ---
 printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n' >"$tmp/truncated.ply"
@@ -139,6 +152,13 @@ expect_error 2 "crack-rings" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --crack-ri
 expect_error 2 "output must end" -- "$tailor" map "$mesh" -o "$tmp/x.txt"
 expect_error 2 "" -- "$tailor" map "$mesh"
 expect_error 2 "" -- "$tailor" frobnicate
+# A usage error points to the help of the command it is in.
+expect_error 2 "crack-rings.*\(run 'tailor map --help'\)$" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --crack-rings 1
+expect_error 2 "\(run 'tailor map --help'\)$" -- "$tailor" map
+expect_error 2 "\(run 'tailor eval --help'\)$" -- "$tailor" eval "$tmp/a.glb" --frobnicate
+expect_error 2 "\(run 'tailor tile --help'\)$" -- "$tailor" tile "$texture"
+expect_error 2 "\(run 'tailor --help'\)$" -- "$tailor" frobnicate
+expect_error 2 "\(run 'tailor --help'\)$" -- "$tailor"
 # --symmetry 4 (experimental): the same bytes for any thread count, the metrics count quarter turns
 # (in the report and in eval); it needs a square texture (a 64x48 render here) and eval takes 1 or 4.
 "$tailor" map "$mesh" --texture "$texture" -o "$tmp/s4a.glb" --symmetry 4 --threads 1 --stats "$tmp/s4.json" -q &&

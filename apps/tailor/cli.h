@@ -109,6 +109,11 @@ class Progress {
   std::chrono::steady_clock::time_point start_;
 };
 
+//! A count and its noun, singular for exactly one: counted(1, "file", "files") is "1 file".
+inline std::string counted(size_t n, const char* one, const char* many) {
+  return std::to_string(n) + " " + (n == 1 ? one : many);
+}
+
 //! Seconds since `start`.
 inline double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
