@@ -334,18 +334,57 @@ expect_error 1 "mid.pgm: truncated image: the header claims 4000x4000 px" -- lim
 expect_error 1 "mid.bmp: truncated image: the header claims 4000x4000 px" -- limited "$tailor" tile "$tmp/img/mid.bmp" -o "$tmp/img/o.png"
 expect_error 1 "vistex-tile04-128.png: image too large: 128x128 is 16384 px, the limit is 16383" -- "$tailor" tile tests/data/textures/vistex-tile04-128.png -o "$tmp/img/o.png" --max-image-pixels 16383
 [[ ! -e $tmp/img/o.png && ! -e $tmp/img/o.glb ]] && ok || fail "a refused image left an output"
-for cmd in map tile eval eval-tile; do
+for cmd in map tile eval-tile; do
   "$tailor" "$cmd" --help >"$tmp/help.txt" 2>&1 && grep -q -- "--max-image-pixels UINT:POSITIVE=67108864" "$tmp/help.txt" && ok ||
     fail "tailor $cmd --help has no --max-image-pixels with its default"
 done
-# eval reads a .glb's embedded texture size from its header: a PNG header patched to 16000 x 16000
-# is reported as such under the 300 MB cap (decoding it would need 768 MB), and refused by the limit.
+# eval reads a glTF's texture size from its header and never decodes it, whatever the size: a PNG
+# header patched to 16000 x 15000 (decoding it would need 720 MB) and to 100000 x 70000 (beyond any
+# decoder's limit) is reported as such under the 300 MB cap.
+# patch_png_size FILE W H: the first IHDR in FILE claims W x H.
+patch_png_size() {
+  local at
+  at=$(grep -obUa IHDR "$1" | head -1 | cut -d: -f1)
+  printf "$(printf '\\x%02x' $(($2 >> 24 & 255)) $(($2 >> 16 & 255)) $(($2 >> 8 & 255)) $(($2 & 255)) \
+    $(($3 >> 24 & 255)) $(($3 >> 16 & 255)) $(($3 >> 8 & 255)) $(($3 & 255)))" |
+    dd of="$1" bs=1 seek=$((at + 4)) conv=notrunc status=none
+}
 cp "$tmp/a.glb" "$tmp/img/big.glb"
-ihdr=$(grep -obUa IHDR "$tmp/img/big.glb" | head -1 | cut -d: -f1)
-printf '\x00\x00\x3e\x80\x00\x00\x3e\x80' | dd of="$tmp/img/big.glb" bs=1 seek=$((ihdr + 4)) conv=notrunc status=none
-limited "$tailor" eval "$tmp/img/big.glb" --max-image-pixels 300000000 >"$tmp/img/eval.txt" 2>&1 &&
-  grep -q "texture 16000x16000 px, embedded texture" "$tmp/img/eval.txt" && ok || fail "eval big.glb: $(cat "$tmp/img/eval.txt")"
-expect_error 1 "big.glb: embedded texture too large: 16000x16000" -- limited "$tailor" eval "$tmp/img/big.glb"
+for size in 16000x15000 100000x70000; do
+  patch_png_size "$tmp/img/big.glb" "${size%x*}" "${size#*x}"
+  limited "$tailor" eval "$tmp/img/big.glb" >"$tmp/img/eval.txt" 2>&1 &&
+    grep -q "texture ${size} px, embedded texture)" "$tmp/img/eval.txt" && ok || fail "eval big.glb ($size): $(cat "$tmp/img/eval.txt")"
+done
+# A .gltf whose texture is a file next to it, and one whose texture is a data: URI: the same, from
+# the file's header (only its first bytes are read) or the URI's.
+python3 - "$tmp/a.glb" "$tmp/img" <<'EOF'
+import base64, json, struct, sys
+data = open(sys.argv[1], "rb").read()
+length = struct.unpack_from("<I", data, 12)[0]
+doc = json.loads(data[20:20 + length])
+bin_chunk = data[20 + length + 8:]
+image = doc["images"][0]
+view = doc["bufferViews"][image.pop("bufferView")]
+png = bin_chunk[view.get("byteOffset", 0):view.get("byteOffset", 0) + view["byteLength"]]
+open(sys.argv[2] + "/a.bin", "wb").write(bin_chunk)
+open(sys.argv[2] + "/tex.png", "wb").write(png)
+doc["buffers"][0]["uri"] = "a.bin"
+image["uri"] = "tex.png"
+json.dump(doc, open(sys.argv[2] + "/file.gltf", "w"))
+image["uri"] = "data:image/png;base64," + base64.b64encode(png).decode()
+json.dump(doc, open(sys.argv[2] + "/data.gltf", "w"))
+EOF
+png_size=$(python3 -c "import struct, sys; print('%dx%d' % struct.unpack('>II', open(sys.argv[1], 'rb').read()[16:24]))" "$tmp/img/tex.png")
+"$tailor" eval "$tmp/img/file.gltf" >"$tmp/img/eval.txt" 2>&1 &&
+  grep -q "texture $png_size px, texture file)" "$tmp/img/eval.txt" && ok || fail "eval file.gltf: $(cat "$tmp/img/eval.txt")"
+"$tailor" eval "$tmp/img/data.gltf" >"$tmp/img/eval.txt" 2>&1 &&
+  grep -q "texture $png_size px, embedded texture)" "$tmp/img/eval.txt" && ok || fail "eval data.gltf: $(cat "$tmp/img/eval.txt")"
+patch_png_size "$tmp/img/tex.png" 40000 30000
+limited "$tailor" eval "$tmp/img/file.gltf" >"$tmp/img/eval.txt" 2>&1 &&
+  grep -q "texture 40000x30000 px, texture file)" "$tmp/img/eval.txt" && ok || fail "eval file.gltf (40000x30000): $(cat "$tmp/img/eval.txt")"
+rm "$tmp/img/tex.png"
+"$tailor" eval "$tmp/img/file.gltf" >"$tmp/img/eval.txt" 2>&1 &&
+  grep -q "texture 512x512 px, default)" "$tmp/img/eval.txt" && ok || fail "eval file.gltf without its texture: $(cat "$tmp/img/eval.txt")"
 # 9. and 10. Only regular files are read: /dev/zero, a FIFO without a writer (it would block), a
 # directory are refused at once with one line, for every kind of input.
 mkfifo "$tmp/img/in.obj" "$tmp/img/in.png"
