@@ -32,8 +32,10 @@ test: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
 	@bash scripts/fuzz.sh short
 
-# The main job on the bundled example: textured .glb, preview pictures and stats in out/.
-run: build
+# The main job on the bundled example: textured .glb, preview pictures and stats in out/. Builds
+# only the tailor command (`make build` and `make test` build the tests, benchmarks and tools too).
+run: configure
+	@cmake --build $(BUILD_DIR) -j $(JOBS) --target tailor
 	@mkdir -p out
 	@$(BUILD_DIR)/tailor tile $(EXAMPLE_TEXTURE) -o out/gravel_tile.png
 	@$(BUILD_DIR)/tailor map $(EXAMPLE_MESH) --texture out/gravel_tile.png -o out/example.glb \

@@ -33,11 +33,11 @@ void bind_eval(py::module_& m) {
           raise_error("texture_size must be an int or (width, height)");
         }
         if (width < 1 || height < 1 || width > (1 << 16) || height > (1 << 16))
-          raise_error("--texture-size must be between 1 and 65536, got " + std::to_string(width) + "x" +
+          raise_error("texture_size must be between 1 and 65536, got " + std::to_string(width) + "x" +
                       std::to_string(height));
-        if (symmetry != 1 && symmetry != 4) raise_error("--symmetry must be 1 or 4");
+        if (symmetry != 1 && symmetry != 4) raise_error("symmetry must be 1 or 4, got " + std::to_string(symmetry));
         if (symmetry == 4 && width != height)
-          raise_error("--symmetry 4 needs a square texture, got " + std::to_string(width) + "x" +
+          raise_error("symmetry=4 needs a square texture_size, got " + std::to_string(width) + "x" +
                       std::to_string(height));
         const auto uvs = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(corner_uvs);
         EvalRun run;

@@ -15,7 +15,7 @@ void bind_save(py::module_& m) {
           raise_error("the result has " + std::to_string(result.atlas.patch.size()) + " faces, the mesh " +
                       std::to_string(mesh.mesh.face_count()) + ": save the mesh that was mapped");
         if (!texture.is_none() && !material.is_none())
-          raise_error("give --texture or --material, not both (the material's colour map is the texture)");
+          raise_error("give texture= or material=, not both (the material's colour map is the texture)");
         std::string ext = path.size() >= 4 ? path.substr(path.size() - 4) : "";
         for (char& c : ext) c = static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
         // The material: the one given, else map()'s when no texture is given and the file is a .glb
@@ -23,7 +23,7 @@ void bind_save(py::module_& m) {
         const std::string material_path = !material.is_none()                  ? path_of(material)
                                           : texture.is_none() && ext == ".glb" ? result.material
                                                                                : "";
-        if (!material.is_none() && ext != ".glb") raise_error("--material needs a .glb output, got '" + path + "'");
+        if (!material.is_none() && ext != ".glb") raise_error("material= needs a .glb output, got '" + path + "'");
         ExportOptions options;
         options.texture_path = texture.is_none() ? result.texture : path_of(texture);
         options.texture_width = result.texture_width;

@@ -37,8 +37,17 @@ done
 # --- info on a real mesh: exact counts from MANIFEST.md ---
 "$tailor" info "$mesh" --json >"$tmp/info.json" || fail "info failed"
 grep -q '"faces": 5856' "$tmp/info.json" && grep -q '"vertices": 2930' "$tmp/info.json" &&
-  grep -q '"components": 1' "$tmp/info.json" && grep -q '"boundary_edges": 0' "$tmp/info.json" && ok ||
+  grep -q '"components": 1' "$tmp/info.json" && grep -q '"boundary_edges": 0' "$tmp/info.json" &&
+  grep -q '"nonmanifold_vertices": 0' "$tmp/info.json" && ok ||
   fail "info counts wrong: $(cat "$tmp/info.json")"
+# Non-manifold vertices: two triangles touching at one vertex (a bow tie), and a fin (three faces
+# on one edge: both its ends).
+printf 'v 0 0 0\nv 1 0 0\nv 0.5 1 0\nv 0 2 0\nv 1 2 0\nf 1 2 3\nf 3 4 5\n' >"$tmp/bowtie.obj"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n' >"$tmp/fin.obj"
+"$tailor" info "$tmp/bowtie.obj" >"$tmp/bowtie.txt" && grep -q "^  non-manifold vertices  1 " "$tmp/bowtie.txt" && ok ||
+  fail "info bowtie.obj: $(cat "$tmp/bowtie.txt")"
+"$tailor" info "$tmp/fin.obj" --json >"$tmp/fin.json" && grep -q '"nonmanifold_vertices": 2' "$tmp/fin.json" &&
+  grep -q '"nonmanifold_edges": 1' "$tmp/fin.json" && ok || fail "info fin.obj: $(cat "$tmp/fin.json")"
 
 # --- map: summary line, outputs, stats; determinism (bit-identical files) ---
 "$tailor" map "$mesh" --texture "$texture" -o "$tmp/a.glb" --stats "$tmp/a.json" >"$tmp/map.txt" 2>&1 ||
@@ -79,6 +88,10 @@ expect_error 1 "no texture coordinates" -- "$tailor" eval tests/data/meshes/fand
   fail "map --chunks on: $(cat "$tmp/chunks_map.txt")"
 expect_error 2 "--chunks must be auto, on or off, got 'maybe'" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --chunks maybe
 expect_error 2 "--chunk-cell must be auto or a whole number in -60..60" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --chunk-cell 1.5
+# One of a thing is singular in the summary: "1 face, 1 patch".
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 0.1 0\nvt 0 0.1\nf 1/1 2/2 3/3\n' >"$tmp/one.obj"
+"$tailor" eval "$tmp/one.obj" >"$tmp/one.txt" 2>&1 && grep -q "one.obj: 1 face, 1 patch (" "$tmp/one.txt" && ok ||
+  fail "eval of one triangle: $(cat "$tmp/one.txt")"
 
 # --- bad input: clear one-line errors, exit 1, nothing written ---
 printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n' >"$tmp/truncated.ply"
@@ -151,6 +164,13 @@ expect_error 2 "crack-rings" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --crack-ri
 expect_error 2 "output must end" -- "$tailor" map "$mesh" -o "$tmp/x.txt"
 expect_error 2 "" -- "$tailor" map "$mesh"
 expect_error 2 "" -- "$tailor" frobnicate
+# A usage error points to the help of the command it is in.
+expect_error 2 "crack-rings.*\(run 'tailor map --help'\)$" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --crack-rings 1
+expect_error 2 "\(run 'tailor map --help'\)$" -- "$tailor" map
+expect_error 2 "\(run 'tailor eval --help'\)$" -- "$tailor" eval "$tmp/a.glb" --frobnicate
+expect_error 2 "\(run 'tailor tile --help'\)$" -- "$tailor" tile "$texture"
+expect_error 2 "\(run 'tailor --help'\)$" -- "$tailor" frobnicate
+expect_error 2 "\(run 'tailor --help'\)$" -- "$tailor"
 # --symmetry 4 (experimental): the same bytes for any thread count, the metrics count quarter turns
 # (in the report and in eval); it needs a square texture (a 64x48 render here) and eval takes 1 or 4.
 "$tailor" map "$mesh" --texture "$texture" -o "$tmp/s4a.glb" --symmetry 4 --threads 1 --stats "$tmp/s4.json" -q &&
@@ -326,18 +346,57 @@ expect_error 1 "mid.pgm: truncated image: the header claims 4000x4000 px" -- lim
 expect_error 1 "mid.bmp: truncated image: the header claims 4000x4000 px" -- limited "$tailor" tile "$tmp/img/mid.bmp" -o "$tmp/img/o.png"
 expect_error 1 "vistex-tile04-128.png: image too large: 128x128 is 16384 px, the limit is 16383" -- "$tailor" tile tests/data/textures/vistex-tile04-128.png -o "$tmp/img/o.png" --max-image-pixels 16383
 [[ ! -e $tmp/img/o.png && ! -e $tmp/img/o.glb ]] && ok || fail "a refused image left an output"
-for cmd in map tile eval eval-tile; do
+for cmd in map tile eval-tile; do
   "$tailor" "$cmd" --help >"$tmp/help.txt" 2>&1 && grep -q -- "--max-image-pixels UINT:POSITIVE=67108864" "$tmp/help.txt" && ok ||
     fail "tailor $cmd --help has no --max-image-pixels with its default"
 done
-# eval reads a .glb's embedded texture size from its header: a PNG header patched to 16000 x 16000
-# is reported as such under the 300 MB cap (decoding it would need 768 MB), and refused by the limit.
+# eval reads a glTF's texture size from its header and never decodes it, whatever the size: a PNG
+# header patched to 16000 x 15000 (decoding it would need 720 MB) and to 100000 x 70000 (beyond any
+# decoder's limit) is reported as such under the 300 MB cap.
+# patch_png_size FILE W H: the first IHDR in FILE claims W x H.
+patch_png_size() {
+  local at
+  at=$(grep -obUa IHDR "$1" | head -1 | cut -d: -f1)
+  printf "$(printf '\\x%02x' $(($2 >> 24 & 255)) $(($2 >> 16 & 255)) $(($2 >> 8 & 255)) $(($2 & 255)) \
+    $(($3 >> 24 & 255)) $(($3 >> 16 & 255)) $(($3 >> 8 & 255)) $(($3 & 255)))" |
+    dd of="$1" bs=1 seek=$((at + 4)) conv=notrunc status=none
+}
 cp "$tmp/a.glb" "$tmp/img/big.glb"
-ihdr=$(grep -obUa IHDR "$tmp/img/big.glb" | head -1 | cut -d: -f1)
-printf '\x00\x00\x3e\x80\x00\x00\x3e\x80' | dd of="$tmp/img/big.glb" bs=1 seek=$((ihdr + 4)) conv=notrunc status=none
-limited "$tailor" eval "$tmp/img/big.glb" --max-image-pixels 300000000 >"$tmp/img/eval.txt" 2>&1 &&
-  grep -q "texture 16000x16000 px, embedded texture" "$tmp/img/eval.txt" && ok || fail "eval big.glb: $(cat "$tmp/img/eval.txt")"
-expect_error 1 "big.glb: embedded texture too large: 16000x16000" -- limited "$tailor" eval "$tmp/img/big.glb"
+for size in 16000x15000 100000x70000; do
+  patch_png_size "$tmp/img/big.glb" "${size%x*}" "${size#*x}"
+  limited "$tailor" eval "$tmp/img/big.glb" >"$tmp/img/eval.txt" 2>&1 &&
+    grep -q "texture ${size} px, embedded texture)" "$tmp/img/eval.txt" && ok || fail "eval big.glb ($size): $(cat "$tmp/img/eval.txt")"
+done
+# A .gltf whose texture is a file next to it, and one whose texture is a data: URI: the same, from
+# the file's header (only its first bytes are read) or the URI's.
+python3 - "$tmp/a.glb" "$tmp/img" <<'EOF'
+import base64, json, struct, sys
+data = open(sys.argv[1], "rb").read()
+length = struct.unpack_from("<I", data, 12)[0]
+doc = json.loads(data[20:20 + length])
+bin_chunk = data[20 + length + 8:]
+image = doc["images"][0]
+view = doc["bufferViews"][image.pop("bufferView")]
+png = bin_chunk[view.get("byteOffset", 0):view.get("byteOffset", 0) + view["byteLength"]]
+open(sys.argv[2] + "/a.bin", "wb").write(bin_chunk)
+open(sys.argv[2] + "/tex.png", "wb").write(png)
+doc["buffers"][0]["uri"] = "a.bin"
+image["uri"] = "tex.png"
+json.dump(doc, open(sys.argv[2] + "/file.gltf", "w"))
+image["uri"] = "data:image/png;base64," + base64.b64encode(png).decode()
+json.dump(doc, open(sys.argv[2] + "/data.gltf", "w"))
+EOF
+png_size=$(python3 -c "import struct, sys; print('%dx%d' % struct.unpack('>II', open(sys.argv[1], 'rb').read()[16:24]))" "$tmp/img/tex.png")
+"$tailor" eval "$tmp/img/file.gltf" >"$tmp/img/eval.txt" 2>&1 &&
+  grep -q "texture $png_size px, texture file)" "$tmp/img/eval.txt" && ok || fail "eval file.gltf: $(cat "$tmp/img/eval.txt")"
+"$tailor" eval "$tmp/img/data.gltf" >"$tmp/img/eval.txt" 2>&1 &&
+  grep -q "texture $png_size px, embedded texture)" "$tmp/img/eval.txt" && ok || fail "eval data.gltf: $(cat "$tmp/img/eval.txt")"
+patch_png_size "$tmp/img/tex.png" 40000 30000
+limited "$tailor" eval "$tmp/img/file.gltf" >"$tmp/img/eval.txt" 2>&1 &&
+  grep -q "texture 40000x30000 px, texture file)" "$tmp/img/eval.txt" && ok || fail "eval file.gltf (40000x30000): $(cat "$tmp/img/eval.txt")"
+rm "$tmp/img/tex.png"
+"$tailor" eval "$tmp/img/file.gltf" >"$tmp/img/eval.txt" 2>&1 &&
+  grep -q "texture 512x512 px, default)" "$tmp/img/eval.txt" && ok || fail "eval file.gltf without its texture: $(cat "$tmp/img/eval.txt")"
 # 9. and 10. Only regular files are read: /dev/zero, a FIFO without a writer (it would block), a
 # directory are refused at once with one line, for every kind of input.
 mkfifo "$tmp/img/in.obj" "$tmp/img/in.png"

@@ -306,6 +306,67 @@ TEST(GltfScene, GltfWithDataUriAndBinFile) {
   fs::remove_all(dir);
 }
 
+// The first bytes of a PNG claiming width x height (IHDR only: enough for its header).
+std::string png_header(uint32_t width, uint32_t height) {
+  std::string png("\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR", 16);
+  for (const uint32_t v : {width, height})
+    for (int shift = 24; shift >= 0; shift -= 8) png.push_back(static_cast<char>(v >> shift & 0xff));
+  return png + std::string("\x08\x02\0\0\0\0\0\0\0", 9);
+}
+
+TEST(GltfScene, TextureSizeIsReadFromItsHeaderWhereverItIs) {
+  // One textured triangle; the image in a buffer view, a data: URI or a file next to the .gltf.
+  Builder b = one_triangle({{{"mesh", 0}}}, {{{"nodes", {0}}}});
+  b.json["meshes"][0]["primitives"][0]["material"] = 0;
+  b.json["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}};
+  b.json["textures"] = {{{"source", 0}}};
+  const auto size_of = [](const std::string& path, LoadReport& report) {
+    Mesh mesh;
+    const Status s = read_glb_file(path, mesh, nullptr, &report);
+    EXPECT_TRUE(s.is_ok()) << s.message();
+    return std::to_string(report.texture_width) + "x" + std::to_string(report.texture_height);
+  };
+  const std::string dir = test::empty_temp_dir("gltf_texture_size");
+  LoadReport report;
+  // Embedded: a header no decoder takes (100000 x 70000 RGB is 21 GB), read all the same.
+  {
+    Builder e = b;
+    const std::string png = png_header(100000, 70000);
+    e.json["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", e.bin.size()}, {"byteLength", png.size()}});
+    e.bin += png;
+    e.json["images"] = {{{"bufferView", e.json["bufferViews"].size() - 1}, {"mimeType", "image/png"}}};
+    std::ofstream(dir + "/embedded.glb", std::ios::binary) << e.glb();
+    EXPECT_EQ(size_of(dir + "/embedded.glb", report), "100000x70000");
+    EXPECT_FALSE(report.texture_file);
+  }
+  // A data: URI.
+  {
+    Builder d = b;
+    Builder bytes;
+    bytes.bin = png_header(16000, 15000);
+    d.json["images"] = {{{"uri", "data:image/png;base64," + bytes.base64()}}};
+    std::ofstream(dir + "/data.gltf") << d.gltf();
+    EXPECT_EQ(size_of(dir + "/data.gltf", report), "16000x15000");
+    EXPECT_FALSE(report.texture_file);
+  }
+  // A file next to the .gltf: a PNG, and a JPEG whose frame header lies beyond 128 KiB of APP1
+  // segments (more than the first read of 64 KiB).
+  std::ofstream(dir + "/tex.png", std::ios::binary) << png_header(40000, 30000);
+  std::string jpeg("\xff\xd8", 2);
+  for (int k = 0; k < 2; ++k) jpeg += std::string("\xff\xe1\xff\xff", 4) + std::string(0xffff - 2, 'x');
+  jpeg += std::string("\xff\xc0\x00\x11\x08\x75\x30\x9c\x40\x03", 10) + std::string(15, '\0');
+  std::ofstream(dir + "/tex.jpg", std::ios::binary) << jpeg;
+  for (const auto& [uri, size] : std::vector<std::pair<std::string, std::string>>{
+           {"tex.png", "40000x30000"}, {"tex.jpg", "40000x30000"}, {"missing.png", "0x0"}, {"../tex.png", "0x0"}}) {
+    Builder f = b;
+    f.json["images"] = {{{"uri", uri}}};
+    std::ofstream(dir + "/file.gltf") << f.gltf();
+    EXPECT_EQ(size_of(dir + "/file.gltf", report), size) << uri;
+    EXPECT_EQ(report.texture_file, size != "0x0") << uri;
+  }
+  fs::remove_all(dir);
+}
+
 // === Files made by glTF-Transform =================================================================
 
 std::string gltf_transform() {

@@ -1,16 +1,18 @@
 #!/usr/bin/env bash
 # The installed tailor, as a user or a packager gets it, run by ctest from the repo root as
 #   bash tests/install_test.sh <build-dir>/tailor
-# 1. cmake --install of that build into a temporary prefix: the layout, and no installed text file
-#    naming the source or build tree;
+# 1. cmake --install of that build into a temporary prefix: the layout, and no installed file (the
+#    tailor binary and the libraries included) naming the source or build tree;
 # 2. the installed `tailor` runs (--version, map); the installed Python module (when built) imports
 #    from the prefix alone and writes the same .glb;
 # 3. examples/consumer built against the prefix with find_package(tailor) and with pkg-config
 #    (static libraries): both run, write valid .glb files (node + glTF-Validator, skipped without
-#    node), byte-identical to the installed `tailor map`'s;
+#    node), byte-identical to the installed `tailor map`'s; a program whose only include is
+#    "tailor/tailor.h" (on its first line) builds both ways with -Wall -Wextra -Werror and runs;
 # 4. the installed `tailor view` serves the installed share/tailor/web (it says so in its startup
 #    line): the page and every module it imports, following the imports from viewer.js, and no
-#    installed module goes unused;
+#    installed module goes unused; share/ holds nothing else (the pages, the modules, three.js's
+#    licence and Draco's decoder);
 # 5. BUILD_SHARED_LIBS=ON: the three libraries alone (kept in <build-dir>/install-test-shared, so a
 #    rerun rebuilds only what changed), installed with `--component library`; the consumer built
 #    with find_package is dynamically linked to libtailor_core.so and gives the same .glb; a
@@ -68,8 +70,8 @@ for f in bin/tailor include/tailor/tailor.h include/tailor/api.h include/tailor/
   [[ -f $prefix/$f ]] && ok || fail "not installed: $f"
 done
 [[ ! -e $prefix/include/tailor/version.h.in ]] && ok || fail "version.h.in was installed"
-# Text files only: the tailor binary keeps the source tree's web/ as its last fallback, for build trees.
-refs=$(grep -rIlF -e "$repo" -e "$build" "$prefix")
+# Binary files too: the tailor binary finds its viewer relative to itself, and nothing else names a path.
+refs=$(grep -rlF -e "$repo" -e "$build" "$prefix")
 [[ -z $refs ]] && ok || fail "installed files name the source or build tree: $refs"
 
 # --- 2. the installed command ---
@@ -119,6 +121,42 @@ if g++ -std=c++20 -O2 examples/consumer/main.cpp $(pkg-config --cflags --libs --
   run_consumer consumer-pkg-config "$tmp/consumer-pkg-config"
 else
   fail "examples/consumer does not build with pkg-config: $(tail -20 "$tmp/g++.log")"
+fi
+
+# A program whose only include is tailor/tailor.h, on line 1: every header includes what it uses.
+# It calls the three libraries (core, texture, render).
+mkdir -p "$tmp/only-tailor-h"
+cat >"$tmp/only-tailor-h/main.cpp" <<'EOF'
+#include "tailor/tailor.h"
+int main() {
+  tailor::Image image{64, 32, 1, std::vector<uint8_t>(64 * 32, 7)};
+  const tailor::Image swapped = tailor::swap_quadrants(image);  // tailor::texture
+  tailor::PreviewView view;
+  const bool parsed = tailor::preview_view_from_name("patches", view);  // tailor::render
+  const tailor::Atlas atlas;
+  if (!parsed || swapped.width != 64 || atlas.face_count() != 0) return 1;
+  return tailor::check_image(swapped).is_ok() ? 0 : 1;  // tailor::core
+}
+EOF
+cat >"$tmp/only-tailor-h/CMakeLists.txt" <<'EOF'
+cmake_minimum_required(VERSION 3.20)
+project(only_tailor_h CXX)
+find_package(tailor 0.1 CONFIG REQUIRED)
+add_executable(only_tailor_h main.cpp)
+target_compile_options(only_tailor_h PRIVATE -Wall -Wextra -Werror)
+target_link_libraries(only_tailor_h PRIVATE tailor::core tailor::texture tailor::render)
+EOF
+if cmake -S "$tmp/only-tailor-h" -B "$tmp/only-tailor-h/build" -DCMAKE_PREFIX_PATH="$prefix" >"$tmp/only.log" 2>&1 &&
+  cmake --build "$tmp/only-tailor-h/build" >>"$tmp/only.log" 2>&1; then
+  "$tmp/only-tailor-h/build/only_tailor_h" && ok || fail "the find_package program including only tailor/tailor.h failed"
+else
+  fail "a program including only tailor/tailor.h does not build with find_package: $(tail -20 "$tmp/only.log")"
+fi
+if g++ -std=c++20 -Wall -Wextra -Werror "$tmp/only-tailor-h/main.cpp" $(pkg-config --cflags --libs --static tailor) \
+  -o "$tmp/only-tailor-h/pkg-config" >"$tmp/only-pc.log" 2>&1; then
+  "$tmp/only-tailor-h/pkg-config" && ok || fail "the pkg-config program including only tailor/tailor.h failed"
+else
+  fail "a program including only tailor/tailor.h does not build with pkg-config: $(tail -20 "$tmp/only-pc.log")"
 fi
 
 # --- 4. the installed tailor view serves the installed viewer ---
@@ -176,6 +214,10 @@ else
   imported=$(printf '%s\n' "${!seen[@]}" | sort)
   [[ $installed == "$imported" ]] && ok ||
     fail "installed modules and imported ones differ: $(diff <(echo "$installed") <(echo "$imported") | grep '^[<>]' | tr '\n' ' ')"
+  # Nothing else under share/: the two pages, three.js's licence and Draco's decoder (fetched above).
+  others=$(cd "$web" && find . -type f -not -name '*.js' | sed 's/^\.//' | sort | tr '\n' ' ')
+  [[ $others == "/edit.html /index.html /node_modules/three/LICENSE /node_modules/three/examples/jsm/libs/draco/gltf/draco_decoder.wasm " ]] &&
+    ok || fail "share/tailor/web holds other files than the pages, the modules and the licence: $others"
   echo "tailor view served the installed viewer: ${#seen[@]} modules"
 fi
 kill -INT "$server_pid" 2>/dev/null

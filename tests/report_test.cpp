@@ -89,6 +89,34 @@ TEST(Report, FileNamesThatAreNotUtf8DoNotBreakTheJson) {
                                       "patches_full", "removed_faces", "seconds", "within_1px_ratio"}));
 }
 
+TEST(Report, EvalSummaryCountsInTheSingularForOne) {
+  EvalRun run;
+  run.file = "one.obj";
+  run.metrics.faces = 1;
+  run.metrics.patches = 1;
+  run.metrics.seam_edges = 1;
+  run.metrics.visible_dangling_ends = 1;
+  run.metrics.visible_branch_points = 1;
+  std::string text = eval_summary(run);
+  EXPECT_EQ(text.find("one.obj: 1 face, 1 patch (0 single-face)"), 0u) << text;
+  EXPECT_NE(text.find("(1 edge)"), std::string::npos) << text;
+  EXPECT_NE(text.find("1 dangling end, 1 branch point)"), std::string::npos) << text;
+  run.metrics.faces = 2;
+  run.metrics.patches = 0;
+  run.metrics.seam_edges = 2;
+  text = eval_summary(run);
+  EXPECT_EQ(text.find("one.obj: 2 faces, 0 patches"), 0u) << text;
+  EXPECT_NE(text.find("(2 edges)"), std::string::npos) << text;
+  StabilityReport r;
+  r.faces = 1;
+  r.corners_beyond_radius = 1;
+  r.identical_beyond_radius_ratio = 1;
+  text = stability_summary("one.obj", r);
+  EXPECT_NE(text.find("removed 0 of 1 face,"), std::string::npos) << text;
+  EXPECT_NE(text.find("of the 1 surviving corner farther than"), std::string::npos) << text;
+  EXPECT_NE(text.find("from the cut is bit-identical"), std::string::npos) << text;
+}
+
 TEST(Report, TileReportsTheWorstVariant) {
   TileRun run;
   run.input = "in.png";

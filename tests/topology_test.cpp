@@ -92,6 +92,7 @@ TEST(Topology, TwoTrianglesShareOneEdge) {
   EXPECT_EQ(t.edges, 5u);
   EXPECT_EQ(t.boundary_edges, 4u);
   EXPECT_EQ(t.edge_components, 1u);
+  EXPECT_EQ(count_nonmanifold_vertices(m), 0u);
 }
 
 TEST(Topology, BowTieVertexJoinsByVertexOnly) {
@@ -102,6 +103,7 @@ TEST(Topology, BowTieVertexJoinsByVertexOnly) {
   EXPECT_EQ(t.edge_components, 2u);
   EXPECT_EQ(t.boundary_edges, 6u);
   for (uint32_t o : t.opposite) EXPECT_EQ(o, kInvalid);
+  EXPECT_EQ(count_nonmanifold_vertices(m), 1u);  // vertex 2: two fans
 }
 
 TEST(Topology, FinEdgeWithThreeFacesIsCutAndCounted) {
@@ -114,6 +116,7 @@ TEST(Topology, FinEdgeWithThreeFacesIsCutAndCounted) {
   EXPECT_EQ(t.opposite[6], kInvalid);
   EXPECT_EQ(t.edge_components, 3u);
   EXPECT_EQ(t.vertex_components, 1u);
+  EXPECT_EQ(count_nonmanifold_vertices(m), 2u);  // the fin edge's two ends
 }
 
 TEST(Topology, FlippedFaceIsInconsistentNotPaired) {
@@ -123,6 +126,30 @@ TEST(Topology, FlippedFaceIsInconsistentNotPaired) {
   EXPECT_EQ(t.inconsistent_edges, 1u);
   for (uint32_t o : t.opposite) EXPECT_EQ(o, kInvalid);
   EXPECT_EQ(t.edge_components, 2u);
+  EXPECT_EQ(count_nonmanifold_vertices(m), 0u);  // badly oriented, but a manifold
+}
+
+TEST(Topology, NonManifoldVertices) {
+  // Two closed fans (cones) of 6 faces joined at their apex 0: one vertex, every edge shared by two.
+  std::vector<float> p = {0, 0, 0};
+  std::vector<uint32_t> idx;
+  for (uint32_t cone = 0; cone < 2; ++cone) {
+    const uint32_t base = 1 + 6 * cone;
+    for (uint32_t i = 0; i < 6; ++i) {
+      const float a = 1.0471976f * static_cast<float>(i);
+      p.insert(p.end(), {std::cos(a), std::sin(a), cone == 0 ? 1.f : -1.f});
+      idx.insert(idx.end(), {0, base + i, base + (i + 1) % 6});
+    }
+  }
+  Mesh m = make_mesh(p, idx);
+  EXPECT_EQ(build_topology(m).nonmanifold_edges, 0u);
+  EXPECT_EQ(count_nonmanifold_vertices(m), 1u);
+  // One closed cone and an open fan of two faces around the same apex: still two fans.
+  m.indices.resize(6 * 3 + 2 * 3);
+  EXPECT_EQ(count_nonmanifold_vertices(m), 1u);
+  // The first cone alone is a single closed fan; a vertex of no face is not counted.
+  m.indices.resize(6 * 3);
+  EXPECT_EQ(count_nonmanifold_vertices(m), 0u);
 }
 
 TEST(Topology, HighValenceFanUsesSortedMatching) {

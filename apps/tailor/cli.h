@@ -109,14 +109,20 @@ class Progress {
   std::chrono::steady_clock::time_point start_;
 };
 
+//! A count and its noun, singular for exactly one: counted(1, "file", "files") is "1 file".
+inline std::string counted(size_t n, const char* one, const char* many) {
+  return std::to_string(n) + " " + (n == 1 ? one : many);
+}
+
 //! Seconds since `start`.
 inline double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 //! The web pages' folder of `tailor view` and `tailor edit`: `given` (--web-root), else the installed
-//! share/tailor/web relative to the executable, else the source tree's web/. Fails with kIo when
-//! none holds index.html, or three.js is not installed there.
+//! share/tailor/web relative to the executable, else web/ beside or above it (a build tree's link to
+//! the source tree's web/). Fails with kIo when none holds index.html, or three.js is not installed
+//! there.
 Status find_web_root(const std::string& given, std::string& root);
 
 //! What a subcommand's CLI11 callback sets: the work to run once parsing succeeded.

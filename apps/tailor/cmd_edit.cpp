@@ -187,8 +187,9 @@ int run_edit(const EditArgs& opt) {
     settler_done.store(true);
   });
   // Always printed (also with --quiet): the URL is the point of the command, and scripts read it.
-  std::printf("tailor edit: http://127.0.0.1:%d/  (%s, %zu faces mapped in %.2f s; saves to %s; Ctrl-C to stop)\n",
-              server.port(), context.name.c_str(), context.session->mesh().face_count(), open_seconds,
+  std::printf("tailor edit: http://127.0.0.1:%d/  (%s, %s mapped in %.2f s; saves to %s; Ctrl-C to stop)\n",
+              server.port(), context.name.c_str(),
+              counted(context.session->mesh().face_count(), "face", "faces").c_str(), open_seconds,
               context.glb_path.c_str());
   std::fflush(stdout);
   server.serve(g_stop);

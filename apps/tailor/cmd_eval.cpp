@@ -21,8 +21,7 @@ namespace {
 
 struct EvalOptions {
   std::string input;
-  int texture_size = 0;            // 0 = not given: the embedded image size for .glb, else MetricsOptions' default
-  ImageLoadOptions image_options;  // --max-image-pixels: the embedded texture's header size
+  int texture_size = 0;  // 0 = not given: a glTF texture's header size, else MetricsOptions' default
   bool json = false;
   bool quiet = false;
   bool stability = false;
@@ -65,7 +64,7 @@ int run_eval(const EvalOptions& opt) {
   LoadReport report;
   const MeshFormat input_format = mesh_format_from_path(opt.input);
   const bool glb = input_format == MeshFormat::kGlb || input_format == MeshFormat::kGltf;
-  // The embedded texture is never decoded: its size comes from its header (LoadReport).
+  // A glTF's texture is never decoded: its size comes from its header (LoadReport), any size.
   const Status status = [&] {
     const ReadingInput reading(opt.input);
     return glb ? read_glb_file(opt.input, mesh, nullptr, &report) : load_mesh(opt.input, mesh, &report);
@@ -86,17 +85,9 @@ int run_eval(const EvalOptions& opt) {
     width = height = opt.texture_size;
     size_source = "option";
   } else if (report.texture_width > 0) {
-    const uint64_t pixels = static_cast<uint64_t>(report.texture_width) * static_cast<uint64_t>(report.texture_height);
-    if (report.texture_width > kMaxImageSide || report.texture_height > kMaxImageSide ||
-        pixels > opt.image_options.max_pixels)
-      return report_error(Status::error(ErrorCode::kInvalidImage, opt.input,
-                                        "embedded texture too large: " + std::to_string(report.texture_width) + "x" +
-                                            std::to_string(report.texture_height) + " is " + std::to_string(pixels) +
-                                            " px, the limit is " + std::to_string(opt.image_options.max_pixels) +
-                                            " px (raise it with --max-image-pixels)"));
     width = report.texture_width;
     height = report.texture_height;
-    size_source = "embedded texture";
+    size_source = report.texture_file ? "texture file" : "embedded texture";
   }
   // A 4-fold map says so in its .glb (tailor map --symmetry 4): measured as the map was.
   const uint32_t symmetry = glb && !opt.symmetry_given ? report.texture_symmetry : opt.symmetry;
@@ -151,12 +142,10 @@ void register_eval(CLI::App& app, Runner& run) {
                   "UV-mapped mesh: .obj (vt), .ply (s,t) or .glb (TEXCOORD_0); any mesh with --stability")
       ->required();
   cmd->add_option("--texture-size", opt->texture_size,
-                  "Texture size in pixels (UVs are in repeats; this gives pixels). Default: the embedded "
-                  "texture's size for .glb, else " +
+                  "Texture size in pixels (UVs are in repeats; this gives pixels). Default: a .glb or .gltf's "
+                  "texture's size, read from its header (embedded or a file next to it), else " +
                       std::to_string(static_cast<int>(MetricsOptions{}.texture_width_px)))
       ->check(CLI::Range(1, 1 << 16));
-  add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), opt->image_options.max_pixels)
-      ->check(CLI::PositiveNumber);
   add_symmetry_option(cmd, option_doc(kMetricsOptionDocs, "symmetry"), opt->symmetry);
   cmd->add_flag("--json", opt->json, "Print the full report as a JSON object");
   cmd->add_flag("-q,--quiet", opt->quiet, "Print nothing but the result and errors");

@@ -25,6 +25,7 @@ int run_info(const InfoOptions& opt) {
   }();
   if (!status) return report_error(status);
   const Topology topology = build_topology(mesh);
+  const size_t nonmanifold_vertices = count_nonmanifold_vertices(mesh);
 
   float lo[3], hi[3];
   for (int k = 0; k < 3; ++k) {
@@ -52,6 +53,7 @@ int run_info(const InfoOptions& opt) {
     j["edges"] = topology.edges;
     j["boundary_edges"] = topology.boundary_edges;
     j["nonmanifold_edges"] = topology.nonmanifold_edges;
+    j["nonmanifold_vertices"] = nonmanifold_vertices;
     j["inconsistent_edges"] = topology.inconsistent_edges;
     j["degenerate_faces"] = report.degenerate_faces;
     j["duplicate_faces"] = report.duplicate_faces;
@@ -77,7 +79,8 @@ int run_info(const InfoOptions& opt) {
               topology.vertex_components, topology.edge_components);
   std::printf("  edges                  %zu\n", topology.edges);
   std::printf("  boundary edges         %zu\n", topology.boundary_edges);
-  std::printf("  non-manifold edges     %zu\n", topology.nonmanifold_edges);
+  std::printf("  non-manifold edges     %zu (three or more faces)\n", topology.nonmanifold_edges);
+  std::printf("  non-manifold vertices  %zu (faces not one fan, or on a non-manifold edge)\n", nonmanifold_vertices);
   std::printf("  inconsistent edges     %zu (shared by two faces running the same way)\n", topology.inconsistent_edges);
   std::printf("  degenerate faces       %zu (dropped)\n", report.degenerate_faces);
   std::printf("  duplicate faces        %zu (dropped)\n", report.duplicate_faces);

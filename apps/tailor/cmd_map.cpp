@@ -406,8 +406,9 @@ int run_map_inputs(const MapArgs& args) {
     }
   }
   if (!args.quiet)
-    std::printf("batch: %zu files, %zu mapped, %zu failed%s in %.2f s -> %s\n", outputs.size(), outputs.size() - failed,
-                failed, failures.empty() ? "" : (" (" + failures + ")").c_str(), seconds_since(start), out.c_str());
+    std::printf("batch: %s, %zu mapped, %zu failed%s in %.2f s -> %s\n",
+                counted(outputs.size(), "file", "files").c_str(), outputs.size() - failed, failed,
+                failures.empty() ? "" : (" (" + failures + ")").c_str(), seconds_since(start), out.c_str());
   return failed ? kExitBadInput : kExitOk;
 }
 

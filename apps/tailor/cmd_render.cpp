@@ -109,8 +109,9 @@ int run_render(const RenderArgs& args) {
   status = write_png(args.output, picture);
   if (!status) return report_error(status.with_file(args.output));
   if (!args.quiet) {
-    std::printf("wrote %s (%dx%d, %s view, %zu faces) in %.2f s\n", args.output.c_str(), picture.width, picture.height,
-                preview_view_name(options.view), mesh.face_count(), seconds_since(start));
+    std::printf("wrote %s (%dx%d, %s view, %s) in %.2f s\n", args.output.c_str(), picture.width, picture.height,
+                preview_view_name(options.view), counted(mesh.face_count(), "face", "faces").c_str(),
+                seconds_since(start));
   }
   return kExitOk;
 }

@@ -154,8 +154,8 @@ int run_view(const ViewArgs& args) {
 }  // namespace
 
 //! The viewer's files: --web-root, else the installed share/tailor/web relative to the executable
-//! (any prefix: the tree can be moved), else the source tree this binary was built from (a build
-//! tree). web/ next to or above the executable is also tried, for a copied build.
+//! (any prefix: the tree can be moved), else web/ next to the executable (a build tree: CMake links
+//! <build>/web to the source tree's web/) or above it. The binary holds no absolute path.
 Status find_web_root(const std::string& given, std::string& root) {
   std::vector<std::string> candidates;
   if (!given.empty()) {
@@ -169,7 +169,6 @@ Status find_web_root(const std::string& given, std::string& root) {
       candidates.push_back(dir + "/web");
       candidates.push_back(dir + "/../web");
     }
-    candidates.push_back(TAILOR_SOURCE_WEB_DIR);
   }
   for (const std::string& dir : candidates) {
     if (!file_exists(dir + "/index.html")) continue;

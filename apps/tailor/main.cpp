@@ -5,6 +5,8 @@
 #include <cstring>
 #include <exception>
 #include <new>
+#include <string>
+#include <vector>
 
 #include "cli.h"
 #include "tailor/version.h"
@@ -48,7 +50,10 @@ int run_command(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "tailor: error: %s (run 'tailor --help')\n", e.what());
+    // Point to the help of the command whose options were wrong: 'tailor map --help'.
+    const std::vector<CLI::App*> commands = app.get_subcommands();
+    const std::string help = commands.empty() ? "tailor --help" : "tailor " + commands.back()->get_name() + " --help";
+    std::fprintf(stderr, "tailor: error: %s (run '%s')\n", e.what(), help.c_str());
     return kExitUsage;
   }
   if (!run) return kExitUsage;

@@ -6,6 +6,7 @@
 // texture size to get glTF/OBJ coordinates in texture repeats.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 

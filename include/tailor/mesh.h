@@ -83,8 +83,10 @@ struct LoadReport {
   size_t skipped_primitives = 0;     //!< glTF: point and line primitives of those instances, not read
   std::string not_kept;              //!< what the file has that the output will not (", "-separated), e.g.
                                      //!< "material textures, TANGENT"; empty when nothing is lost
-  int texture_width = 0;             //!< glb: the embedded base colour texture's size, read from its header
-  int texture_height = 0;            //!< without decoding it (0: no texture, or a header stb cannot read)
+  int texture_width = 0;             //!< glTF (read_glb_file): the base colour texture's size, read from its
+  int texture_height = 0;            //!< header without decoding it, any size: embedded, or given by a URI (a
+                                     //!< data: URI, a file next to the .gltf); 0: none, or no header read
+  bool texture_file = false;         //!< glTF: that texture is a file next to the .gltf (only its header read)
   uint32_t texture_symmetry = 1;     //!< glb: 4 where that texture's material (without a texture, the first
                                      //!< primitive's) says the map is 4-fold (written by tailor map
                                      //!< --symmetry 4: ExportOptions::symmetry), else 1

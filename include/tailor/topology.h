@@ -10,6 +10,7 @@
 // and counted.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -38,6 +39,13 @@ TAILOR_API Topology build_topology(const Mesh& mesh);
 //! The same, telling `progress` (tailor/progress.h) the share done after each of its passes; it
 //! cannot cancel (its return value is ignored).
 TAILOR_API Topology build_topology(const Mesh& mesh, const ProgressCallback& progress);
+
+//! Vertices where the surface is not a manifold, as `tailor info` counts them: a vertex whose faces
+//! do not form a single fan (faces joined through the edges at the vertex that exactly two faces
+//! share, whichever way they run; a bow tie is two fans), or an end of an edge with three or more
+//! faces. Vertices no face uses are not counted. O(F log valence) time, O(F) memory.
+//! Precondition: as build_topology.
+TAILOR_API size_t count_nonmanifold_vertices(const Mesh& mesh);
 
 //! The neighbour face across edge e, or kInvalid.
 inline uint32_t neighbour_face(const Topology& t, uint32_t e) {

@@ -237,6 +237,25 @@ Status GltfDocument::open(std::span<const char> data, const std::string& name, c
   return load_buffers(bin);
 }
 
+bool GltfDocument::image_uri_bytes(uint64_t index, size_t max_file_bytes, std::string& bytes, bool& file) const {
+  bytes.clear();
+  file = false;
+  const Json* image = get_element(json_, "images", index);
+  if (!image) return false;
+  const auto uri_it = image->find("uri");
+  if (uri_it == image->end() || !uri_it->is_string()) return false;
+  const std::string& uri = uri_it->get_ref<const std::string&>();
+  if (uri.starts_with("data:")) {
+    const size_t comma = uri.find(',');
+    return comma != std::string::npos && comma >= 7 && uri.compare(comma - 7, 7, ";base64") == 0 &&
+           decode_base64(std::string_view(uri).substr(comma + 1), bytes);
+  }
+  std::string relative;
+  if (base_dir_.empty() || !relative_file_uri(uri, relative)) return false;
+  file = true;
+  return read_file_head((std::filesystem::path(base_dir_) / relative).string(), max_file_bytes, bytes).is_ok();
+}
+
 Status GltfDocument::load_buffers(std::span<const unsigned char> bin) {
   const auto buffers = json_.find("buffers");
   if (buffers == json_.end()) return Status::ok();

@@ -61,6 +61,12 @@ class GltfDocument {
   //! byteStride (0 when not given).
   Status view_bytes(uint64_t index, std::span<const unsigned char>& bytes, uint64_t& stride);
 
+  //! The bytes of image `index` when it is given by a URI, for reading its header: a data: URI
+  //! decoded, or the first `max_file_bytes` of a file its relative URI names in or below the
+  //! .gltf's folder (the same rule as buffers; never with an empty base_dir). `file` tells which.
+  //! False when the image has no such URI or it cannot be read (the caller then has no size).
+  bool image_uri_bytes(uint64_t index, size_t max_file_bytes, std::string& bytes, bool& file) const;
+
   //! The description of accessor `index`.
   Status accessor_info(uint64_t index, AccessorInfo& info);
   //! Accessor `index` as floats (#count by info.components; normalized integers mapped to [0, 1]

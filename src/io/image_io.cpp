@@ -46,8 +46,8 @@ uint32_t be32(const unsigned char* p) {
 //! The size a PNG, JPEG or BMP header claims, read directly: stb_image refuses (with a vague
 //! "unknown image type") headers whose size would overflow its own limits, and the user should
 //! rather hear "too large". Returns false when the header is not recognised.
-bool claimed_size(const std::string& bytes, long& width, long& height) {
-  const auto* p = reinterpret_cast<const unsigned char*>(bytes.data());
+bool claimed_size(std::span<const unsigned char> bytes, long& width, long& height) {
+  const unsigned char* p = bytes.data();
   const size_t n = bytes.size();
   if (n >= 24 && std::memcmp(p, "\x89PNG\r\n\x1a\n", 8) == 0 && std::memcmp(p + 12, "IHDR", 4) == 0) {
     width = be32(p + 16);
@@ -115,6 +115,19 @@ uint64_t min_file_bytes(std::span<const unsigned char> b, uint64_t width, uint64
 
 namespace internal {
 
+bool image_header_size(std::span<const unsigned char> bytes, long& width, long& height) {
+  width = height = 0;
+  if (!claimed_size(bytes, width, height)) {
+    int w = 0, h = 0, channels = 0;
+    if (bytes.size() > size_t{INT_MAX} ||
+        stbi_info_from_memory(bytes.data(), static_cast<int>(bytes.size()), &w, &h, &channels) == 0)
+      return false;
+    width = w;
+    height = h;
+  }
+  return width > 0 && height > 0;
+}
+
 Status check_image_header(std::span<const unsigned char> bytes, long width, long height,
                           const ImageLoadOptions& options, const std::string& name) {
   if (width <= 0 || height <= 0)
@@ -157,7 +170,8 @@ Status load_pixels(const std::string& path, Image& image, Image16* deep, const I
   int width = 0, height = 0, channels = 0;
   if (stbi_info_from_memory(data, length, &width, &height, &channels) == 0) {
     long claimed_w = 0, claimed_h = 0;
-    if (claimed_size(bytes, claimed_w, claimed_h) && (claimed_w > kMaxImageSide || claimed_h > kMaxImageSide))
+    if (claimed_size({data, bytes.size()}, claimed_w, claimed_h) &&
+        (claimed_w > kMaxImageSide || claimed_h > kMaxImageSide))
       return Status::error(ErrorCode::kInvalidImage, path,
                            "image too large (the limit is " + std::to_string(kMaxImageSide) + " px a side)",
                            "header says " + size_text(claimed_w, claimed_h));

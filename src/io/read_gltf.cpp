@@ -332,24 +332,33 @@ Status read_primitive(GltfDocument& doc, const Json& prim, uint64_t mode, const 
 }
 
 // The image of a material's texture `key` ("baseColorTexture" and "metallicRoughnessTexture" in
-// pbrMetallicRoughness, "normalTexture" and "occlusionTexture" in the material itself), if it is
-// stored in a buffer view (URIs are never opened).
-void find_texture(GltfDocument& doc, uint64_t material, const char* key, std::span<const unsigned char>& bytes) {
-  bytes = {};
+// pbrMetallicRoughness, "normalTexture" and "occlusionTexture" in the material itself): its index
+// in "images", or UINT64_MAX when the material has no such texture.
+uint64_t texture_image(const GltfDocument& doc, uint64_t material, const char* key) {
   const Json* m = get_element(doc.json(), "materials", material);
-  if (!m || !m->is_object()) return;
+  if (!m || !m->is_object()) return UINT64_MAX;
   const Json* holder = m;
   if (std::string_view(key) == "baseColorTexture" || std::string_view(key) == "metallicRoughnessTexture") {
     const auto pbr = m->find("pbrMetallicRoughness");
-    if (pbr == m->end() || !pbr->is_object()) return;
+    if (pbr == m->end() || !pbr->is_object()) return UINT64_MAX;
     holder = &*pbr;
   }
   const auto base = holder->find(key);
-  if (base == holder->end() || !base->is_object()) return;
-  uint64_t texture = 0, source = 0, view = 0, stride = 0;
-  if (!get_uint(*base, "index", texture)) return;
+  if (base == holder->end() || !base->is_object()) return UINT64_MAX;
+  uint64_t texture = 0, source = 0;
+  if (!get_uint(*base, "index", texture)) return UINT64_MAX;
   const Json* t = get_element(doc.json(), "textures", texture);
-  if (!t || !get_uint(*t, "source", source)) return;
+  if (!t || !get_uint(*t, "source", source) || !get_element(doc.json(), "images", source)) return UINT64_MAX;
+  return source;
+}
+
+// The encoded image of a material's texture `key` (texture_image), if it is stored in a buffer
+// view (URIs are never decoded).
+void find_texture(GltfDocument& doc, uint64_t material, const char* key, std::span<const unsigned char>& bytes) {
+  bytes = {};
+  const uint64_t source = texture_image(doc, material, key);
+  if (source == UINT64_MAX) return;
+  uint64_t view = 0, stride = 0;
   const Json* image = get_element(doc.json(), "images", source);
   if (!image || !get_uint(*image, "bufferView", view)) return;
   std::span<const unsigned char> view_bytes;
@@ -638,8 +647,9 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
   std::vector<std::optional<std::vector<Primitive>>> decoded(meshes.size());
   size_t triangle_primitives = 0, with_uv = 0;
   bool texture_found = false;
-  bool symmetry_read = false;       // report.texture_symmetry: of the first material, until a texture's
-  std::vector<uint8_t> incomplete;  // per mesh.corner_attributes: missing on some primitive
+  uint64_t first_image = UINT64_MAX;  // the first base colour texture's image, embedded or not
+  bool symmetry_read = false;         // report.texture_symmetry: of the first material, until a texture's
+  std::vector<uint8_t> incomplete;    // per mesh.corner_attributes: missing on some primitive
   std::vector<std::string> lost;
   // Names, extras and materials of what the faces came from (Mesh::scene, Mesh::face_parts).
   SceneParts& scene = mesh.scene;
@@ -716,6 +726,8 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
         report.texture_symmetry = material_symmetry(doc, p.material);
         symmetry_read = true;
       }
+      if (texture_bytes && first_image == UINT64_MAX && p.material != UINT64_MAX)
+        first_image = texture_image(doc, p.material, "baseColorTexture");
       if (texture_bytes && !texture_found && p.material != UINT64_MAX) {
         find_texture(doc, p.material, "baseColorTexture", *texture_bytes);
         texture_found = !texture_bytes->empty();
@@ -745,6 +757,30 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
   }
   not_kept(doc, instances, lost);
   for (const std::string& item : lost) report.not_kept += (report.not_kept.empty() ? "" : ", ") + item;
+  // The texture's size from its header, never decoded, whatever its size: the embedded texture's
+  // (the one decoded when asked), else the first base colour image given by a URI (a data: URI, or a
+  // file next to the .gltf, of which only the first bytes are read).
+  if (texture_bytes) {
+    long width = 0, height = 0;
+    bool sized = !texture_bytes->empty() && internal::image_header_size(*texture_bytes, width, height);
+    if (!sized && texture_bytes->empty() && first_image != UINT64_MAX) {
+      std::string head;
+      bool file = false;
+      for (const size_t max_bytes : {size_t{64} << 10, size_t{16} << 20}) {  // a JPEG's frame header may lie far in
+        if (!doc.image_uri_bytes(first_image, max_bytes, head, file)) break;
+        sized = internal::image_header_size({reinterpret_cast<const unsigned char*>(head.data()), head.size()}, width,
+                                            height);
+        if (sized || head.size() < max_bytes) break;
+      }
+      report.texture_file = sized && file;
+    }
+    if (sized && width <= INT_MAX && height <= INT_MAX) {
+      report.texture_width = static_cast<int>(width);
+      report.texture_height = static_cast<int>(height);
+    } else {
+      report.texture_file = false;
+    }
+  }
   // glTF splits vertices on UV seams; weld them so that seams are edges between faces again.
   report.welded_vertices = weld_identical_positions(mesh);
   return Status::ok();
@@ -798,14 +834,6 @@ Status read_gltf_with_texture(std::span<const char> data, const std::string& nam
           {material_bytes.metallic_roughness, &material->metallic_roughness}};
       for (const auto& [bytes, image] : maps)
         if (s.is_ok() && !bytes.empty()) s = decode_texture(bytes, name, image_options, *image);
-    }
-    int width = 0, height = 0, channels = 0;  // the texture's size from its header only
-    if (s.is_ok() && !texture_bytes.empty() && texture_bytes.size() <= size_t{INT_MAX} &&
-        stbi_info_from_memory(texture_bytes.data(), static_cast<int>(texture_bytes.size()), &width, &height,
-                              &channels) != 0 &&
-        width > 0 && height > 0) {
-      r.texture_width = width;
-      r.texture_height = height;
     }
     if (s.is_ok() && texture && !texture_bytes.empty())
       s = decode_texture(texture_bytes, name, image_options, *texture);

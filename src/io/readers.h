@@ -64,6 +64,12 @@ Status read_stl(std::span<const char> data, const std::string& name, Mesh& mesh,
 Status read_gltf(std::span<const char> data, const std::string& name, const std::string& base_dir, Mesh& mesh,
                  LoadReport& report, ReadProgress* progress = nullptr);
 
+//! The size an image's header claims, read without decoding anything: PNG (IHDR), JPEG (the first
+//! start-of-frame marker) and BMP directly, whatever the size; other formats stb_image reads (TGA,
+//! GIF, PSD, HDR, PNM) through stbi_info_from_memory. False when no header is recognised (a JPEG
+//! whose frame header lies beyond `bytes`, a truncated PNG) or it claims no pixels.
+bool image_header_size(std::span<const unsigned char> bytes, long& width, long& height);
+
 //! Checks the size an image header claims (width x height, read by stbi_info_from_memory) before
 //! decoding `bytes`: each side within kMaxImageSide, width x height within options.max_pixels, and
 //! for uncompressed TGA, BMP and binary PPM/PGM the file long enough for that many pixels (RLE TGA:

@@ -5,6 +5,7 @@
 
 namespace tailor {
 
+using internal::counted;
 using internal::format_text;
 
 std::string eval_report_json(const EvalRun& run) {
@@ -47,14 +48,16 @@ std::string eval_report_json(const EvalRun& run) {
 std::string eval_summary(const EvalRun& run) {
   const UvMetrics& m = run.metrics;
   return format_text(
-      "%s: %zu faces, %u patches (%zu single-face), seams %.2f%% of edge length (%zu edges), %zu flipped, "
+      "%s: %s, %s (%zu single-face), seams %.2f%% of edge length (%s), %zu flipped, "
       "stretch %.4f (area-weighted %.4f), L2 %.4f, Linf %.4f, distortion %.2f deg (median), "
       "seam gap %.2f px, %.1f%% invisible, visible seams %.2f%% of edge length (%.2f%% off sharp edges, "
-      "%zu dangling ends, %zu branch points) (texture %dx%d px, %s%s)\n",
-      run.file.c_str(), m.faces, m.patches, m.single_face_patches, 100.0 * m.seam_length_ratio, m.seam_edges, m.flipped,
+      "%s, %s) (texture %dx%d px, %s%s)\n",
+      run.file.c_str(), counted(m.faces, "face", "faces").c_str(), counted(m.patches, "patch", "patches").c_str(),
+      m.single_face_patches, 100.0 * m.seam_length_ratio, counted(m.seam_edges, "edge", "edges").c_str(), m.flipped,
       m.stretch, m.stretch_area_weighted, m.l2_stretch, m.linf_stretch, m.distortion_deg, m.seam_gap_px,
       100.0 * m.seam_invisible_ratio, 100.0 * m.visible_seam_ratio, 100.0 * m.visible_off_sharp_ratio,
-      m.visible_dangling_ends, m.visible_branch_points, run.texture_width, run.texture_height,
+      counted(m.visible_dangling_ends, "dangling end", "dangling ends").c_str(),
+      counted(m.visible_branch_points, "branch point", "branch points").c_str(), run.texture_width, run.texture_height,
       run.texture_size_from.c_str(), run.symmetry == 4 ? ", symmetry 4" : "");
 }
 
@@ -84,15 +87,16 @@ std::string stability_summary(const std::string& file, const StabilityReport& r)
     text += format_text("%s: stability: another face, vertex and corner order: %.1f%% of corners bit-identical\n",
                         file.c_str(), 100.0 * r.order_identical_ratio);
   text += format_text(
-      "%s: stability: removed %zu of %zu faces, surviving corners moved %.3f px on average (max %.2f px), "
+      "%s: stability: removed %zu of %s, surviving corners moved %.3f px on average (max %.2f px), "
       "%.1f%% bit-identical, %.1f%% within 1 px; patches %u -> %u (%.0f ms)\n",
-      file.c_str(), r.removed_faces, r.faces, r.mean_difference_px, r.max_difference_px, 100.0 * r.identical_ratio,
-      100.0 * r.within_1px_ratio, r.patches_full, r.patches_cut, r.seconds * 1e3);
+      file.c_str(), r.removed_faces, counted(r.faces, "face", "faces").c_str(), r.mean_difference_px,
+      r.max_difference_px, 100.0 * r.identical_ratio, 100.0 * r.within_1px_ratio, r.patches_full, r.patches_cut,
+      r.seconds * 1e3);
   if (r.identical_beyond_radius_ratio >= 0)
-    text += format_text(
-        "%s: stability: %.1f%% of the %zu surviving corners farther than %g units from the cut are "
-        "bit-identical\n",
-        file.c_str(), 100.0 * r.identical_beyond_radius_ratio, r.corners_beyond_radius, r.locality_radius);
+    text += format_text("%s: stability: %.1f%% of the %s farther than %g units from the cut %s bit-identical\n",
+                        file.c_str(), 100.0 * r.identical_beyond_radius_ratio,
+                        counted(r.corners_beyond_radius, "surviving corner", "surviving corners").c_str(),
+                        r.locality_radius, r.corners_beyond_radius == 1 ? "is" : "are");
   return text;
 }
 

@@ -28,6 +28,11 @@ __attribute__((format(printf, 1, 2))) inline std::string format_text(const char*
   return text;
 }
 
+//! A count and its noun, singular for exactly one: counted(1, "patch", "patches") is "1 patch".
+inline std::string counted(unsigned long long n, const char* one, const char* many) {
+  return std::to_string(n) + " " + (n == 1 ? one : many);
+}
+
 //! Milliseconds of a time in seconds.
 inline double ms(double seconds) { return seconds * 1e3; }
 

@@ -8,6 +8,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <numeric>
+#include <utility>
+#include <vector>
 
 #include "util/huge_pages.h"
 
@@ -166,6 +169,57 @@ Topology build_topology(const Mesh& mesh, const ProgressCallback& progress) {
   t.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   reached(1.f);
   return t;
+}
+
+size_t count_nonmanifold_vertices(const Mesh& mesh) {
+  const size_t nv = mesh.vertex_count();
+  const std::vector<uint32_t>& idx = mesh.indices;
+  // The corners of each vertex (CSR, by a counting sort).
+  std::vector<uint32_t> first(nv + 1, 0);
+  for (const uint32_t v : idx) ++first[v + 1];
+  for (size_t v = 0; v < nv; ++v) first[v + 1] += first[v];
+  std::vector<uint32_t> corners(idx.size());
+  {
+    std::vector<uint32_t> cursor(first.begin(), first.end() - 1);
+    for (uint32_t c = 0; c < idx.size(); ++c) corners[cursor[idx[c]]++] = c;
+  }
+  size_t count = 0;
+  std::vector<std::pair<uint32_t, uint32_t>> around;  // (the other end of an edge at v, the face's slot)
+  std::vector<uint32_t> parent;
+  for (size_t v = 0; v < nv; ++v) {
+    const uint32_t begin = first[v], degree = first[v + 1] - begin;
+    if (degree <= 1) continue;
+    around.clear();
+    for (uint32_t i = 0; i < degree; ++i) {
+      const uint32_t c = corners[begin + i], f = c / 3, k = c % 3;
+      around.emplace_back(idx[3 * f + (k + 1) % 3], i);
+      around.emplace_back(idx[3 * f + (k + 2) % 3], i);
+    }
+    std::sort(around.begin(), around.end());
+    parent.resize(degree);
+    std::iota(parent.begin(), parent.end(), 0u);
+    uint32_t fans = degree;
+    bool fin = false;
+    for (size_t g = 0; g < around.size();) {
+      size_t end = g + 1;
+      while (end < around.size() && around[end].first == around[g].first) ++end;
+      if (end - g >= 3) {
+        fin = true;  // an edge with three or more faces
+        break;
+      }
+      if (end - g == 2) {
+        const uint32_t a = find_root(parent.data(), around[g].second);
+        const uint32_t b = find_root(parent.data(), around[g + 1].second);
+        if (a != b) {
+          parent[a] = b;
+          --fans;
+        }
+      }
+      g = end;
+    }
+    if (fin || fans > 1) ++count;
+  }
+  return count;
 }
 
 }  // namespace tailor

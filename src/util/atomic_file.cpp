@@ -7,6 +7,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <csignal>
@@ -349,6 +350,30 @@ Status read_file(const std::string& path, std::string& bytes) {
     bytes.clear();
     return Status::error(ErrorCode::kIo, path, "read error");
   }
+  return Status::ok();
+}
+
+Status read_file_head(const std::string& path, size_t max_bytes, std::string& bytes) {
+  bytes.clear();
+  int fd = -1;
+  size_t size = 0;
+  TAILOR_RETURN_IF_ERROR(open_input(path, fd, size));
+  bytes.resize(std::min(size, max_bytes));
+  size_t got = 0;
+  while (got < bytes.size()) {
+    const ssize_t n = ::read(fd, bytes.data() + got, bytes.size() - got);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      const int err = errno;
+      close(fd);
+      bytes.clear();
+      return Status::error(ErrorCode::kIo, path, std::string("read error: ") + std::strerror(err));
+    }
+    if (n == 0) break;  // the file shrank meanwhile
+    got += static_cast<size_t>(n);
+  }
+  close(fd);
+  bytes.resize(got);
   return Status::ok();
 }
 

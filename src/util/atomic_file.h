@@ -120,4 +120,8 @@ Status open_input(const std::string& path, int& fd, size_t& size);
 //! and on inputs that are not regular files, kLimit above kMaxReadBytes.
 Status read_file(const std::string& path, std::string& bytes);
 
+//! Reads the first `max_bytes` of a regular file (all of it when shorter) into `bytes`, as
+//! read_file opens it: for a header, without reading the rest of a large file.
+Status read_file_head(const std::string& path, size_t max_bytes, std::string& bytes);
+
 }  // namespace tailor::internal

@@ -95,6 +95,13 @@ def test_evaluate_matches_the_map_and_the_cli(tmp_path, tailor_binary):
     bad[3, 1, 0] = np.inf
     with pytest.raises(tailor.Error):
         tailor.evaluate(mesh, bad, 512)
+    # Errors name the keywords, not the command's flags.
+    with pytest.raises(tailor.Error, match=r"^texture_size must be between 1 and 65536, got 0x512$"):
+        tailor.evaluate(mesh, result.corner_uvs, (0, 512))
+    with pytest.raises(tailor.Error, match=r"^symmetry must be 1 or 4, got 2$"):
+        tailor.evaluate(mesh, result.corner_uvs, 512, symmetry=2)
+    with pytest.raises(tailor.Error, match=r"^symmetry=4 needs a square texture_size, got 512x256$"):
+        tailor.evaluate(mesh, result.corner_uvs, (512, 256), symmetry=4)
 
 
 @pytest.mark.parametrize(

@@ -80,8 +80,10 @@ def test_material_errors_are_the_cli_messages(tmp_path, material_dir):
     with pytest.raises(tailor.Error, match="all maps of a material must share one size"):
         tailor.map(mesh, material=small)
     result = tailor.map(mesh, material=material_dir)
-    with pytest.raises(tailor.Error, match="--material needs a .glb output"):
+    with pytest.raises(tailor.Error, match="^material= needs a .glb output"):
         tailor.save(tmp_path / "x.obj", mesh, result, material=material_dir)
+    with pytest.raises(tailor.Error, match="^give texture= or material=, not both"):
+        tailor.save(tmp_path / "x.glb", mesh, result, texture=GRAVEL, material=material_dir)
     assert not (tmp_path / "x.obj").exists()
     (material_dir / "gravel.height.png").write_bytes((material_dir / "gravel_roughness.png").read_bytes())
     with pytest.warns(UserWarning, match="height map not embedded"):
