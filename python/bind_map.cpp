@@ -52,7 +52,7 @@ std::string set_axis(const py::object& axis, OrientationOptions& orientation, bo
     else if (text == "z")
       orientation.user_axis = {0, 0, 1};
     else
-      raise_error("--axis must be pca, skeleton, x, y, z or three numbers X,Y,Z, got '" + text + "'");
+      raise_error("--axis must be auto, pca, skeleton, x, y, z or three numbers X,Y,Z, got '" + text + "'");
     return text;
   }
   std::array<float, 3> v{};
@@ -61,10 +61,12 @@ std::string set_axis(const py::object& axis, OrientationOptions& orientation, bo
     if (values.size() != 3) throw py::cast_error();
     for (size_t i = 0; i < 3; ++i) v[i] = static_cast<float>(values[i]);
   } catch (const py::cast_error&) {
-    raise_error("--axis must be pca, skeleton, x, y, z or three numbers X,Y,Z, got '" + sequence_text(axis) + "'");
+    raise_error("--axis must be auto, pca, skeleton, x, y, z or three numbers X,Y,Z, got '" + sequence_text(axis) +
+                "'");
   }
   if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
-    raise_error("--axis must be pca, skeleton, x, y, z or three numbers X,Y,Z, got '" + sequence_text(axis) + "'");
+    raise_error("--axis must be auto, pca, skeleton, x, y, z or three numbers X,Y,Z, got '" + sequence_text(axis) +
+                "'");
   orientation.axis = AxisSource::kUser;
   orientation.user_axis = v;
   char text[64];

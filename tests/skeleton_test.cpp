@@ -182,7 +182,7 @@ TEST(Skeleton, CliAxisSkeletonGivesTheSameFileForAnyThreadCount) {
   EXPECT_NE(test::run_command(
                 std::string(TAILOR_BINARY) + " map " + mesh + " --axis skeletn -o " + test::temp_path("bad.glb"), out),
             0);
-  EXPECT_NE(out.find("--axis must be pca, skeleton, x, y, z"), std::string::npos) << out;
+  EXPECT_NE(out.find("--axis must be auto, pca, skeleton, x, y, z"), std::string::npos) << out;
 }
 
 }  // namespace

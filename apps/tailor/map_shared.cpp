@@ -40,7 +40,7 @@ Status parse_axis(const std::string& text, OrientationOptions& o) {
     o.user_axis = {0, 0, 1};
   else if (!parse_vec3(text, o.user_axis))
     return Status::error(ErrorCode::kInvalidArgument, "",
-                         "--axis must be pca, skeleton, x, y, z or three numbers X,Y,Z, got '" + text + "'");
+                         "--axis must be auto, pca, skeleton, x, y, z or three numbers X,Y,Z, got '" + text + "'");
   return Status::ok();
 }
 

@@ -131,27 +131,29 @@ std::string map_summary(const MapRun& run) {
   const std::string axis_choice =
       run.axis_auto ? "axis choice " + std::to_string(static_cast<long>(ms(run.axis_choice_seconds))) + ", " : "";
   std::string text = format_text(
-      "%s: %zu faces, %u patches, seams %.2f%% of edge length, %zu flipped, stretch %.3f, L2 %.3f, "
+      "%s: %s, %s, seams %.2f%% of edge length, %zu flipped, stretch %.3f, L2 %.3f, "
       "Linf %.2f, median angle %.2f deg, visible seams %.2f%% (%.0f%% of seam length invisible%s, %zu dangling ends) | "
       "load %.1f ms, topology %.1f, "
       "%sorientation %.1f, mapping %.1f, export %.1f ms -> %s\n",
-      run.input.c_str(), run.faces, m.patches, 100.0 * m.seam_length_ratio, m.flipped, m.stretch, m.l2_stretch,
-      m.linf_stretch, m.distortion_deg, 100.0 * m.visible_seam_ratio, 100.0 * m.seam_invisible_ratio,
+      run.input.c_str(), internal::counted(run.faces, "face", "faces").c_str(),
+      internal::counted(m.patches, "patch", "patches").c_str(), 100.0 * m.seam_length_ratio, m.flipped, m.stretch,
+      m.l2_stretch, m.linf_stretch, m.distortion_deg, 100.0 * m.visible_seam_ratio, 100.0 * m.seam_invisible_ratio,
       run.options.metrics.symmetry == 4 ? " up to quarter turns" : "", m.visible_dangling_ends,
       ms(run.load.load_seconds), ms(run.topology_seconds), axis_choice.c_str(), ms(run.orientation_seconds),
       ms(run.mapping.seconds), ms(run.export_seconds), run.output.c_str());
   if (run.mapping.chunks > 0)
     text += format_text(
-        "chunks: %u of side %g world units, mapped at %g texels per unit; corners farther than %g units from "
+        "chunks: %s of side %g world units, mapped at %g texels per unit; corners farther than %g units from "
         "an edit keep their UVs\n",
-        run.mapping.chunks, run.mapping.chunk_cell_size, run.mapping.texels_per_unit, run.mapping.locality_radius);
+        internal::counted(run.mapping.chunks, "chunk", "chunks").c_str(), run.mapping.chunk_cell_size,
+        run.mapping.texels_per_unit, run.mapping.locality_radius);
   if (run.stability) {
     const StabilityReport& s = *run.stability;
     text += format_text(
-        "stability: removed %zu faces, surviving corners moved %.3f px on average (max %.2f px), "
+        "stability: removed %s, surviving corners moved %.3f px on average (max %.2f px), "
         "%.1f%% bit-identical, %.1f%% within 1 px\n",
-        s.removed_faces, s.mean_difference_px, s.max_difference_px, 100.0 * s.identical_ratio,
-        100.0 * s.within_1px_ratio);
+        internal::counted(s.removed_faces, "face", "faces").c_str(), s.mean_difference_px, s.max_difference_px,
+        100.0 * s.identical_ratio, 100.0 * s.within_1px_ratio);
     if (s.order_identical_ratio >= 0)
       text += format_text("stability: another face, vertex and corner order: %.1f%% of corners bit-identical\n",
                           100.0 * s.order_identical_ratio);
