@@ -52,7 +52,7 @@ printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\
 # --- map: summary line, outputs, stats; determinism (bit-identical files) ---
 "$tailor" map "$mesh" --texture "$texture" -o "$tmp/a.glb" --stats "$tmp/a.json" >"$tmp/map.txt" 2>&1 ||
   fail "map failed: $(cat "$tmp/map.txt")"
-grep -Eq "5856 faces, [0-9]+ patches, .* 0 flipped" "$tmp/map.txt" && ok || fail "map summary: $(cat "$tmp/map.txt")"
+grep -Eq "5856 faces, [0-9]+ patch(es)?, .* 0 flipped" "$tmp/map.txt" && ok || fail "map summary: $(cat "$tmp/map.txt")"
 [[ -s $tmp/a.glb && -s $tmp/a.json ]] && ok || fail "map outputs missing"
 "$tailor" map "$mesh" --texture "$texture" -o "$tmp/b.glb" --quiet >"$tmp/quiet.txt" 2>&1 || fail "second map failed"
 [[ ! -s $tmp/quiet.txt ]] && ok || fail "--quiet printed: $(cat "$tmp/quiet.txt")"
