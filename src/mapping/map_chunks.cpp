@@ -21,6 +21,7 @@
 #include "tailor/chunks.h"
 #include "tailor/mapping.h"
 #include "tailor/topology.h"
+#include "util/mesh_bounds.h"
 
 namespace tailor::internal {
 namespace {
@@ -84,13 +85,9 @@ Status map_whole_canonical(const Mesh& mesh, const MapTextureOptions& options, T
     side = 1.0 / options.orientation.fixed_unit_scale;
     for (size_t k = 0; k < 3; ++k) origin[k] = options.orientation.fixed_origin[k];
   } else {
-    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-    for (const uint32_t v : mesh.indices)
-      for (size_t k = 0; k < 3; ++k) {
-        lo[k] = std::min(lo[k], double{mesh.positions[3 * size_t{v} + k]});
-        hi[k] = std::max(hi[k], double{mesh.positions[3 * size_t{v} + k]});
-      }
-    const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+    const Bounds box = referenced_bounds(mesh);
+    const std::array<double, 3>& lo = box.lo;
+    const double extent = box.longest();
     const double grid = extent > 0 && std::isfinite(extent) ? std::exp2(std::ceil(std::log2(extent))) : 1.0;
     for (size_t k = 0; k < 3; ++k) origin[k] = std::isfinite(lo[k]) ? std::floor(lo[k] / grid) * grid : 0.0;
     side = 2 * grid;
@@ -169,13 +166,7 @@ double chunk_texels_per_unit(const Mesh& mesh, const MapTextureOptions& options)
   // The longest side of the referenced vertices' bounding box, as the whole-mesh mapping
   // normalises, then the density rounded to a power of two: a local edit that does not change the
   // bounding box by a factor near sqrt(2) leaves it where it is.
-  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  for (const uint32_t v : mesh.indices)
-    for (size_t k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], mesh.positions[3 * size_t{v} + k]);
-      hi[k] = std::max(hi[k], mesh.positions[3 * size_t{v} + k]);
-    }
-  const double longest = std::max({double{hi[0]} - lo[0], double{hi[1]} - lo[1], double{hi[2]} - lo[2]});
+  const double longest = referenced_bounds(mesh).longest();
   if (!(longest > 0) || !std::isfinite(longest)) return 0;
   return std::exp2(std::round(std::log2(double{options.mapping.scale} / longest)));
 }

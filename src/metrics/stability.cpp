@@ -15,6 +15,7 @@
 
 #include "tailor/mapping.h"
 #include "tailor/topology.h"
+#include "util/mesh_bounds.h"
 
 namespace tailor {
 namespace {
@@ -109,13 +110,8 @@ Status measure_stability(const Mesh& mesh, const MapTextureOptions& options, Sta
     }
     for (int i = 0; i < 3; ++i) seed[i] = map_options.seed_point[static_cast<size_t>(i)];
   } else {
-    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-    for (const uint32_t v : mesh.indices)
-      for (size_t k = 0; k < 3; ++k) {
-        lo[k] = std::min(lo[k], double{mesh.positions[3 * size_t{v} + k]});
-        hi[k] = std::max(hi[k], double{mesh.positions[3 * size_t{v} + k]});
-      }
-    for (size_t k = 0; k < 3; ++k) seed[k] = 0.5 * (lo[k] + hi[k]);
+    const internal::Bounds box = internal::referenced_bounds(mesh);
+    for (size_t k = 0; k < 3; ++k) seed[k] = 0.5 * (box.lo[k] + box.hi[k]);
   }
   // === The ball: centred on the face farthest from that point, holding remove_fraction of faces ===
   size_t far_face = 0;
