@@ -447,5 +447,29 @@ printf '{"strokes": [' >"$tmp/cut_strokes.json"
 expect_error 1 "cut_strokes.json: not valid JSON \(byte" -- "$tailor" map "$mesh" -o "$tmp/bs.glb" --strokes "$tmp/cut_strokes.json"
 [[ ! -e $tmp/bs.glb ]] && ok || fail "map --strokes with a bad file wrote an output"
 
+# --- a .obj output is portable: the texture lies beside the .mtl, named by its bare file name ---
+mkdir -p "$tmp/port/tex" "$tmp/port/out/dir"
+cp tests/data/textures/vistex-tile04-128.png "$tmp/port/tex/tile.png"
+"$tailor" map "$mesh" -t "$tmp/port/tex/tile.png" -o "$tmp/port/out/dir/x.obj" -q 2>/dev/null || fail "map to a nested .obj"
+mv "$tmp/port/out/dir" "$tmp/port/moved" && rm -rf "$tmp/port/tex"
+# Another reader: the .obj's mtllib, the .mtl's map_Kd, the picture, every face's vt in range.
+python3 - "$tmp/port/moved/x.obj" <<'PY' && ok || fail "the moved .obj lost its texture"
+import os, sys
+obj = sys.argv[1]
+folder = os.path.dirname(obj)
+lines = open(obj).read().splitlines()
+mtllib = [l.split(None, 1)[1] for l in lines if l.startswith("mtllib ")]
+assert mtllib == ["x.mtl"], mtllib
+vt = sum(1 for l in lines if l.startswith("vt "))
+for l in lines:
+    if l.startswith("f "):
+        assert all(1 <= int(c.split("/")[1]) <= vt for c in l.split()[1:]), l
+maps = [l.split(None, 1)[1] for l in open(os.path.join(folder, mtllib[0])).read().splitlines() if l.startswith("map_Kd ")]
+assert len(maps) == 1 and os.path.basename(maps[0]) == maps[0], maps
+with open(os.path.join(folder, maps[0]), "rb") as f:
+    assert f.read(8) == b"\x89PNG\r\n\x1a\n"
+PY
+"$tailor" eval "$tmp/port/moved/x.obj" >/dev/null 2>&1 && ok || fail "eval of the moved .obj"
+
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]
