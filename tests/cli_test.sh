@@ -52,7 +52,7 @@ printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\
 # --- map: summary line, outputs, stats; determinism (bit-identical files) ---
 "$tailor" map "$mesh" --texture "$texture" -o "$tmp/a.glb" --stats "$tmp/a.json" >"$tmp/map.txt" 2>&1 ||
   fail "map failed: $(cat "$tmp/map.txt")"
-grep -Eq "5856 faces, [0-9]+ patch(es)?, .* 0 flipped" "$tmp/map.txt" && ok || fail "map summary: $(cat "$tmp/map.txt")"
+grep -Eq "5856 faces, [0-9]+ patch(es)?, [0-9]+\.[0-9]{2} repeats across the mesh, .* 0 flipped" "$tmp/map.txt" && ok || fail "map summary: $(cat "$tmp/map.txt")"
 [[ -s $tmp/a.glb && -s $tmp/a.json ]] && ok || fail "map outputs missing"
 "$tailor" map "$mesh" --texture "$texture" -o "$tmp/b.glb" --quiet >"$tmp/quiet.txt" 2>&1 || fail "second map failed"
 [[ ! -s $tmp/quiet.txt ]] && ok || fail "--quiet printed: $(cat "$tmp/quiet.txt")"
@@ -446,6 +446,48 @@ expect_error 1 "bad_radius.json: .*radius.* > 0" -- "$tailor" map "$mesh" -o "$t
 printf '{"strokes": [' >"$tmp/cut_strokes.json"
 expect_error 1 "cut_strokes.json: not valid JSON \(byte" -- "$tailor" map "$mesh" -o "$tmp/bs.glb" --strokes "$tmp/cut_strokes.json"
 [[ ! -e $tmp/bs.glb ]] && ok || fail "map --strokes with a bad file wrote an output"
+
+# --- a .obj output is portable: the texture lies beside the .mtl, named by its bare file name ---
+mkdir -p "$tmp/port/tex" "$tmp/port/out/dir"
+cp tests/data/textures/vistex-tile04-128.png "$tmp/port/tex/tile.png"
+"$tailor" map "$mesh" -t "$tmp/port/tex/tile.png" -o "$tmp/port/out/dir/x.obj" -q 2>/dev/null || fail "map to a nested .obj"
+mv "$tmp/port/out/dir" "$tmp/port/moved" && rm -rf "$tmp/port/tex"
+# Another reader: the .obj's mtllib, the .mtl's map_Kd, the picture, every face's vt in range.
+python3 - "$tmp/port/moved/x.obj" <<'PY' && ok || fail "the moved .obj lost its texture"
+import os, sys
+obj = sys.argv[1]
+folder = os.path.dirname(obj)
+lines = open(obj).read().splitlines()
+mtllib = [l.split(None, 1)[1] for l in lines if l.startswith("mtllib ")]
+assert mtllib == ["x.mtl"], mtllib
+vt = sum(1 for l in lines if l.startswith("vt "))
+for l in lines:
+    if l.startswith("f "):
+        assert all(1 <= int(c.split("/")[1]) <= vt for c in l.split()[1:]), l
+maps = [l.split(None, 1)[1] for l in open(os.path.join(folder, mtllib[0])).read().splitlines() if l.startswith("map_Kd ")]
+assert len(maps) == 1 and os.path.basename(maps[0]) == maps[0], maps
+with open(os.path.join(folder, maps[0]), "rb") as f:
+    assert f.read(8) == b"\x89PNG\r\n\x1a\n"
+PY
+"$tailor" eval "$tmp/port/moved/x.obj" >/dev/null 2>&1 && ok || fail "eval of the moved .obj"
+
+# --- a texture that does not wrap, and fewer than one repeat: one warning line each, and the summary's repeats ---
+photo=tests/data/textures/water-caustics-300.jpg
+"$tailor" map "$mesh" -t "$photo" -o "$tmp/wrap.glb" >"$tmp/wrap.txt" 2>"$tmp/wrap.err" || fail "map with a photo"
+grep -Eq "^tailor: warning: $photo does not wrap \(wrap ratio [0-9]+\.[0-9]{2} in x, [0-9]+\.[0-9]{2} in y; seamless is 0\.8-1\.2\): .*'tailor tile $photo -o tests/data/textures/water-caustics-300_tile\.png'$" \
+  "$tmp/wrap.err" && [[ $(grep -c "does not wrap" "$tmp/wrap.err") -eq 1 ]] && ok ||
+  fail "no wrap warning for a photo: $(cat "$tmp/wrap.err")"
+"$tailor" map "$mesh" -t "$photo" -o "$tmp/wrap.glb" -q 2>"$tmp/wrap.err" >/dev/null && [[ ! -s $tmp/wrap.err ]] && ok ||
+  fail "--quiet printed a warning: $(cat "$tmp/wrap.err")"
+"$tailor" tile "$photo" -o "$tmp/photo_tile.png" -q || fail "tile the photo"
+"$tailor" map "$mesh" -t "$tmp/photo_tile.png" -o "$tmp/wrap.glb" --tile-size 0.5 >"$tmp/wrap.txt" 2>"$tmp/wrap.err"
+! grep -q "does not wrap" "$tmp/wrap.err" && ok || fail "a tile from tailor tile warned: $(cat "$tmp/wrap.err")"
+grep -Eq "^examples/spot.obj: 5856 faces, [0-9]+ patch(es)?, [0-9]+\.[0-9]{2} repeats across the mesh \(600 texels per unit\), seams " \
+  "$tmp/wrap.txt" && ok || fail "summary without repeats and texels per unit: $(cat "$tmp/wrap.txt")"
+"$tailor" map "$mesh" -o "$tmp/small.glb" --scale 100 >"$tmp/small.txt" 2>"$tmp/small.err"
+grep -q "^tailor: warning: the 512 px texture repeats 0.20 times across the mesh" "$tmp/small.err" &&
+  grep -q ", 0.20 repeats across the mesh, seams" "$tmp/small.txt" && ok ||
+  fail "no warning below one repeat: $(cat "$tmp/small.err" "$tmp/small.txt")"
 
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]

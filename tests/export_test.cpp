@@ -416,8 +416,9 @@ TEST_F(ExportTest, ObjRoundTripsWithMaterial) {
   const std::string out = path("sub/cube.obj");
   ASSERT_TRUE(export_mesh(out, cube_, cube_atlas_, options).is_ok());
   const std::string mtl = read_all(path("sub/cube.mtl"));
-  const std::string expected = fs::relative(kTexture, dir_ / "sub").generic_string();
-  EXPECT_NE(mtl.find("map_Kd " + expected + "\n"), std::string::npos) << mtl;
+  // The texture is copied beside the .mtl and named by its bare file name: the folder moves whole.
+  EXPECT_NE(mtl.find("map_Kd vistex-tile04-128.png\n"), std::string::npos) << mtl;
+  EXPECT_EQ(read_all(path("sub/vistex-tile04-128.png")), read_all(kTexture));
   EXPECT_NE(read_all(out).find("mtllib cube.mtl\n"), std::string::npos);
 
   Mesh back;
@@ -429,6 +430,41 @@ TEST_F(ExportTest, ObjRoundTripsWithMaterial) {
   ASSERT_EQ(back.corner_uvs.size(), cube_atlas_.corner_uv.size());
   for (size_t i = 0; i < back.corner_uvs.size(); ++i)
     EXPECT_FLOAT_EQ(back.corner_uvs[i], cube_atlas_.corner_uv[i] / 128.0f) << i;
+  EXPECT_EQ(temporaries(), 0u);
+}
+
+// The copy of the texture beside an .obj/.ply never replaces a different file of its name (another
+// output may name it): it takes the next free name; the same bytes are named again, not copied.
+TEST_F(ExportTest, TextureCopyBesideTheOutputNeverReplacesAnotherFile) {
+  ExportOptions options;
+  options.texture_path = kTexture;
+  options.texture_width = options.texture_height = 128;
+  fs::create_directories(dir_ / "out");
+  {
+    std::ofstream other(path("out/vistex-tile04-128.png"), std::ios::binary);
+    other << "another picture";
+  }
+  ASSERT_TRUE(export_mesh(path("out/a.obj"), cube_, cube_atlas_, options).is_ok());
+  EXPECT_NE(read_all(path("out/a.mtl")).find("map_Kd vistex-tile04-128-2.png\n"), std::string::npos);
+  EXPECT_EQ(read_all(path("out/vistex-tile04-128.png")), "another picture");
+  EXPECT_EQ(read_all(path("out/vistex-tile04-128-2.png")), read_all(kTexture));
+  // Again, and as a .ply: the copy already there is named, nothing more is written.
+  ASSERT_TRUE(export_mesh(path("out/b.obj"), cube_, cube_atlas_, options).is_ok());
+  EXPECT_NE(read_all(path("out/b.mtl")).find("map_Kd vistex-tile04-128-2.png\n"), std::string::npos);
+  ASSERT_TRUE(export_mesh(path("out/c.ply"), cube_, cube_atlas_, options).is_ok());
+  EXPECT_NE(read_all(path("out/c.ply")).find("comment TextureFile vistex-tile04-128-2.png\n"), std::string::npos);
+  EXPECT_FALSE(fs::exists(path("out/vistex-tile04-128-3.png")));
+  // A texture that already lies beside the output is named as it is, whatever its name.
+  fs::copy_file(kTexture, path("out/my tile.png"));
+  options.texture_path = path("out/my tile.png");
+  ASSERT_TRUE(export_mesh(path("out/d.obj"), cube_, cube_atlas_, options).is_ok());
+  // ...but a name with a space is one map_Kd readers split: the copy is named my_tile.png.
+  EXPECT_NE(read_all(path("out/d.mtl")).find("map_Kd my_tile.png\n"), std::string::npos);
+  fs::copy_file(kTexture, path("out/plain.png"));
+  options.texture_path = path("out/plain.png");
+  ASSERT_TRUE(export_mesh(path("out/e.obj"), cube_, cube_atlas_, options).is_ok());
+  EXPECT_NE(read_all(path("out/e.mtl")).find("map_Kd plain.png\n"), std::string::npos);
+  EXPECT_FALSE(fs::exists(path("out/plain-2.png")));
   EXPECT_EQ(temporaries(), 0u);
 }
 

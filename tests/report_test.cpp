@@ -61,7 +61,9 @@ TEST(Report, MapSummaryIsOneLinePlusStability) {
   run.metrics.patches = 2;
   run.metrics.seam_length_ratio = 0.0512;
   std::string text = map_summary(run);
-  EXPECT_EQ(text.find("in.ply: 12 faces, 2 patches, seams 5.12% of edge length"), 0u) << text;
+  // The default scale (800 px across the mesh) of a 512 px texture: 1.56 repeats.
+  EXPECT_EQ(text.find("in.ply: 12 faces, 2 patches, 1.56 repeats across the mesh, seams 5.12% of edge length"), 0u)
+      << text;
   EXPECT_EQ(text.find("axis choice"), std::string::npos);
   EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1);
   run.axis_auto = true;
@@ -71,6 +73,35 @@ TEST(Report, MapSummaryIsOneLinePlusStability) {
   EXPECT_NE(text.find("axis choice 42, orientation"), std::string::npos) << text;
   EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 2);
   EXPECT_NE(text.find("\nstability: removed 0 faces"), std::string::npos) << text;
+}
+
+// The repeats across the mesh: its longest side in texture periods at the density the map used.
+TEST(Report, MapSummaryStatesTheRepeatsAcrossTheMesh) {
+  MapRun run;
+  run.input = "in.ply";
+  run.faces = 12;
+  run.metrics.patches = 2;
+  run.longest_side = 4.0;
+  run.options.mapping.texture_period_px = 512.f;
+  run.options.mapping.scale = 1024.f;  // normalised: the scale spans the longest side
+  EXPECT_DOUBLE_EQ(map_repeats_across(run), 2.0);
+  std::string text = map_summary(run);
+  EXPECT_EQ(text.find("in.ply: 12 faces, 2 patches, 2.00 repeats across the mesh, seams "), 0u) << text;
+  EXPECT_EQ(text.find("texels per unit"), std::string::npos) << text;
+  EXPECT_DOUBLE_EQ(nlohmann::json::parse(map_report_json(run))["mapping"]["repeats_across_mesh"].get<double>(), 2.0);
+  // World units (--tile-size 2 of a 512 px texture): 256 texels per unit, 4 units = 2 repeats.
+  run.texels_per_unit = 256.0;
+  run.options.orientation.fixed_unit_scale = 0.25f;
+  run.options.mapping.scale = 1024.f;
+  text = map_summary(run);
+  EXPECT_NE(text.find(", 2.00 repeats across the mesh (256 texels per unit), seams"), std::string::npos) << text;
+  // Chunked: the density per world unit every chunk was mapped at (a power of two), not the scale.
+  run.texels_per_unit = 0.0;
+  run.options.orientation.fixed_unit_scale = 0.f;
+  run.mapping.chunks = 3;
+  run.mapping.texels_per_unit = 64.0;
+  EXPECT_DOUBLE_EQ(map_repeats_across(run), 0.5);
+  EXPECT_NE(map_summary(run).find(", 0.50 repeats across the mesh, seams"), std::string::npos);
 }
 
 TEST(Report, FileNamesThatAreNotUtf8DoNotBreakTheJson) {

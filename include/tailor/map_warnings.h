@@ -12,12 +12,23 @@
 
 namespace tailor {
 
+//! How many times the texture repeats across the longest side of `mesh`'s bounding box when mapped
+//! with `options` (complete, as for map_warnings): options.mapping.scale over the texture period,
+//! in the units of the normalisation (the unit cube, or orientation.fixed_unit_scale's). A chunked
+//! map without a fixed normalisation rounds the density to a power of two (within a factor of
+//! sqrt(2) of this); MapRun's summary states the figure the map used. O(V).
+TAILOR_API double map_repeats(const Mesh& mesh, const MapTextureOptions& options);
+
 //! The warnings of mapping `mesh` with `options` under `texture` (may be empty: not looked at),
-//! one sentence each, empty when there is nothing to say. With symmetry 4: the texture is not
+//! one sentence each, empty when there is nothing to say. Any mode: the texture does not wrap
+//! (a wrap ratio, eval-tile's measure, above kWrapRatioSeamless: every repeat shows a cut; the
+//! sentence names the `tailor tile` command that fixes it); the texture repeats less than once
+//! across the mesh (map_repeats; part of it is never seen). With symmetry 4: the texture is not
 //! unchanged by a quarter turn (quarter_turn_difference over kQuarterTurnNoiseLevels), or turns
 //! into itself only about a point off its centre and corner (quarter-turn seams would show or jump
 //! by half a repeat); the texture repeats less than once across the mesh's longest side (quarter-
-//! turn seams land on the lattice less often the fewer the repeats). Sentences about the texture
+//! turn seams land on the lattice less often the fewer the repeats; this one instead of the
+//! any-mode sentence). Sentences about the texture
 //! start with texture_name. Call with the options complete (set_map_texture_size, the final
 //! scale and orientation.fixed_unit_scale). O(V + texture pixels).
 TAILOR_API std::vector<std::string> map_warnings(const Mesh& mesh, const MapTextureOptions& options,

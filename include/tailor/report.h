@@ -48,6 +48,7 @@ struct MapRun {
   LoadReport load;  //!< what the reader saw and repaired, its time
   size_t vertices = 0;
   size_t faces = 0;
+  double longest_side = 0;  //!< longest side of the mesh's bounding box, mesh (world) units
   uint32_t components = 0;  //!< Topology::vertex_components
   size_t boundary_edges = 0;
   size_t nonmanifold_edges = 0;
@@ -64,6 +65,13 @@ struct MapRun {
   double preview_seconds = 0;
   double total_seconds = 0;  //!< the whole command
 };
+
+//! The texture repeats across the longest side of the mesh's bounding box as mapped, from the
+//! texel density the map used: per world unit when it was chunked (MappingStats::texels_per_unit)
+//! or normalised by orientation.fixed_unit_scale (--tile-size, --texels-per-unit), else
+//! options.mapping.scale across the mesh; in texture periods (options.mapping.texture_period_px).
+//! 0 when unknown (no faces, no period).
+TAILOR_API double map_repeats_across(const MapRun& run);
 
 //! Fills the fields of `run` that come from the loaded mesh, its topology and map_texture's result.
 TAILOR_API void add_map_results(const Mesh& mesh, const LoadReport& load, const Topology& topology,

@@ -264,6 +264,14 @@ struct TileMetrics {
 //! an inconsistent image or one smaller than 8 px a side. Safe for untrusted images.
 TAILOR_API Status tile_metrics(const Image& tile, const Image* exemplar, TileMetrics& metrics);
 
+//! The wrap ratios of tile_metrics alone (TileMetrics::wrap_ratio_x / _y: the difference across the
+//! wrap column / row over the median interior one; ~1 seamless, eval-tile's target [0.8, 1.2]), for
+//! the check `tailor map` makes of its texture. O(pixels), one pass. Fails with kInvalidImage like
+//! tile_metrics (inconsistent, or smaller than 8 px a side).
+TAILOR_API Status wrap_ratios(const Image& tile, double& x, double& y);
+//! The upper end of eval-tile's wrap-ratio target: above it, the wrap shows as a cut.
+inline constexpr double kWrapRatioSeamless = 1.2;
+
 //! The quality targets: wrap ratios in [0.8, 1.2], worst seam <= max(exemplar's, 1.5),
 //! histogram L1 <= 0.1, gradient ratio >= 0.95, patch coherence <= the exemplar's toroidal one
 //! (no allowance). Returns true when all hold; `failed` lists the others.

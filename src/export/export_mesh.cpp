@@ -40,16 +40,60 @@ void append_float(std::string& out, float value) {
   out.append(buffer, result.ptr);
 }
 
-// Path of `target` relative to `base_dir` when one exists, else `target` as given (absolute).
-std::string relative_path(const std::string& target, const std::filesystem::path& base_dir) {
+namespace {
+
+// A file name a .mtl or .ply header can hold: whitespace splits a map_Kd in most readers and a
+// newline ends the line, so both become '_'.
+std::string portable_file_name(const std::string& name) {
+  std::string out = name;
+  for (char& c : out)
+    if (c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f') c = '_';
+  return out;
+}
+
+// Whether `path` is a regular file holding exactly `bytes`.
+bool holds_bytes(const std::filesystem::path& path, const std::string& bytes) {
   std::error_code error;
-  const std::filesystem::path absolute_target = std::filesystem::absolute(target, error);
-  if (error) return target;
-  const std::filesystem::path absolute_base = std::filesystem::absolute(base_dir.empty() ? "." : base_dir, error);
-  if (error) return absolute_target.string();
-  const std::filesystem::path relative =
-      absolute_target.lexically_normal().lexically_relative(absolute_base.lexically_normal());
-  return relative.empty() ? absolute_target.string() : relative.generic_string();
+  if (!std::filesystem::is_regular_file(path, error) || std::filesystem::file_size(path, error) != bytes.size() ||
+      error)
+    return false;
+  std::string existing;
+  return read_file(path.string(), existing).is_ok() && existing == bytes;
+}
+
+}  // namespace
+
+Status texture_name_beside(const std::string& texture_path, const std::string& bytes,
+                           const std::filesystem::path& out_dir, std::span<const std::string> taken, std::string& name,
+                           bool& copy) {
+  copy = false;
+  const std::filesystem::path source(texture_path);
+  const std::filesystem::path folder = out_dir.empty() ? std::filesystem::path(".") : out_dir;
+  const std::string wanted = portable_file_name(source.filename().string());
+  std::error_code error;
+  if (wanted == source.filename().string() && std::filesystem::equivalent(source, folder / wanted, error)) {
+    name = wanted;  // the texture already lies beside the output
+    return Status::ok();
+  }
+  const std::string stem = std::filesystem::path(wanted).stem().string();
+  const std::string extension = std::filesystem::path(wanted).extension().string();
+  constexpr int kMaxCandidates = 1000;
+  for (int k = 1; k <= kMaxCandidates; ++k) {
+    const std::string candidate = k == 1 ? wanted : stem + "-" + std::to_string(k) + extension;
+    const std::filesystem::path target = folder / candidate;
+    if (std::find(taken.begin(), taken.end(), candidate) != taken.end()) continue;
+    if (holds_bytes(target, bytes)) {  // the same picture: referenced, not written again
+      name = candidate;
+      return Status::ok();
+    }
+    if (std::filesystem::symlink_status(target, error).type() != std::filesystem::file_type::not_found) continue;
+    name = candidate;
+    copy = true;
+    return Status::ok();
+  }
+  return Status::error(ErrorCode::kIo, (folder / wanted).string(),
+                       "cannot place the texture beside the output: " + std::to_string(kMaxCandidates) +
+                           " files of that name already hold other pictures");
 }
 
 }  // namespace internal

@@ -1,7 +1,8 @@
 // Wavefront OBJ writer: `v` per source vertex (`v x y z r g b` when the mesh kept colours, COLOR_0) (so the reloaded
 // mesh keeps its connectivity), `vt` per split vertex (one per distinct (vertex, uv) pair, in texture repeats, t up),
 // `vn` per source vertex when normals are on, faces `f v/vt[/vn]` (1-based). With a texture, a <stem>.mtl next to the
-// .obj holds one material whose map_Kd is the texture path relative to the .obj's folder. Numbers are written with
+// .obj holds one material whose map_Kd is the texture's bare file name: the texture lies beside the .mtl (copied
+// there when it is elsewhere, texture_name_beside), so the output folder can be moved whole. Numbers are written with
 // std::to_chars (shortest text that reads back bit-exact).
 #include <filesystem>
 
@@ -20,17 +21,11 @@ Status write_obj(const std::string& path, const ExportData& data, const ExportOp
   const SplitMesh& split = data.split;
   const std::filesystem::path obj_path(path);
   const bool textured = !options.texture_path.empty();
-  std::string mtl_name;
-
+  const std::string mtl_name = obj_path.stem().string() + ".mtl";
+  std::string texture_bytes;
   if (textured) {
-    std::string bytes, mime_type;  // fail early on a missing or non-image texture
-    TAILOR_RETURN_IF_ERROR(read_texture_bytes(options.texture_path, bytes, mime_type));
-    mtl_name = obj_path.stem().string() + ".mtl";
-    std::string mtl = "# written by tailor\nnewmtl tailor\nKa 1 1 1\nKd 1 1 1\nKs 0 0 0\nd 1\nillum 1\nmap_Kd ";
-    mtl += relative_path(options.texture_path, obj_path.parent_path());
-    mtl += "\n";
-    const std::filesystem::path mtl_path = obj_path.parent_path() / mtl_name;
-    TAILOR_RETURN_IF_ERROR(write_file_atomic(mtl_path.string(), mtl));
+    std::string mime_type;  // fail early on a missing or non-image texture
+    TAILOR_RETURN_IF_ERROR(read_texture_bytes(options.texture_path, texture_bytes, mime_type));
   }
 
   // The text goes out in pieces of about kFlushBytes through one reused string: the file is never
@@ -108,6 +103,18 @@ Status write_obj(const std::string& path, const ExportData& data, const ExportOp
   }
   TAILOR_RETURN_IF_ERROR(file.write(out));
   if (!progress.reached(1.f)) return progress.cancelled();
+  if (textured) {  // after the .obj's text, before it lands: a failure leaves none of the three
+    std::string texture_name;
+    bool copy = false;
+    const std::string own_files[] = {obj_path.filename().string(), mtl_name};
+    const std::filesystem::path folder = obj_path.parent_path();
+    TAILOR_RETURN_IF_ERROR(
+        texture_name_beside(options.texture_path, texture_bytes, folder, own_files, texture_name, copy));
+    if (copy) TAILOR_RETURN_IF_ERROR(write_file_atomic((folder / texture_name).string(), texture_bytes));
+    std::string mtl = "# written by tailor\nnewmtl tailor\nKa 1 1 1\nKd 1 1 1\nKs 0 0 0\nd 1\nillum 1\nmap_Kd ";
+    mtl += texture_name + "\n";
+    TAILOR_RETURN_IF_ERROR(write_file_atomic((folder / mtl_name).string(), mtl));
+  }
   return file.commit();
 }
 

@@ -1,6 +1,7 @@
 // PLY writer: binary little endian, one vertex per split vertex with float x y z s t (texture
 // repeats, t up as in OBJ) and uchar red green blue alpha when the mesh kept colours (COLOR_0), faces as `list uchar
-// uint vertex_indices`. A `comment TextureFile` line names the texture the way MeshLab does. Vertices are split on UV,
+// uint vertex_indices`. A `comment TextureFile` line names the texture the way MeshLab does, by its bare file name
+// (texture_name_beside: copied beside the .ply when it lies elsewhere). Vertices are split on UV,
 // so the faces of different patches do not share vertices in the file; tailor's readers of split files weld identical
 // positions back when they need the connectivity (weld_identical_positions).
 #include <algorithm>
@@ -26,18 +27,20 @@ Status write_ply(const std::string& path, const ExportData& data, const ExportOp
   const SplitMesh& split = data.split;
   const size_t vertex_count = split.xref.size();
   const size_t face_count = split.indices.size() / 3;
+  std::string texture_bytes, texture_name;
+  bool copy_texture = false;
   if (!options.texture_path.empty()) {
-    std::string bytes, mime_type;  // fail on a missing or non-image texture like the other writers
-    TAILOR_RETURN_IF_ERROR(read_texture_bytes(options.texture_path, bytes, mime_type));
+    std::string mime_type;  // fail on a missing or non-image texture like the other writers
+    TAILOR_RETURN_IF_ERROR(read_texture_bytes(options.texture_path, texture_bytes, mime_type));
+    const std::string own_file[] = {std::filesystem::path(path).filename().string()};
+    // The name the header gives, decided now; the copy beside the .ply (if any) is written at the end.
+    TAILOR_RETURN_IF_ERROR(texture_name_beside(options.texture_path, texture_bytes,
+                                               std::filesystem::path(path).parent_path(), own_file, texture_name,
+                                               copy_texture));
   }
 
   std::string out = "ply\nformat binary_little_endian 1.0\ncomment written by tailor\n";
-  if (!options.texture_path.empty()) {
-    std::string name = relative_path(options.texture_path, std::filesystem::path(path).parent_path());
-    for (char& c : name)
-      if (c == '\n' || c == '\r') c = ' ';
-    out += "comment TextureFile " + name + "\n";
-  }
+  if (!texture_name.empty()) out += "comment TextureFile " + texture_name + "\n";
   out += "element vertex " + std::to_string(vertex_count) + "\n";
   out += "property float x\nproperty float y\nproperty float z\nproperty float s\nproperty float t\n";
   const CornerAttribute* colour = nullptr;  // per source vertex (export_mesh kept it)
@@ -79,6 +82,9 @@ Status write_ply(const std::string& path, const ExportData& data, const ExportOp
     if (!progress.wrote((end - begin) * 13)) return progress.cancelled();
   }
   if (!progress.reached(1.f)) return progress.cancelled();
+  if (copy_texture)  // before the .ply lands: a failure leaves neither
+    TAILOR_RETURN_IF_ERROR(
+        write_file_atomic((std::filesystem::path(path).parent_path() / texture_name).string(), texture_bytes));
   return file.commit();
 }
 

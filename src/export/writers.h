@@ -98,8 +98,17 @@ Status read_texture_bytes(const std::string& path, std::string& bytes, std::stri
 //! Appends the shortest decimal text that reads back as exactly `value` (std::to_chars).
 void append_float(std::string& out, float value);
 
-//! Path of `target` relative to the folder `base_dir` (generic separators), or absolute when none exists.
-std::string relative_path(const std::string& target, const std::filesystem::path& base_dir);
+//! The file name by which an output in the folder `out_dir` names the texture `texture_path` (its file's bytes:
+//! `bytes`): the .mtl's map_Kd, the .ply's TextureFile. The texture lies beside the output under that name, so the
+//! output folder can be moved or sent on its own. `name` is the texture's own name when the texture already lies
+//! there; else `copy` is set and the writer writes `bytes` to out_dir/name (write_file_atomic, staged with its other
+//! files) under the texture's name (whitespace made '_'). A file of that name beside the output holding the same
+//! bytes is used as it is; one holding anything else is never replaced (another output may name it): the copy
+//! takes the first of "<stem>-2<ext>", "<stem>-3<ext>"... that is free or holds the same bytes. Names in `taken`
+//! (the writer's own files) are skipped. Fails with kIo.
+Status texture_name_beside(const std::string& texture_path, const std::string& bytes,
+                           const std::filesystem::path& out_dir, std::span<const std::string> taken, std::string& name,
+                           bool& copy);
 
 //! The material every .glb gets (named "tailor", not metallic, fully rough) and its images: the
 //! base colour `base_color` (PNG/JPEG bytes of type mime_type, may be empty) and the maps of

@@ -1,4 +1,7 @@
 // The report of `tailor map` (tailor/report.h): the --stats JSON and the summary lines.
+#include <algorithm>
+#include <cmath>
+
 #include "report/report_text.h"
 #include "tailor/report.h"
 
@@ -12,6 +15,14 @@ void add_map_results(const Mesh& mesh, const LoadReport& load, const Topology& t
   run.load = load;
   run.vertices = mesh.vertex_count();
   run.faces = mesh.face_count();
+  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (size_t v = 0; v < mesh.vertex_count(); ++v)
+    for (size_t k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], mesh.positions[3 * v + k]);
+      hi[k] = std::max(hi[k], mesh.positions[3 * v + k]);
+    }
+  run.longest_side =
+      mesh.vertex_count() > 0 ? std::max({double{hi[0]} - lo[0], double{hi[1]} - lo[1], double{hi[2]} - lo[2]}) : 0.0;
   run.components = topology.vertex_components;
   run.boundary_edges = topology.boundary_edges;
   run.nonmanifold_edges = topology.nonmanifold_edges;
@@ -82,7 +93,8 @@ std::string map_report_json(const MapRun& run) {
                   {"chunks", stats.chunks},
                   {"chunk_cell_size", stats.chunk_cell_size},
                   {"texels_per_unit", stats.texels_per_unit},
-                  {"locality_radius", stats.locality_radius}};
+                  {"locality_radius", stats.locality_radius},
+                  {"repeats_across_mesh", map_repeats_across(run)}};  // the bounding box's longest side
   j["metrics"] = {{"patches", metrics.patches},
                   {"single_face_patches", metrics.single_face_patches},
                   {"stretch", metrics.stretch},
@@ -126,21 +138,41 @@ std::string map_report_json(const MapRun& run) {
   return internal::json_text(j);
 }
 
+double map_repeats_across(const MapRun& run) {
+  const double period = run.options.mapping.texture_period_px;
+  if (!(period > 0)) return 0.0;
+  double repeats = 0.0;
+  if (run.mapping.chunks > 0 && run.mapping.texels_per_unit > 0)  // one density per world unit for every chunk
+    repeats = run.longest_side * run.mapping.texels_per_unit / period;
+  else if (run.options.orientation.fixed_unit_scale > 0.f)
+    repeats = run.longest_side * run.options.orientation.fixed_unit_scale * run.options.mapping.scale / period;
+  else  // normalised into the unit cube: the scale spans the longest side
+    repeats = run.options.mapping.scale / period;
+  return std::isfinite(repeats) && repeats > 0 ? repeats : 0.0;
+}
+
 std::string map_summary(const MapRun& run) {
   const UvMetrics& m = run.metrics;
+  // The repeats across the mesh (and the texel density when it is per world unit): below one, part of
+  // the texture is never seen.
+  std::string repeats;
+  if (const double r = map_repeats_across(run); r > 0) {
+    repeats = format_text(r < 100 ? ", %.2f repeats across the mesh" : ", %.0f repeats across the mesh", r);
+    if (run.texels_per_unit > 0) repeats += format_text(" (%g texels per unit)", run.texels_per_unit);
+  }
   const std::string axis_choice =
       run.axis_auto ? "axis choice " + std::to_string(static_cast<long>(ms(run.axis_choice_seconds))) + ", " : "";
   std::string text = format_text(
-      "%s: %s, %s, seams %.2f%% of edge length, %zu flipped, stretch %.3f, L2 %.3f, "
+      "%s: %s, %s%s, seams %.2f%% of edge length, %zu flipped, stretch %.3f, L2 %.3f, "
       "Linf %.2f, median angle %.2f deg, visible seams %.2f%% (%.0f%% of seam length invisible%s, %zu dangling ends) | "
       "load %.1f ms, topology %.1f, "
       "%sorientation %.1f, mapping %.1f, export %.1f ms -> %s\n",
       run.input.c_str(), internal::counted(run.faces, "face", "faces").c_str(),
-      internal::counted(m.patches, "patch", "patches").c_str(), 100.0 * m.seam_length_ratio, m.flipped, m.stretch,
-      m.l2_stretch, m.linf_stretch, m.distortion_deg, 100.0 * m.visible_seam_ratio, 100.0 * m.seam_invisible_ratio,
-      run.options.metrics.symmetry == 4 ? " up to quarter turns" : "", m.visible_dangling_ends,
-      ms(run.load.load_seconds), ms(run.topology_seconds), axis_choice.c_str(), ms(run.orientation_seconds),
-      ms(run.mapping.seconds), ms(run.export_seconds), run.output.c_str());
+      internal::counted(m.patches, "patch", "patches").c_str(), repeats.c_str(), 100.0 * m.seam_length_ratio, m.flipped,
+      m.stretch, m.l2_stretch, m.linf_stretch, m.distortion_deg, 100.0 * m.visible_seam_ratio,
+      100.0 * m.seam_invisible_ratio, run.options.metrics.symmetry == 4 ? " up to quarter turns" : "",
+      m.visible_dangling_ends, ms(run.load.load_seconds), ms(run.topology_seconds), axis_choice.c_str(),
+      ms(run.orientation_seconds), ms(run.mapping.seconds), ms(run.export_seconds), run.output.c_str());
   if (run.mapping.chunks > 0)
     text += format_text(
         "chunks: %s of side %g world units, mapped at %g texels per unit; corners farther than %g units from "

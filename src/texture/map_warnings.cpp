@@ -1,19 +1,60 @@
-// map_warnings: the symmetry-4 checks `tailor map` and tailor.map make before mapping.
+// map_warnings: the checks `tailor map` and tailor.map make before mapping.
 #include "tailor/map_warnings.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 
 #include "tailor/tiling.h"
 
 namespace tailor {
 
+double map_repeats(const Mesh& mesh, const MapTextureOptions& options) {
+  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (size_t v = 0; v < mesh.vertex_count(); ++v)
+    for (size_t k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], mesh.positions[3 * v + k]);
+      hi[k] = std::max(hi[k], mesh.positions[3 * v + k]);
+    }
+  const double longest = std::max({double{hi[0]} - lo[0], double{hi[1]} - lo[1], double{hi[2]} - lo[2]});
+  // In the mapping's units: the unit cube, or the fixed normalisation's.
+  const double extent =
+      options.orientation.fixed_unit_scale > 0.f ? longest * options.orientation.fixed_unit_scale : 1.0;
+  return options.mapping.scale * extent / options.mapping.texture_period_px;
+}
+
 std::vector<std::string> map_warnings(const Mesh& mesh, const MapTextureOptions& options, const Image& texture,
                                       const std::string& texture_name) {
   std::vector<std::string> warnings;
   const MappingOptions& mapping = options.mapping;
-  if (mapping.symmetry != 4) return warnings;
+  // A texture whose wrap is a cut (eval-tile's wrap ratio above its target): every repeat shows it.
+  double wrap_x = 0.0, wrap_y = 0.0;
+  if (!texture.empty() && wrap_ratios(texture, wrap_x, wrap_y).is_ok() &&
+      (wrap_x > kWrapRatioSeamless || wrap_y > kWrapRatioSeamless)) {
+    const std::filesystem::path name(texture_name);
+    std::string tile = name.stem().string() + "_tile.png";
+    tile = name.has_parent_path() ? (name.parent_path() / tile).string() : tile;
+    char figures[160];
+    std::snprintf(figures, sizeof figures, " does not wrap (wrap ratio %.2f in x, %.2f in y; seamless is 0.8-1.2)",
+                  wrap_x, wrap_y);
+    warnings.push_back(texture_name + figures + ": every repeat shows a cut; make it tileable with 'tailor tile " +
+                       texture_name + " -o " + tile + "'");
+  }
+  // The texture repeats less than once across the mesh's longest side: part of the picture is
+  // never seen, and with symmetry 4 quarter-turn seams land on the lattice less often.
+  const double repeats = map_repeats(mesh, options);
+  if (mapping.symmetry != 4) {
+    if (std::isfinite(repeats) && repeats > 0.0 && repeats < 1.0) {
+      char line[320];
+      std::snprintf(line, sizeof line,
+                    "the %.0f px texture repeats %.2f times across the mesh: part of it is never seen (a larger "
+                    "--scale, or a smaller --tile-size, repeats it more)",
+                    static_cast<double>(mapping.texture_period_px), repeats);
+      warnings.emplace_back(line);
+    }
+    return warnings;
+  }
   // The map turns the tile about lattice points: a tile unchanged only about another point (or
   // none) shows its quarter-turn seams.
   if (!texture.empty()) {
@@ -32,17 +73,6 @@ std::vector<std::string> map_warnings(const Mesh& mesh, const MapTextureOptions&
   // Cones go to lattice points, so the 4-fold seams land on the lattice less often the fewer
   // lattice points the mesh spans (docs/mapping.md: 3.5 % visible seams at 0.8 repeats across the
   // mesh, 2.9 % at 1.6, 1.5 % at 16).
-  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  for (size_t v = 0; v < mesh.vertex_count(); ++v)
-    for (size_t k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], mesh.positions[3 * v + k]);
-      hi[k] = std::max(hi[k], mesh.positions[3 * v + k]);
-    }
-  const double longest = std::max({double{hi[0]} - lo[0], double{hi[1]} - lo[1], double{hi[2]} - lo[2]});
-  // In the mapping's units: the unit cube, or the fixed normalisation's.
-  const double extent =
-      options.orientation.fixed_unit_scale > 0.f ? longest * options.orientation.fixed_unit_scale : 1.0;
-  const double repeats = mapping.scale * extent / mapping.texture_period_px;
   if (std::isfinite(repeats) && repeats > 0.0 && repeats < 1.0) {
     char line[320];
     std::snprintf(line, sizeof line,

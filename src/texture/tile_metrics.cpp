@@ -408,6 +408,17 @@ double orientation_anisotropy(const Image& image) {
   return std::sqrt((jxx - jyy) * (jxx - jyy) + 4.0 * jxy * jxy) / trace;
 }
 
+Status wrap_ratios(const Image& tile, double& x, double& y) {
+  x = y = 0.0;
+  TAILOR_RETURN_IF_ERROR(check_image(tile));
+  if (tile.width < 8 || tile.height < 8)
+    return Status::error(ErrorCode::kInvalidImage, "", "image too small to evaluate (at least 8 px a side)");
+  const SeamStats s = seam_stats(view(tile));
+  x = s.wrap_x;
+  y = s.wrap_y;
+  return Status::ok();
+}
+
 Status tile_metrics(const Image& tile_in, const Image* exemplar_in, TileMetrics& metrics) {
   metrics = TileMetrics{};
   TAILOR_RETURN_IF_ERROR(check_image(tile_in));

@@ -181,7 +181,22 @@ def test_symmetry_4_warns_as_the_cli(tmp_path, tailor_binary):
         with pytest.raises(UserWarning, match="repeats 0.78 times"):
             tailor.map(mesh, symmetry=4, texture_size=1024)
         tailor.map(mesh, symmetry=4, relax_iterations=0)  # 512 px, 1.56 repeats, no texture: nothing to say
-        tailor.map(mesh, texture_size=1024, relax_iterations=0)  # symmetry 1: nothing to say
+        # Below one repeat in any mode: part of the texture is never seen.
+        with pytest.raises(UserWarning, match="the 1024 px texture repeats 0.78 times across the mesh: part of it"):
+            tailor.map(mesh, texture_size=1024, relax_iterations=0)
+
+
+def test_a_texture_that_does_not_wrap_warns_as_the_cli(tmp_path, tailor_binary):
+    mesh = tailor.load(SPOT)
+    # The gravel photo's wrap is a cut (eval-tile's wrap ratio 2.89 / 3.63): the warning names the figure and the fix.
+    with pytest.warns(UserWarning, match=r"gravel.png does not wrap \(wrap ratio 2.89 in x, 3.63 in y; .*'tailor tile "):
+        tailor.map(mesh, texture=GRAVEL, relax_iterations=0)
+    tile = tmp_path / "gravel_tile.png"
+    code, _, err = run_cli(tailor_binary, "tile", GRAVEL, "-o", tile, "-q")
+    assert code == 0, err
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        tailor.map(mesh, texture=tile, relax_iterations=0)  # a tile from tailor tile wraps: nothing to say
 
 
 def test_a_set_of_quarter_turn_tiles_is_mapped_with_symmetry_4(tmp_path, tailor_binary):
