@@ -162,6 +162,12 @@ TEST(ChunkedMapping, CancelsAndRefusesWhatNeedsTheWholeMesh) {
   MapTextureOptions skeleton = chunked(exponent_for(mesh, 2));
   skeleton.orientation.axis = AxisSource::kSkeleton;
   EXPECT_EQ(map_texture(mesh, topology, skeleton, map).code(), ErrorCode::kInvalidArgument);
+  // Automatic chunks map such a mesh whole instead.
+  skeleton.chunks.mode = ChunkMode::kAuto;
+  skeleton.chunks.min_faces = 1000;
+  ASSERT_TRUE(map_texture(mesh, topology, skeleton, map).is_ok());
+  EXPECT_EQ(map.stats.chunks, 0u);
+  EXPECT_EQ(map.atlas.corner_uv.size(), 6 * mesh.face_count());
 }
 
 // The faces of `result` as a mesh of their own (vertices renumbered, in another order than the

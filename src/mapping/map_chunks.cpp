@@ -8,10 +8,8 @@
 // reaches in.
 #include <algorithm>
 #include <atomic>
-#include <bit>
 #include <chrono>
 #include <cmath>
-#include <cstring>
 #include <mutex>
 #include <thread>
 #include <vector>

@@ -189,7 +189,9 @@ Status map_texture(const Mesh& mesh, const Topology& topology, const MapTextureO
   // === 0. Chunks: a large mesh is cut by the world-space chunk rule and every chunk runs steps
   //        1-5 on its own, in parallel (mapping/map_chunks.cpp, tailor/chunks.h) ===
   TAILOR_RETURN_IF_ERROR(check_chunk_options(options.chunks));
-  if (uses_chunks(options.chunks, mesh.face_count())) {
+  // The skeleton axis needs the whole mesh: auto maps it whole, `on` refuses it (map_chunks).
+  const bool whole_only = options.chunks.mode == ChunkMode::kAuto && options.orientation.axis == AxisSource::kSkeleton;
+  if (uses_chunks(options.chunks, mesh.face_count()) && !whole_only) {
     if (topology.opposite.size() != 3 * mesh.face_count())
       return Status::error(ErrorCode::kInvalidMesh, "", "topology does not match the mesh");
     TAILOR_RETURN_IF_ERROR(internal::map_chunks(mesh, options, map));
