@@ -187,21 +187,18 @@ Status map_texture(const Mesh& mesh, const Topology& topology, const MapTextureO
   map.stats = MappingStats{};
   map.metrics = UvMetrics{};
   // === 0. Chunks: a large mesh is cut by the world-space chunk rule and every chunk runs steps
-  //        1-5 on its own, in parallel (mapping/map_chunks.cpp, tailor/chunks.h) ===
+  //        1-4 on its own, in parallel (mapping/map_chunks.cpp, tailor/chunks.h); a smaller mesh
+  //        runs them on the whole mesh rebuilt in canonical order, so that the file's order of
+  //        faces, vertices and corners does not change a bit. The topology serves the metrics. ===
   TAILOR_RETURN_IF_ERROR(check_chunk_options(options.chunks));
-  // The skeleton axis needs the whole mesh: auto maps it whole, `on` refuses it (map_chunks).
-  const bool whole_only = options.chunks.mode == ChunkMode::kAuto && options.orientation.axis == AxisSource::kSkeleton;
-  if (uses_chunks(options.chunks, mesh.face_count()) && !whole_only) {
-    if (topology.opposite.size() != 3 * mesh.face_count())
-      return Status::error(ErrorCode::kInvalidMesh, "", "topology does not match the mesh");
-    TAILOR_RETURN_IF_ERROR(internal::map_chunks(mesh, options, map));
-    return measure_atlas(mesh, topology, options, map);
-  }
-  // Smaller meshes: steps 1-5 on the whole mesh rebuilt in canonical order, so that the file's
-  // order of faces, vertices and corners does not change a bit (mapping/map_chunks.cpp)
   if (topology.opposite.size() != 3 * mesh.face_count())
     return Status::error(ErrorCode::kInvalidMesh, "", "topology does not match the mesh");
-  TAILOR_RETURN_IF_ERROR(internal::map_whole_canonical(mesh, options, map));
+  // The skeleton axis needs the whole mesh: auto maps it whole, `on` refuses it (map_chunks).
+  const bool whole_only = options.chunks.mode == ChunkMode::kAuto && options.orientation.axis == AxisSource::kSkeleton;
+  const bool chunked = uses_chunks(options.chunks, mesh.face_count()) && !whole_only;
+  TAILOR_RETURN_IF_ERROR(chunked ? internal::map_chunks(mesh, options, map)
+                                 : internal::map_whole_canonical(mesh, options, map));
+  // === 5. Metrics of the result, on the mesh as given (metrics/uv_metrics.cpp) ===
   return measure_atlas(mesh, topology, options, map);
 }
 
