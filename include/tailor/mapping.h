@@ -191,6 +191,12 @@ struct MappingStats {
   uint64_t inverted_accepted = 0;      //!< kThesis: faces accepted with a non-positive UV area (always 0 in kPatches)
   double seconds = 0.0;                //!< wall time of the growth, seam shortening and crack closing (steps 2-4);
                                        //!< chunked: of the whole per-chunk pipeline (orientation included)
+  // Each stage's time, seconds: wall time when the mesh is mapped whole; in chunks, the sum over
+  // the chunks (thread time: on N busy threads about N times the wall time).
+  double orientation_seconds = 0.0;  //!< step 1, the orientation field
+  double growth_seconds = 0.0;       //!< steps 2-3, the growth (or the integer-grid map) and seam shortening
+  double closing_seconds = 0.0;      //!< step 4, the crack closing
+  double relaxing_seconds = 0.0;     //!< step 5, the relaxation
   // The chunked engine (tailor/chunks.h); chunks = 0 when the mesh was mapped whole.
   uint32_t chunks = 0;         //!< chunks mapped
   double chunk_cell_size = 0;  //!< the chunk grid's cell side, world units (a power of two)

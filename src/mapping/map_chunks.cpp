@@ -42,6 +42,10 @@ void add_stats(const MappingStats& s, MappingStats& total) {
   total.relax_moves += s.relax_moves;
   total.faces_seam += s.faces_seam;
   total.inverted_accepted += s.inverted_accepted;
+  total.orientation_seconds += s.orientation_seconds;
+  total.growth_seconds += s.growth_seconds;
+  total.closing_seconds += s.closing_seconds;
+  total.relaxing_seconds += s.relaxing_seconds;
 }
 
 }  // namespace

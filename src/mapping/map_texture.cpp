@@ -154,6 +154,10 @@ bool mapping_mode_from_name(std::string_view name, MappingMode& mode) {
 
 namespace {
 
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 // The progress of one named stage of options.stage_progress (empty when that is unset).
 ProgressCallback stage_progress(const StageProgressCallback& stage, const char* name) {
   return stage ? ProgressCallback([&stage, name](float done) { return stage(name, done); }) : ProgressCallback();
@@ -208,6 +212,7 @@ Status internal::map_texture_in_order(const Mesh& mesh, const Topology& topology
   map.stats = MappingStats{};
   map.metrics = UvMetrics{};
   // === 1. Orientation field: per-face frames, the field and its variation (surface/orientation.cpp) ===
+  const auto start = std::chrono::steady_clock::now();
   if (options.stage_progress) {
     OrientationOptions orientation = options.orientation;
     orientation.progress = both_progress(orientation.progress, stage_progress(options.stage_progress, "orientation"));
@@ -215,7 +220,10 @@ Status internal::map_texture_in_order(const Mesh& mesh, const Topology& topology
   } else {
     TAILOR_RETURN_IF_ERROR(compute_orientation(mesh, topology, options.orientation, map.frames));
   }
-  return internal::map_texture_frames(mesh, topology, options, map);
+  const double orientation_seconds = seconds_since(start);
+  TAILOR_RETURN_IF_ERROR(internal::map_texture_frames(mesh, topology, options, map));
+  map.stats.orientation_seconds = orientation_seconds;
+  return Status::ok();
 }
 
 Status internal::map_texture_frames(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options,
@@ -259,6 +267,7 @@ Status internal::map_texture_frames(const Mesh& mesh, const Topology& topology, 
   // === 2. Growth: the patch-discovery front (mapping/grow_patches.cpp), or the thesis's (thesis_mode.cpp);
   //        with symmetry 4 the integer-grid map instead (mapping/grid_map.cpp) ===
   std::vector<uint8_t> on_seam;  // per face: placed on a seam by the growth (where step 3 looks)
+  auto stage_start = start;
   Status status = grid     ? internal::map_grid(input, map.atlas, stats, on_seam)
                   : thesis ? internal::map_thesis(input, map.atlas, stats)
                            : internal::grow_patches(input, map.atlas, stats, on_seam);
@@ -267,19 +276,24 @@ Status internal::map_texture_frames(const Mesh& mesh, const Topology& topology, 
     stats.faces_reseamed = internal::shorten_seams(input, on_seam, map.atlas);
   if (status.is_ok() && stage && !stage("mapping", 1.f))  // the growth reports only every few thousand faces
     status = Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
+  stats.growth_seconds = seconds_since(stage_start);
   // === 4. Crack closing (mapping/close_cracks.cpp) ===
+  stage_start = std::chrono::steady_clock::now();
   if (status.is_ok() && close_cracks)
     status = internal::close_cracks(input, closing_progress, map.atlas, stats.cracks_closed);
+  stats.closing_seconds = seconds_since(stage_start);
   // === 5. Relaxation of the angle distortion (mapping/relax_patches.cpp) ===
+  stage_start = std::chrono::steady_clock::now();
   if (status.is_ok() && !thesis && mapping.relax_iterations > 0)
     status = internal::relax_patches(input, map.atlas, stats.relax_moves, stage_callback("relaxing"));
+  stats.relaxing_seconds = seconds_since(stage_start);
   if (!status.is_ok()) {
     clear_atlas(map.atlas);
     map.stats = MappingStats{};
     return status;
   }
   stats.patches = map.atlas.patch_count;
-  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  stats.seconds = seconds_since(start);
 
   // === 6. Metrics of the result (metrics/uv_metrics.cpp) ===
   return measure_atlas(mesh, topology, options, map);

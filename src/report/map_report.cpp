@@ -95,6 +95,11 @@ std::string map_report_json(const MapRun& run) {
                   {"texels_per_unit", stats.texels_per_unit},
                   {"locality_radius", stats.locality_radius},
                   {"repeats_across_mesh", map_repeats_across(run)}};  // the bounding box's longest side
+  // Each stage's time: wall time mapped whole, thread time summed over the chunks in chunks.
+  j["mapping"]["stage_ms"] = {{"orientation", ms(stats.orientation_seconds)},
+                              {"growth", ms(stats.growth_seconds)},
+                              {"closing", ms(stats.closing_seconds)},
+                              {"relaxing", ms(stats.relaxing_seconds)}};
   j["metrics"] = {{"patches", metrics.patches},
                   {"single_face_patches", metrics.single_face_patches},
                   {"stretch", metrics.stretch},
@@ -162,23 +167,27 @@ std::string map_summary(const MapRun& run) {
   }
   const std::string axis_choice =
       run.axis_auto ? "axis choice " + std::to_string(static_cast<long>(ms(run.axis_choice_seconds))) + ", " : "";
+  // In chunks every chunk orients itself inside the mapping's time (the chunks line has the stages).
+  const std::string orientation = run.mapping.chunks > 0 ? "orientation in the chunks"
+                                                         : format_text("orientation %.1f", ms(run.orientation_seconds));
   std::string text = format_text(
       "%s: %s, %s%s, seams %.2f%% of edge length, %zu flipped, stretch %.3f, L2 %.3f, "
       "Linf %.2f, median angle %.2f deg, visible seams %.2f%% (%.0f%% of seam length invisible%s, %zu dangling ends) | "
       "load %.1f ms, topology %.1f, "
-      "%sorientation %.1f, mapping %.1f, export %.1f ms -> %s\n",
+      "%s%s, mapping %.1f, export %.1f ms -> %s\n",
       run.input.c_str(), internal::counted(run.faces, "face", "faces").c_str(),
       internal::counted(m.patches, "patch", "patches").c_str(), repeats.c_str(), 100.0 * m.seam_length_ratio, m.flipped,
       m.stretch, m.l2_stretch, m.linf_stretch, m.distortion_deg, 100.0 * m.visible_seam_ratio,
       100.0 * m.seam_invisible_ratio, run.options.metrics.symmetry == 4 ? " up to quarter turns" : "",
       m.visible_dangling_ends, ms(run.load.load_seconds), ms(run.topology_seconds), axis_choice.c_str(),
-      ms(run.orientation_seconds), ms(run.mapping.seconds), ms(run.export_seconds), run.output.c_str());
+      orientation.c_str(), ms(run.mapping.seconds), ms(run.export_seconds), run.output.c_str());
   if (run.mapping.chunks > 0)
     text += format_text(
         "chunks: %s of side %g world units, mapped at %g texels per unit; corners farther than %g units from "
-        "an edit keep their UVs\n",
+        "an edit keep their UVs; thread time orientation %.1f, growth %.1f, closing %.1f, relaxing %.1f ms\n",
         internal::counted(run.mapping.chunks, "chunk", "chunks").c_str(), run.mapping.chunk_cell_size,
-        run.mapping.texels_per_unit, run.mapping.locality_radius);
+        run.mapping.texels_per_unit, run.mapping.locality_radius, ms(run.mapping.orientation_seconds),
+        ms(run.mapping.growth_seconds), ms(run.mapping.closing_seconds), ms(run.mapping.relaxing_seconds));
   if (run.stability) {
     const StabilityReport& s = *run.stability;
     text += format_text(
