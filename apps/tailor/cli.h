@@ -18,8 +18,9 @@
 namespace tailor::cli {
 
 inline constexpr int kExitOk = 0;
-inline constexpr int kExitBadInput = 1;  //!< unreadable or invalid input, I/O failure
-inline constexpr int kExitUsage = 2;     //!< bad command line
+inline constexpr int kExitBadInput = 1;       //!< unreadable or invalid input, I/O failure
+inline constexpr int kExitUsage = 2;          //!< bad command line
+inline constexpr int kExitTargetsMissed = 3;  //!< tailor tile: the tile is written but misses its quality targets
 
 //! Prints "tailor: error: <file>: <what> (<where>)" on stderr; returns the exit code for `status`.
 int report_error(const Status& status);

@@ -34,7 +34,28 @@ struct TileCliOptions {
   ImageLoadOptions image_options;  // --max-image-pixels (default: ImageLoadOptions')
   int variants = 1;
   bool quiet = false;
+  bool allow_misses = false;  // --allow-misses: a tile that misses its targets is a warning, exit 0
 };
+
+//! The verdict on the written tiles: each missed target on stderr, one line with its figure
+//! (missed_tile_targets), and the exit code: kExitTargetsMissed when a tile misses one, unless
+//! --allow-misses (then warnings, silenced by --quiet, and kExitOk).
+int judge_tiles(const std::vector<TileQuality>& tiles, const TileCliOptions& opt) {
+  bool missed = false;
+  for (const TileQuality& tile : tiles)
+    for (const std::string& target : missed_tile_targets(tile.metrics)) {
+      missed = true;
+      if (opt.allow_misses)
+        warn(opt.quiet, tile.file + ": misses a target: " + target);
+      else
+        std::fprintf(stderr, "tailor: error: %s: misses a target, written anyway (--allow-misses accepts it): %s\n",
+                     tile.file.c_str(), target.c_str());
+    }
+  return missed && !opt.allow_misses ? kExitTargetsMissed : kExitOk;
+}
+
+//! Whether the run measures its tiles: for the summary line, --json, or the verdict.
+bool measures(const TileCliOptions& opt) { return !opt.quiet || !opt.json.empty() || !opt.allow_misses; }
 
 bool ends_with_png(const std::string& path) {
   if (path.size() < 4) return false;
@@ -79,7 +100,7 @@ int run_tile16(const TileCliOptions& opt, const Image16& input) {
   if (opt.variants > 1) {
     if (Status s = internal::write_file_atomic(stem + ".json", tile_variants_json(run)); !s) return report_error(s);
   }
-  if (!opt.quiet || !opt.json.empty()) {
+  if (measures(opt)) {
     const Image input8 = to_image8(input);
     for (size_t k = 0; k < tiles.size(); ++k) {
       TileQuality& tile = run.tiles[k];
@@ -95,7 +116,7 @@ int run_tile16(const TileCliOptions& opt, const Image16& input) {
   }
   if (Status s = batch.commit(); !s) return report_error(s);
   if (!opt.quiet) std::fputs(tile_summary(run).c_str(), stdout);
-  return kExitOk;
+  return measures(opt) ? judge_tiles(run.tiles, opt) : kExitOk;
 }
 
 int run_tile(const TileCliOptions& opt) {
@@ -153,7 +174,7 @@ int run_tile(const TileCliOptions& opt) {
     if (Status s = internal::write_file_atomic(stem + ".json", tile_variants_json(run)); !s) return report_error(s);
   }
 
-  if (opt.quiet && opt.json.empty()) {
+  if (!measures(opt)) {
     if (Status s = batch.commit(); !s) return report_error(s);
     return kExitOk;
   }
@@ -170,7 +191,7 @@ int run_tile(const TileCliOptions& opt) {
   }
   if (Status s = batch.commit(); !s) return report_error(s);
   if (!opt.quiet) std::fputs(tile_summary(run).c_str(), stdout);
-  return kExitOk;
+  return judge_tiles(run.tiles, opt);
 }
 
 std::string base_name(const std::string& path) {
@@ -323,7 +344,7 @@ int run_tile_set(TileCliOptions opt) {
         run.tiles.push_back(q);
       }
     if (Status s = write_tile_set_record(outdir, record); !s) return s;
-    if (!opt.quiet || !opt.json.empty()) {
+    if (measures(opt)) {
       // Metrics of every output map against its input (8-bit reductions of 16-bit maps).
       bool all_met = true;
       std::string failed;
@@ -355,7 +376,7 @@ int run_tile_set(TileCliOptions opt) {
     return report_error(written);
   }
   if (!opt.quiet) std::fputs(tile_summary(run).c_str(), stdout);
-  return kExitOk;
+  return measures(opt) ? judge_tiles(run.tiles, opt) : kExitOk;
 }
 
 }  // namespace
@@ -402,7 +423,13 @@ void register_tile(CLI::App& app, Runner& run) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--json", opt->json, "Write the metrics and settings as JSON to this file");
   cmd->add_flag("-q,--quiet", opt->quiet, "Print nothing but errors");
+  cmd->add_flag("--allow-misses", opt->allow_misses,
+                "Accept a tile that misses its quality targets (those of 'tailor eval-tile'): exit 0 with a "
+                "warning per missed target. Without it each missed target is one error line on stderr with "
+                "its figure and the exit code is 3; the tile is written either way");
   cmd->footer(
+      "Exit codes: 0 done, 1 bad input or I/O error, 2 bad command line, 3 the tile is written but misses "
+      "a quality target (see --allow-misses).\n"
       "Examples:\n"
       "  tailor tile bricks.jpg -o bricks_tile.png\n"
       "  tailor tile bricks.jpg -o bricks.png --fit-period --variants 4   # bricks_0..3.png + bricks.json\n"

@@ -156,7 +156,8 @@ def make_tileable(kind, tool, image_path, out_png, symmetry=1):
     """Writes a self-tileable version of image_path to out_png (PNG); symmetry 4: also unchanged by a
     quarter turn (twice the image's side)."""
     if kind == "cli":
-        _run([tool, "tile", image_path, "-o", out_png, "-q", "--symmetry", str(symmetry)])
+        # --allow-misses: the add-on keeps the tile as the Python module's tile() does (no verdict).
+        _run([tool, "tile", image_path, "-o", out_png, "-q", "--allow-misses", "--symmetry", str(symmetry)])
         return None
     return tool.tile(image_path, symmetry=symmetry)  # (H, W, C) uint8: the caller makes a Blender image of it
 
@@ -166,7 +167,8 @@ def make_tileable_set(kind, tool, map_paths, normal_paths, out_folder, symmetry=
     under their own names (.png), as `tailor tile --set`; symmetry 4: one quarter-turn tile for all
     (twice the maps' side, normal maps turned with their content)."""
     if kind == "cli":
-        command = [tool, "tile", "--set", *map_paths, "-o", out_folder + os.sep, "-q", "--symmetry", str(symmetry)]
+        command = [tool, "tile", "--set", *map_paths, "-o", out_folder + os.sep, "-q", "--allow-misses",
+                   "--symmetry", str(symmetry)]
         for path in normal_paths:
             command += ["--normal-map", path]
         _run(command)

@@ -277,4 +277,10 @@ inline constexpr double kWrapRatioSeamless = 1.2;
 //! (no allowance). Returns true when all hold; `failed` lists the others.
 TAILOR_API bool meets_tile_targets(const TileMetrics& metrics, std::string* failed = nullptr);
 
+//! The targets of meets_tile_targets that `metrics` misses, one entry each with its figure and
+//! limit, e.g. "wrap ratio x 1.61 outside [0.8, 1.2]" or "worst seam 6.71 above 6.52 (the
+//! exemplar's 6.52, at least 1.5)"; empty when every target is met (what `tailor tile` prints on
+//! stderr, one line per entry).
+TAILOR_API std::vector<std::string> missed_tile_targets(const TileMetrics& metrics);
+
 }  // namespace tailor

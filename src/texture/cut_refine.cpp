@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <limits>
 #include <type_traits>
 #include <vector>
@@ -55,13 +57,54 @@ void CutRefiner::upsample(const std::vector<uint8_t>& reduced, std::vector<uint8
   }
 }
 
+void CutRefiner::choose_wrap(int plan_shift_x, int plan_shift_y) {
+  const int w = guide_.width, h = guide_.height, c = guide_.channels;
+  std::vector<double> cols(static_cast<size_t>(w), 0.0), rows(static_cast<size_t>(h), 0.0);
+  for (int y = 0; y < h; ++y) {
+    const uint8_t* row = &guide_.px[static_cast<size_t>(y) * w * c];
+    const uint8_t* up = y > 0 ? row - static_cast<size_t>(w) * c : nullptr;
+    int64_t across = 0;
+    for (int x = 0; x < w; ++x)
+      for (int k = 0; k < c; ++k) {
+        const int v = row[x * c + k];
+        if (x > 0) cols[static_cast<size_t>(x)] += std::abs(v - row[(x - 1) * c + k]);
+        if (up) across += std::abs(v - up[x * c + k]);
+      }
+    rows[static_cast<size_t>(y)] = static_cast<double>(across);
+  }
+  // The boundary (s - 1, s) nearest the median within `half` of `planned` (ties to the nearer).
+  auto pick = [](const std::vector<double>& diff, int size, int planned, int half) {
+    planned = Plane::mod(planned, size);
+    if (size < 3) return planned;
+    std::vector<double> interior(diff.begin() + 1, diff.end());
+    std::nth_element(interior.begin(), interior.begin() + static_cast<std::ptrdiff_t>(interior.size() / 2),
+                     interior.end());
+    const double median = std::max(interior[interior.size() / 2], 1e-9);
+    int best = planned;
+    double best_score = std::numeric_limits<double>::max();
+    for (int d = 0; d <= half; ++d)
+      for (int s : {planned - d, planned + d}) {
+        if (s < 1 || s >= size) continue;
+        const double score = std::abs(std::log(std::max(diff[static_cast<size_t>(s)], 1e-9) / median));
+        if (score < best_score - 1e-12) {
+          best_score = score;
+          best = s;
+        }
+      }
+    return best;
+  };
+  shift_x_ = pick(cols, w, map_x(plan_shift_x), std::max(0, (w / plan_w_) / 2));
+  shift_y_ = pick(rows, h, map_y(plan_shift_y), std::max(0, (h / plan_h_) / 2));
+}
+
 void CutRefiner::replay(const TilePlan& plan, size_t s, const std::vector<int32_t>* base, int radius) {
   const int w = guide_.width, h = guide_.height;
   const SessionRecord& session = plan.sessions[s];
   if (base) {
     source_ = *base;
   } else {
-    const int sx = Plane::mod(map_x(plan.shift_x), w), sy = Plane::mod(map_y(plan.shift_y), h);
+    const int sx = shift_x_ >= 0 ? shift_x_ : Plane::mod(map_x(plan.shift_x), w);
+    const int sy = shift_y_ >= 0 ? shift_y_ : Plane::mod(map_y(plan.shift_y), h);
     source_.resize(static_cast<size_t>(w) * h);
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x)

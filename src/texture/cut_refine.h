@@ -49,8 +49,21 @@ class CutRefiner {
   int map_x(int v) const { return scale(v, guide_.width, plan_w_); }
   int map_y(int v) const { return scale(v, guide_.height, plan_h_); }
 
-  //! Replays session `s` of `plan` (base tile: the canvas starts as the shifted exemplar; a
-  //! variant: as `base`, the base tile's source map). radius: the refinement search (px).
+  //! Chooses the full-size wrap of the base tile (its columns start at the guide's column
+  //! shift_x(), its rows at shift_y()). One boundary of the plan stands for about W / w boundaries
+  //! of the guide, which differ at full size (a JPEG's 8 x 8 block grid, which the exact scale 8 of
+  //! a 4096 px photo hits every time; fine lines): of the guide's column boundaries (x - 1, x)
+  //! within half a plan pixel of the planned one, the one whose mean absolute difference is
+  //! closest (in log ratio) to the median over all columns, as choose_shift picks the planned one;
+  //! rows likewise. Every candidate lies inside the plan's repaired zone, whose blocks are
+  //! replayed over it. O(N). Without a call, replay uses the planned boundary scaled.
+  void choose_wrap(int plan_shift_x, int plan_shift_y);
+  int shift_x() const { return shift_x_; }
+  int shift_y() const { return shift_y_; }
+
+  //! Replays session `s` of `plan` (base tile: the canvas starts as the guide shifted by
+  //! (shift_x(), shift_y()); a variant: as `base`, the base tile's source map). radius: the
+  //! refinement search (px).
   void replay(const TilePlan& plan, size_t s, const std::vector<int32_t>* base, int radius);
 
   //! Exemplar pixel index (y * W + x) shown by each tile pixel.
@@ -67,6 +80,7 @@ class CutRefiner {
 
   Guide guide_;
   int plan_w_, plan_h_;
+  int shift_x_ = -1, shift_y_ = -1;  // the base tile's wrap (choose_wrap), -1: the plan's scaled
   std::vector<int> cell_x_, cell_y_;
   std::vector<int32_t> source_;
   std::vector<uint8_t> known_, locked_, take_new_;

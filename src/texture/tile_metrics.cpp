@@ -14,7 +14,9 @@
 // exemplar patch took 40 s and 1.1 GB).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "tailor/image_ops.h"
@@ -488,26 +490,57 @@ double fast_target_misses(const Image& tile, const Image& exemplar) {
 
 }  // namespace internal
 
-bool meets_tile_targets(const TileMetrics& m, std::string* failed) {
-  std::string out;
-  auto check = [&](bool ok, const char* what) {
-    if (!ok) out += (out.empty() ? "" : ", ") + std::string(what);
+namespace {
+
+//! Every target of meets_tile_targets in one place: `check(ok, label, figure)` is called once per
+//! target, with the label meets_tile_targets lists and the same with the measured figure.
+template <typename Check>
+void each_tile_target(const TileMetrics& m, Check check) {
+  auto fixed = [](double v, int digits) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.*f", digits, v);
+    return std::string(text);
   };
-  check(m.wrap_ratio_x >= 0.8 && m.wrap_ratio_x <= 1.2, "wrap ratio x outside [0.8, 1.2]");
-  check(m.wrap_ratio_y >= 0.8 && m.wrap_ratio_y <= 1.2, "wrap ratio y outside [0.8, 1.2]");
+  check(m.wrap_ratio_x >= 0.8 && m.wrap_ratio_x <= 1.2, "wrap ratio x outside [0.8, 1.2]",
+        "wrap ratio x " + fixed(m.wrap_ratio_x, 2) + " outside [0.8, 1.2]");
+  check(m.wrap_ratio_y >= 0.8 && m.wrap_ratio_y <= 1.2, "wrap ratio y outside [0.8, 1.2]",
+        "wrap ratio y " + fixed(m.wrap_ratio_y, 2) + " outside [0.8, 1.2]");
   if (m.has_exemplar) {
-    check(m.worst_seam_ratio <= std::max(m.exemplar_worst_seam_ratio, 1.5),
-          "worst seam above the exemplar's (and 1.5)");
-    check(m.histogram_l1 <= 0.1, "histogram L1 above 0.1");
-    check(m.gradient_ratio >= 0.95, "gradient ratio below 0.95");
+    const double seam = std::max(m.exemplar_worst_seam_ratio, 1.5);
+    check(m.worst_seam_ratio <= seam, "worst seam above the exemplar's (and 1.5)",
+          "worst seam " + fixed(m.worst_seam_ratio, 3) + " above " + fixed(seam, 3) + " (the exemplar's " +
+              fixed(m.exemplar_worst_seam_ratio, 3) + ", at least 1.5)");
+    check(m.histogram_l1 <= 0.1, "histogram L1 above 0.1", "histogram L1 " + fixed(m.histogram_l1, 3) + " above 0.1");
+    check(m.gradient_ratio >= 0.95, "gradient ratio below 0.95",
+          "gradient ratio " + fixed(m.gradient_ratio, 3) + " below 0.95");
     // No allowance: the estimator is deterministic (constant seed), and it can only overestimate
     // the tile's figure (patches not copied verbatim are matched approximately).
-    check(m.patch_coherence <= m.exemplar_patch_coherence, "patch coherence worse than the exemplar's");
+    check(m.patch_coherence <= m.exemplar_patch_coherence, "patch coherence worse than the exemplar's",
+          "patch coherence " + fixed(m.patch_coherence, 4) + " above the exemplar's " +
+              fixed(m.exemplar_patch_coherence, 4));
   } else {
-    check(m.worst_seam_ratio <= 1.5, "worst seam above 1.5");
+    check(m.worst_seam_ratio <= 1.5, "worst seam above 1.5",
+          "worst seam " + fixed(m.worst_seam_ratio, 3) + " above 1.5");
   }
+}
+
+}  // namespace
+
+bool meets_tile_targets(const TileMetrics& m, std::string* failed) {
+  std::string out;
+  each_tile_target(m, [&](bool ok, const char* what, const std::string&) {
+    if (!ok) out += (out.empty() ? "" : ", ") + std::string(what);
+  });
   if (failed) *failed = out;
   return out.empty();
+}
+
+std::vector<std::string> missed_tile_targets(const TileMetrics& m) {
+  std::vector<std::string> out;
+  each_tile_target(m, [&](bool ok, const char*, const std::string& figure) {
+    if (!ok) out.push_back(figure);
+  });
+  return out;
 }
 
 }  // namespace tailor

@@ -155,6 +155,7 @@ Status plan_and_replay(Image& guide, bool all_channels, const TileOptions& optio
   // only to within a reduced pixel shows as a straight step (bark resampled to 4096 px: worst seam
   // 1.96 with 1 px, 1.65 with 2, 1.54 with 4 against the photo's 1.56; gradient ratio 1.007).
   out.feather = std::max(1, static_cast<int>(std::lround(out.scale / 2.0)));
+  refiner.choose_wrap(plan.shift_x, plan.shift_y);
   out.sources.clear();
   for (size_t s = 0; s < plan.sessions.size(); ++s) {
     refiner.replay(plan, s, s == 0 ? nullptr : &out.sources[0], radius);
@@ -171,8 +172,8 @@ Status plan_and_replay(Image& guide, bool all_channels, const TileOptions& optio
   rep.block = refiner.map_x(rep.block);
   rep.overlap = refiner.map_x(rep.overlap);
   rep.border = bx;
-  rep.shift_x = refiner.map_x(rep.shift_x) % guide.width;
-  rep.shift_y = refiner.map_y(rep.shift_y) % guide.height;
+  rep.shift_x = refiner.shift_x();
+  rep.shift_y = refiner.shift_y();
   if (out.period_message != 0) rep.warnings.push_back(period_message(out.period_message == 1, rep));
   if (out.scale > 1.0)
     rep.warnings.push_back("planned on a " + std::to_string(rw) + "x" + std::to_string(rh) +

@@ -125,7 +125,9 @@ def test_tile_set_writes_the_maps_as_the_cli_does(tmp_path, tailor_binary):
     sand, bark = textures + "vistex-sand05-128.png", textures + "vistex-bark11-128.png"
     written = tailor.tile_set([sand, bark], tmp_path / "py", normal_maps=[bark])
     assert [os.path.basename(p) for p in written] == ["vistex-sand05-128.png", "vistex-bark11-128.png"]
-    code, _, err = run_cli(tailor_binary, "tile", "--set", sand, bark, "--normal-map", bark, "-o", tmp_path / "cli", "-q")
+    # --allow-misses: bark read as a normal map is renormalised, so its tile misses the histogram target.
+    code, _, err = run_cli(tailor_binary, "tile", "--set", sand, bark, "--normal-map", bark, "-o", tmp_path / "cli", "-q",
+                           "--allow-misses")
     assert code == 0, err
     for name in ("vistex-sand05-128.png", "vistex-bark11-128.png", "material.json"):
         assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes(), name
@@ -137,7 +139,7 @@ def test_tile_set_writes_the_maps_as_the_cli_does(tmp_path, tailor_binary):
     # With symmetry 4: one quarter-turn tile for both, the command's bytes; the tiles twice the side.
     tailor.tile_set([sand, bark], tmp_path / "py4", normal_maps=[bark], symmetry=4)
     code, _, err = run_cli(tailor_binary, "tile", "--set", sand, bark, "--normal-map", bark, "-o", tmp_path / "cli4",
-                           "-q", "--symmetry", "4")
+                           "-q", "--allow-misses", "--symmetry", "4")
     assert code == 0, err
     for name in ("vistex-sand05-128.png", "vistex-bark11-128.png", "material.json"):
         assert (tmp_path / "py4" / name).read_bytes() == (tmp_path / "cli4" / name).read_bytes(), name
