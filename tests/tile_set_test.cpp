@@ -182,7 +182,7 @@ TEST(TileSet, SixteenBitMapsStaySixteenBit) {
   ASSERT_TRUE(load_image16(dir + "/t16.png", tiled).is_ok());
   EXPECT_EQ(tiled.bits, 16);
   EXPECT_EQ(tiled.width, 512);
-  // The quarter-turn tile of a 16-bit PNG (refused until the thirteenth session): 16-bit, twice
+  // The quarter-turn tile of a 16-bit PNG: 16-bit, twice
   // the side, exactly unchanged by a quarter turn, the low bytes kept.
   ASSERT_EQ(test::run_command(std::string(TAILOR_BINARY) + " tile " + dir + "/h16.png -o " + dir +
                                   "/q16.png --symmetry 4 -q --allow-misses",

@@ -52,7 +52,7 @@ constexpr float kRobustScale = 0.5f;
 // 3.22 / 1.77 -> 3.27 / 1.80 % of edge length, the horse in 0.98x / 0.59x the time. Looser settles
 // are faster and worse (1.5 %: 3.32 / 1.82 %, 2 %: 3.36 / 1.90 %), tighter ones with more sweeps
 // better and slower (0.2 % and 60 sweeps a round: 2.89 / 1.62 % for 2.6x the time): the figures
-// follow the relaxation's convergence (docs/mapping.md section 7, tenth session).
+// follow the relaxation's convergence (docs/mapping.md section 7).
 constexpr float kSettledShare = 0.01f;
 // ... or less than this many pixels (a twentieth of a texel), whichever is larger: finer moves do
 // not show in the texture, and on meshes whose faces are a pixel or less wide (horse_x16 at scale
