@@ -560,6 +560,72 @@ TEST_F(ExportTest, MappedMeshExportsUpright) {
   expect_valid_gltf(path("fandisk.glb"));
 }
 
+// A map's figures are those of the file it is written to: the UVs the writers store are the bits
+// uv_repeats_from_px gives (a 300 px texture, where pixels / 300 and back is not exact), and
+// compute_stored_uv_metrics of the map equals it of the file read back, .glb and .obj alike. The
+// .obj's .mtl gives the texture's size and a 4-fold map's record (load_mesh); without it, none.
+TEST_F(ExportTest, StoredMetricsOfAMapAreThoseOfItsFile) {
+  Mesh spot;
+  ASSERT_TRUE(load_mesh(kSpot, spot).is_ok());
+  const std::string texture = std::string(TAILOR_TEST_DATA) + "/textures/water-caustics-300.jpg";
+  const float size = 300;
+  Atlas atlas;
+  atlas.corner_uv = repeats_to_px(spot.corner_uvs, size * 1.37f);  // pixels that are no round repeats
+  std::vector<uint32_t> patch;
+  atlas.patch_count = derive_patches(spot, build_topology(spot), atlas.corner_uv, patch);
+  atlas.patch = patch;
+  std::vector<float> stored;
+  uv_repeats_from_px(atlas.corner_uv, size, size, stored);
+  MetricsOptions metrics_options{size, size};
+  metrics_options.symmetry = 4;
+  UvMetrics of_map;
+  ASSERT_TRUE(compute_stored_uv_metrics(spot, nullptr, stored, metrics_options, of_map).is_ok());
+  size_t inexact = 0;  // pixels -> repeats -> pixels changes some bits here: the reason to measure `stored`
+  for (size_t i = 0; i < stored.size(); ++i) inexact += stored[i] * size != atlas.corner_uv[i];
+  EXPECT_GT(inexact, 0u);
+
+  ExportOptions options;
+  options.texture_path = texture;
+  options.texture_width = options.texture_height = 300;
+  options.symmetry = 4;
+  for (const char* name : {"spot.glb", "spot.obj"}) {
+    SCOPED_TRACE(name);
+    const std::string out = path(name);
+    ASSERT_TRUE(export_mesh(out, spot, atlas, options).is_ok());
+    Mesh back;
+    LoadReport report;
+    const bool glb = std::string(name).ends_with(".glb");
+    const Status s = glb ? read_glb_file(out, back, nullptr, &report) : load_mesh(out, back, &report);
+    ASSERT_TRUE(s.is_ok()) << s.message();
+    EXPECT_EQ(report.texture_width, 300);
+    EXPECT_EQ(report.texture_height, 300);
+    EXPECT_EQ(report.texture_symmetry, 4u);
+    EXPECT_EQ(report.texture_file, !glb);
+    UvMetrics of_file;
+    if (!glb) {  // the .obj keeps the corner order: the stored UVs bit for bit
+      ASSERT_EQ(back.corner_uvs.size(), stored.size());
+      EXPECT_EQ(std::memcmp(back.corner_uvs.data(), stored.data(), 4 * stored.size()), 0);
+    }
+    ASSERT_TRUE(compute_stored_uv_metrics(back, nullptr, back.corner_uvs, metrics_options, of_file).is_ok());
+    EXPECT_EQ(of_file.patches, of_map.patches);
+    EXPECT_EQ(of_file.seam_edges, of_map.seam_edges);
+    EXPECT_EQ(of_file.flipped, of_map.flipped);
+    EXPECT_EQ(of_file.seam_length_ratio, of_map.seam_length_ratio);
+    EXPECT_EQ(of_file.seam_gap_px, of_map.seam_gap_px);
+    EXPECT_EQ(of_file.seam_invisible_ratio, of_map.seam_invisible_ratio);
+    EXPECT_EQ(of_file.visible_seam_ratio, of_map.visible_seam_ratio);
+    EXPECT_EQ(of_file.visible_dangling_ends, of_map.visible_dangling_ends);
+    EXPECT_EQ(of_file.visible_branch_points, of_map.visible_branch_points);
+  }
+  // Without its .mtl the .obj still loads, with no texture size and no record.
+  fs::remove(path("spot.mtl"));
+  Mesh back;
+  LoadReport report;
+  ASSERT_TRUE(load_mesh(path("spot.obj"), back, &report).is_ok());
+  EXPECT_EQ(report.texture_width, 0);
+  EXPECT_EQ(report.texture_symmetry, 1u);
+}
+
 TEST_F(ExportTest, OutputIsDeterministic) {
   ExportOptions options;
   options.texture_path = kTexture;
@@ -671,15 +737,16 @@ TEST_F(ExportTest, EvalCommandReportsMetrics) {
   // Patch q is offset by 100 q px: across the seams gaps are k*100 px modulo 128, never 0 here.
   EXPECT_GT(j["seam_gap_px"].get<double>(), 1.0);
 
-  // OBJ: UVs in repeats times --texture-size.
-  ASSERT_EQ(run_command(std::string(TAILOR_BINARY) + " eval --json --texture-size 128 " + path("cube.obj"), out), 0)
-      << out;
+  // OBJ: UVs in repeats times the size of the texture its .mtl names, or --texture-size.
+  ASSERT_EQ(run_command(std::string(TAILOR_BINARY) + " eval --json " + path("cube.obj"), out), 0) << out;
   nlohmann::json k = nlohmann::json::parse(out);
   EXPECT_EQ(k["patches"], 6);
-  EXPECT_NEAR(k["seam_gap_px"].get<double>(), j["seam_gap_px"].get<double>(), 1e-3);
-  ASSERT_EQ(run_command(std::string(TAILOR_BINARY) + " eval " + path("cube.obj"), out), 0) << out;
+  EXPECT_EQ(k["texture_width"], 128);
+  EXPECT_EQ(k["texture_size_from"], "texture file");
+  EXPECT_EQ(k["seam_gap_px"].get<double>(), j["seam_gap_px"].get<double>());
+  ASSERT_EQ(run_command(std::string(TAILOR_BINARY) + " eval --texture-size 512 " + path("cube.obj"), out), 0) << out;
   EXPECT_NE(out.find("12 faces, 6 patches"), std::string::npos) << out;
-  EXPECT_NE(out.find("512x512"), std::string::npos) << out;
+  EXPECT_NE(out.find("512x512 px, option"), std::string::npos) << out;
 
   // PLY (split vertices): eval welds them, so the 12 seams come back.
   ASSERT_TRUE(export_mesh(path("cube.ply"), cube_, cube_atlas_, options).is_ok());

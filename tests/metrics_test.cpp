@@ -5,9 +5,12 @@
 
 #include <cmath>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include "support/fixtures.h"
+#include "tailor/export.h"
+#include "tailor/io.h"
 #include "tailor/topology.h"
 
 namespace tailor {
@@ -347,6 +350,52 @@ TEST(Metrics, DerivesPatchesOfAMeshCutInTwo) {
   EXPECT_EQ(m.seam_edges, 2u);  // the cut x = 2 crosses two cells
   // 1000 px = 1000 - 2*512 = -24 px on the torus.
   EXPECT_NEAR(m.seam_gap_px, 24.0, 1e-6);
+}
+
+// compute_stored_uv_metrics measures UVs in repeats as a file holds them: on spot's own atlas the
+// figures of compute_uv_metrics in pixels with derived patches; on spot split along its UV seams
+// (vertices at identical positions, as a .glb or .ply stores it) the same figures again, the split
+// vertices joined, where compute_uv_metrics of the split mesh sees boundaries and no seam.
+TEST(Metrics, StoredMetricsJoinIdenticalPositionsAndDerivePatches) {
+  Mesh spot;
+  ASSERT_TRUE(load_mesh(std::string(TAILOR_TEST_DATA) + "/meshes/spot.obj", spot).is_ok());
+  const float size = 256;  // a power of two: repeats times the size are exact pixels
+  std::vector<float> px(spot.corner_uvs.size());
+  for (size_t i = 0; i < px.size(); ++i) px[i] = spot.corner_uvs[i] * size;
+  const MetricsOptions options{size, size};
+  const UvMetrics reference = metrics_of(spot, px, {}, options);
+  ASSERT_GT(reference.seam_edges, 0u);
+  ASSERT_GT(reference.patches, 1u);
+
+  UvMetrics stored;
+  StoredSurface surface;
+  const Topology topology = build_topology(spot);
+  ASSERT_TRUE(compute_stored_uv_metrics(spot, &topology, spot.corner_uvs, options, stored, &surface).is_ok());
+  EXPECT_EQ(surface.welded_vertices, 0u);
+  EXPECT_EQ(surface.boundary_edges, topology.boundary_edges);
+  EXPECT_EQ(stored.patches, reference.patches);
+  EXPECT_EQ(stored.seam_edges, reference.seam_edges);
+  EXPECT_EQ(stored.seam_gap_px, reference.seam_gap_px);
+  EXPECT_EQ(stored.visible_dangling_ends, reference.visible_dangling_ends);
+  EXPECT_EQ(stored.stretch, reference.stretch);
+
+  SplitMesh split;
+  split_vertices(spot, spot.corner_uvs, split);
+  Mesh split_mesh;
+  split_mesh.positions = split.positions;
+  split_mesh.indices = split.indices;
+  ASSERT_GT(split_mesh.vertex_count(), spot.vertex_count());
+  EXPECT_EQ(metrics_of(split_mesh, px, {}, options).seam_edges, 0u);  // every seam became a boundary
+  UvMetrics joined;
+  ASSERT_TRUE(compute_stored_uv_metrics(split_mesh, nullptr, spot.corner_uvs, options, joined, &surface).is_ok());
+  EXPECT_EQ(surface.welded_vertices, split_mesh.vertex_count() - spot.vertex_count());
+  EXPECT_EQ(surface.boundary_edges, topology.boundary_edges);
+  EXPECT_EQ(joined.patches, reference.patches);
+  EXPECT_EQ(joined.seam_edges, reference.seam_edges);
+  EXPECT_EQ(joined.seam_length_ratio, reference.seam_length_ratio);
+  EXPECT_EQ(joined.seam_invisible_ratio, reference.seam_invisible_ratio);
+  EXPECT_EQ(joined.visible_dangling_ends, reference.visible_dangling_ends);
+  EXPECT_EQ(joined.visible_branch_points, reference.visible_branch_points);
 }
 
 TEST(Metrics, DegenerateFacesAreSkippedWithoutNaN) {

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "cli.h"
 #include "map_shared.h"
@@ -27,7 +28,7 @@ struct EvalOptions {
   bool stability = false;
   std::string seed_point;
   uint32_t symmetry = MetricsOptions{}.symmetry;
-  bool symmetry_given = false;  // else a .glb's record of a 4-fold map (LoadReport::texture_symmetry) decides
+  bool symmetry_given = false;  // else the file's record of a 4-fold map (LoadReport::texture_symmetry) decides
   StabilityOptions stability_options;
   std::string chunks = "auto", chunk_cell = "auto";  // --chunks, --chunk-cell: the mapping --stability runs
 };
@@ -74,9 +75,6 @@ int run_eval(const EvalOptions& opt) {
     return report_error(
         Status::error(ErrorCode::kInvalidMesh, opt.input,
                       "mesh has no texture coordinates to evaluate (OBJ vt, PLY s/t or glTF TEXCOORD_0)"));
-  // glb readers weld split vertices themselves; PLY files written after splitting need it here
-  // so that seams are edges between faces again (corner UVs are unaffected).
-  const size_t welded = glb ? 0 : weld_identical_positions(mesh);
 
   int width = static_cast<int>(MetricsOptions{}.texture_width_px);
   int height = static_cast<int>(MetricsOptions{}.texture_height_px);
@@ -89,24 +87,22 @@ int run_eval(const EvalOptions& opt) {
     height = report.texture_height;
     size_source = report.texture_file ? "texture file" : "embedded texture";
   }
-  // A 4-fold map says so in its .glb (tailor map --symmetry 4): measured as the map was.
-  const uint32_t symmetry = glb && !opt.symmetry_given ? report.texture_symmetry : opt.symmetry;
+  // A 4-fold map says so in its .glb's material or its .obj's .mtl (tailor map --symmetry 4):
+  // measured as the map was.
+  const uint32_t symmetry = opt.symmetry_given ? opt.symmetry : report.texture_symmetry;
   if (symmetry == 4 && width != height)
     return report_error(Status::error(
         ErrorCode::kInvalidArgument, "",
         "--symmetry 4 needs a square texture, got " + std::to_string(width) + "x" + std::to_string(height)));
 
-  // Texture repeats -> pixels.
-  std::vector<float> uv_px(mesh.corner_uvs.size());
-  for (size_t c = 0; c < uv_px.size() / 2; ++c) {
-    uv_px[2 * c] = mesh.corner_uvs[2 * c] * static_cast<float>(width);
-    uv_px[2 * c + 1] = mesh.corner_uvs[2 * c + 1] * static_cast<float>(height);
-  }
-  const Topology topology = build_topology(mesh);
+  // The figures of the file as `tailor map` reports them for the file it writes: UVs in repeats
+  // scaled to pixels, vertices at identical positions joined, patches as the UVs join faces.
   UvMetrics m;
   MetricsOptions options{static_cast<float>(width), static_cast<float>(height)};
   options.symmetry = symmetry;
-  const Status metrics_status = compute_uv_metrics(mesh, topology, uv_px, {}, options, m);
+  StoredSurface surface;
+  const Status metrics_status =
+      compute_stored_uv_metrics(mesh, nullptr, std::move(mesh.corner_uvs), options, m, &surface);
   if (!metrics_status) return report_error(metrics_status.with_file(opt.input));
   const double seconds = seconds_since(start);
 
@@ -120,14 +116,14 @@ int run_eval(const EvalOptions& opt) {
   run.file = opt.input;
   run.format = report.format;
   run.vertices = mesh.vertex_count();
-  run.welded_vertices = glb ? report.welded_vertices : welded;
+  run.welded_vertices = report.welded_vertices + surface.welded_vertices;
   run.texture_width = width;
   run.texture_height = height;
   run.texture_size_from = size_source;
   run.symmetry = symmetry;
   run.metrics = m;
-  run.boundary_edges = topology.boundary_edges;
-  run.nonmanifold_edges = topology.nonmanifold_edges;
+  run.boundary_edges = surface.boundary_edges;
+  run.nonmanifold_edges = surface.nonmanifold_edges;
   run.seconds = seconds;
   std::fputs((opt.json ? eval_report_json(run) : eval_summary(run)).c_str(), stdout);
   return kExitOk;
@@ -141,10 +137,12 @@ void register_eval(CLI::App& app, Runner& run) {
   cmd->add_option("mesh", opt->input,
                   "UV-mapped mesh: .obj (vt), .ply (s,t) or .glb (TEXCOORD_0); any mesh with --stability")
       ->required();
-  cmd->add_option("--texture-size", opt->texture_size,
-                  "Texture size in pixels (UVs are in repeats; this gives pixels). Default: a .glb or .gltf's "
-                  "texture's size, read from its header (embedded or a file next to it), else " +
-                      std::to_string(static_cast<int>(MetricsOptions{}.texture_width_px)))
+  cmd->add_option(
+         "--texture-size", opt->texture_size,
+         "Texture size in pixels (UVs are in repeats; this gives pixels). Default: the size of the texture the "
+         "file names, read from its header (a .glb or .gltf's base colour texture, embedded or a file next "
+         "to it; an .obj's map_Kd in its .mtl), else " +
+             std::to_string(static_cast<int>(MetricsOptions{}.texture_width_px)))
       ->check(CLI::Range(1, 1 << 16));
   add_symmetry_option(cmd, option_doc(kMetricsOptionDocs, "symmetry"), opt->symmetry);
   cmd->add_flag("--json", opt->json, "Print the full report as a JSON object");
@@ -168,7 +166,8 @@ void register_eval(CLI::App& app, Runner& run) {
       "(coefficient of variation of UV/3D area ratio, 0 ideal), L2/Linf stretch (Sander 2001, 1 ideal),\n"
       "median angle distortion, seam gap (px, modulo the texture) and share of invisible seams.\n"
       "Example:\n  tailor eval bunny.glb\n  tailor eval spot.obj --texture-size 1024 --json\n"
-      "  tailor eval bunny_grid.obj --symmetry 4   (a map made with tailor map --symmetry 4; a .glb says so itself)\n"
+      "  tailor eval bunny_grid.obj --symmetry 4   (a map made with tailor map --symmetry 4; its .glb or .mtl says so "
+      "itself)\n"
       "  tailor eval bunny.ply --stability --seed-point 0,0.1,0\n"
       "  tailor eval scan.ply --stability --remove-fraction 0.01 --chunks on\n");
   cmd->callback([&run, opt, cmd] {

@@ -85,7 +85,8 @@ struct ExportOptions {
   MaterialTextures material;  //!< .glb: normal, metallic-roughness and occlusion maps (kInvalidArgument otherwise)
   uint32_t symmetry = 1;      //!< .glb: 4 records in the material ("extras": {"tailor": {"symmetry": 4}}) that
                               //!< the map is 4-fold (MappingOptions::symmetry), so that eval, render and the
-                              //!< viewer count quarter-turn seams as invisible without being told
+                              //!< viewer count quarter-turn seams as invisible without being told; .obj with a
+                              //!< texture: a `# tailor symmetry 4` line in its .mtl (for eval)
   ProgressCallback progress;  //!< optional: the vertex split, then the bytes written (every few MB) or the
                               //!< codec's steps; false cancels (kCancelled, nothing written)
 };

@@ -227,7 +227,8 @@ struct TextureMap {
   FaceFrames frames;   //!< step 1: per-face frames and the orientation field (frames.seconds: its time)
   Atlas atlas;         //!< steps 2-4: per-corner UVs in pixels and patch ids
   MappingStats stats;  //!< steps 2-4: what they did (stats.seconds: their time)
-  UvMetrics metrics;   //!< step 5: quality of the atlas (metrics.seconds: its time)
+  UvMetrics metrics;   //!< step 5: quality of the atlas as a file holds it (compute_stored_uv_metrics: UVs in
+                       //!< repeats, patches as the UVs join faces, not atlas.patch; metrics.seconds: its time)
 };
 
 //! Maps the texture, as `tailor map` does: 0. from options.chunks.min_faces faces on (kAuto), the
@@ -238,7 +239,8 @@ struct TextureMap {
 //! 1. the orientation field (compute_orientation),
 //! 2. the growth (patches mode: the patch-discovery front; thesis mode: the reference algorithm),
 //! 3. seam shortening, 4. crack closing and relaxation (patches mode, each unless switched off),
-//! 5. the metrics of the result (compute_uv_metrics, unless options.measure is false). With
+//! 5. the metrics of the result as an exported file holds it (compute_stored_uv_metrics, unless
+//! options.measure is false: `tailor eval` of the file reports the same figures). With
 //! mapping.symmetry 4 the integer-grid map (experimental) takes the place of step 2.
 //! Fills map.atlas: corner_uv (#F*3 by 2, pixels), patch (#F) and patch_count; every face is
 //! placed and every UV is finite. Precondition: topology = build_topology(mesh).
@@ -248,7 +250,7 @@ struct TextureMap {
 //! or 4, symmetry 4 outside the patches mode, with texture_period_px < 1 or with faces narrower
 //! on average than 2^-18 of the period at this scale: floats modulo the period), kInvalidMesh
 //! when the topology does not match the mesh, kCancelled when the progress callback returns false
-//! (the atlas is then empty), and as compute_uv_metrics does.
+//! (the atlas is then empty), and as compute_stored_uv_metrics does.
 //! Cost: the orientation and the metrics O(F); the growth O(F log front) time; the crack closing
 //! O(F) plus, per crack vertex tried, a relaxation of O(crack_rings^2) faces (in practice 3-10x
 //! the growth; vertices of valence > 64 are not zipped, so a huge fan cannot make it quadratic);

@@ -83,13 +83,14 @@ struct LoadReport {
   size_t skipped_primitives = 0;     //!< glTF: point and line primitives of those instances, not read
   std::string not_kept;              //!< what the file has that the output will not (", "-separated), e.g.
                                      //!< "material textures, TANGENT"; empty when nothing is lost
-  int texture_width = 0;             //!< glTF (read_glb_file): the base colour texture's size, read from its
-  int texture_height = 0;            //!< header without decoding it, any size: embedded, or given by a URI (a
-                                     //!< data: URI, a file next to the .gltf); 0: none, or no header read
-  bool texture_file = false;         //!< glTF: that texture is a file next to the .gltf (only its header read)
-  uint32_t texture_symmetry = 1;     //!< glb: 4 where that texture's material (without a texture, the first
-                                     //!< primitive's) says the map is 4-fold (written by tailor map
-                                     //!< --symmetry 4: ExportOptions::symmetry), else 1
+  int texture_width = 0;             //!< the base colour texture's size, read from its header without decoding
+  int texture_height = 0;            //!< it, any size. glTF (read_glb_file): embedded, or given by a URI (a
+                                     //!< data: URI, a file next to the .gltf); OBJ (load_mesh of a path): the
+                                     //!< first map_Kd of the .mtl its mtllib names. 0: none, or no header read
+  bool texture_file = false;         //!< that texture is a file next to the .gltf or .mtl (only its header read)
+  uint32_t texture_symmetry = 1;     //!< 4 where the file says the map is 4-fold (written by tailor map
+                                     //!< --symmetry 4: ExportOptions::symmetry): glb: that texture's material
+                                     //!< (without a texture, the first primitive's); OBJ: its .mtl; else 1
   double load_seconds = 0.0;
 };
 

@@ -81,6 +81,35 @@ TAILOR_API Status compute_uv_metrics(const Mesh& mesh, const Topology& topology,
                                      std::span<const uint32_t> patch, const MetricsOptions& options,
                                      UvMetrics& metrics);
 
+//! Pixel UVs -> texture repeats as files store them (OBJ vt, PLY s/t, glTF TEXCOORD_0): each u times
+//! 1.0 / width and v times 1.0 / height in double, cast to float, -0 written as +0: the same bits
+//! export_mesh writes. uv_px: #F*3 by 2 (any count of pairs); uv_repeats gets as many. O(F).
+TAILOR_API void uv_repeats_from_px(std::span<const float> uv_px, double width, double height,
+                                   std::vector<float>& uv_repeats);
+
+//! What compute_stored_uv_metrics measured the surface as.
+struct StoredSurface {
+  size_t welded_vertices = 0;    //!< vertices joined to others at bit-identical positions
+  size_t boundary_edges = 0;     //!< of the (joined) surface: edges used by one face
+  size_t nonmanifold_edges = 0;  //!< of the (joined) surface: edges used by three or more faces
+};
+
+//! The metrics of a UV map as a file holds it: what `tailor eval` reports for a file, and what
+//! `tailor map` (map_texture) reports for the map it writes, so the two agree bit for bit.
+//! - corner_uv: #F*3 by 2, in texture repeats as stored (uv_repeats_from_px of a map's pixels),
+//!   taken by value and turned into pixels in place (u * options.texture_width_px, a float product,
+//!   as a reader scales a file's repeats): move a vector in to save the copy.
+//! - vertices at bit-identical positions count as one (weld_identical_positions, on a copy): readers
+//!   of split files (.glb, .ply) join them, so a seam is an edge between two faces again;
+//! - patches are derived from the UVs (derive_patches): a file holds no patch ids.
+//! topology: build_topology(mesh), or null to build it here (it is built for the joined copy anyway).
+//! surface (optional) gets the joined vertices and the edge counts of the surface measured.
+//! Fails as compute_uv_metrics does. Cost: O(F) time; O(V) for the check of identical positions,
+//! plus O(F) (a topology, a copy of the indices) when some are found or no topology is given.
+TAILOR_API Status compute_stored_uv_metrics(const Mesh& mesh, const Topology* topology, std::vector<float> corner_uv,
+                                            const MetricsOptions& options, UvMetrics& metrics,
+                                            StoredSurface* surface = nullptr);
+
 //! Lattice gap of a seam edge, in pixels: with the edge's ends a and b seen from its two faces f
 //! and g (uv_fa, uv_fb, uv_ga, uv_gb: 2 floats each, pixels), d_a = uv_f(a) - uv_g(a) and
 //! d_b = uv_f(b) - uv_g(b); k = the texture period (width, height) times round((d_a + d_b) / 2 /

@@ -2,7 +2,8 @@
 // mesh keeps its connectivity), `vt` per split vertex (one per distinct (vertex, uv) pair, in texture repeats, t up),
 // `vn` per source vertex when normals are on, faces `f v/vt[/vn]` (1-based). With a texture, a <stem>.mtl next to the
 // .obj holds one material whose map_Kd is the texture's bare file name: the texture lies beside the .mtl (copied
-// there when it is elsewhere, texture_name_beside), so the output folder can be moved whole. Numbers are written with
+// there when it is elsewhere, texture_name_beside), so the output folder can be moved whole; a 4-fold map
+// (ExportOptions::symmetry 4) adds the comment line `# tailor symmetry 4` to it. Numbers are written with
 // std::to_chars (shortest text that reads back bit-exact).
 #include <filesystem>
 
@@ -113,6 +114,7 @@ Status write_obj(const std::string& path, const ExportData& data, const ExportOp
     if (copy) TAILOR_RETURN_IF_ERROR(write_file_atomic((folder / texture_name).string(), texture_bytes));
     std::string mtl = "# written by tailor\nnewmtl tailor\nKa 1 1 1\nKd 1 1 1\nKs 0 0 0\nd 1\nillum 1\nmap_Kd ";
     mtl += texture_name + "\n";
+    if (options.symmetry == 4) mtl += "# tailor symmetry 4\n";  // a 4-fold map (LoadReport::texture_symmetry)
     TAILOR_RETURN_IF_ERROR(write_file_atomic((folder / mtl_name).string(), mtl));
   }
   return file.commit();

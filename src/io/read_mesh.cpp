@@ -3,10 +3,13 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <climits>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <new>
+#include <string>
 #include <string_view>
 #include <thread>
 #include <utility>
@@ -175,6 +178,69 @@ MeshFormat mesh_format_from_path(const std::string& path) {
 
 namespace {
 
+// Up to max_bytes of a file's start; false when it cannot be opened.
+bool read_file_start(const std::filesystem::path& path, size_t max_bytes, std::string& out) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return false;
+  out.resize(max_bytes);
+  in.read(out.data(), static_cast<std::streamsize>(max_bytes));
+  out.resize(static_cast<size_t>(in.gcount()));
+  return true;
+}
+
+std::string_view trimmed(std::string_view text) {
+  const size_t b = text.find_first_not_of(" \t\r");
+  if (b == std::string_view::npos) return {};
+  return text.substr(b, text.find_last_not_of(" \t\r") + 1 - b);
+}
+
+// An .obj's texture, as its .mtl names it (the first map_Kd: the file name after any options, a
+// file next to the .mtl), into report.texture_width/height (from the image's header, never
+// decoded) and texture_file; a `# tailor symmetry 4` line (tailor map --symmetry 4) into
+// report.texture_symmetry. Anything missing or unreadable leaves them as they are: the .obj itself
+// loaded, and a .mtl is optional.
+void read_obj_material(const std::filesystem::path& folder, const std::string& library, LoadReport& report) {
+  std::string mtl;
+  std::filesystem::path mtl_path = folder / library;
+  if (!read_file_start(mtl_path, size_t{1} << 20, mtl)) {
+    // `mtllib a.mtl b.mtl`: several names; the first.
+    const size_t blank = library.find_first_of(" \t");
+    if (blank == std::string::npos) return;
+    mtl_path = folder / library.substr(0, blank);
+    if (!read_file_start(mtl_path, size_t{1} << 20, mtl)) return;
+  }
+  std::string texture;
+  uint32_t symmetry = 1;
+  std::string_view rest = mtl;
+  while (!rest.empty()) {
+    const size_t end = rest.find('\n');
+    const std::string_view line = trimmed(rest.substr(0, end));
+    rest = end == std::string_view::npos ? std::string_view{} : rest.substr(end + 1);
+    if (line == "# tailor symmetry 4") symmetry = 4;
+    if (!texture.empty() || (line.substr(0, 7) != "map_Kd " && line.substr(0, 7) != "map_Kd\t")) continue;
+    const std::string_view name = trimmed(line.substr(7));
+    // The name, unless options (-s 1 1 1, -clamp on, ...) come first: then its last word.
+    const size_t last_blank = name.find_last_of(" \t");
+    texture =
+        std::string(name.front() == '-' && last_blank != std::string_view::npos ? name.substr(last_blank + 1) : name);
+  }
+  report.texture_symmetry = symmetry;
+  if (texture.empty()) return;
+  const std::filesystem::path image = mtl_path.parent_path() / texture;
+  std::string head;
+  long width = 0, height = 0;
+  for (const size_t max_bytes : {size_t{64} << 10, size_t{16} << 20}) {  // a JPEG's frame header may lie far in
+    if (!read_file_start(image, max_bytes, head)) return;
+    if (internal::image_header_size({reinterpret_cast<const unsigned char*>(head.data()), head.size()}, width, height))
+      break;
+    if (head.size() < max_bytes) return;
+  }
+  if (width <= 0 || height <= 0 || width > INT_MAX || height > INT_MAX) return;
+  report.texture_width = static_cast<int>(width);
+  report.texture_height = static_cast<int>(height);
+  report.texture_file = true;
+}
+
 // read_mesh with the folder where a .gltf's buffer files are (empty: none is opened).
 Status read_mesh_in(std::span<const char> data, MeshFormat format, const std::string& name, const std::string& base_dir,
                     Mesh& mesh, LoadReport* report, const ProgressCallback* callback = nullptr) {
@@ -186,11 +252,12 @@ Status read_mesh_in(std::span<const char> data, MeshFormat format, const std::st
   if (format == MeshFormat::kUnknown) format = sniff_format(data);
   Status s;
   internal::ReadProgress progress(callback, data.size());
+  std::string material_library;  // OBJ: its mtllib (the texture's size is read from it)
   // The parsers never throw by design; only an allocation of a (checked, but large) size can.
   try {
     switch (format) {
       case MeshFormat::kPly: s = internal::read_ply(data, name, mesh, r, &progress); break;
-      case MeshFormat::kObj: s = internal::read_obj(data, name, mesh, r, &progress); break;
+      case MeshFormat::kObj: s = internal::read_obj(data, name, mesh, r, &progress, &material_library); break;
       case MeshFormat::kOff: s = internal::read_off(data, name, mesh, r, &progress); break;
       case MeshFormat::kStl: s = internal::read_stl(data, name, mesh, r, &progress); break;
       case MeshFormat::kGlb:
@@ -201,6 +268,7 @@ Status read_mesh_in(std::span<const char> data, MeshFormat format, const std::st
     }
     if (s.is_ok() && !progress.repairs(0.f)) s = progress.cancelled(name);
     if (s.is_ok()) s = finalize_mesh(name, mesh, r);
+    if (s.is_ok() && !base_dir.empty() && !material_library.empty()) read_obj_material(base_dir, material_library, r);
     if (s.is_ok() && !progress.repairs(1.f)) s = progress.cancelled(name);
   } catch (const std::bad_alloc&) {
     s = Status::error(ErrorCode::kLimit, name, "not enough memory to load the mesh");

@@ -2,7 +2,8 @@
 // indices relative to the current counts), polygons fan-triangulated, `\r\n` line ends, `#`
 // comments, backslash line continuation. Vertex colours (`v x y z r g b`) and normals (`vn`, when
 // every corner names one) are kept as COLOR_0 and NORMAL corner attributes. `o`, `g`, `s`,
-// `usemtl`, `mtllib`, `l`, `p` and any other statement are ignored; no .mtl file is ever opened.
+// `usemtl`, `l`, `p` and any other statement are ignored; the first `mtllib`'s file name is handed
+// back (load_mesh reads that .mtl's texture size, read_mesh.cpp).
 //
 // Hand-written instead of tinyobjloader (which Debian ships): tinyobjloader reports bad indices as
 // warnings without line numbers (or silently clamps them), stores per-shape index structs that we
@@ -47,7 +48,8 @@ bool resolve(int64_t raw, size_t count, uint64_t& out) {
 }  // namespace
 
 Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,
-                ReadProgress* progress) {
+                ReadProgress* progress, std::string* material_library) {
+  if (material_library) material_library->clear();
   report.format = "OBJ";
   TextScanner s(data.data(), data.data() + data.size());
   s.set_hash_comments(true);
@@ -160,8 +162,15 @@ Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh,
       }
       if (mesh.indices.size() / 3 > kMaxFaces)
         return Status::error(ErrorCode::kLimit, name, "too many faces", s.where());
+    } else if (w == "mtllib" && material_library && material_library->empty()) {
+      s.skip_blanks();  // the file name: the rest of the line (names may hold blanks)
+      const char* b = s.pos();
+      const char* e = b;
+      while (e < s.end() && *e != '\n' && *e != '#') ++e;
+      while (e > b && (e[-1] == ' ' || e[-1] == '\t' || e[-1] == '\r')) --e;
+      material_library->assign(b, static_cast<size_t>(e - b));
     }
-    // Every other statement (vn, o, g, s, usemtl, mtllib, l, p, unknown ones) is skipped.
+    // Every other statement (vn, o, g, s, usemtl, l, p, unknown ones) is skipped.
     s.next_line();
   }
 

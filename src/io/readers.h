@@ -53,8 +53,10 @@ class ReadProgress {
 //! primitive, in faces).
 Status read_ply(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,
                 ReadProgress* progress = nullptr);
+//! OBJ: material_library (optional) gets the first `mtllib` statement's file name (the rest of its
+//! line, blanks trimmed), empty when there is none.
 Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,
-                ReadProgress* progress = nullptr);
+                ReadProgress* progress = nullptr, std::string* material_library = nullptr);
 Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,
                 ReadProgress* progress = nullptr);
 Status read_stl(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,

@@ -12,6 +12,8 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <utility>
+#include <vector>
 
 #include "mapping/chunk_mesh.h"
 #include "mapping/face_stretch.h"
@@ -178,8 +180,11 @@ Status measure_atlas(const Mesh& mesh, const Topology& topology, const MapTextur
   if (!options.measure) return Status::ok();
   const StageProgressCallback& stage = options.stage_progress;
   if (stage && !stage("metrics", 0.f)) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
-  TAILOR_RETURN_IF_ERROR(
-      compute_uv_metrics(mesh, topology, map.atlas.corner_uv, map.atlas.patch, options.metrics, map.metrics));
+  // Measured as a file holds the map (`tailor eval` of it reports the same figures): the UVs in
+  // texture repeats as the writers store them, patches as the UVs join faces.
+  std::vector<float> stored;
+  uv_repeats_from_px(map.atlas.corner_uv, options.metrics.texture_width_px, options.metrics.texture_height_px, stored);
+  TAILOR_RETURN_IF_ERROR(compute_stored_uv_metrics(mesh, &topology, std::move(stored), options.metrics, map.metrics));
   if (stage && !stage("metrics", 1.f)) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
   return Status::ok();
 }

@@ -7,11 +7,13 @@
 //   - P. V. Sander, J. Snyder, S. J. Gortler, H. Hoppe, "Texture Mapping Progressive Meshes",
 //     SIGGRAPH 2001 (L2 and Linf stretch of the map from texture to surface).
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <numbers>
 #include <string>
 
+#include "tailor/export.h"
 #include "tailor/metrics.h"
 #include "util/huge_pages.h"
 #include "util/parallel_chunks.h"
@@ -508,6 +510,80 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
   }
   metrics.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return Status::ok();
+}
+
+namespace {
+
+// True when two vertices have bit-identical positions (-0 and +0 alike), the vertices
+// weld_identical_positions would join. One open-addressing pass, 4 bytes per table slot.
+bool has_identical_positions(const Mesh& mesh) {
+  const size_t nv = mesh.vertex_count();
+  size_t table_size = 16;
+  while (table_size < 2 * nv) table_size *= 2;
+  const size_t mask = table_size - 1;
+  std::vector<uint32_t> table(table_size, kInvalid);
+  auto bits = [](float x) { return std::bit_cast<uint32_t>(x + 0.0f); };
+  for (size_t v = 0; v < nv; ++v) {
+    const float* p = &mesh.positions[3 * v];
+    const uint32_t x = bits(p[0]), y = bits(p[1]), z = bits(p[2]);
+    uint64_t h = ((uint64_t{x} << 32) | y) * 0x9e3779b97f4a7c15ULL;
+    h = (h ^ (h >> 29) ^ z) * 0xbf58476d1ce4e5b9ULL;
+    size_t slot = static_cast<size_t>(h ^ (h >> 32)) & mask;
+    for (; table[slot] != kInvalid; slot = (slot + 1) & mask) {
+      const float* q = &mesh.positions[3 * size_t{table[slot]}];
+      if (bits(q[0]) == x && bits(q[1]) == y && bits(q[2]) == z) return true;
+    }
+    table[slot] = static_cast<uint32_t>(v);
+  }
+  return false;
+}
+
+}  // namespace
+
+void uv_repeats_from_px(std::span<const float> uv_px, double width, double height, std::vector<float>& uv_repeats) {
+  const double su = 1.0 / width, sv = 1.0 / height;
+  uv_repeats.resize(uv_px.size());
+  for (size_t i = 0; i + 1 < uv_px.size(); i += 2) {
+    uv_repeats[i] = static_cast<float>(uv_px[i] * su) + 0.0f;
+    uv_repeats[i + 1] = static_cast<float>(uv_px[i + 1] * sv) + 0.0f;
+  }
+}
+
+Status compute_stored_uv_metrics(const Mesh& mesh, const Topology* topology, std::vector<float> corner_uv,
+                                 const MetricsOptions& options, UvMetrics& metrics, StoredSurface* surface) {
+  metrics = UvMetrics{};
+  if (surface) *surface = StoredSurface{};
+  if (corner_uv.size() != 6 * mesh.face_count())
+    return Status::error(
+        ErrorCode::kInvalidArgument, "", "corner UVs do not match the mesh",
+        std::to_string(corner_uv.size()) + " floats for " + std::to_string(mesh.face_count()) + " faces");
+  // Repeats -> pixels in place (the float product, as a reader of the file scales them).
+  const float width = options.texture_width_px, height = options.texture_height_px;
+  for (size_t i = 0; i < corner_uv.size(); i += 2) {
+    corner_uv[i] *= width;
+    corner_uv[i + 1] *= height;
+  }
+  // The surface a reader of a split file (.glb, .ply) sees: vertices at bit-identical positions joined.
+  Mesh welded;
+  const Mesh* measured = &mesh;
+  if (has_identical_positions(mesh)) {
+    welded.positions = mesh.positions;
+    welded.indices = mesh.indices;
+    const size_t joined = weld_identical_positions(welded);
+    if (surface) surface->welded_vertices = joined;
+    measured = &welded;
+    topology = nullptr;
+  }
+  Topology built;
+  if (!topology || topology->opposite.size() != 3 * measured->face_count()) {
+    built = build_topology(*measured);
+    topology = &built;
+  }
+  if (surface) {
+    surface->boundary_edges = topology->boundary_edges;
+    surface->nonmanifold_edges = topology->nonmanifold_edges;
+  }
+  return compute_uv_metrics(*measured, *topology, corner_uv, {}, options, metrics);
 }
 
 }  // namespace tailor
