@@ -19,6 +19,7 @@
 #include "mapping/face_stretch.h"
 #include "mapping/grid_map.h"
 #include "mapping/mapping_common.h"
+#include "metrics/stored_metrics.h"
 #include "tailor/mapping.h"
 
 namespace tailor {
@@ -182,9 +183,17 @@ Status measure_atlas(const Mesh& mesh, const Topology& topology, const MapTextur
   if (stage && !stage("metrics", 0.f)) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
   // Measured as a file holds the map (`tailor eval` of it reports the same figures): the UVs in
   // texture repeats as the writers store them, patches as the UVs join faces.
-  std::vector<float> stored;
-  uv_repeats_from_px(map.atlas.corner_uv, options.metrics.texture_width_px, options.metrics.texture_height_px, stored);
-  TAILOR_RETURN_IF_ERROR(compute_stored_uv_metrics(mesh, &topology, std::move(stored), options.metrics, map.metrics));
+  // For a power-of-two texture the stored repeats scale back to the atlas's own pixels: it is
+  // measured as it is (a copy of the UVs is 24 bytes per face at the mapping's peak).
+  const float width = options.metrics.texture_width_px, height = options.metrics.texture_height_px;
+  if (internal::stored_round_trip_exact(map.atlas.corner_uv, width, height)) {
+    TAILOR_RETURN_IF_ERROR(internal::compute_stored_uv_metrics_px(mesh, &topology, map.atlas.corner_uv, options.metrics,
+                                                                  map.metrics, nullptr));
+  } else {
+    std::vector<float> stored;
+    uv_repeats_from_px(map.atlas.corner_uv, width, height, stored);
+    TAILOR_RETURN_IF_ERROR(compute_stored_uv_metrics(mesh, &topology, std::move(stored), options.metrics, map.metrics));
+  }
   if (stage && !stage("metrics", 1.f)) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
   return Status::ok();
 }

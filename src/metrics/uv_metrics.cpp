@@ -13,6 +13,7 @@
 #include <numbers>
 #include <string>
 
+#include "metrics/stored_metrics.h"
 #include "tailor/export.h"
 #include "tailor/metrics.h"
 #include "util/huge_pages.h"
@@ -551,18 +552,36 @@ void uv_repeats_from_px(std::span<const float> uv_px, double width, double heigh
 
 Status compute_stored_uv_metrics(const Mesh& mesh, const Topology* topology, std::vector<float> corner_uv,
                                  const MetricsOptions& options, UvMetrics& metrics, StoredSurface* surface) {
-  metrics = UvMetrics{};
-  if (surface) *surface = StoredSurface{};
-  if (corner_uv.size() != 6 * mesh.face_count())
-    return Status::error(
-        ErrorCode::kInvalidArgument, "", "corner UVs do not match the mesh",
-        std::to_string(corner_uv.size()) + " floats for " + std::to_string(mesh.face_count()) + " faces");
   // Repeats -> pixels in place (the float product, as a reader of the file scales them).
   const float width = options.texture_width_px, height = options.texture_height_px;
   for (size_t i = 0; i < corner_uv.size(); i += 2) {
     corner_uv[i] *= width;
     corner_uv[i + 1] *= height;
   }
+  return internal::compute_stored_uv_metrics_px(mesh, topology, corner_uv, options, metrics, surface);
+}
+
+bool internal::stored_round_trip_exact(std::span<const float> uv_px, float width, float height) {
+  const double su = 1.0 / width, sv = 1.0 / height;
+  bool exact = true;
+  for (size_t i = 0; i + 1 < uv_px.size(); i += 2) {
+    const float u = (static_cast<float>(uv_px[i] * su) + 0.0f) * width;
+    const float v = (static_cast<float>(uv_px[i + 1] * sv) + 0.0f) * height;
+    exact &= std::bit_cast<uint32_t>(u) == std::bit_cast<uint32_t>(uv_px[i]) &&
+             std::bit_cast<uint32_t>(v) == std::bit_cast<uint32_t>(uv_px[i + 1]);
+  }
+  return exact;
+}
+
+Status internal::compute_stored_uv_metrics_px(const Mesh& mesh, const Topology* topology,
+                                              std::span<const float> corner_uv, const MetricsOptions& options,
+                                              UvMetrics& metrics, StoredSurface* surface) {
+  metrics = UvMetrics{};
+  if (surface) *surface = StoredSurface{};
+  if (corner_uv.size() != 6 * mesh.face_count())
+    return Status::error(
+        ErrorCode::kInvalidArgument, "", "corner UVs do not match the mesh",
+        std::to_string(corner_uv.size()) + " floats for " + std::to_string(mesh.face_count()) + " faces");
   // The surface a reader of a split file (.glb, .ply) sees: vertices at bit-identical positions joined.
   Mesh welded;
   const Mesh* measured = &mesh;
