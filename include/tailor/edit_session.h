@@ -31,7 +31,7 @@
 //
 // Memory: besides the mesh and one TextureMap, the UVs of the last 8 versions (24 bytes per face
 // each) and the atlases of the last 8 history states and one spare (28 bytes per face each); a
-// chunked session keeps no frames for the whole mesh, but the canonical form of the last 4 chunks
+// chunked session keeps no frames for the whole mesh, but the canonical form of the last 8 chunks
 // it edited (about 180 bytes per face of those chunks).
 //
 // Thread safety: every member may be called from several threads. settle() works on a snapshot

@@ -2,7 +2,10 @@
 #include "edit/chunk_edit.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <system_error>
+#include <thread>
 
 #include "mapping/mapping_common.h"
 #include "surface/orientation_setup.h"
@@ -11,9 +14,9 @@
 namespace tailor::internal {
 namespace {
 
-// Canonical forms kept: the chunks a user paints on in a row (a chunk of 200k faces keeps about
-// 60 MB: its mesh, topology, frames, atlas and scratch).
-constexpr size_t kKeptChunks = 4;
+// Canonical forms kept: the chunks a user paints on in a row (a brush band across a body crosses
+// several; a chunk keeps about 180 bytes per face: its mesh, topology, frames, atlas and scratch).
+constexpr size_t kKeptChunks = 8;
 
 // A stroke's reach as the touched test takes it: its radius grown by this share (the faces' centroids
 // are summed in another corner order there than in the field's lookup: a few ulps).
@@ -35,6 +38,25 @@ MapTextureOptions chunk_options(const ChunkedEdits::Layout& layout, const MapTex
   o.mapping.scale = static_cast<float>(layout.texels_per_unit * plan.cell_size);
   o.mapping.seam_faces = seam;
   return o;
+}
+
+// Runs body(i) for i in [0, n) on up to `threads` threads (0: the cores), each i on one thread:
+// the chunks an edit touches are independent, so the result does not depend on the count.
+template <class Body>
+void for_each_index(size_t n, uint32_t threads, Body body) {
+  const size_t cores = std::max<size_t>(std::thread::hardware_concurrency(), 1);
+  const size_t count = std::min<size_t>(n, threads ? threads : cores);
+  std::atomic<size_t> next{0};
+  auto work = [&] {
+    for (size_t i; (i = next.fetch_add(1)) < n;) body(i);
+  };
+  std::vector<std::thread> workers;
+  try {
+    for (size_t t = 1; t < count; ++t) workers.emplace_back(work);
+  } catch (const std::system_error&) {  // no thread to be had: the calling thread does the rest
+  }
+  work();
+  for (std::thread& t : workers) t.join();
 }
 
 std::span<const uint32_t> chunk_faces(const ChunkPlan& plan, uint32_t chunk) {
@@ -178,20 +200,24 @@ void ChunkedEdits::drop(uint32_t chunk) {
               kept_.end());
 }
 
-Status ChunkedEdits::canonical(const Mesh& mesh, const MapTextureOptions& options, uint32_t chunk, const Atlas& atlas,
-                               Kept*& out) {
+ChunkedEdits::Kept* ChunkedEdits::find_or_add(uint32_t chunk) {
   ++clock_;
   for (const auto& k : kept_)
     if (k->chunk == chunk) {
       k->used = clock_;
-      out = k.get();
-      return Status::ok();
+      return k.get();
     }
-  const Layout& layout = *layout_;
-  const ChunkPlan& plan = layout.plan;
   auto k = std::make_unique<Kept>();
   k->chunk = chunk;
   k->used = clock_;
+  kept_.push_back(std::move(k));
+  return kept_.back().get();
+}
+
+Status ChunkedEdits::build(const Mesh& mesh, const MapTextureOptions& options, const Atlas& atlas, Kept* k) {
+  const uint32_t chunk = k->chunk;
+  const Layout& layout = *layout_;
+  const ChunkPlan& plan = layout.plan;
   build_chunk_mesh(mesh, chunk_faces(plan, chunk), cell_origin(plan.cells[chunk], plan.cell_size), plan.cell_size,
                    options.mapping.seam_faces, k->w);
   for (size_t i = 0; i < k->w.faces.size(); ++i) position_[k->w.faces[i].face] = static_cast<uint32_t>(i);
@@ -204,8 +230,6 @@ Status ChunkedEdits::canonical(const Mesh& mesh, const MapTextureOptions& option
   k->local.region.assign(k->w.faces.size(), 0);
   k->local.ring.resize(k->w.faces.size());
   k->local.ready = true;
-  out = k.get();
-  kept_.push_back(std::move(k));
   return Status::ok();
 }
 
@@ -288,19 +312,32 @@ Status ChunkedEdits::update(const Mesh& mesh, const MapTextureOptions& options, 
   if (!local) {
     // The touched chunks mapped again (their smoothing, grid or thesis growth spans the chunk).
     std::vector<ChunkWorker> maps(chunks.size());
-    for (size_t i = 0; i < chunks.size(); ++i)
-      TAILOR_RETURN_IF_ERROR(map_chunk_fresh(layout, mesh, options, chunks[i], m.threads, {}, maps[i]));
+    std::vector<Status> statuses(chunks.size(), Status::ok());
+    for_each_index(chunks.size(), m.threads, [&](size_t i) {
+      statuses[i] = map_chunk_fresh(layout, mesh, options, chunks[i], m.threads, {}, maps[i]);
+    });
+    for (const Status& s : statuses) TAILOR_RETURN_IF_ERROR(s);
     for (const uint32_t c : chunks) drop(c);
     adopt(options, chunks, maps, atlas, changed);
     return Status::ok();
   }
+  // The canonical forms (found or added here, built below), then each touched chunk's update on
+  // its own thread: each writes only its own form, its patch count and its faces' positions.
   std::vector<Kept*> forms(chunks.size(), nullptr);
-  Status status = Status::ok();
-  for (size_t i = 0; i < chunks.size() && status.is_ok(); ++i) {
+  std::vector<uint8_t> fresh(chunks.size(), 0);
+  for (size_t i = 0; i < chunks.size(); ++i) {
+    const size_t before = kept_.size();
+    forms[i] = find_or_add(chunks[i]);
+    fresh[i] = kept_.size() > before;
+  }
+  std::vector<Status> statuses(chunks.size(), Status::ok());
+  for_each_index(chunks.size(), m.threads, [&](size_t i) {
     const uint32_t c = chunks[i];
-    status = canonical(mesh, options, c, atlas, forms[i]);
-    if (!status) break;
     Kept& k = *forms[i];
+    if (fresh[i]) {
+      statuses[i] = build(mesh, options, atlas, &k);
+      if (!statuses[i]) return;
+    }
     // The chunk's flipped faces (canonical ids, in the order given) and its new seam flags.
     std::vector<uint32_t> flipped_here;
     for (const uint32_t f : flipped)
@@ -313,9 +350,12 @@ Status ChunkedEdits::update(const Mesh& mesh, const MapTextureOptions& options, 
     std::vector<uint32_t> affected;
     refresh_stroke_frames(k.w.mesh, k.topology, o, changed_strokes, k.w.map, k.local, affected);
     uint32_t region_changed = 0;
-    status = update_region(k.w.mesh, k.topology, o, flipped_here, affected, k.w.map, k.local, region_changed);
+    statuses[i] = update_region(k.w.mesh, k.topology, o, flipped_here, affected, k.w.map, k.local, region_changed);
     patches_[c] = k.w.map.atlas.patch_count;
-  }
+  });
+  Status status = Status::ok();
+  for (const Status& s : statuses)
+    if (status.is_ok() && !s) status = s;
   if (!status) {
     // A kept form may be half updated: the next edit builds it again from the atlas.
     for (const uint32_t c : chunks) drop(c);

@@ -11,9 +11,10 @@
 // gives. Options the local update cannot follow (thesis mode, symmetry 4, field smoothing) map the
 // touched chunks again at once.
 //
-// The canonical form of the chunks edited last (mesh, topology, frames, atlas, seeds) is kept, so
-// that painting on in the same place costs the region's update only. Patch ids: each chunk's after
-// those of the chunks before it in cell order, as map_texture numbers them.
+// The canonical form of the 8 chunks edited last (mesh, topology, frames, atlas, seeds) is kept, so
+// that painting on in the same place costs the region's update only; the chunks an edit touches
+// are updated on parallel threads (each on its own form: the result is the same for any count). Patch ids: each chunk's
+// after those of the chunks before it in cell order, as map_texture numbers them.
 #pragma once
 
 #include <cstdint>
@@ -100,7 +101,10 @@ class ChunkedEdits {
 
  private:
   struct Kept;
-  Status canonical(const Mesh& mesh, const MapTextureOptions& options, uint32_t chunk, const Atlas& atlas, Kept*& out);
+  // The kept form of a chunk (a new, empty one when there is none: build it).
+  Kept* find_or_add(uint32_t chunk);
+  // A form's canonical mesh, topology, frames (the state's strokes), atlas (from `atlas`) and seeds.
+  Status build(const Mesh& mesh, const MapTextureOptions& options, const Atlas& atlas, Kept* k);
   void drop(uint32_t chunk);
   void trim();
   void load_atlas(Kept& k, const Atlas& atlas) const;
