@@ -25,8 +25,8 @@
 // map_texture's: each chunk's after those of the chunks before it, so a chunk whose patch count
 // changed shifts the later chunks' ids (counted in changed_faces).
 // Measured (bench/bench_edit.cpp, docs/performance.md): apply about 20 ms on 100k faces; on
-// 1.55 M faces (chunked) 30-80 ms of CPU per seam brush or stroke, the settle the touched chunks'
-// map (0.3-1 s) where the full map takes 2.5-5 s.
+// 1.55 M faces (chunked) 45-75 ms per seam brush or stroke on 2 busy cores, the settle the touched
+// chunks' map (0.3-4 s, by their size) where the full map takes 2.5 s of CPU.
 // `tailor edit` serves a session over HTTP (docs/edit-api.md).
 //
 // Memory: besides the mesh and one TextureMap, the UVs of the last 8 versions (24 bytes per face
