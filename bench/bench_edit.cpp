@@ -1,10 +1,15 @@
-// Interactive editing (tailor/edit_session.h, issue 19 point 3): the time of one EditSession::apply
-// against the full map_texture it replaces, on the shared nefertiti (100k faces, when the shared
-// data is present) and the 1.55 M face subdivided horse (bench_meshes.h).
-//   Edit/seams/MESH   a brush of ~60 seam faces marked, then unmarked (alternating iterations)
-//   Edit/stroke/MESH  a stroke of 10 points added (radius 2% of the mesh), then undone
-//   Edit/full/MESH    map_texture of the whole mesh with the same options (the v1 apply, the settle)
-// Targets (issue 19): apply <= ~60 ms at 100k faces, <= ~400 ms at 1M, on the project's 2-core machine.
+// Interactive editing (tailor/edit_session.h): the time of one EditSession::apply against the full
+// map_texture it replaces, on the shared nefertiti (100k faces, when the shared data is present)
+// and the 1.55 M face subdivided horse (bench_meshes.h), which the default options cut into chunks.
+//   Edit/seams/MESH          a brush of ~60 seam faces marked, then unmarked (alternating iterations)
+//   Edit/stroke/MESH         a stroke of 10 points added (radius 2% of the mesh), then undone
+//   Edit/stroke-settle/MESH  the settle after that stroke (chunked: the chunks it touched mapped
+//                            again; whole: the full map)
+//   Edit/stroke-whole/MESH   the stroke on the mesh mapped whole (--chunks off): the local update
+//                            over the whole mesh, as before the chunked sessions
+//   Edit/full/MESH           map_texture of the whole mesh with the same options
+// Targets: apply <= ~60 ms at 100k faces; a stroke <= 100 ms at 1.5 M faces (chunked), on the
+// project's 2-core machine.
 //
 // Run: tailor_bench --benchmark_filter=Edit
 #include <benchmark/benchmark.h>
@@ -31,11 +36,15 @@ struct EditBench {
   std::string error;
 };
 
-tailor::MapTextureOptions bench_options() {
+tailor::MapTextureOptions bench_options(bool whole = false) {
   tailor::MapTextureOptions options;
   (void)tailor::set_map_texture_size(options, 512, 512);
+  if (whole) options.chunks.mode = tailor::ChunkMode::kOff;
   return options;
 }
+
+// "KEY" or "KEY#whole" (the session maps the mesh whole).
+bool whole_key(const std::string& key) { return key.ends_with("#whole"); }
 
 // The mesh, a session on it, a brush of ~60 faces and a stroke at the face in the middle of the
 // face order (a deterministic spot well inside the mesh on the shared scans).
@@ -45,9 +54,10 @@ EditBench& edit_bench(const std::string& key) {
   if (cached && cached_key == key) return *cached;
   cached.reset();  // one mesh in memory at a time
   auto b = std::make_unique<EditBench>();
-  if (key == "horse_x16") {
+  const std::string file = whole_key(key) ? key.substr(0, key.size() - 6) : key;
+  if (file == "horse_x16") {
     b->mesh = subdivided_horse();
-  } else if (tailor::Status s = tailor::load_mesh(key, b->mesh); !s) {
+  } else if (tailor::Status s = tailor::load_mesh(file, b->mesh); !s) {
     b->error = s.message();
   }
   if (b->error.empty()) {
@@ -72,7 +82,8 @@ EditBench& edit_bench(const std::string& key) {
       for (int c = 0; c < 3; ++c)
         b->stroke.points.push_back(b->mesh.positions[3 * b->mesh.indices[3 * b->brush[i]] + c]);
     b->stroke.radius = 0.02f * std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
-    if (tailor::Status s = tailor::EditSession::open(b->mesh, bench_options(), b->session); !s) b->error = s.message();
+    if (tailor::Status s = tailor::EditSession::open(b->mesh, bench_options(whole_key(key)), b->session); !s)
+      b->error = s.message();
   }
   cached = std::move(b);
   cached_key = key;
@@ -120,6 +131,29 @@ void BM_EditStroke(benchmark::State& state, const std::string& key) {
   set_faces_rate(state, b.mesh.face_count());
 }
 
+// The settle after a stroke: the stroke applied and the settle timed, then undone (untimed).
+void BM_EditStrokeSettle(benchmark::State& state, const std::string& key) {
+  EditBench& b = edit_bench(key);
+  if (!b.error.empty()) return state.SkipWithError(b.error.c_str());
+  for (auto _ : state) {
+    state.PauseTiming();
+    tailor::EditRequest edit;
+    edit.strokes.push_back(b.stroke);
+    tailor::EditResult result;
+    if (tailor::Status s = b.session->apply(edit, result); !s) return state.SkipWithError(s.message().c_str());
+    state.ResumeTiming();
+    const auto start = std::chrono::steady_clock::now();
+    const tailor::Status s = b.session->settle(result);
+    state.SetIterationTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    if (!s) return state.SkipWithError(s.message().c_str());
+    state.PauseTiming();
+    (void)b.session->undo(result);
+    (void)b.session->settle(result);
+    state.ResumeTiming();
+  }
+  set_faces_rate(state, b.mesh.face_count());
+}
+
 void BM_EditFull(benchmark::State& state, const std::string& key) {
   EditBench& b = edit_bench(key);
   if (!b.error.empty()) return state.SkipWithError(b.error.c_str());
@@ -147,9 +181,15 @@ const bool registered = [] {
   for (const auto& [name, key] : meshes) {
     benchmark::RegisterBenchmark(("Edit/seams/" + name).c_str(), BM_EditSeams, key)
         ->Unit(benchmark::kMillisecond)
+        ->MinWarmUpTime(2.0)
         ->MinTime(0.5)
         ->UseManualTime();
     benchmark::RegisterBenchmark(("Edit/stroke/" + name).c_str(), BM_EditStroke, key)
+        ->Unit(benchmark::kMillisecond)
+        ->MinWarmUpTime(2.0)
+        ->MinTime(0.5)
+        ->UseManualTime();
+    benchmark::RegisterBenchmark(("Edit/stroke-settle/" + name).c_str(), BM_EditStrokeSettle, key)
         ->Unit(benchmark::kMillisecond)
         ->MinTime(0.5)
         ->UseManualTime();
@@ -157,6 +197,12 @@ const bool registered = [] {
         ->Unit(benchmark::kMillisecond)
         ->MinTime(0.5)
         ->UseManualTime();
+    if (name == "horse_x16")  // last: it maps the mesh whole (seconds) for a session of its own
+      benchmark::RegisterBenchmark(("Edit/stroke-whole/" + name).c_str(), BM_EditStroke, key + "#whole")
+          ->Unit(benchmark::kMillisecond)
+          ->MinWarmUpTime(2.0)
+          ->MinTime(0.5)
+          ->UseManualTime();
   }
   return true;
 }();

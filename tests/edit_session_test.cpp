@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <span>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "support/fixtures.h"
+#include "tailor/chunks.h"
 #include "tailor/topology.h"
 
 namespace tailor {
@@ -456,6 +458,201 @@ TEST(EditSession, EditsFromSeveralThreadsSettleToTheFullMap) {
   for (uint32_t i = 0; i < 6; ++i)
     for (uint32_t f = 500 * i; f < 500 * i + 80; ++f) seam[f] = 1;
   EXPECT_EQ(current_atlas(*session).corner_uv, full_map(mesh, seam, {}, default_options()).corner_uv);
+}
+
+// === Chunked sessions: the mesh cut into chunks (tailor/chunks.h); an edit touches only its chunks ===
+
+// Options that cut the horse (97k faces) into chunks of a cell 1/3 of its longest side.
+MapTextureOptions chunked_options(const Mesh& mesh) {
+  MapTextureOptions options = default_options();
+  float lo = INFINITY, hi = -INFINITY;
+  for (size_t v = 0; v < mesh.vertex_count(); ++v)
+    for (size_t k = 0; k < 3; ++k) {
+      lo = std::min(lo, mesh.positions[3 * v + k]);
+      hi = std::max(hi, mesh.positions[3 * v + k]);
+    }
+  options.chunks.mode = ChunkMode::kOn;
+  options.chunks.cell_exponent = static_cast<int>(std::floor(std::log2((double{hi} - lo) / 3)));
+  return options;
+}
+
+// Each face's chunk under those options.
+std::vector<uint32_t> chunk_of_faces(const Mesh& mesh, const MapTextureOptions& options, size_t& chunks) {
+  ChunkPlan plan;
+  EXPECT_TRUE(plan_chunks(mesh, options.chunks, plan).is_ok());
+  std::vector<uint32_t> chunk(mesh.face_count(), 0);
+  for (uint32_t c = 0; c < plan.chunk_count(); ++c)
+    for (uint32_t i = plan.chunk_start[c]; i < plan.chunk_start[c + 1]; ++i) chunk[plan.faces[i]] = c;
+  chunks = plan.chunk_count();
+  return chunk;
+}
+
+// The chunks holding a face whose centroid lies within a stroke's radius (brute force).
+std::vector<uint8_t> chunks_reached(const Mesh& mesh, const std::vector<uint32_t>& chunk, size_t chunks,
+                                    const OrientationStroke& stroke) {
+  std::vector<uint8_t> reached(chunks, 0);
+  for (size_t f = 0; f < mesh.face_count(); ++f) {
+    double q[3] = {0, 0, 0};
+    for (int k = 0; k < 3; ++k)
+      for (int c = 0; c < 3; ++c) q[c] += mesh.positions[3 * size_t{mesh.indices[3 * f + k]} + c] / 3.0;
+    for (size_t i = 0; i + 5 < stroke.points.size(); i += 3) {
+      double d[3], aq[3], dd = 0, t = 0;
+      for (int c = 0; c < 3; ++c) {
+        d[c] = double{stroke.points[i + 3 + c]} - stroke.points[i + c];
+        aq[c] = q[c] - stroke.points[i + c];
+        dd += d[c] * d[c];
+        t += aq[c] * d[c];
+      }
+      t = dd > 0 ? std::clamp(t / dd, 0.0, 1.0) : 0.0;
+      double e2 = 0;
+      for (int c = 0; c < 3; ++c) e2 += (aq[c] - t * d[c]) * (aq[c] - t * d[c]);
+      if (e2 < double{stroke.radius} * stroke.radius * 1.01) reached[chunk[f]] = 1;
+    }
+  }
+  return reached;
+}
+
+// The UVs (repeats, 6 per face) of the faces in chunks not flagged are bit-identical in a and b;
+// returns how many faces were compared.
+size_t expect_same_outside(const std::vector<float>& a, const std::vector<float>& b, const std::vector<uint32_t>& chunk,
+                           const std::vector<uint8_t>& touched) {
+  size_t compared = 0;
+  for (size_t f = 0; f < chunk.size(); ++f) {
+    if (touched[chunk[f]]) continue;
+    ++compared;
+    for (size_t k = 6 * f; k < 6 * f + 6; ++k)
+      if (std::bit_cast<uint32_t>(a[k]) != std::bit_cast<uint32_t>(b[k])) {
+        ADD_FAILURE() << "face " << f << " of untouched chunk " << chunk[f] << " moved";
+        return compared;
+      }
+  }
+  return compared;
+}
+
+std::vector<uint8_t> changed_chunks(const std::vector<float>& a, const std::vector<float>& b,
+                                    const std::vector<uint32_t>& chunk, size_t chunks) {
+  std::vector<uint8_t> changed(chunks, 0);
+  for (size_t f = 0; f < chunk.size(); ++f)
+    for (size_t k = 6 * f; k < 6 * f + 6; ++k)
+      if (std::bit_cast<uint32_t>(a[k]) != std::bit_cast<uint32_t>(b[k])) changed[chunk[f]] = 1;
+  return changed;
+}
+
+TEST(EditSession, ChunkedEditsChangeOnlyTheTouchedChunksAndSettleToAFreshChunkedMap) {
+  const Mesh mesh = test::load_test_mesh("horse.ply");
+  const MapTextureOptions options = chunked_options(mesh);
+  size_t chunks = 0;
+  const std::vector<uint32_t> chunk = chunk_of_faces(mesh, options, chunks);
+  ASSERT_GE(chunks, 6u);
+  const auto session = open_session(mesh, options);
+  ASSERT_TRUE(session);
+  {  // version 0 is the chunked map_texture
+    const Atlas expected = full_map(mesh, {}, {}, options);
+    EXPECT_EQ(current_atlas(*session).corner_uv, expected.corner_uv);
+    EXPECT_EQ(current_atlas(*session).patch, expected.patch);
+  }
+  const std::vector<float> uv0 = uvs_of(*session, 0);
+
+  // Seam faces in one chunk: only that chunk's UVs change.
+  const uint32_t brush_chunk = chunk[20000];
+  EditRequest seams;
+  std::vector<uint8_t> seam(mesh.face_count(), 0);
+  for (uint32_t f = 20000; seams.add_seam_faces.size() < 60 && f < mesh.face_count(); ++f)
+    if (chunk[f] == brush_chunk) seams.add_seam_faces.push_back(f), seam[f] = 1;
+  EditResult result;
+  ASSERT_TRUE(session->apply(seams, result).is_ok());
+  EXPECT_FALSE(result.settled);
+  EXPECT_GT(result.changed_faces, 0u);
+  const std::vector<float> uv1 = uvs_of(*session, result.version);
+  std::vector<uint8_t> touched(chunks, 0);
+  touched[brush_chunk] = 1;
+  EXPECT_GT(expect_same_outside(uv0, uv1, chunk, touched), mesh.face_count() / 2);
+  EXPECT_TRUE(changed_chunks(uv0, uv1, chunk, chunks)[brush_chunk]);
+
+  // A stroke: only the chunks holding faces it reaches change.
+  OrientationStroke stroke = stroke_along(mesh, 60000, 12);
+  stroke.radius *= 0.5f;
+  const std::vector<uint8_t> reached = chunks_reached(mesh, chunk, chunks, stroke);
+  ASSERT_LT(std::count(reached.begin(), reached.end(), 1), static_cast<std::ptrdiff_t>(chunks) - 2);
+  EditRequest draw;
+  draw.strokes.push_back(stroke);
+  ASSERT_TRUE(session->apply(draw, result).is_ok());
+  const std::vector<float> uv2 = uvs_of(*session, result.version);
+  EXPECT_GT(expect_same_outside(uv1, uv2, chunk, reached), mesh.face_count() / 3);
+  const std::vector<uint8_t> moved = changed_chunks(uv1, uv2, chunk, chunks);
+  EXPECT_GT(std::count(moved.begin(), moved.end(), 1), 0);
+
+  // Settled: a fresh chunked map of the mesh with those seam faces and that stroke, bit for bit;
+  // the chunks no edit touched still have version 0's UVs.
+  ASSERT_TRUE(session->settle(result).is_ok());
+  EXPECT_TRUE(result.settled);
+  const Atlas expected = full_map(mesh, seam, {stroke}, options);
+  const Atlas atlas = current_atlas(*session);
+  EXPECT_EQ(atlas.corner_uv, expected.corner_uv);
+  EXPECT_EQ(atlas.patch, expected.patch);
+  EXPECT_EQ(atlas.patch_count, expected.patch_count);
+  std::vector<uint8_t> any = reached;
+  any[brush_chunk] = 1;
+  expect_same_outside(uv0, uvs_of(*session, result.version), chunk, any);
+
+  // Undo the stroke (the kept atlas of version 1), then draw it elsewhere and settle: the kept
+  // canonical forms followed the undo.
+  ASSERT_TRUE(session->undo(result).is_ok());
+  EXPECT_EQ(uvs_of(*session, result.version), uv1);
+  const OrientationStroke other = stroke_along(mesh, 20100, 10);
+  draw.strokes = {other};
+  ASSERT_TRUE(session->apply(draw, result).is_ok());
+  ASSERT_TRUE(session->settle(result).is_ok());
+  const Atlas expected2 = full_map(mesh, seam, {other}, options);
+  EXPECT_EQ(current_atlas(*session).corner_uv, expected2.corner_uv);
+  EXPECT_EQ(current_atlas(*session).patch, expected2.patch);
+}
+
+TEST(EditSession, ChunkedLocalUpdatesAreTheSameForAnyThreadCount) {
+  const Mesh mesh = test::load_test_mesh("horse.ply");
+  MapTextureOptions one = chunked_options(mesh), three = chunked_options(mesh);
+  one.mapping.threads = one.orientation.threads = 1;
+  three.mapping.threads = three.orientation.threads = 3;
+  const auto a = open_session(mesh, one);
+  const auto b = open_session(mesh, three);
+  ASSERT_TRUE(a && b);
+  for (uint32_t i = 0; i < 3; ++i) {
+    EditRequest edit;
+    for (uint32_t f = 30000 * i; f < 30000 * i + 50; ++f) edit.add_seam_faces.push_back(f);
+    edit.strokes.push_back(stroke_along(mesh, 30000 * i + 1000, 8));
+    EditResult ra, rb;
+    ASSERT_TRUE(a->apply(edit, ra).is_ok());
+    ASSERT_TRUE(b->apply(edit, rb).is_ok());
+    EXPECT_EQ(ra.changed_faces, rb.changed_faces);
+    EXPECT_EQ(uvs_of(*a, ra.version), uvs_of(*b, rb.version));
+  }
+  EditResult ra, rb;
+  ASSERT_TRUE(a->settle(ra).is_ok());
+  ASSERT_TRUE(b->settle(rb).is_ok());
+  EXPECT_EQ(uvs_of(*a, ra.version), uvs_of(*b, rb.version));
+}
+
+// Field smoothing spreads a stroke within its chunk: the touched chunks are mapped again at
+// once (settled), the others keep their bits.
+TEST(EditSession, ChunkedEditsWithSmoothingMapTheTouchedChunksAtOnce) {
+  const Mesh mesh = test::load_test_mesh("horse.ply");
+  MapTextureOptions options = chunked_options(mesh);
+  options.orientation.smooth_passes = 2;
+  size_t chunks = 0;
+  const std::vector<uint32_t> chunk = chunk_of_faces(mesh, options, chunks);
+  const auto session = open_session(mesh, options);
+  ASSERT_TRUE(session);
+  OrientationStroke stroke = stroke_along(mesh, 60000, 12);
+  stroke.radius *= 0.5f;
+  EditRequest draw;
+  draw.strokes.push_back(stroke);
+  EditResult result;
+  ASSERT_TRUE(session->apply(draw, result).is_ok());
+  EXPECT_TRUE(result.settled);
+  EXPECT_GT(expect_same_outside(uvs_of(*session, 0), uvs_of(*session, result.version), chunk,
+                                chunks_reached(mesh, chunk, chunks, stroke)),
+            mesh.face_count() / 3);
+  EXPECT_EQ(current_atlas(*session).corner_uv, full_map(mesh, {}, {stroke}, options).corner_uv);
 }
 
 }  // namespace

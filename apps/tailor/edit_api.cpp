@@ -238,8 +238,13 @@ std::string replay_command(const EditContext& c, const MapTextureOptions& option
          std::to_string(m.min_patch_faces) + " --hop-age " + number(m.hop_age) + " --crack-rings " +
          std::to_string(m.crack_rings) + " --relax-iterations " + std::to_string(m.relax_iterations) + " --threshold " +
          number(m.threshold_px) + " --axis " + shell_word(axis_text(options.orientation)) + " --smooth " +
-         std::to_string(options.orientation.smooth_passes) + " --symmetry " + std::to_string(m.symmetry) +
-         " --chunks off";
+         std::to_string(options.orientation.smooth_passes) + " --symmetry " + std::to_string(m.symmetry);
+  // The session maps as map_texture does with its chunk options (chunked from the threshold on).
+  const ChunkOptions& chunks = options.chunks;
+  cmd += chunks.mode == ChunkMode::kOn    ? " --chunks on"
+         : chunks.mode == ChunkMode::kOff ? " --chunks off"
+                                          : " --chunks auto";
+  if (chunks.cell_exponent != kAutoCellExponent) cmd += " --chunk-cell " + std::to_string(chunks.cell_exponent);
   if (m.use_seed_point)
     cmd += " --seed-point " + number(m.seed_point[0]) + "," + number(m.seed_point[1]) + "," + number(m.seed_point[2]);
   if (!m.shorten_seams) cmd += " --no-seam-shortening";

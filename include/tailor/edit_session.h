@@ -13,12 +13,26 @@
 // which is byte for byte what `tailor map --seam-faces F --strokes S` gives with the same options
 // (any thread count). Edits that change the options, and sessions in the thesis mode, with
 // symmetry 4 or with field smoothing, map the whole mesh at each edit instead.
-// Measured (bench/bench_edit.cpp, docs/performance.md): apply about 20 ms on 100k faces and
-// 0.1-0.2 s on 1.55 M faces, where the full map takes 0.17-0.3 s and 4.5-8 s.
+//
+// A mesh that map_texture cuts into chunks (tailor/chunks.h: from ChunkOptions::min_faces faces
+// on, or --chunks on) is edited chunk by chunk (src/edit/chunk_edit.h): an edit touches the chunks
+// holding a face whose seam flag flipped or a face a stroke added or removed reaches (a stroke acts
+// within its radius only), and every other chunk keeps its UVs bit for bit, settled or not. The
+// touched chunks get the local update above within the chunk (in its own frame and density) and
+// settle() maps only them again by the whole pipeline, which gives the fresh chunked map_texture
+// bit for bit (the same for any thread count). With the thesis mode, symmetry 4 or field smoothing
+// the touched chunks are mapped again at once (the version is then settled). Patch ids are
+// map_texture's: each chunk's after those of the chunks before it, so a chunk whose patch count
+// changed shifts the later chunks' ids (counted in changed_faces).
+// Measured (bench/bench_edit.cpp, docs/performance.md): apply about 20 ms on 100k faces; on
+// 1.55 M faces (chunked) 45-75 ms per seam brush or stroke on 2 busy cores, the settle the touched
+// chunks' map (0.3-4 s, by their size) where the full map takes 2.5 s of CPU.
 // `tailor edit` serves a session over HTTP (docs/edit-api.md).
 //
 // Memory: besides the mesh and one TextureMap, the UVs of the last 8 versions (24 bytes per face
-// each) and the atlases of the last 8 history states (28 bytes per face each).
+// each) and the atlases of the last 8 history states and one spare (28 bytes per face each); a
+// chunked session keeps no frames for the whole mesh, but the canonical form of the last 8 chunks
+// it edited (about 180 bytes per face of those chunks).
 //
 // Thread safety: every member may be called from several threads. settle() works on a snapshot
 // of the state and publishes its result only if no edit came in meanwhile (it then reports false

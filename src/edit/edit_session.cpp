@@ -11,8 +11,11 @@
 #include <chrono>
 #include <deque>
 #include <mutex>
+#include <system_error>
+#include <thread>
 #include <utility>
 
+#include "edit/chunk_edit.h"
 #include "edit/local_update.h"
 #include "surface/stroke_field.h"
 
@@ -23,6 +26,8 @@ namespace {
 // that undo and redo restore them bit for bit (older ones are mapped again).
 constexpr size_t kKeptVersions = 8;
 constexpr size_t kKeptAtlases = 8;
+// From this many UV floats on (2 per corner: 100k faces) publish copies on two threads.
+constexpr size_t kParallelPublishCorners = 600000;
 
 double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -40,6 +45,8 @@ struct KeptAtlas {
   size_t position = 0;  // steps in effect
   Atlas atlas;
   bool settled = false;
+  std::vector<uint8_t> dirty;     // chunked sessions: the chunks whose UVs were a local update
+  std::vector<uint32_t> patches;  // chunked sessions: each chunk's patch count
 };
 
 // The session's options with the parts it owns cleared: spans (its own seam flags and strokes are
@@ -74,9 +81,12 @@ struct EditSession::State {
   MapTextureOptions options;               // own_options()
   std::vector<Step> steps;                 // the history
   size_t applied = 0;                      // steps[0, applied) are in effect
-  TextureMap map;                          // the current version's frames and atlas
-  internal::LocalUpdate local;             // what the fast update keeps between edits
+  TextureMap map;                          // the current version's atlas, and its frames unless chunked
+  internal::LocalUpdate local;             // what the fast update keeps between edits (whole mesh)
+  bool chunked = false;                    // the options cut the mesh into chunks: edits go chunk by chunk
+  internal::ChunkedEdits chunks;           // chunked: the plan, the chunks' patch ranges and dirty flags
   std::deque<KeptAtlas> kept;              // recent history states' atlases
+  KeptAtlas spare;                         // one dropped from `kept`, its arrays kept for reuse
 
   std::atomic<uint64_t> version{0};
   std::atomic<bool> settled{true};
@@ -94,15 +104,75 @@ struct EditSession::State {
     return o;
   }
 
+  // The settle of a chunked session: the dirty chunks mapped again by the whole pipeline (without
+  // a lock, on a snapshot of the state; an edit arriving meanwhile cancels it), then put in.
+  Status settle_chunks(const internal::ChunkedEdits::Layout& layout, const std::vector<uint8_t>& seam_flags,
+                       const std::vector<OrientationStroke>& stroke_list, const MapTextureOptions& base,
+                       const std::vector<uint32_t>& dirty, uint64_t edits_seen,
+                       std::chrono::steady_clock::time_point start, EditResult& result) {
+    const MapTextureOptions o = with_state(base, seam_flags, stroke_list);
+    const auto still = [this, edits_seen](float) { return edits.load() == edits_seen; };
+    std::vector<internal::ChunkWorker> maps(dirty.size());
+    for (size_t i = 0; i < dirty.size(); ++i) {
+      const Status s =
+          internal::ChunkedEdits::map_chunk_fresh(layout, mesh, o, dirty[i], o.mapping.threads, still, maps[i]);
+      if (s.code() == ErrorCode::kCancelled || edits.load() != edits_seen) {
+        result.ms = ms_since(start);
+        return Status::ok();
+      }
+      TAILOR_RETURN_IF_ERROR(s);
+    }
+    const std::lock_guard<std::mutex> lock(edit_mutex);
+    result.ms = ms_since(start);
+    if (edits.load() != edits_seen) {
+      result.version = version.load();
+      return Status::ok();
+    }
+    chunks.adopt(o, dirty, maps, map.atlas, result.changed_faces);
+    if (result.changed_faces == 0) {
+      settled.store(true);
+      keep_atlas(true);
+    } else {
+      publish(version.load() + 1, true);
+    }
+    result.version = version.load();
+    result.settled = true;
+    result.ms = ms_since(start);
+    return Status::ok();
+  }
+
   // Makes the current atlas version v's and keeps its UVs.
   void publish(uint64_t v, bool is_settled) {
     const double su = 1.0 / options.metrics.texture_width_px, sv = 1.0 / options.metrics.texture_height_px;
     const std::vector<float>& px = map.atlas.corner_uv;
-    std::vector<float> repeats(px.size());
+    // The oldest kept version's array, when it is about to go, is reused: 24 bytes per face of
+    // fresh memory at every edit cost more in page faults than the conversion itself.
+    std::vector<float> repeats;
+    {
+      const std::lock_guard<std::mutex> lock(versions_mutex);
+      if (versions.size() >= kKeptVersions) {
+        repeats = std::move(versions.front().second);
+        versions.pop_front();
+      }
+    }
+    // On a large mesh the atlas kept for undo is copied on a second thread meanwhile: both are
+    // passes over tens of megabytes, most of an edit's time once the chunks are mapped.
+    std::thread keeper;
+    if (px.size() >= kParallelPublishCorners) {
+      try {
+        keeper = std::thread([this, is_settled] { keep_atlas(is_settled); });
+      } catch (const std::system_error&) {  // no thread to be had: copied below
+      }
+    }
+    repeats.resize(px.size());
     for (size_t i = 0; i + 1 < px.size(); i += 2) {
       repeats[i] = static_cast<float>(px[i] * su);
       repeats[i + 1] = static_cast<float>(px[i + 1] * sv);
     }
+    if (keeper.joinable())
+      keeper.join();
+    else
+      keep_atlas(is_settled);
     {
       const std::lock_guard<std::mutex> lock(versions_mutex);
       versions.emplace_back(v, std::move(repeats));
@@ -110,17 +180,34 @@ struct EditSession::State {
     }
     settled.store(is_settled);
     version.store(v);
-    keep_atlas(is_settled);
   }
 
   // Remembers the current atlas for history position `applied` (replacing an older one).
   void keep_atlas(bool is_settled) {
+    // The entry replaced, or the oldest when it is about to go, gives its arrays to the new one
+    // (assigning into them costs no page faults).
+    KeptAtlas entry;
     for (auto it = kept.begin(); it != kept.end(); ++it)
       if (it->position == applied) {
+        entry = std::move(*it);
         kept.erase(it);
         break;
       }
-    kept.push_back({applied, map.atlas, is_settled});
+    if (entry.atlas.corner_uv.empty() && kept.size() >= kKeptAtlases) {
+      entry = std::move(kept.front());
+      kept.pop_front();
+    } else if (entry.atlas.corner_uv.empty()) {
+      entry = std::move(spare);
+      spare = KeptAtlas{};
+    }
+    entry.position = applied;
+    entry.atlas.corner_uv.assign(map.atlas.corner_uv.begin(), map.atlas.corner_uv.end());
+    entry.atlas.patch.assign(map.atlas.patch.begin(), map.atlas.patch.end());
+    entry.atlas.patch_count = map.atlas.patch_count;
+    entry.settled = is_settled;
+    entry.dirty = chunked ? chunks.dirty_flags() : std::vector<uint8_t>{};
+    entry.patches = chunked ? chunks.patch_counts() : std::vector<uint32_t>{};
+    kept.push_back(std::move(entry));
     while (kept.size() > kKeptAtlases) kept.pop_front();
   }
 
@@ -133,10 +220,25 @@ struct EditSession::State {
       if (k.position == applied) found = &k;
     if (!found) {
       TAILOR_RETURN_IF_ERROR(update(flipped, changed_strokes, options_changed, result.changed_faces));
-      publish(version.load() + 1, false);
+      publish(version.load() + 1, chunked && !chunks.any_dirty());
       return Status::ok();
     }
     const MapTextureOptions o = with_state(options, seam, strokes);
+    // A history state's options decide its chunks: the kept atlas was cut as they cut it now.
+    if (internal::session_uses_chunks(o, mesh.face_count())) {
+      if (options_changed || !chunked) {
+        TAILOR_RETURN_IF_ERROR(chunks.prepare(mesh, o));
+        chunked = true;
+        map.frames = FaceFrames{};
+        local.reset();
+      }
+      result.changed_faces = count_changed(map.atlas, found->atlas);
+      map.atlas = found->atlas;
+      chunks.restore(o, flipped, changed_strokes, map.atlas, found->dirty, found->patches);
+      publish(version.load() + 1, found->settled);
+      return Status::ok();
+    }
+    chunked = false;
     if (options_changed || !internal::can_update_locally(o, local)) {
       local.reset();
       TAILOR_RETURN_IF_ERROR(
@@ -160,7 +262,21 @@ struct EditSession::State {
   Status update(const std::vector<uint32_t>& flipped, const std::vector<OrientationStroke>& changed_strokes,
                 bool options_changed, uint32_t& changed) {
     const MapTextureOptions o = with_state(options, seam, strokes);
+    if (options_changed && internal::session_uses_chunks(o, mesh.face_count())) {
+      internal::ChunkedEdits fresh;
+      Atlas next;
+      TAILOR_RETURN_IF_ERROR(fresh.map_all(mesh, topology, o, next));
+      changed = count_changed(map.atlas, next);
+      map.atlas = std::move(next);
+      map.frames = FaceFrames{};
+      chunks = std::move(fresh);
+      chunked = true;
+      local.reset();
+      return Status::ok();
+    }
+    if (chunked && !options_changed) return chunks.update(mesh, o, flipped, changed_strokes, map.atlas, changed);
     if (options_changed || !internal::can_update_locally(o, local)) {
+      chunked = false;
       TextureMap next;
       TAILOR_RETURN_IF_ERROR(internal::map_keeping_setup(mesh, topology, o, next, local));
       changed = count_changed(map.atlas, next.atlas);
@@ -194,7 +310,11 @@ Status EditSession::open(Mesh mesh, const MapTextureOptions& options, std::uniqu
   st.strokes.assign(options.orientation.strokes.begin(), options.orientation.strokes.end());
   MapTextureOptions first = State::with_state(st.options, st.seam, st.strokes);
   first.mapping.progress = options.mapping.progress;
-  TAILOR_RETURN_IF_ERROR(internal::map_keeping_setup(st.mesh, st.topology, first, st.map, st.local));
+  st.chunked = internal::session_uses_chunks(first, st.mesh.face_count());
+  if (st.chunked)
+    TAILOR_RETURN_IF_ERROR(st.chunks.map_all(st.mesh, st.topology, first, st.map.atlas));
+  else
+    TAILOR_RETURN_IF_ERROR(internal::map_keeping_setup(st.mesh, st.topology, first, st.map, st.local));
   st.publish(0, true);
   session = std::move(s);
   return Status::ok();
@@ -264,14 +384,18 @@ Status EditSession::apply(const EditRequest& edit, EditResult& result) {
   }
   // A new step: the redo branch is dropped with the atlases kept for it.
   st.steps.resize(st.applied);
-  st.kept.erase(
-      std::remove_if(st.kept.begin(), st.kept.end(), [&](const KeptAtlas& k) { return k.position > st.applied; }),
-      st.kept.end());
+  for (auto it = st.kept.begin(); it != st.kept.end();)
+    if (it->position > st.applied) {
+      st.spare = std::move(*it);  // its arrays serve the next keep_atlas
+      it = st.kept.erase(it);
+    } else {
+      ++it;
+    }
   st.steps.push_back(std::move(step));
   st.applied = st.steps.size();
-  st.publish(st.version.load() + 1, false);
+  st.publish(st.version.load() + 1, st.chunked && !st.chunks.any_dirty());
   result.version = st.version.load();
-  result.settled = false;
+  result.settled = st.settled.load();
   result.ms = ms_since(start);
   return Status::ok();
 }
@@ -322,6 +446,9 @@ Status EditSession::settle(EditResult& result) {
   std::vector<OrientationStroke> strokes;
   MapTextureOptions options;
   uint64_t edits = 0;
+  bool chunked = false;
+  std::shared_ptr<const internal::ChunkedEdits::Layout> layout;
+  std::vector<uint32_t> dirty;
   {
     const std::lock_guard<std::mutex> lock(st.edit_mutex);
     result.version = st.version.load();
@@ -334,7 +461,13 @@ Status EditSession::settle(EditResult& result) {
     strokes = st.strokes;
     options = st.options;
     edits = st.edits.load();
+    chunked = st.chunked;
+    if (chunked) {
+      layout = st.chunks.layout();
+      dirty = st.chunks.dirty_chunks();
+    }
   }
+  if (chunked) return st.settle_chunks(*layout, seam, strokes, options, dirty, edits, start, result);
   // The full map without a lock; an edit arriving meanwhile cancels it.
   TextureMap map;
   internal::LocalUpdate local;
