@@ -22,20 +22,11 @@ constexpr size_t kKeptChunks = 8;
 // are summed in another corner order there than in the field's lookup: a few ulps).
 constexpr double kReachMargin = 1e-3;
 
-// The options map_chunk maps chunk `cell` with (map_chunks.cpp): the cell's frame and the density.
+// The options map_chunk maps chunk `chunk` with (chunk_map_options), with its seam faces.
 MapTextureOptions chunk_options(const ChunkedEdits::Layout& layout, const MapTextureOptions& options, uint32_t chunk,
                                 std::span<const uint8_t> seam) {
-  const ChunkPlan& plan = layout.plan;
-  MapTextureOptions o = options;
-  o.chunks.mode = ChunkMode::kOff;
-  o.measure = false;
-  o.stage_progress = nullptr;
-  o.mapping.progress = nullptr;
-  o.orientation.progress = nullptr;
-  o.orientation.fixed_unit_scale = static_cast<float>(1.0 / plan.cell_size);
-  for (size_t k = 0; k < 3; ++k)
-    o.orientation.fixed_origin[k] = static_cast<float>(plan.cells[chunk][k] * plan.cell_size);
-  o.mapping.scale = static_cast<float>(layout.texels_per_unit * plan.cell_size);
+  MapTextureOptions o =
+      chunk_map_options(options, layout.plan.cells[chunk], layout.plan.cell_size, layout.texels_per_unit);
   o.mapping.seam_faces = seam;
   return o;
 }

@@ -68,6 +68,13 @@ inline std::array<double, 3> cell_origin(const std::array<int32_t, 3>& cell, dou
 //! map_chunks.cpp.
 Status map_whole_canonical(const Mesh& mesh, const MapTextureOptions& options, TextureMap& map);
 
+//! The options a chunk is mapped with (map_chunk; the edit session's local updates inside a chunk
+//! too): its cell's frame (origin at the cell's corner, unit the cell side), texels_per_unit times
+//! the cell side as its scale, no chunks, metrics or progress, no seam faces (the caller sets the
+//! chunk's own).
+MapTextureOptions chunk_map_options(const MapTextureOptions& options, const std::array<int32_t, 3>& cell,
+                                    double cell_size, double texels_per_unit);
+
 //! Maps the chunk built in w (build_chunk_mesh) by map_texture with `options` (no metrics): its
 //! frame is its cell's (origin at the cell's corner, unit the cell side), its density
 //! texels_per_unit, `threads` for its own stages, `progress` its share (optional). Results in w.map,

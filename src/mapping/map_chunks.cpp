@@ -50,6 +50,21 @@ void add_stats(const MappingStats& s, MappingStats& total) {
 
 }  // namespace
 
+MapTextureOptions chunk_map_options(const MapTextureOptions& options, const std::array<int32_t, 3>& cell,
+                                    double cell_size, double texels_per_unit) {
+  MapTextureOptions o = options;
+  o.chunks.mode = ChunkMode::kOff;
+  o.measure = false;
+  o.stage_progress = nullptr;
+  o.mapping.progress = nullptr;
+  o.orientation.progress = nullptr;
+  o.orientation.fixed_unit_scale = static_cast<float>(1.0 / cell_size);
+  for (size_t k = 0; k < 3; ++k) o.orientation.fixed_origin[k] = static_cast<float>(cell[k] * cell_size);
+  o.mapping.scale = static_cast<float>(texels_per_unit * cell_size);
+  o.mapping.seam_faces = {};
+  return o;
+}
+
 Status map_chunk(const MapTextureOptions& options, const std::array<int32_t, 3>& cell, double cell_size,
                  double texels_per_unit, uint32_t threads, ProgressCallback progress, ChunkWorker& w) {
   const double chunk_scale = texels_per_unit * cell_size;
@@ -58,17 +73,10 @@ Status map_chunk(const MapTextureOptions& options, const std::array<int32_t, 3>&
                          "the texel density gives " + std::to_string(chunk_scale) +
                              " pixels per chunk cell, outside 0.001 to 1e7: give another chunk cell or scale");
   const Topology topology = build_topology(w.mesh);
-  MapTextureOptions o = options;
-  o.chunks.mode = ChunkMode::kOff;
-  o.measure = false;
-  o.stage_progress = nullptr;
+  MapTextureOptions o = chunk_map_options(options, cell, cell_size, texels_per_unit);
   o.mapping.progress = std::move(progress);
-  o.orientation.progress = nullptr;
   o.mapping.threads = threads;
   o.orientation.threads = threads;
-  o.orientation.fixed_unit_scale = static_cast<float>(1.0 / cell_size);
-  for (size_t k = 0; k < 3; ++k) o.orientation.fixed_origin[k] = static_cast<float>(cell[k] * cell_size);
-  o.mapping.scale = static_cast<float>(chunk_scale);
   o.mapping.seam_faces = w.seam_flags;
   return map_texture_in_order(w.mesh, topology, o, w.map);
 }
