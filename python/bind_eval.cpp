@@ -45,17 +45,13 @@ void bind_eval(py::module_& m) {
         {
           const py::gil_scoped_release release;
           const auto start = std::chrono::steady_clock::now();
-          // Texture repeats -> pixels, as `tailor eval` converts them.
-          std::vector<float> uv_px(static_cast<size_t>(uvs.size()));
-          const float* in = uvs.data();
-          for (size_t c = 0; c < uv_px.size() / 2; ++c) {
-            uv_px[2 * c] = in[2 * c] * static_cast<float>(width);
-            uv_px[2 * c + 1] = in[2 * c + 1] * static_cast<float>(height);
-          }
-          const Topology topology = build_topology(mesh.mesh);
+          // As `tailor eval` measures a file: repeats -> pixels, identical positions joined, patches
+          // from the UVs (compute_stored_uv_metrics).
+          std::vector<float> uv(uvs.data(), uvs.data() + uvs.size());
           MetricsOptions options{static_cast<float>(width), static_cast<float>(height)};
           options.symmetry = symmetry;
-          status = compute_uv_metrics(mesh.mesh, topology, uv_px, {}, options, run.metrics);
+          StoredSurface surface;
+          status = compute_stored_uv_metrics(mesh.mesh, nullptr, std::move(uv), options, run.metrics, &surface);
           run.file = mesh.source;
           run.format = mesh.load.format;
           run.vertices = mesh.mesh.vertex_count();
@@ -63,8 +59,8 @@ void bind_eval(py::module_& m) {
           run.texture_height = height;
           run.texture_size_from = "option";
           run.symmetry = symmetry;
-          run.boundary_edges = topology.boundary_edges;
-          run.nonmanifold_edges = topology.nonmanifold_edges;
+          run.boundary_edges = surface.boundary_edges;
+          run.nonmanifold_edges = surface.nonmanifold_edges;
           run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         }
         if (!status) raise_status(status.with_file(mesh.source));
