@@ -63,6 +63,8 @@ class ChunkedMapper:
         threads: int = 0,
         field_following: float = 1.0,
         max_stretch: float = 0.25,
+        texture_size: Optional[Tuple[int, int]] = None,
+        crack_rings: Optional[int] = None,
     ) -> None: ...
     def set_chunk(self, cell: Sequence[int], faces: Mesh) -> None: ...
     def set_mesh(self, mesh: Mesh) -> List[Tuple[int, int, int]]: ...
@@ -75,6 +77,14 @@ class ChunkedMapper:
     def texels_per_unit(self) -> float: ...
 
 def load(path: _Path) -> Mesh: ...
+def plan_chunks(mesh: Mesh, chunk_cell: Optional[int] = None) -> Dict[str, Any]: ...
+def save_uvs(
+    path: _Path,
+    mesh: Mesh,
+    corner_uvs: npt.ArrayLike,
+    texture_size: Tuple[int, int],
+    texture: Optional[_Path] = None,
+) -> None: ...
 def map(
     mesh: Mesh,
     texture_size: int = 512,
