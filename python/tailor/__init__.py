@@ -24,6 +24,7 @@ from ._tailor import (
     plan_chunks,
     save,
     save_uvs,
+    simplify_uvs,
     tile,
     tile_set,
 )
@@ -40,6 +41,7 @@ __all__ = [
     "plan_chunks",
     "save",
     "save_uvs",
+    "simplify_uvs",
     "tile",
     "tile_set",
     "__version__",

@@ -85,6 +85,7 @@ def save_uvs(
     texture_size: Tuple[int, int],
     texture: Optional[_Path] = None,
 ) -> None: ...
+def simplify_uvs(mesh: Mesh, corner_uvs: npt.ArrayLike, target_faces: int, lock_border: bool = True) -> Dict[str, Any]: ...
 def map(
     mesh: Mesh,
     texture_size: int = 512,

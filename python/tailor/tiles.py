@@ -93,10 +93,6 @@ def tile_digest(positions, faces, params):
     return h.hexdigest()
 
 
-def tile_name(tile):
-    return "%d_%d_%d" % tuple(int(v) for v in tile)
-
-
 # === The .glb: the library's writer, the texture referenced by URI ===
 
 
@@ -133,7 +129,7 @@ def write_tile_glb(path, positions, faces, corner_uvs, params, texture_uri):
         reference_texture(path, texture_uri)
 
 
-# === One tile: the Dask task ===
+# === The tasks: a leaf tile maps its chunks, a parent simplifies its children ===
 
 
 def make_mapper(params, threads):
@@ -148,26 +144,104 @@ def make_mapper(params, threads):
     )
 
 
-def tile_record(job, positions, faces, params):
+def node_name(level, tile):
+    return "%d_%d_%d_%d" % (level, tile[0], tile[1], tile[2])
+
+
+def glb_path(folder, name):
+    return pathlib.Path(folder) / "tiles" / (name + ".glb")
+
+
+def coarse_path(folder, name):
+    return pathlib.Path(folder) / "lod" / (name + ".bin")
+
+
+def save_coarse(path, positions, faces, uvs, error):
+    """What a node hands its parent: its content simplified to a quarter, and that step's error."""
+    head = struct.pack("<QQd", positions.shape[0], faces.shape[0], error)
+    tmp = str(path) + ".part"
+    with open(tmp, "wb") as f:
+        for block in (head, positions.astype("<f4"), faces.astype("<u4"), uvs.astype("<f4")):
+            f.write(block if isinstance(block, bytes) else block.tobytes())
+    os.replace(tmp, path)
+
+
+def load_coarse(path):
+    data = pathlib.Path(path).read_bytes()
+    v, f, error = struct.unpack_from("<QQd", data, 0)
+    at = 24
+    positions = np.frombuffer(data, "<f4", 3 * v, at).reshape(v, 3)
+    at += 12 * v
+    faces = np.frombuffer(data, "<u4", 3 * f, at).reshape(f, 3)
+    at += 12 * f
+    uvs = np.frombuffer(data, "<f4", 6 * f, at).reshape(f, 3, 2)
+    return positions, faces, uvs, error
+
+
+def clean(faces, uvs):
+    """Without faces that repeat a vertex or another face's vertices (welding and collapses make
+    some; tailor.Mesh would drop them)."""
+    ok = (faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2]) & (faces[:, 0] != faces[:, 2])
+    faces, uvs = faces[ok], uvs[ok]
+    first = np.sort(np.unique(np.sort(faces, axis=1), axis=0, return_index=True)[1])
+    return faces[first], uvs[first]
+
+
+def simplify(positions, faces, uvs, target):
+    """tailor.simplify_uvs on arrays: the open borders (the node's sides) stay where they are."""
+    faces, uvs = clean(faces, uvs)
+    r = tailor.simplify_uvs(tailor.Mesh(positions, faces), uvs, max(int(target), 1))
+    f, t = clean(r["faces"], r["corner_uvs"])
+    return r["positions"], f, t, r["error"]
+
+
+def kept(keep_from, digest, folder, name, lod):
+    """Links the previous run's files of this node into folder when its digest is the same."""
+    if not keep_from or keep_from.get("digest") != digest:
+        return False
+    pairs = [(keep_from["glb"], glb_path(folder, name))]
+    if lod:
+        pairs.append((keep_from["coarse"], coarse_path(folder, name)))
+    if not all(os.path.exists(old) for old, _ in pairs):
+        return False
+    for old, new in pairs:
+        if os.path.exists(new):  # a retried task
+            os.unlink(new)
+        os.link(old, new)
+    return True
+
+
+def finish_node(record, folder, positions, faces, uvs, params, texture_uri, lod):
+    """Writes a node's .glb (and, with levels of detail, the quarter its parent starts from)."""
+    write_tile_glb(glb_path(folder, record["name"]), positions, faces, uvs, params, texture_uri)
+    if lod:
+        p, f, t, error = simplify(positions, faces, uvs, faces.shape[0] / 4)
+        save_coarse(coarse_path(folder, record["name"]), p, f, t, error)
+        record["coarse_error"] = error
+    record["written"] = True
+    return record
+
+
+def leaf_record(job, positions, faces, params):
     return {
         "name": job["name"],
+        "level": 0,
         "tile": job["tile"],
         "digest": tile_digest(positions, faces, params),
         "faces": int(faces.shape[0]),
         "min": positions.min(axis=0).astype(float).tolist(),
         "max": positions.max(axis=0).astype(float).tolist(),
+        "error": 0.0,
+        "coarse_error": 0.0,
     }
 
 
-def map_tile(job, positions, faces, params, folder, texture_uri, keep_from, threads):
-    """Maps one tile's chunks and writes folder/tiles/<name>.glb; when keep_from (the previous
-    output's file) has the same digest, links it instead. Returns the tile's record."""
-    record = tile_record(job, positions, faces, params)
-    out = pathlib.Path(folder) / "tiles" / (job["name"] + ".glb")
-    if keep_from and keep_from.get("digest") == record["digest"] and os.path.exists(keep_from["path"]):
-        if os.path.exists(out):  # a retried task
-            os.unlink(out)
-        os.link(keep_from["path"], out)
+def map_tile(job, positions, faces, params, folder, texture_uri, keep_from, threads, lod):
+    """A leaf: maps the tile's chunks and writes tiles/<name>.glb, or links the previous run's
+    files when the digest is the same. Returns the node's record."""
+    record = leaf_record(job, positions, faces, params)
+    if kept(keep_from, record["digest"], folder, job["name"], lod):
+        record["coarse_error"] = keep_from.get("coarse_error", 0.0)
         record["written"] = False
         return record
     mapper = make_mapper(params, threads)
@@ -176,20 +250,53 @@ def map_tile(job, positions, faces, params, folder, texture_uri, keep_from, thre
     for cell in mapper.set_mesh(mesh):
         chunk = mapper.chunk(cell)
         uv[chunk["faces"]] = chunk["corner_uvs"]
-    write_tile_glb(out, positions, faces, uv, params, texture_uri)
-    record["written"] = True
-    return record
+    del mapper, mesh
+    return finish_node(record, folder, positions, faces, uv, params, texture_uri, lod)
 
 
-def map_in_process(jobs, order, params, folder, texture_uri, threads):
+def build_parent(job, params, folder, texture_uri, keep_from, *children):
+    """A parent: its children's quarters joined (vertices at one position welded, so that the
+    children's shared sides can be simplified) and simplified to a quarter of the children's
+    faces; its error is its own simplification's plus the largest a child's content had."""
+    children = sorted(children, key=lambda r: r["name"])
+    h = hashlib.sha256(json.dumps(params, sort_keys=True).encode())
+    for c in children:
+        h.update(("%s %s\n" % (c["name"], c["digest"])).encode())
+    record = {
+        "name": job["name"],
+        "level": job["level"],
+        "tile": job["tile"],
+        "digest": h.hexdigest(),
+        "min": np.min([c["min"] for c in children], axis=0).tolist(),
+        "max": np.max([c["max"] for c in children], axis=0).tolist(),
+        "children": [c["name"] for c in children],
+    }
+    below = max(c["error"] + c["coarse_error"] for c in children)
+    if kept(keep_from, record["digest"], folder, job["name"], True):
+        record.update(faces=keep_from["faces"], error=keep_from["error"], coarse_error=keep_from["coarse_error"])
+        record["written"] = False
+        return record
+    parts = [load_coarse(coarse_path(folder, c["name"])) for c in children]
+    positions = np.concatenate([p[0] for p in parts])
+    offsets = np.cumsum([0] + [p[0].shape[0] for p in parts])
+    faces = np.concatenate([p[1].astype(np.int64) + offsets[k] for k, p in enumerate(parts)])
+    uvs = np.concatenate([p[2] for p in parts])
+    positions, inverse = np.unique(positions, axis=0, return_inverse=True)
+    faces = inverse.reshape(-1)[faces].astype(np.uint32)
+    p, f, t, error = simplify(positions, faces, uvs, sum(c["faces"] for c in children) / 4)
+    record.update(faces=int(f.shape[0]), error=below + error)
+    return finish_node(record, folder, p, f, t, params, texture_uri, True)
+
+
+def map_in_process(jobs, order, params, folder, texture_uri, threads, lod):
     """--workers 0: the tiles to write mapped together by one ChunkedMapper.set_mesh (the library's
     chunked map, its chunks in parallel on `threads` threads), then written one by one. Yields
     (job index, record) in `order`."""
     pending = []
     for i in order:
         job, p, f, keep = jobs[i]
-        if keep and keep.get("digest") == tile_digest(p, f, params) and os.path.exists(keep["path"]):
-            yield i, map_tile(job, p, f, params, folder, texture_uri, keep, threads)
+        if keep and keep.get("digest") == tile_digest(p, f, params):
+            yield i, map_tile(job, p, f, params, folder, texture_uri, keep, threads, lod)
         else:
             pending.append(i)
     if not pending:
@@ -207,17 +314,27 @@ def map_in_process(jobs, order, params, folder, texture_uri, threads):
     del mapper
     for k, i in enumerate(pending):
         job, p, f, _ = jobs[i]
-        record = tile_record(job, p, f, params)
-        write_tile_glb(
-            pathlib.Path(folder) / "tiles" / (job["name"] + ".glb"),
-            p,
-            f,
-            uv[face_offsets[k] : face_offsets[k + 1]],
-            params,
-            texture_uri,
-        )
-        record["written"] = True
-        yield i, record
+        record = leaf_record(job, p, f, params)
+        yield i, finish_node(record, folder, p, f, uv[face_offsets[k] : face_offsets[k + 1]], params, texture_uri, lod)
+
+
+def parent_levels(leaves):
+    """The parents above the leaf tiles: level L groups the tiles whose coordinates agree after a
+    shift by L (2 x 2 x 2 blocks), up to one root, or to the level where grouping stops helping
+    (tiles on both sides of a zero coordinate never meet). Returns [[(tile, child names)], ...]."""
+    levels = []
+    below = {tuple(t): node_name(0, t) for t in leaves}
+    level = 0
+    while len(below) > 1 and level < 40:
+        level += 1
+        groups = {}
+        for tile, name in sorted(below.items(), key=lambda item: item[1]):
+            groups.setdefault(tuple(v >> 1 for v in tile), []).append(name)
+        if len(groups) == len(below) and level > 1:
+            break
+        levels.append(sorted(groups.items(), key=lambda g: (g[0][2], g[0][1], g[0][0])))
+        below = {tile: node_name(level, tile) for tile in groups}
+    return levels
 
 
 # === The tileset ===
@@ -231,27 +348,42 @@ def box_volume(lo, hi):
     return {"box": [c[0], -c[2], c[1], h[0], 0, 0, 0, h[2], 0, 0, 0, h[1]]}
 
 
-def tileset_json(records, params):
+def tileset_json(records, lod):
+    """Leaves under their parents (refine REPLACE: a parent's simplified copy gives way to its
+    children), or, without levels of detail, every leaf under one root (refine ADD)."""
+    by_name = {r["name"]: r for r in records}
     lo = np.min([r["min"] for r in records], axis=0).tolist()
     hi = np.max([r["max"] for r in records], axis=0).tolist()
     diagonal = float(np.linalg.norm(np.subtract(hi, lo)))
-    children = [
-        {
+
+    def node(r):
+        out = {
             "boundingVolume": box_volume(r["min"], r["max"]),
-            "geometricError": 0.0,
+            "geometricError": float(r["error"]),
             "content": {"uri": "tiles/%s.glb" % r["name"]},
         }
-        for r in records
-    ]
-    return {
-        "asset": {"version": "1.1", "generator": "tailor %s (python3 -m tailor.tiles)" % tailor.__version__},
-        "geometricError": diagonal,
-        "root": {
+        if r.get("children"):
+            out["refine"] = "REPLACE"
+            out["children"] = [node(by_name[c]) for c in r["children"]]
+        return out
+
+    top_level = max(r["level"] for r in records) if lod else 0
+    top = [r for r in records if r["level"] == top_level]
+    if lod and len(top) == 1:
+        root = node(top[0])
+        error = max(root["geometricError"], diagonal)  # a client far away still shows the root
+    else:
+        root = {
             "boundingVolume": box_volume(lo, hi),
             "geometricError": diagonal,
-            "refine": "ADD",
-            "children": children,
-        },
+            "refine": "REPLACE" if lod else "ADD",
+            "children": [node(r) for r in top],
+        }
+        error = diagonal
+    return {
+        "asset": {"version": "1.1", "generator": "tailor %s (python3 -m tailor.tiles)" % tailor.__version__},
+        "geometricError": error,
+        "root": root,
     }
 
 
@@ -306,6 +438,7 @@ def plan_tiles(mesh, args):
         "field_following": args.field_following,
         "max_stretch": args.max_stretch,
         "crack_rings": args.crack_rings,
+        "lod": args.lod,
     }
     tiles = {}
     cells = plan["cells"] >> level  # arithmetic shift: floor division by 2**level
@@ -352,10 +485,11 @@ def previous_output(outdir, params):
         return {}
     if old.get("params") != params:
         return {}
-    return {
-        name: {"digest": digest, "path": str(outdir / "tiles" / (name + ".glb"))}
-        for name, digest in old.get("tiles", {}).items()
-    }
+    out = {}
+    for name, r in old.get("tiles", {}).items():
+        if isinstance(r, dict):
+            out[name] = dict(r, glb=str(glb_path(outdir, name)), coarse=str(coarse_path(outdir, name)))
+    return out
 
 
 def start_client(args):
@@ -402,39 +536,61 @@ def run(args):
             else:
                 shutil.copyfile(args.texture, tmp / name)
             texture_uri = "../" + name
+        if args.lod:
+            (tmp / "lod").mkdir()
         positions = mesh.positions
         faces = mesh.faces
         jobs = []
         for tile in sorted(tiles, key=lambda t: (t[2], t[1], t[0])):
             p, f = canonical_tile(positions, faces[tiles[tile]])
-            name = tile_name(tile)
+            name = node_name(0, tile)
             jobs.append(({"name": name, "tile": list(tile)}, p, f, old.get(name)))
+        del positions, faces
+        levels = parent_levels([job[0]["tile"] for job in jobs]) if args.lod else []
+        t_cut = time.monotonic()
         # Largest first, so that the last tasks to finish are small ones.
         order = sorted(range(len(jobs)), key=lambda i: -jobs[i][2].shape[0])
-        progress = Progress(len(jobs), not args.quiet)
-        records = [None] * len(jobs)
+        progress = Progress(len(jobs) + sum(len(groups) for groups in levels), not args.quiet)
+        records = {}
+        folder = str(tmp)
         if args.workers == 0 and not args.scheduler:
-            for i, record in map_in_process(jobs, order, params, str(tmp), texture_uri, args.threads):
-                records[i] = record
+            for i, record in map_in_process(jobs, order, params, folder, texture_uri, args.threads, args.lod):
+                records[record["name"]] = record
                 progress.step(record["written"])
+            for level, groups in enumerate(levels, start=1):
+                for tile, names in groups:
+                    job = {"name": node_name(level, tile), "level": level, "tile": list(tile)}
+                    kids = [records[n] for n in names]
+                    record = build_parent(job, params, folder, texture_uri, old.get(job["name"]), *kids)
+                    records[job["name"]] = record
+                    progress.step(record["written"])
         else:
+            from dask.distributed import as_completed
+
             client, cluster = start_client(args)
             threads = args.threads or 1
             futures = {}
             for i in order:
                 job, p, f, keep = jobs[i]
-                fut = client.submit(
-                    map_tile, job, p, f, params, str(tmp), texture_uri, keep, threads, key="tile-" + job["name"], pure=False
+                futures[job["name"]] = client.submit(
+                    map_tile, job, p, f, params, folder, texture_uri, keep, threads, args.lod, key="tile-%s-%s" % (tmp.name, job["name"])
                 )
-                futures[fut] = i
-            from dask.distributed import as_completed
-
-            for fut in as_completed(list(futures)):
-                records[futures[fut]] = fut.result()
-                progress.step(records[futures[fut]]["written"])
+            for level, groups in enumerate(levels, start=1):
+                for tile, names in groups:
+                    job = {"name": node_name(level, tile), "level": level, "tile": list(tile)}
+                    kids = [futures[n] for n in names]
+                    futures[job["name"]] = client.submit(
+                        build_parent, job, params, folder, texture_uri, old.get(job["name"]), *kids, key="tile-%s-%s" % (tmp.name, job["name"])
+                    )
+            for fut in as_completed(list(futures.values())):
+                record = fut.result()
+                records[record["name"]] = record
+                progress.step(record["written"])
+        records = sorted(records.values(), key=lambda r: (-r["level"], r["tile"][2], r["tile"][1], r["tile"][0]))
         t_map = time.monotonic()
-        (tmp / "tileset.json").write_text(json.dumps(tileset_json(records, params), indent=1) + "\n")
-        manifest = {"params": params, "tiles": {r["name"]: r["digest"] for r in records}}
+        (tmp / "tileset.json").write_text(json.dumps(tileset_json(records, args.lod), indent=1) + "\n")
+        fields = ("digest", "faces", "error", "coarse_error")
+        manifest = {"params": params, "tiles": {r["name"]: {k: r[k] for k in fields} for r in records}}
         (tmp / MANIFEST).write_text(json.dumps(manifest, indent=1, sort_keys=True) + "\n")
         # Into place: the old folder aside, the new one in, the old one removed.
         aside = None
@@ -455,6 +611,8 @@ def run(args):
     written = sum(1 for r in records if r["written"])
     summary = {
         "tiles": len(records),
+        "leaves": len(jobs),
+        "levels": 1 + len(levels),
         "written": written,
         "kept": len(records) - written,
         "faces": int(mesh.face_count),
@@ -463,7 +621,12 @@ def run(args):
         "tile_size": plan["cell_size"] * 2 ** params["tile_level"],
         "texels_per_unit": params["texels_per_unit"],
         "workers": args.workers if not args.scheduler else None,
-        "seconds": {"load_plan": t_plan - t0, "map_write": t_map - t_plan, "total": time.monotonic() - t0},
+        "seconds": {
+            "load_plan": t_plan - t0,
+            "cut": t_cut - t_plan,
+            "map_write": t_map - t_cut,
+            "total": time.monotonic() - t0,
+        },
     }
     return summary
 
@@ -511,6 +674,12 @@ def parse_args(argv):
     p.add_argument("--field-following", type=float, default=1.0, help="as tailor map (0..1; default 1)")
     p.add_argument("--max-stretch", type=float, default=0.25, help="as tailor map")
     p.add_argument("--crack-rings", type=int, default=None, help="as tailor map (default 16)")
+    p.add_argument(
+        "--no-lod",
+        dest="lod",
+        action="store_false",
+        help="no levels of detail: the leaf tiles only, under one root (refine ADD)",
+    )
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no summary")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     args = p.parse_args(argv)

@@ -70,11 +70,23 @@ def test_tiles_are_the_chunked_map_for_any_worker_count(tmp_path):
     out = tmp_path / "w2"
     tileset = json.loads((out / "tileset.json").read_text())
     assert tileset["asset"]["version"] == "1.1"
-    children = tileset["root"]["children"]
-    assert len(children) == summary["tiles"] and tileset["root"]["refine"] == "ADD"
+    nodes = []
+
+    def walk(node, depth):
+        nodes.append((depth, node))
+        for child in node.get("children", []):
+            assert child["geometricError"] <= node["geometricError"]
+            walk(child, depth + 1)
+
+    walk(tileset["root"], 0)
+    leaves = [n for _, n in nodes if "children" not in n]
+    parents = [n for _, n in nodes if "children" in n and "content" in n]
+    assert len(leaves) == summary["leaves"] and len(parents) == summary["tiles"] - summary["leaves"] > 2
+    assert all(n["geometricError"] == 0 for n in leaves)
+    assert all(n["refine"] == "REPLACE" and n["geometricError"] > 0 for n in parents)
     assert (out / "texture.png").read_bytes() == TEXTURE.read_bytes()
 
-    # Every face of the mesh in exactly one tile, with the UVs of `tailor map --chunks on`.
+    # Every face of the mesh in exactly one leaf tile, with the UVs of `tailor map --chunks on`.
     mesh = tailor.load(HORSE)
     with pytest.warns(UserWarning, match="does not wrap"):  # the example texture is not a tile: fine here
         whole = tailor.map(
@@ -94,7 +106,8 @@ def test_tiles_are_the_chunked_map_for_any_worker_count(tmp_path):
             turn = [(r + k) % 3 for k in range(3)]
             reference[corners[f, turn].tobytes()] = whole.corner_uvs[f, turn]
     seen = 0
-    for child in children:
+    vertices = set()  # (position, uv) of every leaf vertex
+    for child in leaves:
         positions, uvs, faces, gltf = read_glb(out / child["content"]["uri"])
         assert gltf["images"] == [{"uri": "../texture.png"}]
         assert gltf["samplers"][0]["wrapS"] == 10497
@@ -108,7 +121,14 @@ def test_tiles_are_the_chunked_map_for_any_worker_count(tmp_path):
             got = uvs[faces[f]] * np.array([1, -1], dtype=np.float32)
             assert np.array_equal(got, expected), (child["content"]["uri"], f)
         seen += faces.shape[0]
+        vertices |= {positions[v].tobytes() + uvs[v].tobytes() for v in range(positions.shape[0])}
     assert seen == mesh.face_count
+    # Parents: fewer faces than their children, every vertex one of the leaves' with its UV bit for bit.
+    for parent in parents:
+        positions, uvs, faces, _ = read_glb(out / parent["content"]["uri"])
+        below = sum(read_glb(out / c["content"]["uri"])[2].shape[0] for c in parent["children"])
+        assert 0 < faces.shape[0] < below
+        assert all(positions[v].tobytes() + uvs[v].tobytes() in vertices for v in range(positions.shape[0]))
 
 
 def write_ply(path, positions, faces):
@@ -181,6 +201,11 @@ def test_errors_are_one_line_and_leave_the_output_as_it_was(tmp_path):
     code, stdout, stderr = run_tiles(HORSE, "-o", out, "--workers", 0, "--chunk-cell", CELL, "--tile-size", 0.125)
     assert code == 0, stderr
     assert "tailor.tiles: " in stdout
+    code, _, stderr = run_tiles(HORSE, "-o", out, "--workers", 0, "--chunk-cell", CELL, "--tile-size", 0.125, "--no-lod")
+    assert code == 0, stderr
+    root = json.loads((out / "tileset.json").read_text())["root"]
+    assert root["refine"] == "ADD" and all("children" not in c for c in root["children"])
+    assert not (out / "lod").exists()
     good = folder_bytes(out)
     bad = tmp_path / "bad.png"
     bad.write_bytes(b"not an image")
