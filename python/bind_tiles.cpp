@@ -106,7 +106,6 @@ map -o` does: .glb, .obj or .ply, atomically. texture: a PNG or JPEG to embed (.
   bind_simplify(m);
 }
 
-
 void bind_simplify(py::module_& m) {
   m.def(
       "simplify_uvs",
@@ -123,10 +122,10 @@ void bind_simplify(py::module_& m) {
           const size_t vertices = split.xref.size();
           // Corners with one position and different UVs are one vertex to the simplifier (its
           // seams): both sides of a UV seam move together, so the surface stays closed.
-          const size_t count = meshopt_simplify(
-              kept.data(), split.indices.data(), split.indices.size(), split.positions.data(), vertices,
-              3 * sizeof(float), 3 * std::min(target_faces, faces), std::numeric_limits<float>::max(),
-              lock_border ? unsigned{meshopt_SimplifyLockBorder} : 0u, &error);
+          const size_t count = meshopt_simplify(kept.data(), split.indices.data(), split.indices.size(),
+                                                split.positions.data(), vertices, 3 * sizeof(float),
+                                                3 * std::min(target_faces, faces), std::numeric_limits<float>::max(),
+                                                lock_border ? unsigned{meshopt_SimplifyLockBorder} : 0u, &error);
           kept.resize(count);
           scale = meshopt_simplifyScale(split.positions.data(), vertices, 3 * sizeof(float));
         }
