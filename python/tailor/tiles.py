@@ -49,7 +49,8 @@ class TilesError(Exception):
 def texels_per_unit_for(mesh, scale):
     """The chunked engine's texel density for `tailor map --scale S` (unit scale 0): scale over the
     longest side of the referenced vertices' bounding box, rounded to a power of two."""
-    used = np.unique(mesh.faces)
+    used = np.zeros(mesh.vertex_count, dtype=bool)
+    used[mesh.faces.ravel()] = True
     p = mesh.positions[used].astype(np.float64)
     longest = float((p.max(axis=0) - p.min(axis=0)).max())
     if not (longest > 0) or not math.isfinite(longest):
@@ -60,29 +61,36 @@ def texels_per_unit_for(mesh, scale):
 
 def canonical_tile(positions, faces):
     """A tile's faces and vertices in an order that depends on its geometry only: each face turned so
-    that its lexicographically smallest corner comes first, faces sorted by their nine coordinates,
-    vertices numbered by first use. Returns (positions (V, 3) float32, faces (F, 3) uint32)."""
-    corners = positions[faces]  # (F, 3, 3)
-    keys = corners.view(np.float32)
-    # The first corner: the smallest by x, then y, then z (a triangle has three distinct ones).
-    rank = np.lexsort((keys[:, :, 2].T.ravel(), keys[:, :, 1].T.ravel(), keys[:, :, 0].T.ravel()))
-    # rank sorts all 3F corners; the first corner of face f to appear in it is its smallest.
-    face_of = rank % faces.shape[0]
-    corner_of = rank // faces.shape[0]
-    first = np.full(faces.shape[0], -1, dtype=np.int64)
-    seen_order = np.unique(face_of, return_index=True)[1]
-    first[face_of[seen_order]] = corner_of[seen_order]
+    that its smallest corner (by x, then y, then z) comes first, faces sorted by a 64-bit hash of
+    their nine coordinates' bits, vertices numbered by first use. O(F) but for one sort of the
+    hashes. Returns (positions (V, 3) float32, faces (F, 3) uint32)."""
+    faces = np.asarray(faces, dtype=np.int64)
+    c = positions[faces]  # (F, 3, 3)
+
+    def less(a, b):
+        return (a[:, 0] < b[:, 0]) | (
+            (a[:, 0] == b[:, 0]) & ((a[:, 1] < b[:, 1]) | ((a[:, 1] == b[:, 1]) & (a[:, 2] < b[:, 2])))
+        )
+
+    first = np.zeros(faces.shape[0], dtype=np.int64)
+    first[less(c[:, 1], c[:, 0])] = 1
+    smallest = np.take_along_axis(c, first[:, None, None], axis=1)[:, 0]
+    first[less(c[:, 2], smallest)] = 2
     turn = (first[:, None] + np.arange(3)[None, :]) % 3
     faces = np.take_along_axis(faces, turn, axis=1)
-    corners = positions[faces].reshape(-1, 9)
-    order = np.lexsort(tuple(corners[:, k] for k in range(8, -1, -1)))
-    faces = faces[order]
-    used, first_use = np.unique(faces.ravel(), return_index=True)
-    by_use = np.argsort(first_use, kind="stable")
-    new_id = np.empty(used.shape[0], dtype=np.uint32)
-    new_id[by_use] = np.arange(used.shape[0], dtype=np.uint32)
-    compact = new_id[np.searchsorted(used, faces.ravel())].reshape(-1, 3)
-    return np.ascontiguousarray(positions[used[by_use]], dtype=np.float32), compact
+    words = np.ascontiguousarray(positions[faces].reshape(-1, 9)).view(np.uint32).astype(np.uint64)
+    h = np.full(faces.shape[0], 0xCBF29CE484222325, dtype=np.uint64)  # FNV-1a over the 9 words
+    for k in range(9):
+        h = (h ^ words[:, k]) * np.uint64(0x100000001B3)
+    faces = faces[np.argsort(h, kind="stable")]
+    flat = faces.ravel()
+    first_use = np.full(positions.shape[0], flat.shape[0], dtype=np.int64)
+    first_use[flat[::-1]] = np.arange(flat.shape[0] - 1, -1, -1)  # the last write, the first use, wins
+    used = np.flatnonzero(first_use < flat.shape[0])
+    by_use = used[np.argsort(first_use[used], kind="stable")]
+    new_id = np.empty(positions.shape[0], dtype=np.uint32)
+    new_id[by_use] = np.arange(by_use.shape[0], dtype=np.uint32)
+    return np.ascontiguousarray(positions[by_use], dtype=np.float32), new_id[faces]
 
 
 def tile_digest(positions, faces, params):
@@ -237,8 +245,9 @@ def leaf_record(job, positions, faces, params):
 
 
 def map_tile(job, positions, faces, params, folder, texture_uri, keep_from, threads, lod):
-    """A leaf: maps the tile's chunks and writes tiles/<name>.glb, or links the previous run's
-    files when the digest is the same. Returns the node's record."""
+    """A leaf: puts the tile in its canonical order, maps its chunks and writes tiles/<name>.glb, or
+    links the previous run's files when the digest is the same. Returns the node's record."""
+    positions, faces = canonical_tile(positions, faces)
     record = leaf_record(job, positions, faces, params)
     if kept(keep_from, record["digest"], folder, job["name"], lod):
         record["coarse_error"] = keep_from.get("coarse_error", 0.0)
@@ -293,8 +302,11 @@ def map_in_process(jobs, order, params, folder, texture_uri, threads, lod):
     chunked map, its chunks in parallel on `threads` threads), then written one by one. Yields
     (job index, record) in `order`."""
     pending = []
+    jobs = list(jobs)
     for i in order:
         job, p, f, keep = jobs[i]
+        p, f = canonical_tile(p, f)
+        jobs[i] = (job, p, f, keep)
         if keep and keep.get("digest") == tile_digest(p, f, params):
             yield i, map_tile(job, p, f, params, folder, texture_uri, keep, threads, lod)
         else:
@@ -542,7 +554,9 @@ def run(args):
         faces = mesh.faces
         jobs = []
         for tile in sorted(tiles, key=lambda t: (t[2], t[1], t[0])):
-            p, f = canonical_tile(positions, faces[tiles[tile]])
+            # The tile's own vertices; its canonical order is the task's work (in parallel).
+            used, compact = np.unique(faces[tiles[tile]], return_inverse=True)
+            p, f = positions[used], compact.reshape(-1, 3).astype(np.uint32)
             name = node_name(0, tile)
             jobs.append(({"name": name, "tile": list(tile)}, p, f, old.get(name)))
         del positions, faces
