@@ -260,7 +260,14 @@ def map_tile(job, positions, faces, params, folder, texture_uri, keep_from, thre
         chunk = mapper.chunk(cell)
         uv[chunk["faces"]] = chunk["corner_uvs"]
     del mapper, mesh
-    return finish_node(record, folder, positions, faces, uv, params, texture_uri, lod)
+    record = finish_node(record, folder, positions, faces, uv, params, texture_uri, lod)
+    # Test hook: TAILOR_TILES_KILL_ONCE=NAME=MARKER ends this worker process abruptly once, after
+    # tile NAME's files are written and before its result is sent (tests/python/test_tiles.py).
+    name, _, marker = os.environ.get("TAILOR_TILES_KILL_ONCE", "").partition("=")
+    if name == job["name"] and marker and not os.path.exists(marker):
+        pathlib.Path(marker).touch()
+        os._exit(70)
+    return record
 
 
 def build_parent(job, params, folder, texture_uri, keep_from, *children):

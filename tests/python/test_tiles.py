@@ -47,8 +47,8 @@ def folder_bytes(folder):
     return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(pathlib.Path(folder).rglob("*")) if p.is_file()}
 
 
-def run_tiles(*args):
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+def run_tiles(*args, env=None):
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path), **(env or {}))
     done = subprocess.run(
         [sys.executable, "-m", "tailor.tiles", *map(str, args)], capture_output=True, text=True, env=env, timeout=300
     )
@@ -67,6 +67,13 @@ def test_tiles_are_the_chunked_map_for_any_worker_count(tmp_path):
         outputs[workers] = folder_bytes(out)
     # Byte for byte the same folder, whatever the number of workers.
     assert outputs[1] == outputs[0] and outputs[2] == outputs[0]
+    # A worker process killed after writing a tile, before reporting it: Dask runs the task again.
+    marker = tmp_path / "killed"
+    out = tmp_path / "killed_run"
+    kill = {"TAILOR_TILES_KILL_ONCE": "0_0_0_0=%s" % marker}
+    code, stdout, stderr = run_tiles(*common, "-o", out, "--workers", 2, env=kill)
+    assert code == 0, stderr
+    assert marker.exists() and folder_bytes(out) == outputs[0]
     out = tmp_path / "w2"
     tileset = json.loads((out / "tileset.json").read_text())
     assert tileset["asset"]["version"] == "1.1"
