@@ -2,7 +2,7 @@
 # End-to-end test of a tileset in the viewer, run by ctest from the repo root as
 #   bash tests/tiles_view_test.sh <tailor-binary>
 # 1. `python3 -m tailor.tiles` (the Python module built beside the binary) maps the horse as tiles
-#    with levels of detail (no Dask: --workers 0);
+#    with levels of detail (no Dask: --workers 0); every tile passes the glTF validator;
 # 2. `tailor view OUTDIR/tileset.json` serves the tileset's folder; a file that is not a tileset
 #    gives one error line and exit 1;
 # 3. headless Chromium with 3d-tiles-renderer loads every leaf tile, shows the textured horse, and
@@ -37,6 +37,10 @@ trap cleanup EXIT
 PYTHONPATH="$python_dir" timeout 120 /usr/bin/python3 -m tailor.tiles tests/data/meshes/horse.ply -o "$tmp/horse_tiles" \
   --chunk-cell -4 --texture examples/gravel.png --workers 0 -q || fail "python3 -m tailor.tiles failed"
 [ -s "$tmp/horse_tiles/tileset.json" ] || fail "no tileset.json"
+# Every tile, leaves and parents, passes the Khronos glTF validator without a warning (the shared
+# texture read beside them).
+timeout 120 node tests/tools/validate_gltf.mjs --strict --allow-external "$tmp"/horse_tiles/tiles/*.glb >"$tmp/validate.log" \
+  || fail "glTF validator: $(grep -v 'errors 0 warnings 0' "$tmp/validate.log" | head -5)"
 
 # --- 2. tailor view: not a tileset -----------------------------------------------------------------
 echo '{"name": "not a tileset"}' >"$tmp/other.json"
