@@ -227,3 +227,17 @@ def test_errors_are_one_line_and_leave_the_output_as_it_was(tmp_path):
     code, _, stderr = run_tiles(HORSE, "-o", other, "--workers", 0)
     assert code == 1 and "not a folder of tiles" in stderr
     assert (other / "keep.txt").read_text() == "mine"
+
+
+@pytest.mark.filterwarnings("ignore:make_current is deprecated:DeprecationWarning")  # Debian's tornado and Dask
+def test_a_running_scheduler_gives_the_same_tiles(tmp_path):
+    from distributed import LocalCluster
+
+    common = [HORSE, "--chunk-cell", CELL, "--texture-size", 128, "--json"]
+    code, _, stderr = run_tiles(*common, "-o", tmp_path / "here", "--workers", 0)
+    assert code == 0, stderr
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        code, stdout, stderr = run_tiles(*common, "-o", tmp_path / "there", "--scheduler", cluster.scheduler_address)
+    assert code == 0, stderr
+    assert json.loads(stdout)["workers"] is None
+    assert folder_bytes(tmp_path / "there") == folder_bytes(tmp_path / "here")
