@@ -2,6 +2,7 @@
 // clients that map a streamed world piece by piece.
 #include "bindings.h"
 #include "tailor/chunked_mapper.h"
+#include "tailor/mapping.h"
 
 namespace tailor::python {
 namespace {
@@ -18,25 +19,37 @@ py::tuple cell_tuple(const ChunkCell& cell) { return py::make_tuple(cell[0], cel
 void bind_chunks(py::module_& m) {
   py::class_<ChunkedMapper>(
       m, "ChunkedMapper",
-      "ChunkedMapper(cell_exponent, texels_per_unit, *, threads=0, field_following=1.0, max_stretch=0.25)\n\n"
+      "ChunkedMapper(cell_exponent, texels_per_unit, *, threads=0, field_following=1.0, max_stretch=0.25,\n"
+      "              texture_size=None, crack_rings=None)\n\n"
       "A mapping kept chunk by chunk, for worlds that load and change piece by piece. Chunks are the cells\n"
       "of a grid anchored at the world origin, side 2**cell_exponent world units (tailor map --chunk-cell);\n"
       "a face belongs to the cell of its centroid. A chunk's UVs depend on its own faces only: the same\n"
       "bits as `tailor map --chunks on --chunk-cell N` gives that chunk inside the whole mesh at the same\n"
       "density, whatever else is loaded, and setting or removing one chunk changes no other.\n"
-      "texels_per_unit: texture pixels per world unit.")
+      "texels_per_unit: texture pixels per world unit. texture_size: (width, height) of one texture repeat in\n"
+      "pixels (the lattice the crack closing snaps to; None = 512 x 512), as tailor.map's texture_size or\n"
+      "texture; crack_rings: None = 16, as tailor.map.")
       .def(py::init([](int cell_exponent, double texels_per_unit, uint32_t threads, float field_following,
-                       float max_stretch) {
+                       float max_stretch, const py::object& texture_size, const py::object& crack_rings) {
              MapTextureOptions options;
              options.mapping.threads = threads;
              options.mapping.field_following = field_following;
              options.mapping.max_stretch = max_stretch;
+             if (!crack_rings.is_none()) options.mapping.crack_rings = crack_rings.cast<uint32_t>();
+             if (!texture_size.is_none()) {
+               // The lattice of whole repeats the crack closing snaps to, as tailor.map(texture_size=...).
+               const auto size = texture_size.cast<std::vector<int>>();
+               if (size.size() != 2 || size[0] <= 0 || size[1] <= 0)
+                 raise_error("texture_size must be (width, height), positive, got " + sequence_text(texture_size));
+               if (const Status s = set_map_texture_size(options, size[0], size[1]); !s) raise_status(s);
+             }
              auto mapper = std::make_unique<ChunkedMapper>(options, cell_exponent, texels_per_unit);
              if (const Status s = mapper->check(); !s) raise_status(s);
              return mapper;
            }),
            py::arg("cell_exponent"), py::arg("texels_per_unit"), py::kw_only(), py::arg("threads") = 0,
-           py::arg("field_following") = 1.f, py::arg("max_stretch") = MappingOptions{}.max_stretch)
+           py::arg("field_following") = 1.f, py::arg("max_stretch") = MappingOptions{}.max_stretch,
+           py::arg("texture_size") = py::none(), py::arg("crack_rings") = py::none())
       .def(
           "set_chunk",
           [](ChunkedMapper& mapper, const py::sequence& cell, const PyMesh& faces) {

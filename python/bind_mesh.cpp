@@ -20,11 +20,11 @@ void copy_positions(const py::array& positions, std::vector<float>& out) {
   const size_t count = static_cast<size_t>(positions.shape(0)) * 3;
   if (count / 3 > kMaxVertices) raise_status(Status::error(ErrorCode::kLimit, kArraysName, "too many vertices"));
   out.resize(count);
-  if (positions.dtype().is(py::dtype::of<float>())) {
+  if (positions.dtype().equal(py::dtype::of<float>())) {
     const auto typed = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(positions);
     const py::gil_scoped_release release;
     if (count) std::memcpy(out.data(), typed.data(), count * sizeof(float));
-  } else if (positions.dtype().is(py::dtype::of<double>())) {
+  } else if (positions.dtype().equal(py::dtype::of<double>())) {
     const auto typed = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(positions);
     const double* in = typed.data();
     const py::gil_scoped_release release;

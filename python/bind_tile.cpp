@@ -19,7 +19,7 @@ namespace {
 
 // (H, W) or (H, W, C) uint8 with C in 1..4 -> Image (rows top first, interleaved channels).
 Image image_from_array(const py::array& array) {
-  if (!array.dtype().is(py::dtype::of<uint8_t>()))
+  if (!array.dtype().equal(py::dtype::of<uint8_t>()))
     raise_error("image must be a uint8 array (H, W) or (H, W, C), got " + describe(array));
   if (array.ndim() != 2 && array.ndim() != 3)
     raise_error("image must be a uint8 array (H, W) or (H, W, C), got " + describe(array));

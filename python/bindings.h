@@ -1,6 +1,7 @@
 // The Python module `tailor`: what the binding files share. One file per entry point
-// (bind_mesh.cpp, bind_map.cpp, bind_tile.cpp, bind_eval.cpp, bind_save.cpp, bind_chunks.cpp); errors and the
-// progress bridge in errors.cpp and progress.cpp. Every call releases the GIL while the library works.
+// (bind_mesh.cpp, bind_map.cpp, bind_tile.cpp, bind_eval.cpp, bind_save.cpp, bind_chunks.cpp,
+// bind_tiles.cpp); errors and the progress bridge in errors.cpp and progress.cpp. Every call
+// releases the GIL while the library works.
 #pragma once
 
 #include <pybind11/numpy.h>
@@ -98,5 +99,6 @@ void bind_tile_set(py::module_& m);
 void bind_eval(py::module_& m);
 void bind_save(py::module_& m);
 void bind_chunks(py::module_& m);
+void bind_tiles(py::module_& m);
 
 }  // namespace tailor::python

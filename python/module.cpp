@@ -16,4 +16,5 @@ PYBIND11_MODULE(_tailor, m) {
   tp::bind_eval(m);
   tp::bind_save(m);
   tp::bind_chunks(m);
+  tp::bind_tiles(m);
 }

@@ -3,6 +3,7 @@
 // seams view draws the seams `tailor eval` calls visible in red, the invisible ones in green.
 // Frames are drawn only when something changed, so a 1 M face mesh costs nothing while idle.
 // A small test hook (window.tailorViewer) lets the browser test switch views and read pixels.
+// A tileset.json (`tailor view OUTDIR/tileset.json`) is shown by tileset_view.js instead.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { DRACOLoader } from 'three/addons/loaders/DRACOLoader.js';
@@ -33,6 +34,7 @@ const stats = {
 let frames = 0;
 let dirty = true;
 let ready = false;
+let tilesetMode = false;  // a 3D Tiles tileset (tileset_view.js) instead of one .glb
 
 const container = document.getElementById('view');
 const view = createView(container, () => { dirty = true; });
@@ -69,6 +71,14 @@ async function load() {
   const config = await (await fetch('/config.json')).json();
   document.getElementById('title').textContent = config.name || 'tailor viewer';
   document.title = `${config.name} - tailor viewer`;
+  if (config.tileset) {
+    // A 3D Tiles tileset: streamed by 3d-tiles-renderer (tileset_view.js), which draws every frame.
+    tilesetMode = true;
+    document.getElementById('panel').style.display = 'none';
+    const { showTileset } = await import('./tileset_view.js');
+    await showTileset(config, view, showError);
+    return;
+  }
   // `tailor map --compress meshopt|draco` files: the decoders are three.js's own (WebAssembly; Draco's
   // in a worker), served from node_modules like the rest of three.js.
   const loader = new GLTFLoader();
@@ -217,5 +227,5 @@ window.tailorViewer = {
 bindPanel();
 animate();
 load()
-  .then(() => { ready = true; dirty = true; })
+  .then(() => { ready = !tilesetMode; dirty = true; })
   .catch((e) => showError(`cannot load the model: ${e.message}`));

@@ -1,4 +1,5 @@
-// tailor view: serve the web viewer (web/, three.js) and one .glb on 127.0.0.1 until Ctrl-C.
+// tailor view: serve the web viewer (web/, three.js) and one .glb, or a 3D Tiles tileset and its
+// folder, on 127.0.0.1 until Ctrl-C.
 #include <unistd.h>
 
 #include <array>
@@ -116,18 +117,56 @@ Status add_texture(const std::string& path, std::vector<Route>& routes, nlohmann
   return Status::ok();
 }
 
+//! A 3D Tiles tileset (a tileset.json, e.g. from `python3 -m tailor.tiles`): the files in its
+//! folder and below (tile contents, the shared texture) are served under /tileset/, as the
+//! tileset names them; hidden files and folders are not.
+Status add_tileset(const std::string& path, std::vector<Route>& routes, nlohmann::json& config) {
+  namespace fs = std::filesystem;
+  std::ifstream in(path);
+  if (!in) return Status::error(ErrorCode::kIo, path, "cannot open file");
+  const nlohmann::json tileset = nlohmann::json::parse(in, nullptr, false);
+  if (tileset.is_discarded() || !tileset.is_object() || !tileset.contains("asset") || !tileset.contains("root"))
+    return Status::error(ErrorCode::kParse, path, "not a 3D Tiles tileset", "no \"asset\" and \"root\"");
+  const fs::path folder = fs::path(path).has_parent_path() ? fs::path(path).parent_path() : fs::path(".");
+  std::error_code error;
+  for (auto it = fs::recursive_directory_iterator(folder, error); !error && it != fs::recursive_directory_iterator();
+       it.increment(error)) {
+    const std::string name = it->path().filename().string();
+    if (!name.empty() && name[0] == '.') {
+      if (it->is_directory(error)) it.disable_recursion_pending();
+      continue;
+    }
+    if (!it->is_regular_file(error)) continue;
+    const std::string relative = fs::relative(it->path(), folder, error).generic_string();
+    if (!error && !relative.empty()) routes.push_back({"/tileset/" + relative, it->path().string(), "", ""});
+  }
+  if (error) return Status::error(ErrorCode::kIo, folder.string(), "cannot list the tileset's folder", error.message());
+  config["tileset"] = "/tileset/" + fs::path(path).filename().string();
+  config["model"] = nullptr;
+  return Status::ok();
+}
+
 int run_view(const ViewArgs& args) {
-  if (Status s = check_glb(args.input); !s) return report_error(s);
+  const bool tileset = extension_of(args.input) == "json";
+  if (!tileset) {
+    if (Status s = check_glb(args.input); !s) return report_error(s);
+  }
   std::string root;
   if (Status s = find_web_root(args.web_root, root); !s) return report_error(s);
 
   std::vector<Route> routes;
   nlohmann::json config;
   config["model"] = "/files/model.glb";
+  config["tileset"] = nullptr;
   config["name"] = base_name(args.input);
   config["texture"] = nullptr;
   config["variants"] = nullptr;
-  routes.push_back({"/files/model.glb", args.input, "", ""});
+  if (tileset) {
+    if (Status s = add_tileset(args.input, routes, config); !s) return report_error(s);
+    config["name"] = base_name(dir_of(args.input)) + "/" + base_name(args.input);
+  } else {
+    routes.push_back({"/files/model.glb", args.input, "", ""});
+  }
   if (!args.texture.empty()) {
     if (Status s = add_texture(args.texture, routes, config, args.quiet); !s) return report_error(s);
   }
@@ -186,9 +225,14 @@ Status find_web_root(const std::string& given, std::string& root) {
 }
 
 void register_view(CLI::App& app, Runner& run) {
-  auto* cmd = app.add_subcommand("view", "Open a .glb in the web viewer (three.js) served on 127.0.0.1");
+  auto* cmd = app.add_subcommand("view",
+                                 "Open a .glb or a 3D Tiles tileset.json in the web viewer (three.js) "
+                                 "served on 127.0.0.1");
   auto args = std::make_shared<ViewArgs>();
-  cmd->add_option("mesh", args->input, "binary glTF file (.glb), e.g. from 'tailor map'")->required();
+  cmd->add_option("mesh", args->input,
+                  "binary glTF file (.glb), e.g. from 'tailor map', or a 3D Tiles tileset.json (its folder is served), "
+                  "e.g. from 'python3 -m tailor.tiles'")
+      ->required();
   cmd->add_option("--texture", args->texture,
                   "texture to show instead of the embedded one: an image, or the variants .json written by "
                   "'tailor tile --variants K' (a random variant per tile cell)");
@@ -199,7 +243,8 @@ void register_view(CLI::App& app, Runner& run) {
       "Examples:\n"
       "  tailor view spot.glb                       # prints http://127.0.0.1:PORT/ : open it in a browser\n"
       "  tailor view spot.glb --port 8080 --texture gravel_tile.png\n"
-      "  tailor view spot.glb --texture gravel_tile.json   # tile variants from 'tailor tile --variants 4'");
+      "  tailor view spot.glb --texture gravel_tile.json   # tile variants from 'tailor tile --variants 4'\n"
+      "  tailor view scan_tiles/tileset.json        # the tiles of 'python3 -m tailor.tiles' (3d-tiles-renderer)");
   cmd->callback([&run, args] { run = [args] { return run_view(*args); }; });
 }
 

@@ -8,8 +8,41 @@ textures.
     tailor.save("bunny.glb", mesh, result)
 
 Every call releases the GIL while the C++ library works; errors raise tailor.Error (a ValueError)
-with the message the tailor command prints. See docs/python.md.
+with the message the tailor command prints. See docs/python.md; `python3 -m tailor.tiles` maps a
+large mesh as 3D Tiles on a Dask cluster (docs/scale.md).
 """
-from ._tailor import ChunkedMapper, Error, Mesh, Result, __version__, evaluate, load, map, material_role, save, tile, tile_set
+from ._tailor import (
+    ChunkedMapper,
+    Error,
+    Mesh,
+    Result,
+    __version__,
+    evaluate,
+    load,
+    map,
+    material_role,
+    plan_chunks,
+    save,
+    save_uvs,
+    simplify_uvs,
+    tile,
+    tile_set,
+)
 
-__all__ = ["ChunkedMapper", "Error", "Mesh", "Result", "evaluate", "load", "map", "material_role", "save", "tile", "tile_set", "__version__"]
+__all__ = [
+    "ChunkedMapper",
+    "Error",
+    "Mesh",
+    "Result",
+    "evaluate",
+    "load",
+    "map",
+    "material_role",
+    "plan_chunks",
+    "save",
+    "save_uvs",
+    "simplify_uvs",
+    "tile",
+    "tile_set",
+    "__version__",
+]

@@ -1,4 +1,6 @@
 """tailor.load and tailor.Mesh: round trips, dtypes, views, and bad arrays as errors."""
+import pickle
+
 import numpy as np
 import pytest
 
@@ -46,6 +48,16 @@ def test_non_contiguous_arrays_are_read_correctly():
     strided = np.zeros((positions.shape[0], 6), np.float64)
     strided[:, ::2] = positions
     assert np.array_equal(tailor.Mesh(strided[:, ::2], faces).positions, positions)
+
+
+def test_unpickled_arrays_are_accepted():
+    # numpy gives an unpickled array (multiprocessing, Dask) its own, equal dtype object.
+    positions, faces = bumpy_grid(8)
+    copied = pickle.loads(pickle.dumps(positions))
+    assert copied.dtype is not positions.dtype and copied.dtype == positions.dtype
+    assert np.array_equal(tailor.Mesh(copied, pickle.loads(pickle.dumps(faces))).positions, positions)
+    image = pickle.loads(pickle.dumps(np.zeros((32, 32, 3), np.uint8)))
+    assert tailor.tile(image, block=8).dtype == np.uint8
 
 
 def test_degenerate_and_duplicate_faces_are_dropped_and_counted():

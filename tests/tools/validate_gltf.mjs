@@ -4,7 +4,9 @@
 //   0  no error (and, with --strict, no warning either),
 //   1  errors (or warnings with --strict),
 //   2  usage error, unreadable file, or the validator could not run.
-// Usage: node tests/tools/validate_gltf.mjs [--strict] FILE...
+// Usage: node tests/tools/validate_gltf.mjs [--strict] [--allow-external] FILE...
+// --allow-external: images and buffers named by a relative URI are read beside the file (the
+// tiles of `python3 -m tailor.tiles` name one shared texture); otherwise they are an error.
 import { readFile } from 'node:fs/promises';
 import path from 'node:path';
 import { fileURLToPath, pathToFileURL } from 'node:url';
@@ -14,7 +16,8 @@ const validatorPath = path.resolve(here, '../../web/node_modules/gltf-validator/
 
 const args = process.argv.slice(2);
 const strict = args.includes('--strict');
-const files = args.filter((a) => a !== '--strict');
+const allowExternal = args.includes('--allow-external');
+const files = args.filter((a) => a !== '--strict' && a !== '--allow-external');
 if (files.length === 0) {
   console.error('usage: node tests/tools/validate_gltf.mjs [--strict] FILE...');
   process.exit(2);
@@ -42,8 +45,10 @@ for (const file of files) {
     report = await validator.validateBytes(bytes, {
       uri: path.basename(file),
       maxIssues: 0,  // 0 = no limit
-      // External resources are never fetched: tailor's files are self-contained.
-      externalResourceFunction: (uri) => Promise.reject(`external resource ${uri} not allowed`),
+      // External resources are fetched only when asked: tailor's single files are self-contained.
+      externalResourceFunction: (uri) => (allowExternal && !/^[a-z]+:|^\//i.test(uri)
+        ? readFile(path.join(path.dirname(file), decodeURIComponent(uri))).then((b) => new Uint8Array(b))
+        : Promise.reject(`external resource ${uri} not allowed`)),
     });
   } catch (error) {
     console.error(`validate_gltf: ${file}: validator failed: ${error}`);

@@ -1,0 +1,175 @@
+// tailor.plan_chunks, tailor.save_uvs and tailor.simplify_uvs: the chunk rule, the writer of
+// `tailor map -o` and libmeshoptimizer's simplifier for code that cuts a mesh into tiles itself
+// (python -m tailor.tiles): the rule's cells and faces as arrays, any mesh written with per-corner
+// UVs in texture pixels (as ChunkedMapper gives them), and a coarser copy that keeps those UVs.
+#include <meshoptimizer.h>
+
+#include <algorithm>
+#include <cstring>
+#include <limits>
+
+#include "bindings.h"
+#include "tailor/chunks.h"
+#include "tailor/export.h"
+
+namespace tailor::python {
+
+namespace {
+
+// (F, 3, 2) float32 per-corner UVs of `mesh`, checked.
+py::array_t<float, py::array::c_style | py::array::forcecast> corner_uv_array(const py::array& corner_uvs,
+                                                                              size_t faces) {
+  const auto uv = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(corner_uvs);
+  if (!uv || uv.ndim() != 3 || static_cast<size_t>(uv.shape(0)) != faces || uv.shape(1) != 3 || uv.shape(2) != 2)
+    raise_error("corner_uvs must be an (F, 3, 2) array with F = " + std::to_string(faces) + ", got " +
+                describe(corner_uvs));
+  return uv;
+}
+
+}  // namespace
+
+void bind_simplify(py::module_& m);
+
+void bind_tiles(py::module_& m) {
+  m.def(
+      "plan_chunks",
+      [](const PyMesh& mesh, const py::object& chunk_cell) {
+        ChunkOptions options;
+        options.mode = ChunkMode::kOn;
+        if (!chunk_cell.is_none()) {
+          const int e = chunk_cell.cast<int>();
+          if (e < -60 || e > 60) raise_error("chunk_cell must be None or a whole number in -60..60");
+          options.cell_exponent = e;
+        }
+        ChunkPlan plan;
+        Status status;
+        {
+          const py::gil_scoped_release release;
+          status = plan_chunks(mesh.mesh, options, plan);
+        }
+        if (!status) raise_status(status.with_file(mesh.source));
+        const auto chunks = static_cast<py::ssize_t>(plan.chunk_count());
+        py::array_t<int32_t> cells({chunks, py::ssize_t{3}});
+        if (chunks) std::memcpy(cells.mutable_data(), plan.cells.data(), plan.cells.size() * sizeof(plan.cells[0]));
+        py::dict d;
+        d["cell_exponent"] = plan.cell_exponent;
+        d["cell_size"] = plan.cell_size;
+        d["median_edge"] = plan.median_edge;
+        d["longest_edge"] = plan.longest_edge;
+        d["locality_radius"] = plan.locality_radius();
+        d["cells"] = cells;
+        d["chunk_start"] = py::array_t<uint32_t>({py::ssize_t(plan.chunk_start.size())}, plan.chunk_start.data());
+        d["faces"] = py::array_t<uint32_t>({py::ssize_t(plan.faces.size())}, plan.faces.data());
+        return d;
+      },
+      py::arg("mesh"), py::arg("chunk_cell") = py::none(),
+      R"(plan_chunks(mesh, chunk_cell=None) -> dict
+
+The chunked engine's rule (`tailor map --chunks on`): a grid anchored at the world origin, cell
+side 2**cell_exponent world units (chunk_cell, else from the median edge length); a face belongs
+to the cell of its centroid. Returns cell_exponent, cell_size, median_edge, longest_edge,
+locality_radius, cells (K, 3) int32 in cell order (z, then y, then x), chunk_start (K+1,) uint32
+and faces (F,) uint32: chunk k's face ids are faces[chunk_start[k]:chunk_start[k+1]].)");
+
+  m.def(
+      "save_uvs",
+      [](const py::object& path_object, const PyMesh& mesh, const py::array& corner_uvs, const py::sequence& size,
+         const py::object& texture) {
+        const std::string path = path_of(path_object);
+        const size_t faces = mesh.mesh.face_count();
+        const auto uv = corner_uv_array(corner_uvs, faces);
+        if (py::len(size) != 2) raise_error("texture_size must be (width, height), got " + sequence_text(size));
+        ExportOptions options;
+        options.texture_width = size[0].cast<int>();
+        options.texture_height = size[1].cast<int>();
+        if (options.texture_width <= 0 || options.texture_height <= 0)
+          raise_error("texture_size must be positive, got " + sequence_text(size));
+        if (!texture.is_none()) options.texture_path = path_of(texture);
+        Atlas atlas;
+        atlas.corner_uv.assign(uv.data(), uv.data() + 6 * faces);
+        atlas.patch.assign(faces, 0);
+        atlas.patch_count = faces ? 1 : 0;
+        Status status;
+        {
+          const py::gil_scoped_release release;
+          status = export_mesh(path, mesh.mesh, atlas, options);
+        }
+        if (!status) raise_status(status);
+      },
+      py::arg("path"), py::arg("mesh"), py::arg("corner_uvs"), py::arg("texture_size"), py::arg("texture") = py::none(),
+      R"(save_uvs(path, mesh, corner_uvs, texture_size, texture=None) -> None
+
+Writes the mesh with per-corner UVs given in texture pixels ((F, 3, 2), as ChunkedMapper.chunk()
+gives them), divided by texture_size = (width, height) into texture repeats exactly as `tailor
+map -o` does: .glb, .obj or .ply, atomically. texture: a PNG or JPEG to embed (.glb) or name
+(.obj); None writes the UVs with a plain material.)");
+  bind_simplify(m);
+}
+
+void bind_simplify(py::module_& m) {
+  m.def(
+      "simplify_uvs",
+      [](const PyMesh& mesh, const py::array& corner_uvs, size_t target_faces, bool lock_border) {
+        const size_t faces = mesh.mesh.face_count();
+        const auto uv = corner_uv_array(corner_uvs, faces);
+        SplitMesh split;
+        std::vector<uint32_t> kept;
+        float error = 0.f, scale = 0.f;
+        {
+          const py::gil_scoped_release release;
+          split_vertices(mesh.mesh, std::span<const float>(uv.data(), 6 * faces), split);
+          kept.resize(split.indices.size());
+          const size_t vertices = split.xref.size();
+          // Corners with one position and different UVs are one vertex to the simplifier (its
+          // seams): both sides of a UV seam move together, so the surface stays closed.
+          const size_t count = meshopt_simplify(kept.data(), split.indices.data(), split.indices.size(),
+                                                split.positions.data(), vertices, 3 * sizeof(float),
+                                                3 * std::min(target_faces, faces), std::numeric_limits<float>::max(),
+                                                lock_border ? unsigned{meshopt_SimplifyLockBorder} : 0u, &error);
+          kept.resize(count);
+          scale = meshopt_simplifyScale(split.positions.data(), vertices, 3 * sizeof(float));
+        }
+        // The kept split vertices in order of first use; each keeps its UV bit for bit.
+        std::vector<uint32_t> new_id(split.xref.size(), kInvalid);
+        std::vector<uint32_t> order;
+        for (uint32_t& v : kept) {
+          if (new_id[v] == kInvalid) {
+            new_id[v] = static_cast<uint32_t>(order.size());
+            order.push_back(v);
+          }
+          v = new_id[v];
+        }
+        const auto n = static_cast<py::ssize_t>(order.size()), f = static_cast<py::ssize_t>(kept.size() / 3);
+        py::array_t<float> positions({n, py::ssize_t{3}});
+        py::array_t<uint32_t> out_faces({f, py::ssize_t{3}});
+        py::array_t<float> out_uv({f, py::ssize_t{3}, py::ssize_t{2}});
+        float* p = positions.mutable_data();
+        for (size_t i = 0; i < order.size(); ++i)
+          for (size_t k = 0; k < 3; ++k) p[3 * i + k] = split.positions[3 * size_t{order[i]} + k];
+        if (!kept.empty()) std::memcpy(out_faces.mutable_data(), kept.data(), kept.size() * sizeof(uint32_t));
+        float* t = out_uv.mutable_data();
+        for (size_t c = 0; c < kept.size(); ++c) {
+          const uint32_t s = order[kept[c]];
+          t[2 * c] = split.uvs[2 * size_t{s}];
+          t[2 * c + 1] = split.uvs[2 * size_t{s} + 1];
+        }
+        py::dict d;
+        d["positions"] = positions;
+        d["faces"] = out_faces;
+        d["corner_uvs"] = out_uv;
+        d["error"] = static_cast<double>(error) * static_cast<double>(scale);
+        return d;
+      },
+      py::arg("mesh"), py::arg("corner_uvs"), py::arg("target_faces"), py::arg("lock_border") = true,
+      R"(simplify_uvs(mesh, corner_uvs, target_faces, lock_border=True) -> dict
+
+A coarser copy of a mapped mesh by libmeshoptimizer's simplifier (edge collapses under a quadric
+error), down to about target_faces faces where the error allows. The UVs are kept: vertices are
+split where their corners' UVs differ (as the .glb writer splits them), the simplifier moves both
+sides of such a seam together, and every kept corner has its UV bit for bit. lock_border keeps
+the mesh's open borders (a tile's sides) where they are, so neighbouring tiles still meet.
+Returns positions (V, 3), faces (F, 3), corner_uvs (F, 3, 2) and error: the largest deviation
+from the input surface the simplifier measured, in world units.)");
+}
+
+}  // namespace tailor::python

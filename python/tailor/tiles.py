@@ -1,0 +1,755 @@
+"""python3 -m tailor.tiles: a mesh mapped as tiles on a Dask cluster, written as OGC 3D Tiles 1.1.
+
+    python3 -m tailor.tiles scan.ply -o scan_tiles --texture gravel.png --workers 2
+    python3 -m tailor.tiles scan.ply -o scan_tiles --scheduler tcp://head:8786
+
+The mesh is cut by the chunked engine's rule (tailor.plan_chunks: a grid anchored at the world
+origin, cell side a power of two of world units); a tile is a cube of 2**k x 2**k x 2**k chunk
+cells (--tile-size, world units). Each tile is one Dask task that maps its chunks with
+tailor.ChunkedMapper and writes tiles/<x>_<y>_<z>.glb: a chunk's UVs depend on its own faces only,
+so every tile holds the bits `tailor map --chunks on` gives those faces inside the whole mesh, for
+any number of workers. The texture is copied once beside tileset.json and every .glb names it
+(an image URI), so that a 3D Tiles client downloads it once.
+
+A tile's faces are written in a canonical order (by their corners' coordinates), so its bytes do
+not depend on the input file's face or vertex order. tailor-tiles.json records each tile's digest
+(its geometry and the options); a re-run into the same folder maps and writes only the tiles whose
+digest changed and keeps the others' files as they are (bytes and modification times).
+
+Everything is written into a temporary folder beside OUTDIR, renamed into place at the end: a
+failed run leaves OUTDIR as it was. With --scheduler the workers write the tiles themselves, so
+OUTDIR must be on a file system every worker sees, and each worker must import the same tailor.
+"""
+import argparse
+import hashlib
+import json
+import math
+import os
+import pathlib
+import shutil
+import struct
+import sys
+import time
+
+import numpy as np
+
+import tailor
+
+MANIFEST = "tailor-tiles.json"
+FORMAT = 1  # of the manifest: a different number means every tile is written again
+
+
+class TilesError(Exception):
+    """A one-line error the command prints as `tailor.tiles: error: ...`."""
+
+
+# === Geometry ===
+
+
+def texels_per_unit_for(mesh, scale):
+    """The chunked engine's texel density for `tailor map --scale S` (unit scale 0): scale over the
+    longest side of the referenced vertices' bounding box, rounded to a power of two."""
+    used = np.zeros(mesh.vertex_count, dtype=bool)
+    used[mesh.faces.ravel()] = True
+    p = mesh.positions[used].astype(np.float64)
+    longest = float((p.max(axis=0) - p.min(axis=0)).max())
+    if not (longest > 0) or not math.isfinite(longest):
+        raise TilesError("the mesh has no extent: give --texels-per-unit")
+    x = math.log2(float(np.float32(scale)) / longest)
+    return math.ldexp(1.0, int(math.copysign(math.floor(abs(x) + 0.5), x)))  # std::round: half away from 0
+
+
+def canonical_tile(positions, faces):
+    """A tile's faces and vertices in an order that depends on its geometry only: each face turned so
+    that its smallest corner (by x, then y, then z) comes first, faces sorted by a 64-bit hash of
+    their nine coordinates' bits, vertices numbered by first use. O(F) but for one sort of the
+    hashes. Returns (positions (V, 3) float32, faces (F, 3) uint32)."""
+    faces = np.asarray(faces, dtype=np.int64)
+    c = positions[faces]  # (F, 3, 3)
+
+    def less(a, b):
+        return (a[:, 0] < b[:, 0]) | (
+            (a[:, 0] == b[:, 0]) & ((a[:, 1] < b[:, 1]) | ((a[:, 1] == b[:, 1]) & (a[:, 2] < b[:, 2])))
+        )
+
+    first = np.zeros(faces.shape[0], dtype=np.int64)
+    first[less(c[:, 1], c[:, 0])] = 1
+    smallest = np.take_along_axis(c, first[:, None, None], axis=1)[:, 0]
+    first[less(c[:, 2], smallest)] = 2
+    turn = (first[:, None] + np.arange(3)[None, :]) % 3
+    faces = np.take_along_axis(faces, turn, axis=1)
+    words = np.ascontiguousarray(positions[faces].reshape(-1, 9)).view(np.uint32).astype(np.uint64)
+    h = np.full(faces.shape[0], 0xCBF29CE484222325, dtype=np.uint64)  # FNV-1a over the 9 words
+    for k in range(9):
+        h = (h ^ words[:, k]) * np.uint64(0x100000001B3)
+    faces = faces[np.argsort(h, kind="stable")]
+    flat = faces.ravel()
+    first_use = np.full(positions.shape[0], flat.shape[0], dtype=np.int64)
+    first_use[flat[::-1]] = np.arange(flat.shape[0] - 1, -1, -1)  # the last write, the first use, wins
+    used = np.flatnonzero(first_use < flat.shape[0])
+    by_use = used[np.argsort(first_use[used], kind="stable")]
+    new_id = np.empty(positions.shape[0], dtype=np.uint32)
+    new_id[by_use] = np.arange(by_use.shape[0], dtype=np.uint32)
+    return np.ascontiguousarray(positions[by_use], dtype=np.float32), new_id[faces]
+
+
+def tile_digest(positions, faces, params):
+    h = hashlib.sha256()
+    h.update(json.dumps(params, sort_keys=True).encode())
+    h.update(np.ascontiguousarray(positions).tobytes())
+    h.update(np.ascontiguousarray(faces).tobytes())
+    return h.hexdigest()
+
+
+# === The .glb: the library's writer, the texture referenced by URI ===
+
+
+def reference_texture(path, texture_uri):
+    """Rewrites a .glb written without a texture so that its material's base colour is the image at
+    texture_uri (relative to the .glb), sampled with REPEAT as tailor's embedded textures are."""
+    data = pathlib.Path(path).read_bytes()
+    magic, version, _ = struct.unpack_from("<4sII", data, 0)
+    json_length, json_type = struct.unpack_from("<II", data, 12)
+    if magic != b"glTF" or version != 2 or json_type != 0x4E4F534A:
+        raise TilesError("%s: not a glTF 2.0 binary" % path)
+    gltf = json.loads(data[20 : 20 + json_length])
+    rest = data[20 + json_length :]
+    gltf["images"] = [{"uri": texture_uri}]
+    gltf["samplers"] = [{"magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497}]
+    gltf["textures"] = [{"sampler": 0, "source": 0}]
+    gltf["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {"index": 0}
+    text = json.dumps(gltf, separators=(",", ":")).encode()
+    text += b" " * (-len(text) % 4)
+    out = struct.pack("<4sII", b"glTF", 2, 12 + 8 + len(text) + len(rest))
+    out += struct.pack("<II", len(text), 0x4E4F534A) + text + rest
+    tmp = str(path) + ".part"
+    with open(tmp, "wb") as f:
+        f.write(out)
+    os.replace(tmp, path)
+
+
+def write_tile_glb(path, positions, faces, corner_uvs, params, texture_uri):
+    mesh = tailor.Mesh(positions, faces)
+    if mesh.face_count != faces.shape[0]:
+        raise TilesError("tile %s: %d faces dropped as degenerate" % (path, faces.shape[0] - mesh.face_count))
+    tailor.save_uvs(str(path), mesh, corner_uvs, tuple(params["texture_size"]))
+    if texture_uri:
+        reference_texture(path, texture_uri)
+
+
+# === The tasks: a leaf tile maps its chunks, a parent simplifies its children ===
+
+
+def make_mapper(params, threads):
+    return tailor.ChunkedMapper(
+        params["cell_exponent"],
+        params["texels_per_unit"],
+        threads=threads,
+        field_following=params["field_following"],
+        max_stretch=params["max_stretch"],
+        texture_size=tuple(params["texture_size"]),
+        crack_rings=params["crack_rings"],
+    )
+
+
+def node_name(level, tile):
+    return "%d_%d_%d_%d" % (level, tile[0], tile[1], tile[2])
+
+
+def glb_path(folder, name):
+    return pathlib.Path(folder) / "tiles" / (name + ".glb")
+
+
+def coarse_path(folder, name):
+    return pathlib.Path(folder) / "lod" / (name + ".bin")
+
+
+def save_coarse(path, positions, faces, uvs, error):
+    """What a node hands its parent: its content simplified to a quarter, and that step's error."""
+    head = struct.pack("<QQd", positions.shape[0], faces.shape[0], error)
+    tmp = str(path) + ".part"
+    with open(tmp, "wb") as f:
+        for block in (head, positions.astype("<f4"), faces.astype("<u4"), uvs.astype("<f4")):
+            f.write(block if isinstance(block, bytes) else block.tobytes())
+    os.replace(tmp, path)
+
+
+def load_coarse(path):
+    data = pathlib.Path(path).read_bytes()
+    v, f, error = struct.unpack_from("<QQd", data, 0)
+    at = 24
+    positions = np.frombuffer(data, "<f4", 3 * v, at).reshape(v, 3)
+    at += 12 * v
+    faces = np.frombuffer(data, "<u4", 3 * f, at).reshape(f, 3)
+    at += 12 * f
+    uvs = np.frombuffer(data, "<f4", 6 * f, at).reshape(f, 3, 2)
+    return positions, faces, uvs, error
+
+
+def clean(faces, uvs):
+    """Without faces that repeat a vertex or another face's vertices (welding and collapses make
+    some; tailor.Mesh would drop them)."""
+    ok = (faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2]) & (faces[:, 0] != faces[:, 2])
+    faces, uvs = faces[ok], uvs[ok]
+    first = np.sort(np.unique(np.sort(faces, axis=1), axis=0, return_index=True)[1])
+    return faces[first], uvs[first]
+
+
+def simplify(positions, faces, uvs, target):
+    """tailor.simplify_uvs on arrays: the open borders (the node's sides) stay where they are."""
+    faces, uvs = clean(faces, uvs)
+    r = tailor.simplify_uvs(tailor.Mesh(positions, faces), uvs, max(int(target), 1))
+    f, t = clean(r["faces"], r["corner_uvs"])
+    return r["positions"], f, t, r["error"]
+
+
+def kept(keep_from, digest, folder, name, lod):
+    """Links the previous run's files of this node into folder when its digest is the same."""
+    if not keep_from or keep_from.get("digest") != digest:
+        return False
+    pairs = [(keep_from["glb"], glb_path(folder, name))]
+    if lod:
+        pairs.append((keep_from["coarse"], coarse_path(folder, name)))
+    if not all(os.path.exists(old) for old, _ in pairs):
+        return False
+    for old, new in pairs:
+        if os.path.exists(new):  # a retried task
+            os.unlink(new)
+        os.link(old, new)
+    return True
+
+
+def finish_node(record, folder, positions, faces, uvs, params, texture_uri, lod):
+    """Writes a node's .glb (and, with levels of detail, the quarter its parent starts from)."""
+    write_tile_glb(glb_path(folder, record["name"]), positions, faces, uvs, params, texture_uri)
+    if lod:
+        p, f, t, error = simplify(positions, faces, uvs, faces.shape[0] / 4)
+        save_coarse(coarse_path(folder, record["name"]), p, f, t, error)
+        record["coarse_error"] = error
+    record["written"] = True
+    return record
+
+
+def leaf_record(job, positions, faces, params):
+    return {
+        "name": job["name"],
+        "level": 0,
+        "tile": job["tile"],
+        "digest": tile_digest(positions, faces, params),
+        "faces": int(faces.shape[0]),
+        "min": positions.min(axis=0).astype(float).tolist(),
+        "max": positions.max(axis=0).astype(float).tolist(),
+        "error": 0.0,
+        "coarse_error": 0.0,
+    }
+
+
+def map_tile(job, positions, faces, params, folder, texture_uri, keep_from, threads, lod):
+    """A leaf: puts the tile in its canonical order, maps its chunks and writes tiles/<name>.glb, or
+    links the previous run's files when the digest is the same. Returns the node's record."""
+    positions, faces = canonical_tile(positions, faces)
+    record = leaf_record(job, positions, faces, params)
+    if kept(keep_from, record["digest"], folder, job["name"], lod):
+        record["coarse_error"] = keep_from.get("coarse_error", 0.0)
+        record["written"] = False
+        return record
+    mapper = make_mapper(params, threads)
+    mesh = tailor.Mesh(positions, faces)
+    uv = np.empty((faces.shape[0], 3, 2), dtype=np.float32)
+    for cell in mapper.set_mesh(mesh):
+        chunk = mapper.chunk(cell)
+        uv[chunk["faces"]] = chunk["corner_uvs"]
+    del mapper, mesh
+    record = finish_node(record, folder, positions, faces, uv, params, texture_uri, lod)
+    # Test hook: TAILOR_TILES_KILL_ONCE=NAME=MARKER ends this worker process abruptly once, after
+    # tile NAME's files are written and before its result is sent (tests/python/test_tiles.py).
+    name, _, marker = os.environ.get("TAILOR_TILES_KILL_ONCE", "").partition("=")
+    if name == job["name"] and marker and not os.path.exists(marker):
+        pathlib.Path(marker).touch()
+        os._exit(70)
+    return record
+
+
+def build_parent(job, params, folder, texture_uri, keep_from, *children):
+    """A parent: its children's quarters joined (vertices at one position welded, so that the
+    children's shared sides can be simplified) and simplified to a quarter of the children's
+    faces; its error is its own simplification's plus the largest a child's content had."""
+    children = sorted(children, key=lambda r: r["name"])
+    h = hashlib.sha256(json.dumps(params, sort_keys=True).encode())
+    for c in children:
+        h.update(("%s %s\n" % (c["name"], c["digest"])).encode())
+    record = {
+        "name": job["name"],
+        "level": job["level"],
+        "tile": job["tile"],
+        "digest": h.hexdigest(),
+        "min": np.min([c["min"] for c in children], axis=0).tolist(),
+        "max": np.max([c["max"] for c in children], axis=0).tolist(),
+        "children": [c["name"] for c in children],
+    }
+    below = max(c["error"] + c["coarse_error"] for c in children)
+    if kept(keep_from, record["digest"], folder, job["name"], True):
+        record.update(faces=keep_from["faces"], error=keep_from["error"], coarse_error=keep_from["coarse_error"])
+        record["written"] = False
+        return record
+    parts = [load_coarse(coarse_path(folder, c["name"])) for c in children]
+    positions = np.concatenate([p[0] for p in parts])
+    offsets = np.cumsum([0] + [p[0].shape[0] for p in parts])
+    faces = np.concatenate([p[1].astype(np.int64) + offsets[k] for k, p in enumerate(parts)])
+    uvs = np.concatenate([p[2] for p in parts])
+    positions, inverse = np.unique(positions, axis=0, return_inverse=True)
+    faces = inverse.reshape(-1)[faces].astype(np.uint32)
+    p, f, t, error = simplify(positions, faces, uvs, sum(c["faces"] for c in children) / 4)
+    record.update(faces=int(f.shape[0]), error=below + error)
+    return finish_node(record, folder, p, f, t, params, texture_uri, True)
+
+
+def map_in_process(jobs, order, params, folder, texture_uri, threads, lod):
+    """--workers 0: the tiles to write mapped together by one ChunkedMapper.set_mesh (the library's
+    chunked map, its chunks in parallel on `threads` threads), then written one by one. Yields
+    (job index, record) in `order`."""
+    pending = []
+    jobs = list(jobs)
+    for i in order:
+        job, p, f, keep = jobs[i]
+        p, f = canonical_tile(p, f)
+        jobs[i] = (job, p, f, keep)
+        if keep and keep.get("digest") == tile_digest(p, f, params):
+            yield i, map_tile(job, p, f, params, folder, texture_uri, keep, threads, lod)
+        else:
+            pending.append(i)
+    if not pending:
+        return
+    offsets = np.cumsum([0] + [jobs[i][1].shape[0] for i in pending])
+    face_offsets = np.cumsum([0] + [jobs[i][2].shape[0] for i in pending])
+    positions = np.concatenate([jobs[i][1] for i in pending])
+    faces = np.concatenate([jobs[i][2] + np.uint32(offsets[k]) for k, i in enumerate(pending)])
+    mapper = make_mapper(params, threads)
+    uv = np.empty((faces.shape[0], 3, 2), dtype=np.float32)
+    for cell in mapper.set_mesh(tailor.Mesh(positions, faces)):
+        chunk = mapper.chunk(cell)
+        uv[chunk["faces"]] = chunk["corner_uvs"]
+        mapper.remove_chunk(cell)
+    del mapper
+    for k, i in enumerate(pending):
+        job, p, f, _ = jobs[i]
+        record = leaf_record(job, p, f, params)
+        yield i, finish_node(record, folder, p, f, uv[face_offsets[k] : face_offsets[k + 1]], params, texture_uri, lod)
+
+
+def parent_levels(leaves):
+    """The parents above the leaf tiles: level L groups the tiles whose coordinates agree after a
+    shift by L (2 x 2 x 2 blocks), up to one root, or to the level where grouping stops helping
+    (tiles on both sides of a zero coordinate never meet). Returns [[(tile, child names)], ...]."""
+    levels = []
+    below = {tuple(t): node_name(0, t) for t in leaves}
+    level = 0
+    while len(below) > 1 and level < 40:
+        level += 1
+        groups = {}
+        for tile, name in sorted(below.items(), key=lambda item: item[1]):
+            groups.setdefault(tuple(v >> 1 for v in tile), []).append(name)
+        if len(groups) == len(below) and level > 1:
+            break
+        levels.append(sorted(groups.items(), key=lambda g: (g[0][2], g[0][1], g[0][0])))
+        below = {tile: node_name(level, tile) for tile in groups}
+    return levels
+
+
+# === The tileset ===
+
+
+def box_volume(lo, hi):
+    """A 3D Tiles box around glTF coordinates lo..hi (Y up), in the tileset's Z-up frame (a client
+    turns glTF content Y-up to Z-up: x, y, z -> x, -z, y)."""
+    c = [(a + b) / 2 for a, b in zip(lo, hi)]
+    h = [max((b - a) / 2, 1e-9) for a, b in zip(lo, hi)]
+    return {"box": [c[0], -c[2], c[1], h[0], 0, 0, 0, h[2], 0, 0, 0, h[1]]}
+
+
+def tileset_json(records, lod):
+    """Leaves under their parents (refine REPLACE: a parent's simplified copy gives way to its
+    children), or, without levels of detail, every leaf under one root (refine ADD)."""
+    by_name = {r["name"]: r for r in records}
+    lo = np.min([r["min"] for r in records], axis=0).tolist()
+    hi = np.max([r["max"] for r in records], axis=0).tolist()
+    diagonal = float(np.linalg.norm(np.subtract(hi, lo)))
+
+    def node(r):
+        out = {
+            "boundingVolume": box_volume(r["min"], r["max"]),
+            "geometricError": float(r["error"]),
+            "content": {"uri": "tiles/%s.glb" % r["name"]},
+        }
+        if r.get("children"):
+            out["refine"] = "REPLACE"
+            out["children"] = [node(by_name[c]) for c in r["children"]]
+        return out
+
+    top_level = max(r["level"] for r in records) if lod else 0
+    top = [r for r in records if r["level"] == top_level]
+    if lod and len(top) == 1:
+        root = node(top[0])
+        error = max(root["geometricError"], diagonal)  # a client far away still shows the root
+    else:
+        root = {
+            "boundingVolume": box_volume(lo, hi),
+            "geometricError": diagonal,
+            "refine": "REPLACE" if lod else "ADD",
+            "children": [node(r) for r in top],
+        }
+        error = diagonal
+    return {
+        "asset": {"version": "1.1", "generator": "tailor %s (python3 -m tailor.tiles)" % tailor.__version__},
+        "geometricError": error,
+        "root": root,
+    }
+
+
+# === The run ===
+
+
+def image_size(path):
+    """(width, height) of a PNG or JPEG, from its header."""
+    with open(path, "rb") as f:
+        head = f.read(32)
+        if head[:8] == b"\x89PNG\r\n\x1a\n" and head[12:16] == b"IHDR":
+            return struct.unpack(">II", head[16:24])
+        if head[:2] == b"\xff\xd8":
+            f.seek(2)
+            while True:
+                marker = f.read(2)
+                if len(marker) < 2 or marker[0] != 0xFF:
+                    break
+                (length,) = struct.unpack(">H", f.read(2))
+                if marker[1] in (0xC0, 0xC1, 0xC2, 0xC3, 0xC5, 0xC6, 0xC7, 0xC9, 0xCA, 0xCB, 0xCD, 0xCE, 0xCF):
+                    height, width = struct.unpack(">xHH", f.read(5))
+                    return width, height
+                f.seek(length - 2, 1)
+    raise TilesError("%s: not a PNG or JPEG image" % path)
+
+
+def plan_tiles(mesh, args):
+    """The tiles: {tile: face ids}, and the parameters every tile's digest and mapping use."""
+    plan = tailor.plan_chunks(mesh, args.chunk_cell)
+    e = plan["cell_exponent"]
+    if args.tile_size is None:
+        level = 0
+    else:
+        t = math.log2(args.tile_size) if args.tile_size > 0 else float("nan")
+        if not (t == math.floor(t)) or t < e:
+            raise TilesError(
+                "--tile-size must be the chunk cell (%g) times a power of two, got %g" % (plan["cell_size"], args.tile_size)
+            )
+        level = int(t) - e
+    tpu = args.texels_per_unit if args.texels_per_unit is not None else texels_per_unit_for(mesh, args.scale)
+    if args.texture:
+        width, height = image_size(args.texture)
+    else:
+        width = height = args.texture_size
+    params = {
+        "format": FORMAT,
+        "tailor": tailor.__version__,
+        "cell_exponent": e,
+        "tile_level": level,
+        "texels_per_unit": float(np.float32(tpu)),
+        "texture_size": [int(width), int(height)],
+        "field_following": args.field_following,
+        "max_stretch": args.max_stretch,
+        "crack_rings": args.crack_rings,
+        "lod": args.lod,
+    }
+    tiles = {}
+    cells = plan["cells"] >> level  # arithmetic shift: floor division by 2**level
+    start, faces = plan["chunk_start"], plan["faces"]
+    for k in range(cells.shape[0]):
+        tiles.setdefault(tuple(int(v) for v in cells[k]), []).append(faces[start[k] : start[k + 1]])
+    tiles = {t: np.concatenate(parts) for t, parts in tiles.items()}
+    return plan, params, tiles
+
+
+class Progress:
+    """`tiles: 12/40 (3 kept)` on one terminal line, updated in place; nothing when not a terminal."""
+
+    def __init__(self, total, enabled):
+        self.total, self.done, self.kept = total, 0, 0
+        self.enabled = enabled and sys.stderr.isatty()
+        self.last = 0.0
+
+    def step(self, written):
+        self.done += 1
+        self.kept += 0 if written else 1
+        now = time.monotonic()
+        if self.enabled and (now - self.last > 0.1 or self.done == self.total):
+            self.last = now
+            bar = "#" * (30 * self.done // self.total)
+            sys.stderr.write("\rtiles [%-30s] %d/%d (%d kept)" % (bar, self.done, self.total, self.kept))
+            if self.done == self.total:
+                sys.stderr.write("\n")
+            sys.stderr.flush()
+
+
+def previous_output(outdir, params):
+    """{tile name: {digest, path}} of an earlier run into outdir with the same parameters."""
+    manifest = outdir / MANIFEST
+    if not outdir.exists():
+        return {}
+    if not manifest.exists():
+        if any(outdir.iterdir()):
+            raise TilesError("%s exists and is not a folder of tiles written by tailor.tiles" % outdir)
+        return {}
+    try:
+        old = json.loads(manifest.read_text())
+    except ValueError:
+        return {}
+    if old.get("params") != params:
+        return {}
+    out = {}
+    for name, r in old.get("tiles", {}).items():
+        if isinstance(r, dict):
+            out[name] = dict(r, glb=str(glb_path(outdir, name)), coarse=str(coarse_path(outdir, name)))
+    return out
+
+
+def start_client(args):
+    import logging
+
+    import dask
+    from dask.distributed import Client, LocalCluster
+
+    if args.scheduler:
+        return Client(args.scheduler), None
+    # Dask starts workers with MALLOC_TRIM_THRESHOLD_=65536, which turns off glibc's adaptive mmap
+    # threshold: every large buffer of the mapping is then mapped and unmapped per tile (page
+    # faults: 20-30 % more time on the 6.2 M-face horse). The workers here keep glibc's default.
+    environ = dict(dask.config.get("distributed.nanny.pre-spawn-environ"))
+    environ.pop("MALLOC_TRIM_THRESHOLD_", None)
+    dask.config.set({"distributed.nanny.pre-spawn-environ": environ})
+    cluster = LocalCluster(
+        n_workers=args.workers,
+        threads_per_worker=1,
+        processes=True,
+        dashboard_address=None,
+        silence_logs=logging.ERROR,
+    )
+    return Client(cluster), cluster
+
+
+def run(args):
+    outdir = pathlib.Path(args.output).resolve()
+    t0 = time.monotonic()
+    try:
+        mesh = tailor.load(args.input)
+    except tailor.Error as e:
+        raise TilesError(str(e)) from None
+    if args.texture and not os.path.isfile(args.texture):
+        raise TilesError("%s: no such file" % args.texture)
+    plan, params, tiles = plan_tiles(mesh, args)
+    old = previous_output(outdir, params)
+    t_plan = time.monotonic()
+
+    tmp = outdir.parent / (".%s.tmp-%d" % (outdir.name, os.getpid()))
+    shutil.rmtree(tmp, ignore_errors=True)
+    (tmp / "tiles").mkdir(parents=True)
+    client = cluster = None
+    try:
+        texture_uri = None
+        if args.texture:
+            name = "texture" + pathlib.Path(args.texture).suffix.lower()
+            previous = outdir / name
+            if previous.exists() and previous.read_bytes() == pathlib.Path(args.texture).read_bytes():
+                os.link(previous, tmp / name)
+            else:
+                shutil.copyfile(args.texture, tmp / name)
+            texture_uri = "../" + name
+        if args.lod:
+            (tmp / "lod").mkdir()
+        positions = mesh.positions
+        faces = mesh.faces
+        jobs = []
+        for tile in sorted(tiles, key=lambda t: (t[2], t[1], t[0])):
+            # The tile's own vertices; its canonical order is the task's work (in parallel).
+            used, compact = np.unique(faces[tiles[tile]], return_inverse=True)
+            p, f = positions[used], compact.reshape(-1, 3).astype(np.uint32)
+            name = node_name(0, tile)
+            jobs.append(({"name": name, "tile": list(tile)}, p, f, old.get(name)))
+        del positions, faces
+        levels = parent_levels([job[0]["tile"] for job in jobs]) if args.lod else []
+        t_cut = time.monotonic()
+        # Largest first, so that the last tasks to finish are small ones.
+        order = sorted(range(len(jobs)), key=lambda i: -jobs[i][2].shape[0])
+        progress = Progress(len(jobs) + sum(len(groups) for groups in levels), not args.quiet)
+        records = {}
+        folder = str(tmp)
+        if args.workers == 0 and not args.scheduler:
+            for i, record in map_in_process(jobs, order, params, folder, texture_uri, args.threads, args.lod):
+                records[record["name"]] = record
+                progress.step(record["written"])
+            for level, groups in enumerate(levels, start=1):
+                for tile, names in groups:
+                    job = {"name": node_name(level, tile), "level": level, "tile": list(tile)}
+                    kids = [records[n] for n in names]
+                    record = build_parent(job, params, folder, texture_uri, old.get(job["name"]), *kids)
+                    records[job["name"]] = record
+                    progress.step(record["written"])
+        else:
+            from dask.distributed import as_completed
+
+            client, cluster = start_client(args)
+            threads = args.threads or 1
+            futures = {}
+            for i in order:
+                job, p, f, keep = jobs[i]
+                futures[job["name"]] = client.submit(
+                    map_tile, job, p, f, params, folder, texture_uri, keep, threads, args.lod, key="tile-%s-%s" % (tmp.name, job["name"])
+                )
+            for level, groups in enumerate(levels, start=1):
+                for tile, names in groups:
+                    job = {"name": node_name(level, tile), "level": level, "tile": list(tile)}
+                    kids = [futures[n] for n in names]
+                    futures[job["name"]] = client.submit(
+                        build_parent, job, params, folder, texture_uri, old.get(job["name"]), *kids, key="tile-%s-%s" % (tmp.name, job["name"])
+                    )
+            for fut in as_completed(list(futures.values())):
+                record = fut.result()
+                records[record["name"]] = record
+                progress.step(record["written"])
+        records = sorted(records.values(), key=lambda r: (-r["level"], r["tile"][2], r["tile"][1], r["tile"][0]))
+        t_map = time.monotonic()
+        (tmp / "tileset.json").write_text(json.dumps(tileset_json(records, args.lod), indent=1) + "\n")
+        fields = ("digest", "faces", "error", "coarse_error")
+        manifest = {"params": params, "tiles": {r["name"]: {k: r[k] for k in fields} for r in records}}
+        (tmp / MANIFEST).write_text(json.dumps(manifest, indent=1, sort_keys=True) + "\n")
+        # Into place: the old folder aside, the new one in, the old one removed.
+        aside = None
+        if outdir.exists():
+            aside = outdir.parent / (".%s.old-%d" % (outdir.name, os.getpid()))
+            os.rename(outdir, aside)
+        os.rename(tmp, outdir)
+        if aside:
+            shutil.rmtree(aside, ignore_errors=True)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    finally:
+        if client is not None:
+            client.close()
+        if cluster is not None:
+            cluster.close()
+    written = sum(1 for r in records if r["written"])
+    summary = {
+        "tiles": len(records),
+        "leaves": len(jobs),
+        "levels": 1 + len(levels),
+        "written": written,
+        "kept": len(records) - written,
+        "faces": int(mesh.face_count),
+        "chunks": int(plan["cells"].shape[0]),
+        "cell_size": plan["cell_size"],
+        "tile_size": plan["cell_size"] * 2 ** params["tile_level"],
+        "texels_per_unit": params["texels_per_unit"],
+        "workers": args.workers if not args.scheduler else None,
+        "seconds": {
+            "load_plan": t_plan - t0,
+            "cut": t_cut - t_plan,
+            "map_write": t_map - t_cut,
+            "total": time.monotonic() - t0,
+        },
+    }
+    return summary
+
+
+def parse_args(argv):
+    p = argparse.ArgumentParser(
+        prog="python3 -m tailor.tiles",
+        description="Maps a mesh as tiles (Dask tasks) and writes OGC 3D Tiles 1.1: OUTDIR/tileset.json, "
+        "OUTDIR/tiles/*.glb and the shared texture.",
+    )
+    p.add_argument("input", help="the mesh (.ply .obj .off .stl .glb)")
+    p.add_argument("-o", "--output", required=True, metavar="OUTDIR", help="the folder of the tileset (replaced)")
+    p.add_argument(
+        "--tile-size",
+        type=float,
+        metavar="L",
+        help="side of a tile in world units: the chunk cell times a power of two (default: the chunk cell)",
+    )
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=os.cpu_count() or 1,
+        metavar="N",
+        help="worker processes of a local Dask cluster (default: one per core); 0 maps in this process, "
+        "without Dask",
+    )
+    p.add_argument("--scheduler", metavar="tcp://HOST:8786", help="a running Dask scheduler to use instead")
+    p.add_argument(
+        "--threads",
+        type=int,
+        default=0,
+        metavar="T",
+        help="threads of each tile's mapping (default: 1 per Dask worker; all cores with --workers 0)",
+    )
+    p.add_argument("--texture", metavar="T", help="PNG or JPEG texture: its size sets the repeat, tiles name it")
+    p.add_argument("--texture-size", type=int, default=512, help="pixels of one repeat without --texture")
+    p.add_argument("--scale", type=float, default=800.0, help="as tailor map --scale (density from the bounding box)")
+    p.add_argument(
+        "--texels-per-unit",
+        type=float,
+        metavar="D",
+        help="texture pixels per world unit (instead of --scale: does not depend on the bounding box)",
+    )
+    p.add_argument("--chunk-cell", type=int, metavar="E", help="chunk cell side 2**E world units (default: auto)")
+    p.add_argument("--field-following", type=float, default=1.0, help="as tailor map (0..1; default 1)")
+    p.add_argument("--max-stretch", type=float, default=0.25, help="as tailor map")
+    p.add_argument("--crack-rings", type=int, default=None, help="as tailor map (default 16)")
+    p.add_argument(
+        "--no-lod",
+        dest="lod",
+        action="store_false",
+        help="no levels of detail: the leaf tiles only, under one root (refine ADD)",
+    )
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no summary")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    args = p.parse_args(argv)
+    if args.workers < 0:
+        p.error("--workers must be 0 or more")
+    if args.threads < 0 or args.threads > 64:
+        p.error("--threads must be in 0..64")
+    return args
+
+
+def main(argv=None):
+    args = parse_args(argv)
+    try:
+        summary = run(args)
+    except TilesError as e:
+        print("tailor.tiles: error: %s" % e, file=sys.stderr)
+        return 1
+    except tailor.Error as e:
+        print("tailor.tiles: error: %s" % e, file=sys.stderr)
+        return 1
+    except OSError as e:
+        print("tailor.tiles: error: %s" % e, file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("tailor.tiles: interrupted; %s left as it was" % args.output, file=sys.stderr)
+        return 130
+    if args.json:
+        print(json.dumps(summary, indent=1))
+    elif not args.quiet:
+        print(
+            "tailor.tiles: %d tiles (%d written, %d kept), %d faces, %.2f s -> %s/tileset.json"
+            % (
+                summary["tiles"],
+                summary["written"],
+                summary["kept"],
+                summary["faces"],
+                summary["seconds"]["total"],
+                args.output,
+            )
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
