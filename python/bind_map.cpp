@@ -393,6 +393,30 @@ void bind_map(py::module_& m) {
       py::arg("unit_scale") = OrientationOptions{}.fixed_unit_scale,
       py::arg("smooth") = OrientationOptions{}.smooth_passes, py::arg("material") = py::none(),
       py::arg("chunks") = "auto", py::arg("chunk_cell") = py::none(), map_docstring().c_str());
+
+  m.def(
+      "auto_field_following",
+      [](const py::object& texture) {
+        const std::string path = path_of(texture);  // with the GIL: it reads a Python object
+        Image image;
+        Status s;
+        {
+          const py::gil_scoped_release release;
+          s = load_image(path, image);
+        }
+        if (!s) raise_status(s);
+        MappingOptions mapping;
+        {
+          const py::gil_scoped_release release;
+          adapt_mapping_to_texture(image, mapping);
+        }
+        return py::make_tuple(mapping.field_following, mapping.crack_rings);
+      },
+      py::arg("texture"),
+      "auto_field_following(texture) -> (field_following, crack_rings)\n\n"
+      "What field_following='auto' (tailor.map, tailor map) picks for a texture: (0.0, 32) for one\n"
+      "without a direction (gravel, grass), else (1.0, 16). For callers that set the options\n"
+      "themselves (ChunkedMapper, tailor.tiles).");
 }
 
 }  // namespace tailor::python

@@ -150,6 +150,7 @@ def tile_set(
     same_size: bool = False,
     progress: Optional[_Progress] = None,
 ) -> List[str]: ...
+def auto_field_following(texture: _Path) -> Tuple[float, int]: ...
 def evaluate(
     mesh: Mesh,
     corner_uvs: npt.ArrayLike,

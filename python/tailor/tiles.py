@@ -447,6 +447,7 @@ def plan_tiles(mesh, args):
         width, height = image_size(args.texture)
     else:
         width = height = args.texture_size
+    field_following, crack_rings = resolve_field_following(args)
     params = {
         "format": FORMAT,
         "tailor": tailor.__version__,
@@ -454,9 +455,9 @@ def plan_tiles(mesh, args):
         "tile_level": level,
         "texels_per_unit": float(np.float32(tpu)),
         "texture_size": [int(width), int(height)],
-        "field_following": args.field_following,
+        "field_following": field_following,
         "max_stretch": args.max_stretch,
-        "crack_rings": args.crack_rings,
+        "crack_rings": crack_rings,
         "lod": args.lod,
     }
     tiles = {}
@@ -466,6 +467,22 @@ def plan_tiles(mesh, args):
         tiles.setdefault(tuple(int(v) for v in cells[k]), []).append(faces[start[k] : start[k + 1]])
     tiles = {t: np.concatenate(parts) for t, parts in tiles.items()}
     return plan, params, tiles
+
+
+def resolve_field_following(args):
+    """(field_following, crack_rings) as tailor map resolves them: auto follows the texture's direction."""
+    if args.field_following != "auto":
+        try:
+            value = float(args.field_following)
+        except ValueError:
+            raise TilesError("--field-following must be auto or a number in [0, 1], got %r" % args.field_following)
+        if not 0.0 <= value <= 1.0:
+            raise TilesError("--field-following must be auto or a number in [0, 1], got %g" % value)
+        return value, args.crack_rings
+    if not args.texture:
+        return 1.0, args.crack_rings
+    value, rings = tailor.auto_field_following(args.texture)
+    return float(value), (args.crack_rings if args.crack_rings is not None else int(rings))
 
 
 class Progress:
@@ -699,7 +716,11 @@ def parse_args(argv):
         help="texture pixels per world unit (instead of --scale: does not depend on the bounding box)",
     )
     p.add_argument("--chunk-cell", type=int, metavar="E", help="chunk cell side 2**E world units (default: auto)")
-    p.add_argument("--field-following", type=float, default=1.0, help="as tailor map (0..1; default 1)")
+    p.add_argument(
+        "--field-following",
+        default="auto",
+        help="as tailor map: 0..1, or auto (default: 0 with 32 crack rings for a texture without a direction, else 1)",
+    )
     p.add_argument("--max-stretch", type=float, default=0.25, help="as tailor map")
     p.add_argument("--crack-rings", type=int, default=None, help="as tailor map (default 16)")
     p.add_argument(

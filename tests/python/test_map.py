@@ -223,3 +223,19 @@ def test_a_set_of_quarter_turn_tiles_is_mapped_with_symmetry_4(tmp_path, tailor_
     assert tailor.map(mesh, material=tmp_path / "py4", relax_iterations=0).stats["options"]["symmetry"] == 4
     with pytest.raises(tailor.Error, match="--symmetry: 3 not in"):
         tailor.map(mesh, symmetry=3)
+
+
+def test_auto_field_following_is_what_map_picks_for_a_texture():
+    brick = DATA / "textures" / "brick-gray-512.png"
+    assert tailor.auto_field_following(GRAVEL) == (0.0, 32)  # no direction: rigid unfolding, 32 rings
+    assert tailor.auto_field_following(brick) == (1.0, 16)  # courses of bricks: follow the field
+    mesh = tailor.load(SPOT)
+    for texture in (GRAVEL, brick):
+        field_following, crack_rings = tailor.auto_field_following(texture)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            auto = tailor.map(mesh, texture=texture)
+            given = tailor.map(mesh, texture=texture, field_following=field_following, crack_rings=crack_rings)
+        assert np.array_equal(auto.corner_uvs, given.corner_uvs)
+    with pytest.raises(tailor.Error, match="cannot open"):
+        tailor.auto_field_following(DATA / "textures" / "missing.png")

@@ -93,7 +93,8 @@ def test_tiles_are_the_chunked_map_for_any_worker_count(tmp_path):
     assert all(n["refine"] == "REPLACE" and n["geometricError"] > 0 for n in parents)
     assert (out / "texture.png").read_bytes() == TEXTURE.read_bytes()
 
-    # Every face of the mesh in exactly one leaf tile, with the UVs of `tailor map --chunks on`.
+    # Every face of the mesh in exactly one leaf tile, with the UVs of `tailor map --chunks on` (both
+    # with their default field following: auto, from the texture).
     mesh = tailor.load(HORSE)
     with pytest.warns(UserWarning, match="does not wrap"):  # the example texture is not a tile: fine here
         whole = tailor.map(
@@ -103,7 +104,6 @@ def test_tiles_are_the_chunked_map_for_any_worker_count(tmp_path):
             chunk_cell=CELL,
             unit_scale=1.0,
             scale=summary["texels_per_unit"],
-            field_following=1.0,
         )
     assert whole.stats["mapping"]["texels_per_unit"] == summary["texels_per_unit"]
     reference = {}
