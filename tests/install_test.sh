@@ -194,6 +194,7 @@ else
       case $spec in
         three) target=/node_modules/three/build/three.module.js ;;
         three/addons/*) target=/node_modules/three/examples/jsm/${spec#three/addons/} ;;
+        /node_modules/*) target=$spec ;;
         ./* | ../*)
           target=${path%/*}/$spec
           while [[ $target == */./* ]]; do target=${target/\/.\//\/}; done
@@ -201,8 +202,13 @@ else
         *) fail "$path imports '$spec', which the page cannot resolve"; continue ;;
       esac
       queue+=("$target")
-    done < <(grep -E "^[[:space:]]*(import|export|\})[^'\"]*['\"][^'\"]+['\"];?[[:space:]]*$" "$tmp/module.js" |
-      grep -oE "(from|import)[[:space:]]+['\"][^'\"]+['\"]" | sed -E "s/^(from|import)[[:space:]]+['\"]//; s/['\"]$//")
+    done < <({
+      grep -E "^[[:space:]]*(import|export|\})[^'\"]*['\"][^'\"]+['\"];?[[:space:]]*$" "$tmp/module.js" |
+        grep -oE "(from|import)[[:space:]]+['\"][^'\"]+['\"]"
+      # A package's bundle (3d-tiles-renderer) puts its imports anywhere on a line; dynamic import('./x.js').
+      [[ $path == /node_modules/3d-tiles-renderer/* ]] && grep -oE "from ?\"[^\"]+\"" "$tmp/module.js" | sed -E 's/^from ?/from /'
+      grep -oE "import\((['\"])\./[^'\"]+['\"]\)" "$tmp/module.js" | sed -E "s/^import\(/import /; s/\)$//"
+    } | sed -E "s/^(from|import)[[:space:]]*['\"]//; s/['\"]$//" | sort -u)
   done
   # libs/draco/ holds Draco's decoder, which DRACOLoader fetches at run time (not an import).
   installed=$(cd "$web" && find . -name '*.js' -not -path './node_modules/three/examples/jsm/libs/draco/*' |
@@ -213,9 +219,10 @@ else
   imported=$(printf '%s\n' "${!seen[@]}" | sort)
   [[ $installed == "$imported" ]] && ok ||
     fail "installed modules and imported ones differ: $(diff <(echo "$installed") <(echo "$imported") | grep '^[<>]' | tr '\n' ' ')"
-  # Nothing else under share/: the two pages, three.js's licence and Draco's decoder (fetched above).
+  # Nothing else under share/: the two pages, the licences of three.js and 3d-tiles-renderer and
+  # Draco's decoder (fetched above).
   others=$(cd "$web" && find . -type f -not -name '*.js' | sed 's/^\.//' | sort | tr '\n' ' ')
-  [[ $others == "/edit.html /index.html /node_modules/three/LICENSE /node_modules/three/examples/jsm/libs/draco/gltf/draco_decoder.wasm " ]] &&
+  [[ $others == "/edit.html /index.html /node_modules/3d-tiles-renderer/LICENSE /node_modules/three/LICENSE /node_modules/three/examples/jsm/libs/draco/gltf/draco_decoder.wasm " ]] &&
     ok || fail "share/tailor/web holds other files than the pages, the modules and the licence: $others"
   echo "tailor view served the installed viewer: ${#seen[@]} modules"
 fi
