@@ -471,11 +471,12 @@ TEST(TileRegular, BrickBondsFollowTheirPeriodAndMeetTheStraightSeamTarget) {
   EXPECT_EQ(gravel_tile.width, 128);
 }
 
-TEST(TileRegular, BrickPhotosKeepTheirStrongestLineAtMostTheExemplars) {
-  // Two bonds with a detected period: the shared stretcher-bond photo and a Flemish bond (header
-  // and stretcher alternating in each course; tests/data/textures/README.md). The repair follows
-  // the joints: no straight line of the tile is stronger than 1.03 x the exemplar's strongest.
-  for (const char* name : {"brick-gray-512.png", "flemish-bond-256.png"}) {
+TEST(TileRegular, BondsAndTilesKeepTheirStrongestLineAtMostTheExemplars) {
+  // Regular patterns with a detected period: the shared stretcher-bond photo, a photo of
+  // ornamental wall tiles (VisTex Tile.0004, a square grid of joints) and a Flemish bond (header and
+  // stretcher alternating in each course, synthetic; tests/data/textures/README.md). The repair
+  // follows the joints: no straight line of the tile is stronger than 1.03 x the exemplar's strongest.
+  for (const char* name : {"brick-gray-512.png", "vistex-tile04-128.png", "flemish-bond-256.png"}) {
     SCOPED_TRACE(name);
     const Image wall = load(name);
     const PeriodEstimate p = estimate_period(wall);
