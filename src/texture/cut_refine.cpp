@@ -11,6 +11,8 @@
 #include <type_traits>
 #include <vector>
 
+#include "texture/tiling_util.h"
+
 namespace tailor::internal {
 
 void min_error_path(const std::vector<float>& err, int length, int width, std::vector<float>& cost,
@@ -72,29 +74,9 @@ void CutRefiner::choose_wrap(int plan_shift_x, int plan_shift_y) {
       }
     rows[static_cast<size_t>(y)] = static_cast<double>(across);
   }
-  // The boundary (s - 1, s) nearest the median within `half` of `planned` (ties to the nearer).
-  auto pick = [](const std::vector<double>& diff, int size, int planned, int half) {
-    planned = Plane::mod(planned, size);
-    if (size < 3) return planned;
-    std::vector<double> interior(diff.begin() + 1, diff.end());
-    std::nth_element(interior.begin(), interior.begin() + static_cast<std::ptrdiff_t>(interior.size() / 2),
-                     interior.end());
-    const double median = std::max(interior[interior.size() / 2], 1e-9);
-    int best = planned;
-    double best_score = std::numeric_limits<double>::max();
-    for (int d = 0; d <= half; ++d)
-      for (int s : {planned - d, planned + d}) {
-        if (s < 1 || s >= size) continue;
-        const double score = std::abs(std::log(std::max(diff[static_cast<size_t>(s)], 1e-9) / median));
-        if (score < best_score - 1e-12) {
-          best_score = score;
-          best = s;
-        }
-      }
-    return best;
-  };
-  shift_x_ = pick(cols, w, map_x(plan_shift_x), std::max(0, (w / plan_w_) / 2));
-  shift_y_ = pick(rows, h, map_y(plan_shift_y), std::max(0, (h / plan_h_) / 2));
+  // The most ordinary boundary within half a plan pixel of the planned one.
+  shift_x_ = ordinary_boundary(cols, Plane::mod(map_x(plan_shift_x), w), std::max(0, (w / plan_w_) / 2));
+  shift_y_ = ordinary_boundary(rows, Plane::mod(map_y(plan_shift_y), h), std::max(0, (h / plan_h_) / 2));
 }
 
 void CutRefiner::replay(const TilePlan& plan, size_t s, const std::vector<int32_t>* base, int radius) {

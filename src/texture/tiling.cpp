@@ -259,28 +259,8 @@ void choose_shift(const Plane& ex, int& shift_x, int& shift_y) {
         if (y > 0) rows[static_cast<size_t>(y)] += std::abs(a[k] - ex.at(x, y - 1)[k]);
       }
     }
-  auto pick = [](const std::vector<double>& diff, int size) {
-    std::vector<double> interior(diff.begin() + 1, diff.end());
-    std::nth_element(interior.begin(), interior.begin() + static_cast<std::ptrdiff_t>(interior.size() / 2),
-                     interior.end());
-    const double median = std::max(interior[interior.size() / 2], 1e-9);
-    int best = size / 2;
-    double best_score = std::numeric_limits<double>::max();
-    const int reach = std::max(1, size / 8);
-    for (int d = 0; d <= reach; ++d) {
-      for (int s : {size / 2 - d, size / 2 + d}) {
-        if (s < 1 || s >= size) continue;
-        const double score = std::abs(std::log(std::max(diff[static_cast<size_t>(s)], 1e-9) / median));
-        if (score < best_score - 1e-12) {
-          best_score = score;
-          best = s;
-        }
-      }
-    }
-    return best;
-  };
-  shift_x = pick(cols, w);
-  shift_y = pick(rows, h);
+  shift_x = internal::ordinary_boundary(cols, w / 2, std::max(1, w / 8));
+  shift_y = internal::ordinary_boundary(rows, h / 2, std::max(1, h / 8));
 }
 
 //! Largest (mean absolute difference across a column or row boundary) / (median one), the wrap
@@ -604,6 +584,27 @@ Image swap_quadrants(const Image& image) {
 }
 
 namespace internal {
+
+int ordinary_boundary(const std::vector<double>& diff, int centre, int reach) {
+  const int size = static_cast<int>(diff.size());
+  if (size < 3) return centre;
+  std::vector<double> interior(diff.begin() + 1, diff.end());
+  std::nth_element(interior.begin(), interior.begin() + static_cast<std::ptrdiff_t>(interior.size() / 2),
+                   interior.end());
+  const double median = std::max(interior[interior.size() / 2], 1e-9);
+  int best = centre;
+  double best_score = std::numeric_limits<double>::max();
+  for (int d = 0; d <= reach; ++d)
+    for (int s : {centre - d, centre + d}) {
+      if (s < 1 || s >= size) continue;
+      const double score = std::abs(std::log(std::max(diff[static_cast<size_t>(s)], 1e-9) / median));
+      if (score < best_score - 1e-12) {
+        best_score = score;
+        best = s;
+      }
+    }
+  return best;
+}
 
 Status plan_tile_variants(const Image& exemplar, const TileOptions& options, int count, bool all_channels,
                           std::vector<Image>& tiles, TileReport* report, TilePlan* tile_plan,

@@ -53,6 +53,12 @@ inline Plane to_plane(const Image& image) {
   return p;
 }
 
+//! The most ordinary boundary (s - 1, s) within `reach` of `centre` (0 < s < diff.size()): the
+//! one whose difference diff[s] is closest, in log ratio, to the median of the interior ones (ties
+//! to the nearer, then the lower), so that a wrap placed there is as ordinary as any interior
+//! boundary. `centre` when diff has fewer than 3 entries. tiling.cpp.
+int ordinary_boundary(const std::vector<double>& diff, int centre, int reach);
+
 //! How far `tile` misses the O(N) targets of meets_tile_targets against `exemplar` (same
 //! channels): the sum of the relative excesses of the worst seam, the wrap ratios, histogram L1
 //! and gradient ratio (0 = all met; patch coherence is not measured). tile_metrics.cpp.
