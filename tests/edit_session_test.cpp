@@ -7,8 +7,10 @@
 #include <bit>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <span>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "support/fixtures.h"
@@ -382,24 +384,34 @@ TEST(EditSession, AStrokeUpdatesOnlyThePatchesItReaches) {
   EXPECT_EQ(current_atlas(*session).corner_uv, full_map(mesh, {}, {stroke}, default_options()).corner_uv);
 }
 
-TEST(EditSession, LocalUpdatesAreTheSameForAnyThreadCount) {
-  const Mesh mesh = test::load_test_mesh("fertility.off");
-  MapTextureOptions one = default_options(), three = default_options();
+// Opens `mesh` with `options` on 1 and on 3 threads, applies three edits (50 seam faces from face
+// `stride` * i and a stroke from face `stride` * i + 1000) to both and expects the same changes and
+// UV bits after each. Returns the two sessions for more checks.
+std::pair<std::unique_ptr<EditSession>, std::unique_ptr<EditSession>> expect_edits_same_on_1_and_3_threads(
+    const Mesh& mesh, const MapTextureOptions& options, uint32_t stride) {
+  MapTextureOptions one = options, three = options;
   one.mapping.threads = one.orientation.threads = 1;
   three.mapping.threads = three.orientation.threads = 3;
-  const auto a = open_session(mesh, one);
-  const auto b = open_session(mesh, three);
-  ASSERT_TRUE(a && b);
+  auto a = open_session(mesh, one);
+  auto b = open_session(mesh, three);
+  EXPECT_TRUE(a && b);
+  if (!a || !b) return {};
   for (uint32_t i = 0; i < 3; ++i) {
     EditRequest edit;
-    for (uint32_t f = 2000 * i; f < 2000 * i + 50; ++f) edit.add_seam_faces.push_back(f);
-    edit.strokes.push_back(stroke_along(mesh, 2000 * i + 1000, 8));
+    for (uint32_t f = stride * i; f < stride * i + 50; ++f) edit.add_seam_faces.push_back(f);
+    edit.strokes.push_back(stroke_along(mesh, stride * i + 1000, 8));
     EditResult ra, rb;
-    ASSERT_TRUE(a->apply(edit, ra).is_ok());
-    ASSERT_TRUE(b->apply(edit, rb).is_ok());
+    EXPECT_TRUE(a->apply(edit, ra).is_ok());
+    EXPECT_TRUE(b->apply(edit, rb).is_ok());
     EXPECT_EQ(ra.changed_faces, rb.changed_faces);
     EXPECT_EQ(uvs_of(*a, ra.version), uvs_of(*b, rb.version));
   }
+  return {std::move(a), std::move(b)};
+}
+
+TEST(EditSession, LocalUpdatesAreTheSameForAnyThreadCount) {
+  const Mesh mesh = test::load_test_mesh("fertility.off");
+  expect_edits_same_on_1_and_3_threads(mesh, default_options(), 2000);
 }
 
 // Beyond the 8 kept atlases, undo updates locally (strokes removed, seam flags flipped back):
@@ -610,22 +622,8 @@ TEST(EditSession, ChunkedEditsChangeOnlyTheTouchedChunksAndSettleToAFreshChunked
 
 TEST(EditSession, ChunkedLocalUpdatesAreTheSameForAnyThreadCount) {
   const Mesh mesh = test::load_test_mesh("horse.ply");
-  MapTextureOptions one = chunked_options(mesh), three = chunked_options(mesh);
-  one.mapping.threads = one.orientation.threads = 1;
-  three.mapping.threads = three.orientation.threads = 3;
-  const auto a = open_session(mesh, one);
-  const auto b = open_session(mesh, three);
+  const auto [a, b] = expect_edits_same_on_1_and_3_threads(mesh, chunked_options(mesh), 30000);
   ASSERT_TRUE(a && b);
-  for (uint32_t i = 0; i < 3; ++i) {
-    EditRequest edit;
-    for (uint32_t f = 30000 * i; f < 30000 * i + 50; ++f) edit.add_seam_faces.push_back(f);
-    edit.strokes.push_back(stroke_along(mesh, 30000 * i + 1000, 8));
-    EditResult ra, rb;
-    ASSERT_TRUE(a->apply(edit, ra).is_ok());
-    ASSERT_TRUE(b->apply(edit, rb).is_ok());
-    EXPECT_EQ(ra.changed_faces, rb.changed_faces);
-    EXPECT_EQ(uvs_of(*a, ra.version), uvs_of(*b, rb.version));
-  }
   EditResult ra, rb;
   ASSERT_TRUE(a->settle(ra).is_ok());
   ASSERT_TRUE(b->settle(rb).is_ok());
