@@ -20,10 +20,10 @@ namespace {
 // the message is assembled beforehand).
 char reading_message[4200];
 size_t reading_length = 0;
-volatile sig_atomic_t reading = 0;
+volatile sig_atomic_t reading_now = 0;
 
 extern "C" void on_bus_error(int signal) {
-  if (!reading) {  // not an input read: the default action, when the faulting access runs again
+  if (!reading_now) {  // not an input read: the default action, when the faulting access runs again
     std::signal(signal, SIG_DFL);
     return;
   }
@@ -46,10 +46,10 @@ ReadingInput::ReadingInput(const std::string& path) {
     return sigaction(SIGBUS, &action, nullptr) == 0;
   }();
   (void)installed;
-  reading = 1;
+  reading_now = 1;
 }
 
-ReadingInput::~ReadingInput() { reading = 0; }
+ReadingInput::~ReadingInput() { reading_now = 0; }
 
 int report_error(const Status& status) {
   std::fprintf(stderr, "tailor: error: %s\n", status.message().c_str());
@@ -58,6 +58,42 @@ int report_error(const Status& status) {
 
 void warn(bool quiet, const std::string& text) {
   if (!quiet) std::fprintf(stderr, "tailor: warning: %s\n", text.c_str());
+}
+
+Status usage_error(const std::string& what) { return Status::error(ErrorCode::kInvalidArgument, "", what); }
+
+std::string base_name(const std::string& path) {
+  const size_t slash = path.rfind('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+std::string dir_name(const std::string& path) {
+  const size_t slash = path.rfind('/');
+  return slash == std::string::npos ? std::string(".") : path.substr(0, slash);
+}
+
+std::string extension_of(const std::string& path) {
+  const std::string base = base_name(path);
+  const size_t dot = base.rfind('.');
+  std::string ext = dot == std::string::npos ? "" : base.substr(dot + 1);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+namespace {
+std::atomic<bool> g_stop{false};
+extern "C" void on_stop_signal(int) { g_stop.store(true); }
+}  // namespace
+
+std::atomic<bool>& stop_requested() {
+  static const bool installed = [] {
+    struct sigaction action {};
+    action.sa_handler = on_stop_signal;
+    sigemptyset(&action.sa_mask);
+    return ::sigaction(SIGINT, &action, nullptr) == 0 && ::sigaction(SIGTERM, &action, nullptr) == 0;
+  }();
+  (void)installed;
+  return g_stop;
 }
 
 Status check_outputs(const std::vector<OutputPath>& outputs, const std::vector<std::string>& inputs) {

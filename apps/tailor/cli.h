@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -40,6 +41,18 @@ class ReadingInput {
 
 //! Prints "tailor: warning: <text>" on stderr unless quiet.
 void warn(bool quiet, const std::string& text);
+
+//! A bad command line: reported by report_error with exit code 2.
+Status usage_error(const std::string& what);
+
+//! "dir/a.B.glb" -> "a.B.glb", "dir", "glb" (lower case, without the dot; "" when there is none).
+std::string base_name(const std::string& path);
+std::string dir_name(const std::string& path);
+std::string extension_of(const std::string& path);
+
+//! The flag SIGINT and SIGTERM set (Ctrl-C), installing their handlers on the first call: the
+//! servers of `tailor view` and `tailor edit` poll it to stop cleanly.
+std::atomic<bool>& stop_requested();
 
 //! JSON text that never throws: bytes that are not UTF-8 (file names can hold any) become U+FFFD.
 inline std::string json_text(const nlohmann::json& j, int indent = 2) {

@@ -29,12 +29,6 @@ namespace tailor::cli {
 
 namespace {
 
-std::atomic<bool> g_stop{false};
-
-extern "C" void on_edit_stop_signal(int) { g_stop.store(true); }
-
-Status usage_error(const std::string& what) { return Status::error(ErrorCode::kInvalidArgument, "", what); }
-
 struct EditArgs {
   std::string input;
   std::string output;
@@ -53,12 +47,6 @@ struct EditArgs {
 std::string beside(const std::string& path, const std::string& suffix) {
   const std::filesystem::path p(path);
   return (p.parent_path() / (p.stem().string() + "_" + suffix)).string();
-}
-
-std::string extension_of(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext.empty() ? ext : ext.substr(1);
 }
 
 // A private temporary folder, removed when the command ends.
@@ -175,15 +163,11 @@ int run_edit(const EditArgs& opt) {
   EditApi api(context);
   api.install(server);
 
-  struct sigaction action {};
-  action.sa_handler = on_edit_stop_signal;
-  sigemptyset(&action.sa_mask);
-  ::sigaction(SIGINT, &action, nullptr);
-  ::sigaction(SIGTERM, &action, nullptr);
+  std::atomic<bool>& stop = stop_requested();
 
   std::atomic<bool> settler_done{false};
-  std::thread settler([&api, &settler_done] {
-    api.run_settler(g_stop);
+  std::thread settler([&api, &settler_done, &stop] {
+    api.run_settler(stop);
     settler_done.store(true);
   });
   // Always printed (also with --quiet): the URL is the point of the command, and scripts read it.
@@ -192,7 +176,7 @@ int run_edit(const EditArgs& opt) {
               counted(context.session->mesh().face_count(), "face", "faces").c_str(), open_seconds,
               context.glb_path.c_str());
   std::fflush(stdout);
-  server.serve(g_stop);
+  server.serve(stop);
   api.wake();
   // A settle of a large mesh cannot be interrupted (seconds at a million faces): Ctrl-C does not wait
   // for it. Nothing is being written then (saves run on the server's threads, which have ended).

@@ -29,8 +29,6 @@
 namespace tailor::cli {
 namespace {
 
-Status usage_error(const std::string& what) { return Status::error(ErrorCode::kInvalidArgument, "", what); }
-
 // The command line of `tailor map`. The library's options are bound to their flags in `options`
 // (defaults: the structs' own); those given as text are parsed in run_map.
 struct MapArgs {

@@ -194,16 +194,6 @@ int run_tile(const TileCliOptions& opt) {
   return judge_tiles(run.tiles, opt);
 }
 
-std::string base_name(const std::string& path) {
-  const size_t slash = path.find_last_of('/');
-  return slash == std::string::npos ? path : path.substr(slash + 1);
-}
-
-std::string dir_name(const std::string& path) {
-  const size_t slash = path.find_last_of('/');
-  return slash == std::string::npos ? "." : path.substr(0, slash);
-}
-
 //! --material JSON: {"maps": [{"file": "color.png"}, {"file": "normal.png", "normal": true}, ...],
 //! "normal_convention": "gl"}; files relative to the JSON's folder. Fills opt.set / normal_maps.
 Status read_material(TileCliOptions& opt) {

@@ -23,10 +23,6 @@ namespace {
 // Shader samplers the viewer sets aside for tile variants (web/viewer.js, kMaxVariants).
 constexpr size_t kMaxVariants = 8;
 
-std::atomic<bool> g_stop{false};
-
-extern "C" void on_stop_signal(int) { g_stop.store(true); }
-
 struct ViewArgs {
   std::string input;
   std::string texture;
@@ -36,24 +32,6 @@ struct ViewArgs {
 };
 
 bool file_exists(const std::string& path) { return std::ifstream(path).good(); }
-
-std::string dir_of(const std::string& path) {
-  const size_t slash = path.rfind('/');
-  return slash == std::string::npos ? std::string(".") : path.substr(0, slash);
-}
-
-std::string base_name(const std::string& path) {
-  const size_t slash = path.rfind('/');
-  return slash == std::string::npos ? path : path.substr(slash + 1);
-}
-
-std::string extension_of(const std::string& path) {
-  const std::string base = base_name(path);
-  const size_t dot = base.rfind('.');
-  std::string ext = dot == std::string::npos ? "" : base.substr(dot + 1);
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
 
 //! Cheap check that `path` is a binary glTF 2.0 file, so a wrong file fails here with one line
 //! rather than in the browser.
@@ -95,7 +73,7 @@ Status add_texture(const std::string& path, std::vector<Route>& routes, nlohmann
     return Status::error(ErrorCode::kParse, path, "no \"files\" list of tile variants");
   }
   nlohmann::json urls = nlohmann::json::array();
-  const std::string dir = dir_of(path);
+  const std::string dir = dir_name(path);
   size_t k = 0;
   for (const auto& f : j["files"]) {
     if (!f.is_string()) return Status::error(ErrorCode::kParse, path, "\"files\" must hold file names");
@@ -163,7 +141,7 @@ int run_view(const ViewArgs& args) {
   config["variants"] = nullptr;
   if (tileset) {
     if (Status s = add_tileset(args.input, routes, config); !s) return report_error(s);
-    config["name"] = base_name(dir_of(args.input)) + "/" + base_name(args.input);
+    config["name"] = base_name(dir_name(args.input)) + "/" + base_name(args.input);
   } else {
     routes.push_back({"/files/model.glb", args.input, "", ""});
   }
@@ -175,17 +153,13 @@ int run_view(const ViewArgs& args) {
   StaticServer server;
   if (Status s = server.start(root, routes, args.port); !s) return report_error(s);
 
-  struct sigaction action {};
-  action.sa_handler = on_stop_signal;
-  sigemptyset(&action.sa_mask);
-  ::sigaction(SIGINT, &action, nullptr);
-  ::sigaction(SIGTERM, &action, nullptr);
+  std::atomic<bool>& stop = stop_requested();
 
   // Always printed (also with --quiet): the URL is the point of the command, and scripts read it.
   std::printf("tailor view: http://127.0.0.1:%d/  (%s, viewer in %s; Ctrl-C to stop)\n", server.port(),
               base_name(args.input).c_str(), root.c_str());
   std::fflush(stdout);
-  server.serve(g_stop);
+  server.serve(stop);
   if (!args.quiet) std::fprintf(stderr, "tailor view: stopped\n");
   return kExitOk;
 }
@@ -203,7 +177,7 @@ Status find_web_root(const std::string& given, std::string& root) {
     std::array<char, 4096> exe{};
     const ssize_t n = ::readlink("/proc/self/exe", exe.data(), exe.size() - 1);
     if (n > 0) {
-      const std::string dir = dir_of(std::string(exe.data(), static_cast<size_t>(n)));
+      const std::string dir = dir_name(std::string(exe.data(), static_cast<size_t>(n)));
       candidates.push_back(dir + "/" TAILOR_INSTALLED_DATA_DIR "/web");
       candidates.push_back(dir + "/web");
       candidates.push_back(dir + "/../web");
