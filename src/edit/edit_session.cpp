@@ -33,6 +33,11 @@ double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
+}  // namespace
+
+// The types EditSession::State holds: named (not in an unnamed namespace) because State is.
+namespace edit_types {
+
 // One applied edit, as what it changed: enough to undo and redo it.
 struct Step {
   std::vector<uint32_t> flipped;           // faces whose seam flag flipped (ascending)
@@ -48,6 +53,12 @@ struct KeptAtlas {
   std::vector<uint8_t> dirty;     // chunked sessions: the chunks whose UVs were a local update
   std::vector<uint32_t> patches;  // chunked sessions: each chunk's patch count
 };
+
+}  // namespace edit_types
+using edit_types::KeptAtlas;
+using edit_types::Step;
+
+namespace {
 
 // The session's options with the parts it owns cleared: spans (its own seam flags and strokes are
 // set when mapping) and the progress callback.

@@ -13,35 +13,17 @@
 #include <vector>
 
 #include "export/writers.h"
+#include "io/glb_format.h"
 #include "util/atomic_file.h"
 
 namespace tailor::internal {
 namespace {
 
-// glTF enumerations (spec section 5).
-constexpr int kFloat = 5126;
-constexpr int kUnsignedInt = 5125;
-constexpr int kArrayBuffer = 34962;
-constexpr int kElementArrayBuffer = 34963;
+// glTF sampler enumerations (spec section 5).
 constexpr int kLinear = 9729;
 constexpr int kLinearMipmapLinear = 9987;
 constexpr int kRepeat = 10497;
-constexpr int kTriangles = 4;
-constexpr uint32_t kGlbMagic = 0x46546C67;          // "glTF"
-constexpr uint32_t kChunkJson = 0x4E4F534A;         // "JSON"
-constexpr uint32_t kChunkBin = 0x004E4942;          // "BIN\0"
 constexpr double kHalfSqrt2 = 0.70710678118654752;  // the node rotation of a Z-up scene: -90 degrees about x
-
-void append_u32(std::string& out, uint32_t value) {
-  static_assert(std::endian::native == std::endian::little, "glb writer assumes a little-endian host");
-  char bytes[4];
-  std::memcpy(bytes, &value, 4);
-  out.append(bytes, 4);
-}
-
-void pad_to_4(std::string& out, char fill) {
-  while (out.size() % 4 != 0) out.push_back(fill);
-}
 
 template <typename T>
 std::span<const char> bytes_of(const T* data, size_t count) {
@@ -137,17 +119,17 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
   const bool normals = !data.normals.empty();
   size_t bin_size = 0;
   nlohmann::json views = nlohmann::json::array(), accessors = nlohmann::json::array();
-  std::vector<nlohmann::json> primitives(parts.size(), {{"mode", kTriangles}});
+  std::vector<nlohmann::json> primitives(parts.size(), {{"mode", kGltfTriangles}});
   // A view of `width` bytes per element (of `count`) and one accessor per part into it.
   auto add_array = [&](const std::string& attribute, size_t width, size_t count, int component_type, const char* type,
                        int target, auto&& extra) {
     const size_t view = add_view(views, bin_size, width * count, target);
     bin_size += width * count;
     // Several accessors on one vertex view need its stride (spec 3.6.2.4).
-    if (target == kArrayBuffer && parts.size() > 1) views[view]["byteStride"] = width;
+    if (target == kGltfArrayBuffer && parts.size() > 1) views[view]["byteStride"] = width;
     for (size_t i = 0; i < parts.size(); ++i) {
       const ExportPart& p = parts[i];
-      const bool vertices = target == kArrayBuffer;
+      const bool vertices = target == kGltfArrayBuffer;
       const size_t begin = vertices ? p.vertex_begin : p.index_begin, end = vertices ? p.vertex_end : p.index_end;
       nlohmann::json accessor = {
           {"bufferView", view}, {"componentType", component_type}, {"count", end - begin}, {"type", type}};
@@ -163,7 +145,7 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
   auto nothing = [](const ExportPart&, nlohmann::json&) {};
   // Split positions are source positions through xref, in split order (the order matters for
   // min/max: -0 and +0 compare equal, the first one seen is kept).
-  add_array("POSITION", 12, vertex_count, kFloat, "VEC3", kArrayBuffer, [&](const ExportPart& p, nlohmann::json& a) {
+  add_array("POSITION", 12, vertex_count, kGltfFloat, "VEC3", kGltfArrayBuffer, [&](const ExportPart& p, nlohmann::json& a) {
     float lo[3] = {std::numeric_limits<float>::max(), std::numeric_limits<float>::max(),
                    std::numeric_limits<float>::max()};
     float hi[3] = {-lo[0], -lo[1], -lo[2]};
@@ -177,18 +159,18 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
     a["min"] = {lo[0], lo[1], lo[2]};
     a["max"] = {hi[0], hi[1], hi[2]};
   });
-  if (normals) add_array("NORMAL", 12, vertex_count, kFloat, "VEC3", kArrayBuffer, nothing);
+  if (normals) add_array("NORMAL", 12, vertex_count, kGltfFloat, "VEC3", kGltfArrayBuffer, nothing);
   for (const CornerAttribute& a : data.kept)  // the file's own: colours, other UV sets
-    add_array(a.name, 4 * size_t(a.components), vertex_count, kFloat,
+    add_array(a.name, 4 * size_t(a.components), vertex_count, kGltfFloat,
               a.components == 2   ? "VEC2"
               : a.components == 3 ? "VEC3"
                                   : "VEC4",
-              kArrayBuffer, nothing);
-  add_array("TEXCOORD_" + std::to_string(data.uv_set), 8, vertex_count, kFloat, "VEC2", kArrayBuffer, nothing);
-  add_array("", 4, index_count, kUnsignedInt, "SCALAR", kElementArrayBuffer, nothing);
+              kGltfArrayBuffer, nothing);
+  add_array("TEXCOORD_" + std::to_string(data.uv_set), 8, vertex_count, kGltfFloat, "VEC2", kGltfArrayBuffer, nothing);
+  add_array("", 4, index_count, kGltfUnsignedInt, "SCALAR", kGltfElementArrayBuffer, nothing);
   const bool tangents = !data.tangents.empty();
   // per split vertex, after the indices (written straight from data.tangents)
-  if (tangents) add_array("TANGENT", 16, vertex_count, kFloat, "VEC4", kArrayBuffer, nothing);
+  if (tangents) add_array("TANGENT", 16, vertex_count, kGltfFloat, "VEC4", kGltfArrayBuffer, nothing);
 
   nlohmann::json node = {{"name", "tailor"}};
   if (options.up == SceneUp::kZ) node["rotation"] = {-kHalfSqrt2, 0.0, 0.0, kHalfSqrt2};

@@ -27,20 +27,17 @@
 #include <vector>
 
 #include "export/writers.h"
+#include "io/glb_format.h"
 #include "util/atomic_file.h"
 
 namespace tailor::internal {
 namespace {
 
-constexpr int kByte = 5120, kShort = 5122, kUnsignedShort = 5123, kUnsignedInt = 5125, kFloat = 5126;
-constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963;
-constexpr int kTriangles = 4;
-
 // One array of the file: its bytes (uncompressed), element stride and the accessor that reads it.
 struct Stream {
   std::string bytes;
   size_t stride = 0;
-  int target = kArrayBuffer;
+  int target = kGltfArrayBuffer;
   nlohmann::json accessor;
   const char* attribute = nullptr;  // null: the indices
   const char* filter = nullptr;     // meshopt: the filter `bytes` went through (they are its output)
@@ -50,16 +47,6 @@ template <class T>
 std::string bytes_of(const std::vector<T>& v) {
   static_assert(std::endian::native == std::endian::little, "glb writer assumes a little-endian host");
   return std::string(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
-}
-
-void pad_to_4(std::string& s, char fill = '\0') {
-  while (s.size() % 4 != 0) s.push_back(fill);
-}
-
-void append_u32(std::string& out, uint32_t value) {
-  char bytes[4];
-  std::memcpy(bytes, &value, 4);
-  out.append(bytes, 4);
 }
 
 // The source arrays of the split mesh: positions, normals (may be empty), UVs in glTF's
@@ -172,8 +159,8 @@ std::vector<Stream> quantized_streams(const Arrays& a, const double center[3], d
     }
   streams.push_back({bytes_of(q),
                      8,
-                     kArrayBuffer,
-                     {{"componentType", kShort},
+                     kGltfArrayBuffer,
+                     {{"componentType", kGltfShort},
                       {"normalized", true},
                       {"count", nv},
                       {"type", "VEC3"},
@@ -186,15 +173,15 @@ std::vector<Stream> quantized_streams(const Arrays& a, const double center[3], d
       for (int k = 0; k < 3; ++k) q[4 * v + size_t(k)] = snorm16(a.normals[3 * v + size_t(k)]);
     streams.push_back({bytes_of(q),
                        8,
-                       kArrayBuffer,
-                       {{"componentType", kShort}, {"normalized", true}, {"count", nv}, {"type", "VEC3"}},
+                       kGltfArrayBuffer,
+                       {{"componentType", kGltfShort}, {"normalized", true}, {"count", nv}, {"type", "VEC3"}},
                        "NORMAL"});
   }
   for (const CornerAttribute& k : a.kept)
     streams.push_back({bytes_of(k.values),
                        4 * size_t(k.components),
-                       kArrayBuffer,
-                       {{"componentType", kFloat},
+                       kGltfArrayBuffer,
+                       {{"componentType", kGltfFloat},
                         {"count", nv},
                         {"type", k.components == 2   ? "VEC2"
                                  : k.components == 3 ? "VEC3"
@@ -202,20 +189,20 @@ std::vector<Stream> quantized_streams(const Arrays& a, const double center[3], d
                        k.name.c_str()});
   streams.push_back({bytes_of(a.uvs),
                      8,
-                     kArrayBuffer,
-                     {{"componentType", kFloat}, {"count", nv}, {"type", "VEC2"}},
+                     kGltfArrayBuffer,
+                     {{"componentType", kGltfFloat}, {"count", nv}, {"type", "VEC2"}},
                      a.uv_name.c_str()});
   if (nv <= 65535) {
     const std::vector<uint16_t> small(a.indices.begin(), a.indices.end());
     streams.push_back({bytes_of(small),
                        2,
-                       kElementArrayBuffer,
-                       {{"componentType", kUnsignedShort}, {"count", small.size()}, {"type", "SCALAR"}}});
+                       kGltfElementArrayBuffer,
+                       {{"componentType", kGltfUnsignedShort}, {"count", small.size()}, {"type", "SCALAR"}}});
   } else {
     streams.push_back({bytes_of(a.indices),
                        4,
-                       kElementArrayBuffer,
-                       {{"componentType", kUnsignedInt}, {"count", a.indices.size()}, {"type", "SCALAR"}}});
+                       kGltfElementArrayBuffer,
+                       {{"componentType", kGltfUnsignedInt}, {"count", a.indices.size()}, {"type", "SCALAR"}}});
   }
   return streams;
 }
@@ -236,7 +223,7 @@ void apply_meshopt_filters(const Arrays& a, std::vector<Stream>& streams) {
       std::string out(4 * nv, '\0');
       meshopt_encodeFilterOct(out.data(), nv, 4, kNormalBits, four.data());
       s = {out,          4,
-           kArrayBuffer, {{"componentType", kByte}, {"normalized", true}, {"count", nv}, {"type", "VEC3"}},
+           kGltfArrayBuffer, {{"componentType", kGltfByte}, {"normalized", true}, {"count", nv}, {"type", "VEC3"}},
            "NORMAL",     "OCTAHEDRAL"};
     } else if (s.attribute == std::string_view(a.uv_name)) {
       std::string out(8 * nv, '\0');
@@ -365,8 +352,8 @@ Status draco_primitive(const std::string& path, const Arrays& a, std::string& bi
   pad_to_4(bin);
   streams.push_back({{},
                      0,
-                     kArrayBuffer,
-                     {{"componentType", kFloat},
+                     kGltfArrayBuffer,
+                     {{"componentType", kGltfFloat},
                       {"count", points},
                       {"type", "VEC3"},
                       {"min", {lo[0], lo[1], lo[2]}},
@@ -374,24 +361,24 @@ Status draco_primitive(const std::string& path, const Arrays& a, std::string& bi
                      "POSITION"});
   if (!a.normals.empty())
     streams.push_back(
-        {{}, 0, kArrayBuffer, {{"componentType", kFloat}, {"count", points}, {"type", "VEC3"}}, "NORMAL"});
+        {{}, 0, kGltfArrayBuffer, {{"componentType", kGltfFloat}, {"count", points}, {"type", "VEC3"}}, "NORMAL"});
   for (const CornerAttribute& k : a.kept)
     streams.push_back({{},
                        0,
-                       kArrayBuffer,
-                       {{"componentType", kFloat},
+                       kGltfArrayBuffer,
+                       {{"componentType", kGltfFloat},
                         {"count", points},
                         {"type", k.components == 2   ? "VEC2"
                                  : k.components == 3 ? "VEC3"
                                                      : "VEC4"}},
                        k.name.c_str()});
   streams.push_back(
-      {{}, 0, kArrayBuffer, {{"componentType", kFloat}, {"count", points}, {"type", "VEC2"}}, a.uv_name.c_str()});
+      {{}, 0, kGltfArrayBuffer, {{"componentType", kGltfFloat}, {"count", points}, {"type", "VEC2"}}, a.uv_name.c_str()});
   streams.push_back(
       {{},
        0,
-       kElementArrayBuffer,
-       {{"componentType", points <= 65535 ? kUnsignedShort : kUnsignedInt}, {"count", 3 * faces}, {"type", "SCALAR"}}});
+       kGltfElementArrayBuffer,
+       {{"componentType", points <= 65535 ? kGltfUnsignedShort : kGltfUnsignedInt}, {"count", 3 * faces}, {"type", "SCALAR"}}});
   return Status::ok();
 }
 
@@ -437,7 +424,7 @@ Status write_glb_compressed(const std::string& path, const ExportData& data, con
     };
     Arrays part_arrays = whole ? Arrays{} : slice(arrays, p);
     Arrays& a = whole ? arrays : part_arrays;
-    nlohmann::json primitive = {{"mode", kTriangles}};
+    nlohmann::json primitive = {{"mode", kGltfTriangles}};
     std::vector<Stream> streams;
     if (options.compression == MeshCompression::kDraco) {
       nlohmann::json extension;
@@ -514,14 +501,14 @@ Status write_glb_compressed(const std::string& path, const ExportData& data, con
   if (total > std::numeric_limits<uint32_t>::max())
     return Status::error(ErrorCode::kLimit, path, "output larger than the 4 GiB a .glb can hold");
   std::string head;
-  append_u32(head, 0x46546C67);  // "glTF"
+  append_u32(head, kGlbMagic);
   append_u32(head, 2);
   append_u32(head, static_cast<uint32_t>(total));
   append_u32(head, static_cast<uint32_t>(json.size()));
-  append_u32(head, 0x4E4F534A);  // "JSON"
+  append_u32(head, kChunkJson);
   head += json;
   append_u32(head, static_cast<uint32_t>(bin.size()));
-  append_u32(head, 0x004E4942);  // "BIN\0"
+  append_u32(head, kChunkBin);
   AtomicFileWriter file(path);
   TAILOR_RETURN_IF_ERROR(file.open());
   TAILOR_RETURN_IF_ERROR(file.write(head));

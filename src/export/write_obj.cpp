@@ -13,7 +13,7 @@
 namespace tailor::internal {
 namespace {
 
-void append_u32(std::string& out, uint32_t value) { out += std::to_string(value); }
+void append_decimal(std::string& out, uint32_t value) { out += std::to_string(value); }
 
 }  // namespace
 
@@ -91,12 +91,12 @@ Status write_obj(const std::string& path, const ExportData& data, const ExportOp
     for (int k = 0; k < 3; ++k) {
       const size_t c = 3 * f + k;
       out += ' ';
-      append_u32(out, mesh.indices[c] + 1);
+      append_decimal(out, mesh.indices[c] + 1);
       out += '/';
-      append_u32(out, split.indices[c] + 1);
+      append_decimal(out, split.indices[c] + 1);
       if (normals) {
         out += '/';
-        append_u32(out, mesh.indices[c] + 1);
+        append_decimal(out, mesh.indices[c] + 1);
       }
     }
     out += '\n';

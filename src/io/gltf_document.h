@@ -13,16 +13,13 @@
 #include <string>
 #include <vector>
 
+#include "io/glb_format.h"
 #include "io/readers.h"
 #include "tailor/status.h"
 
 namespace tailor::internal {
 
 using Json = nlohmann::json;
-
-// glTF enumerations (spec section 5).
-inline constexpr int kGltfByte = 5120, kGltfUnsignedByte = 5121, kGltfShort = 5122, kGltfUnsignedShort = 5123,
-                     kGltfUnsignedInt = 5125, kGltfFloat = 5126;
 
 //! Largest accessor count read (2^32: every id tailor stores is 32-bit).
 inline constexpr uint64_t kMaxAccessorCount = uint64_t{1} << 32;

@@ -7,6 +7,7 @@
 
 #include "io/readers.h"
 #include "util/huge_pages.h"
+#include "util/saturating.h"
 #include "util/text_scan.h"
 
 namespace tailor::internal {
@@ -15,8 +16,6 @@ namespace {
 // Smallest ascii encodings: "0 0 0\n" for a vertex, "3 0 0 0\n" for a face.
 constexpr uint64_t kMinVertexBytes = 6;
 constexpr uint64_t kMinFaceBytes = 8;
-
-uint64_t mul_sat(uint64_t a, uint64_t b) { return (a != 0 && b > UINT64_MAX / a) ? UINT64_MAX : a * b; }
 
 }  // namespace
 

@@ -24,6 +24,7 @@
 
 #include "io/readers.h"
 #include "util/huge_pages.h"
+#include "util/saturating.h"
 #include "util/text_scan.h"
 
 namespace tailor::internal {
@@ -121,13 +122,6 @@ struct PlyHeader {
   size_t body_offset = 0;   // first byte after end_header's line end
   size_t header_lines = 0;  // line number of end_header (ascii bodies count lines from there)
 };
-
-// a * b, saturating at SIZE_MAX (header counts are untrusted).
-uint64_t mul_sat(uint64_t a, uint64_t b) {
-  if (a != 0 && b > UINT64_MAX / a) return UINT64_MAX;
-  return a * b;
-}
-uint64_t add_sat(uint64_t a, uint64_t b) { return b > UINT64_MAX - a ? UINT64_MAX : a + b; }
 
 std::vector<std::string_view> split_words(std::string_view line) {
   std::vector<std::string_view> w;

@@ -28,8 +28,6 @@
 
 namespace tailor::internal {
 
-inline constexpr int kNext[3] = {1, 2, 0};
-inline constexpr int kPrev[3] = {2, 0, 1};
 // Tuned on the shared meshes (bunny, horse, spot, chinese-dragon; docs/mapping.md section 2):
 // A gap wider than its crack edge is more than a region of 16 rings absorbs within the bound
 // (< 1 % of those zips passed): left without trying.

@@ -33,7 +33,7 @@ namespace {
 // visible seams at scale 800 / 8000: 1.6: 3.27 / 1.80 %, 1.8: 3.09 / 1.68 %, 1.85: 2.98 / 1.63 %,
 // 1.9: 2.88 / 1.60 %, 1.95: 2.75 / 1.61 % (Sander L2 up to 1.026 without grid_map's L2 budget),
 // the horse in 1.1x / 1.5x the time of 1.6. 1.9 keeps a margin from 2 for the changing rotations.
-constexpr float kOverRelaxation = 1.9f;
+constexpr float kLatticeOverRelaxation = 1.9f;
 // Robust weights: a face's energy counts 1 / (1 + |J - R|^2 / kRobustScale^2). Where the lattice
 // maps cannot be met isometrically (a strip where the position field's whole-repeat jumps disagree
 // with the surface by a fraction of a repeat), least squares would spread the mismatch over every
@@ -57,7 +57,7 @@ constexpr float kSettledShare = 0.01f;
 // ... or less than this many pixels (a twentieth of a texel), whichever is larger: finer moves do
 // not show in the texture, and on meshes whose faces are a pixel or less wide (horse_x16 at scale
 // 800: 0.65 px) the share alone took 1.4x the time for 0.885 -> 0.822 % visible seams.
-constexpr float kSettledPx = 0.05f;
+constexpr float kLatticeSettledPx = 0.05f;
 
 //! apply(m, period, in, out) of rosy_field.h, the turn as a product (kQuarterTurn).
 inline void map_point(const LatticeMap& m, float period, const float* in, float* out) {
@@ -148,7 +148,7 @@ LatticeRelaxation::LatticeRelaxation(const Mesh& mesh, const FaceFrames& frames,
       float side = 0.f;
       for (uint32_t c = start[p]; c < start[p + 1]; ++c) side += std::sqrt(area[corners[c] / 3]);
       const uint32_t n = start[p + 1] - start[p];
-      settled[p] = std::max(kSettledPx, n > 0 ? kSettledShare * side / static_cast<float>(n) : 0.f);
+      settled[p] = std::max(kLatticeSettledPx, n > 0 ? kSettledShare * side / static_cast<float>(n) : 0.f);
     }
   });
 
@@ -213,7 +213,7 @@ void LatticeRelaxation::run(const std::vector<LatticeMap>& corner_map, const std
     }
     if (!(sw > 0.0)) return;
     const float mx = static_cast<float>(sx / sw), my = static_cast<float>(sy / sw);
-    const float dx = kOverRelaxation * (mx - uv[2 * v]), dy = kOverRelaxation * (my - uv[2 * v + 1]);
+    const float dx = kLatticeOverRelaxation * (mx - uv[2 * v]), dy = kLatticeOverRelaxation * (my - uv[2 * v + 1]);
     uv[2 * v] += dx;
     uv[2 * v + 1] += dy;
     moved[v] = std::abs(dx) + std::abs(dy) > settled[p];

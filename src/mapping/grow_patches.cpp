@@ -23,9 +23,6 @@ namespace tailor::internal {
 namespace {
 
 constexpr float kPi = 3.14159265358979f;
-// Next and previous corner of a face (cheaper than % 3 in the inner loops).
-constexpr int kNext[3] = {1, 2, 0};
-constexpr int kPrev[3] = {2, 0, 1};
 constexpr uint32_t kAnyPatch = kInvalid;
 
 // Everything the growth reads or writes about one face, in one cache line: the popped face's

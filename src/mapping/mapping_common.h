@@ -18,6 +18,10 @@
 
 namespace tailor::internal {
 
+// Corner k of a face: the next and previous corner (its edges are k -> kNext[k]).
+inline constexpr int kNext[3] = {1, 2, 0};
+inline constexpr int kPrev[3] = {2, 0, 1};
+
 // === Front key =================================================================================
 // One uint64, smaller = sooner:
 //   bits 62-63  class: 0 waiting, 1 deferred (failed since its neighbourhood last changed),

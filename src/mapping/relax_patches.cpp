@@ -20,7 +20,7 @@
 // of |J - R| instead of its square: the distortion concentrates on fewer faces, the median goes
 // down); the global step moves each free wedge towards the weighted mean of the positions its
 // faces predict from their other two corners with that rotation (cotangent weights divided by the
-// face's area: every face's |J - R|^2 counts alike), over-relaxed by kOverRelaxation, unless a
+// face's area: every face's |J - R|^2 counts alike), over-relaxed by kPatchOverRelaxation, unless a
 // face around it would leave max_stretch or invert (checked with stretch_error; skipped where the
 // face's slack, the distance of its singular values from the bound at the local step less what
 // its corners moved since, covers the move: a singular value moves by at most the move times
@@ -59,12 +59,10 @@
 namespace tailor::internal {
 namespace {
 
-constexpr int kNext[3] = {1, 2, 0};
-constexpr int kPrev[3] = {2, 0, 1};
 // Tuned on the 16 shared meshes (docs/mapping.md, section 2, relaxation); 10 iterations by default:
 // Successive over-relaxation of the global step: 1.6 / 1.8 / 1.9 gave a median distortion of
 // 1.97 / 1.83 / 1.88 degrees after 10 iterations (1.0: about twice the iterations for the same).
-constexpr float kOverRelaxation = 1.8f;
+constexpr float kPatchOverRelaxation = 1.8f;
 // Reweighting floor (|J - R|, dimensionless): 0.005 / 0.01 / 0.02 gave 1.94 / 1.83 / 2.09 degrees;
 // without reweighting (plain ARAP) 2.86, with the CAD parts' distortion up from 0.2-0.45 to 1-1.6.
 constexpr float kIrlsFloor = 0.01f;
@@ -72,7 +70,7 @@ constexpr float kIrlsFloor = 0.01f;
 // invisible gap): they stay put.
 constexpr float kInvisibleGapPx = 1.f;
 // The iterations stop early once no wedge moves by this much (|du| + |dv|).
-constexpr float kSettledPx = 0.01f;
+constexpr float kPatchSettledPx = 0.01f;
 // The slack that lets a move skip its check is kept kSlackMargin + kRoundingPerCondition times the
 // face's condition (|q1|^2 + |q2|^2) / det(q) inside the bound: the float singular values of the
 // local step and of stretch_error are each within ~1e-7 times the condition of the exact ones, so
@@ -255,7 +253,7 @@ class Relaxer {
       phase = 0;
       const float moved = *std::max_element(largest.begin(), largest.end());
       std::fill(largest.begin(), largest.end(), 0.f);
-      done = ++iteration == iterations || moved < kSettledPx;
+      done = ++iteration == iterations || moved < kPatchSettledPx;
       if (!done && progress) {  // on one thread at a time (the barrier's completion)
         bool go = true;
         try {
@@ -414,7 +412,7 @@ class Relaxer {
     }
     float* const at = &pos_[2 * size_t{w}];
     const float u0 = at[0], v0 = at[1];
-    const float u = u0 + kOverRelaxation * (su / sw - u0), v = v0 + kOverRelaxation * (sv / sw - v0);
+    const float u = u0 + kPatchOverRelaxation * (su / sw - u0), v = v0 + kPatchOverRelaxation * (sv / sw - v0);
     if ((u == u0 && v == v0) || !fits(begin, end, u, v, u0, v0)) return 0.f;
     at[0] = u;
     at[1] = v;

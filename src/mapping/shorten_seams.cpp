@@ -22,8 +22,6 @@
 namespace tailor::internal {
 namespace {
 
-constexpr int kNext[3] = {1, 2, 0};
-constexpr int kPrev[3] = {2, 0, 1};
 // Passes over the changed faces' neighbourhoods; each strictly shortens the seams, the cap only
 // bounds the time on adversarial input (measured: 3-5 passes settle the shared meshes).
 constexpr int kMaxPasses = 16;

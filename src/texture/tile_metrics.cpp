@@ -28,14 +28,14 @@ namespace tailor {
 namespace {
 
 //! The 8-bit samples of an image, read in place (layout of image.h).
-struct Plane {
+struct BytePlane {
   int width = 0, height = 0, channels = 0;
   const uint8_t* data = nullptr;
   const uint8_t* at(int x, int y) const { return data + (static_cast<size_t>(y) * width + x) * channels; }
   size_t size() const { return static_cast<size_t>(width) * height * channels; }
 };
 
-Plane view(const Image& image) { return {image.width, image.height, image.channels, image.pixels.data()}; }
+BytePlane view(const Image& image) { return {image.width, image.height, image.channels, image.pixels.data()}; }
 
 constexpr int kPatch = 7;
 constexpr int kMaxPatches = 16384;
@@ -59,7 +59,7 @@ double ratio(double value, double median) {
 }
 
 //! Mean absolute difference across each column boundary (x, x+1 mod W) and row boundary.
-void boundary_differences(const Plane& p, std::vector<double>& cols, std::vector<double>& rows) {
+void boundary_differences(const BytePlane& p, std::vector<double>& cols, std::vector<double>& rows) {
   const int w = p.width, h = p.height, c = p.channels;
   cols.assign(static_cast<size_t>(w), 0.0);
   rows.assign(static_cast<size_t>(h), 0.0);
@@ -85,7 +85,7 @@ struct SeamStats {
   double wrap_x = 0.0, wrap_y = 0.0, worst_all = 0.0, worst_interior = 0.0;
 };
 
-SeamStats seam_stats(const Plane& p) {
+SeamStats seam_stats(const BytePlane& p) {
   std::vector<double> cols, rows;
   boundary_differences(p, cols, rows);
   const double mc = median_of(std::vector<double>(cols.begin(), cols.end() - 1));
@@ -106,7 +106,7 @@ SeamStats seam_stats(const Plane& p) {
   return s;
 }
 
-double gradient_energy(const Plane& p) {
+double gradient_energy(const BytePlane& p) {
   const int w = p.width, h = p.height, c = p.channels;
   double sum = 0.0;
   for (int y = 0; y + 1 < h; ++y)
@@ -139,7 +139,7 @@ double histogram_l1(const Image& a, const Image& b) {
 }
 
 //! Mean over channels of the per-channel variance (8-bit units squared).
-double variance(const Plane& p) {
+double variance(const BytePlane& p) {
   const int c = p.channels;
   const double n = static_cast<double>(p.width) * p.height;
   double total = 0.0;
@@ -157,7 +157,7 @@ double variance(const Plane& p) {
 //! PatchMatch nearest-patch distances from a fixed grid of (toroidal) `source` patches to the
 //! patches of `target` (non-toroidal): `cost` gets each grid patch's squared distance (summed over
 //! its samples).
-void nearest_patch_costs(const Plane& source, const Plane& target, std::vector<float>& cost);
+void nearest_patch_costs(const BytePlane& source, const BytePlane& target, std::vector<float>& cost);
 
 //! The smallest stride whose grid over a w x h image holds at most `limit` patches.
 int patch_stride(int w, int h, int limit) {
@@ -168,14 +168,14 @@ int patch_stride(int w, int h, int limit) {
 
 //! The mean per-sample squared distance of nearest_patch_costs; with `turns`, the nearest over
 //! the target and its three quarter turns.
-double mean_nearest_patch_distance(const Plane& source, const Plane& target, bool turns = false) {
+double mean_nearest_patch_distance(const BytePlane& source, const BytePlane& target, bool turns = false) {
   std::vector<float> cost, other;
   nearest_patch_costs(source, target, cost);
   if (turns) {
     std::vector<uint8_t> prev(target.data, target.data + target.size()), next(prev.size());
-    Plane turned = target;
+    BytePlane turned = target;
     for (int k = 1; k < 4; ++k) {
-      const Plane from{turned.width, turned.height, turned.channels, prev.data()};
+      const BytePlane from{turned.width, turned.height, turned.channels, prev.data()};
       turned.width = from.height;
       turned.height = from.width;
       turned.data = next.data();
@@ -196,7 +196,7 @@ double mean_nearest_patch_distance(const Plane& source, const Plane& target, boo
   return total / (static_cast<double>(cost.size()) * kPatch * kPatch * source.channels);
 }
 
-void nearest_patch_costs(const Plane& source, const Plane& target, std::vector<float>& cost) {
+void nearest_patch_costs(const BytePlane& source, const BytePlane& target, std::vector<float>& cost) {
   const int c = source.channels;
   const int w = source.width, h = source.height;
   const int pw = w + kPatch - 1, ph = h + kPatch - 1;
@@ -444,7 +444,7 @@ Status tile_metrics(const Image& tile_in, const Image* exemplar_in, TileMetrics&
   const Image& tile = *tile_ptr;
   metrics.quarter_turn_difference =
       quarter_turn_difference(tile, &metrics.quarter_turn_shift_x, &metrics.quarter_turn_shift_y);
-  const Plane tp = view(tile);
+  const BytePlane tp = view(tile);
   const SeamStats ts = seam_stats(tp);
   metrics.wrap_ratio_x = ts.wrap_x;
   metrics.wrap_ratio_y = ts.wrap_y;
@@ -453,7 +453,7 @@ Status tile_metrics(const Image& tile_in, const Image* exemplar_in, TileMetrics&
   if (!exemplar_in) return Status::ok();
 
   const Image& exemplar = *exemplar_ptr;
-  const Plane ep = view(exemplar);
+  const BytePlane ep = view(exemplar);
   const SeamStats es = seam_stats(ep);
   metrics.has_exemplar = true;
   metrics.exemplar_worst_seam_ratio = es.worst_interior;
