@@ -1,7 +1,8 @@
-// tailor.plan_chunks, tailor.save_uvs and tailor.simplify_uvs: the chunk rule, the writer of
-// `tailor map -o` and libmeshoptimizer's simplifier for code that cuts a mesh into tiles itself
-// (python -m tailor.tiles): the rule's cells and faces as arrays, any mesh written with per-corner
-// UVs in texture pixels (as ChunkedMapper gives them), and a coarser copy that keeps those UVs.
+// tailor.plan_chunks, tailor.save_uvs, tailor.load_material and tailor.simplify_uvs: the chunk
+// rule, the writer of `tailor map -o` and libmeshoptimizer's simplifier for code that cuts a mesh
+// into tiles itself (python -m tailor.tiles): the rule's cells and faces as arrays, any mesh
+// written with per-corner UVs in texture pixels (as ChunkedMapper gives them), with a texture or
+// a PBR material read once, and a coarser copy that keeps those UVs.
 #include <meshoptimizer.h>
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include "bindings.h"
 #include "tailor/chunks.h"
 #include "tailor/export.h"
+#include "tailor/material.h"
 
 namespace tailor::python {
 
@@ -24,6 +26,44 @@ py::array_t<float, py::array::c_style | py::array::forcecast> corner_uv_array(co
     raise_error("corner_uvs must be an (F, 3, 2) array with F = " + std::to_string(faces) + ", got " +
                 describe(corner_uvs));
   return uv;
+}
+
+// A material as tailor.load_material returns it: the dict's fields into the export options.
+void material_from_dict(const py::dict& d, ExportOptions& options) {
+  auto bytes_of = [&](const char* key) {
+    return d.contains(key) && !d[key].is_none() ? d[key].cast<std::string>() : std::string();
+  };
+  if (d.contains("color") && !d["color"].is_none()) options.texture_path = path_of(d["color"]);
+  options.material.normal_png = bytes_of("normal_png");
+  options.material.orm_png = bytes_of("orm_png");
+  options.material.orm_roughness_metallic =
+      d.contains("orm_roughness_metallic") && d["orm_roughness_metallic"].cast<bool>();
+  options.material.orm_occlusion = d.contains("orm_occlusion") && d["orm_occlusion"].cast<bool>();
+  if (!d.contains("width") || !d.contains("height"))
+    raise_error("material must be a folder, a JSON or what tailor.load_material returns");
+  if (d["width"].cast<int>() != options.texture_width || d["height"].cast<int>() != options.texture_height)
+    raise_error("the material is " + std::to_string(d["width"].cast<int>()) + "x" +
+                std::to_string(d["height"].cast<int>()) + " but texture_size is " +
+                std::to_string(options.texture_width) + "x" + std::to_string(options.texture_height));
+}
+
+// What tailor.load_material returns for a material read by load_material.
+py::dict material_dict(const MaterialMaps& maps) {
+  auto bytes_or_none = [](const std::string& b) {
+    return b.empty() ? py::object(py::none()) : py::object(py::bytes(b));
+  };
+  py::dict d;
+  d["color"] = maps.color.empty() ? py::object(py::none()) : py::object(py::str(maps.color));
+  d["width"] = maps.width;
+  d["height"] = maps.height;
+  d["normal_png"] = bytes_or_none(maps.textures.normal_png);
+  d["orm_png"] = bytes_or_none(maps.textures.orm_png);
+  d["orm_roughness_metallic"] = maps.textures.orm_roughness_metallic;
+  d["orm_occlusion"] = maps.textures.orm_occlusion;
+  d["symmetry"] = maps.symmetry;
+  d["files"] = maps.files;
+  d["notes"] = maps.notes;
+  return d;
 }
 
 }  // namespace
@@ -74,7 +114,7 @@ and faces (F,) uint32: chunk k's face ids are faces[chunk_start[k]:chunk_start[k
   m.def(
       "save_uvs",
       [](const py::object& path_object, const PyMesh& mesh, const py::array& corner_uvs, const py::sequence& size,
-         const py::object& texture) {
+         const py::object& texture, const py::object& material, const std::string& up) {
         const std::string path = path_of(path_object);
         const size_t faces = mesh.mesh.face_count();
         const auto uv = corner_uv_array(corner_uvs, faces);
@@ -84,7 +124,24 @@ and faces (F,) uint32: chunk k's face ids are faces[chunk_start[k]:chunk_start[k
         options.texture_height = size[1].cast<int>();
         if (options.texture_width <= 0 || options.texture_height <= 0)
           raise_error("texture_size must be positive, got " + sequence_text(size));
+        if (up != "y" && up != "z") raise_error("--up must be y or z, got '" + up + "'");
+        options.up = up == "z" ? SceneUp::kZ : SceneUp::kY;
+        if (!texture.is_none() && !material.is_none())
+          raise_error("give texture= or material=, not both (the material's colour map is the texture)");
         if (!texture.is_none()) options.texture_path = path_of(texture);
+        if (py::isinstance<py::dict>(material)) {
+          material_from_dict(material.cast<py::dict>(), options);
+        } else if (!material.is_none()) {
+          const std::string material_path = path_of(material);
+          MaterialMaps maps;
+          Status s;
+          {
+            const py::gil_scoped_release release;
+            s = load_material(material_path, maps);
+          }
+          if (!s) raise_status(s);
+          material_from_dict(material_dict(maps), options);
+        }
         Atlas atlas;
         atlas.corner_uv.assign(uv.data(), uv.data() + 6 * faces);
         atlas.patch.assign(faces, 0);
@@ -97,12 +154,42 @@ and faces (F,) uint32: chunk k's face ids are faces[chunk_start[k]:chunk_start[k
         if (!status) raise_status(status);
       },
       py::arg("path"), py::arg("mesh"), py::arg("corner_uvs"), py::arg("texture_size"), py::arg("texture") = py::none(),
-      R"(save_uvs(path, mesh, corner_uvs, texture_size, texture=None) -> None
+      py::arg("material") = py::none(), py::arg("up") = "y",
+      R"(save_uvs(path, mesh, corner_uvs, texture_size, texture=None, material=None, up='y') -> None
 
 Writes the mesh with per-corner UVs given in texture pixels ((F, 3, 2), as ChunkedMapper.chunk()
 gives them), divided by texture_size = (width, height) into texture repeats exactly as `tailor
 map -o` does: .glb, .obj or .ply, atomically. texture: a PNG or JPEG to embed (.glb) or name
-(.obj); None writes the UVs with a plain material.)");
+(.obj); None writes the UVs with a plain material. material: instead of texture, a PBR material
+as `tailor map --material` (.glb: base colour, normal map with tangents, metallicRoughness,
+occlusion): a folder or JSON, or what tailor.load_material returned (read once for many files);
+its size must be texture_size. up: 'z' for Z-up coordinates, turned Y-up by the .glb node's
+rotation as `tailor map --up z`.)");
+
+  m.def(
+      "load_material",
+      [](const py::object& path_object) {
+        const std::string path = path_of(path_object);
+        MaterialMaps maps;
+        Status status;
+        {
+          const py::gil_scoped_release release;
+          status = load_material(path, maps);
+        }
+        if (!status) raise_status(status);
+        return material_dict(maps);
+      },
+      py::arg("path"),
+      R"(load_material(path) -> dict
+
+Reads a PBR material as `tailor map --material` does (a folder of maps named *_color, *_normal,
+*_roughness..., or a JSON naming them, such as the material.json of `tailor tile --set`) and
+returns the maps a .glb holds: color (the colour map's path, embedded as is, or None), width and
+height (the repeat in pixels), normal_png (the normal map in glTF's convention, PNG bytes, or
+None), orm_png (occlusion, roughness and metallic packed in R, G, B as glTF wants, or None),
+orm_roughness_metallic and orm_occlusion (what orm_png serves as), symmetry (4 for quarter-turn
+tiles, 1 or 0 otherwise), files ("role: path" of every map read) and notes (one-line warnings).
+save_uvs(material=...) takes the dict.)");
   bind_simplify(m);
 }
 

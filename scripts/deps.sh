@@ -11,12 +11,13 @@ packages=(
   libopencv-core-dev libopencv-imgproc-dev libosmesa6-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-format python3 time
-  pybind11-dev python3-dev python3-numpy python3-pytest python3-distributed
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-distributed python3-jsonschema
   libcgal-dev
   chromium
 )
 # pybind11, Python's headers, numpy and pytest: the Python module and its tests (/usr/bin/python3).
 # python3-distributed (Dask): python3 -m tailor.tiles maps tiles as Dask tasks on a cluster.
+# python3-jsonschema: tests/tiles_schema_test.sh checks the tilesets against the 3D Tiles 1.1 schema.
 # libcgal-dev (header-only in Debian 12's CGAL 5.5, with GMP/MPFR and Boost headers): --axis skeleton.
 # clang + its fuzzer runtime are optional: the fuzz step skips cleanly without them.
 # Blender only on request (TAILOR_BLENDER=1, make deps-blender): the add-on's test skips without it.

@@ -84,7 +84,10 @@ def save_uvs(
     corner_uvs: npt.ArrayLike,
     texture_size: Tuple[int, int],
     texture: Optional[_Path] = None,
+    material: Union[_Path, Dict[str, Any], None] = None,
+    up: Literal["y", "z"] = "y",
 ) -> None: ...
+def load_material(path: _Path) -> Dict[str, Any]: ...
 def simplify_uvs(mesh: Mesh, corner_uvs: npt.ArrayLike, target_faces: int, lock_border: bool = True) -> Dict[str, Any]: ...
 def map(
     mesh: Mesh,

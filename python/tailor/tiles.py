@@ -2,14 +2,17 @@
 
     python3 -m tailor.tiles scan.ply -o scan_tiles --texture gravel.png --workers 2
     python3 -m tailor.tiles scan.ply -o scan_tiles --scheduler tcp://head:8786
+    python3 -m tailor.tiles scan.ply -o scan_tiles --material tiled/material.json --up z
 
 The mesh is cut by the chunked engine's rule (tailor.plan_chunks: a grid anchored at the world
 origin, cell side a power of two of world units); a tile is a cube of 2**k x 2**k x 2**k chunk
 cells (--tile-size, world units). Each tile is one Dask task that maps its chunks with
 tailor.ChunkedMapper and writes tiles/<x>_<y>_<z>.glb: a chunk's UVs depend on its own faces only,
 so every tile holds the bits `tailor map --chunks on` gives those faces inside the whole mesh, for
-any number of workers. The texture is copied once beside tileset.json and every .glb names it
-(an image URI), so that a 3D Tiles client downloads it once.
+any number of workers. The texture (or a PBR material's images: --material) is written once
+beside tileset.json and every .glb names it (image URIs), so that a 3D Tiles client downloads it
+once. --up z: Z-up coordinates, turned Y up by each .glb's node as glTF wants and back to Z up by
+the client as 3D Tiles prescribes; the bounding volumes follow either choice.
 
 A tile's faces are written in a canonical order (by their corners' coordinates), so its bytes do
 not depend on the input file's face or vertex order. tailor-tiles.json records each tile's digest
@@ -104,37 +107,111 @@ def tile_digest(positions, faces, params):
 # === The .glb: the library's writer, the texture referenced by URI ===
 
 
-def reference_texture(path, texture_uri):
-    """Rewrites a .glb written without a texture so that its material's base colour is the image at
-    texture_uri (relative to the .glb), sampled with REPEAT as tailor's embedded textures are."""
+def read_glb(path):
+    """(the glTF JSON, the BIN chunk's bytes) of a binary glTF."""
     data = pathlib.Path(path).read_bytes()
     magic, version, _ = struct.unpack_from("<4sII", data, 0)
     json_length, json_type = struct.unpack_from("<II", data, 12)
     if magic != b"glTF" or version != 2 or json_type != 0x4E4F534A:
         raise TilesError("%s: not a glTF 2.0 binary" % path)
     gltf = json.loads(data[20 : 20 + json_length])
-    rest = data[20 + json_length :]
-    gltf["images"] = [{"uri": texture_uri}]
-    gltf["samplers"] = [{"magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497}]
-    gltf["textures"] = [{"sampler": 0, "source": 0}]
-    gltf["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {"index": 0}
+    at = 20 + json_length
+    binary = b""
+    if at + 8 <= len(data):
+        bin_length, bin_type = struct.unpack_from("<II", data, at)
+        if bin_type == 0x004E4942:
+            binary = data[at + 8 : at + 8 + bin_length]
+    return gltf, binary
+
+
+def write_glb(path, gltf, binary):
+    """A binary glTF of the JSON and the BIN chunk's bytes, written atomically."""
     text = json.dumps(gltf, separators=(",", ":")).encode()
     text += b" " * (-len(text) % 4)
-    out = struct.pack("<4sII", b"glTF", 2, 12 + 8 + len(text) + len(rest))
-    out += struct.pack("<II", len(text), 0x4E4F534A) + text + rest
+    binary = bytes(binary) + b"\0" * (-len(binary) % 4)
+    out = struct.pack("<4sII", b"glTF", 2, 12 + 8 + len(text) + (8 + len(binary) if binary else 0))
+    out += struct.pack("<II", len(text), 0x4E4F534A) + text
+    if binary:
+        out += struct.pack("<II", len(binary), 0x004E4942) + binary
     tmp = str(path) + ".part"
     with open(tmp, "wb") as f:
         f.write(out)
     os.replace(tmp, path)
 
 
-def write_tile_glb(path, positions, faces, corner_uvs, params, texture_uri):
+def reference_images(path, uris):
+    """Rewrites a .glb that embeds its material's images so that each names a file instead:
+    uris maps a role (color: the base colour, normal: the normal map, orm: the metallicRoughness
+    and occlusion map) to a URI relative to the .glb. The images' bytes leave the BIN chunk; the
+    sampler (REPEAT) and the material stay as the library wrote them."""
+    gltf, binary = read_glb(path)
+    images = gltf.get("images", [])
+    if not images:
+        return
+    material = gltf["materials"][0]
+    pbr = material.get("pbrMetallicRoughness", {})
+    refs = {
+        "color": pbr.get("baseColorTexture"),
+        "normal": material.get("normalTexture"),
+        "orm": pbr.get("metallicRoughnessTexture") or material.get("occlusionTexture"),
+    }
+    uri_of = {}
+    for role, ref in refs.items():
+        if ref is not None:
+            uri_of[gltf["textures"][ref["index"]]["source"]] = uris[role]
+    if sorted(uri_of) != list(range(len(images))):
+        raise TilesError("%s: an image the material does not use" % path)
+    dropped = {image["bufferView"] for image in images}
+    gltf["images"] = [{"uri": uri_of[i]} for i in range(len(images))]
+    # The other views' bytes packed again in their order, each at a multiple of 4 bytes.
+    views, new_index, packed = [], {}, bytearray()
+    for k, view in enumerate(gltf["bufferViews"]):
+        if k in dropped:
+            continue
+        start = view.get("byteOffset", 0)
+        packed += b"\0" * (-len(packed) % 4)
+        new_index[k] = len(views)
+        views.append(dict(view, byteOffset=len(packed)))
+        packed += binary[start : start + view["byteLength"]]
+    gltf["bufferViews"] = views
+    for accessor in gltf.get("accessors", []):
+        accessor["bufferView"] = new_index[accessor["bufferView"]]
+    gltf["buffers"][0]["byteLength"] = len(packed)
+    write_glb(path, gltf, packed)
+
+
+def tile_material(folder, params):
+    """The tile's material for tailor.save_uvs, from the images beside tileset.json (written once
+    by the driver: every task reads them from there), or None for a plain material."""
+    images = params["images"]
+    if not images:
+        return None
+    folder = pathlib.Path(folder)
+
+    def read(role):
+        return (folder / images[role]).read_bytes() if role in images else None
+
+    roles = params.get("orm_roles", [])
+    return {
+        "color": str(folder / images["color"]) if "color" in images else None,
+        "width": params["texture_size"][0],
+        "height": params["texture_size"][1],
+        "normal_png": read("normal"),
+        "orm_png": read("orm"),
+        "orm_roughness_metallic": "roughness_metallic" in roles,
+        "orm_occlusion": "occlusion" in roles,
+    }
+
+
+def write_tile_glb(folder, name, positions, faces, corner_uvs, params):
+    path = glb_path(folder, name)
     mesh = tailor.Mesh(positions, faces)
     if mesh.face_count != faces.shape[0]:
         raise TilesError("tile %s: %d faces dropped as degenerate" % (path, faces.shape[0] - mesh.face_count))
-    tailor.save_uvs(str(path), mesh, corner_uvs, tuple(params["texture_size"]))
-    if texture_uri:
-        reference_texture(path, texture_uri)
+    material = tile_material(folder, params)
+    tailor.save_uvs(str(path), mesh, corner_uvs, tuple(params["texture_size"]), material=material, up=params["up"])
+    if material is not None:
+        reference_images(path, {role: "../" + file for role, file in params["images"].items()})
 
 
 # === The tasks: a leaf tile maps its chunks, a parent simplifies its children ===
@@ -219,9 +296,9 @@ def kept(keep_from, digest, folder, name, lod):
     return True
 
 
-def finish_node(record, folder, positions, faces, uvs, params, texture_uri, lod):
+def finish_node(record, folder, positions, faces, uvs, params, lod):
     """Writes a node's .glb (and, with levels of detail, the quarter its parent starts from)."""
-    write_tile_glb(glb_path(folder, record["name"]), positions, faces, uvs, params, texture_uri)
+    write_tile_glb(folder, record["name"], positions, faces, uvs, params)
     if lod:
         p, f, t, error = simplify(positions, faces, uvs, faces.shape[0] / 4)
         save_coarse(coarse_path(folder, record["name"]), p, f, t, error)
@@ -244,7 +321,7 @@ def leaf_record(job, positions, faces, params):
     }
 
 
-def map_tile(job, positions, faces, params, folder, texture_uri, keep_from, threads, lod):
+def map_tile(job, positions, faces, params, folder, keep_from, threads, lod):
     """A leaf: puts the tile in its canonical order, maps its chunks and writes tiles/<name>.glb, or
     links the previous run's files when the digest is the same. Returns the node's record."""
     positions, faces = canonical_tile(positions, faces)
@@ -260,7 +337,7 @@ def map_tile(job, positions, faces, params, folder, texture_uri, keep_from, thre
         chunk = mapper.chunk(cell)
         uv[chunk["faces"]] = chunk["corner_uvs"]
     del mapper, mesh
-    record = finish_node(record, folder, positions, faces, uv, params, texture_uri, lod)
+    record = finish_node(record, folder, positions, faces, uv, params, lod)
     # Test hook: TAILOR_TILES_KILL_ONCE=NAME=MARKER ends this worker process abruptly once, after
     # tile NAME's files are written and before its result is sent (tests/python/test_tiles.py).
     name, _, marker = os.environ.get("TAILOR_TILES_KILL_ONCE", "").partition("=")
@@ -270,7 +347,7 @@ def map_tile(job, positions, faces, params, folder, texture_uri, keep_from, thre
     return record
 
 
-def build_parent(job, params, folder, texture_uri, keep_from, *children):
+def build_parent(job, params, folder, keep_from, *children):
     """A parent: its children's quarters joined (vertices at one position welded, so that the
     children's shared sides can be simplified) and simplified to a quarter of the children's
     faces; its error is its own simplification's plus the largest a child's content had."""
@@ -301,10 +378,10 @@ def build_parent(job, params, folder, texture_uri, keep_from, *children):
     faces = inverse.reshape(-1)[faces].astype(np.uint32)
     p, f, t, error = simplify(positions, faces, uvs, sum(c["faces"] for c in children) / 4)
     record.update(faces=int(f.shape[0]), error=below + error)
-    return finish_node(record, folder, p, f, t, params, texture_uri, True)
+    return finish_node(record, folder, p, f, t, params, True)
 
 
-def map_in_process(jobs, order, params, folder, texture_uri, threads, lod):
+def map_in_process(jobs, order, params, folder, threads, lod):
     """--workers 0: the tiles to write mapped together by one ChunkedMapper.set_mesh (the library's
     chunked map, its chunks in parallel on `threads` threads), then written one by one. Yields
     (job index, record) in `order`."""
@@ -315,7 +392,7 @@ def map_in_process(jobs, order, params, folder, texture_uri, threads, lod):
         p, f = canonical_tile(p, f)
         jobs[i] = (job, p, f, keep)
         if keep and keep.get("digest") == tile_digest(p, f, params):
-            yield i, map_tile(job, p, f, params, folder, texture_uri, keep, threads, lod)
+            yield i, map_tile(job, p, f, params, folder, keep, threads, lod)
         else:
             pending.append(i)
     if not pending:
@@ -334,7 +411,7 @@ def map_in_process(jobs, order, params, folder, texture_uri, threads, lod):
     for k, i in enumerate(pending):
         job, p, f, _ = jobs[i]
         record = leaf_record(job, p, f, params)
-        yield i, finish_node(record, folder, p, f, uv[face_offsets[k] : face_offsets[k + 1]], params, texture_uri, lod)
+        yield i, finish_node(record, folder, p, f, uv[face_offsets[k] : face_offsets[k + 1]], params, lod)
 
 
 def parent_levels(leaves):
@@ -359,15 +436,20 @@ def parent_levels(leaves):
 # === The tileset ===
 
 
-def box_volume(lo, hi):
-    """A 3D Tiles box around glTF coordinates lo..hi (Y up), in the tileset's Z-up frame (a client
-    turns glTF content Y-up to Z-up: x, y, z -> x, -z, y)."""
+def box_volume(lo, hi, up):
+    """A 3D Tiles box around the mesh's coordinates lo..hi, in the tileset's Z-up frame. A client
+    turns glTF content from Y up to Z up (x, y, z -> x, -z, y: 3D Tiles 1.1, "y-up to z-up") after
+    the glTF node's transform. up "y": the coordinates are the glTF's, so the box is turned the
+    same way; up "z": the node turns Z-up coordinates Y up (x, y, z -> x, z, -y), the client turns
+    them back, and the box is in the mesh's own coordinates."""
     c = [(a + b) / 2 for a, b in zip(lo, hi)]
     h = [max((b - a) / 2, 1e-9) for a, b in zip(lo, hi)]
+    if up == "z":
+        return {"box": [c[0], c[1], c[2], h[0], 0, 0, 0, h[1], 0, 0, 0, h[2]]}
     return {"box": [c[0], -c[2], c[1], h[0], 0, 0, 0, h[2], 0, 0, 0, h[1]]}
 
 
-def tileset_json(records, lod):
+def tileset_json(records, lod, up):
     """Leaves under their parents (refine REPLACE: a parent's simplified copy gives way to its
     children), or, without levels of detail, every leaf under one root (refine ADD)."""
     by_name = {r["name"]: r for r in records}
@@ -377,7 +459,7 @@ def tileset_json(records, lod):
 
     def node(r):
         out = {
-            "boundingVolume": box_volume(r["min"], r["max"]),
+            "boundingVolume": box_volume(r["min"], r["max"], up),
             "geometricError": float(r["error"]),
             "content": {"uri": "tiles/%s.glb" % r["name"]},
         }
@@ -393,7 +475,7 @@ def tileset_json(records, lod):
         error = max(root["geometricError"], diagonal)  # a client far away still shows the root
     else:
         root = {
-            "boundingVolume": box_volume(lo, hi),
+            "boundingVolume": box_volume(lo, hi, up),
             "geometricError": diagonal,
             "refine": "REPLACE" if lod else "ADD",
             "children": [node(r) for r in top],
@@ -429,7 +511,41 @@ def image_size(path):
     raise TilesError("%s: not a PNG or JPEG image" % path)
 
 
-def plan_tiles(mesh, args):
+def read_look(args):
+    """What every tile's material shows, read once: images {role: (file name beside tileset.json,
+    bytes)} (color, normal, orm), orm_roles (what the orm image serves as), size (the repeat in
+    pixels, None without a texture) and colour (the colour map's path, for --field-following auto)."""
+    look = {"images": {}, "orm_roles": [], "size": None, "colour": None, "notes": []}
+    if args.texture:
+        if not os.path.isfile(args.texture):
+            raise TilesError("%s: no such file" % args.texture)
+        look["size"] = list(image_size(args.texture))
+        look["colour"] = args.texture
+        name = "texture" + pathlib.Path(args.texture).suffix.lower()
+        look["images"]["color"] = (name, pathlib.Path(args.texture).read_bytes())
+    elif args.material:
+        m = tailor.load_material(args.material)
+        look["size"] = [m["width"], m["height"]]
+        look["notes"] = list(m["notes"])
+        if m["symmetry"] == 4:
+            look["notes"].append(
+                "%s records quarter-turn tiles (symmetry 4); the tiles map them as plain tiles (symmetry 1)"
+                % args.material
+            )
+        if m["color"]:
+            look["colour"] = m["color"]
+            name = "material_color" + pathlib.Path(m["color"]).suffix.lower()
+            look["images"]["color"] = (name, pathlib.Path(m["color"]).read_bytes())
+        if m["normal_png"]:
+            look["images"]["normal"] = ("material_normal.png", m["normal_png"])
+        if m["orm_png"]:
+            look["images"]["orm"] = ("material_orm.png", m["orm_png"])
+            roles = (("occlusion", m["orm_occlusion"]), ("roughness_metallic", m["orm_roughness_metallic"]))
+            look["orm_roles"] = [role for role, used in roles if used]
+    return look
+
+
+def plan_tiles(mesh, args, look):
     """The tiles: {tile: face ids}, and the parameters every tile's digest and mapping use."""
     plan = tailor.plan_chunks(mesh, args.chunk_cell)
     e = plan["cell_exponent"]
@@ -443,11 +559,8 @@ def plan_tiles(mesh, args):
             )
         level = int(t) - e
     tpu = args.texels_per_unit if args.texels_per_unit is not None else texels_per_unit_for(mesh, args.scale)
-    if args.texture:
-        width, height = image_size(args.texture)
-    else:
-        width = height = args.texture_size
-    field_following, crack_rings = resolve_field_following(args)
+    width, height = look["size"] if look["size"] else (args.texture_size, args.texture_size)
+    field_following, crack_rings = resolve_field_following(args, look["colour"])
     params = {
         "format": FORMAT,
         "tailor": tailor.__version__,
@@ -459,6 +572,9 @@ def plan_tiles(mesh, args):
         "max_stretch": args.max_stretch,
         "crack_rings": crack_rings,
         "lod": args.lod,
+        "up": args.up,
+        "images": {role: name for role, (name, _) in look["images"].items()},
+        "orm_roles": look["orm_roles"],
     }
     tiles = {}
     cells = plan["cells"] >> level  # arithmetic shift: floor division by 2**level
@@ -469,8 +585,9 @@ def plan_tiles(mesh, args):
     return plan, params, tiles
 
 
-def resolve_field_following(args):
-    """(field_following, crack_rings) as tailor map resolves them: auto follows the texture's direction."""
+def resolve_field_following(args, colour):
+    """(field_following, crack_rings) as tailor map resolves them: auto follows the direction of the
+    texture (or of the material's colour map)."""
     if args.field_following != "auto":
         try:
             value = float(args.field_following)
@@ -479,9 +596,9 @@ def resolve_field_following(args):
         if not 0.0 <= value <= 1.0:
             raise TilesError("--field-following must be auto or a number in [0, 1], got %g" % value)
         return value, args.crack_rings
-    if not args.texture:
+    if not colour:
         return 1.0, args.crack_rings
-    value, rings = tailor.auto_field_following(args.texture)
+    value, rings = tailor.auto_field_following(colour)
     return float(value), (args.crack_rings if args.crack_rings is not None else int(rings))
 
 
@@ -559,9 +676,11 @@ def run(args):
         mesh = tailor.load(args.input)
     except tailor.Error as e:
         raise TilesError(str(e)) from None
-    if args.texture and not os.path.isfile(args.texture):
-        raise TilesError("%s: no such file" % args.texture)
-    plan, params, tiles = plan_tiles(mesh, args)
+    look = read_look(args)
+    if not args.quiet:
+        for note in look["notes"]:
+            print("tailor.tiles: warning: %s" % note, file=sys.stderr)
+    plan, params, tiles = plan_tiles(mesh, args, look)
     old = previous_output(outdir, params)
     t_plan = time.monotonic()
 
@@ -570,15 +689,14 @@ def run(args):
     (tmp / "tiles").mkdir(parents=True)
     client = cluster = None
     try:
-        texture_uri = None
-        if args.texture:
-            name = "texture" + pathlib.Path(args.texture).suffix.lower()
+        # The images every tile names, once beside tileset.json (the previous run's file linked
+        # when it has the same bytes, so that it keeps its time).
+        for name, data in look["images"].values():
             previous = outdir / name
-            if previous.exists() and previous.read_bytes() == pathlib.Path(args.texture).read_bytes():
+            if previous.is_file() and previous.read_bytes() == data:
                 os.link(previous, tmp / name)
             else:
-                shutil.copyfile(args.texture, tmp / name)
-            texture_uri = "../" + name
+                (tmp / name).write_bytes(data)
         if args.lod:
             (tmp / "lod").mkdir()
         positions = mesh.positions
@@ -599,14 +717,14 @@ def run(args):
         records = {}
         folder = str(tmp)
         if args.workers == 0 and not args.scheduler:
-            for i, record in map_in_process(jobs, order, params, folder, texture_uri, args.threads, args.lod):
+            for i, record in map_in_process(jobs, order, params, folder, args.threads, args.lod):
                 records[record["name"]] = record
                 progress.step(record["written"])
             for level, groups in enumerate(levels, start=1):
                 for tile, names in groups:
                     job = {"name": node_name(level, tile), "level": level, "tile": list(tile)}
                     kids = [records[n] for n in names]
-                    record = build_parent(job, params, folder, texture_uri, old.get(job["name"]), *kids)
+                    record = build_parent(job, params, folder, old.get(job["name"]), *kids)
                     records[job["name"]] = record
                     progress.step(record["written"])
         else:
@@ -618,14 +736,14 @@ def run(args):
             for i in order:
                 job, p, f, keep = jobs[i]
                 futures[job["name"]] = client.submit(
-                    map_tile, job, p, f, params, folder, texture_uri, keep, threads, args.lod, key="tile-%s-%s" % (tmp.name, job["name"])
+                    map_tile, job, p, f, params, folder, keep, threads, args.lod, key="tile-%s-%s" % (tmp.name, job["name"])
                 )
             for level, groups in enumerate(levels, start=1):
                 for tile, names in groups:
                     job = {"name": node_name(level, tile), "level": level, "tile": list(tile)}
                     kids = [futures[n] for n in names]
                     futures[job["name"]] = client.submit(
-                        build_parent, job, params, folder, texture_uri, old.get(job["name"]), *kids, key="tile-%s-%s" % (tmp.name, job["name"])
+                        build_parent, job, params, folder, old.get(job["name"]), *kids, key="tile-%s-%s" % (tmp.name, job["name"])
                     )
             for fut in as_completed(list(futures.values())):
                 record = fut.result()
@@ -633,7 +751,7 @@ def run(args):
                 progress.step(record["written"])
         records = sorted(records.values(), key=lambda r: (-r["level"], r["tile"][2], r["tile"][1], r["tile"][0]))
         t_map = time.monotonic()
-        (tmp / "tileset.json").write_text(json.dumps(tileset_json(records, args.lod), indent=1) + "\n")
+        (tmp / "tileset.json").write_text(json.dumps(tileset_json(records, args.lod, args.up), indent=1) + "\n")
         fields = ("digest", "faces", "error", "coarse_error")
         manifest = {"params": params, "tiles": {r["name"]: {k: r[k] for k in fields} for r in records}}
         (tmp / MANIFEST).write_text(json.dumps(manifest, indent=1, sort_keys=True) + "\n")
@@ -676,6 +794,11 @@ def run(args):
     return summary
 
 
+def usage_error(message):
+    print("tailor.tiles: error: %s" % message, file=sys.stderr)
+    sys.exit(2)
+
+
 def parse_args(argv):
     p = argparse.ArgumentParser(
         prog="python3 -m tailor.tiles",
@@ -707,6 +830,20 @@ def parse_args(argv):
         help="threads of each tile's mapping (default: 1 per Dask worker; all cores with --workers 0)",
     )
     p.add_argument("--texture", metavar="T", help="PNG or JPEG texture: its size sets the repeat, tiles name it")
+    p.add_argument(
+        "--material",
+        metavar="M",
+        help="instead of --texture, a PBR material as tailor map --material (a folder of maps, or a JSON such as "
+        "tailor tile --set's material.json): its maps' size sets the repeat; the tiles name its base colour, normal "
+        "and occlusion/roughness/metallic images, written once beside tileset.json",
+    )
+    p.add_argument(
+        "--up",
+        default="y",
+        metavar="y|z",
+        help="up axis of the mesh's coordinates, as tailor map --up: z (scans, CAD) gives each .glb a node rotation "
+        "that turns it Y up, so the tileset's Z up is the mesh's own (default y)",
+    )
     p.add_argument("--texture-size", type=int, default=512, help="pixels of one repeat without --texture")
     p.add_argument("--scale", type=float, default=800.0, help="as tailor map --scale (density from the bounding box)")
     p.add_argument(
@@ -732,6 +869,10 @@ def parse_args(argv):
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no summary")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     args = p.parse_args(argv)
+    if args.texture and args.material:
+        usage_error("give --texture or --material, not both (the material's colour map is the texture)")
+    if args.up not in ("y", "z"):
+        usage_error("--up must be y or z, got '%s'" % args.up)
     if args.workers < 0:
         p.error("--workers must be 0 or more")
     if args.threads < 0 or args.threads > 64:

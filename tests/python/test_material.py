@@ -90,6 +90,36 @@ def test_material_errors_are_the_cli_messages(tmp_path, material_dir):
         tailor.map(mesh, material=material_dir)
 
 
+def test_save_uvs_writes_a_material_read_once(tmp_path, material_dir):
+    # Per-corner UVs in pixels, as ChunkedMapper gives them, with the material of `tailor map
+    # --material`: read from the folder, or once by load_material for many files.
+    mesh = tailor.load(SPOT)
+    with pytest.warns(UserWarning, match="does not wrap"):  # the example photo is not a tile: fine here
+        uv = tailor.map(mesh, material=material_dir).corner_uvs * np.float32(512)
+    loaded = tailor.load_material(material_dir)
+    assert (loaded["width"], loaded["height"]) == (512, 512) and loaded["color"].endswith("gravel_Color.png")
+    assert loaded["normal_png"][:8] == b"\x89PNG\r\n\x1a\n" and loaded["orm_png"][:8] == b"\x89PNG\r\n\x1a\n"
+    assert loaded["orm_roughness_metallic"] and loaded["orm_occlusion"] and len(loaded["files"]) == 4
+    tailor.save_uvs(tmp_path / "folder.glb", mesh, uv, (512, 512), material=material_dir)
+    tailor.save_uvs(tmp_path / "loaded.glb", mesh, uv, (512, 512), material=loaded)
+    data = (tmp_path / "folder.glb").read_bytes()
+    assert data == (tmp_path / "loaded.glb").read_bytes()
+    assert b"normalTexture" in data and b"TANGENT" in data and b"occlusionTexture" in data
+    assert loaded["normal_png"] in data and loaded["orm_png"] in data and GRAVEL.read_bytes() in data
+    # up='z': the node turns Z-up coordinates Y up, as `tailor map --up z`.
+    tailor.save_uvs(tmp_path / "z.glb", mesh, uv, (512, 512), up="z")
+    assert b'"rotation":[-0.7071067811865476,0.0,0.0,0.7071067811865476]' in (tmp_path / "z.glb").read_bytes()
+    with pytest.raises(tailor.Error, match="^give texture= or material=, not both"):
+        tailor.save_uvs(tmp_path / "x.glb", mesh, uv, (512, 512), texture=GRAVEL, material=loaded)
+    with pytest.raises(tailor.Error, match="^the material is 512x512 but texture_size is 256x256"):
+        tailor.save_uvs(tmp_path / "x.glb", mesh, uv, (256, 256), material=loaded)
+    with pytest.raises(tailor.Error, match="^--up must be y or z, got 'x'"):
+        tailor.save_uvs(tmp_path / "x.glb", mesh, uv, (512, 512), up="x")
+    with pytest.raises(tailor.Error, match="no map recognised"):
+        tailor.load_material(tmp_path)
+    assert not (tmp_path / "x.glb").exists()
+
+
 def load_addon_table():
     path = ROOT / "blender" / "tailor_addon" / "material_files.py"
     spec = importlib.util.spec_from_file_location("tailor_material_files", path)

@@ -6,6 +6,7 @@ import pathlib
 import struct
 import subprocess
 import sys
+import zlib
 
 import numpy as np
 import pytest
@@ -241,3 +242,174 @@ def test_a_running_scheduler_gives_the_same_tiles(tmp_path):
     assert code == 0, stderr
     assert json.loads(stdout)["workers"] is None
     assert folder_bytes(tmp_path / "there") == folder_bytes(tmp_path / "here")
+
+
+def write_png(path, pixels):
+    """An 8-bit PNG of a (H, W) or (H, W, 3) uint8 array."""
+    pixels = np.ascontiguousarray(pixels, np.uint8)
+    height, width = pixels.shape[:2]
+    raw = b"".join(b"\0" + pixels[y].tobytes() for y in range(height))
+
+    def chunk(kind, body):
+        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
+
+    header = struct.pack(">IIBBBBB", width, height, 8, {2: 0, 3: 2}[pixels.ndim], 0, 0, 0)
+    body = chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b"")
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" + body)
+
+
+def content_nodes(tileset):
+    """Every tile of a tileset that has content."""
+    out, todo = [], [tileset["root"]]
+    while todo:
+        node = todo.pop()
+        todo.extend(node.get("children", []))
+        if "content" in node:
+            out.append(node)
+    return out
+
+
+def test_a_material_is_named_by_every_tile_and_written_once(tmp_path):
+    # The brick photo as colour, with a normal map, roughness and occlusion derived from one height
+    # field, named by a material description as `tailor tile --set` writes one (files relative to
+    # the JSON's folder, roles from "role", "normal" or the names).
+    colour = DATA / "textures" / "brick-gray-512.png"
+    folder = tmp_path / "brick"
+    folder.mkdir()
+    y, x = np.mgrid[0:512, 0:512] / 512.0 * 2 * np.pi
+    height = np.sin(8 * x) * np.cos(4 * y)
+    n = np.stack([-np.gradient(height, axis=1) * 30, np.gradient(height, axis=0) * 30, np.ones_like(height)], -1)
+    n /= np.linalg.norm(n, axis=-1, keepdims=True)
+    write_png(folder / "bricks_normal.png", np.round((n * 0.5 + 0.5) * 255))
+    write_png(folder / "bricks_roughness.png", np.round(127 + 100 * height))
+    write_png(folder / "bricks_ao.png", np.round(200 + 50 * height))
+    material = folder / "material.json"
+    material.write_text(
+        json.dumps(
+            {
+                "maps": [
+                    {"file": str(colour), "role": "color"},
+                    {"file": "bricks_normal.png", "normal": True},
+                    {"file": "bricks_roughness.png"},
+                    {"file": "bricks_ao.png"},
+                ]
+            }
+        )
+    )
+    common = [HORSE, "--chunk-cell", CELL, "--workers", 0, "--json"]
+    out = tmp_path / "tiles"
+    code, stdout, stderr = run_tiles(*common, "-o", out, "--material", material)
+    assert code == 0, stderr
+    summary = json.loads(stdout)
+    # The maps once beside tileset.json: the colour map as it is, the normal map and the packed
+    # occlusion / roughness / metallic image as `tailor map --material` embeds them.
+    loaded = tailor.load_material(material)
+    assert (out / "material_color.png").read_bytes() == colour.read_bytes()
+    assert (out / "material_normal.png").read_bytes() == loaded["normal_png"]
+    assert (out / "material_orm.png").read_bytes() == loaded["orm_png"]
+    expected = {"../material_color.png", "../material_normal.png", "../material_orm.png"}
+    nodes = content_nodes(json.loads((out / "tileset.json").read_text()))
+    assert len(nodes) == summary["tiles"] > summary["leaves"]
+    for node in nodes:
+        positions, uvs, faces, gltf = read_glb(out / node["content"]["uri"])
+        assert {image["uri"] for image in gltf["images"]} == expected and len(gltf["images"]) == 3
+        assert all("bufferView" not in image for image in gltf["images"])
+        uri = lambda ref: gltf["images"][gltf["textures"][ref["index"]]["source"]]["uri"]  # noqa: E731
+        m = gltf["materials"][0]
+        pbr = m["pbrMetallicRoughness"]
+        assert uri(pbr["baseColorTexture"]) == "../material_color.png"
+        assert uri(m["normalTexture"]) == "../material_normal.png"
+        assert uri(pbr["metallicRoughnessTexture"]) == uri(m["occlusionTexture"]) == "../material_orm.png"
+        assert "TANGENT" in gltf["meshes"][0]["primitives"][0]["attributes"]
+        # The BIN chunk holds the geometry only.
+        assert gltf["buffers"][0]["byteLength"] == sum(v["byteLength"] for v in gltf["bufferViews"])
+    # The first map's size sets the repeat, as --texture does with that map: the same UVs.
+    code, _, stderr = run_tiles(*common, "-o", tmp_path / "texture", "--texture", colour)
+    assert code == 0, stderr
+    for node in nodes:
+        with_material = read_glb(out / node["content"]["uri"])
+        with_texture = read_glb(tmp_path / "texture" / node["content"]["uri"])
+        for a, b in zip(with_material[:3], with_texture[:3]):
+            assert np.array_equal(a, b)
+    # --texture and --material together: one line, bad usage, nothing written.
+    code, _, stderr = run_tiles(*common, "-o", tmp_path / "both", "--material", material, "--texture", colour)
+    assert code == 2 and stderr.count("\n") == 1 and "give --texture or --material, not both" in stderr
+    assert not (tmp_path / "both").exists()
+    code, _, stderr = run_tiles(*common, "-o", tmp_path / "bad", "--material", tmp_path / "missing.json")
+    assert code == 1 and stderr.count("\n") == 1 and stderr.startswith("tailor.tiles: error: ")
+    assert not (tmp_path / "bad").exists()
+
+
+def node_transform(gltf):
+    """The 4x4 matrix of the glTF scene's one node (TRS or matrix; the .glb writer's one node)."""
+    (node,) = gltf["nodes"]
+    if "matrix" in node:
+        return np.array(node["matrix"], dtype=np.float64).reshape(4, 4).T  # column-major
+    x, y, z, w = node.get("rotation", [0, 0, 0, 1])
+    r = np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+    m = np.eye(4)
+    m[:3, :3] = r * np.array(node.get("scale", [1, 1, 1]))[None, :]
+    m[:3, 3] = node.get("translation", [0, 0, 0])
+    return m
+
+
+# 3D Tiles 1.1, "y-up to z-up": a client turns glTF content Z up by this matrix, after the glTF
+# node's transform and before the tile's.
+Y_UP_TO_Z_UP = np.array([[1, 0, 0, 0], [0, 0, -1, 0], [0, 1, 0, 0], [0, 0, 0, 1]], dtype=np.float64)
+
+
+@pytest.mark.parametrize("up", ["y", "z"])
+def test_bounding_boxes_hold_the_content_as_a_client_places_it(tmp_path, up):
+    out = tmp_path / "tiles"
+    args = ["--chunk-cell", CELL, "--texture-size", 128, "--workers", 0, "--up", up]
+    code, _, stderr = run_tiles(HORSE, "-o", out, *args)
+    assert code == 0, stderr
+    tileset = json.loads((out / "tileset.json").read_text())
+    assert "transform" not in tileset["root"]
+    mesh = tailor.load(HORSE)
+    nodes = content_nodes(tileset)
+    assert len(nodes) > 10
+    for node in nodes:
+        positions, _, _, gltf = read_glb(out / node["content"]["uri"])
+        m = Y_UP_TO_Z_UP @ node_transform(gltf)
+        placed = positions.astype(np.float64) @ m[:3, :3].T + m[:3, 3]
+        if up == "z":  # the node and the client's turn cancel: the tileset's frame is the mesh's own
+            assert np.allclose(placed, positions, atol=1e-7)
+        else:
+            assert np.array_equal(placed, positions[:, [0, 2, 1]] * np.array([1, -1, 1]))
+        box = np.array(node["boundingVolume"]["box"], dtype=np.float64)
+        centre, axes = box[:3], box[3:].reshape(3, 3)
+        # In the box's own frame: every point inside, and the content reaches each face (a tight box).
+        local = (placed - centre) @ axes.T / np.sum(axes * axes, axis=1)
+        assert np.all(np.abs(local) <= 1 + 1e-5), node["content"]["uri"]
+        assert np.allclose(np.abs(local).max(axis=0), 1, atol=1e-4), node["content"]["uri"]
+    # Each child's box inside its parent's (the corners of one in the other's frame).
+    def local_of(box, points):
+        box = np.array(box["boundingVolume"]["box"], dtype=np.float64)
+        axes = box[3:].reshape(3, 3)
+        return (points - box[:3]) @ axes.T / np.sum(axes * axes, axis=1)
+
+    todo = [tileset["root"]]
+    while todo:
+        parent = todo.pop()
+        for child in parent.get("children", []):
+            box = np.array(child["boundingVolume"]["box"], dtype=np.float64)
+            signs = np.array([[a, b, c] for a in (-1, 1) for b in (-1, 1) for c in (-1, 1)], dtype=np.float64)
+            corners = box[:3] + signs @ box[3:].reshape(3, 3)
+            assert np.all(np.abs(local_of(parent, corners)) <= 1 + 1e-5)
+            todo.append(child)
+    # The root's box around the whole mesh: its own coordinates with --up z, turned with --up y.
+    root = np.array(tileset["root"]["boundingVolume"]["box"])
+    lo, hi = mesh.positions.min(axis=0).astype(np.float64), mesh.positions.max(axis=0).astype(np.float64)
+    centre = (lo + hi) / 2
+    expected = centre if up == "z" else np.array([centre[0], -centre[2], centre[1]])
+    assert np.allclose(root[:3], expected, atol=1e-7)
+    # --up x: one line, bad usage.
+    code, _, stderr = run_tiles(HORSE, "-o", tmp_path / "x", "--workers", 0, "--up", "x")
+    assert code == 2 and stderr == "tailor.tiles: error: --up must be y or z, got 'x'\n"
