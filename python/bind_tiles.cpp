@@ -111,6 +111,64 @@ to the cell of its centroid. Returns cell_exponent, cell_size, median_edge, long
 locality_radius, cells (K, 3) int32 in cell order (z, then y, then x), chunk_start (K+1,) uint32
 and faces (F,) uint32: chunk k's face ids are faces[chunk_start[k]:chunk_start[k+1]].)");
 
+  // The rule's arithmetic on blocks of faces, for a partition that streams the mesh (tailor.tiles).
+  using Corners = py::array_t<float, py::array::c_style | py::array::forcecast>;
+  auto corners_of = [](const py::array& corners) {
+    const Corners c = Corners::ensure(corners);
+    if (!c || c.ndim() != 3 || c.shape(1) != 3 || c.shape(2) != 3)
+      raise_error("corners must be an (F, 3, 3) float32 array, got " + describe(corners));
+    return c;
+  };
+  m.def(
+      "chunk_edge_lengths",
+      [corners_of](const py::array& corners) {
+        const Corners c = corners_of(corners);
+        const py::ssize_t n = c.shape(0);
+        py::array_t<float> out({n, py::ssize_t{3}});
+        Status status;
+        {
+          const py::gil_scoped_release release;
+          status = chunk_edge_lengths({c.data(), static_cast<size_t>(9 * n)},
+                                      {out.mutable_data(), static_cast<size_t>(3 * n)});
+        }
+        if (!status) raise_status(status);
+        return out;
+      },
+      py::arg("corners"),
+      "chunk_edge_lengths(corners) -> (F, 3) float32: each face's edge lengths (corner k to k+1) exactly as\n"
+      "plan_chunks measures them for its median; corners: (F, 3, 3) float32");
+  m.def(
+      "chunk_cell_exponent",
+      [](double median_edge, const py::object& chunk_cell) {
+        ChunkOptions options;
+        if (!chunk_cell.is_none()) options.cell_exponent = chunk_cell.cast<int>();
+        if (const Status s = check_chunk_options(options); !s) raise_status(s);
+        int exponent = 0;
+        if (const Status s = chunk_cell_exponent(median_edge, options, exponent); !s) raise_status(s);
+        return exponent;
+      },
+      py::arg("median_edge"), py::arg("chunk_cell") = py::none(),
+      "chunk_cell_exponent(median_edge, chunk_cell=None) -> int: the cell exponent plan_chunks takes for a mesh\n"
+      "of this median edge length (chunk_cell when given)");
+  m.def(
+      "chunk_cells",
+      [corners_of](const py::array& corners, int cell_exponent) {
+        const Corners c = corners_of(corners);
+        const py::ssize_t n = c.shape(0);
+        py::array_t<int32_t> out({n, py::ssize_t{3}});
+        Status status;
+        {
+          const py::gil_scoped_release release;
+          status = chunk_cells({c.data(), static_cast<size_t>(9 * n)}, cell_exponent,
+                               {out.mutable_data(), static_cast<size_t>(3 * n)});
+        }
+        if (!status) raise_status(status);
+        return out;
+      },
+      py::arg("corners"), py::arg("cell_exponent"),
+      "chunk_cells(corners, cell_exponent) -> (F, 3) int32: each face's chunk cell (x, y, z), the cell of its\n"
+      "centroid exactly as plan_chunks computes it; corners: (F, 3, 3) float32");
+
   m.def(
       "save_uvs",
       [](const py::object& path_object, const PyMesh& mesh, const py::array& corner_uvs, const py::sequence& size,

@@ -12,6 +12,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "tailor/api.h"
@@ -80,5 +81,22 @@ TAILOR_API bool uses_chunks(const ChunkOptions& options, size_t face_count);
 //! axis (a mesh spanning more than a million cells: give a larger cell). O(F) time (the median by
 //! selection), 12 bytes per face while it runs and 4 in the result.
 TAILOR_API Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& plan);
+
+//! The rule's arithmetic for code that streams a mesh instead of holding it (python -m tailor.tiles
+//! partitions a binary PLY block by block): plan_chunks computes with these very functions, so a
+//! streamed partition and plan_chunks cannot disagree. `corners` holds 9 floats per face (its three
+//! corners' x, y, z).
+//! Each face's three edge lengths as plan_chunks measures them (edge k from corner k to k+1), into
+//! `lengths` (3 per face; kInvalidArgument when the sizes do not match). O(F).
+TAILOR_API Status chunk_edge_lengths(std::span<const float> corners, std::span<float> lengths);
+
+//! The cell exponent plan_chunks derives from a median edge length: round(log2(cell_edges * median))
+//! clamped to -60..60, or options.cell_exponent when given. kInvalidMesh when the median is not
+//! positive and finite. O(1).
+TAILOR_API Status chunk_cell_exponent(double median_edge, const ChunkOptions& options, int& exponent);
+
+//! Each face's cell (x, y, z: the cell of its centroid, side 2^cell_exponent) into `cells` (3 per
+//! face). kInvalidMesh when a cell lies beyond 2^20 cells from the origin, as plan_chunks. O(F).
+TAILOR_API Status chunk_cells(std::span<const float> corners, int cell_exponent, std::span<int32_t> cells);
 
 }  // namespace tailor

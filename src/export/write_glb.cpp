@@ -145,20 +145,21 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
   auto nothing = [](const ExportPart&, nlohmann::json&) {};
   // Split positions are source positions through xref, in split order (the order matters for
   // min/max: -0 and +0 compare equal, the first one seen is kept).
-  add_array("POSITION", 12, vertex_count, kGltfFloat, "VEC3", kGltfArrayBuffer, [&](const ExportPart& p, nlohmann::json& a) {
-    float lo[3] = {std::numeric_limits<float>::max(), std::numeric_limits<float>::max(),
-                   std::numeric_limits<float>::max()};
-    float hi[3] = {-lo[0], -lo[1], -lo[2]};
-    for (size_t s = p.vertex_begin; s < p.vertex_end; ++s) {
-      const float* q = &positions[3 * size_t{split.xref[s]}];
-      for (int i = 0; i < 3; ++i) {
-        lo[i] = std::min(lo[i], q[i]);
-        hi[i] = std::max(hi[i], q[i]);
-      }
-    }
-    a["min"] = {lo[0], lo[1], lo[2]};
-    a["max"] = {hi[0], hi[1], hi[2]};
-  });
+  add_array("POSITION", 12, vertex_count, kGltfFloat, "VEC3", kGltfArrayBuffer,
+            [&](const ExportPart& p, nlohmann::json& a) {
+              float lo[3] = {std::numeric_limits<float>::max(), std::numeric_limits<float>::max(),
+                             std::numeric_limits<float>::max()};
+              float hi[3] = {-lo[0], -lo[1], -lo[2]};
+              for (size_t s = p.vertex_begin; s < p.vertex_end; ++s) {
+                const float* q = &positions[3 * size_t{split.xref[s]}];
+                for (int i = 0; i < 3; ++i) {
+                  lo[i] = std::min(lo[i], q[i]);
+                  hi[i] = std::max(hi[i], q[i]);
+                }
+              }
+              a["min"] = {lo[0], lo[1], lo[2]};
+              a["max"] = {hi[0], hi[1], hi[2]};
+            });
   if (normals) add_array("NORMAL", 12, vertex_count, kGltfFloat, "VEC3", kGltfArrayBuffer, nothing);
   for (const CornerAttribute& a : data.kept)  // the file's own: colours, other UV sets
     add_array(a.name, 4 * size_t(a.components), vertex_count, kGltfFloat,

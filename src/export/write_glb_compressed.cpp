@@ -222,9 +222,12 @@ void apply_meshopt_filters(const Arrays& a, std::vector<Stream>& streams) {
       for (size_t v = 0; v < nv; ++v) std::memcpy(&four[4 * v], &a.normals[3 * v], 12);
       std::string out(4 * nv, '\0');
       meshopt_encodeFilterOct(out.data(), nv, 4, kNormalBits, four.data());
-      s = {out,          4,
-           kGltfArrayBuffer, {{"componentType", kGltfByte}, {"normalized", true}, {"count", nv}, {"type", "VEC3"}},
-           "NORMAL",     "OCTAHEDRAL"};
+      s = {out,
+           4,
+           kGltfArrayBuffer,
+           {{"componentType", kGltfByte}, {"normalized", true}, {"count", nv}, {"type", "VEC3"}},
+           "NORMAL",
+           "OCTAHEDRAL"};
     } else if (s.attribute == std::string_view(a.uv_name)) {
       std::string out(8 * nv, '\0');
       meshopt_encodeFilterExp(out.data(), nv, 8, kUvBits, a.uvs.data());
@@ -372,13 +375,17 @@ Status draco_primitive(const std::string& path, const Arrays& a, std::string& bi
                                  : k.components == 3 ? "VEC3"
                                                      : "VEC4"}},
                        k.name.c_str()});
-  streams.push_back(
-      {{}, 0, kGltfArrayBuffer, {{"componentType", kGltfFloat}, {"count", points}, {"type", "VEC2"}}, a.uv_name.c_str()});
-  streams.push_back(
-      {{},
-       0,
-       kGltfElementArrayBuffer,
-       {{"componentType", points <= 65535 ? kGltfUnsignedShort : kGltfUnsignedInt}, {"count", 3 * faces}, {"type", "SCALAR"}}});
+  streams.push_back({{},
+                     0,
+                     kGltfArrayBuffer,
+                     {{"componentType", kGltfFloat}, {"count", points}, {"type", "VEC2"}},
+                     a.uv_name.c_str()});
+  streams.push_back({{},
+                     0,
+                     kGltfElementArrayBuffer,
+                     {{"componentType", points <= 65535 ? kGltfUnsignedShort : kGltfUnsignedInt},
+                      {"count", 3 * faces},
+                      {"type", "SCALAR"}}});
   return Status::ok();
 }
 

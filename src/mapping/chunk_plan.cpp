@@ -29,16 +29,45 @@ constexpr double kMaxCell = double{1 << 20};
 
 // The face's centroid as three times it, in doubles, the three terms added smallest first so that
 // the corners' order cannot change a rounding.
-inline void centroid3(const Mesh& mesh, size_t f, double out[3]) {
-  const float* p = mesh.positions.data();
-  const uint32_t* idx = mesh.indices.data() + 3 * f;
+inline void centroid3(const float* p0, const float* p1, const float* p2, double out[3]) {
   for (int k = 0; k < 3; ++k) {
-    double a = p[3 * size_t{idx[0]} + k], b = p[3 * size_t{idx[1]} + k], c = p[3 * size_t{idx[2]} + k];
+    double a = p0[k], b = p1[k], c = p2[k];
     if (a > b) std::swap(a, b);
     if (b > c) std::swap(b, c);
     if (a > b) std::swap(a, b);
     out[k] = (a + b) + c;
   }
+}
+
+// An edge's length as the median is taken over: the difference in doubles, rounded to float.
+inline float edge_length(const float* a, const float* b) {
+  const double dx = double{a[0]} - b[0], dy = double{a[1]} - b[1], dz = double{a[2]} - b[2];
+  return static_cast<float>(std::sqrt(dx * dx + dy * dy + dz * dz));
+}
+
+// The cell of a face (its corners p0, p1, p2) packed in 63 bits (21 per axis, offset to be
+// unsigned, x fastest); false when it lies beyond kMaxCell cells from the origin.
+inline bool face_cell_key(const float* p0, const float* p1, const float* p2, double inverse3, uint64_t& key) {
+  double c[3];
+  centroid3(p0, p1, p2, c);
+  uint64_t packed = 0;
+  for (int k = 2; k >= 0; --k) {
+    const double cell = std::floor(c[k] * inverse3);
+    if (!(cell >= -kMaxCell && cell < kMaxCell)) return false;
+    packed = (packed << 21) | static_cast<uint64_t>(cell + kMaxCell);
+  }
+  key = packed;
+  return true;
+}
+
+inline int32_t unpack_cell(uint64_t key, int axis) {
+  return static_cast<int32_t>(static_cast<int64_t>((key >> (21 * axis)) & ((uint64_t{1} << 21) - 1)) -
+                              static_cast<int64_t>(kMaxCell));
+}
+
+Status too_many_cells() {
+  return Status::error(ErrorCode::kInvalidMesh, "",
+                       "the mesh spans more than 2^21 chunk cells along an axis: give a larger chunk cell");
 }
 
 // A set of cell keys (open addressing, linear probing): the distinct cells are few (one per ~100k
@@ -103,10 +132,7 @@ Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& pla
   float longest = 0.f;
   for (size_t f = 0; f < face_count; ++f)
     for (int k = 0; k < 3; ++k) {
-      const float* a = p + 3 * size_t{idx[3 * f + k]};
-      const float* b = p + 3 * size_t{idx[3 * f + (k + 1) % 3]};
-      const double dx = double{a[0]} - b[0], dy = double{a[1]} - b[1], dz = double{a[2]} - b[2];
-      const float l = static_cast<float>(std::sqrt(dx * dx + dy * dy + dz * dz));
+      const float l = edge_length(p + 3 * size_t{idx[3 * f + k]}, p + 3 * size_t{idx[3 * f + (k + 1) % 3]});
       lengths[3 * f + static_cast<size_t>(k)] = l;
       longest = std::max(longest, l);
     }
@@ -117,13 +143,8 @@ Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& pla
   plan.median_edge = median;
   plan.longest_edge = longest;
 
-  int exponent = options.cell_exponent;
-  if (exponent == kAutoCellExponent) {
-    if (!(median > 0.0) || !std::isfinite(median))
-      return Status::error(ErrorCode::kInvalidMesh, "", "no edge of positive length to size the chunks by");
-    exponent = static_cast<int>(std::lround(std::log2(double{options.cell_edges} * median)));
-    exponent = std::clamp(exponent, -60, 60);
-  }
+  int exponent = 0;
+  TAILOR_RETURN_IF_ERROR(chunk_cell_exponent(median, options, exponent));
   plan.cell_exponent = exponent;
   plan.cell_size = std::ldexp(1.0, exponent);
   const double inverse3 = std::ldexp(1.0, -exponent) / 3.0;
@@ -131,17 +152,10 @@ Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& pla
   // Each face's cell, packed in 63 bits (21 per axis, offset to be unsigned): x fastest.
   std::vector<uint64_t> key(face_count);
   for (size_t f = 0; f < face_count; ++f) {
-    double c[3];
-    centroid3(mesh, f, c);
-    uint64_t packed = 0;
-    for (int k = 2; k >= 0; --k) {
-      const double cell = std::floor(c[k] * inverse3);
-      if (!(cell >= -kMaxCell && cell < kMaxCell))
-        return Status::error(ErrorCode::kInvalidMesh, "",
-                             "the mesh spans more than 2^21 chunk cells along an axis: give a larger chunk cell");
-      packed = (packed << 21) | static_cast<uint64_t>(cell + kMaxCell);
-    }
-    key[f] = packed;
+    const uint32_t* corner = idx + 3 * f;
+    if (!face_cell_key(p + 3 * size_t{corner[0]}, p + 3 * size_t{corner[1]}, p + 3 * size_t{corner[2]}, inverse3,
+                       key[f]))
+      return too_many_cells();
   }
   // The distinct cells, in key order (z, y, x).
   CellTable table;
@@ -152,9 +166,7 @@ Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& pla
   for (size_t c = 0; c < chunks; ++c) table.set_value(cells[c], static_cast<uint32_t>(c));
   plan.cells.resize(chunks);
   for (size_t c = 0; c < chunks; ++c)
-    for (int k = 0; k < 3; ++k)
-      plan.cells[c][static_cast<size_t>(k)] = static_cast<int32_t>(
-          static_cast<int64_t>((cells[c] >> (21 * k)) & ((uint64_t{1} << 21) - 1)) - static_cast<int64_t>(kMaxCell));
+    for (int k = 0; k < 3; ++k) plan.cells[c][static_cast<size_t>(k)] = unpack_cell(cells[c], k);
   // Faces grouped by chunk (a counting sort, file order within a chunk).
   std::vector<uint32_t> chunk_of(face_count);
   plan.chunk_start.assign(chunks + 1, 0);
@@ -168,6 +180,42 @@ Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& pla
   plan.faces.resize(face_count);
   std::vector<uint32_t> fill(plan.chunk_start.begin(), plan.chunk_start.end() - 1);
   for (size_t f = 0; f < face_count; ++f) plan.faces[fill[chunk_of[f]]++] = static_cast<uint32_t>(f);
+  return Status::ok();
+}
+
+Status chunk_edge_lengths(std::span<const float> corners, std::span<float> lengths) {
+  if (corners.size() % 9 != 0 || lengths.size() != corners.size() / 3)
+    return Status::error(ErrorCode::kInvalidArgument, "", "chunk_edge_lengths: 9 floats per face in, 3 out");
+  const size_t faces = corners.size() / 9;
+  const float* c = corners.data();
+  for (size_t f = 0; f < faces; ++f, c += 9)
+    for (int k = 0; k < 3; ++k) lengths[3 * f + static_cast<size_t>(k)] = edge_length(c + 3 * k, c + 3 * ((k + 1) % 3));
+  return Status::ok();
+}
+
+Status chunk_cell_exponent(double median_edge, const ChunkOptions& options, int& exponent) {
+  exponent = options.cell_exponent;
+  if (exponent != kAutoCellExponent) return Status::ok();
+  if (!(median_edge > 0.0) || !std::isfinite(median_edge))
+    return Status::error(ErrorCode::kInvalidMesh, "", "no edge of positive length to size the chunks by");
+  exponent = static_cast<int>(std::lround(std::log2(double{options.cell_edges} * median_edge)));
+  exponent = std::clamp(exponent, -60, 60);
+  return Status::ok();
+}
+
+Status chunk_cells(std::span<const float> corners, int cell_exponent, std::span<int32_t> cells) {
+  if (corners.size() % 9 != 0 || cells.size() != corners.size() / 3)
+    return Status::error(ErrorCode::kInvalidArgument, "", "chunk_cells: 9 floats per face in, 3 out");
+  if (cell_exponent < -60 || cell_exponent > 60)
+    return Status::error(ErrorCode::kInvalidArgument, "", "chunk cell exponent must be in -60..60");
+  const double inverse3 = std::ldexp(1.0, -cell_exponent) / 3.0;
+  const size_t faces = corners.size() / 9;
+  const float* c = corners.data();
+  for (size_t f = 0; f < faces; ++f, c += 9) {
+    uint64_t key = 0;
+    if (!face_cell_key(c, c + 3, c + 6, inverse3, key)) return too_many_cells();
+    for (int k = 0; k < 3; ++k) cells[3 * f + static_cast<size_t>(k)] = unpack_cell(key, k);
+  }
   return Status::ok();
 }
 
