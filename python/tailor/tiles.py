@@ -38,6 +38,8 @@ import numpy as np
 
 import tailor
 
+from . import tiles_stream
+
 MANIFEST = "tailor-tiles.json"
 FORMAT = 1  # of the manifest: a different number means every tile is written again
 
@@ -54,8 +56,13 @@ def texels_per_unit_for(mesh, scale):
     longest side of the referenced vertices' bounding box, rounded to a power of two."""
     used = np.zeros(mesh.vertex_count, dtype=bool)
     used[mesh.faces.ravel()] = True
-    p = mesh.positions[used].astype(np.float64)
-    longest = float((p.max(axis=0) - p.min(axis=0)).max())
+    p = mesh.positions[used]
+    return texels_per_unit_of_box(p.min(axis=0), p.max(axis=0), scale)
+
+
+def texels_per_unit_of_box(lo, hi, scale):
+    """texels_per_unit_for from the referenced vertices' bounding box (lo, hi: float32)."""
+    longest = float((np.asarray(hi, dtype=np.float64) - np.asarray(lo, dtype=np.float64)).max())
     if not (longest > 0) or not math.isfinite(longest):
         raise TilesError("the mesh has no extent: give --texels-per-unit")
     x = math.log2(float(np.float32(scale)) / longest)
@@ -347,6 +354,12 @@ def map_tile(job, positions, faces, params, folder, keep_from, threads, lod):
     return record
 
 
+def map_tile_file(job, path, index_dtype, params, folder, keep_from, threads, lod):
+    """A leaf from its file of the streamed partition (tiles_stream): read, then map_tile."""
+    positions, faces = tiles_stream.read_tile(path, np.dtype(index_dtype), params["cell_exponent"], params["tile_level"])
+    return map_tile(job, positions, faces, params, folder, keep_from, threads, lod)
+
+
 def build_parent(job, params, folder, keep_from, *children):
     """A parent: its children's quarters joined (vertices at one position welded, so that the
     children's shared sides can be simplified) and simplified to a quarter of the children's
@@ -548,17 +561,30 @@ def read_look(args):
 def plan_tiles(mesh, args, look):
     """The tiles: {tile: face ids}, and the parameters every tile's digest and mapping use."""
     plan = tailor.plan_chunks(mesh, args.chunk_cell)
-    e = plan["cell_exponent"]
+    params = tile_params(args, look, plan["cell_exponent"], lambda: texels_per_unit_for(mesh, args.scale))
+    level = params["tile_level"]
+    tiles = {}
+    cells = plan["cells"] >> level  # arithmetic shift: floor division by 2**level
+    start, faces = plan["chunk_start"], plan["faces"]
+    for k in range(cells.shape[0]):
+        tiles.setdefault(tuple(int(v) for v in cells[k]), []).append(faces[start[k] : start[k + 1]])
+    tiles = {t: np.concatenate(parts) for t, parts in tiles.items()}
+    return plan, params, tiles
+
+
+def tile_params(args, look, e, density):
+    """The parameters every tile's digest and mapping use, for cell exponent e; density() gives the
+    texel density of --scale (read only without --texels-per-unit)."""
     if args.tile_size is None:
         level = 0
     else:
         t = math.log2(args.tile_size) if args.tile_size > 0 else float("nan")
         if not (t == math.floor(t)) or t < e:
             raise TilesError(
-                "--tile-size must be the chunk cell (%g) times a power of two, got %g" % (plan["cell_size"], args.tile_size)
+                "--tile-size must be the chunk cell (%g) times a power of two, got %g" % (math.ldexp(1.0, e), args.tile_size)
             )
         level = int(t) - e
-    tpu = args.texels_per_unit if args.texels_per_unit is not None else texels_per_unit_for(mesh, args.scale)
+    tpu = args.texels_per_unit if args.texels_per_unit is not None else density()
     width, height = look["size"] if look["size"] else (args.texture_size, args.texture_size)
     field_following, crack_rings = resolve_field_following(args, look["colour"])
     params = {
@@ -576,13 +602,7 @@ def plan_tiles(mesh, args, look):
         "images": {role: name for role, (name, _) in look["images"].items()},
         "orm_roles": look["orm_roles"],
     }
-    tiles = {}
-    cells = plan["cells"] >> level  # arithmetic shift: floor division by 2**level
-    start, faces = plan["chunk_start"], plan["faces"]
-    for k in range(cells.shape[0]):
-        tiles.setdefault(tuple(int(v) for v in cells[k]), []).append(faces[start[k] : start[k + 1]])
-    tiles = {t: np.concatenate(parts) for t, parts in tiles.items()}
-    return plan, params, tiles
+    return params
 
 
 def resolve_field_following(args, colour):
@@ -672,15 +692,28 @@ def start_client(args):
 def run(args):
     outdir = pathlib.Path(args.output).resolve()
     t0 = time.monotonic()
-    try:
-        mesh = tailor.load(args.input)
-    except tailor.Error as e:
-        raise TilesError(str(e)) from None
+    # A binary little-endian PLY of triangles is partitioned by streaming it (tiles_stream); any
+    # other input is loaded whole and cut in memory (--in-memory, hidden, forces that for tests).
+    layout = None if args.in_memory else tiles_stream.read_layout(args.input)
+    mesh = None
+    if layout is None:
+        try:
+            mesh = tailor.load(args.input)
+        except tailor.Error as e:
+            raise TilesError(str(e)) from None
     look = read_look(args)
     if not args.quiet:
         for note in look["notes"]:
             print("tailor.tiles: warning: %s" % note, file=sys.stderr)
-    plan, params, tiles = plan_tiles(mesh, args, look)
+    if mesh is not None:
+        plan, params, tiles = plan_tiles(mesh, args, look)
+        chunk_count, cell_size = int(plan["cells"].shape[0]), plan["cell_size"]
+    else:
+        survey = tiles_stream.survey(layout, args.chunk_cell, args.block_faces)
+        params = tile_params(
+            args, look, survey["cell_exponent"], lambda: texels_per_unit_of_box(survey["lo"], survey["hi"], args.scale)
+        )
+        cell_size = math.ldexp(1.0, survey["cell_exponent"])
     old = previous_output(outdir, params)
     t_plan = time.monotonic()
 
@@ -699,20 +732,38 @@ def run(args):
                 (tmp / name).write_bytes(data)
         if args.lod:
             (tmp / "lod").mkdir()
-        positions = mesh.positions
-        faces = mesh.faces
         jobs = []
-        for tile in sorted(tiles, key=lambda t: (t[2], t[1], t[0])):
-            # The tile's own vertices; its canonical order is the task's work (in parallel).
-            used, compact = np.unique(faces[tiles[tile]], return_inverse=True)
-            p, f = positions[used], compact.reshape(-1, 3).astype(np.uint32)
-            name = node_name(0, tile)
-            jobs.append(({"name": name, "tile": list(tile)}, p, f, old.get(name)))
-        del positions, faces
+        scratch = tmp / "partition"
+        if mesh is not None:
+            positions = mesh.positions
+            faces = mesh.faces
+            for tile in sorted(tiles, key=lambda t: (t[2], t[1], t[0])):
+                # The tile's own vertices; its canonical order is the task's work (in parallel).
+                used, compact = np.unique(faces[tiles[tile]], return_inverse=True)
+                p, f = positions[used], compact.reshape(-1, 3).astype(np.uint32)
+                name = node_name(0, tile)
+                jobs.append(({"name": name, "tile": list(tile)}, p, f, old.get(name)))
+            del positions, faces, mesh
+            sizes = [job[2].shape[0] for job in jobs]
+        else:
+            # One pass: each face appended to its tile's file in the scratch folder.
+            counts, chunk_count = tiles_stream.partition(
+                layout, params["cell_exponent"], params["tile_level"], scratch, args.block_faces
+            )
+            index_dtype = layout.index_dtype.str
+            for tile in sorted(counts, key=lambda t: (t[2], t[1], t[0])):
+                name = node_name(0, tile)
+                path = str(tiles_stream.tile_file(scratch, tile))
+                if args.workers == 0 and not args.scheduler:  # mapped in this process: all of them
+                    p, f = tiles_stream.read_tile(path, layout.index_dtype, params["cell_exponent"], params["tile_level"])
+                    jobs.append(({"name": name, "tile": list(tile)}, p, f, old.get(name)))
+                else:
+                    jobs.append(({"name": name, "tile": list(tile), "file": path}, None, None, old.get(name)))
+            sizes = [counts[tuple(job[0]["tile"])] for job in jobs]
         levels = parent_levels([job[0]["tile"] for job in jobs]) if args.lod else []
         t_cut = time.monotonic()
         # Largest first, so that the last tasks to finish are small ones.
-        order = sorted(range(len(jobs)), key=lambda i: -jobs[i][2].shape[0])
+        order = sorted(range(len(jobs)), key=lambda i: -sizes[i])
         progress = Progress(len(jobs) + sum(len(groups) for groups in levels), not args.quiet)
         records = {}
         folder = str(tmp)
@@ -735,9 +786,18 @@ def run(args):
             futures = {}
             for i in order:
                 job, p, f, keep = jobs[i]
-                futures[job["name"]] = client.submit(
-                    map_tile, job, p, f, params, folder, keep, threads, args.lod, key="tile-%s-%s" % (tmp.name, job["name"])
-                )
+                key = "tile-%s-%s" % (tmp.name, job["name"])
+                if "file" in job:
+                    job = dict(job)
+                    path = job.pop("file")
+                    futures[job["name"]] = client.submit(
+                        map_tile_file, job, path, index_dtype, params, folder, keep, threads, args.lod, key=key
+                    )
+                else:
+                    futures[job["name"]] = client.submit(
+                        map_tile, job, p, f, params, folder, keep, threads, args.lod, key=key
+                    )
+            del jobs[:]
             for level, groups in enumerate(levels, start=1):
                 for tile, names in groups:
                     job = {"name": node_name(level, tile), "level": level, "tile": list(tile)}
@@ -750,6 +810,7 @@ def run(args):
                 records[record["name"]] = record
                 progress.step(record["written"])
         records = sorted(records.values(), key=lambda r: (-r["level"], r["tile"][2], r["tile"][1], r["tile"][0]))
+        shutil.rmtree(scratch, ignore_errors=True)
         t_map = time.monotonic()
         (tmp / "tileset.json").write_text(json.dumps(tileset_json(records, args.lod, args.up), indent=1) + "\n")
         fields = ("digest", "faces", "error", "coarse_error")
@@ -774,14 +835,15 @@ def run(args):
     written = sum(1 for r in records if r["written"])
     summary = {
         "tiles": len(records),
-        "leaves": len(jobs),
+        "leaves": len(sizes),
         "levels": 1 + len(levels),
         "written": written,
         "kept": len(records) - written,
-        "faces": int(mesh.face_count),
-        "chunks": int(plan["cells"].shape[0]),
-        "cell_size": plan["cell_size"],
-        "tile_size": plan["cell_size"] * 2 ** params["tile_level"],
+        "faces": sum(int(r["faces"]) for r in records if r["level"] == 0),
+        "chunks": chunk_count,
+        "cell_size": cell_size,
+        "tile_size": cell_size * 2 ** params["tile_level"],
+        "input": "streamed" if layout is not None else "in memory",
         "texels_per_unit": params["texels_per_unit"],
         "workers": args.workers if not args.scheduler else None,
         "seconds": {
@@ -805,7 +867,12 @@ def parse_args(argv):
         description="Maps a mesh as tiles (Dask tasks) and writes OGC 3D Tiles 1.1: OUTDIR/tileset.json, "
         "OUTDIR/tiles/*.glb and the shared texture.",
     )
-    p.add_argument("input", help="the mesh (.ply .obj .off .stl .glb)")
+    p.add_argument(
+        "input",
+        help="the mesh (.ply .obj .off .stl .glb). A binary little-endian PLY of triangles is partitioned by "
+        "streaming it (never held whole: out of core); other inputs (OBJ, OFF, STL, glTF, ASCII or big-endian "
+        "PLY, polygons) are loaded whole",
+    )
     p.add_argument("-o", "--output", required=True, metavar="OUTDIR", help="the folder of the tileset (replaced)")
     p.add_argument(
         "--tile-size",
@@ -867,6 +934,9 @@ def parse_args(argv):
         help="no levels of detail: the leaf tiles only, under one root (refine ADD)",
     )
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no summary")
+    # Tests: the in-memory path for any input, and the streamed partition's block size.
+    p.add_argument("--in-memory", action="store_true", help=argparse.SUPPRESS)
+    p.add_argument("--block-faces", type=int, default=tiles_stream.BLOCK_FACES, help=argparse.SUPPRESS)
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     args = p.parse_args(argv)
     if args.texture and args.material:
@@ -887,7 +957,7 @@ def main(argv=None):
     except TilesError as e:
         print("tailor.tiles: error: %s" % e, file=sys.stderr)
         return 1
-    except tailor.Error as e:
+    except (tailor.Error, tiles_stream.StreamError) as e:
         print("tailor.tiles: error: %s" % e, file=sys.stderr)
         return 1
     except OSError as e:

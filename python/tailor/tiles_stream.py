@@ -1,0 +1,357 @@
+"""The out-of-core input of `python3 -m tailor.tiles`: a binary little-endian PLY cut into per-tile
+files by streaming it, never held whole.
+
+The header is parsed here; the body is read in blocks of faces (BLOCK_FACES), each face's corners
+gathered from a memory map of the vertex element (pages released after every block, so that the
+driver's resident memory stays bounded by the block, not by the file). The chunk rule's arithmetic
+is the library's own (tailor.chunk_edge_lengths, tailor.chunk_cell_exponent, tailor.chunk_cells: the
+functions plan_chunks computes with), so the tiles hold the faces `tailor.plan_chunks` gives them.
+
+Passes over the faces: (1) checks (counts, index range, finite coordinates), the bounding box of the
+referenced vertices and a histogram of the edge lengths' float bits (high 16 bits), (2) when the
+cell is automatic, the exact median from the low 16 bits of the lengths in the one bin that holds
+it, (3) each face's tile, its three vertex ids and corner positions appended to the tile's file.
+What tailor.load would change is done the same way: faces that repeat a vertex are dropped here,
+faces that repeat another face's vertices (the first kept) by the task that reads the tile.
+"""
+import math
+import mmap
+import os
+import pathlib
+
+import numpy as np
+
+import tailor
+
+BLOCK_FACES = 1 << 20
+
+_TYPES = {
+    "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1",
+    "short": "<i2", "int16": "<i2", "ushort": "<u2", "uint16": "<u2",
+    "int": "<i4", "int32": "<i4", "uint": "<u4", "uint32": "<u4",
+    "float": "<f4", "float32": "<f4", "double": "<f8", "float64": "<f8",
+}  # fmt: skip
+
+
+class StreamError(Exception):
+    """A one-line error about the input (tailor.tiles prints it as its own)."""
+
+
+class PlyLayout:
+    """Where a binary little-endian PLY keeps its vertices and triangles."""
+
+    def __init__(self, path, size, vertex_count, vertex_offset, vertex_dtype, face_count, face_offset, face_dtype):
+        self.path, self.size = path, size
+        self.vertex_count, self.vertex_offset, self.vertex_dtype = vertex_count, vertex_offset, vertex_dtype
+        self.face_count, self.face_offset, self.face_dtype = face_count, face_offset, face_dtype
+        self.index_dtype = np.dtype("<u4") if vertex_count <= 0xFFFFFFFF else np.dtype("<u8")
+
+
+def read_layout(path):
+    """The layout of a binary little-endian PLY of triangles that can be streamed, else None (another
+    format, ASCII or big-endian PLY, tristrips, a list before the faces other than their indices, a
+    first face that is not a triangle: tailor.load reads those, whole). StreamError when the header's
+    counts need more bytes than the file has."""
+    path = str(path)
+    try:
+        with open(path, "rb") as f:
+            head = f.read(1 << 20)
+            size = os.fstat(f.fileno()).st_size
+    except OSError:
+        return None
+    if not head.startswith(b"ply\n") and not head.startswith(b"ply\r\n"):
+        return None
+    end = head.find(b"end_header")
+    if end < 0:
+        return None
+    eol = head.find(b"\n", end)
+    if eol < 0:
+        return None
+    body = eol + 1
+    elements, fmt = [], None
+    for raw in head[:end].split(b"\n")[1:]:
+        w = raw.decode("latin-1").split()
+        if not w or w[0] in ("comment", "obj_info"):
+            continue
+        if w[0] == "format":
+            fmt = w[1] if len(w) > 1 else None
+        elif w[0] == "element" and len(w) == 3 and w[2].isdigit():
+            elements.append({"name": w[1], "count": int(w[2]), "props": []})
+        elif w[0] == "property" and elements and len(w) == 5 and w[1] == "list":
+            if w[2] not in _TYPES or w[3] not in _TYPES:
+                return None
+            elements[-1]["props"].append(("list", w[4], _TYPES[w[2]], _TYPES[w[3]]))
+        elif w[0] == "property" and elements and len(w) == 3 and w[1] in _TYPES:
+            elements[-1]["props"].append(("scalar", w[2], _TYPES[w[1]], None))
+        else:
+            return None  # tailor.load says what is wrong
+    if fmt != "binary_little_endian":
+        return None
+    names = [e["name"] for e in elements]
+    if "vertex" not in names or "face" not in names or "tristrips" in names or len(set(names)) != len(names):
+        return None
+    offset = body
+    vertex = face = None
+    for e in elements:
+        lists = [p for p in e["props"] if p[0] == "list"]
+        if e["name"] == "face":
+            index = [p for p in lists if p[1] in ("vertex_indices", "vertex_index")][:1]
+            if len(lists) != 1 or not index or np.dtype(index[0][3]).kind == "f":
+                return None
+            fields, formats = [], []
+            for kind, name, t, item in e["props"]:
+                if kind == "list":
+                    fields += ["n", "i"]
+                    formats += [t, (item, 3)]
+                else:
+                    fields.append("_%d" % len(fields))
+                    formats.append(t)
+            dtype = np.dtype({"names": fields, "formats": formats})
+            face = (e["count"], offset, dtype)
+        else:
+            if lists:
+                if face is not None and vertex is not None:
+                    break  # after both: never read
+                return None
+            dtype = np.dtype({"names": ["_%d" % k for k in range(len(e["props"]))], "formats": [p[2] for p in e["props"]]})
+            if e["name"] == "vertex":
+                props = [p[1] for p in e["props"]]
+                if not all(axis in props for axis in "xyz"):
+                    return None
+                fields = {axis: props.index(axis) for axis in "xyz"}
+                xyz = np.dtype(
+                    {
+                        "names": list("xyz"),
+                        "formats": [dtype.fields["_%d" % fields[a]][0] for a in "xyz"],
+                        "offsets": [dtype.fields["_%d" % fields[a]][1] for a in "xyz"],
+                        "itemsize": dtype.itemsize,
+                    }
+                )
+                vertex = (e["count"], offset, xyz)
+        offset += e["count"] * dtype.itemsize
+        if face is not None and vertex is not None:
+            break
+    need = max(vertex[1] + vertex[0] * vertex[2].itemsize, face[1] + face[0] * face[2].itemsize)
+    if need > size:
+        raise StreamError(
+            "%s: truncated: the header's counts (%d vertices, %d triangles) need %d bytes, the file has %d"
+            % (path, vertex[0], face[0], need, size)
+        )
+    layout = PlyLayout(path, size, vertex[0], vertex[1], vertex[2], face[0], face[1], face[2])
+    if layout.face_count == 0 or layout.vertex_count == 0:
+        return None
+    first = np.frombuffer(_read(path, face[1], face[2].itemsize), dtype=face[2])
+    if int(first["n"][0]) != 3:
+        return None  # polygons: tailor.load triangulates them
+    return layout
+
+
+def _read(path, offset, count):
+    with open(path, "rb") as f:
+        f.seek(offset)
+        return f.read(count)
+
+
+class _Body:
+    """The vertex element memory-mapped (read-only), and the faces read block by block."""
+
+    def __init__(self, layout):
+        self.layout = layout
+        self.file = open(layout.path, "rb")
+        self.map = mmap.mmap(self.file.fileno(), 0, access=mmap.ACCESS_READ)
+        self.vertices = np.ndarray(
+            (layout.vertex_count,), dtype=layout.vertex_dtype, buffer=self.map, offset=layout.vertex_offset
+        )
+
+    def close(self):
+        del self.vertices
+        try:
+            self.map.close()
+        except BufferError:  # a block still viewed by a frame an error left: closed when collected
+            pass
+        self.file.close()
+
+    def release(self):
+        """Drops the mapped pages from this process's resident memory (they stay in the page cache)."""
+        if hasattr(self.map, "madvise") and hasattr(mmap, "MADV_DONTNEED"):
+            self.map.madvise(mmap.MADV_DONTNEED)
+
+    def positions(self, first, count):
+        v = self.vertices[first : first + count]
+        out = np.empty((v.shape[0], 3), dtype=np.float32)
+        for k, axis in enumerate("xyz"):
+            out[:, k] = v[axis]
+        return out
+
+    def blocks(self, block_faces):
+        """(first face, (n, 3) int64 vertex ids, (n, 3, 3) float32 corners, kept: not repeating a vertex)
+        per block of faces, checked."""
+        layout = self.layout
+        dtype = layout.face_dtype
+        nv = layout.vertex_count
+        for first in range(0, layout.face_count, block_faces):
+            n = min(block_faces, layout.face_count - first)
+            records = np.frombuffer(self.map, dtype=dtype, count=n, offset=layout.face_offset + first * dtype.itemsize)
+            bad = np.flatnonzero(records["n"] != 3)
+            if bad.size:
+                f = first + int(bad[0])
+                raise StreamError(
+                    "%s: face %d has %d vertices: a binary PLY is streamed as triangles only"
+                    % (layout.path, f, int(records["n"][bad[0]]))
+                )
+            ids = records["i"].astype(np.int64)
+            del records
+            out = (ids < 0) | (ids >= nv)
+            if out.any():
+                c = int(np.flatnonzero(out.ravel())[0])
+                raise StreamError(
+                    "%s: face index %d out of range (mesh has %d vertices) at face %d"
+                    % (layout.path, int(ids.ravel()[c]), nv, first + c // 3)
+                )
+            kept = (ids[:, 0] != ids[:, 1]) & (ids[:, 1] != ids[:, 2]) & (ids[:, 0] != ids[:, 2])
+            v = self.vertices[ids.ravel()]
+            corners = np.empty((n * 3, 3), dtype=np.float32)
+            for k, axis in enumerate("xyz"):
+                corners[:, k] = v[axis]
+            del v
+            self.release()
+            yield first, ids, corners.reshape(n, 3, 3), kept
+
+
+def _check_finite(body, block):
+    for first in range(0, body.layout.vertex_count, block):
+        p = body.positions(first, block)
+        bad = ~np.isfinite(p).all(axis=1)
+        if bad.any():
+            raise StreamError("%s: non-finite vertex coordinate at vertex %d" % (body.layout.path, first + int(np.flatnonzero(bad)[0])))
+        body.release()
+
+
+def survey(layout, chunk_cell, block_faces=BLOCK_FACES):
+    """The streaming passes before the partition: checks, the bounding box of the referenced vertices
+    and the chunk rule's median edge length (exact: plan_chunks takes element n // 2 of the 3F
+    lengths). Returns {faces, lo, hi, median_edge, cell_exponent}."""
+    body = _Body(layout)
+    try:
+        _check_finite(body, block_faces)
+        lo = np.full(3, np.inf, dtype=np.float32)
+        hi = np.full(3, -np.inf, dtype=np.float32)
+        coarse = np.zeros(1 << 16, dtype=np.int64)
+        faces = 0
+        for _, _, corners, kept in body.blocks(block_faces):
+            corners = corners[kept]
+            if corners.shape[0] == 0:
+                continue
+            faces += corners.shape[0]
+            flat = corners.reshape(-1, 3)
+            lo = np.minimum(lo, flat.min(axis=0))
+            hi = np.maximum(hi, flat.max(axis=0))
+            if chunk_cell is None:
+                bits = tailor.chunk_edge_lengths(corners).view(np.uint32).ravel()
+                coarse += np.bincount(bits >> 16, minlength=1 << 16)
+        if faces == 0:
+            raise StreamError("%s: mesh has no faces" % layout.path)
+        median = None
+        if chunk_cell is None:
+            rank = (3 * faces) // 2
+            cumulative = np.cumsum(coarse)
+            top = int(np.searchsorted(cumulative, rank, side="right"))
+            below = int(cumulative[top - 1]) if top else 0
+            fine = np.zeros(1 << 16, dtype=np.int64)
+            for _, _, corners, kept in body.blocks(block_faces):
+                bits = tailor.chunk_edge_lengths(corners[kept]).view(np.uint32).ravel()
+                bits = bits[(bits >> 16) == top]
+                fine += np.bincount(bits & 0xFFFF, minlength=1 << 16)
+            low = int(np.searchsorted(np.cumsum(fine), rank - below, side="right"))
+            median = float(np.array([(top << 16) | low], dtype=np.uint32).view(np.float32)[0])
+        try:
+            exponent = tailor.chunk_cell_exponent(median if median is not None else 0.0, chunk_cell)
+        except tailor.Error as e:
+            raise StreamError("%s: %s" % (layout.path, e)) from None
+        return {"faces": faces, "lo": lo, "hi": hi, "median_edge": median, "cell_exponent": exponent}
+    finally:
+        body.close()
+
+
+def record_dtype(layout):
+    return np.dtype([("i", layout.index_dtype, 3), ("p", "<f4", (3, 3))])
+
+
+def tile_file(folder, tile):
+    return pathlib.Path(folder) / ("%d_%d_%d.faces" % tuple(tile))
+
+
+def partition(layout, cell_exponent, tile_level, folder, block_faces=BLOCK_FACES):
+    """Appends every kept face (its vertex ids and corners, file order) to its tile's file in folder.
+    Returns ({tile: face count}, number of distinct chunk cells)."""
+    folder = pathlib.Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    dtype = record_dtype(layout)
+    counts, cells_seen = {}, set()
+    body = _Body(layout)
+    try:
+        for _, ids, corners, kept in body.blocks(block_faces):
+            ids, corners = ids[kept], corners[kept]
+            if ids.shape[0] == 0:
+                continue
+            try:
+                cells = tailor.chunk_cells(corners, cell_exponent).astype(np.int64)
+            except tailor.Error as e:
+                raise StreamError("%s: %s" % (layout.path, e)) from None
+            packed = ((cells[:, 2] + (1 << 20)) << 42) | ((cells[:, 1] + (1 << 20)) << 21) | (cells[:, 0] + (1 << 20))
+            cells_seen.update(np.unique(packed).tolist())
+            tiles = cells >> tile_level
+            key = ((tiles[:, 2] + (1 << 20)) << 42) | ((tiles[:, 1] + (1 << 20)) << 21) | (tiles[:, 0] + (1 << 20))
+            order = np.argsort(key, kind="stable")
+            records = np.empty(ids.shape[0], dtype=dtype)
+            records["i"] = ids[order]
+            records["p"] = corners[order]
+            key = key[order]
+            starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+            ends = np.r_[starts[1:], key.shape[0]]
+            for s, e in zip(starts.tolist(), ends.tolist()):
+                tile = tuple(int(v) for v in tiles[order[s]])
+                with open(tile_file(folder, tile), "ab") as f:
+                    f.write(records[s:e].tobytes())
+                counts[tile] = counts.get(tile, 0) + (e - s)
+    finally:
+        body.close()
+    return counts, len(cells_seen)
+
+
+def read_tile(path, index_dtype, cell_exponent, tile_level):
+    """A tile's file as tailor.load and plan_chunks would give the tile: faces that repeat another
+    face's vertices dropped (the first kept), faces grouped by chunk in cell order (file order
+    within a chunk), the tile's vertices in the order of their ids. Returns (positions (V, 3)
+    float32, faces (F, 3) uint32)."""
+    records = np.fromfile(path, dtype=np.dtype([("i", index_dtype, 3), ("p", "<f4", (3, 3))]))
+    ids = records["i"].astype(np.int64)
+    corners = records["p"]
+    del records
+    s = np.sort(ids, axis=1)
+    order = np.lexsort((s[:, 2], s[:, 1], s[:, 0]))  # stable: the first of equals is the earliest
+    s = s[order]
+    repeat = np.flatnonzero((s[1:] == s[:-1]).all(axis=1)) + 1
+    del s
+    if repeat.size:
+        keep = np.ones(ids.shape[0], dtype=bool)
+        keep[order[repeat]] = False
+        ids, corners = ids[keep], corners[keep]
+    del order
+    if tile_level > 0:
+        cells = tailor.chunk_cells(corners, cell_exponent).astype(np.int64)
+        key = ((cells[:, 2] + (1 << 20)) << 42) | ((cells[:, 1] + (1 << 20)) << 21) | (cells[:, 0] + (1 << 20))
+        order = np.argsort(key, kind="stable")
+        ids, corners = ids[order], corners[order]
+    used, first, compact = np.unique(ids.ravel(), return_index=True, return_inverse=True)
+    positions = np.ascontiguousarray(corners.reshape(-1, 3)[first])
+    return positions, compact.reshape(-1, 3).astype(np.uint32)
+
+
+def texels_per_unit(lo, hi, scale):
+    """tailor.tiles.texels_per_unit_for from a streamed bounding box."""
+    longest = float((hi.astype(np.float64) - lo.astype(np.float64)).max())
+    if not (longest > 0) or not math.isfinite(longest):
+        return None
+    x = math.log2(float(np.float32(scale)) / longest)
+    return math.ldexp(1.0, int(math.copysign(math.floor(abs(x) + 0.5), x)))
