@@ -689,6 +689,21 @@ def start_client(args):
     return Client(cluster), cluster
 
 
+def driver_peak_rss():
+    """This process's peak resident memory in bytes (the driver's; the workers are other processes):
+    VmHWM, not getrusage's ru_maxrss, which execve keeps from the parent that forked this process."""
+    try:
+        with open("/proc/self/status") as f:
+            for line in f:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    import resource
+
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+
+
 def run(args):
     outdir = pathlib.Path(args.output).resolve()
     t0 = time.monotonic()
@@ -762,6 +777,15 @@ def run(args):
             sizes = [counts[tuple(job[0]["tile"])] for job in jobs]
         levels = parent_levels([job[0]["tile"] for job in jobs]) if args.lod else []
         t_cut = time.monotonic()
+        if args.cut_only:  # tests: the driver's work without the tasks; nothing is written
+            shutil.rmtree(tmp, ignore_errors=True)
+            return {
+                "leaves": len(sizes),
+                "faces": int(sum(sizes)),
+                "input": "streamed" if layout is not None else "in memory",
+                "driver_peak_rss": driver_peak_rss(),
+                "seconds": {"load_plan": t_plan - t0, "cut": t_cut - t_plan},
+            }
         # Largest first, so that the last tasks to finish are small ones.
         order = sorted(range(len(jobs)), key=lambda i: -sizes[i])
         progress = Progress(len(jobs) + sum(len(groups) for groups in levels), not args.quiet)
@@ -846,6 +870,7 @@ def run(args):
         "input": "streamed" if layout is not None else "in memory",
         "texels_per_unit": params["texels_per_unit"],
         "workers": args.workers if not args.scheduler else None,
+        "driver_peak_rss": driver_peak_rss(),
         "seconds": {
             "load_plan": t_plan - t0,
             "cut": t_cut - t_plan,
@@ -937,6 +962,7 @@ def parse_args(argv):
     # Tests: the in-memory path for any input, and the streamed partition's block size.
     p.add_argument("--in-memory", action="store_true", help=argparse.SUPPRESS)
     p.add_argument("--block-faces", type=int, default=tiles_stream.BLOCK_FACES, help=argparse.SUPPRESS)
+    p.add_argument("--cut-only", action="store_true", help=argparse.SUPPRESS)
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     args = p.parse_args(argv)
     if args.texture and args.material:

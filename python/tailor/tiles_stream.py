@@ -23,7 +23,7 @@ import numpy as np
 
 import tailor
 
-BLOCK_FACES = 1 << 20
+BLOCK_FACES = 1 << 18  # the driver holds about 300 bytes per face of a block
 
 _TYPES = {
     "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1",
@@ -208,14 +208,15 @@ class _Body:
                     "%s: face index %d out of range (mesh has %d vertices) at face %d"
                     % (layout.path, int(ids.ravel()[c]), nv, first + c // 3)
                 )
+            del out
             kept = (ids[:, 0] != ids[:, 1]) & (ids[:, 1] != ids[:, 2]) & (ids[:, 0] != ids[:, 2])
-            v = self.vertices[ids.ravel()]
-            corners = np.empty((n * 3, 3), dtype=np.float32)
+            if kept.all():
+                kept = slice(None)
+            corners = np.empty((n, 3, 3), dtype=np.float32)
             for k, axis in enumerate("xyz"):
-                corners[:, k] = v[axis]
-            del v
+                corners[:, :, k] = self.vertices[axis][ids]
             self.release()
-            yield first, ids, corners.reshape(n, 3, 3), kept
+            yield first, ids, corners, kept
 
 
 def _check_finite(body, block):
@@ -300,12 +301,16 @@ def partition(layout, cell_exponent, tile_level, folder, block_faces=BLOCK_FACES
                 raise StreamError("%s: %s" % (layout.path, e)) from None
             packed = ((cells[:, 2] + (1 << 20)) << 42) | ((cells[:, 1] + (1 << 20)) << 21) | (cells[:, 0] + (1 << 20))
             cells_seen.update(np.unique(packed).tolist())
+            del packed
             tiles = cells >> tile_level
+            del cells
             key = ((tiles[:, 2] + (1 << 20)) << 42) | ((tiles[:, 1] + (1 << 20)) << 21) | (tiles[:, 0] + (1 << 20))
             order = np.argsort(key, kind="stable")
             records = np.empty(ids.shape[0], dtype=dtype)
             records["i"] = ids[order]
+            del ids
             records["p"] = corners[order]
+            del corners
             key = key[order]
             starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
             ends = np.r_[starts[1:], key.shape[0]]

@@ -413,3 +413,152 @@ def test_bounding_boxes_hold_the_content_as_a_client_places_it(tmp_path, up):
     # --up x: one line, bad usage.
     code, _, stderr = run_tiles(HORSE, "-o", tmp_path / "x", "--workers", 0, "--up", "x")
     assert code == 2 and stderr == "tailor.tiles: error: --up must be y or z, got 'x'\n"
+
+
+# === The streamed input: a binary little-endian PLY partitioned without loading it whole ===
+
+
+def write_ply(path, vertices, faces, *, vertex_props, face_props, counts=None, header_faces=None, cut=0):
+    """A binary little-endian PLY: vertices and faces as numpy structured arrays of the given
+    fields ((name, PLY type, numpy type) each; the face list is ("vertex_indices", count type,
+    index type) with numpy types). counts: per-face list lengths (default 3)."""
+    lines = ["ply", "format binary_little_endian 1.0", "element vertex %d" % len(vertices)]
+    lines += ["property %s %s" % (t, n) for n, t, _ in vertex_props]
+    lines.append("element face %d" % (len(faces) if header_faces is None else header_faces))
+    body = b""
+    for n, t, _ in face_props:
+        lines.append("property list %s %s %s" % (t[0], t[1], n) if isinstance(t, tuple) else "property %s %s" % (t, n))
+    vdt = np.dtype([(n, d) for n, _, d in vertex_props])
+    v = np.zeros(len(vertices), dtype=vdt)
+    for k, axis in enumerate("xyz"):
+        v[axis] = vertices[:, k]
+    body += v.tobytes()
+    out = bytearray()
+    for f_index, face in enumerate(faces):
+        for n, t, d in face_props:
+            if isinstance(t, tuple):
+                count = 3 if counts is None else counts[f_index]
+                out += np.array([count], dtype=d[0]).tobytes()
+                out += np.array(list(face) + [face[0]] * (count - 3), dtype=d[1])[:count].tobytes()
+            else:
+                out += np.array([7], dtype=d).tobytes()
+    body += bytes(out)
+    data = ("\n".join(lines) + "\nend_header\n").encode() + body
+    path.write_bytes(data[: len(data) - cut])
+    return path
+
+
+def horse_arrays():
+    mesh = tailor.load(str(HORSE))
+    return mesh.positions.astype(np.float64), mesh.faces.astype(np.int64)
+
+
+def test_a_streamed_ply_gives_the_in_memory_tiles(tmp_path):
+    # The horse as it is (float x y z, normals, uchar int lists): auto cell; then cut coarser.
+    for extra in ([], ["--chunk-cell", CELL, "--tile-size", 2.0**(CELL + 1)]):
+        streamed, in_memory = tmp_path / "s", tmp_path / "m"
+        code, stdout, stderr = run_tiles(HORSE, "-o", streamed, "--workers", 1, "--json", *extra)
+        assert code == 0, stderr
+        assert json.loads(stdout)["input"] == "streamed"
+        code, stdout, stderr = run_tiles(HORSE, "-o", in_memory, "--workers", 0, "--in-memory", "--json", *extra)
+        assert code == 0, stderr
+        assert json.loads(stdout)["input"] == "in memory"
+        assert folder_bytes(streamed) == folder_bytes(in_memory)
+        assert not (streamed / "partition").exists()
+        assert sorted(p.name for p in tmp_path.iterdir()) == ["m", "s"]
+        for folder in (streamed, in_memory):
+            for p in sorted(folder.rglob("*"), reverse=True):
+                p.unlink() if p.is_file() else p.rmdir()
+            folder.rmdir()
+    # Another layout: double x y z among other properties, ushort indices counted by a char, a face
+    # property, a face that repeats a vertex, a face that repeats another's vertices, an unused vertex.
+    positions, faces = horse_arrays()
+    positions = np.concatenate([positions, [[9.0, 9.0, 9.0]]])
+    faces = np.concatenate([faces[:500], [[1, 1, 2]], faces[500:], faces[7:8]])
+    ply = write_ply(
+        tmp_path / "other.ply",
+        positions,
+        faces,
+        vertex_props=[("confidence", "uchar", "u1"), ("x", "double", "<f8"), ("y", "double", "<f8"),
+                      ("quality", "float", "<f4"), ("z", "double", "<f8")],
+        face_props=[("flags", "int", "<i4"), ("vertex_indices", ("char", "ushort"), ("i1", "<u2"))],
+    )  # fmt: skip
+    streamed, in_memory = tmp_path / "s2", tmp_path / "m2"
+    code, stdout, stderr = run_tiles(ply, "-o", streamed, "--workers", 2, "--json", "--block-faces", 10000)
+    assert code == 0, stderr
+    summary = json.loads(stdout)
+    assert summary["input"] == "streamed" and summary["faces"] == faces.shape[0] - 2
+    code, _, stderr = run_tiles(ply, "-o", in_memory, "--workers", 0, "--in-memory")
+    assert code == 0, stderr
+    assert folder_bytes(streamed) == folder_bytes(in_memory)
+    # A re-run keeps every tile.
+    code, stdout, stderr = run_tiles(ply, "-o", streamed, "--workers", 0, "--json")
+    assert code == 0, stderr
+    summary = json.loads(stdout)
+    assert summary["written"] == 0 and summary["kept"] == summary["tiles"]
+    assert folder_bytes(streamed) == folder_bytes(in_memory)
+
+
+def test_a_bad_streamed_ply_is_one_line_and_leaves_nothing(tmp_path):
+    positions, faces = horse_arrays()
+    props = dict(
+        vertex_props=[("x", "float", "<f4"), ("y", "float", "<f4"), ("z", "float", "<f4")],
+        face_props=[("vertex_indices", ("uchar", "int"), ("u1", "<i4"))],
+    )
+    out = tmp_path / "out"
+    bad_index = faces.copy()
+    bad_index[900, 1] = positions.shape[0] + 5
+    counts = np.full(faces.shape[0], 3)
+    counts[1000] = 4
+    cases = {
+        "truncated": (write_ply(tmp_path / "truncated.ply", positions, faces, cut=100, **props), "truncated"),
+        "index": (write_ply(tmp_path / "index.ply", positions, bad_index, **props), "out of range"),
+        "quad": (write_ply(tmp_path / "quad.ply", positions, faces, counts=counts, **props), "has 4 vertices"),
+        "count": (
+            write_ply(tmp_path / "count.ply", positions, faces, header_faces=faces.shape[0] + 10, **props),
+            "truncated",
+        ),
+    }
+    # A cell so small that the mesh spans more than 2^21 cells: found while partitioning, after
+    # the temporary folder (and its scratch folder) exist.
+    cases["cells"] = (HORSE, "more than 2^21 chunk cells")
+    for name, (ply, message) in cases.items():
+        extra = ["--chunk-cell", -40] if name == "cells" else []
+        code, _, stderr = run_tiles(ply, "-o", out, "--workers", 0, *extra)
+        assert code == 1, name
+        assert stderr.count("\n") == 1 and stderr.startswith("tailor.tiles: error: ") and message in stderr, stderr
+        assert not out.exists()
+        assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")], name
+
+
+def test_the_streamed_driver_holds_a_block_not_the_mesh(tmp_path):
+    # A 2.9 M-face height field: the driver's peak memory through the partition, both paths.
+    n = 1200
+    x, y = np.meshgrid(np.arange(n + 1, dtype=np.float32), np.arange(n + 1, dtype=np.float32))
+    z = np.sin(x * 0.05) * np.cos(y * 0.07) * 3
+    v = (np.stack([x.ravel(), y.ravel(), z.ravel()], 1) / np.float32(n)).astype("<f4")
+    i = np.arange(n * n)
+    a = (i // n) * (n + 1) + i % n
+    f = np.empty(2 * n * n, dtype=[("n", "u1"), ("i", "<i4", 3)])
+    f["n"] = 3
+    f["i"][0::2] = np.stack([a, a + 1, a + n + 2], 1)
+    f["i"][1::2] = np.stack([a, a + n + 2, a + n + 1], 1)
+    ply = tmp_path / "grid.ply"
+    with open(ply, "wb") as out:
+        out.write(b"ply\nformat binary_little_endian 1.0\nelement vertex %d\n" % len(v))
+        out.write(b"property float x\nproperty float y\nproperty float z\nelement face %d\n" % len(f))
+        out.write(b"property list uchar int vertex_indices\nend_header\n")
+        out.write(v.tobytes())
+        out.write(f.tobytes())
+    del x, y, z, v, i, a, f
+    peaks = {}
+    for path in ("streamed", "in memory"):
+        extra = ["--in-memory"] if path == "in memory" else ["--block-faces", 32768]
+        code, stdout, stderr = run_tiles(ply, "-o", tmp_path / "out", "--cut-only", "--json", *extra)
+        assert code == 0, stderr
+        summary = json.loads(stdout)
+        assert summary["input"] == path and summary["faces"] == 2 * n * n
+        peaks[path] = summary["driver_peak_rss"]
+    assert not (tmp_path / "out").exists()
+    # The interpreter, numpy and tailor take about 45 MB; a block of 32768 faces about 10 MB more.
+    assert peaks["streamed"] < 100e6 and peaks["streamed"] < peaks["in memory"] / 2, peaks
