@@ -418,7 +418,7 @@ def test_bounding_boxes_hold_the_content_as_a_client_places_it(tmp_path, up):
 # === The streamed input: a binary little-endian PLY partitioned without loading it whole ===
 
 
-def write_ply(path, vertices, faces, *, vertex_props, face_props, counts=None, header_faces=None, cut=0):
+def write_layout_ply(path, vertices, faces, *, vertex_props, face_props, counts=None, header_faces=None, cut=0):
     """A binary little-endian PLY: vertices and faces as numpy structured arrays of the given
     fields ((name, PLY type, numpy type) each; the face list is ("vertex_indices", count type,
     index type) with numpy types). counts: per-face list lengths (default 3)."""
@@ -475,7 +475,7 @@ def test_a_streamed_ply_gives_the_in_memory_tiles(tmp_path):
     positions, faces = horse_arrays()
     positions = np.concatenate([positions, [[9.0, 9.0, 9.0]]])
     faces = np.concatenate([faces[:500], [[1, 1, 2]], faces[500:], faces[7:8]])
-    ply = write_ply(
+    ply = write_layout_ply(
         tmp_path / "other.ply",
         positions,
         faces,
@@ -511,11 +511,11 @@ def test_a_bad_streamed_ply_is_one_line_and_leaves_nothing(tmp_path):
     counts = np.full(faces.shape[0], 3)
     counts[1000] = 4
     cases = {
-        "truncated": (write_ply(tmp_path / "truncated.ply", positions, faces, cut=100, **props), "truncated"),
-        "index": (write_ply(tmp_path / "index.ply", positions, bad_index, **props), "out of range"),
-        "quad": (write_ply(tmp_path / "quad.ply", positions, faces, counts=counts, **props), "has 4 vertices"),
+        "truncated": (write_layout_ply(tmp_path / "truncated.ply", positions, faces, cut=100, **props), "truncated"),
+        "index": (write_layout_ply(tmp_path / "index.ply", positions, bad_index, **props), "out of range"),
+        "quad": (write_layout_ply(tmp_path / "quad.ply", positions, faces, counts=counts, **props), "has 4 vertices"),
         "count": (
-            write_ply(tmp_path / "count.ply", positions, faces, header_faces=faces.shape[0] + 10, **props),
+            write_layout_ply(tmp_path / "count.ply", positions, faces, header_faces=faces.shape[0] + 10, **props),
             "truncated",
         ),
     }
