@@ -14,6 +14,9 @@ beside tileset.json and every .glb names it (image URIs), so that a 3D Tiles cli
 once. --up z: Z-up coordinates, turned Y up by each .glb's node as glTF wants and back to Z up by
 the client as 3D Tiles prescribes; the bounding volumes follow either choice.
 
+A binary little-endian PLY of triangles is partitioned by streaming it (tailor.tiles_stream: per-tile
+files in a scratch folder, the driver never holds the whole mesh); other inputs are loaded whole.
+
 A tile's faces are written in a canonical order (by their corners' coordinates), so its bytes do
 not depend on the input file's face or vertex order. tailor-tiles.json records each tile's digest
 (its geometry and the options); a re-run into the same folder maps and writes only the tiles whose
