@@ -151,6 +151,28 @@ TEST(ChunkedMapping, SameBitsForAnyThreadCountAndQualityKept) {
   }
 }
 
+// Each chunk places its patches' seeds by their world position modulo the texture's repeat: on a
+// plane with one texture direction (a user axis, not along a grid axis, on a grid that does not
+// start at a cell corner) the patches of neighbouring chunks differ by whole repeats, so every
+// chunk border is an invisible seam.
+TEST(ChunkedMapping, ChunkBordersOnAPlaneWithOneDirectionAreInvisible) {
+  Mesh mesh = test::grid(160, 120, test::Diagonal::kRising);
+  for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+    mesh.positions[3 * v] = 0.37f * mesh.positions[3 * v] - 23.3f;
+    mesh.positions[3 * v + 1] = 0.37f * mesh.positions[3 * v + 1] + 12.6f;
+  }
+  const Topology topology = build_topology(mesh);
+  MapTextureOptions options = chunked(exponent_for(mesh, 4));
+  options.orientation.axis = AxisSource::kUser;
+  options.orientation.user_axis = {1.f, 0.37f, 0.f};
+  TextureMap map;
+  ASSERT_TRUE(map_texture(mesh, topology, options, map).is_ok());
+  EXPECT_GT(map.stats.chunks, 8u);
+  EXPECT_GT(map.metrics.seam_edges, 100u);  // the chunk borders
+  EXPECT_EQ(map.metrics.seam_invisible_ratio, 1.0);
+  EXPECT_EQ(map.metrics.visible_seam_ratio, 0.0);
+}
+
 TEST(ChunkedMapping, CancelsAndRefusesWhatNeedsTheWholeMesh) {
   const Mesh mesh = load_test_mesh("fandisk.off");
   const Topology topology = build_topology(mesh);

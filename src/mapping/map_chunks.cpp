@@ -61,6 +61,12 @@ MapTextureOptions chunk_map_options(const MapTextureOptions& options, const std:
   o.orientation.fixed_unit_scale = static_cast<float>(1.0 / cell_size);
   for (size_t k = 0; k < 3; ++k) o.orientation.fixed_origin[k] = static_cast<float>(cell[k] * cell_size);
   o.mapping.scale = static_cast<float>(texels_per_unit * cell_size);
+  // Seeds placed by their world position modulo the texture's repeat: where two chunks' patches
+  // meet on a plane with one direction (a user axis), their UVs differ by whole repeats and the
+  // chunk border does not show under the tiling texture.
+  const double period_u = options.mapping.texture_period_px;
+  const double period_v = options.mapping.texture_period_v_px > 0.f ? options.mapping.texture_period_v_px : period_u;
+  o.orientation.anchor_period = {period_u / o.mapping.scale, period_v / o.mapping.scale};
   o.mapping.seam_faces = {};
   return o;
 }

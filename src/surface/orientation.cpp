@@ -85,6 +85,10 @@ struct FaceFramer {
   const internal::StrokeField* strokes;  // may be empty
   bool corners;                          // write the corner frame (no smoothing follows)
   FaceFrames* frames;
+  // OrientationOptions::anchor_period: the world origin's offset from `origin`, projected on a
+  // face's (o, p) and reduced modulo the period, is added to its anchor (in double: a cell far from
+  // the origin projects to millions of periods).
+  std::array<double, 2> anchor_period{0.0, 0.0};
 
   // Corner k of face f in normalised coordinates.
   Vec3 corner(size_t f, int k) const { return mul(sub(load(pos + 3 * idx[3 * f + k]), origin), unit_scale); }
@@ -103,8 +107,14 @@ struct FaceFramer {
     local[3] = static_cast<float>(dot(d1, p));
     local[4] = static_cast<float>(dot(d2, o));
     local[5] = static_cast<float>(dot(d2, p));
-    frames->anchor[2 * f] = static_cast<float>(dot(p0, o));
-    frames->anchor[2 * f + 1] = static_cast<float>(dot(p0, p));
+    double anchor_o = dot(p0, o), anchor_p = dot(p0, p);
+    if (anchor_period[0] > 0.0 && anchor_period[1] > 0.0) {
+      const Vec3 shift = mul(origin, unit_scale);
+      anchor_o += std::fmod(dot(shift, o), anchor_period[0]);
+      anchor_p += std::fmod(dot(shift, p), anchor_period[1]);
+    }
+    frames->anchor[2 * f] = static_cast<float>(anchor_o);
+    frames->anchor[2 * f + 1] = static_cast<float>(anchor_p);
   }
   void write_corner_frame(size_t f) const { write_corner_frame(f, corner(f, 0), corner(f, 1), corner(f, 2)); }
 
@@ -187,6 +197,9 @@ Status compute_orientation_setup(const Mesh& mesh, const Topology& topology, con
     return Status::error(ErrorCode::kInvalidArgument, "", "smoothing passes must be at most 1000");
   if (!(options.degenerate_cos >= 0.5f && options.degenerate_cos <= 1.f))
     return Status::error(ErrorCode::kInvalidArgument, "", "degenerate_cos must be in [0.5, 1]");
+  if (!(options.anchor_period[0] >= 0.0) || !(options.anchor_period[1] >= 0.0) ||
+      !std::isfinite(options.anchor_period[0]) || !std::isfinite(options.anchor_period[1]))
+    return Status::error(ErrorCode::kInvalidArgument, "", "anchor periods must be finite and >= 0");
   if (!(options.fixed_unit_scale >= 0.f) || !std::isfinite(options.fixed_unit_scale))
     return Status::error(ErrorCode::kInvalidArgument, "", "fixed unit scale must be finite and >= 0");
   TAILOR_RETURN_IF_ERROR(internal::check_strokes(options.strokes));
@@ -300,7 +313,8 @@ Status compute_orientation_setup(const Mesh& mesh, const Topology& topology, con
                           face_axis.empty() ? nullptr : face_axis.data(),
                           &strokes,
                           options.smooth_passes == 0,
-                          &frames};
+                          &frames,
+                          options.anchor_period};
   // Faces are independent here: they are cut into fixed chunks shared out among the threads
   // (each writes only its own faces; counters are summed after), so the result is the same
   // bit for bit whatever the thread count.
@@ -416,7 +430,8 @@ void refresh_face_frames(const Mesh& mesh, const Topology& topology, const Orien
                           setup.face_axis.empty() ? nullptr : setup.face_axis.data(),
                           &strokes,
                           true,
-                          &frames};
+                          &frames,
+                          options.anchor_period};
   for (const uint32_t f : faces) framer.frame(f);
   // The variation of every face with an angle that changed (some twice: the same value).
   const uint32_t* opposite = topology.opposite.data();
