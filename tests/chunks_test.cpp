@@ -65,8 +65,8 @@ TEST(ChunkPlan, EveryFaceIsInTheCellOfItsCentroid) {
         double centroid = 0;
         for (size_t j = 0; j < 3; ++j) centroid += mesh.positions[3 * size_t{mesh.indices[3 * f + j]} + k];
         centroid /= 3.0;
-        EXPECT_GE(centroid, plan.cells[c][k] * plan.cell_size - 1e-9);
-        EXPECT_LE(centroid, (plan.cells[c][k] + 1) * plan.cell_size + 1e-9);
+        EXPECT_GE(centroid, (plan.cells[c][k] + kChunkGridOffset) * plan.cell_size - 1e-9);
+        EXPECT_LE(centroid, (plan.cells[c][k] + 1 + kChunkGridOffset) * plan.cell_size + 1e-9);
       }
     }
   }

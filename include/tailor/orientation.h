@@ -64,15 +64,15 @@ struct OrientationOptions {
   // Normalisation into the unit cube. Leave fixed_unit_scale at 0 to derive it from the mesh's
   // bounding box; stability runs pass the full mesh's values so a cut mesh keeps the same frame.
   std::array<float, 3> fixed_origin{0.f, 0.f, 0.f};  //!< with fixed_unit_scale > 0: bbox minimum, mesh units
-  float fixed_unit_scale = 0.f;                //!< > 0: normalised = (x - origin) * this; 0 = 1 / longest bbox side
+  float fixed_unit_scale = 0.f;                   //!< > 0: normalised = (x - origin) * this; 0 = 1 / longest bbox side
   std::array<double, 2> anchor_period{0.0, 0.0};  //!< > 0: each face's anchor is its position's projection
                                                   //!< measured from the world origin, modulo these periods
                                                   //!< (normalised units, u and v): seeds of neighbouring
                                                   //!< chunks sit whole repeats apart (the chunked engine)
-  uint32_t threads = 0;                        //!< threads for the per-face frames (0 = one per 100k faces, at most
-                                               //!< the cores and 8); the result is identical for any count
-  std::span<const OrientationStroke> strokes;  //!< user strokes blended into the field (empty = none)
-  ProgressCallback progress;                   //!< optional, at each pass over the faces; false cancels (kCancelled)
+  uint32_t threads = 0;                           //!< threads for the per-face frames (0 = one per 100k faces, at most
+                                                  //!< the cores and 8); the result is identical for any count
+  std::span<const OrientationStroke> strokes;     //!< user strokes blended into the field (empty = none)
+  ProgressCallback progress;                      //!< optional, at each pass over the faces; false cancels (kCancelled)
 };
 
 //! Flags and help of the OrientationOptions a user sets (option_doc.h).

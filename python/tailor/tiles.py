@@ -4,8 +4,8 @@
     python3 -m tailor.tiles scan.ply -o scan_tiles --scheduler tcp://head:8786
     python3 -m tailor.tiles scan.ply -o scan_tiles --material tiled/material.json --up z
 
-The mesh is cut by the chunked engine's rule (tailor.plan_chunks: a grid anchored at the world
-origin, cell side a power of two of world units); a tile is a cube of 2**k x 2**k x 2**k chunk
+The mesh is cut by the chunked engine's rule (tailor.plan_chunks: a world grid whose planes sit
+sqrt(2) - 1 cells off the origin's, cell side a power of two of world units); a tile is a cube of 2**k x 2**k x 2**k chunk
 cells (--tile-size, world units). Each tile is one Dask task that maps its chunks with
 tailor.ChunkedMapper and writes tiles/<x>_<y>_<z>.glb: a chunk's UVs depend on its own faces only,
 so every tile holds the bits `tailor map --chunks on` gives those faces inside the whole mesh, for

@@ -58,7 +58,8 @@ void build_chunk_mesh(const Mesh& mesh, std::span<const uint32_t> faces, const s
 
 //! The origin of a chunk's cell, world units.
 inline std::array<double, 3> cell_origin(const std::array<int32_t, 3>& cell, double cell_size) {
-  return {cell[0] * cell_size, cell[1] * cell_size, cell[2] * cell_size};
+  return {(cell[0] + kChunkGridOffset) * cell_size, (cell[1] + kChunkGridOffset) * cell_size,
+          (cell[2] + kChunkGridOffset) * cell_size};
 }
 
 //! Maps a whole mesh (not cut into chunks) in canonical form, so that the same surface in any

@@ -1,4 +1,4 @@
-// The chunk rule (tailor/chunks.h): a world grid anchored at the origin, cell side a power of two
+// The chunk rule (tailor/chunks.h): a world grid kChunkGridOffset cells off the origin, cell side a power of two
 // from the median edge length, a face in the cell of its centroid. Everything here is a function
 // of the geometry alone: the median is order-free, the cell of a face depends on its own corners.
 #include <algorithm>
@@ -52,7 +52,7 @@ inline bool face_cell_key(const float* p0, const float* p1, const float* p2, dou
   centroid3(p0, p1, p2, c);
   uint64_t packed = 0;
   for (int k = 2; k >= 0; --k) {
-    const double cell = std::floor(c[k] * inverse3);
+    const double cell = std::floor(c[k] * inverse3 - kChunkGridOffset);
     if (!(cell >= -kMaxCell && cell < kMaxCell)) return false;
     packed = (packed << 21) | static_cast<uint64_t>(cell + kMaxCell);
   }

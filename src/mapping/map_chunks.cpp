@@ -59,7 +59,8 @@ MapTextureOptions chunk_map_options(const MapTextureOptions& options, const std:
   o.mapping.progress = nullptr;
   o.orientation.progress = nullptr;
   o.orientation.fixed_unit_scale = static_cast<float>(1.0 / cell_size);
-  for (size_t k = 0; k < 3; ++k) o.orientation.fixed_origin[k] = static_cast<float>(cell[k] * cell_size);
+  const std::array<double, 3> origin = cell_origin(cell, cell_size);
+  for (size_t k = 0; k < 3; ++k) o.orientation.fixed_origin[k] = static_cast<float>(origin[k]);
   o.mapping.scale = static_cast<float>(texels_per_unit * cell_size);
   // Seeds placed by their world position modulo the texture's repeat: where two chunks' patches
   // meet on a plane with one direction (a user axis), their UVs differ by whole repeats and the
