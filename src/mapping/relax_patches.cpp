@@ -102,24 +102,6 @@ struct alignas(16) Term {
 // edges opposite corners 0, 1, 2 (over its area), the margin kept off its slack.
 enum FaceField : size_t { kQ1x, kQ1y, kQ2x, kQ2y, kInv, kW0, kW1, kW2, kMargin, kFaceFields };
 
-// With GCC on x86-64 the local and global steps are also compiled for AVX (the same SSE operations
-// in three-operand form, no FMA: the same bits), taken at load time where the CPU has it, as the
-// crack closing's kernels (arap_kernels.cpp).
-#if TAILOR_SSE2 && defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define TAILOR_AVX_CLONES __attribute__((target_clones("avx", "default")))
-#else
-#define TAILOR_AVX_CLONES
-#endif
-
-#if TAILOR_SSE2
-inline __m128 load_pair(const float* p) {  // p[0] p[1] 0 0
-  return _mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)));
-}
-inline __m128 blend(__m128 mask, __m128 yes, __m128 no) {
-  return _mm_or_ps(_mm_and_ps(mask, yes), _mm_andnot_ps(mask, no));
-}
-#endif
-
 class Relaxer {
  public:
   Relaxer(const MappingInput& in, Atlas& atlas)
