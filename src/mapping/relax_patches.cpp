@@ -93,7 +93,7 @@ struct alignas(16) Term {
   // corners (pixels): the prediction is mwn p_next + mwp p_prev + (tx, ty), of weight mwn + mwp.
   float mwn, mwp, tx, ty;
   uint32_t next, prev;  // offsets in pos of the face's corners k + 1 and k + 2
-  uint32_t face;        // the face's active index << 2 | k
+  uint32_t face;        // the face's active index
   float inv_height;     // 1 / the face's height over corner k, 1/pixels
 };
 
@@ -288,7 +288,7 @@ class Relaxer {
                             0.f,
                             2 * corner_wedge[3 * f + static_cast<uint32_t>(kNext[k])],
                             2 * corner_wedge[3 * f + static_cast<uint32_t>(kPrev[k])],
-                            static_cast<uint32_t>(i << 2) | k,
+                            static_cast<uint32_t>(i),
                             inv_height[k]};
       }
     }
@@ -405,13 +405,18 @@ class Relaxer {
     const float* const pos = pos_.data();
     const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.f), half = _mm_set1_ps(0.5f);
     const __m128 high = _mm_set1_ps(high_), low = _mm_set1_ps(low_), floor = _mm_set1_ps(kIrlsFloor);
+    // Locals, not members: a vector store may alias anything, the members would be read again.
+    const uint32_t* const corner_pos = corner_pos_.get();
+    const uint32_t* const slot = slot_.get();
+    Term* const terms = terms_.get();
+    float* const slack_out = slack_.get();
     const __m128 sign = _mm_set1_ps(-0.f), minus_inf = _mm_set1_ps(-std::numeric_limits<float>::infinity());
     for (; i + 4 <= last; i += 4) {
       __m128 u1x, u1y, u2x, u2y;
       {
         __m128 e[4];  // per face u1x u1y u2x u2y
         for (size_t k = 0; k < 4; ++k) {
-          const uint32_t* c = &corner_pos_[3 * (i + k)];
+          const uint32_t* c = corner_pos + 3 * (i + k);
           const __m128 p0 = load_pair(pos + c[0]);
           const __m128 p12 = _mm_loadh_pi(load_pair(pos + c[1]), reinterpret_cast<const __m64*>(pos + c[2]));
           e[k] = _mm_sub_ps(p12, _mm_movelh_ps(p0, p0));
@@ -435,7 +440,7 @@ class Relaxer {
       const __m128 slack =
           _mm_sub_ps(_mm_min_ps(_mm_sub_ps(_mm_sub_ps(qn, rn), low), _mm_sub_ps(high, _mm_add_ps(qn, rn))),
                      _mm_loadu_ps(field + kMargin * n + i));
-      _mm_storeu_ps(&slack_[i], _mm_max_ps(slack, minus_inf));
+      _mm_storeu_ps(slack_out + i, _mm_max_ps(slack, minus_inf));
       const __m128 qm = _mm_sub_ps(qn, one);
       const __m128 residual = _mm_max_ps(floor, _mm_sqrt_ps(_mm_add_ps(_mm_mul_ps(qm, qm), _mm_mul_ps(rn, rn))));
       const __m128 turned = _mm_cmpgt_ps(qn, zero);
@@ -462,7 +467,7 @@ class Relaxer {
         __m128 r3 = _mm_add_ps(_mm_mul_ps(ms, dx), _mm_mul_ps(mc, dy));
         _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
         const __m128 record[4] = {r0, r1, r2, r3};
-        for (size_t j = 0; j < 4; ++j) _mm_store_ps(&terms_[slot_[3 * (i + j) + k]].mwn, record[j]);
+        for (size_t j = 0; j < 4; ++j) _mm_store_ps(&terms[slot[3 * (i + j) + k]].mwn, record[j]);
       }
     }
 #endif
@@ -547,7 +552,7 @@ class Relaxer {
     // of mwn p_next and mwp p_prev, records those of mwn, mwp, tx, ty.
     __m128 pairs = _mm_setzero_ps(), records = _mm_setzero_ps();
     for (const Term* t = begin; t != end; ++t) {
-      lowest = std::min(lowest, slack[t->face >> 2]);
+      lowest = std::min(lowest, slack[t->face]);
       widest = std::max(widest, t->inv_height);
       const __m128 r = _mm_load_ps(&t->mwn);
       const __m128 p = _mm_movelh_ps(load_pair(pos + t->next), load_pair(pos + t->prev));
@@ -564,7 +569,7 @@ class Relaxer {
 #else
     float nu = 0.f, nv = 0.f, pu = 0.f, pv = 0.f, wn = 0.f, wp = 0.f, tu = 0.f, tv = 0.f;
     for (const Term* t = begin; t != end; ++t) {
-      lowest = std::min(lowest, slack[t->face >> 2]);
+      lowest = std::min(lowest, slack[t->face]);
       widest = std::max(widest, t->inv_height);
       const float* a = pos + t->next;
       const float* b = pos + t->prev;
@@ -581,7 +586,7 @@ class Relaxer {
     u = u0 + kPatchOverRelaxation * (((nu + pu) + tu) / sw - u0);
     v = v0 + kPatchOverRelaxation * (((nv + pv) + tv) / sw - v0);
 #endif
-    if ((u == u0 && v == v0) || !fits(begin, end, u, v, u0, v0, lowest, widest)) return 0.f;
+    if ((u == u0 && v == v0) || !fits(w, begin, end, u, v, u0, v0, lowest, widest)) return 0.f;
     at[0] = u;
     at[1] = v;
     return std::abs(u - u0) + std::abs(v - v0);
@@ -591,20 +596,24 @@ class Relaxer {
   // from (u0, v0) to (u, v); if so, takes the move off their slack. lowest, widest: the least slack
   // and the largest inverse height of those faces (when the move times widest is within lowest,
   // it is within each face's slack: a float product does not decrease with a factor).
-  bool fits(const Term* begin, const Term* end, float u, float v, float u0, float v0, float lowest, float widest) {
+  bool fits(size_t w, const Term* begin, const Term* end, float u, float v, float u0, float v0, float lowest,
+            float widest) {
     float* const slack = slack_.get();
     const float distance = std::sqrt((u - u0) * (u - u0) + (v - v0) * (v - v0));
     if (!(distance * widest <= lowest))
       for (const Term* t = begin; t != end; ++t)  // within the bound by the slack, else checked
-        if (!(distance * t->inv_height <= slack[t->face >> 2]) && !within_bound(*t, u, v)) return false;
-    for (const Term* t = begin; t != end; ++t) slack[t->face >> 2] -= distance * t->inv_height;
+        if (!(distance * t->inv_height <= slack[t->face]) && !within_bound(*t, w, u, v)) return false;
+    for (const Term* t = begin; t != end; ++t) slack[t->face] -= distance * t->inv_height;
     return true;
   }
 
-  // Whether term t's face stays within the bound with its corner moved to (u, v) (stretch_error).
-  [[gnu::noinline]] bool within_bound(const Term& t, float u, float v) const {
+  // Whether term t's face stays within the bound with its corner on free wedge w moved to (u, v)
+  // (stretch_error).
+  [[gnu::noinline]] bool within_bound(const Term& t, size_t w, float u, float v) const {
     const float* const pos = pos_.data();
-    const uint32_t i = t.face >> 2, k = t.face & 3;
+    const uint32_t i = t.face;
+    uint32_t k = 0;
+    while (corner_pos_[3 * size_t{i} + k] != 2 * w) ++k;
     const uint32_t n = static_cast<uint32_t>(kNext[k]), p = static_cast<uint32_t>(kPrev[k]);
     float uv[6];
     uv[2 * k] = u;
