@@ -40,27 +40,10 @@ void fit_face(size_t i, size_t count, float bound, float u1x, float u1y, float u
   r[4] = r[5] = wt;
 }
 
-// With GCC on x86-64 the fit and the sweep are also compiled for AVX, and that version is taken at
-// load time where the CPU has it: the same SSE operations in three-operand (VEX) form, 8 % fewer
-// instructions in the closing on the horse (AVX enables no FMA: the results are the same). Clang
-// 14 cannot multiversion a template.
-#if TAILOR_SSE2 && defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define TAILOR_AVX_CLONES __attribute__((target_clones("avx", "default")))
-#else
-#define TAILOR_AVX_CLONES
-#endif
-
-#if TAILOR_SSE2
-inline __m128 load_pair(const float* p) {  // p[0] p[1] 0 0
-  return _mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)));
-}
-inline __m128 blend(__m128 mask, __m128 yes, __m128 no) {
-  return _mm_or_ps(_mm_and_ps(mask, yes), _mm_andnot_ps(mask, no));
-}
-#endif
-
 }  // namespace
 
+// With GCC on x86-64 the fit and the sweep are also compiled for AVX (TAILOR_AVX_CLONES,
+// util/simd.h): 8 % fewer instructions in the closing on the horse.
 template <bool kReweight>
 TAILOR_AVX_CLONES void fit_rotations(size_t count, float bound, const uint32_t* corner_pos, const float* pos,
                                      const float* frame, float* weight, float* ratio, float* record) {

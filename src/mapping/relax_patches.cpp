@@ -35,9 +35,18 @@
 // the horse (5.0 -> 4.5 on the armadillo); a pull (the rotation of J + 0.1 R_patch) took it to 2.3
 // for a median distortion of 2.4 instead of 1.85 degrees over the shared meshes.
 //
-// Cost: O(F) setup (wedges, colouring, per-corner terms; sequential), then O(F) per iteration,
-// parallel over faces (local step) and over the wedges of each colour (global step); no global
-// solve. Memory: ~50 bytes per corner (horse_x16: 170 MB more at the peak).
+// Cost: O(F) setup (wedges, colouring, per-face fields and per-corner terms; sequential), then
+// O(F) per iteration, parallel over faces (local step) and over the wedges of each colour (global
+// step); no global solve. The local step reads the faces' fields in blocks (SoA: four faces per
+// SSE2 instruction) and writes each free corner's prediction (m wn, m wp, m R d) into its term;
+// the global step reads a wedge's terms in a row and its neighbours' positions, u and v side by
+// side, and checks the slack of the wedge's faces at once (their least slack against the move
+// times their largest inverse height) before it checks them one by one. Each SIMD loop has its
+// scalar twin (same bits: tests/simd_test.sh), and GCC also compiles both steps for AVX. On the
+// horse, one thread (`valgrind --tool=callgrind --toggle-collect='tailor::internal::relax_patches*'
+// build/tailor map horse.ply -o h.glb --threads 1`): ~2,800 instructions per face, ~850 of them
+// setup, then ~190 per face and iteration (local step ~57, global step ~120, stretch checks ~12).
+// Memory: ~57 bytes per corner while it runs.
 //
 // This work is based on:
 //   L. Liu, L. Zhang, Y. Xu, C. Gotsman, S. J. Gortler, "A local/global approach to mesh
@@ -46,6 +55,7 @@
 #include <atomic>
 #include <barrier>
 #include <cmath>
+#include <limits>
 #include <system_error>
 #include <thread>
 #include <vector>
@@ -55,6 +65,7 @@
 #include "tailor/metrics.h"
 #include "util/huge_pages.h"
 #include "util/parallel_chunks.h"
+#include "util/simd.h"
 
 namespace tailor::internal {
 namespace {
@@ -82,15 +93,23 @@ constexpr size_t kFacesPerChunk = 4096;
 constexpr size_t kWedgesPerChunk = 1024;
 constexpr size_t kFacesPerRelaxThread = 20000;
 
-// Per corner of a free wedge: what its prediction and its check need. The terms of a wedge are
-// contiguous, and the wedges of a colour too, so a sweep streams through them.
-struct Term {
-  uint32_t corner;      // corner id (3 f + k)
-  uint32_t next, prev;  // the wedges of the face's corners k + 1 and k + 2
-  float wn, wp;         // the weights of the predictions from the next and the previous corner
-  float dx, dy;         // wn (x_k - x_next) + wp (x_k - x_prev), face frame, pixels
+// Per corner of a free wedge: its prediction (rewritten by every local step) and what the global
+// step and the check read of it. The terms of a wedge are contiguous, and the wedges of a colour
+// too, so a sweep streams through them; the local step writes each face's three.
+struct alignas(16) Term {
+  // The face's weight m times the cotangent weights of the predictions from the next and the
+  // previous corner, and m R (wn (x_k - x_next) + wp (x_k - x_prev)), R its rotation, x its frame
+  // corners (pixels): the prediction is mwn p_next + mwp p_prev + (tx, ty), of weight mwn + mwp.
+  float mwn, mwp, tx, ty;
+  uint32_t next, prev;  // offsets in pos of the face's corners k + 1 and k + 2
+  uint32_t face;        // the face's active index
   float inv_height;     // 1 / the face's height over corner k, 1/pixels
 };
+
+// Per active face, blocks of the face count (SoA: the local step reads four faces at a time): its
+// frame edges q1, q2 (pixels) and the inverse of their determinant, the cotangent weights of its
+// edges opposite corners 0, 1, 2 (over its area), the margin kept off its slack.
+enum FaceField : size_t { kQ1x, kQ1y, kQ2x, kQ2y, kInv, kW0, kW1, kW2, kMargin, kFaceFields };
 
 class Relaxer {
  public:
@@ -104,17 +123,21 @@ class Relaxer {
     lattice_ = lattice_of(in.options);  // quarter turns too with symmetry 4
   }
 
-  // Wedges, the free ones' colours and terms, per face its frame.
+  // Wedges, the free ones' colours and terms, per active face its frame and weights.
   void build() {
     const size_t face_count = in_.mesh.face_count();
     const uint32_t corners = static_cast<uint32_t>(3 * face_count);
     const uint32_t* const opposite = in_.topology.opposite.data();
     const float* const local = in_.frames.local.data();
     // Wedges: union-find over every paired edge whose two faces agree on the shared corner's UV;
-    // a root is its wedge's lowest corner.
-    std::vector<uint32_t> root;
-    reserve_huge(root, corners);
-    root.resize(corners);
+    // a root is its wedge's lowest corner. id: per corner kInvalid when pinned (both sides at both
+    // ends of an invisible seam, and the corners of zero-area faces), else (below) its free
+    // wedge's provisional id; a wedge with a pinned corner is pinned.
+    constexpr uint32_t kFree = 0;
+    HugeArray<uint32_t> root = huge_uninitialized<uint32_t>(corners);
+    std::vector<uint32_t> id;
+    reserve_huge(id, corners);
+    id.assign(corners, kFree);
     for (uint32_t c = 0; c < corners; ++c) root[c] = c;
     const auto find = [&root](uint32_t c) {
       while (root[c] != c) c = root[c] = root[root[c]];
@@ -124,41 +147,46 @@ class Relaxer {
       const uint32_t o = opposite[e];
       if (o == kInvalid || o < e) continue;
       const Sides s = sides(e, o);
+      bool seamless = true;
       for (const auto& [x, y] : {std::pair{s.fa, s.ga}, std::pair{s.fb, s.gb}}) {
-        if (!same_uv(x, y)) continue;
+        if (!same_uv(x, y)) {
+          seamless = false;
+          continue;
+        }
         const uint32_t rx = find(x), ry = find(y);
         if (rx != ry) root[std::max(rx, ry)] = std::min(rx, ry);
       }
-    }
-    for (uint32_t c = 0; c < corners; ++c) root[c] = find(c);
-    // id: per root, kInvalid when pinned, else (below) its free wedge's provisional id. Pinned: both
-    // sides at both ends of an invisible seam, and the corners of zero-area faces.
-    constexpr uint32_t kFree = 0;
-    std::vector<uint32_t> id;
-    reserve_huge(id, corners);
-    id.assign(corners, kFree);
-    for (uint32_t e = 0; e < corners; ++e) {
-      const uint32_t o = opposite[e];
-      if (o == kInvalid || o < e) continue;
-      const Sides s = sides(e, o);
-      if (root[s.fa] == root[s.ga] && root[s.fb] == root[s.gb]) continue;  // seamless
+      if (seamless) continue;
       const bool narrow = gap(s.fa, s.ga) < kInvisibleGapPx && gap(s.fb, s.gb) < kInvisibleGapPx;
       if (!narrow && !(seam_gap_px(&uv_[2 * size_t{s.fa}], &uv_[2 * size_t{s.fb}], &uv_[2 * size_t{s.ga}],
                                    &uv_[2 * size_t{s.gb}], lattice_) < kInvisibleGapPx))
         continue;
-      for (const uint32_t c : {s.fa, s.fb, s.ga, s.gb}) id[root[c]] = kInvalid;
+      for (const uint32_t c : {s.fa, s.fb, s.ga, s.gb}) id[c] = kInvalid;
     }
     for (size_t f = 0; f < face_count; ++f)
       if (is_zero_area_frame(local + 6 * f))
-        for (size_t k = 0; k < 3; ++k) id[root[3 * f + k]] = kInvalid;
-    uint32_t free_count = 0;
-    for (uint32_t c = 0; c < corners; ++c)
-      if (root[c] == c && id[c] == kFree) id[c] = free_count++;
-    for (uint32_t c = 0; c < corners; ++c) id[c] = root[c] == c ? id[c] : id[root[c]];
-    // The corners of each free wedge (CSR, in corner order).
-    std::vector<uint32_t> start(size_t{free_count} + 1, 0), members;
-    for (uint32_t c = 0; c < corners; ++c)
-      if (id[c] != kInvalid) ++start[id[c] + 1];
+        for (size_t k = 0; k < 3; ++k) id[3 * f + k] = kInvalid;
+    for (uint32_t c = 0; c < corners; ++c) {
+      root[c] = find(c);
+      if (id[c] == kInvalid) id[root[c]] = kInvalid;
+    }
+    // Provisional ids in root order (a wedge's root comes before its other corners), and the
+    // corners of each free wedge (CSR, in corner order).
+    uint32_t free_count = 0, pinned = 0;
+    std::vector<uint32_t> start(1, 0), members;
+    for (uint32_t c = 0; c < corners; ++c) {
+      uint32_t w = kInvalid;
+      if (root[c] != c) {
+        w = id[root[c]];
+      } else if (id[c] == kFree) {
+        w = free_count++;
+        start.push_back(0);
+      } else {
+        ++pinned;
+      }
+      id[c] = w;
+      if (w != kInvalid) ++start[w + 1];
+    }
     for (size_t w = 0; w < free_count; ++w) start[w + 1] += start[w];
     reserve_huge(members, start[free_count]);
     members.resize(start[free_count]);
@@ -197,43 +225,82 @@ class Relaxer {
       for (uint32_t w = 0; w < free_count; ++w) final_id[w] = fill[colour[w]]++;
     }
     free_count_ = free_count;
+    // Final ids (a wedge's root comes before its other corners) and positions.
     uint32_t wedges = free_count;
-    for (uint32_t c = 0; c < corners; ++c) {  // a wedge's root comes before its other corners
-      if (id[c] != kInvalid)
-        id[c] = final_id[id[c]];
-      else
-        id[c] = root[c] == c ? wedges++ : id[root[c]];
-    }
-    corner_wedge_.swap(id);
-    root = {};
-    // Positions, faces with a free corner, their frames and the terms.
-    pos_.resize(2 * size_t{wedges});
+    pos_.resize(2 * (size_t{free_count} + pinned));
     for (uint32_t c = 0; c < corners; ++c) {
-      pos_[2 * size_t{corner_wedge_[c]}] = uv_[2 * size_t{c}];
-      pos_[2 * size_t{corner_wedge_[c]} + 1] = uv_[2 * size_t{c} + 1];
+      if (id[c] != kInvalid) {
+        id[c] = final_id[id[c]];
+      } else if (root[c] == c) {
+        id[c] = wedges++;
+      } else {
+        id[c] = id[root[c]];
+        continue;
+      }
+      pos_[2 * size_t{id[c]}] = uv_[2 * size_t{c}];
+      pos_[2 * size_t{id[c]} + 1] = uv_[2 * size_t{c} + 1];
     }
-    for (uint32_t f = 0; f < face_count; ++f)
-      if (corner_wedge_[3 * f] < free_count || corner_wedge_[3 * f + 1] < free_count ||
-          corner_wedge_[3 * f + 2] < free_count)
-        active_.push_back(f);
-    frame_.resize(face_count);
-    record_.resize(3 * face_count);
-    slack_.resize(face_count);
-    margin_.resize(face_count);
-    for (const uint32_t f : active_) {
-      const StretchFrame& q = frame_[f] = stretch_frame(local + 6 * size_t{f}, scale_);
-      const float condition = (q.q1x * q.q1x + q.q1y * q.q1y + q.q2x * q.q2x + q.q2y * q.q2y) * q.inv;
-      margin_[f] = kSlackMargin + kRoundingPerCondition * condition;
-    }
+    const std::vector<uint32_t> corner_wedge = std::move(id);
+    root.reset();
+    // The active faces (with a free corner), their frames and the terms. Each corner of an active
+    // face on a pinned wedge gets a term of its own after the free wedges' (a sink: the local step
+    // writes every corner's term, nothing reads these).
     term_start_.assign(size_t{free_count} + 1, 0);
-    for (uint32_t c = 0; c < corners; ++c)
-      if (corner_wedge_[c] < free_count) ++term_start_[corner_wedge_[c] + 1];
+    size_t sinks = 0;
+    for (uint32_t f = 0; f < face_count; ++f) {
+      const uint32_t* const w = &corner_wedge[3 * size_t{f}];
+      const size_t free_corners = (w[0] < free_count) + (w[1] < free_count) + (w[2] < free_count);
+      if (free_corners == 0) continue;
+      active_.push_back(f);
+      sinks += 3 - free_corners;
+      for (uint32_t k = 0; k < 3; ++k)
+        if (w[k] < free_count) ++term_start_[w[k] + 1];
+    }
+    const size_t n = active_.size();
     for (size_t w = 0; w < free_count; ++w) term_start_[w + 1] += term_start_[w];
-    reserve_huge(terms_, term_start_[free_count]);
-    terms_.resize(term_start_[free_count]);
+    terms_ = huge_uninitialized<Term>(term_start_[free_count] + sinks);
+    uint32_t sink = term_start_[free_count];
+    face_ = huge_uninitialized<float>(kFaceFields * n);
+    corner_pos_ = huge_uninitialized<uint32_t>(3 * n);
+    slot_ = huge_uninitialized<uint32_t>(3 * n);
+    slack_ = huge_uninitialized<float>(n);
     std::vector<uint32_t> fill(term_start_.begin(), term_start_.end() - 1);
-    for (uint32_t c = 0; c < corners; ++c)  // in corner order: the frames are read in order
-      if (corner_wedge_[c] < free_count) terms_[fill[corner_wedge_[c]]++] = term(c, local + 6 * size_t{c / 3});
+    float* const field = face_.get();
+    for (size_t i = 0; i < n; ++i) {  // in face order: the frames are read in order, each wedge's terms in corner order
+      const uint32_t f = active_[i];
+      const StretchFrame q = stretch_frame(local + 6 * size_t{f}, scale_);
+      // The frame's corners are 0, q1, q2 (pixels); per corner j the dot product of its edges,
+      // times 2 / det^2: the cotangent of its angle over the face's area.
+      const float per_area = 2.f * q.inv * q.inv;
+      const float e12x = q.q2x - q.q1x, e12y = q.q2y - q.q1y;
+      const float w[3] = {per_area * (q.q1x * q.q2x + q.q1y * q.q2y), per_area * -(e12x * q.q1x + e12y * q.q1y),
+                          per_area * (e12x * q.q2x + e12y * q.q2y)};
+      // 1 / the height over corner k: the opposite edge's length over twice the area.
+      const float inv_height[3] = {std::sqrt(e12x * e12x + e12y * e12y) * q.inv,
+                                   std::sqrt(q.q2x * q.q2x + q.q2y * q.q2y) * q.inv,
+                                   std::sqrt(q.q1x * q.q1x + q.q1y * q.q1y) * q.inv};
+      const float condition = (q.q1x * q.q1x + q.q1y * q.q1y + q.q2x * q.q2x + q.q2y * q.q2y) * q.inv;
+      const float values[kFaceFields] = {
+          q.q1x, q.q1y, q.q2x, q.q2y, q.inv, w[0], w[1], w[2], kSlackMargin + kRoundingPerCondition * condition};
+      for (size_t j = 0; j < kFaceFields; ++j) field[j * n + i] = values[j];
+      for (uint32_t k = 0; k < 3; ++k) {
+        const uint32_t wedge = corner_wedge[3 * f + k];
+        corner_pos_[3 * i + k] = 2 * wedge;
+        if (wedge >= free_count) {
+          slot_[3 * i + k] = sink++;
+          continue;
+        }
+        const uint32_t slot = slot_[3 * i + k] = fill[wedge]++;
+        terms_[slot] = Term{0.f,
+                            0.f,
+                            0.f,
+                            0.f,
+                            2 * corner_wedge[3 * f + static_cast<uint32_t>(kNext[k])],
+                            2 * corner_wedge[3 * f + static_cast<uint32_t>(kPrev[k])],
+                            static_cast<uint32_t>(i),
+                            inv_height[k]};
+      }
+    }
   }
 
   // threads iterations at most, on `threads` threads (each phase's work is claimed in fixed
@@ -274,15 +341,10 @@ class Relaxer {
         const size_t chunk = local_step ? kFacesPerChunk : kWedgesPerChunk;
         for (size_t i; (i = next_chunk.fetch_add(1, std::memory_order_relaxed) * chunk) < count;) {
           const size_t end = std::min(count, i + chunk);
-          if (local_step) {
-            for (; i < end; ++i) fit(active_[i]);
-          } else {
-            for (; i < end; ++i) {
-              const float m = move(static_cast<uint32_t>(first + i));
-              moves[t] += m > 0.f;
-              largest[t] = std::max(largest[t], m);
-            }
-          }
+          if (local_step)
+            fit(i, end);
+          else
+            largest[t] = std::max(largest[t], sweep(first + i, first + end, moves[t]));
         }
         sync.arrive_and_wait();
       }
@@ -307,15 +369,17 @@ class Relaxer {
 
   bool cancelled() const { return cancelled_; }
 
-  // Writes the free wedges' positions to their corners.
+  // Writes the free wedges' positions to their corners (only active faces have free corners).
   void store() const {
-    const size_t corners = corner_wedge_.size();
-    for (size_t c = 0; c < corners; ++c) {
-      const uint32_t w = corner_wedge_[c];
-      if (w >= free_count_) continue;
-      uv_[2 * c] = pos_[2 * size_t{w}];
-      uv_[2 * c + 1] = pos_[2 * size_t{w} + 1];
-    }
+    const uint32_t free_end = 2 * free_count_;
+    for (size_t i = 0; i < active_.size(); ++i)
+      for (size_t k = 0; k < 3; ++k) {
+        const uint32_t p = corner_pos_[3 * i + k];
+        if (p >= free_end) continue;
+        const size_t c = 3 * size_t{active_[i]} + k;
+        uv_[2 * c] = pos_[p];
+        uv_[2 * c + 1] = pos_[p + 1];
+      }
   }
 
  private:
@@ -335,111 +399,248 @@ class Relaxer {
     return std::hypot(uv_[2 * size_t{a}] - uv_[2 * size_t{b}], uv_[2 * size_t{a} + 1] - uv_[2 * size_t{b} + 1]);
   }
 
-  // The term of corner c (of a free wedge) of the face whose frame corners are l (6 floats).
-  Term term(uint32_t c, const float* l) const {
-    const uint32_t f = c / 3;
-    const int k = static_cast<int>(c - 3 * f), n = kNext[k], p = kPrev[k];
-    const float inv_twice = 1.f / ((l[2] - l[0]) * (l[5] - l[1]) - (l[4] - l[0]) * (l[3] - l[1]));
-    // Cotangent weights (the edge k-next is opposite corner prev, k-prev opposite next: cot = the
-    // dot product of the edges at that corner over twice the area) over the area in pixels.
-    const auto dot = [&](int j) {
-      const int a = kNext[j], b = kPrev[j];
-      const float ax = l[2 * a] - l[2 * j], ay = l[2 * a + 1] - l[2 * j + 1];
-      const float bx = l[2 * b] - l[2 * j], by = l[2 * b + 1] - l[2 * j + 1];
-      return ax * bx + ay * by;
-    };
-    const float per_area = 2.f * inv_twice * inv_twice / (scale_ * scale_);
-    const float wn = per_area * dot(p), wp = per_area * dot(n);
-    const float dx = (wn * (l[2 * k] - l[2 * n]) + wp * (l[2 * k] - l[2 * p])) * scale_;
-    const float dy = (wn * (l[2 * k + 1] - l[2 * n + 1]) + wp * (l[2 * k + 1] - l[2 * p + 1])) * scale_;
-    const float ox = l[2 * p] - l[2 * n], oy = l[2 * p + 1] - l[2 * n + 1];
-    const float inv_height = std::sqrt(ox * ox + oy * oy) * inv_twice / scale_;
-    return Term{c,
-                corner_wedge_[3 * f + static_cast<uint32_t>(n)],
-                corner_wedge_[3 * f + static_cast<uint32_t>(p)],
-                wn,
-                wp,
-                dx,
-                dy,
-                inv_height};
+  // Local step for active faces [first, last): per face its slack, how far its singular values
+  // may move before one leaves [1/(1+bound), 1+bound], and its corners' terms: its weight m and
+  // the rotation R nearest to its Jacobian J. With J = [a b; c d] (times the frame's inverse
+  // determinant), R turns by atan2(c - b, a + d) and the singular values are |q| +- |r|, q and r
+  // its conformal and anti-conformal parts (face_stretch.h); m = 1 / max(|J - R|, kIrlsFloor)
+  // with |J - R| measured as sqrt((|q| - 1)^2 + |r|^2) (the Frobenius norm over sqrt 2). Four
+  // faces at a time with SSE2, the scalar operations lane by lane (same bits as fit_face).
+  TAILOR_AVX_CLONES void fit(size_t first, size_t last) {
+    size_t i = first;
+#if TAILOR_SSE2
+    const size_t n = active_.size();
+    const float* const field = face_.get();
+    const float* const pos = pos_.data();
+    const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.f), half = _mm_set1_ps(0.5f);
+    const __m128 high = _mm_set1_ps(high_), low = _mm_set1_ps(low_), floor = _mm_set1_ps(kIrlsFloor);
+    // Locals, not members: a vector store may alias anything, the members would be read again.
+    const uint32_t* const corner_pos = corner_pos_.get();
+    const uint32_t* const slot = slot_.get();
+    Term* const terms = terms_.get();
+    float* const slack_out = slack_.get();
+    const __m128 sign = _mm_set1_ps(-0.f), minus_inf = _mm_set1_ps(-std::numeric_limits<float>::infinity());
+    for (; i + 4 <= last; i += 4) {
+      __m128 u1x, u1y, u2x, u2y;
+      {
+        __m128 e[4];  // per face u1x u1y u2x u2y
+        for (size_t k = 0; k < 4; ++k) {
+          const uint32_t* c = corner_pos + 3 * (i + k);
+          const __m128 p0 = load_pair(pos + c[0]);
+          const __m128 p12 = _mm_loadh_pi(load_pair(pos + c[1]), reinterpret_cast<const __m64*>(pos + c[2]));
+          e[k] = _mm_sub_ps(p12, _mm_movelh_ps(p0, p0));
+        }
+        _MM_TRANSPOSE4_PS(e[0], e[1], e[2], e[3]);
+        u1x = e[0], u1y = e[1], u2x = e[2], u2y = e[3];
+      }
+      const __m128 q1x = _mm_loadu_ps(field + kQ1x * n + i), q1y = _mm_loadu_ps(field + kQ1y * n + i);
+      const __m128 q2x = _mm_loadu_ps(field + kQ2x * n + i), q2y = _mm_loadu_ps(field + kQ2y * n + i);
+      const __m128 a = _mm_sub_ps(_mm_mul_ps(u1x, q2y), _mm_mul_ps(u2x, q1y));
+      const __m128 b = _mm_sub_ps(_mm_mul_ps(u2x, q1x), _mm_mul_ps(u1x, q2x));
+      const __m128 c = _mm_sub_ps(_mm_mul_ps(u1y, q2y), _mm_mul_ps(u2y, q1y));
+      const __m128 d = _mm_sub_ps(_mm_mul_ps(u2y, q1x), _mm_mul_ps(u1y, q2x));
+      const __m128 h = _mm_mul_ps(half, _mm_loadu_ps(field + kInv * n + i));
+      const __m128 x = _mm_mul_ps(_mm_add_ps(a, d), h), y = _mm_mul_ps(_mm_sub_ps(c, b), h);
+      const __m128 fx = _mm_sub_ps(a, d), fy = _mm_add_ps(c, b);
+      const __m128 qn = _mm_sqrt_ps(_mm_add_ps(_mm_mul_ps(x, x), _mm_mul_ps(y, y)));
+      const __m128 rn = _mm_mul_ps(_mm_sqrt_ps(_mm_add_ps(_mm_mul_ps(fx, fx), _mm_mul_ps(fy, fy))), h);
+      // std::min(p, q) is _mm_min_ps(q, p) and std::max(p, q) is _mm_max_ps(q, p): the same
+      // operand on ties and NaN.
+      const __m128 slack =
+          _mm_sub_ps(_mm_min_ps(_mm_sub_ps(_mm_sub_ps(qn, rn), low), _mm_sub_ps(high, _mm_add_ps(qn, rn))),
+                     _mm_loadu_ps(field + kMargin * n + i));
+      _mm_storeu_ps(slack_out + i, _mm_max_ps(slack, minus_inf));
+      const __m128 qm = _mm_sub_ps(qn, one);
+      const __m128 residual = _mm_max_ps(floor, _mm_sqrt_ps(_mm_add_ps(_mm_mul_ps(qm, qm), _mm_mul_ps(rn, rn))));
+      const __m128 turned = _mm_cmpgt_ps(qn, zero);
+      const __m128 inv = _mm_div_ps(one, blend(turned, _mm_mul_ps(qn, residual), residual));
+      const __m128 mc = blend(turned, _mm_mul_ps(x, inv), inv), ms = blend(turned, _mm_mul_ps(y, inv), zero);
+      const __m128 m = blend(turned, _mm_mul_ps(qn, inv), inv);
+      const __m128 w0 = _mm_loadu_ps(field + kW0 * n + i), w1 = _mm_loadu_ps(field + kW1 * n + i);
+      const __m128 w2 = _mm_loadu_ps(field + kW2 * n + i);
+      const __m128 ex = _mm_sub_ps(q1x, q2x), ey = _mm_sub_ps(q1y, q2y);
+      const __m128 nq1x = _mm_xor_ps(q1x, sign), nq1y = _mm_xor_ps(q1y, sign);
+      const __m128 nq2x = _mm_xor_ps(q2x, sign), nq2y = _mm_xor_ps(q2y, sign);
+      const __m128 nex = _mm_xor_ps(ex, sign), ney = _mm_xor_ps(ey, sign);
+      // Per corner k: wn, wp and d = wn (x_k - x_next) + wp (x_k - x_prev).
+      const __m128 corner[3][4] = {{w2, w1, _mm_add_ps(_mm_mul_ps(w2, nq1x), _mm_mul_ps(w1, nq2x)),
+                                    _mm_add_ps(_mm_mul_ps(w2, nq1y), _mm_mul_ps(w1, nq2y))},
+                                   {w0, w2, _mm_add_ps(_mm_mul_ps(w0, ex), _mm_mul_ps(w2, q1x)),
+                                    _mm_add_ps(_mm_mul_ps(w0, ey), _mm_mul_ps(w2, q1y))},
+                                   {w1, w0, _mm_add_ps(_mm_mul_ps(w1, q2x), _mm_mul_ps(w0, nex)),
+                                    _mm_add_ps(_mm_mul_ps(w1, q2y), _mm_mul_ps(w0, ney))}};
+      for (size_t k = 0; k < 3; ++k) {
+        const __m128 dx = corner[k][2], dy = corner[k][3];
+        __m128 r0 = _mm_mul_ps(m, corner[k][0]), r1 = _mm_mul_ps(m, corner[k][1]);
+        __m128 r2 = _mm_sub_ps(_mm_mul_ps(mc, dx), _mm_mul_ps(ms, dy));
+        __m128 r3 = _mm_add_ps(_mm_mul_ps(ms, dx), _mm_mul_ps(mc, dy));
+        _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+        const __m128 record[4] = {r0, r1, r2, r3};
+        for (size_t j = 0; j < 4; ++j) _mm_store_ps(&terms[slot[3 * (i + j) + k]].mwn, record[j]);
+      }
+    }
+#endif
+    for (; i < last; ++i) fit_face(i);
   }
 
-  // Local step for face f: record_ gets its weight m and m times the rotation nearest to its
-  // Jacobian J (columns (c, s) and (-s, c)); slack_ how far its singular values may move before one
-  // leaves [1/(1+bound), 1+bound]. With J = [a b; c d] (times the frame's inverse determinant), the
-  // rotation turns by atan2(c - b, a + d) and the singular values are |q| +- |r|, q and r its
-  // conformal and anti-conformal parts (face_stretch.h); |J - R| is measured as
-  // sqrt((|q| - 1)^2 + |r|^2) (the Frobenius norm over sqrt 2).
-  void fit(uint32_t f) {
-    const StretchFrame& s = frame_[f];
-    const float* p0 = &pos_[2 * size_t{corner_wedge_[3 * size_t{f}]}];
-    const float* p1 = &pos_[2 * size_t{corner_wedge_[3 * size_t{f} + 1]}];
-    const float* p2 = &pos_[2 * size_t{corner_wedge_[3 * size_t{f} + 2]}];
+  // fit for active face i alone (the scalar path, and the SIMD loop's scalar twin).
+  void fit_face(size_t i) {
+    const size_t n = active_.size();
+    const float* const field = face_.get();
+    const float* const p0 = &pos_[corner_pos_[3 * i]];
+    const float* const p1 = &pos_[corner_pos_[3 * i + 1]];
+    const float* const p2 = &pos_[corner_pos_[3 * i + 2]];
     const float u1x = p1[0] - p0[0], u1y = p1[1] - p0[1];
     const float u2x = p2[0] - p0[0], u2y = p2[1] - p0[1];
-    const float a = u1x * s.q2y - u2x * s.q1y, b = u2x * s.q1x - u1x * s.q2x;
-    const float c = u1y * s.q2y - u2y * s.q1y, d = u2y * s.q1x - u1y * s.q2x;
-    const float h = 0.5f * s.inv;
+    const float q1x = field[kQ1x * n + i], q1y = field[kQ1y * n + i];
+    const float q2x = field[kQ2x * n + i], q2y = field[kQ2y * n + i];
+    const float a = u1x * q2y - u2x * q1y, b = u2x * q1x - u1x * q2x;
+    const float c = u1y * q2y - u2y * q1y, d = u2y * q1x - u1y * q2x;
+    const float h = 0.5f * field[kInv * n + i];
     const float x = (a + d) * h, y = (c - b) * h;
-    const float qn = std::sqrt(x * x + y * y), rn = std::sqrt((a - d) * (a - d) + (c + b) * (c + b)) * h;
-    slack_[f] = std::min(high_ - (qn + rn), (qn - rn) - low_) - margin_[f];
-    const float residual = std::max(std::sqrt((qn - 1.f) * (qn - 1.f) + rn * rn), kIrlsFloor);
-    float* r = &record_[3 * size_t{f}];
+    const float fx = a - d, fy = c + b;
+    const float qn = std::sqrt(x * x + y * y), rn = std::sqrt(fx * fx + fy * fy) * h;
+    // Never NaN (-inf instead: every move of the face is checked), so that a wedge's least slack
+    // (move) is that of one of its faces.
+    const float slack = std::min(high_ - (qn + rn), (qn - rn) - low_) - field[kMargin * n + i];
+    slack_[i] = std::max(-std::numeric_limits<float>::infinity(), slack);
+    const float qm = qn - 1.f;
+    const float residual = std::max(std::sqrt(qm * qm + rn * rn), kIrlsFloor);
+    float mc, ms, m;  // m R: its columns (mc, ms) and (-ms, mc)
     if (qn > 0.f) {
-      const float inv = 1.f / (qn * residual);  // m / qn
-      r[0] = x * inv;
-      r[1] = y * inv;
-      r[2] = qn * inv;
+      const float inv = 1.f / (qn * residual);
+      mc = x * inv;
+      ms = y * inv;
+      m = qn * inv;
     } else {
-      r[0] = r[2] = 1.f / residual;
-      r[1] = 0.f;
+      mc = m = 1.f / residual;
+      ms = 0.f;
     }
+    const float w0 = field[kW0 * n + i], w1 = field[kW1 * n + i], w2 = field[kW2 * n + i];
+    const float ex = q1x - q2x, ey = q1y - q2y;
+    const float corner[3][4] = {{w2, w1, w2 * -q1x + w1 * -q2x, w2 * -q1y + w1 * -q2y},
+                                {w0, w2, w0 * ex + w2 * q1x, w0 * ey + w2 * q1y},
+                                {w1, w0, w1 * q2x + w0 * -ex, w1 * q2y + w0 * -ey}};
+    for (size_t k = 0; k < 3; ++k) {
+      const float dx = corner[k][2], dy = corner[k][3];
+      Term& t = terms_[slot_[3 * i + k]];
+      t.mwn = m * corner[k][0];
+      t.mwp = m * corner[k][1];
+      t.tx = mc * dx - ms * dy;
+      t.ty = ms * dx + mc * dy;
+    }
+  }
+
+  // Global step for free wedges [first, last) of one colour: returns the largest move, adds the
+  // moves taken to `moves`.
+  TAILOR_AVX_CLONES float sweep(size_t first, size_t last, uint64_t& moves) {
+    float largest = 0.f;
+    uint64_t taken = 0;
+    for (size_t w = first; w < last; ++w) {
+      const float m = move(w);
+      taken += m > 0.f;
+      largest = std::max(largest, m);
+    }
+    moves += taken;
+    return largest;
   }
 
   // Global step for free wedge w: returns how far it moved (|du| + |dv|; 0: it did not).
-  float move(uint32_t w) {
-    const Term* const begin = terms_.data() + term_start_[w];
-    const Term* const end = terms_.data() + term_start_[w + 1];
+  float move(size_t w) {
+    const Term* const begin = &terms_[term_start_[w]];
+    const Term* const end = &terms_[term_start_[w + 1]];
     const float* const pos = pos_.data();
-    float su = 0.f, sv = 0.f, sw = 0.f;
-    for (const Term* t = begin; t != end; ++t) {
-      const float* a = pos + 2 * size_t{t->next};
-      const float* b = pos + 2 * size_t{t->prev};
-      const float* r = &record_[3 * size_t{t->corner / 3}];
-      su += r[2] * (t->wn * a[0] + t->wp * b[0]) + (r[0] * t->dx - r[1] * t->dy);
-      sv += r[2] * (t->wn * a[1] + t->wp * b[1]) + (r[1] * t->dx + r[0] * t->dy);
-      sw += r[2] * (t->wn + t->wp);
-    }
-    float* const at = &pos_[2 * size_t{w}];
+    float* const at = &pos_[2 * w];
     const float u0 = at[0], v0 = at[1];
-    const float u = u0 + kPatchOverRelaxation * (su / sw - u0), v = v0 + kPatchOverRelaxation * (sv / sw - v0);
-    if ((u == u0 && v == v0) || !fits(begin, end, u, v, u0, v0)) return 0.f;
+    // The sums of mwn p_next, mwp p_prev, the weights and (tx, ty) apart, then added; the least
+    // slack and the largest inverse height of the faces around.
+    const float* const slack = slack_.get();
+    float u, v, lowest = std::numeric_limits<float>::infinity(), widest = 0.f;
+#if TAILOR_SSE2
+    // u and v side by side, the scalar operations lane by lane (same bits): pairs holds the sums
+    // of mwn p_next and mwp p_prev, records those of mwn, mwp, tx, ty.
+    __m128 pairs = _mm_setzero_ps(), records = _mm_setzero_ps();
+    for (const Term* t = begin; t != end; ++t) {
+      lowest = std::min(lowest, slack[t->face]);
+      widest = std::max(widest, t->inv_height);
+      const __m128 r = _mm_load_ps(&t->mwn);
+      const __m128 p = _mm_movelh_ps(load_pair(pos + t->next), load_pair(pos + t->prev));
+      pairs = _mm_add_ps(pairs, _mm_mul_ps(_mm_unpacklo_ps(r, r), p));
+      records = _mm_add_ps(records, r);
+    }
+    const __m128 sum = _mm_add_ps(_mm_add_ps(pairs, _mm_movehl_ps(pairs, pairs)), _mm_movehl_ps(records, records));
+    const __m128 weight = _mm_add_ss(records, _mm_shuffle_ps(records, records, 1));
+    const __m128 p0 = load_pair(at);
+    const __m128 target = _mm_div_ps(sum, _mm_shuffle_ps(weight, weight, 0));
+    const __m128 moved = _mm_add_ps(p0, _mm_mul_ps(_mm_set1_ps(kPatchOverRelaxation), _mm_sub_ps(target, p0)));
+    u = _mm_cvtss_f32(moved);
+    v = _mm_cvtss_f32(_mm_shuffle_ps(moved, moved, 1));
+#else
+    float nu = 0.f, nv = 0.f, pu = 0.f, pv = 0.f, wn = 0.f, wp = 0.f, tu = 0.f, tv = 0.f;
+    for (const Term* t = begin; t != end; ++t) {
+      lowest = std::min(lowest, slack[t->face]);
+      widest = std::max(widest, t->inv_height);
+      const float* a = pos + t->next;
+      const float* b = pos + t->prev;
+      nu += t->mwn * a[0];
+      nv += t->mwn * a[1];
+      pu += t->mwp * b[0];
+      pv += t->mwp * b[1];
+      wn += t->mwn;
+      wp += t->mwp;
+      tu += t->tx;
+      tv += t->ty;
+    }
+    const float sw = wn + wp;
+    u = u0 + kPatchOverRelaxation * (((nu + pu) + tu) / sw - u0);
+    v = v0 + kPatchOverRelaxation * (((nv + pv) + tv) / sw - v0);
+#endif
+    if ((u == u0 && v == v0) || !fits(w, begin, end, u, v, u0, v0, lowest, widest)) return 0.f;
     at[0] = u;
     at[1] = v;
     return std::abs(u - u0) + std::abs(v - v0);
   }
 
   // Whether every face around a free wedge (its terms) stays within the bound with the wedge moved
-  // from (u0, v0) to (u, v); if so, takes the move off their slack.
-  bool fits(const Term* begin, const Term* end, float u, float v, float u0, float v0) {
-    const float* const pos = pos_.data();
+  // from (u0, v0) to (u, v); if so, takes the move off their slack. lowest, widest: the least slack
+  // and the largest inverse height of those faces (when the move times widest is within lowest,
+  // it is within each face's slack: a float product does not decrease with a factor).
+  bool fits(size_t w, const Term* begin, const Term* end, float u, float v, float u0, float v0, float lowest,
+            float widest) {
+    float* const slack = slack_.get();
     const float distance = std::sqrt((u - u0) * (u - u0) + (v - v0) * (v - v0));
-    for (const Term* t = begin; t != end; ++t) {
-      const uint32_t f = t->corner / 3;
-      if (distance * t->inv_height <= slack_[f]) continue;  // within the bound by the slack
-      const uint32_t k = t->corner - 3 * f;
-      const uint32_t n = static_cast<uint32_t>(kNext[k]), p = static_cast<uint32_t>(kPrev[k]);
-      float uv[6];
-      uv[2 * k] = u;
-      uv[2 * k + 1] = v;
-      uv[2 * n] = pos[2 * size_t{t->next}];
-      uv[2 * n + 1] = pos[2 * size_t{t->next} + 1];
-      uv[2 * p] = pos[2 * size_t{t->prev}];
-      uv[2 * p + 1] = pos[2 * size_t{t->prev} + 1];
-      if (!(stretch_error(frame_[f], uv) <= bound_)) return false;
-    }
-    for (const Term* t = begin; t != end; ++t) slack_[t->corner / 3] -= distance * t->inv_height;
+    if (!(distance * widest <= lowest))
+      for (const Term* t = begin; t != end; ++t)  // within the bound by the slack, else checked
+        if (!(distance * t->inv_height <= slack[t->face]) && !within_bound(*t, w, u, v)) return false;
+    for (const Term* t = begin; t != end; ++t) slack[t->face] -= distance * t->inv_height;
     return true;
+  }
+
+  // Whether term t's face stays within the bound with its corner on free wedge w moved to (u, v)
+  // (stretch_error).
+  [[gnu::noinline]] bool within_bound(const Term& t, size_t w, float u, float v) const {
+    const float* const pos = pos_.data();
+    const uint32_t i = t.face;
+    uint32_t k = 0;
+    while (corner_pos_[3 * size_t{i} + k] != 2 * w) ++k;
+    const uint32_t n = static_cast<uint32_t>(kNext[k]), p = static_cast<uint32_t>(kPrev[k]);
+    float uv[6];
+    uv[2 * k] = u;
+    uv[2 * k + 1] = v;
+    uv[2 * n] = pos[t.next];
+    uv[2 * n + 1] = pos[t.next + 1];
+    uv[2 * p] = pos[t.prev];
+    uv[2 * p + 1] = pos[t.prev + 1];
+    const size_t count = active_.size();
+    const float* const field = face_.get();
+    StretchFrame frame;
+    frame.q1x = field[kQ1x * count + i];
+    frame.q1y = field[kQ1y * count + i];
+    frame.q2x = field[kQ2x * count + i];
+    frame.q2y = field[kQ2y * count + i];
+    frame.inv = field[kInv * count + i];
+    frame.valid = frame.inv > 0.f;  // stretch_frame leaves inv 0 when not valid
+    return stretch_error(frame, uv) <= bound_;
   }
 
   const MappingInput& in_;
@@ -448,16 +649,17 @@ class Relaxer {
   const float scale_, bound_;
   const float high_, low_;  // the singular values' bounds
   uint32_t free_count_ = 0;
-  // Per corner: its wedge (free wedges 0..free_count_ - 1 by colour, then the pinned ones); per
-  // wedge its UV; per colour its first free wedge; per free wedge its first term.
-  std::vector<uint32_t> corner_wedge_, colour_start_, term_start_;
+  // Per wedge its UV (free wedges 0..free_count_ - 1 by colour, then the pinned ones); per colour
+  // its first free wedge; per free wedge its first term.
+  std::vector<uint32_t> colour_start_, term_start_;
   std::vector<float> pos_;
-  std::vector<Term> terms_;
-  // The faces with a free corner; per face its frame, record (3 floats, see fit), slack and the
-  // margin kept off its slack.
+  HugeArray<Term> terms_;
+  // The active faces (with a free corner); per active face its fields (kFaceFields blocks), per
+  // corner its wedge's offset in pos_ and its term (a sink for a pinned wedge), its slack.
   std::vector<uint32_t> active_;
-  std::vector<StretchFrame> frame_;
-  std::vector<float> record_, slack_, margin_;
+  HugeArray<float> face_;
+  HugeArray<uint32_t> corner_pos_, slot_;
+  HugeArray<float> slack_;
 };
 
 }  // namespace

@@ -11,3 +11,26 @@
 #else
 #define TAILOR_SSE2 0
 #endif
+
+#if TAILOR_SSE2
+namespace tailor::internal {
+// p[0] p[1] 0 0.
+inline __m128 load_pair(const float* p) {
+  return _mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)));
+}
+// Per lane: yes where mask is set, else no.
+inline __m128 blend(__m128 mask, __m128 yes, __m128 no) {
+  return _mm_or_ps(_mm_and_ps(mask, yes), _mm_andnot_ps(mask, no));
+}
+}  // namespace tailor::internal
+#endif
+
+// With GCC on x86-64 the ARAP kernels (the crack closing's, arap_kernels.cpp, and the
+// relaxation's, relax_patches.cpp) are also compiled for AVX, and that version is taken at load
+// time where the CPU has it: the same SSE operations in three-operand (VEX) form (AVX enables no
+// FMA: the results are the same). Clang 14 cannot multiversion a template.
+#if TAILOR_SSE2 && defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define TAILOR_AVX_CLONES __attribute__((target_clones("avx", "default")))
+#else
+#define TAILOR_AVX_CLONES
+#endif
