@@ -137,10 +137,8 @@ std::vector<uint32_t> ChunkedEdits::touched(const Mesh& mesh, std::span<const ui
       if (hit[c]) continue;
       // Cells whose box misses the strokes' box (grown by their radii) hold no face they reach.
       bool apart = false;
-      for (size_t k = 0; k < 3; ++k) {
-        const double a = plan.cells[c][k] * size;
-        apart = apart || a > hi[k] || a + size < lo[k];
-      }
+      const std::array<double, 3> origin = cell_origin(plan.cells[c], size);
+      for (size_t k = 0; k < 3; ++k) apart = apart || origin[k] > hi[k] || origin[k] + size < lo[k];
       if (apart) continue;
       for (const uint32_t f : chunk_faces(plan, c)) {
         double q[3] = {0, 0, 0};
