@@ -422,17 +422,7 @@ class Relaxer {
     const __m128 sign = _mm_set1_ps(-0.f), minus_inf = _mm_set1_ps(-std::numeric_limits<float>::infinity());
     for (; i + 4 <= last; i += 4) {
       __m128 u1x, u1y, u2x, u2y;
-      {
-        __m128 e[4];  // per face u1x u1y u2x u2y
-        for (size_t k = 0; k < 4; ++k) {
-          const uint32_t* c = corner_pos + 3 * (i + k);
-          const __m128 p0 = load_pair(pos + c[0]);
-          const __m128 p12 = _mm_loadh_pi(load_pair(pos + c[1]), reinterpret_cast<const __m64*>(pos + c[2]));
-          e[k] = _mm_sub_ps(p12, _mm_movelh_ps(p0, p0));
-        }
-        _MM_TRANSPOSE4_PS(e[0], e[1], e[2], e[3]);
-        u1x = e[0], u1y = e[1], u2x = e[2], u2y = e[3];
-      }
+      load_edges4(pos, corner_pos + 3 * i, u1x, u1y, u2x, u2y);
       const __m128 q1x = _mm_loadu_ps(field + kQ1x * n + i), q1y = _mm_loadu_ps(field + kQ1y * n + i);
       const __m128 q2x = _mm_loadu_ps(field + kQ2x * n + i), q2y = _mm_loadu_ps(field + kQ2y * n + i);
       const __m128 a = _mm_sub_ps(_mm_mul_ps(u1x, q2y), _mm_mul_ps(u2x, q1y));

@@ -5,6 +5,9 @@
 // the mapping (meshoptimizer's MESHOPTIMIZER_NO_SIMD idea).
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
+
 #if defined(__SSE2__) && !defined(TAILOR_NO_SIMD)
 #define TAILOR_SSE2 1
 #include <emmintrin.h>
@@ -17,6 +20,20 @@ namespace tailor::internal {
 // p[0] p[1] 0 0.
 inline __m128 load_pair(const float* p) {
   return _mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)));
+}
+// The edges P1 - P0 and P2 - P0 of four faces in UV (pos: 2 floats per UV vertex; corner_pos: the
+// three UV vertices of each face, 3 per face), one face per lane: u1x, u1y, u2x, u2y.
+inline void load_edges4(const float* pos, const uint32_t* corner_pos, __m128& u1x, __m128& u1y, __m128& u2x,
+                        __m128& u2y) {
+  __m128 e[4];  // per face u1x u1y u2x u2y
+  for (size_t k = 0; k < 4; ++k) {
+    const uint32_t* c = corner_pos + 3 * k;
+    const __m128 p0 = load_pair(pos + c[0]);
+    const __m128 p12 = _mm_loadh_pi(load_pair(pos + c[1]), reinterpret_cast<const __m64*>(pos + c[2]));
+    e[k] = _mm_sub_ps(p12, _mm_movelh_ps(p0, p0));
+  }
+  _MM_TRANSPOSE4_PS(e[0], e[1], e[2], e[3]);
+  u1x = e[0], u1y = e[1], u2x = e[2], u2y = e[3];
 }
 // Per lane: yes where mask is set, else no.
 inline __m128 blend(__m128 mask, __m128 yes, __m128 no) {
