@@ -66,6 +66,19 @@ py::dict material_dict(const MaterialMaps& maps) {
   return d;
 }
 
+// A material description (folder, JSON) read without the GIL, as the dict material_dict makes.
+py::dict read_material_dict(const py::object& path_object) {
+  const std::string path = path_of(path_object);
+  MaterialMaps maps;
+  Status status;
+  {
+    const py::gil_scoped_release release;
+    status = load_material(path, maps);
+  }
+  if (!status) raise_status(status);
+  return material_dict(maps);
+}
+
 }  // namespace
 
 void bind_simplify(py::module_& m);
@@ -190,15 +203,7 @@ and faces (F,) uint32: chunk k's face ids are faces[chunk_start[k]:chunk_start[k
         if (py::isinstance<py::dict>(material)) {
           material_from_dict(material.cast<py::dict>(), options);
         } else if (!material.is_none()) {
-          const std::string material_path = path_of(material);
-          MaterialMaps maps;
-          Status s;
-          {
-            const py::gil_scoped_release release;
-            s = load_material(material_path, maps);
-          }
-          if (!s) raise_status(s);
-          material_from_dict(material_dict(maps), options);
+          material_from_dict(read_material_dict(material), options);
         }
         Atlas atlas;
         atlas.corner_uv.assign(uv.data(), uv.data() + 6 * faces);
@@ -225,19 +230,7 @@ its size must be texture_size. up: 'z' for Z-up coordinates, turned Y-up by the 
 rotation as `tailor map --up z`.)");
 
   m.def(
-      "load_material",
-      [](const py::object& path_object) {
-        const std::string path = path_of(path_object);
-        MaterialMaps maps;
-        Status status;
-        {
-          const py::gil_scoped_release release;
-          status = load_material(path, maps);
-        }
-        if (!status) raise_status(status);
-        return material_dict(maps);
-      },
-      py::arg("path"),
+      "load_material", [](const py::object& path_object) { return read_material_dict(path_object); }, py::arg("path"),
       R"(load_material(path) -> dict
 
 Reads a PBR material as `tailor map --material` does (a folder of maps named *_color, *_normal,
