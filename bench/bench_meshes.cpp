@@ -135,3 +135,14 @@ const std::string& subdivided_horse_obj_path() {
 tailor::Status write_subdivided_horse_ply(const std::string& path) {
   return internal::write_file_atomic(path, binary_ply(subdivided_horse()));
 }
+
+tailor::Status write_subdivided_ply(const std::string& path, const std::string& input, int levels) {
+  Mesh mesh;
+  TAILOR_RETURN_IF_ERROR(tailor::load_mesh(input, mesh));
+  for (int i = 0; i < levels; ++i) {
+    if (mesh.face_count() > (size_t{1} << 30) / 4)
+      return Status::error(tailor::ErrorCode::kInvalidArgument, input, "more than 2^30 faces after subdividing");
+    mesh = subdivide(mesh);
+  }
+  return internal::write_file_atomic(path, binary_ply(mesh));
+}

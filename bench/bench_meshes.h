@@ -26,6 +26,10 @@ const std::string& subdivided_horse_ply_path();
 //! Writes subdivided_horse() as binary PLY to `path` (atomically); for tools outside the benchmarks.
 tailor::Status write_subdivided_horse_ply(const std::string& path);
 
+//! Writes the mesh file `input` subdivided `levels` times (each 1-to-4: 4^levels times the faces)
+//! as binary PLY to `path` (atomically).
+tailor::Status write_subdivided_ply(const std::string& path, const std::string& input, int levels);
+
 //! subdivided_horse() as ascii OBJ (`v x y z` with %.9g, `f a b c`).
 const std::string& subdivided_horse_obj_path();
 

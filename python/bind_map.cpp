@@ -140,9 +140,11 @@ const std::string& map_docstring() {
     };
     add(kMappingOptionDocs);
     add(kOrientationOptionDocs);
-    for (const OptionDoc& d : kChunkOptionDocs)
+    for (const OptionDoc& d : kChunkOptionDocs) {
+      if (d.field == std::string_view("split_above")) continue;  // the CLI's only (the library's default here)
       doc += "  " + std::string(d.flag) + " (" + (d.field == std::string_view("mode") ? "chunks" : "chunk_cell") +
              "): " + std::string(d.help) + "\n";
+    }
     return doc;
   }();
   return text;

@@ -111,6 +111,10 @@ void bind_tiles(py::module_& m) {
         d["longest_edge"] = plan.longest_edge;
         d["locality_radius"] = plan.locality_radius();
         d["cells"] = cells;
+        d["levels"] = py::array_t<uint8_t>({chunks}, plan.levels.data());
+        py::array_t<uint16_t> parts({chunks, py::ssize_t{3}});
+        if (chunks) std::memcpy(parts.mutable_data(), plan.parts.data(), plan.parts.size() * sizeof(plan.parts[0]));
+        d["parts"] = parts;
         d["chunk_start"] = py::array_t<uint32_t>({py::ssize_t(plan.chunk_start.size())}, plan.chunk_start.data());
         d["faces"] = py::array_t<uint32_t>({py::ssize_t(plan.faces.size())}, plan.faces.data());
         return d;
@@ -120,9 +124,12 @@ void bind_tiles(py::module_& m) {
 
 The chunked engine's rule (`tailor map --chunks on`): a grid anchored at the world origin, cell
 side 2**cell_exponent world units (chunk_cell, else from the median edge length); a face belongs
-to the cell of its centroid. Returns cell_exponent, cell_size, median_edge, longest_edge,
-locality_radius, cells (K, 3) int32 in cell order (z, then y, then x), chunk_start (K+1,) uint32
-and faces (F,) uint32: chunk k's face ids are faces[chunk_start[k]:chunk_start[k+1]].)");
+to the cell of its centroid; a cell of more than 131,072 faces is cut into octants, recursively
+(parts). Returns cell_exponent, cell_size, median_edge, longest_edge, locality_radius, cells (K, 3)
+int32 in cell order (z, then y, then x; a split cell's parts one after the other share it), levels
+(K,) uint8 (0: the whole cell, else the part's octant depth), parts (K, 3) uint16 (the part's place
+in its cell in units of 2**-level of the side), chunk_start (K+1,) uint32 and faces (F,) uint32:
+chunk k's face ids are faces[chunk_start[k]:chunk_start[k+1]].)");
 
   // The rule's arithmetic on blocks of faces, for a partition that streams the mesh (tailor.tiles).
   using Corners = py::array_t<float, py::array::c_style | py::array::forcecast>;

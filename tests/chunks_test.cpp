@@ -21,6 +21,8 @@ namespace {
 
 using test::load_test_mesh;
 
+Mesh chunk_faces(const Mesh& mesh, const ChunkResult& result);  // below
+
 // Chunk options that cut a test mesh (tens of thousands of faces) into a handful of chunks.
 MapTextureOptions chunked(int cell_exponent) {
   MapTextureOptions options;
@@ -77,6 +79,66 @@ TEST(ChunkPlan, EveryFaceIsInTheCellOfItsCentroid) {
   EXPECT_GE(plan.cell_size, automatic.cell_edges * plan.median_edge / std::sqrt(2.0));
   EXPECT_LE(plan.cell_size, automatic.cell_edges * plan.median_edge * std::sqrt(2.0));
   EXPECT_GT(plan.locality_radius(), plan.cell_size);
+}
+
+// A cell of more faces than split_above is cut into octants (again while a part holds more): each
+// part holds the faces whose centroids lie in its box, the parts of a cell follow one another, and
+// the cells that were not too full are planned as without the split.
+TEST(ChunkPlan, OverFullCellsAreCutIntoOctantsOfTheirOwnFaces) {
+  const Mesh mesh = load_test_mesh("horse.ply");
+  ChunkOptions options;
+  options.mode = ChunkMode::kOn;
+  options.cell_exponent = exponent_for(mesh, 1.5);
+  options.split_above = 0;
+  ChunkPlan whole_cells;
+  ASSERT_TRUE(plan_chunks(mesh, options, whole_cells).is_ok());
+  options.split_above = 2000;
+  ChunkPlan plan;
+  ASSERT_TRUE(plan_chunks(mesh, options, plan).is_ok());
+  ASSERT_GT(plan.chunk_count(), whole_cells.chunk_count());
+  ASSERT_EQ(plan.levels.size(), plan.chunk_count());
+  ASSERT_EQ(plan.parts.size(), plan.chunk_count());
+  ASSERT_EQ(plan.chunk_start.back(), mesh.face_count());
+  EXPECT_GT(int{*std::max_element(plan.levels.begin(), plan.levels.end())}, 1) << "no part was cut again";
+  std::vector<int> seen(mesh.face_count(), 0);
+  size_t kept = 0;  // cells not cut: the same faces in the same order as without the split
+  for (size_t c = 0; c < plan.chunk_count(); ++c) {
+    const uint32_t size = plan.chunk_start[c + 1] - plan.chunk_start[c];
+    ASSERT_GT(size, 0u) << "an empty part";
+    EXPECT_TRUE(size <= options.split_above || plan.levels[c] == kMaxChunkSplitLevels) << c;
+    if (c > 0) {
+      const auto& a = plan.cells[c - 1];
+      const auto& b = plan.cells[c];
+      EXPECT_LE(std::make_tuple(a[2], a[1], a[0]), std::make_tuple(b[2], b[1], b[0])) << "cells out of order";
+    }
+    const double side = plan.chunk_size(c);
+    EXPECT_EQ(side, std::ldexp(plan.cell_size, -int{plan.levels[c]}));
+    const std::array<double, 3> origin = plan.chunk_origin(c);
+    for (uint32_t i = plan.chunk_start[c]; i < plan.chunk_start[c + 1]; ++i) {
+      const uint32_t f = plan.faces[i];
+      ++seen[f];
+      for (size_t k = 0; k < 3; ++k) {
+        double centroid = 0;
+        for (size_t j = 0; j < 3; ++j) centroid += mesh.positions[3 * size_t{mesh.indices[3 * f + j]} + k];
+        centroid /= 3.0;
+        EXPECT_GE(centroid, origin[k] - 1e-6 * side);
+        EXPECT_LE(centroid, origin[k] + side + 1e-6 * side);
+      }
+    }
+    if (plan.levels[c] == 0) {
+      const auto w = std::find(whole_cells.cells.begin(), whole_cells.cells.end(), plan.cells[c]);
+      ASSERT_NE(w, whole_cells.cells.end());
+      const size_t u = static_cast<size_t>(w - whole_cells.cells.begin());
+      EXPECT_TRUE(std::equal(plan.faces.begin() + plan.chunk_start[c], plan.faces.begin() + plan.chunk_start[c + 1],
+                             whole_cells.faces.begin() + whole_cells.chunk_start[u],
+                             whole_cells.faces.begin() + whole_cells.chunk_start[u + 1]));
+      ++kept;
+    }
+  }
+  EXPECT_GT(kept, 0u) << "every cell was cut: the test no longer tests the cells kept whole";
+  EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), static_cast<std::ptrdiff_t>(mesh.face_count()));
+  options.split_above = 10;
+  EXPECT_EQ(plan_chunks(mesh, options, plan).code(), ErrorCode::kInvalidArgument);
 }
 
 TEST(ChunkPlan, RejectsBadOptionsAndHugeSpans) {
@@ -149,6 +211,53 @@ TEST(ChunkedMapping, SameBitsForAnyThreadCountAndQualityKept) {
         << threads << " threads";
     EXPECT_EQ(other.atlas.patch, one.atlas.patch);
   }
+}
+
+// Cells cut into parts map as the chunks do: the same bits for any thread count and file order,
+// each part from its own geometry, and a cell mapped alone (ChunkedMapper) as inside the mesh.
+TEST(ChunkedMapping, CellsCutIntoPartsKeepTheBitsAndTheQuality) {
+  const Mesh mesh = load_test_mesh("horse.ply");
+  const Topology topology = build_topology(mesh);
+  MapTextureOptions options = chunked(exponent_for(mesh, 1.5));
+  options.chunks.split_above = 6000;
+  options.mapping.threads = 1;
+  TextureMap one;
+  ASSERT_TRUE(map_texture(mesh, topology, options, one).is_ok());
+  EXPECT_GT(one.stats.chunks, 16u);
+  EXPECT_EQ(one.metrics.flipped, 0u);
+  EXPECT_LE(one.metrics.l2_stretch, 1.02);
+  EXPECT_LE(one.metrics.linf_stretch, 3.0);
+  options.mapping.threads = 2;
+  TextureMap two;
+  ASSERT_TRUE(map_texture(mesh, topology, options, two).is_ok());
+  EXPECT_EQ(two.atlas.corner_uv, one.atlas.corner_uv);
+  EXPECT_EQ(two.atlas.patch, one.atlas.patch);
+  StabilityReport report;
+  ASSERT_TRUE(measure_stability(mesh, options, report).is_ok());
+  EXPECT_EQ(report.order_identical_ratio, 1.0);
+  EXPECT_EQ(report.identical_beyond_radius_ratio, 1.0);
+  // The most cut cell mapped alone: the same bits as inside the whole mesh.
+  ChunkedMapper whole(options, options.chunks.cell_exponent, one.stats.texels_per_unit);
+  std::vector<ChunkCell> cells;
+  ASSERT_TRUE(whole.set_mesh(mesh, &cells).is_ok());
+  ChunkPlan plan;
+  ASSERT_TRUE(plan_chunks(mesh, options.chunks, plan).is_ok());
+  ChunkCell most = plan.cells[0];
+  size_t most_parts = 0;
+  for (const ChunkCell& cell : cells) {
+    const size_t parts = static_cast<size_t>(std::count(plan.cells.begin(), plan.cells.end(), cell));
+    if (parts > most_parts) {
+      most_parts = parts;
+      most = cell;
+    }
+  }
+  ASSERT_GT(most_parts, 1u);
+  const ChunkResult inside = *whole.chunk(most);
+  ChunkedMapper streamed(options, options.chunks.cell_exponent, one.stats.texels_per_unit);
+  ASSERT_TRUE(streamed.set_chunk(most, chunk_faces(mesh, inside)).is_ok());
+  EXPECT_EQ(streamed.chunk(most)->corner_uv, inside.corner_uv);
+  EXPECT_EQ(streamed.chunk(most)->patch, inside.patch);
+  EXPECT_EQ(streamed.chunk(most)->patch_count, inside.patch_count);
 }
 
 // Each chunk places its patches' seeds by their world position modulo the texture's repeat: on a

@@ -98,6 +98,7 @@ MappingOptionHandles add_mapping_options(CLI::Option_group* group, MappingArgs& 
                          ->check(CLI::IsMember({1u, 4u}));
   add_documented(group, option_doc(kChunkOptionDocs, "mode"), args.chunks);
   add_documented(group, option_doc(kChunkOptionDocs, "cell_exponent"), args.chunk_cell);
+  add_documented(group, option_doc(kChunkOptionDocs, "split_above"), options.chunks.split_above);
   return handles;
 }
 

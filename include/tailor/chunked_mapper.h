@@ -40,8 +40,9 @@ struct ChunkResult {
 
 class TAILOR_API ChunkedMapper {
  public:
-  //! Chunks of side 2^cell_exponent world units (-60..60), mapped with `options` (its chunk
-  //! options and progress callbacks are not used) at texels_per_unit texture pixels per world unit.
+  //! Chunks of side 2^cell_exponent world units (-60..60), mapped with `options` (of its chunk
+  //! options only split_above is used: a cell holding more faces is mapped in parts, as map_texture
+  //! does; its progress callbacks are not used) at texels_per_unit texture pixels per world unit.
   ChunkedMapper(const MapTextureOptions& options, int cell_exponent, double texels_per_unit);
 
   //! kInvalidArgument when the exponent, the density (positive, finite, and 1e-3..1e7 pixels per

@@ -6,13 +6,18 @@
 // wall at x = 10): a noisy surface along a grid plane would have its faces dealt at random between
 // the cells on either side (a plane at z = 0 with noise: 16,190 patches instead of 4). The cell side
 // comes from the median edge length, rounded to a power of two, so neither the file's order, the
-// bounding box nor the thread count moves a chunk border, and a local edit moves none either.
+// bounding box nor the thread count moves a chunk border, and a local edit moves none either. A cell
+// holding more than ChunkOptions::split_above faces (a folded surface: up to 4x a flat cell's) is
+// split into its eight octants, again while a part holds more: the split depends on the cell's own
+// faces only, so a local edit changes no other cell's parts, and no worker maps more than about
+// split_above faces at once (its memory) nor holds back the others (the balance of the threads).
 // map_texture maps each chunk on its own (in parallel) from its own geometry only: the same chunk
 // gives the same UVs bit for bit whatever else is loaded and in whatever order its faces, vertices
 // and corners come.
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -36,15 +41,20 @@ enum class ChunkMode : uint8_t {
 //! and so on. sqrt(2) - 1: no dyadic cell side times it is a round number.
 inline constexpr double kChunkGridOffset = 0.41421356237309503;
 
+//! Octant levels a cell may be split into (parts of 1/16 of its side at the deepest).
+inline constexpr int kMaxChunkSplitLevels = 4;
+
 //! Sentinel of ChunkOptions::cell_exponent: derive it from the mesh's median edge length.
 inline constexpr int kAutoCellExponent = -1000;
 
 struct ChunkOptions {
   ChunkMode mode = ChunkMode::kAuto;
-  uint32_t min_faces = uint32_t{1} << 17;  //!< kAuto: meshes with fewer faces are mapped whole (one chunk)
-  int cell_exponent = kAutoCellExponent;   //!< cell side 2^cell_exponent world units (-60..60), or auto
-  float cell_edges = 256.f;                //!< auto: the cell side is about this many median edges (rounded to a
-                                           //!< power of two): ~50k-200k faces per full cell (8..4096)
+  uint32_t min_faces = uint32_t{1} << 17;    //!< kAuto: meshes with fewer faces are mapped whole (one chunk)
+  int cell_exponent = kAutoCellExponent;     //!< cell side 2^cell_exponent world units (-60..60), or auto
+  float cell_edges = 256.f;                  //!< auto: the cell side is about this many median edges (rounded to a
+                                             //!< power of two): ~50k-200k faces per full cell (8..4096)
+  uint32_t split_above = uint32_t{1} << 17;  //!< a cell (or part) with more faces is split into its octants
+                                             //!< (up to kMaxChunkSplitLevels deep); 0 = never split
 };
 
 //! Flags and help of the ChunkOptions a user sets (option_doc.h).
@@ -57,19 +67,37 @@ inline constexpr OptionDoc kChunkOptionDocs[] = {
     {"cell_exponent", "--chunk-cell",
      "the chunk grid's cell side as a power of two of world units (e.g. 4 = 16 units); default: from the median "
      "edge length"},
+    {"split_above", "--chunk-split",
+     "a chunk cell holding more faces than this (a folded surface) is cut into its eight octants, again while a part "
+     "holds more: bounds each worker's memory (~400 bytes per face of the chunk it maps) and evens out the threads' "
+     "work; 0 = never cut"},
 };
 
 //! The chunks of one mesh: a CSR list of face ids per chunk, chunks in the order of their cells
-//! (z, then y, then x), faces of a chunk in file order (map_texture sorts them spatially).
+//! (z, then y, then x; the parts of a split cell one after the other, octant by octant), faces of a
+//! chunk in file order (map_texture sorts them spatially).
 struct ChunkPlan {
-  int cell_exponent = 0;                      //!< cell side = 2^cell_exponent world units
-  double cell_size = 0;                       //!< 2^cell_exponent
-  double median_edge = 0;                     //!< median edge length of the mesh (world units) the cell came from
-  double longest_edge = 0;                    //!< longest edge (world units): faces reach that far beyond their cell
-  std::vector<std::array<int32_t, 3>> cells;  //!< per chunk: its cell's integer coordinates
-  std::vector<uint32_t> chunk_start;          //!< #chunks + 1: offsets into faces
-  std::vector<uint32_t> faces;                //!< #F: face ids grouped by chunk
+  int cell_exponent = 0;                       //!< cell side = 2^cell_exponent world units
+  double cell_size = 0;                        //!< 2^cell_exponent
+  double median_edge = 0;                      //!< median edge length of the mesh (world units) the cell came from
+  double longest_edge = 0;                     //!< longest edge (world units): faces reach that far beyond their cell
+  std::vector<std::array<int32_t, 3>> cells;   //!< per chunk: its cell's integer coordinates (the parts of a
+                                               //!< split cell share them)
+  std::vector<uint8_t> levels;                 //!< per chunk: 0 = its whole cell, else its part's octant depth
+  std::vector<std::array<uint16_t, 3>> parts;  //!< per chunk: its part's place in the cell, in parts of
+                                               //!< 2^-level of the side per axis (0 for a whole cell)
+  std::vector<uint32_t> chunk_start;           //!< #chunks + 1: offsets into faces
+  std::vector<uint32_t> faces;                 //!< #F: face ids grouped by chunk
   size_t chunk_count() const { return cells.size(); }
+  //! Chunk c's side, world units: the cell's, halved per level.
+  double chunk_size(size_t c) const { return std::ldexp(cell_size, -int{levels[c]}); }
+  //! Chunk c's corner (its cell's at the grid offset, plus its part's place), world units.
+  std::array<double, 3> chunk_origin(size_t c) const {
+    const double part = chunk_size(c);
+    std::array<double, 3> o;
+    for (size_t k = 0; k < 3; ++k) o[k] = (cells[c][k] + kChunkGridOffset) * cell_size + parts[c][k] * part;
+    return o;
+  }
   //! Every corner farther than this from an edited face keeps its UVs bit for bit: the cell's
   //! diagonal plus a face's reach beyond its cell on both sides.
   double locality_radius() const { return cell_size * 1.7320508075688772 + 2.0 * longest_edge; }
@@ -83,7 +111,9 @@ TAILOR_API Status check_chunk_options(const ChunkOptions& options);
 TAILOR_API bool uses_chunks(const ChunkOptions& options, size_t face_count);
 
 //! The chunk rule: the cell side (the option, or 2^round(log2(cell_edges * median edge length))),
-//! then each face's cell from its centroid. Fails with kInvalidArgument on bad options and
+//! then each face's cell from its centroid, then each cell of more than split_above faces cut into
+//! its octants, recursively (the part of a face: its centroid's octant, clamped into the cell, so a
+//! part's faces have their centroids in its box up to rounding). Fails with kInvalidArgument on bad options and
 //! kInvalidMesh when the mesh has no face, no edge of positive length, or cells beyond 2^20 per
 //! axis (a mesh spanning more than a million cells: give a larger cell). O(F) time (the median by
 //! selection), 12 bytes per face while it runs and 4 in the result.

@@ -25,8 +25,8 @@ constexpr double kReachMargin = 1e-3;
 // The options map_chunk maps chunk `chunk` with (chunk_map_options), with its seam faces.
 MapTextureOptions chunk_options(const ChunkedEdits::Layout& layout, const MapTextureOptions& options, uint32_t chunk,
                                 std::span<const uint8_t> seam) {
-  MapTextureOptions o =
-      chunk_map_options(options, layout.plan.cells[chunk], layout.plan.cell_size, layout.texels_per_unit);
+  MapTextureOptions o = chunk_map_options(options, layout.plan.chunk_origin(chunk), layout.plan.chunk_size(chunk),
+                                          layout.texels_per_unit);
   o.mapping.seam_faces = seam;
   return o;
 }
@@ -132,12 +132,12 @@ std::vector<uint32_t> ChunkedEdits::touched(const Mesh& mesh, std::span<const ui
     const StrokeField field(grown);
     const float* pos = mesh.positions.data();
     const uint32_t* idx = mesh.indices.data();
-    const double size = plan.cell_size;
     for (uint32_t c = 0; c < plan.chunk_count(); ++c) {
       if (hit[c]) continue;
-      // Cells whose box misses the strokes' box (grown by their radii) hold no face they reach.
+      // Chunks whose box misses the strokes' box (grown by their radii) hold no face they reach.
       bool apart = false;
-      const std::array<double, 3> origin = cell_origin(plan.cells[c], size);
+      const double size = plan.chunk_size(c);
+      const std::array<double, 3> origin = plan.chunk_origin(c);
       for (size_t k = 0; k < 3; ++k) apart = apart || origin[k] > hi[k] || origin[k] + size < lo[k];
       if (apart) continue;
       for (const uint32_t f : chunk_faces(plan, c)) {
@@ -207,7 +207,7 @@ Status ChunkedEdits::build(const Mesh& mesh, const MapTextureOptions& options, c
   const uint32_t chunk = k->chunk;
   const Layout& layout = *layout_;
   const ChunkPlan& plan = layout.plan;
-  build_chunk_mesh(mesh, chunk_faces(plan, chunk), cell_origin(plan.cells[chunk], plan.cell_size), plan.cell_size,
+  build_chunk_mesh(mesh, chunk_faces(plan, chunk), plan.chunk_origin(chunk), plan.chunk_size(chunk),
                    options.mapping.seam_faces, k->w);
   for (size_t i = 0; i < k->w.faces.size(); ++i) position_[k->w.faces[i].face] = static_cast<uint32_t>(i);
   k->topology = build_topology(k->w.mesh);
@@ -263,9 +263,10 @@ void ChunkedEdits::write_chunk(uint32_t chunk, const Atlas& chunk_atlas, const s
 Status ChunkedEdits::map_chunk_fresh(const Layout& layout, const Mesh& mesh, const MapTextureOptions& options,
                                      uint32_t chunk, uint32_t threads, ProgressCallback progress, ChunkWorker& w) {
   const ChunkPlan& plan = layout.plan;
-  build_chunk_mesh(mesh, chunk_faces(plan, chunk), cell_origin(plan.cells[chunk], plan.cell_size), plan.cell_size,
+  build_chunk_mesh(mesh, chunk_faces(plan, chunk), plan.chunk_origin(chunk), plan.chunk_size(chunk),
                    options.mapping.seam_faces, w);
-  return map_chunk(options, plan.cells[chunk], plan.cell_size, layout.texels_per_unit, threads, std::move(progress), w);
+  return map_chunk(options, plan.chunk_origin(chunk), plan.chunk_size(chunk), layout.texels_per_unit, threads,
+                   std::move(progress), w);
 }
 
 void ChunkedEdits::adopt(const MapTextureOptions& options, std::span<const uint32_t> chunks,

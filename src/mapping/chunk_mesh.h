@@ -56,11 +56,9 @@ struct ChunkWorker {
 void build_chunk_mesh(const Mesh& mesh, std::span<const uint32_t> faces, const std::array<double, 3>& origin,
                       double size, std::span<const uint8_t> seam_faces, ChunkWorker& w);
 
-//! The origin of a chunk's cell, world units.
-inline std::array<double, 3> cell_origin(const std::array<int32_t, 3>& cell, double cell_size) {
-  return {(cell[0] + kChunkGridOffset) * cell_size, (cell[1] + kChunkGridOffset) * cell_size,
-          (cell[2] + kChunkGridOffset) * cell_size};
-}
+//! Adds one chunk's mapping counters and stage times to `total` (counts summed, maxima kept).
+//! Defined in map_chunks.cpp.
+void add_stats(const MappingStats& s, MappingStats& total);
 
 //! Maps a whole mesh (not cut into chunks) in canonical form, so that the same surface in any
 //! file order gets the same UVs: build_chunk_mesh over its bounding box, map_texture on that (its
@@ -70,17 +68,17 @@ inline std::array<double, 3> cell_origin(const std::array<int32_t, 3>& cell, dou
 Status map_whole_canonical(const Mesh& mesh, const MapTextureOptions& options, TextureMap& map);
 
 //! The options a chunk is mapped with (map_chunk; the edit session's local updates inside a chunk
-//! too): its cell's frame (origin at the cell's corner, unit the cell side), texels_per_unit times
-//! the cell side as its scale, no chunks, metrics or progress, no seam faces (the caller sets the
-//! chunk's own).
-MapTextureOptions chunk_map_options(const MapTextureOptions& options, const std::array<int32_t, 3>& cell,
-                                    double cell_size, double texels_per_unit);
+//! too): its box's frame (origin at its corner, ChunkPlan::chunk_origin; unit its side,
+//! chunk_size), texels_per_unit times the side as its scale, no chunks, metrics or progress, no
+//! seam faces (the caller sets the chunk's own).
+MapTextureOptions chunk_map_options(const MapTextureOptions& options, const std::array<double, 3>& origin, double size,
+                                    double texels_per_unit);
 
 //! Maps the chunk built in w (build_chunk_mesh) by map_texture with `options` (no metrics): its
-//! frame is its cell's (origin at the cell's corner, unit the cell side), its density
-//! texels_per_unit, `threads` for its own stages, `progress` its share (optional). Results in w.map,
-//! in w's canonical order. Defined in map_chunks.cpp.
-Status map_chunk(const MapTextureOptions& options, const std::array<int32_t, 3>& cell, double cell_size,
+//! frame is its box's (origin at its corner, unit its side), its density texels_per_unit, `threads`
+//! for its own stages, `progress` its share (optional). Results in w.map, in w's canonical order.
+//! Defined in map_chunks.cpp.
+Status map_chunk(const MapTextureOptions& options, const std::array<double, 3>& origin, double size,
                  double texels_per_unit, uint32_t threads, ProgressCallback progress, ChunkWorker& w);
 
 }  // namespace tailor::internal

@@ -3,6 +3,8 @@
 // of the geometry alone: the median is order-free, the cell of a face depends on its own corners.
 #include <algorithm>
 #include <cmath>
+#include <span>
+#include <vector>
 
 #include "tailor/chunks.h"
 
@@ -15,6 +17,8 @@ Status check_chunk_options(const ChunkOptions& options) {
     return Status::error(ErrorCode::kInvalidArgument, "", "chunk cell exponent must be in -60..60");
   if (!(options.cell_edges >= 8.f && options.cell_edges <= 4096.f))
     return Status::error(ErrorCode::kInvalidArgument, "", "chunk cell edges must be in 8..4096");
+  if (options.split_above != 0 && options.split_above < 64)
+    return Status::error(ErrorCode::kInvalidArgument, "", "the chunk split must be 0 (never cut) or at least 64 faces");
   return Status::ok();
 }
 
@@ -117,6 +121,94 @@ class CellTable {
   size_t size_ = 0;
 };
 
+// Cuts the cells of more than split_above faces into octants, recursively (split_cell), in place:
+// the plan's chunks become the parts, each cell's in octant order (z, then y, then x bit), the
+// faces of a part in the order they had. Only the faces of split cells are touched.
+class CellSplitter {
+ public:
+  CellSplitter(const Mesh& mesh, ChunkPlan& plan, uint32_t split_above)
+      : p_(mesh.positions.data()), idx_(mesh.indices.data()), plan_(plan), split_above_(split_above) {}
+
+  void run() {
+    const size_t chunks = plan_.chunk_count();
+    bool any = false;
+    for (size_t c = 0; c < chunks && !any; ++c) any = plan_.chunk_start[c + 1] - plan_.chunk_start[c] > split_above_;
+    plan_.levels.assign(chunks, 0);
+    plan_.parts.assign(chunks, {0, 0, 0});
+    if (!any) return;
+    std::vector<uint32_t> faces;
+    faces.reserve(plan_.faces.size());
+    for (size_t c = 0; c < chunks; ++c) {
+      const std::span<const uint32_t> cell(plan_.faces.data() + plan_.chunk_start[c],
+                                           plan_.chunk_start[c + 1] - plan_.chunk_start[c]);
+      std::vector<uint32_t> own(cell.begin(), cell.end());
+      split(plan_.cells[c], 0, {0, 0, 0}, own, faces);
+    }
+    plan_.faces = std::move(faces);
+    plan_.cells = std::move(cells_);
+    plan_.levels = std::move(levels_);
+    plan_.parts = std::move(parts_);
+    plan_.chunk_start = std::move(start_);
+  }
+
+ private:
+  // Emits the part (cell, level, part) holding `faces`, or its octants when it holds too many.
+  void split(const std::array<int32_t, 3>& cell, int level, const std::array<uint16_t, 3>& part,
+             std::vector<uint32_t>& faces, std::vector<uint32_t>& out) {
+    if (faces.size() <= split_above_ || level == kMaxChunkSplitLevels) {
+      if (start_.empty()) start_.push_back(0);
+      out.insert(out.end(), faces.begin(), faces.end());
+      start_.push_back(static_cast<uint32_t>(out.size()));
+      cells_.push_back(cell);
+      levels_.push_back(static_cast<uint8_t>(level));
+      parts_.push_back(part);
+      return;
+    }
+    // Each face's octant in the part: its centroid in units of the child parts' side, from the
+    // cell's corner, clamped into the part (a centroid on the cell's edge rounds either way).
+    const int child = level + 1;
+    const double inverse3 = std::ldexp(1.0, child - plan_.cell_exponent) / 3.0;
+    std::vector<uint8_t> octant(faces.size());
+    std::array<uint32_t, 9> start{};
+    for (size_t i = 0; i < faces.size(); ++i) {
+      const uint32_t* corner = idx_ + 3 * size_t{faces[i]};
+      double c[3];
+      centroid3(p_ + 3 * size_t{corner[0]}, p_ + 3 * size_t{corner[1]}, p_ + 3 * size_t{corner[2]}, c);
+      uint8_t o = 0;
+      for (int k = 2; k >= 0; --k) {
+        const double first = 2.0 * part[static_cast<size_t>(k)];
+        const double s = c[k] * inverse3 - std::ldexp(cell[static_cast<size_t>(k)] + kChunkGridOffset, child) - first;
+        o = static_cast<uint8_t>((o << 1) | (s >= 1.0 ? 1 : 0));
+      }
+      octant[i] = o;
+      ++start[o + 1u];
+    }
+    for (size_t o = 0; o < 8; ++o) start[o + 1] += start[o];
+    std::vector<uint32_t> sorted(faces.size());
+    std::array<uint32_t, 9> fill = start;
+    for (size_t i = 0; i < faces.size(); ++i) sorted[fill[octant[i]]++] = faces[i];
+    std::vector<uint32_t>().swap(faces);
+    std::vector<uint8_t>().swap(octant);
+    for (uint32_t o = 0; o < 8; ++o) {
+      if (start[o] == start[o + 1]) continue;
+      std::vector<uint32_t> children(sorted.begin() + start[o], sorted.begin() + start[o + 1]);
+      const std::array<uint16_t, 3> child_part = {static_cast<uint16_t>(2 * part[0] + (o & 1)),
+                                                  static_cast<uint16_t>(2 * part[1] + ((o >> 1) & 1)),
+                                                  static_cast<uint16_t>(2 * part[2] + ((o >> 2) & 1))};
+      split(cell, child, child_part, children, out);
+    }
+  }
+
+  const float* p_;
+  const uint32_t* idx_;
+  ChunkPlan& plan_;
+  uint32_t split_above_;
+  std::vector<std::array<int32_t, 3>> cells_;
+  std::vector<uint8_t> levels_;
+  std::vector<std::array<uint16_t, 3>> parts_;
+  std::vector<uint32_t> start_;
+};
+
 }  // namespace
 
 Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& plan) {
@@ -180,6 +272,7 @@ Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& pla
   plan.faces.resize(face_count);
   std::vector<uint32_t> fill(plan.chunk_start.begin(), plan.chunk_start.end() - 1);
   for (size_t f = 0; f < face_count; ++f) plan.faces[fill[chunk_of[f]]++] = static_cast<uint32_t>(f);
+  CellSplitter(mesh, plan, options.split_above ? options.split_above : ~uint32_t{0}).run();
   return Status::ok();
 }
 

@@ -56,44 +56,50 @@ Status ChunkedMapper::set_chunk(const ChunkCell& cell, const Mesh& faces) {
   if (faces.empty()) return Status::error(ErrorCode::kInvalidMesh, "", "a chunk needs at least one face");
   if (!faces.seam_faces.empty() && faces.seam_faces.size() != faces.face_count())
     return Status::error(ErrorCode::kInvalidMesh, "", "seam face flags must hold one entry per face");
-  // The rule's own test: the plan of these faces alone must be this one cell.
+  // The rule's own test: the plan of these faces alone must be this one cell (in one or more parts).
   ChunkOptions rule;
   rule.mode = ChunkMode::kOn;
   rule.cell_exponent = cell_exponent_;
+  rule.split_above = options_.chunks.split_above;
   ChunkPlan plan;
   TAILOR_RETURN_IF_ERROR(plan_chunks(faces, rule, plan));
-  if (plan.chunk_count() != 1 || plan.cells[0] != cell) {
-    const auto outside =
-        std::find_if(plan.cells.begin(), plan.cells.end(), [&](const ChunkCell& c) { return c != cell; });
+  const auto outside =
+      std::find_if(plan.cells.begin(), plan.cells.end(), [&](const ChunkCell& c) { return c != cell; });
+  if (outside != plan.cells.end()) {
     const size_t c = static_cast<size_t>(outside - plan.cells.begin());
     return Status::error(
         ErrorCode::kInvalidArgument, "",
         "face " + std::to_string(plan.faces[plan.chunk_start[c]]) + " has its centroid outside the chunk's cell",
         "cell " + std::to_string(cell[0]) + "," + std::to_string(cell[1]) + "," + std::to_string(cell[2]));
   }
-  internal::ChunkWorker w;
-  internal::build_chunk_mesh(faces, plan.faces, internal::cell_origin(cell, cell_size_), cell_size_, faces.seam_faces,
-                             w);
-  TAILOR_RETURN_IF_ERROR(
-      internal::map_chunk(options_, cell, cell_size_, texels_per_unit_, options_.mapping.threads, {}, w));
-  // Back to the faces' own order and corners.
+  // Each part of the cell (one unless it holds more than the rule's split_above faces) as map_chunks
+  // maps it, back to the faces' own order and corners, its patch ids after the parts' before it.
   ChunkResult result;
   const size_t n = faces.face_count();
   result.faces.resize(n);
   for (size_t f = 0; f < n; ++f) result.faces[f] = static_cast<uint32_t>(f);
   result.corner_uv.resize(6 * n);
   result.patch.resize(n);
-  for (size_t i = 0; i < n; ++i) {
-    const internal::ChunkFace& face = w.faces[i];
-    for (uint32_t k = 0; k < 3; ++k) {
-      const size_t corner = 3 * size_t{face.face} + (face.rotation + k) % 3;
-      result.corner_uv[2 * corner] = w.map.atlas.corner_uv[6 * i + 2 * k];
-      result.corner_uv[2 * corner + 1] = w.map.atlas.corner_uv[6 * i + 2 * k + 1];
+  internal::ChunkWorker w;
+  for (size_t c = 0; c < plan.chunk_count(); ++c) {
+    const std::span<const uint32_t> part(plan.faces.data() + plan.chunk_start[c],
+                                         plan.chunk_start[c + 1] - plan.chunk_start[c]);
+    internal::build_chunk_mesh(faces, part, plan.chunk_origin(c), plan.chunk_size(c), faces.seam_faces, w);
+    TAILOR_RETURN_IF_ERROR(internal::map_chunk(options_, plan.chunk_origin(c), plan.chunk_size(c), texels_per_unit_,
+                                               options_.mapping.threads, {}, w));
+    for (size_t i = 0; i < w.faces.size(); ++i) {
+      const internal::ChunkFace& face = w.faces[i];
+      for (uint32_t k = 0; k < 3; ++k) {
+        const size_t corner = 3 * size_t{face.face} + (face.rotation + k) % 3;
+        result.corner_uv[2 * corner] = w.map.atlas.corner_uv[6 * i + 2 * k];
+        result.corner_uv[2 * corner + 1] = w.map.atlas.corner_uv[6 * i + 2 * k + 1];
+      }
+      result.patch[face.face] = result.patch_count + w.map.atlas.patch[i];
     }
-    result.patch[face.face] = w.map.atlas.patch[i];
+    result.patch_count += w.map.atlas.patch_count;
+    internal::add_stats(w.map.stats, result.stats);
   }
-  result.patch_count = w.map.atlas.patch_count;
-  result.stats = w.map.stats;
+  result.stats.patches = result.patch_count;
   chunks_[pack(cell)] = std::move(result);
   return Status::ok();
 }
@@ -113,14 +119,16 @@ Status ChunkedMapper::set_mesh(const Mesh& mesh, std::vector<ChunkCell>* cells) 
   ChunkPlan plan;
   TAILOR_RETURN_IF_ERROR(plan_chunks(mesh, o.chunks, plan));
   if (cells) cells->clear();
-  for (size_t c = 0; c < plan.chunk_count(); ++c) {
+  // One result per cell: the parts of a split cell are consecutive chunks, their patches consecutive ids.
+  for (size_t c = 0, end; c < plan.chunk_count(); c = end) {
+    for (end = c + 1; end < plan.chunk_count() && plan.cells[end] == plan.cells[c];) ++end;
     const std::span<const uint32_t> faces(plan.faces.data() + plan.chunk_start[c],
-                                          plan.chunk_start[c + 1] - plan.chunk_start[c]);
+                                          plan.chunk_start[end] - plan.chunk_start[c]);
     ChunkResult result;
     result.faces.assign(faces.begin(), faces.end());
     result.corner_uv.reserve(6 * faces.size());
     result.patch.reserve(faces.size());
-    uint32_t first = kInvalid, last = 0;  // a chunk's patches are consecutive ids (map_chunks)
+    uint32_t first = kInvalid, last = 0;
     for (const uint32_t f : faces) {
       first = std::min(first, map.atlas.patch[f]);
       last = std::max(last, map.atlas.patch[f]);

@@ -22,7 +22,6 @@
 #include "util/mesh_bounds.h"
 
 namespace tailor::internal {
-namespace {
 
 void add_stats(const MappingStats& s, MappingStats& total) {
   total.patches += s.patches;
@@ -48,20 +47,17 @@ void add_stats(const MappingStats& s, MappingStats& total) {
   total.relaxing_seconds += s.relaxing_seconds;
 }
 
-}  // namespace
-
-MapTextureOptions chunk_map_options(const MapTextureOptions& options, const std::array<int32_t, 3>& cell,
-                                    double cell_size, double texels_per_unit) {
+MapTextureOptions chunk_map_options(const MapTextureOptions& options, const std::array<double, 3>& origin, double size,
+                                    double texels_per_unit) {
   MapTextureOptions o = options;
   o.chunks.mode = ChunkMode::kOff;
   o.measure = false;
   o.stage_progress = nullptr;
   o.mapping.progress = nullptr;
   o.orientation.progress = nullptr;
-  o.orientation.fixed_unit_scale = static_cast<float>(1.0 / cell_size);
-  const std::array<double, 3> origin = cell_origin(cell, cell_size);
+  o.orientation.fixed_unit_scale = static_cast<float>(1.0 / size);
   for (size_t k = 0; k < 3; ++k) o.orientation.fixed_origin[k] = static_cast<float>(origin[k]);
-  o.mapping.scale = static_cast<float>(texels_per_unit * cell_size);
+  o.mapping.scale = static_cast<float>(texels_per_unit * size);
   // Seeds placed by their world position modulo the texture's repeat: where two chunks' patches
   // meet on a plane with one direction (a user axis), their UVs differ by whole repeats and the
   // chunk border does not show under the tiling texture.
@@ -72,15 +68,15 @@ MapTextureOptions chunk_map_options(const MapTextureOptions& options, const std:
   return o;
 }
 
-Status map_chunk(const MapTextureOptions& options, const std::array<int32_t, 3>& cell, double cell_size,
+Status map_chunk(const MapTextureOptions& options, const std::array<double, 3>& origin, double size,
                  double texels_per_unit, uint32_t threads, ProgressCallback progress, ChunkWorker& w) {
-  const double chunk_scale = texels_per_unit * cell_size;
+  const double chunk_scale = texels_per_unit * size;
   if (!(chunk_scale >= 1e-3 && chunk_scale <= 1e7))
     return Status::error(ErrorCode::kInvalidArgument, "",
                          "the texel density gives " + std::to_string(chunk_scale) +
                              " pixels per chunk cell, outside 0.001 to 1e7: give another chunk cell or scale");
   const Topology topology = build_topology(w.mesh);
-  MapTextureOptions o = chunk_map_options(options, cell, cell_size, texels_per_unit);
+  MapTextureOptions o = chunk_map_options(options, origin, size, texels_per_unit);
   o.mapping.progress = std::move(progress);
   o.mapping.threads = threads;
   o.orientation.threads = threads;
@@ -216,8 +212,8 @@ Status map_chunks(const Mesh& mesh, const MapTextureOptions& options, TextureMap
   const size_t threads =
       std::clamp<size_t>(options.mapping.threads ? options.mapping.threads : std::min<size_t>(cores, 64), 1, chunks);
   // With fewer chunks than threads each chunk's own stages get the rest; and a chunk holding a large
-  // share of the faces gets that share of the threads (the largest chunk sets the wall time: on
-  // horse_x16 one holds 27 % of the faces). The result is the same for any count (map_texture's
+  // share of the faces gets that share of the threads (the largest chunk sets the wall time: on a
+  // mesh of a few cells, one can hold a fifth of the faces). The result is the same for any count (map_texture's
   // promise); the threads of a large chunk and of the others running beside it may exceed the
   // cores for a while.
   const size_t all_threads = options.mapping.threads ? options.mapping.threads : cores;
@@ -274,11 +270,11 @@ Status map_chunks(const Mesh& mesh, const MapTextureOptions& options, TextureMap
       const uint32_t c = order[i];
       const std::span<const uint32_t> faces(plan.faces.data() + plan.chunk_start[c],
                                             plan.chunk_start[c + 1] - plan.chunk_start[c]);
-      build_chunk_mesh(mesh, faces, cell_origin(plan.cells[c], plan.cell_size), plan.cell_size,
-                       options.mapping.seam_faces, w);
+      const std::array<double, 3> origin = plan.chunk_origin(c);
+      build_chunk_mesh(mesh, faces, origin, plan.chunk_size(c), options.mapping.seam_faces, w);
       const size_t chunk_faces = w.faces.size();
       const Status s = map_chunk(
-          options, plan.cells[c], plan.cell_size, texels_per_unit, inner_threads(chunk_faces),
+          options, origin, plan.chunk_size(c), texels_per_unit, inner_threads(chunk_faces),
           [&report, chunk_faces](float done) {
             return report(static_cast<size_t>(done * static_cast<float>(chunk_faces)), 0, false);
           },
