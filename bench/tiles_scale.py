@@ -7,9 +7,10 @@
 mesh: tests/data/meshes/horse.ply (96,966 faces) refined three times by 1-to-4 midpoint subdivision
 (6,205,824 faces), written as binary PLY. time: wall seconds of `tailor map --chunks on -o x.glb`,
 then of `python3 -m tailor.tiles --no-lod` with --workers 0 (no Dask), 1 and 2, each run into a
-fresh folder, then with levels of detail at 2 workers, and of its re-run (every tile kept). borders: the share of visible edges between tiles
-and inside them (an edge is visible when its two sides are not whole texture repeats apart: a gap
-of 1 px or more at either end).
+fresh folder, then with levels of detail at 2 workers, and of its re-run (every tile kept), with
+each run's peak memory (the driver's, and the largest of a worker process that ran a task).
+borders: the share of visible edges between tiles and inside them (an edge is visible when its two
+sides are not whole texture repeats apart: a gap of 1 px or more at either end).
 """
 import json
 import os
@@ -122,8 +123,12 @@ def time_runs(path, binary):
         extra = ""
         if summary:
             t = summary["seconds"]
-            extra = " (%d tiles, %d written; load+plan %.1f s, cut %.1f s, map+write %.1f s)" % (
-                summary["tiles"], summary["written"], t["load_plan"], t["cut"], t["map_write"])
+            extra = " (%d tiles, %d written; load+plan %.1f s, cut %.1f s, map+write %.1f s; peak MiB: driver %d" % (
+                summary["tiles"], summary["written"], t["load_plan"], t["cut"], t["map_write"],
+                summary["driver_peak_rss"] >> 20)
+            if summary.get("worker_peak_rss"):
+                extra += ", largest worker %d" % (summary["worker_peak_rss"] >> 20)
+            extra += ")"
         print("%-48s %7.1f s%s" % (name, s, extra))
     print("tile folders identical for workers 0/1/2 and threads 1/2: %s" % same)
     print("load average: %s" % " ".join("%.2f" % x for x in os.getloadavg()))

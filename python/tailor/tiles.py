@@ -35,6 +35,7 @@ import pathlib
 import shutil
 import struct
 import sys
+import threading
 import time
 
 import numpy as np
@@ -354,6 +355,13 @@ def map_tile(job, positions, faces, params, folder, keep_from, threads, lod):
     if name == job["name"] and marker and not os.path.exists(marker):
         pathlib.Path(marker).touch()
         os._exit(70)
+    return record
+
+
+def on_worker(task, *args):
+    """A Dask task: task(*args)'s record, with the peak memory of the worker process that ran it."""
+    record = task(*args)
+    record["peak_rss"] = peak_rss()
     return record
 
 
@@ -692,8 +700,46 @@ def start_client(args):
     return Client(cluster), cluster
 
 
-def driver_peak_rss():
-    """This process's peak resident memory in bytes (the driver's; the workers are other processes):
+class ClientStart:
+    """start_client in a thread of its own, started while the driver still reads and cuts the mesh:
+    the local cluster's worker processes start and import tailor meanwhile. result() waits for it;
+    close() waits too, then closes what it started."""
+
+    def __init__(self, args):
+        self.client = self.cluster = self.error = None
+        self.thread = threading.Thread(target=self._run, args=(args,), name="tailor.tiles client", daemon=True)
+        self.thread.start()
+
+    def _run(self, args):
+        try:
+            self.client, self.cluster = start_client(args)
+            if self.cluster is not None:
+                self.client.run(worker_ready)  # each worker imports tailor.tiles now, not at its first task
+        except BaseException as e:  # raised again by result()
+            self.error = e
+
+    def result(self):
+        self.thread.join()
+        if self.error is not None:
+            raise self.error
+        return self.client, self.cluster
+
+    def close(self):
+        self.thread.join()
+        if self.client is not None:
+            self.client.close()
+        if self.cluster is not None:
+            self.cluster.close()
+
+
+def worker_ready():
+    """Run on each worker of the local cluster once it is up: unpickling this function imports
+    tailor.tiles (numpy, the library) there."""
+    return os.getpid()
+
+
+def peak_rss():
+    """This process's peak resident memory in bytes (the driver's in run(), a worker's in a task):
     VmHWM, not getrusage's ru_maxrss, which execve keeps from the parent that forked this process."""
     try:
         with open("/proc/self/status") as f:
@@ -738,8 +784,11 @@ def run(args):
     tmp = outdir.parent / (".%s.tmp-%d" % (outdir.name, os.getpid()))
     shutil.rmtree(tmp, ignore_errors=True)
     (tmp / "tiles").mkdir(parents=True)
-    client = cluster = None
+    in_process = args.workers == 0 and not args.scheduler
+    start = None
     try:
+        if not in_process and not args.cut_only:
+            start = ClientStart(args)  # while the driver cuts the mesh
         # The images every tile names, once beside tileset.json (the previous run's file linked
         # when it has the same bytes, so that it keeps its time).
         for name, data in look["images"].values():
@@ -772,7 +821,7 @@ def run(args):
             for tile in sorted(counts, key=lambda t: (t[2], t[1], t[0])):
                 name = node_name(0, tile)
                 path = str(tiles_stream.tile_file(scratch, tile))
-                if args.workers == 0 and not args.scheduler:  # mapped in this process: all of them
+                if in_process:  # mapped in this process: all of them
                     p, f = tiles_stream.read_tile(path, layout.index_dtype, params["cell_exponent"], params["tile_level"])
                     jobs.append(({"name": name, "tile": list(tile)}, p, f, old.get(name)))
                 else:
@@ -786,7 +835,7 @@ def run(args):
                 "leaves": len(sizes),
                 "faces": int(sum(sizes)),
                 "input": "streamed" if layout is not None else "in memory",
-                "driver_peak_rss": driver_peak_rss(),
+                "driver_peak_rss": peak_rss(),
                 "seconds": {"load_plan": t_plan - t0, "cut": t_cut - t_plan},
             }
         # Largest first, so that the last tasks to finish are small ones.
@@ -794,7 +843,7 @@ def run(args):
         progress = Progress(len(jobs) + sum(len(groups) for groups in levels), not args.quiet)
         records = {}
         folder = str(tmp)
-        if args.workers == 0 and not args.scheduler:
+        if in_process:
             for i, record in map_in_process(jobs, order, params, folder, args.threads, args.lod):
                 records[record["name"]] = record
                 progress.step(record["written"])
@@ -808,7 +857,7 @@ def run(args):
         else:
             from dask.distributed import as_completed
 
-            client, cluster = start_client(args)
+            client, _ = start.result()
             threads = args.threads or 1
             futures = {}
             for i in order:
@@ -818,11 +867,21 @@ def run(args):
                     job = dict(job)
                     path = job.pop("file")
                     futures[job["name"]] = client.submit(
-                        map_tile_file, job, path, index_dtype, params, folder, keep, threads, args.lod, key=key
+                        on_worker,
+                        map_tile_file,
+                        job,
+                        path,
+                        index_dtype,
+                        params,
+                        folder,
+                        keep,
+                        threads,
+                        args.lod,
+                        key=key,
                     )
                 else:
                     futures[job["name"]] = client.submit(
-                        map_tile, job, p, f, params, folder, keep, threads, args.lod, key=key
+                        on_worker, map_tile, job, p, f, params, folder, keep, threads, args.lod, key=key
                     )
             del jobs[:]
             for level, groups in enumerate(levels, start=1):
@@ -830,7 +889,14 @@ def run(args):
                     job = {"name": node_name(level, tile), "level": level, "tile": list(tile)}
                     kids = [futures[n] for n in names]
                     futures[job["name"]] = client.submit(
-                        build_parent, job, params, folder, old.get(job["name"]), *kids, key="tile-%s-%s" % (tmp.name, job["name"])
+                        on_worker,
+                        build_parent,
+                        job,
+                        params,
+                        folder,
+                        old.get(job["name"]),
+                        *kids,
+                        key="tile-%s-%s" % (tmp.name, job["name"]),
                     )
             for fut in as_completed(list(futures.values())):
                 record = fut.result()
@@ -855,10 +921,8 @@ def run(args):
         shutil.rmtree(tmp, ignore_errors=True)
         raise
     finally:
-        if client is not None:
-            client.close()
-        if cluster is not None:
-            cluster.close()
+        if start is not None:
+            start.close()
     written = sum(1 for r in records if r["written"])
     summary = {
         "tiles": len(records),
@@ -873,7 +937,9 @@ def run(args):
         "input": "streamed" if layout is not None else "in memory",
         "texels_per_unit": params["texels_per_unit"],
         "workers": args.workers if not args.scheduler else None,
-        "driver_peak_rss": driver_peak_rss(),
+        "driver_peak_rss": peak_rss(),
+        # The largest peak of a worker process that ran a task (None without Dask).
+        "worker_peak_rss": max((r.get("peak_rss", 0) for r in records), default=0) if not in_process else None,
         "seconds": {
             "load_plan": t_plan - t0,
             "cut": t_cut - t_plan,

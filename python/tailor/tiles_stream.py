@@ -9,8 +9,9 @@ functions plan_chunks computes with), so the tiles hold the faces `tailor.plan_c
 
 Passes over the faces: (1) checks (counts, index range, finite coordinates), the bounding box of the
 referenced vertices and a histogram of the edge lengths' float bits (high 16 bits), (2) when the
-cell is automatic, the exact median from the low 16 bits of the lengths in the one bin that holds
-it, (3) each face's tile, its three vertex ids and corner positions appended to the tile's file.
+cell is automatic and the one bin that holds the median spans two cell exponents, the exact median
+from the low 16 bits of the lengths in that bin, (3) each face's tile, its three vertex ids and
+corner positions appended to the tile's file.
 What tailor.load would change is done the same way: faces that repeat a vertex are dropped here,
 faces that repeat another face's vertices (the first kept) by the task that reads the tile.
 """
@@ -162,9 +163,22 @@ class _Body:
         self.vertices = np.ndarray(
             (layout.vertex_count,), dtype=layout.vertex_dtype, buffer=self.map, offset=layout.vertex_offset
         )
+        # x, y, z as three consecutive float32 (the usual vertex): one row gather per corner instead
+        # of one per axis, on a contiguous (V, 3) view when nothing else is in the vertex.
+        fields = layout.vertex_dtype.fields
+        x = fields["x"][1]
+        self.rows = None
+        if all(fields[a][0] == np.dtype("<f4") and fields[a][1] == x + 4 * k for k, a in enumerate("xyz")):
+            self.rows = np.ndarray(
+                (layout.vertex_count, 3),
+                dtype="<f4",
+                buffer=self.map,
+                offset=layout.vertex_offset + x,
+                strides=(layout.vertex_dtype.itemsize, 4),
+            )
 
     def close(self):
-        del self.vertices
+        del self.vertices, self.rows
         try:
             self.map.close()
         except BufferError:  # a block still viewed by a frame an error left: closed when collected
@@ -212,9 +226,14 @@ class _Body:
             kept = (ids[:, 0] != ids[:, 1]) & (ids[:, 1] != ids[:, 2]) & (ids[:, 0] != ids[:, 2])
             if kept.all():
                 kept = slice(None)
-            corners = np.empty((n, 3, 3), dtype=np.float32)
-            for k, axis in enumerate("xyz"):
-                corners[:, :, k] = self.vertices[axis][ids]
+            if self.rows is None:
+                corners = np.empty((n, 3, 3), dtype=np.float32)
+                for k, axis in enumerate("xyz"):
+                    corners[:, :, k] = self.vertices[axis][ids]
+            elif self.rows.flags.c_contiguous:
+                corners = self.rows.take(ids.reshape(-1), axis=0).reshape(n, 3, 3)
+            else:  # take would copy the whole vertex element first
+                corners = self.rows[ids.reshape(-1)].reshape(n, 3, 3)
             self.release()
             yield first, ids, corners, kept
 
@@ -230,8 +249,10 @@ def _check_finite(body, block):
 
 def survey(layout, chunk_cell, block_faces=BLOCK_FACES):
     """The streaming passes before the partition: checks, the bounding box of the referenced vertices
-    and the chunk rule's median edge length (exact: plan_chunks takes element n // 2 of the 3F
-    lengths). Returns {faces, lo, hi, median_edge, cell_exponent}."""
+    and the chunk rule's cell exponent from the median edge length (exact: plan_chunks takes element
+    n // 2 of the 3F lengths). The second pass, for the median's low 16 bits, runs only when the bin
+    of the coarse histogram that holds the median spans two exponents. Returns {faces, lo, hi,
+    median_edge (None when the bin decided, or with chunk_cell), cell_exponent}."""
     body = _Body(layout)
     try:
         _check_finite(body, block_faces)
@@ -245,8 +266,9 @@ def survey(layout, chunk_cell, block_faces=BLOCK_FACES):
                 continue
             faces += corners.shape[0]
             flat = corners.reshape(-1, 3)
-            lo = np.minimum(lo, flat.min(axis=0))
-            hi = np.maximum(hi, flat.max(axis=0))
+            for k in range(3):  # a column at a time: numpy's reduction along axis 0 of 3 columns is slow
+                lo[k] = min(lo[k], flat[:, k].min())
+                hi[k] = max(hi[k], flat[:, k].max())
             if chunk_cell is None:
                 bits = tailor.chunk_edge_lengths(corners).view(np.uint32).ravel()
                 coarse += np.bincount(bits >> 16, minlength=1 << 16)
@@ -258,15 +280,20 @@ def survey(layout, chunk_cell, block_faces=BLOCK_FACES):
             cumulative = np.cumsum(coarse)
             top = int(np.searchsorted(cumulative, rank, side="right"))
             below = int(cumulative[top - 1]) if top else 0
-            fine = np.zeros(1 << 16, dtype=np.int64)
-            for _, _, corners, kept in body.blocks(block_faces):
-                bits = tailor.chunk_edge_lengths(corners[kept]).view(np.uint32).ravel()
-                bits = bits[(bits >> 16) == top]
-                fine += np.bincount(bits & 0xFFFF, minlength=1 << 16)
-            low = int(np.searchsorted(np.cumsum(fine), rank - below, side="right"))
-            median = float(np.array([(top << 16) | low], dtype=np.uint32).view(np.float32)[0])
+            bin_ends = np.array([top << 16, (top << 16) | 0xFFFF], dtype=np.uint32).view(np.float32)
+            if _same_exponent(float(bin_ends[0]), float(bin_ends[1])):
+                decided = float(bin_ends[0])  # every length of the bin gives the median's exponent
+            else:
+                fine = np.zeros(1 << 16, dtype=np.int64)
+                for _, _, corners, kept in body.blocks(block_faces):
+                    bits = tailor.chunk_edge_lengths(corners[kept]).view(np.uint32).ravel()
+                    bits = bits[(bits >> 16) == top]
+                    fine += np.bincount(bits & 0xFFFF, minlength=1 << 16)
+                low = int(np.searchsorted(np.cumsum(fine), rank - below, side="right"))
+                median = float(np.array([(top << 16) | low], dtype=np.uint32).view(np.float32)[0])
+                decided = median
         try:
-            exponent = tailor.chunk_cell_exponent(median if median is not None else 0.0, chunk_cell)
+            exponent = tailor.chunk_cell_exponent(decided if chunk_cell is None else 0.0, chunk_cell)
         except tailor.Error as e:
             raise StreamError("%s: %s" % (layout.path, e)) from None
         return {"faces": faces, "lo": lo, "hi": hi, "median_edge": median, "cell_exponent": exponent}
@@ -274,8 +301,29 @@ def survey(layout, chunk_cell, block_faces=BLOCK_FACES):
         body.close()
 
 
+def _same_exponent(a, b):
+    """Whether the automatic cell exponent is the same for every median edge length in [a, b] (it
+    grows with the length): then the bin of the coarse histogram that holds the median decides it."""
+    if not (0.0 < a <= b < math.inf):
+        return False
+    try:
+        return tailor.chunk_cell_exponent(a) == tailor.chunk_cell_exponent(b)
+    except tailor.Error:
+        return False
+
+
 def record_dtype(layout):
     return np.dtype([("i", layout.index_dtype, 3), ("p", "<f4", (3, 3))])
+
+
+def _pack(cells):
+    """(n, 3) int64 cells (or tiles) as one int64 each, in the order of (z, y, x)."""
+    return ((cells[:, 2] + (1 << 20)) << 42) | ((cells[:, 1] + (1 << 20)) << 21) | (cells[:, 0] + (1 << 20))
+
+
+def _unpack(key):
+    mask = (1 << 21) - 1
+    return ((key & mask) - (1 << 20), ((key >> 21) & mask) - (1 << 20), (key >> 42) - (1 << 20))
 
 
 def tile_file(folder, tile):
@@ -299,25 +347,30 @@ def partition(layout, cell_exponent, tile_level, folder, block_faces=BLOCK_FACES
                 cells = tailor.chunk_cells(corners, cell_exponent).astype(np.int64)
             except tailor.Error as e:
                 raise StreamError("%s: %s" % (layout.path, e)) from None
-            packed = ((cells[:, 2] + (1 << 20)) << 42) | ((cells[:, 1] + (1 << 20)) << 21) | (cells[:, 0] + (1 << 20))
-            cells_seen.update(np.unique(packed).tolist())
-            del packed
-            tiles = cells >> tile_level
-            del cells
-            key = ((tiles[:, 2] + (1 << 20)) << 42) | ((tiles[:, 1] + (1 << 20)) << 21) | (tiles[:, 0] + (1 << 20))
+            packed = _pack(cells)
+            if tile_level:
+                cells_seen.update(np.unique(packed).tolist())
+                key = _pack(cells >> tile_level)
+            else:
+                key = packed
+            del cells, packed
             order = np.argsort(key, kind="stable")
             records = np.empty(ids.shape[0], dtype=dtype)
-            records["i"] = ids[order]
+            records["i"] = ids
             del ids
-            records["p"] = corners[order]
+            records["p"] = corners
             del corners
+            records = records.view(np.uint8).reshape(order.shape[0], -1).take(order, axis=0)  # whole records
             key = key[order]
+            del order
             starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
             ends = np.r_[starts[1:], key.shape[0]]
+            if not tile_level:
+                cells_seen.update(key[starts].tolist())
             for s, e in zip(starts.tolist(), ends.tolist()):
-                tile = tuple(int(v) for v in tiles[order[s]])
+                tile = _unpack(int(key[s]))
                 with open(tile_file(folder, tile), "ab") as f:
-                    f.write(records[s:e].tobytes())
+                    f.write(records[s:e])
                 counts[tile] = counts.get(tile, 0) + (e - s)
     finally:
         body.close()
