@@ -88,6 +88,7 @@ expect_error 1 "no texture coordinates" -- "$tailor" eval tests/data/meshes/fand
   fail "map --chunks on: $(cat "$tmp/chunks_map.txt")"
 expect_error 2 "--chunks must be auto, on or off, got 'maybe'" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --chunks maybe
 expect_error 2 "--chunk-cell must be auto or a whole number in -60..60" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --chunk-cell 1.5
+expect_error 2 "--chunk-split must be 0 .never cut. or at least 64 faces" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --chunk-split 10
 # One of a thing is singular in the summary: "1 face, 1 patch".
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 0.1 0\nvt 0 0.1\nf 1/1 2/2 3/3\n' >"$tmp/one.obj"
 "$tailor" eval "$tmp/one.obj" >"$tmp/one.txt" 2>&1 && grep -q "one.obj: 1 face, 1 patch (" "$tmp/one.txt" && ok ||

@@ -17,6 +17,8 @@ Status check_map_options(const MapTextureOptions& options) {
     return usage_error("--scale must be between 0.001 and 1e7 pixels per unit");
   if (!(mapping.hop_age >= 0.f && mapping.hop_age <= 1.f))
     return usage_error("--hop-age must be between 0 and 1 radians");
+  if (options.chunks.split_above != 0 && options.chunks.split_above < 64)
+    return usage_error("--chunk-split must be 0 (never cut) or at least 64 faces");
   return Status::ok();
 }
 
