@@ -904,6 +904,11 @@ def run(args):
                 progress.step(record["written"])
         records = sorted(records.values(), key=lambda r: (-r["level"], r["tile"][2], r["tile"][1], r["tile"][0]))
         shutil.rmtree(scratch, ignore_errors=True)
+        # A worker process that died while writing a file (killed, out of memory) leaves that
+        # write's temporary file (".tailor-XXXXXX", beside its target); every node is written now
+        # (its task ran again elsewhere), so those are stray.
+        for stray in tmp.rglob(".tailor-*"):
+            stray.unlink(missing_ok=True)
         t_map = time.monotonic()
         (tmp / "tileset.json").write_text(json.dumps(tileset_json(records, args.lod, args.up), indent=1) + "\n")
         fields = ("digest", "faces", "error", "coarse_error")
