@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -42,6 +43,16 @@ int exponent_for(const Mesh& mesh, double cells_across) {
   return static_cast<int>(std::floor(std::log2((double{hi} - lo) / cells_across)));
 }
 
+// Face f's centroid, world units.
+std::array<double, 3> centroid_of(const Mesh& mesh, uint32_t f) {
+  std::array<double, 3> c{};
+  for (size_t k = 0; k < 3; ++k) {
+    for (size_t j = 0; j < 3; ++j) c[k] += mesh.positions[3 * size_t{mesh.indices[3 * f + j]} + k];
+    c[k] /= 3.0;
+  }
+  return c;
+}
+
 TEST(ChunkPlan, EveryFaceIsInTheCellOfItsCentroid) {
   const Mesh mesh = load_test_mesh("fertility.off");
   ChunkOptions options;
@@ -63,12 +74,10 @@ TEST(ChunkPlan, EveryFaceIsInTheCellOfItsCentroid) {
     for (uint32_t i = plan.chunk_start[c]; i < plan.chunk_start[c + 1]; ++i) {
       const uint32_t f = plan.faces[i];
       ++seen[f];
+      const std::array<double, 3> centroid = centroid_of(mesh, f);
       for (size_t k = 0; k < 3; ++k) {
-        double centroid = 0;
-        for (size_t j = 0; j < 3; ++j) centroid += mesh.positions[3 * size_t{mesh.indices[3 * f + j]} + k];
-        centroid /= 3.0;
-        EXPECT_GE(centroid, (plan.cells[c][k] + kChunkGridOffset) * plan.cell_size - 1e-9);
-        EXPECT_LE(centroid, (plan.cells[c][k] + 1 + kChunkGridOffset) * plan.cell_size + 1e-9);
+        EXPECT_GE(centroid[k], (plan.cells[c][k] + kChunkGridOffset) * plan.cell_size - 1e-9);
+        EXPECT_LE(centroid[k], (plan.cells[c][k] + 1 + kChunkGridOffset) * plan.cell_size + 1e-9);
       }
     }
   }
@@ -117,12 +126,10 @@ TEST(ChunkPlan, OverFullCellsAreCutIntoOctantsOfTheirOwnFaces) {
     for (uint32_t i = plan.chunk_start[c]; i < plan.chunk_start[c + 1]; ++i) {
       const uint32_t f = plan.faces[i];
       ++seen[f];
+      const std::array<double, 3> centroid = centroid_of(mesh, f);
       for (size_t k = 0; k < 3; ++k) {
-        double centroid = 0;
-        for (size_t j = 0; j < 3; ++j) centroid += mesh.positions[3 * size_t{mesh.indices[3 * f + j]} + k];
-        centroid /= 3.0;
-        EXPECT_GE(centroid, origin[k] - 1e-6 * side);
-        EXPECT_LE(centroid, origin[k] + side + 1e-6 * side);
+        EXPECT_GE(centroid[k], origin[k] - 1e-6 * side);
+        EXPECT_LE(centroid[k], origin[k] + side + 1e-6 * side);
       }
     }
     if (plan.levels[c] == 0) {

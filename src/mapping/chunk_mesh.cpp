@@ -140,4 +140,17 @@ void build_chunk_mesh(const Mesh& mesh, std::span<const uint32_t> faces, const s
   }
 }
 
+void write_chunk_atlas(const ChunkWorker& w, uint32_t first_patch, float* corner_uv, uint32_t* patch) {
+  const float* uv = w.map.atlas.corner_uv.data();
+  for (size_t i = 0; i < w.faces.size(); ++i) {
+    const ChunkFace& face = w.faces[i];
+    for (uint32_t k = 0; k < 3; ++k) {
+      const size_t corner = 3 * size_t{face.face} + (face.rotation + k) % 3;
+      corner_uv[2 * corner] = uv[6 * i + 2 * k];
+      corner_uv[2 * corner + 1] = uv[6 * i + 2 * k + 1];
+    }
+    patch[face.face] = first_patch + w.map.atlas.patch[i];
+  }
+}
+
 }  // namespace tailor::internal

@@ -56,6 +56,11 @@ struct ChunkWorker {
 void build_chunk_mesh(const Mesh& mesh, std::span<const uint32_t> faces, const std::array<double, 3>& origin,
                       double size, std::span<const uint8_t> seam_faces, ChunkWorker& w);
 
+//! Writes the chunk's UVs and patches (w.map.atlas, canonical order) back to the faces they came
+//! from: chunk corner k of face i is corner (rotation + k) % 3 of face w.faces[i].face, its patch id
+//! first_patch + the chunk's. `corner_uv` holds 6 floats and `patch` one id per source face.
+void write_chunk_atlas(const ChunkWorker& w, uint32_t first_patch, float* corner_uv, uint32_t* patch);
+
 //! Adds one chunk's mapping counters and stage times to `total` (counts summed, maxima kept).
 //! Defined in map_chunks.cpp.
 void add_stats(const MappingStats& s, MappingStats& total);

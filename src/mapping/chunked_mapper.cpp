@@ -87,15 +87,7 @@ Status ChunkedMapper::set_chunk(const ChunkCell& cell, const Mesh& faces) {
     internal::build_chunk_mesh(faces, part, plan.chunk_origin(c), plan.chunk_size(c), faces.seam_faces, w);
     TAILOR_RETURN_IF_ERROR(internal::map_chunk(options_, plan.chunk_origin(c), plan.chunk_size(c), texels_per_unit_,
                                                options_.mapping.threads, {}, w));
-    for (size_t i = 0; i < w.faces.size(); ++i) {
-      const internal::ChunkFace& face = w.faces[i];
-      for (uint32_t k = 0; k < 3; ++k) {
-        const size_t corner = 3 * size_t{face.face} + (face.rotation + k) % 3;
-        result.corner_uv[2 * corner] = w.map.atlas.corner_uv[6 * i + 2 * k];
-        result.corner_uv[2 * corner + 1] = w.map.atlas.corner_uv[6 * i + 2 * k + 1];
-      }
-      result.patch[face.face] = result.patch_count + w.map.atlas.patch[i];
-    }
+    internal::write_chunk_atlas(w, result.patch_count, result.corner_uv.data(), result.patch.data());
     result.patch_count += w.map.atlas.patch_count;
     internal::add_stats(w.map.stats, result.stats);
   }

@@ -117,11 +117,11 @@ Status map_whole_canonical(const Mesh& mesh, const MapTextureOptions& options, T
     o.measure = false;  // map_texture measures the result on the mesh as given
     TAILOR_RETURN_IF_ERROR(map_texture_in_order(w.mesh, topology, o, w.map));
   }
-  // Back to the mesh's faces and corners: chunk corner k of face i is corner (rotation + k) % 3 of
-  // face w.faces[i].face.
+  // Back to the mesh's faces and corners (write_chunk_atlas), the frames too.
   map.atlas.corner_uv.resize(6 * face_count);
   map.atlas.patch.resize(face_count);
   map.atlas.patch_count = w.map.atlas.patch_count;
+  write_chunk_atlas(w, 0, map.atlas.corner_uv.data(), map.atlas.patch.data());
   const FaceFrames& in = w.map.frames;
   FaceFrames& out = map.frames;
   out = FaceFrames{};
@@ -134,12 +134,6 @@ Status map_whole_canonical(const Mesh& mesh, const MapTextureOptions& options, T
   out.anchor.resize(2 * face_count);
   for (size_t i = 0; i < face_count; ++i) {
     const uint32_t f = w.faces[i].face, r = w.faces[i].rotation;
-    for (uint32_t k = 0; k < 3; ++k) {
-      const size_t corner = 3 * size_t{f} + (r + k) % 3;
-      map.atlas.corner_uv[2 * corner] = w.map.atlas.corner_uv[6 * i + 2 * k];
-      map.atlas.corner_uv[2 * corner + 1] = w.map.atlas.corner_uv[6 * i + 2 * k + 1];
-    }
-    map.atlas.patch[f] = w.map.atlas.patch[i];
     std::copy_n(&in.normal[3 * i], 3, &out.normal[3 * size_t{f}]);
     std::copy_n(&in.orientation[3 * i], 3, &out.orientation[3 * size_t{f}]);
     std::copy_n(&in.bitangent[3 * i], 3, &out.bitangent[3 * size_t{f}]);
@@ -284,17 +278,7 @@ Status map_chunks(const Mesh& mesh, const MapTextureOptions& options, TextureMap
         failed.store(true);
         return;
       }
-      // Back to the mesh's corners: chunk corner k of face i is global corner (rotation + k) % 3.
-      float* uv = map.atlas.corner_uv.data();
-      for (size_t f = 0; f < w.faces.size(); ++f) {
-        const ChunkFace& face = w.faces[f];
-        for (uint32_t k = 0; k < 3; ++k) {
-          const size_t global = 3 * size_t{face.face} + (face.rotation + k) % 3;
-          uv[2 * global] = w.map.atlas.corner_uv[6 * f + 2 * k];
-          uv[2 * global + 1] = w.map.atlas.corner_uv[6 * f + 2 * k + 1];
-        }
-        map.atlas.patch[face.face] = w.map.atlas.patch[f];
-      }
+      write_chunk_atlas(w, 0, map.atlas.corner_uv.data(), map.atlas.patch.data());  // ids offset below
       chunk_patches[c] = w.map.atlas.patch_count;
       chunk_stats[c] = w.map.stats;
       if (!report(0, chunk_faces, true)) return;
