@@ -60,6 +60,12 @@ cmp -s "$tmp/a.glb" "$tmp/b.glb" && ok || fail "two runs gave different .glb fil
 for ext in obj ply; do
   "$tailor" map "$mesh" -o "$tmp/c.$ext" --quiet && [[ -s $tmp/c.$ext ]] && ok || fail "map to .$ext failed"
 done
+# Only a picture loads libOSMesa (and the LLVM it brings, ~50 MB resident): the dynamic loader's
+# log names every library it loads, dlopen'd ones too.
+LD_DEBUG=libs "$tailor" map "$mesh" -o "$tmp/d.glb" --quiet 2>"$tmp/ld.txt" && ! grep -q "libOSMesa" "$tmp/ld.txt" &&
+  ok || fail "map without a preview loaded libOSMesa"
+LD_DEBUG=libs "$tailor" map "$mesh" -o "$tmp/e.glb" --preview "$tmp/e.png" --quiet 2>"$tmp/ld.txt" &&
+  grep -q "libOSMesa" "$tmp/ld.txt" && [[ -s $tmp/e.png ]] && ok || fail "map --preview did not load libOSMesa"
 # --axis auto tries pca, x, y, z and keeps the least seam (a coordinate axis on this CAD part).
 "$tailor" map tests/data/meshes/adis16480.stl -o "$tmp/auto.glb" --axis auto --stats "$tmp/auto.json" >"$tmp/auto.txt" 2>&1 &&
   grep -q "^axis auto: [xyz] (seams without crack closing: pca" "$tmp/auto.txt" &&

@@ -7,11 +7,6 @@
 // What is drawn is prepared on the CPU by preview_scene.h (framing, colours, camera, vertex
 // arrays); this file holds everything that talks to GL: the context, the texture upload, the
 // buffers and draw calls, and render_preview, which runs the whole picture.
-#define GL_GLEXT_PROTOTYPES 1
-#include <GL/gl.h>
-#include <GL/glext.h>
-#include <GL/osmesa.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -20,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "render/gl_api.h"
 #include "render/preview_scene.h"
 #include "tailor/export.h"
 #include "tailor/image.h"
@@ -34,6 +30,7 @@ using internal::checker_image;
 using internal::draw_legend_text;
 using internal::fill_face_colored_batch;
 using internal::Framing;
+using internal::gl;
 using internal::half_size;
 using internal::kBackground;
 using internal::kCheckerDark;
@@ -78,15 +75,15 @@ class OffscreenContext {
   OffscreenContext& operator=(const OffscreenContext&) = delete;
   ~OffscreenContext() {
     if (context_ == nullptr) return;
-    if (OSMesaGetCurrentContext() == context_) OSMesaMakeCurrent(nullptr, nullptr, 0, 0, 0);
-    OSMesaDestroyContext(context_);
+    if (gl().OSMesaGetCurrentContext() == context_) gl().OSMesaMakeCurrent(nullptr, nullptr, 0, 0, 0);
+    gl().OSMesaDestroyContext(context_);
   }
 
   bool create(int width, int height) {
-    context_ = OSMesaCreateContextExt(OSMESA_RGBA, 24, 0, 0, nullptr);
+    context_ = gl().OSMesaCreateContextExt(OSMESA_RGBA, 24, 0, 0, nullptr);
     if (context_ == nullptr) return false;
     buffer_.assign(static_cast<size_t>(width) * static_cast<size_t>(height) * 4, 0);
-    return OSMesaMakeCurrent(context_, buffer_.data(), GL_UNSIGNED_BYTE, width, height) == GL_TRUE;
+    return gl().OSMesaMakeCurrent(context_, buffer_.data(), GL_UNSIGNED_BYTE, width, height) == GL_TRUE;
   }
 
   //! RGBA, bottom row first (OSMesa's default).
@@ -107,10 +104,10 @@ class Texture {
   Texture(const Texture&) = delete;
   Texture& operator=(const Texture&) = delete;
   ~Texture() {
-    if (id_ != 0) glDeleteTextures(1, &id_);
+    if (id_ != 0) gl().glDeleteTextures(1, &id_);
   }
   GLuint make() {
-    if (id_ == 0) glGenTextures(1, &id_);
+    if (id_ == 0) gl().glGenTextures(1, &id_);
     return id_;
   }
 
@@ -124,23 +121,23 @@ class Texture {
 void upload_texture(const Image& image, Texture& texture) {
   static constexpr std::array<GLenum, 4> kFormats = {GL_LUMINANCE, GL_LUMINANCE_ALPHA, GL_RGB, GL_RGBA};
   const GLenum format = kFormats[static_cast<size_t>(image.channels - 1)];
-  glBindTexture(GL_TEXTURE_2D, texture.make());
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  gl().glBindTexture(GL_TEXTURE_2D, texture.make());
+  gl().glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
   Image level_image;
   const Image* current = &image;
   for (GLint level = 0;; ++level) {
-    glTexImage2D(GL_TEXTURE_2D, level, static_cast<GLint>(format), current->width, current->height, 0, format,
-                 GL_UNSIGNED_BYTE, current->pixels.data());
+    gl().glTexImage2D(GL_TEXTURE_2D, level, static_cast<GLint>(format), current->width, current->height, 0, format,
+                      GL_UNSIGNED_BYTE, current->pixels.data());
     if (current->width == 1 && current->height == 1) break;
     level_image = half_size(*current);
     current = &level_image;
   }
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
-  glEnable(GL_TEXTURE_2D);
+  gl().glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  gl().glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  gl().glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  gl().glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  gl().glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
+  gl().glEnable(GL_TEXTURE_2D);
 }
 
 // === The texture view's shader ===================================================================
@@ -202,37 +199,37 @@ class ShaderProgram {
   ShaderProgram(const ShaderProgram&) = delete;
   ShaderProgram& operator=(const ShaderProgram&) = delete;
   ~ShaderProgram() {
-    if (program_ != 0) glDeleteProgram(program_);
+    if (program_ != 0) gl().glDeleteProgram(program_);
   }
 
   //! Compiles and links; false (with the compiler's first line in `log`) when GLSL is missing.
   bool build(std::string& log) {
-    program_ = glCreateProgram();
+    program_ = gl().glCreateProgram();
     if (program_ == 0) return fail("no GLSL", log);
     for (const auto& [type, source] :
          {std::pair{GL_VERTEX_SHADER, kVertexShader}, {GL_FRAGMENT_SHADER, kFragmentShader}}) {
-      const GLuint shader = glCreateShader(type);
-      glShaderSource(shader, 1, &source, nullptr);
-      glCompileShader(shader);
+      const GLuint shader = gl().glCreateShader(type);
+      gl().glShaderSource(shader, 1, &source, nullptr);
+      gl().glCompileShader(shader);
       GLint ok = GL_FALSE;
-      glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+      gl().glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
       if (ok != GL_TRUE) {
         std::array<char, 256> text{};
-        glGetShaderInfoLog(shader, static_cast<GLsizei>(text.size()), nullptr, text.data());
-        glDeleteShader(shader);
+        gl().glGetShaderInfoLog(shader, static_cast<GLsizei>(text.size()), nullptr, text.data());
+        gl().glDeleteShader(shader);
         return fail(text.data(), log);
       }
-      glAttachShader(program_, shader);
-      glDeleteShader(shader);  // freed with the program
+      gl().glAttachShader(program_, shader);
+      gl().glDeleteShader(shader);  // freed with the program
     }
-    glBindAttribLocation(program_, kTangentAttribute, "tangent");
-    glLinkProgram(program_);
+    gl().glBindAttribLocation(program_, kTangentAttribute, "tangent");
+    gl().glLinkProgram(program_);
     GLint ok = GL_FALSE;
-    glGetProgramiv(program_, GL_LINK_STATUS, &ok);
+    gl().glGetProgramiv(program_, GL_LINK_STATUS, &ok);
     return ok == GL_TRUE || fail("link failed", log);
   }
 
-  GLint uniform(const char* name) const { return glGetUniformLocation(program_, name); }
+  GLint uniform(const char* name) const { return gl().glGetUniformLocation(program_, name); }
   GLuint id() const { return program_; }
 
  private:
@@ -258,41 +255,41 @@ struct VertexStreams {
 
 void bind_streams(const VertexStreams& in, const std::array<GLuint, 5>& buffers) {
   const auto upload = [](GLuint buffer, const void* data, size_t bytes) {
-    glBindBuffer(GL_ARRAY_BUFFER, buffer);
-    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(bytes), data, GL_STREAM_DRAW);
+    gl().glBindBuffer(GL_ARRAY_BUFFER, buffer);
+    gl().glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(bytes), data, GL_STREAM_DRAW);
   };
-  glEnableClientState(GL_VERTEX_ARRAY);
+  gl().glEnableClientState(GL_VERTEX_ARRAY);
   upload(buffers[0], in.positions.data(), in.positions.size_bytes());
-  glVertexPointer(3, GL_FLOAT, 0, nullptr);
-  glEnableClientState(GL_NORMAL_ARRAY);
+  gl().glVertexPointer(3, GL_FLOAT, 0, nullptr);
+  gl().glEnableClientState(GL_NORMAL_ARRAY);
   upload(buffers[1], in.normals.data(), in.normals.size_bytes());
-  glNormalPointer(GL_FLOAT, 0, nullptr);
+  gl().glNormalPointer(GL_FLOAT, 0, nullptr);
   if (!in.texcoords.empty()) {
-    glEnableClientState(GL_TEXTURE_COORD_ARRAY);
+    gl().glEnableClientState(GL_TEXTURE_COORD_ARRAY);
     upload(buffers[2], in.texcoords.data(), in.texcoords.size_bytes());
-    glTexCoordPointer(2, GL_FLOAT, 0, nullptr);
+    gl().glTexCoordPointer(2, GL_FLOAT, 0, nullptr);
   }
   if (!in.colors.empty()) {
-    glEnableClientState(GL_COLOR_ARRAY);
+    gl().glEnableClientState(GL_COLOR_ARRAY);
     upload(buffers[3], in.colors.data(), in.colors.size_bytes());
-    glColorPointer(4, GL_UNSIGNED_BYTE, 0, nullptr);
+    gl().glColorPointer(4, GL_UNSIGNED_BYTE, 0, nullptr);
   }
   if (!in.tangents.empty()) {
-    glEnableVertexAttribArray(kTangentAttribute);
+    gl().glEnableVertexAttribArray(kTangentAttribute);
     upload(buffers[4], in.tangents.data(), in.tangents.size_bytes());
-    glVertexAttribPointer(kTangentAttribute, 4, GL_FLOAT, GL_FALSE, 0, nullptr);
+    gl().glVertexAttribPointer(kTangentAttribute, 4, GL_FLOAT, GL_FALSE, 0, nullptr);
   } else {
-    glVertexAttrib4f(kTangentAttribute, 0.0f, 0.0f, 0.0f, 1.0f);
+    gl().glVertexAttrib4f(kTangentAttribute, 0.0f, 0.0f, 0.0f, 1.0f);
   }
-  glBindBuffer(GL_ARRAY_BUFFER, 0);
+  gl().glBindBuffer(GL_ARRAY_BUFFER, 0);
 }
 
 void unbind_streams() {
-  glDisableClientState(GL_VERTEX_ARRAY);
-  glDisableClientState(GL_NORMAL_ARRAY);
-  glDisableClientState(GL_TEXTURE_COORD_ARRAY);
-  glDisableClientState(GL_COLOR_ARRAY);
-  glDisableVertexAttribArray(kTangentAttribute);
+  gl().glDisableClientState(GL_VERTEX_ARRAY);
+  gl().glDisableClientState(GL_NORMAL_ARRAY);
+  gl().glDisableClientState(GL_TEXTURE_COORD_ARRAY);
+  gl().glDisableClientState(GL_COLOR_ARRAY);
+  gl().glDisableVertexAttribArray(kTangentAttribute);
 }
 
 //! Indexed drawing of a mesh split so that every vertex carries one key (a UV, or a patch id):
@@ -306,23 +303,23 @@ void draw_split_surface(const Mesh& mesh, std::span<const float> key, bool key_i
   const SplitMesh& split = surface.split;
   std::array<GLuint, 5> buffers{};
   GLuint element_buffer = 0;
-  glGenBuffers(5, buffers.data());
-  glGenBuffers(1, &element_buffer);
+  gl().glGenBuffers(5, buffers.data());
+  gl().glGenBuffers(1, &element_buffer);
   bind_streams({surface.positions, surface.normals, surface.texcoords, surface.colors, surface.tangents}, buffers);
-  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, element_buffer);
-  glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(split.indices.size() * sizeof(uint32_t)),
-               split.indices.data(), GL_STATIC_DRAW);
+  gl().glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, element_buffer);
+  gl().glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(split.indices.size() * sizeof(uint32_t)),
+                    split.indices.data(), GL_STATIC_DRAW);
   // Batches keep every count within GLsizei.
   const size_t total = split.indices.size();
   for (size_t start = 0; start < total; start += 3 * kBatchFaces) {
     const size_t n = std::min(3 * kBatchFaces, total - start);
-    glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(n), GL_UNSIGNED_INT,
-                   reinterpret_cast<const void*>(start * sizeof(uint32_t)));
+    gl().glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(n), GL_UNSIGNED_INT,
+                        reinterpret_cast<const void*>(start * sizeof(uint32_t)));
   }
-  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, 0);
+  gl().glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, 0);
   unbind_streams();
-  glDeleteBuffers(1, &element_buffer);
-  glDeleteBuffers(5, buffers.data());
+  gl().glDeleteBuffers(1, &element_buffer);
+  gl().glDeleteBuffers(5, buffers.data());
 }
 
 //! Patch colours: vertices are split on (vertex, patch) so each patch keeps its own colour.
@@ -341,7 +338,7 @@ void draw_face_colored_surface(const Mesh& mesh, const std::vector<Rgb>& face_co
   std::vector<float> pos(9 * batch), nor(9 * batch);
   std::vector<uint8_t> col(12 * batch);
   std::array<GLuint, 5> buffers{};
-  glGenBuffers(5, buffers.data());
+  gl().glGenBuffers(5, buffers.data());
   for (size_t start = 0; start < faces; start += batch) {
     const size_t count = std::min(batch, faces - start);
     fill_face_colored_batch(mesh, face_colors, vertex_normal, frame, start, count, pos, nor, col);
@@ -351,26 +348,27 @@ void draw_face_colored_surface(const Mesh& mesh, const std::vector<Rgb>& face_co
                   std::span<const uint8_t>(col).first(12 * count),
                   {}},
                  buffers);
-    glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(3 * count));
+    gl().glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(3 * count));
   }
   unbind_streams();
-  glDeleteBuffers(5, buffers.data());
+  gl().glDeleteBuffers(5, buffers.data());
 }
 
 void draw_lines(const std::vector<float>& lines, float width, const internal::Rgb& color) {
   if (lines.empty()) return;
   GLuint buffer = 0;
-  glGenBuffers(1, &buffer);
-  glBindBuffer(GL_ARRAY_BUFFER, buffer);
-  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(lines.size() * sizeof(float)), lines.data(), GL_STATIC_DRAW);
-  glEnableClientState(GL_VERTEX_ARRAY);
-  glVertexPointer(3, GL_FLOAT, 0, nullptr);
-  glLineWidth(width);
-  glColor3ub(color[0], color[1], color[2]);
-  glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(lines.size() / 3));
-  glDisableClientState(GL_VERTEX_ARRAY);
-  glBindBuffer(GL_ARRAY_BUFFER, 0);
-  glDeleteBuffers(1, &buffer);
+  gl().glGenBuffers(1, &buffer);
+  gl().glBindBuffer(GL_ARRAY_BUFFER, buffer);
+  gl().glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(lines.size() * sizeof(float)), lines.data(),
+                    GL_STATIC_DRAW);
+  gl().glEnableClientState(GL_VERTEX_ARRAY);
+  gl().glVertexPointer(3, GL_FLOAT, 0, nullptr);
+  gl().glLineWidth(width);
+  gl().glColor3ub(color[0], color[1], color[2]);
+  gl().glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(lines.size() / 3));
+  gl().glDisableClientState(GL_VERTEX_ARRAY);
+  gl().glBindBuffer(GL_ARRAY_BUFFER, 0);
+  gl().glDeleteBuffers(1, &buffer);
 }
 
 //! The colour bar of the distortion view, drawn in render-target pixels (`scale` = supersampling).
@@ -379,24 +377,24 @@ void draw_legend_bar(const LegendBox& box, int target_width, int target_height, 
   const std::vector<float>& xy = bar.xy;
   const std::vector<uint8_t>& rgba = bar.rgba;
   const size_t frame_vertices = bar.frame_vertices;
-  glMatrixMode(GL_PROJECTION);
+  gl().glMatrixMode(GL_PROJECTION);
   const Mat4 ortho = orthographic(target_width, target_height);
-  glLoadMatrixf(ortho.data());
-  glMatrixMode(GL_MODELVIEW);
-  glLoadIdentity();
-  glDisable(GL_DEPTH_TEST);
-  glDisable(GL_LIGHTING);
-  glDisable(GL_TEXTURE_2D);
-  glShadeModel(GL_SMOOTH);
-  glEnableClientState(GL_VERTEX_ARRAY);
-  glEnableClientState(GL_COLOR_ARRAY);
-  glVertexPointer(2, GL_FLOAT, 0, xy.data());
-  glColorPointer(4, GL_UNSIGNED_BYTE, 0, rgba.data());
-  glDrawArrays(GL_TRIANGLE_STRIP, 0, static_cast<GLsizei>(frame_vertices));
-  glDrawArrays(GL_TRIANGLE_STRIP, static_cast<GLint>(frame_vertices),
-               static_cast<GLsizei>(xy.size() / 2 - frame_vertices));
-  glDisableClientState(GL_COLOR_ARRAY);
-  glDisableClientState(GL_VERTEX_ARRAY);
+  gl().glLoadMatrixf(ortho.data());
+  gl().glMatrixMode(GL_MODELVIEW);
+  gl().glLoadIdentity();
+  gl().glDisable(GL_DEPTH_TEST);
+  gl().glDisable(GL_LIGHTING);
+  gl().glDisable(GL_TEXTURE_2D);
+  gl().glShadeModel(GL_SMOOTH);
+  gl().glEnableClientState(GL_VERTEX_ARRAY);
+  gl().glEnableClientState(GL_COLOR_ARRAY);
+  gl().glVertexPointer(2, GL_FLOAT, 0, xy.data());
+  gl().glColorPointer(4, GL_UNSIGNED_BYTE, 0, rgba.data());
+  gl().glDrawArrays(GL_TRIANGLE_STRIP, 0, static_cast<GLsizei>(frame_vertices));
+  gl().glDrawArrays(GL_TRIANGLE_STRIP, static_cast<GLint>(frame_vertices),
+                    static_cast<GLsizei>(xy.size() / 2 - frame_vertices));
+  gl().glDisableClientState(GL_COLOR_ARRAY);
+  gl().glDisableClientState(GL_VERTEX_ARRAY);
 }
 
 }  // namespace
@@ -425,12 +423,14 @@ Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::s
     prepare_scene(mesh, corner_uv, patch, options, scene);
     const bool textured = options.view == PreviewView::kTexture || options.view == PreviewView::kChecker;
 
+    std::string gl_error;
+    if (!internal::load_gl_api(gl_error)) return Status::error(ErrorCode::kUnsupported, "", gl_error);
     OffscreenContext context;
     if (!context.create(target_width, target_height)) {
       return Status::error(ErrorCode::kUnsupported, "", "cannot create an off-screen OpenGL context (OSMesa)");
     }
     GLint max_texture = 0;
-    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture);
+    gl().glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture);
     const bool use_image = options.view == PreviewView::kTexture && texture != nullptr;
     bool shaded = options.view == PreviewView::kTexture;  // lit per pixel, with the material's maps
     const Image* normal_map = shaded ? material.normal : nullptr;
@@ -460,48 +460,48 @@ Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::s
     // The distortion view keeps a band at the bottom for its legend, so the mesh never hides it.
     const LegendBox box = legend_box(options.width, options.height);
     const int band = options.view == PreviewView::kDistortion ? options.height - box.y + box.height : 0;
-    glViewport(0, band * scale, target_width, target_height - band * scale);
-    glClearColor(kBackground[0] / 255.0f, kBackground[1] / 255.0f, kBackground[2] / 255.0f, 1.0f);
-    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LEQUAL);
+    gl().glViewport(0, band * scale, target_width, target_height - band * scale);
+    gl().glClearColor(kBackground[0] / 255.0f, kBackground[1] / 255.0f, kBackground[2] / 255.0f, 1.0f);
+    gl().glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    gl().glEnable(GL_DEPTH_TEST);
+    gl().glDepthFunc(GL_LEQUAL);
 
     const Camera camera = place_camera(scene.frame, options, band);
-    glMatrixMode(GL_PROJECTION);
-    glLoadMatrixf(camera.projection.data());
+    gl().glMatrixMode(GL_PROJECTION);
+    gl().glLoadMatrixf(camera.projection.data());
 
     // Light fixed in eye space (up-left of the camera) before the view matrix is loaded.
-    glMatrixMode(GL_MODELVIEW);
-    glLoadIdentity();
+    gl().glMatrixMode(GL_MODELVIEW);
+    gl().glLoadIdentity();
     const std::array<GLfloat, 4> light_dir = {-0.35f, 0.55f, 0.76f, 0.0f};
     const std::array<GLfloat, 4> diffuse = {0.72f, 0.72f, 0.72f, 1.0f};
     const std::array<GLfloat, 4> ambient = {0.0f, 0.0f, 0.0f, 1.0f};
     const std::array<GLfloat, 4> scene_ambient = {0.36f, 0.36f, 0.36f, 1.0f};
-    glLightfv(GL_LIGHT0, GL_POSITION, light_dir.data());
-    glLightfv(GL_LIGHT0, GL_DIFFUSE, diffuse.data());
-    glLightfv(GL_LIGHT0, GL_AMBIENT, ambient.data());
-    glLightModelfv(GL_LIGHT_MODEL_AMBIENT, scene_ambient.data());
-    glLightModeli(GL_LIGHT_MODEL_TWO_SIDE, GL_TRUE);  // open meshes show their inside lit too
-    glEnable(GL_LIGHTING);
-    glEnable(GL_LIGHT0);
-    glEnable(GL_COLOR_MATERIAL);
-    glColorMaterial(GL_FRONT_AND_BACK, GL_AMBIENT_AND_DIFFUSE);
-    glShadeModel(GL_SMOOTH);
-    glLoadMatrixf(camera.view.data());
-    glMultMatrixf(camera.turn.data());
+    gl().glLightfv(GL_LIGHT0, GL_POSITION, light_dir.data());
+    gl().glLightfv(GL_LIGHT0, GL_DIFFUSE, diffuse.data());
+    gl().glLightfv(GL_LIGHT0, GL_AMBIENT, ambient.data());
+    gl().glLightModelfv(GL_LIGHT_MODEL_AMBIENT, scene_ambient.data());
+    gl().glLightModeli(GL_LIGHT_MODEL_TWO_SIDE, GL_TRUE);  // open meshes show their inside lit too
+    gl().glEnable(GL_LIGHTING);
+    gl().glEnable(GL_LIGHT0);
+    gl().glEnable(GL_COLOR_MATERIAL);
+    gl().glColorMaterial(GL_FRONT_AND_BACK, GL_AMBIENT_AND_DIFFUSE);
+    gl().glShadeModel(GL_SMOOTH);
+    gl().glLoadMatrixf(camera.view.data());
+    gl().glMultMatrixf(camera.turn.data());
 
-    glColor4ub(255, 255, 255, 255);
+    gl().glColor4ub(255, 255, 255, 255);
     Texture gl_texture, gl_normal, gl_occlusion;  // after the context: deleted before it
     if (normal_map != nullptr || occlusion_map != nullptr) {
       if (normal_map != nullptr) {
-        glActiveTexture(GL_TEXTURE1);
+        gl().glActiveTexture(GL_TEXTURE1);
         upload_texture(*normal_map, gl_normal);
       }
       if (occlusion_map != nullptr) {
-        glActiveTexture(GL_TEXTURE2);
+        gl().glActiveTexture(GL_TEXTURE2);
         upload_texture(*occlusion_map, gl_occlusion);
       }
-      glActiveTexture(GL_TEXTURE0);
+      gl().glActiveTexture(GL_TEXTURE0);
     }
     if (textured) {
       if (use_image) {
@@ -512,28 +512,29 @@ Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::s
             checker ? checker_image(kCheckerDark, kCheckerLight) : checker_image(kNeutralDark, kNeutralLight),
             gl_texture);
         // The generated image holds 2x2 squares.
-        glMatrixMode(GL_TEXTURE);
-        glLoadIdentity();
-        glScalef(options.checker_squares / 2.0f, options.checker_squares / 2.0f, 1.0f);
-        glMatrixMode(GL_MODELVIEW);
+        gl().glMatrixMode(GL_TEXTURE);
+        gl().glLoadIdentity();
+        gl().glScalef(options.checker_squares / 2.0f, options.checker_squares / 2.0f, 1.0f);
+        gl().glMatrixMode(GL_MODELVIEW);
       }
     }
     // Seams are drawn on top of the faces: push the faces back a little.
-    glEnable(GL_POLYGON_OFFSET_FILL);
-    glPolygonOffset(1.0f, 1.0f);
+    gl().glEnable(GL_POLYGON_OFFSET_FILL);
+    gl().glPolygonOffset(1.0f, 1.0f);
 
     if (shaded) {
-      glUseProgram(program.id());
-      glUniform1i(program.uniform("base_map"), 0);
-      glUniform1i(program.uniform("normal_map"), 1);
-      glUniform1i(program.uniform("occlusion_map"), 2);
-      glUniform1i(program.uniform("has_normal"), normal_map != nullptr ? 1 : 0);
-      glUniform1i(program.uniform("has_occlusion"), occlusion_map != nullptr ? 1 : 0);
+      gl().glUseProgram(program.id());
+      gl().glUniform1i(program.uniform("base_map"), 0);
+      gl().glUniform1i(program.uniform("normal_map"), 1);
+      gl().glUniform1i(program.uniform("occlusion_map"), 2);
+      gl().glUniform1i(program.uniform("has_normal"), normal_map != nullptr ? 1 : 0);
+      gl().glUniform1i(program.uniform("has_occlusion"), occlusion_map != nullptr ? 1 : 0);
       const float length =
           std::sqrt(light_dir[0] * light_dir[0] + light_dir[1] * light_dir[1] + light_dir[2] * light_dir[2]);
-      glUniform3f(program.uniform("light_dir"), light_dir[0] / length, light_dir[1] / length, light_dir[2] / length);
+      gl().glUniform3f(program.uniform("light_dir"), light_dir[0] / length, light_dir[1] / length,
+                       light_dir[2] / length);
       draw_split_surface(mesh, corner_uv, true, scene.normals, scene.frame, tangents);
-      glUseProgram(0);
+      gl().glUseProgram(0);
     } else if (textured) {
       draw_split_surface(mesh, corner_uv, true, scene.normals, scene.frame);
     } else if (options.view == PreviewView::kPatches) {
@@ -541,9 +542,9 @@ Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::s
     } else {
       draw_face_colored_surface(mesh, scene.face_colors, scene.normals, scene.frame);
     }
-    glDisable(GL_POLYGON_OFFSET_FILL);
-    glDisable(GL_LIGHTING);
-    glDisable(GL_TEXTURE_2D);
+    gl().glDisable(GL_POLYGON_OFFSET_FILL);
+    gl().glDisable(GL_LIGHTING);
+    gl().glDisable(GL_TEXTURE_2D);
     if (options.view == PreviewView::kSeams) {
       draw_lines(scene.invisible_lines, 2.0f * static_cast<float>(scale), internal::kInvisibleSeamColor);
       draw_lines(scene.lines, 2.0f * static_cast<float>(scale), internal::kVisibleSeamColor);
@@ -551,10 +552,10 @@ Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::s
       draw_lines(scene.lines, 1.25f * static_cast<float>(scale), kSeamColor);
     }
 
-    glViewport(0, 0, target_width, target_height);
+    gl().glViewport(0, 0, target_width, target_height);
     if (options.view == PreviewView::kDistortion) draw_legend_bar(box, target_width, target_height, scale);
-    glFinish();
-    if (glGetError() == GL_OUT_OF_MEMORY) {
+    gl().glFinish();
+    if (gl().glGetError() == GL_OUT_OF_MEMORY) {
       return Status::error(ErrorCode::kUnsupported, "", "the renderer ran out of memory");
     }
 
