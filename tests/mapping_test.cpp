@@ -323,6 +323,33 @@ TEST(Mapping, IsDeterministic) {
   EXPECT_EQ(a.atlas.corner_uv, b.atlas.corner_uv);
 }
 
+// The topology serves only the metrics: mapped without it (measure off, an empty topology), whole or
+// in chunks, then measured, a map equals map_texture's with its metrics; measuring needs it.
+TEST(Mapping, MeasuredAfterTheMappingWithoutATopologyIsTheSameMap) {
+  const Mesh mesh = load_test_mesh("fertility.off");
+  const Topology topology = build_topology(mesh);
+  for (const ChunkMode mode : {ChunkMode::kOff, ChunkMode::kOn}) {
+    MapTextureOptions options;
+    options.chunks.mode = mode;
+    TextureMap direct, later;
+    ASSERT_TRUE(map_texture(mesh, topology, options, direct).is_ok());
+    MapTextureOptions unmeasured = options;
+    unmeasured.measure = false;
+    ASSERT_TRUE(map_texture(mesh, Topology{}, unmeasured, later).is_ok());
+    EXPECT_EQ(later.metrics.faces, 0u);
+    EXPECT_FALSE(measure_texture_map(mesh, Topology{}, options, later).is_ok());
+    ASSERT_TRUE(measure_texture_map(mesh, topology, options, later).is_ok());
+    EXPECT_EQ(later.atlas.corner_uv, direct.atlas.corner_uv);
+    EXPECT_EQ(later.metrics.visible_seam_ratio, direct.metrics.visible_seam_ratio);
+    EXPECT_EQ(later.metrics.l2_stretch, direct.metrics.l2_stretch);
+    EXPECT_EQ(later.metrics.flipped, direct.metrics.flipped);
+    EXPECT_GT(later.metrics.faces, 0u);
+  }
+  // With metrics asked for, a missing topology is an error, not a crash.
+  TextureMap map;
+  EXPECT_EQ(map_texture(mesh, Topology{}, MapTextureOptions{}, map).code(), ErrorCode::kInvalidMesh);
+}
+
 // The crack closing zips bands of seed distance on several threads: the horse has a dozen bands,
 // and the atlas must not depend on how many workers shared them.
 TEST(Mapping, CrackClosingIsTheSameOnAnyThreadCount) {

@@ -243,7 +243,10 @@ struct TextureMap {
 //! options.measure is false: `tailor eval` of the file reports the same figures). With
 //! mapping.symmetry 4 the integer-grid map (experimental) takes the place of step 2.
 //! Fills map.atlas: corner_uv (#F*3 by 2, pixels), patch (#F) and patch_count; every face is
-//! placed and every UV is finite. Precondition: topology = build_topology(mesh).
+//! placed and every UV is finite. Precondition: topology = build_topology(mesh); only step 5 reads
+//! it, so with options.measure false it may be empty (Topology{}): a caller short of memory maps
+//! first and builds the topology for measure_texture_map afterwards, when the mapping's own
+//! memory is back (`tailor map` does, unless it chooses the axis).
 //! Fails as compute_orientation does, then with kInvalidArgument on bad mapping options (scale <= 0
 //! or non-finite, max_stretch, field_following, hop_age, crack_rings, max_seed_rotation_deg or
 //! factor_step out of range, seam_faces of the wrong size, a non-finite seed point, symmetry not 1
@@ -259,6 +262,13 @@ struct TextureMap {
 //! finalize_mesh (non-manifold and inconsistent edges act as boundaries).
 TAILOR_API Status map_texture(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options,
                               TextureMap& map);
+
+//! Step 5 of map_texture alone: fills map.metrics from map.atlas as map_texture does when
+//! options.measure is true (progress "metrics" to options.stage_progress). For a map made with
+//! options.measure false. Fails with kInvalidMesh when the topology or the atlas does not match
+//! the mesh, kCancelled, and as compute_stored_uv_metrics does. Cost: O(F).
+TAILOR_API Status measure_texture_map(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options,
+                                      TextureMap& map);
 
 //! The checks `tailor map` makes on its options before any work, with its messages (the Python
 //! module raises the same): symmetry 4 only in the patches mode, scale in [1e-3, 1e7] pixels per

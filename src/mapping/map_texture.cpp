@@ -209,7 +209,7 @@ Status map_texture(const Mesh& mesh, const Topology& topology, const MapTextureO
   //        runs them on the whole mesh rebuilt in canonical order, so that the file's order of
   //        faces, vertices and corners does not change a bit. The topology serves the metrics. ===
   TAILOR_RETURN_IF_ERROR(check_chunk_options(options.chunks));
-  if (topology.opposite.size() != 3 * mesh.face_count())
+  if (options.measure && topology.opposite.size() != 3 * mesh.face_count())
     return Status::error(ErrorCode::kInvalidMesh, "", "topology does not match the mesh");
   // The skeleton axis needs the whole mesh: auto maps it whole, `on` refuses it (map_chunks).
   const bool whole_only = options.chunks.mode == ChunkMode::kAuto && options.orientation.axis == AxisSource::kSkeleton;
@@ -218,6 +218,17 @@ Status map_texture(const Mesh& mesh, const Topology& topology, const MapTextureO
                                  : internal::map_whole_canonical(mesh, options, map));
   // === 5. Metrics of the result, on the mesh as given (metrics/uv_metrics.cpp) ===
   return measure_atlas(mesh, topology, options, map);
+}
+
+Status measure_texture_map(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options,
+                           TextureMap& map) {
+  if (topology.opposite.size() != 3 * mesh.face_count())
+    return Status::error(ErrorCode::kInvalidMesh, "", "topology does not match the mesh");
+  if (map.atlas.corner_uv.size() != 6 * mesh.face_count())
+    return Status::error(ErrorCode::kInvalidMesh, "", "the atlas does not match the mesh");
+  MapTextureOptions measured = options;
+  measured.measure = true;
+  return measure_atlas(mesh, topology, measured, map);
 }
 
 Status internal::map_texture_in_order(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options,
