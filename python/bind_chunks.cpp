@@ -20,7 +20,7 @@ void bind_chunks(py::module_& m) {
   py::class_<ChunkedMapper>(
       m, "ChunkedMapper",
       "ChunkedMapper(cell_exponent, texels_per_unit, *, threads=0, field_following=1.0, max_stretch=0.25,\n"
-      "              texture_size=None, crack_rings=None)\n\n"
+      "              texture_size=None, crack_rings=None, chunk_split=None)\n\n"
       "A mapping kept chunk by chunk, for worlds that load and change piece by piece. Chunks are the cells\n"
       "of a grid anchored at the world origin, side 2**cell_exponent world units (tailor map --chunk-cell);\n"
       "a face belongs to the cell of its centroid. A chunk's UVs depend on its own faces only: the same\n"
@@ -28,14 +28,22 @@ void bind_chunks(py::module_& m) {
       "density, whatever else is loaded, and setting or removing one chunk changes no other.\n"
       "texels_per_unit: texture pixels per world unit. texture_size: (width, height) of one texture repeat in\n"
       "pixels (the lattice the crack closing snaps to; None = 512 x 512), as tailor.map's texture_size or\n"
-      "texture; crack_rings: None = 16, as tailor.map.")
+      "texture; crack_rings: None = 16, as tailor.map; chunk_split: None = 131072, as tailor.map (a cell of more\n"
+      "faces is mapped in octant parts, as tailor map --chunk-split).")
       .def(py::init([](int cell_exponent, double texels_per_unit, uint32_t threads, float field_following,
-                       float max_stretch, const py::object& texture_size, const py::object& crack_rings) {
+                       float max_stretch, const py::object& texture_size, const py::object& crack_rings,
+                       const py::object& chunk_split) {
              MapTextureOptions options;
              options.mapping.threads = threads;
              options.mapping.field_following = field_following;
              options.mapping.max_stretch = max_stretch;
              if (!crack_rings.is_none()) options.mapping.crack_rings = crack_rings.cast<uint32_t>();
+             if (!chunk_split.is_none()) {
+               const long long n = chunk_split.cast<long long>();
+               if (n < 0 || n > 0xffffffffLL)
+                 raise_error("chunk_split must be None, 0 (never cut) or at least 64 faces");
+               options.chunks.split_above = static_cast<uint32_t>(n);
+             }
              if (!texture_size.is_none()) {
                // The lattice of whole repeats the crack closing snaps to, as tailor.map(texture_size=...).
                const auto size = texture_size.cast<std::vector<int>>();
@@ -49,7 +57,8 @@ void bind_chunks(py::module_& m) {
            }),
            py::arg("cell_exponent"), py::arg("texels_per_unit"), py::kw_only(), py::arg("threads") = 0,
            py::arg("field_following") = 1.f, py::arg("max_stretch") = MappingOptions{}.max_stretch,
-           py::arg("texture_size") = py::none(), py::arg("crack_rings") = py::none())
+           py::arg("texture_size") = py::none(), py::arg("crack_rings") = py::none(),
+           py::arg("chunk_split") = py::none())
       .def(
           "set_chunk",
           [](ChunkedMapper& mapper, const py::sequence& cell, const PyMesh& faces) {

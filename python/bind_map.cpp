@@ -126,7 +126,7 @@ const std::string& map_docstring() {
         "unit_scale: 0 normalises the mesh into the unit cube (as the CLI); > 0 uses coordinates times unit_scale,\n"
         "  so with unit_scale=1, scale is pixels per mesh unit: one texel density on every mesh (no CLI flag)\n"
         "chunks: 'auto', 'on' or 'off' (--chunks); chunk_cell: None = auto, or the cell side's power of two\n"
-        "  (--chunk-cell)\n\n"
+        "  (--chunk-cell); chunk_split: None = 131072, or 0 (never cut) or at least 64 (--chunk-split)\n\n"
         "The options with the CLI's help (tailor map --help):\n";
     auto add = [&doc](std::span<const OptionDoc> docs) {
       for (const OptionDoc& d : docs) {
@@ -141,9 +141,9 @@ const std::string& map_docstring() {
     add(kMappingOptionDocs);
     add(kOrientationOptionDocs);
     for (const OptionDoc& d : kChunkOptionDocs) {
-      if (d.field == std::string_view("split_above")) continue;  // the CLI's only (the library's default here)
-      doc += "  " + std::string(d.flag) + " (" + (d.field == std::string_view("mode") ? "chunks" : "chunk_cell") +
-             "): " + std::string(d.help) + "\n";
+      const std::string_view field = d.field;
+      const char* name = field == "mode" ? "chunks" : field == "split_above" ? "chunk_split" : "chunk_cell";
+      doc += "  " + std::string(d.flag) + " (" + name + "): " + std::string(d.help) + "\n";
     }
     return doc;
   }();
@@ -197,7 +197,8 @@ void bind_map(py::module_& m) {
          float max_stretch, const py::object& field_following, uint32_t min_patch_faces, float hop_age,
          bool shorten_seams, bool close_cracks, const py::object& crack_rings, uint32_t relax_iterations,
          float threshold, const py::object& seed_point, const py::object& symmetry, float unit_scale, uint32_t smooth,
-         const py::object& material, const std::string& chunks, const py::object& chunk_cell) {
+         const py::object& material, const std::string& chunks, const py::object& chunk_cell,
+         const py::object& chunk_split) {
         // === Options, checked before any work (the CLI's checks and messages) ===
         MapTextureOptions options;
         MappingOptions& mapping = options.mapping;
@@ -272,6 +273,11 @@ void bind_map(py::module_& m) {
           const int e = chunk_cell.cast<int>();
           if (e < -60 || e > 60) raise_error("chunk_cell must be None or a whole number in -60..60");
           options.chunks.cell_exponent = e;
+        }
+        if (!chunk_split.is_none()) {
+          const long long n = chunk_split.cast<long long>();
+          if (n < 0 || n > 0xffffffffLL) raise_error("chunk_split must be None, 0 (never cut) or at least 64 faces");
+          options.chunks.split_above = static_cast<uint32_t>(n);
         }
         if (smooth > 1000) raise_error("--smooth: value " + std::to_string(smooth) + " not in range [0 - 1000]");
         options.orientation.smooth_passes = smooth;
@@ -394,7 +400,8 @@ void bind_map(py::module_& m) {
       py::arg("seed_point") = py::none(), py::arg("symmetry") = py::none(),
       py::arg("unit_scale") = OrientationOptions{}.fixed_unit_scale,
       py::arg("smooth") = OrientationOptions{}.smooth_passes, py::arg("material") = py::none(),
-      py::arg("chunks") = "auto", py::arg("chunk_cell") = py::none(), map_docstring().c_str());
+      py::arg("chunks") = "auto", py::arg("chunk_cell") = py::none(), py::arg("chunk_split") = py::none(),
+      map_docstring().c_str());
 
   m.def(
       "auto_field_following",

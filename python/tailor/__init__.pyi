@@ -65,6 +65,7 @@ class ChunkedMapper:
         max_stretch: float = 0.25,
         texture_size: Optional[Tuple[int, int]] = None,
         crack_rings: Optional[int] = None,
+        chunk_split: Optional[int] = None,
     ) -> None: ...
     def set_chunk(self, cell: Sequence[int], faces: Mesh) -> None: ...
     def set_mesh(self, mesh: Mesh) -> List[Tuple[int, int, int]]: ...
@@ -119,6 +120,7 @@ def map(
     material: Optional[_Path] = None,
     chunks: Literal["auto", "on", "off"] = "auto",
     chunk_cell: Optional[int] = None,
+    chunk_split: Optional[int] = None,
 ) -> Result: ...
 @overload
 def tile(

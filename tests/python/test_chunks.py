@@ -33,3 +33,20 @@ def test_a_chunk_set_alone_matches_the_mesh_and_the_cli_density():
     assert np.array_equal(mapper.chunk(other)["corner_uvs"], before)
     with pytest.raises(tailor.Error, match="texels per unit"):
         tailor.ChunkedMapper(-4, 0.0)
+
+
+def test_cells_cut_into_parts_match_the_map_with_the_same_split():
+    mesh = tailor.load(DATA / "meshes" / "horse.ply")
+    whole = tailor.map(mesh, chunks="on", chunk_cell=-3, chunk_split=4096, texture_size=512)
+    mapper = tailor.ChunkedMapper(-3, whole.stats["mapping"]["texels_per_unit"], chunk_split=4096)
+    cells = mapper.set_mesh(mesh)
+    assert len(cells) < whole.stats["mapping"]["chunks"]  # some cells hold more than 4096 faces: parts
+    for cell in cells:
+        chunk = mapper.chunk(cell)
+        # The map's UVs are repeats of the 512-pixel texture, scaled as the writers scale them.
+        repeats = (chunk["corner_uvs"].astype(np.float64) * (1.0 / 512)).astype(np.float32)
+        assert np.array_equal(repeats, whole.corner_uvs[chunk["faces"]])
+    with pytest.raises(tailor.Error, match="--chunk-split must be 0"):
+        tailor.ChunkedMapper(-3, 4096.0, chunk_split=10)
+    with pytest.raises(tailor.Error, match="chunk_split must be None"):
+        tailor.map(mesh, chunk_split=-1)

@@ -27,6 +27,8 @@ def without_times(stats):
          ["--axis", "0,1,0", "--scale", "400", "--threads", "2", "--no-crack-closing", "--smooth", "2"]),
         (DATA / "meshes" / "horse.ply", dict(chunks="on", chunk_cell=-4, threads=2),
          ["--chunks", "on", "--chunk-cell", "-4", "--threads", "2"]),
+        (DATA / "meshes" / "horse.ply", dict(chunks="on", chunk_cell=-3, chunk_split=4096),
+         ["--chunks", "on", "--chunk-cell", "-3", "--chunk-split", "4096"]),
     ],
 )
 def test_map_is_bit_identical_to_the_cli(tmp_path, tailor_binary, mesh_path, options, cli_options):
