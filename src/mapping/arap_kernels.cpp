@@ -13,8 +13,8 @@ namespace {
 // Moving face i's part of fit_rotations, one face at a time (the SIMD loop's scalar twin: the same
 // operations in the same order). u1x..u2y: its UVs' corners 1 and 2 minus corner 0.
 template <bool kReweight>
-void fit_face(size_t i, size_t count, float bound, float u1x, float u1y, float u2x, float u2y, const float* frame,
-              float* weight, float* ratio, float* record) {
+void fit_face(size_t i, size_t count, float bound, float area_bound, float u1x, float u1y, float u2x, float u2y,
+              const float* frame, float* weight, float* ratio, float* record) {
   constexpr float kCap = 10.f;  // inverted or collapsed: weigh as 10x the bound
   const float q1x = frame[i], q1y = frame[count + i], q2x = frame[2 * count + i], q2y = frame[3 * count + i];
   const float a = u1x * q2y - u2x * q1y, b = u2x * q1x - u1x * q2x;
@@ -26,9 +26,13 @@ void fit_face(size_t i, size_t count, float bound, float u1x, float u1y, float u
     const float fx = a - d, fy = c + b;
     const float qn = n * half_inv, rn = std::sqrt(fx * fx + fy * fy) * half_inv;
     const float sigma_min = qn - rn;
-    const float distortion = sigma_min > 1e-6f ? std::min(std::max(qn + rn - 1.f, 1.f / sigma_min - 1.f), kCap) : kCap;
+    const bool valid = sigma_min > 1e-6f;
+    const float distortion = valid ? std::min(std::max(qn + rn - 1.f, 1.f / sigma_min - 1.f), kCap) : kCap;
+    const float area = (qn + rn) * sigma_min;
+    const float area_change = valid ? std::min(std::max(area - 1.f, 1.f / area - 1.f), kCap) : 0.f;
     ratio[i] = distortion / bound;
-    weight[i] *= 1.f + ratio[i] * ratio[i];
+    const float rw = std::max(ratio[i], area_change / area_bound);
+    weight[i] *= 1.f + rw * rw;
   }
   const float wt = weight[i];
   const float rc = n > 0.f ? wt * x / n : wt, rs = n > 0.f ? wt * y / n : 0.f;
@@ -45,8 +49,8 @@ void fit_face(size_t i, size_t count, float bound, float u1x, float u1y, float u
 // With GCC on x86-64 the fit and the sweep are also compiled for AVX (TAILOR_AVX_CLONES,
 // util/simd.h): 8 % fewer instructions in the closing on the horse.
 template <bool kReweight>
-TAILOR_AVX_CLONES void fit_rotations(size_t count, float bound, const uint32_t* corner_pos, const float* pos,
-                                     const float* frame, float* weight, float* ratio, float* record) {
+TAILOR_AVX_CLONES void fit_rotations(size_t count, float bound, float area_bound, const uint32_t* corner_pos,
+                                     const float* pos, const float* frame, float* weight, float* ratio, float* record) {
   size_t i = 0;
 #if TAILOR_SSE2
   // Four faces at a time: the scalar operations lane by lane (IEEE operations round each lane as
@@ -77,8 +81,13 @@ TAILOR_AVX_CLONES void fit_rotations(size_t count, float bound, const uint32_t* 
       // std::max(p, q) is _mm_max_ps(q, p) and std::min(p, q) is _mm_min_ps(q, p): the same
       // operand on ties and NaN.
       const __m128 worst = _mm_max_ps(_mm_sub_ps(inverse, one), _mm_sub_ps(_mm_add_ps(qn, rn), one));
-      const __m128 r = _mm_div_ps(blend(valid, _mm_min_ps(cap, worst), cap), _mm_set1_ps(bound));
-      _mm_storeu_ps(ratio + i, r);
+      const __m128 area = _mm_mul_ps(_mm_add_ps(qn, rn), sigma_min);
+      const __m128 area_inverse = _mm_div_ps(one, blend(valid, area, one));
+      const __m128 area_worst = _mm_max_ps(_mm_sub_ps(area_inverse, one), _mm_sub_ps(area, one));
+      const __m128 r_area = _mm_div_ps(blend(valid, _mm_min_ps(cap, area_worst), zero), _mm_set1_ps(area_bound));
+      const __m128 r_stretch = _mm_div_ps(blend(valid, _mm_min_ps(cap, worst), cap), _mm_set1_ps(bound));
+      _mm_storeu_ps(ratio + i, r_stretch);
+      const __m128 r = _mm_max_ps(r_area, r_stretch);
       wt = _mm_mul_ps(wt, _mm_add_ps(one, _mm_mul_ps(r, r)));
       _mm_storeu_ps(weight + i, wt);
     }
@@ -106,13 +115,15 @@ TAILOR_AVX_CLONES void fit_rotations(size_t count, float bound, const uint32_t* 
     const float* p0 = pos + corner_pos[3 * i];
     const float* p1 = pos + corner_pos[3 * i + 1];
     const float* p2 = pos + corner_pos[3 * i + 2];
-    fit_face<kReweight>(i, count, bound, p1[0] - p0[0], p1[1] - p0[1], p2[0] - p0[0], p2[1] - p0[1], frame, weight,
-                        ratio, record);
+    fit_face<kReweight>(i, count, bound, area_bound, p1[0] - p0[0], p1[1] - p0[1], p2[0] - p0[0], p2[1] - p0[1], frame,
+                        weight, ratio, record);
   }
 }
 
-template void fit_rotations<false>(size_t, float, const uint32_t*, const float*, const float*, float*, float*, float*);
-template void fit_rotations<true>(size_t, float, const uint32_t*, const float*, const float*, float*, float*, float*);
+template void fit_rotations<false>(size_t, float, float, const uint32_t*, const float*, const float*, float*, float*,
+                                   float*);
+template void fit_rotations<true>(size_t, float, float, const uint32_t*, const float*, const float*, float*, float*,
+                                  float*);
 
 TAILOR_AVX_CLONES float sweep(size_t free_count, const uint32_t* free_wedge, const uint32_t* term_end,
                               const Term* terms, const float* record, float* pos) {

@@ -26,9 +26,11 @@ inline constexpr float kOverRelaxation = 1.2f;
 inline constexpr uint32_t kRecord = 8;
 
 // The local step for the `count` moving faces: per face the rotation nearest to its Jacobian J
-// (frame -> current UVs), premultiplied by its weight; with kReweight, first the weight times
-// 1 + (d / bound)^2, d its distortion max(sigma_max - 1, 1/sigma_min - 1) (capped), and d / bound to
-// ratio. Closed form for 2x2: with J = [a b; c d], the rotation turns by atan2(c - b, a + d) and
+// (frame -> current UVs), premultiplied by its weight; with kReweight, first d / bound to ratio, d
+// its distortion max(sigma_max - 1, 1/sigma_min - 1) (capped), and the weight times 1 + x^2, x the
+// larger of d / bound and the area change max(A - 1, 1/A - 1) / area_bound (A = sigma_max
+// sigma_min): the zip's check bounds both, and weighing only d left the area bound to fail most of
+// the relaxations that failed. Closed form for 2x2: with J = [a b; c d], the rotation turns by atan2(c - b, a + d) and
 // sigma = |q| +- |r|, q and r its conformal and anti-conformal parts (face_stretch.h). The adjugate
 // of Q is used: 1/det(Q) > 0 scales J without turning it.
 // corner_pos: per face its 3 corners' offsets in pos (UV pairs); frame: 5 blocks of `count` floats,
@@ -36,8 +38,8 @@ inline constexpr uint32_t kRecord = 8;
 // their determinant; weight, ratio: per face; record: per face kRecord floats, the rotation's columns
 // (c, s) and (-s, c), then the weight twice.
 template <bool kReweight>
-void fit_rotations(size_t count, float bound, const uint32_t* corner_pos, const float* pos, const float* frame,
-                   float* weight, float* ratio, float* record);
+void fit_rotations(size_t count, float bound, float area_bound, const uint32_t* corner_pos, const float* pos,
+                   const float* frame, float* weight, float* ratio, float* record);
 
 // === Global step ==================================================================================
 // A free wedge's corner in a moving face: what its prediction needs.

@@ -157,9 +157,9 @@ bool CrackCloser::relax(uint32_t patch, int rings) {
   int iteration = 0;
   for (; iteration < kIterations; ++iteration) {
     if (iteration == 0)
-      fit_rotations<false>(moving, bound_, corner_pos, pos, fit_frame, weight, ratio, record);
+      fit_rotations<false>(moving, bound_, area_bound_, corner_pos, pos, fit_frame, weight, ratio, record);
     else
-      fit_rotations<true>(moving, bound_, corner_pos, pos, fit_frame, weight, ratio, record);
+      fit_rotations<true>(moving, bound_, area_bound_, corner_pos, pos, fit_frame, weight, ratio, record);
     const float moved = sweep(free_count, free_wedge, term_end, terms, record, pos);
     if (moved < kSettledPx) break;
     if (iteration == kAbortAt && max_ratio() > kEscalateAbove) break;
