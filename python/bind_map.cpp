@@ -351,8 +351,12 @@ void bind_map(py::module_& m) {
         {
           const py::gil_scoped_release release;
           const auto start = std::chrono::steady_clock::now();
-          const Topology topology = build_topology(mesh.mesh);
+          // As `tailor map`: the topology serves the axis choice and the metrics, so unless the axis
+          // is chosen it is built after the mapping (less memory at the mapping's peak, and progress
+          // reports, hence Ctrl-C, from the start).
+          Topology topology;
           if (run.axis_auto) {
+            topology = build_topology(mesh.mesh);
             const auto axis_start = std::chrono::steady_clock::now();
             mapping.progress = [&report_progress](float f) { return report_progress(f); };
             AxisChoice choice;
@@ -366,7 +370,13 @@ void bind_map(py::module_& m) {
           TextureMap map;
           if (status) {
             mapping.progress = [&report_progress](float f) { return report_progress(f); };
-            status = map_texture(mesh.mesh, topology, options, map);
+            MapTextureOptions unmeasured = options;
+            unmeasured.measure = false;
+            status = map_texture(mesh.mesh, topology, unmeasured, map);
+          }
+          if (status) {
+            if (topology.opposite.empty()) topology = build_topology(mesh.mesh);
+            status = measure_texture_map(mesh.mesh, topology, options, map);
           }
           if (status) {
             run.options = options;
