@@ -11,6 +11,8 @@
 //                white = ideal, red = enlarged, with a colour-bar legend along the bottom;
 //   kChecker     a black/white checker texture, the classic way to judge stretch and shear.
 //
+// libOSMesa (Debian's libosmesa6) is loaded at the first call, not linked: a program that links
+// tailor::render and never draws does not carry Mesa's LLVM (~50 MB resident).
 // Thread safety: every call creates and destroys its own OSMesa context (OSMesa contexts are not
 // safe to share across calls); calls from several threads at once are not supported.
 #pragma once
@@ -120,8 +122,8 @@ struct PreviewMaterial {
 //!   out:       on success an RGB image (3 channels, image.h layout, top row first) of
 //!              options.width by options.height pixels; left empty on failure.
 //! Fails with kInvalidArgument for bad options or array sizes, kInvalidMesh for an empty mesh or
-//! out-of-range indices, kUnsupported when no OpenGL context can be created (OSMesa missing or
-//! out of memory). Cost: O(F) to build vertex arrays plus the rasterisation; about a second for
+//! out-of-range indices, kUnsupported when no OpenGL context can be created (libOSMesa missing:
+//! the message names it and its package; or out of memory). Cost: O(F) to build vertex arrays plus the rasterisation; about a second for
 //! 1 M faces at 1024x768 on two cores. Never prints, never throws.
 TAILOR_API Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::span<const uint32_t> patch,
                                  const Image* texture, const RenderOptions& options, Image& out);
