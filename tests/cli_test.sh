@@ -477,6 +477,25 @@ with open(os.path.join(folder, maps[0]), "rb") as f:
     assert f.read(8) == b"\x89PNG\r\n\x1a\n"
 PY
 "$tailor" eval "$tmp/port/moved/x.obj" >/dev/null 2>&1 && ok || fail "eval of the moved .obj"
+# The .obj and .ply outputs name their texture (the .mtl's map_Kd, the .ply's comment TextureFile):
+# eval measures with its size as map did, render draws it.
+"$tailor" map "$mesh" -t tests/data/textures/vistex-tile04-128.png -o "$tmp/port/moved/y.ply" --stats "$tmp/port/y.json" -q ||
+  fail "map to .ply"
+for out in x.obj y.ply; do
+  "$tailor" eval "$tmp/port/moved/$out" >"$tmp/port/eval.txt" 2>&1 && grep -q "texture 128x128 px, texture file" "$tmp/port/eval.txt" &&
+    ok || fail "eval of $out did not use its texture's size: $(cat "$tmp/port/eval.txt")"
+  "$tailor" render "$tmp/port/moved/$out" -o "$tmp/port/$out.png" >"$tmp/port/render.txt" 2>&1 &&
+    ! grep -q "no texture" "$tmp/port/render.txt" && [[ -s $tmp/port/$out.png ]] && ok ||
+    fail "render of $out did not draw its texture: $(cat "$tmp/port/render.txt")"
+done
+python3 - "$tmp/port/y.json" "$tmp/port/moved/y.ply" "$tailor" <<'PY' && ok || fail "eval of the .ply disagrees with map"
+import json, subprocess, sys
+mapped = json.load(open(sys.argv[1]))["metrics"]["visible_seam_ratio"]
+out = subprocess.run([sys.argv[3], "eval", sys.argv[2], "--json"], capture_output=True, text=True, check=True).stdout
+evaluated = json.loads(out)
+evaluated = evaluated.get("metrics", evaluated)["visible_seam_ratio"]
+assert abs(mapped - evaluated) < 1e-9, (mapped, evaluated)
+PY
 
 # --- a texture that does not wrap, and fewer than one repeat: one warning line each, and the summary's repeats ---
 photo=tests/data/textures/water-caustics-300.jpg

@@ -562,8 +562,9 @@ TEST_F(ExportTest, MappedMeshExportsUpright) {
 
 // A map's figures are those of the file it is written to: the UVs the writers store are the bits
 // uv_repeats_from_px gives (a 300 px texture, where pixels / 300 and back is not exact), and
-// compute_stored_uv_metrics of the map equals it of the file read back, .glb and .obj alike. The
-// .obj's .mtl gives the texture's size and a 4-fold map's record (load_mesh); without it, none.
+// compute_stored_uv_metrics of the map equals it of the file read back, .glb, .obj and .ply alike.
+// The .obj's .mtl and the .ply's comments give the texture's size and file and a 4-fold map's
+// record (load_mesh); without the .mtl, none.
 TEST_F(ExportTest, StoredMetricsOfAMapAreThoseOfItsFile) {
   Mesh spot;
   ASSERT_TRUE(load_mesh(kSpot, spot).is_ok());
@@ -588,7 +589,7 @@ TEST_F(ExportTest, StoredMetricsOfAMapAreThoseOfItsFile) {
   options.texture_path = texture;
   options.texture_width = options.texture_height = 300;
   options.symmetry = 4;
-  for (const char* name : {"spot.glb", "spot.obj"}) {
+  for (const char* name : {"spot.glb", "spot.obj", "spot.ply"}) {
     SCOPED_TRACE(name);
     const std::string out = path(name);
     ASSERT_TRUE(export_mesh(out, spot, atlas, options).is_ok());
@@ -601,8 +602,11 @@ TEST_F(ExportTest, StoredMetricsOfAMapAreThoseOfItsFile) {
     EXPECT_EQ(report.texture_height, 300);
     EXPECT_EQ(report.texture_symmetry, 4u);
     EXPECT_EQ(report.texture_file, !glb);
+    if (!glb) {
+      EXPECT_EQ(fs::path(report.texture_path).filename(), fs::path(texture).filename());
+    }
     UvMetrics of_file;
-    if (!glb) {  // the .obj keeps the corner order: the stored UVs bit for bit
+    if (!glb) {  // the .obj and .ply keep the corner order: the stored UVs bit for bit
       ASSERT_EQ(back.corner_uvs.size(), stored.size());
       EXPECT_EQ(std::memcmp(back.corner_uvs.data(), stored.data(), 4 * stored.size()), 0);
     }

@@ -141,7 +141,7 @@ void register_eval(CLI::App& app, Runner& run) {
          "--texture-size", opt->texture_size,
          "Texture size in pixels (UVs are in repeats; this gives pixels). Default: the size of the texture the "
          "file names, read from its header (a .glb or .gltf's base colour texture, embedded or a file next "
-         "to it; an .obj's map_Kd in its .mtl), else " +
+         "to it; an .obj's map_Kd in its .mtl; a .ply's comment TextureFile), else " +
              std::to_string(static_cast<int>(MetricsOptions{}.texture_width_px)))
       ->check(CLI::Range(1, 1 << 16));
   add_symmetry_option(cmd, option_doc(kMetricsOptionDocs, "symmetry"), opt->symmetry);

@@ -84,6 +84,14 @@ int run_render(const RenderArgs& args) {
           difference >= 0 && difference <= kQuarterTurnNoiseLevels && shift_x == 0 && shift_y == 0 ? 4 : 1;
     }
   }
+  if (args.texture.empty() && texture.empty() && !report.texture_path.empty()) {
+    // The texture an .obj's .mtl or a .ply's TextureFile names, next to it (as tailor map writes).
+    status = load_image(report.texture_path, texture, args.image_options);
+    if (!status) {
+      texture = Image{};
+      warn(args.quiet, "cannot read the texture " + args.input + " names (" + status.message() + ")");
+    }
+  }
   if (!args.normal_map.empty()) {  // replaces the file's; tangents then come from the UVs
     status = load_image(args.normal_map, maps.normal, args.image_options);
     if (!status) return report_error(status.with_file(args.normal_map));
@@ -121,12 +129,16 @@ int run_render(const RenderArgs& args) {
 void register_render(CLI::App& app, Runner& run) {
   auto* cmd = app.add_subcommand("render", "Render a preview picture of a UV-mapped mesh (CPU, no display needed)");
   auto args = std::make_shared<RenderArgs>();
-  cmd->add_option("mesh", args->input, "UV-mapped mesh: .glb (texture embedded) or .obj/.ply with UVs")->required();
+  cmd->add_option(
+         "mesh", args->input,
+         "UV-mapped mesh: .glb (texture embedded) or .obj/.ply with UVs (texture: the .mtl's map_Kd, the .ply's "
+         "comment TextureFile)")
+      ->required();
   cmd->add_option("-o,--output", args->output, "PNG picture to write")->required();
   add_documented(cmd, option_doc(kRenderOptionDocs, "view"), args->view)
       ->check(CLI::IsMember({"texture", "patches", "distortion", "checker", "seams"}));
   add_documented(cmd, option_doc(kRenderOptionDocs, "width"), args->size);
-  cmd->add_option("--texture", args->texture, "texture image to use instead of the one in the .glb");
+  cmd->add_option("--texture", args->texture, "texture image to use instead of the one the file names");
   cmd->add_option("--normal-map", args->normal_map,
                   "tangent-space normal map (OpenGL convention, +Y up) to shade the texture view with, instead of "
                   "the .glb's normalTexture (tangents from the UVs)");

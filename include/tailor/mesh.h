@@ -86,8 +86,11 @@ struct LoadReport {
   int texture_width = 0;             //!< the base colour texture's size, read from its header without decoding
   int texture_height = 0;            //!< it, any size. glTF (read_glb_file): embedded, or given by a URI (a
                                      //!< data: URI, a file next to the .gltf); OBJ (load_mesh of a path): the
-                                     //!< first map_Kd of the .mtl its mtllib names. 0: none, or no header read
-  bool texture_file = false;         //!< that texture is a file next to the .gltf or .mtl (only its header read)
+                                     //!< first map_Kd of the .mtl its mtllib names; PLY (load_mesh of a path):
+                                     //!< its `comment TextureFile` (MeshLab's, and tailor's .ply writer's).
+                                     //!< 0: none, or no header read
+  bool texture_file = false;         //!< that texture is a file next to the .gltf, .mtl or .ply (only its header read)
+  std::string texture_path;          //!< OBJ and PLY: that file's path (empty: none, or no header read)
   uint32_t texture_symmetry = 1;     //!< 4 where the file says the map is 4-fold (written by tailor map
                                      //!< --symmetry 4: ExportOptions::symmetry): glb: that texture's material
                                      //!< (without a texture, the first primitive's); OBJ: its .mtl; else 1

@@ -1,7 +1,8 @@
 // PLY writer: binary little endian, one vertex per split vertex with float x y z s t (texture
 // repeats, t up as in OBJ) and uchar red green blue alpha when the mesh kept colours (COLOR_0), faces as `list uchar
 // uint vertex_indices`. A `comment TextureFile` line names the texture the way MeshLab does, by its bare file name
-// (texture_name_beside: copied beside the .ply when it lies elsewhere). Vertices are split on UV,
+// (texture_name_beside: copied beside the .ply when it lies elsewhere), and `comment tailor symmetry 4` marks a
+// 4-fold map (ExportOptions::symmetry 4), as the .mtl's line does for an .obj. Vertices are split on UV,
 // so the faces of different patches do not share vertices in the file; tailor's readers of split files weld identical
 // positions back when they need the connectivity (weld_identical_positions).
 #include <algorithm>
@@ -41,6 +42,7 @@ Status write_ply(const std::string& path, const ExportData& data, const ExportOp
 
   std::string out = "ply\nformat binary_little_endian 1.0\ncomment written by tailor\n";
   if (!texture_name.empty()) out += "comment TextureFile " + texture_name + "\n";
+  if (options.symmetry == 4) out += "comment tailor symmetry 4\n";  // a 4-fold map (LoadReport::texture_symmetry)
   out += "element vertex " + std::to_string(vertex_count) + "\n";
   out += "property float x\nproperty float y\nproperty float z\nproperty float s\nproperty float t\n";
   const CornerAttribute* colour = nullptr;  // per source vertex (export_mesh kept it)

@@ -194,11 +194,28 @@ std::string_view trimmed(std::string_view text) {
   return text.substr(b, text.find_last_not_of(" \t\r") + 1 - b);
 }
 
+// The texture a mesh file names (an image next to it): report.texture_width/height from the
+// image's header (never decoded), texture_file and texture_path. A missing or unreadable image
+// leaves them as they are: the mesh itself loaded, and its texture is optional.
+void read_texture_header(const std::filesystem::path& image, LoadReport& report) {
+  std::string head;
+  long width = 0, height = 0;
+  for (const size_t max_bytes : {size_t{64} << 10, size_t{16} << 20}) {  // a JPEG's frame header may lie far in
+    if (!read_file_start(image, max_bytes, head)) return;
+    if (internal::image_header_size({reinterpret_cast<const unsigned char*>(head.data()), head.size()}, width, height))
+      break;
+    if (head.size() < max_bytes) return;
+  }
+  if (width <= 0 || height <= 0 || width > INT_MAX || height > INT_MAX) return;
+  report.texture_width = static_cast<int>(width);
+  report.texture_height = static_cast<int>(height);
+  report.texture_file = true;
+  report.texture_path = image.string();
+}
+
 // An .obj's texture, as its .mtl names it (the first map_Kd: the file name after any options, a
-// file next to the .mtl), into report.texture_width/height (from the image's header, never
-// decoded) and texture_file; a `# tailor symmetry 4` line (tailor map --symmetry 4) into
-// report.texture_symmetry. Anything missing or unreadable leaves them as they are: the .obj itself
-// loaded, and a .mtl is optional.
+// file next to the .mtl), read by read_texture_header; a `# tailor symmetry 4` line (tailor map
+// --symmetry 4) into report.texture_symmetry. A missing .mtl leaves them as they are.
 void read_obj_material(const std::filesystem::path& folder, const std::string& library, LoadReport& report) {
   std::string mtl;
   std::filesystem::path mtl_path = folder / library;
@@ -225,20 +242,7 @@ void read_obj_material(const std::filesystem::path& folder, const std::string& l
         std::string(name.front() == '-' && last_blank != std::string_view::npos ? name.substr(last_blank + 1) : name);
   }
   report.texture_symmetry = symmetry;
-  if (texture.empty()) return;
-  const std::filesystem::path image = mtl_path.parent_path() / texture;
-  std::string head;
-  long width = 0, height = 0;
-  for (const size_t max_bytes : {size_t{64} << 10, size_t{16} << 20}) {  // a JPEG's frame header may lie far in
-    if (!read_file_start(image, max_bytes, head)) return;
-    if (internal::image_header_size({reinterpret_cast<const unsigned char*>(head.data()), head.size()}, width, height))
-      break;
-    if (head.size() < max_bytes) return;
-  }
-  if (width <= 0 || height <= 0 || width > INT_MAX || height > INT_MAX) return;
-  report.texture_width = static_cast<int>(width);
-  report.texture_height = static_cast<int>(height);
-  report.texture_file = true;
+  if (!texture.empty()) read_texture_header(mtl_path.parent_path() / texture, report);
 }
 
 // read_mesh with the folder where a .gltf's buffer files are (empty: none is opened).
@@ -253,10 +257,11 @@ Status read_mesh_in(std::span<const char> data, MeshFormat format, const std::st
   Status s;
   internal::ReadProgress progress(callback, data.size());
   std::string material_library;  // OBJ: its mtllib (the texture's size is read from it)
+  std::string texture_name;      // PLY: its TextureFile comment (the same)
   // The parsers never throw by design; only an allocation of a (checked, but large) size can.
   try {
     switch (format) {
-      case MeshFormat::kPly: s = internal::read_ply(data, name, mesh, r, &progress); break;
+      case MeshFormat::kPly: s = internal::read_ply(data, name, mesh, r, &progress, &texture_name); break;
       case MeshFormat::kObj: s = internal::read_obj(data, name, mesh, r, &progress, &material_library); break;
       case MeshFormat::kOff: s = internal::read_off(data, name, mesh, r, &progress); break;
       case MeshFormat::kStl: s = internal::read_stl(data, name, mesh, r, &progress); break;
@@ -269,6 +274,8 @@ Status read_mesh_in(std::span<const char> data, MeshFormat format, const std::st
     if (s.is_ok() && !progress.repairs(0.f)) s = progress.cancelled(name);
     if (s.is_ok()) s = finalize_mesh(name, mesh, r);
     if (s.is_ok() && !base_dir.empty() && !material_library.empty()) read_obj_material(base_dir, material_library, r);
+    if (s.is_ok() && !base_dir.empty() && !texture_name.empty())
+      read_texture_header(std::filesystem::path(base_dir) / texture_name, r);
     if (s.is_ok() && !progress.repairs(1.f)) s = progress.cancelled(name);
   } catch (const std::bad_alloc&) {
     s = Status::error(ErrorCode::kLimit, name, "not enough memory to load the mesh");

@@ -119,8 +119,10 @@ enum class PlyFormat : uint8_t { kAscii, kBinaryLe, kBinaryBe };
 struct PlyHeader {
   PlyFormat format = PlyFormat::kAscii;
   std::vector<PlyElement> elements;
-  size_t body_offset = 0;   // first byte after end_header's line end
-  size_t header_lines = 0;  // line number of end_header (ascii bodies count lines from there)
+  size_t body_offset = 0;    // first byte after end_header's line end
+  size_t header_lines = 0;   // line number of end_header (ascii bodies count lines from there)
+  std::string texture_file;  // the first `comment TextureFile NAME` (MeshLab's, and tailor's writer's)
+  uint32_t symmetry = 1;     // 4 with a `comment tailor symmetry 4` line (tailor map --symmetry 4)
 };
 
 std::vector<std::string_view> split_words(std::string_view line) {
@@ -167,6 +169,14 @@ Status parse_header(std::string_view data, const std::string& name, PlyHeader& h
         return Status::error(ErrorCode::kParse, name, "not a PLY file (no 'ply' magic)", where);
       continue;
     }
+    if (w.size() >= 3 && w[0] == "comment" && w[1] == "TextureFile" && h.texture_file.empty()) {
+      // The name is the rest of the line (it may hold blanks), trimmed.
+      const size_t at = line.find("TextureFile") + 11;
+      const size_t b = line.find_first_not_of(" \t\r", at), e = line.find_last_not_of(" \t\r");
+      if (b != std::string_view::npos && e >= b) h.texture_file = std::string(line.substr(b, e + 1 - b));
+      continue;
+    }
+    if (w.size() == 4 && w[0] == "comment" && w[1] == "tailor" && w[2] == "symmetry" && w[3] == "4") h.symmetry = 4;
     if (w.empty() || w[0] == "comment" || w[0] == "obj_info") continue;
     if (w[0] == "format") {
       if (w.size() < 2) return Status::error(ErrorCode::kParse, name, "PLY format line without a format", where);
@@ -864,12 +874,14 @@ Status check_counts(const PlyHeader& h, size_t body_bytes, const std::string& na
 }  // namespace
 
 Status read_ply(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,
-                ReadProgress* progress) {
+                ReadProgress* progress, std::string* texture_file) {
   ReadProgress none;
   ReadProgress& p = progress ? *progress : none;
   const std::string_view text(data.data(), data.size());
   PlyHeader h;
   TAILOR_RETURN_IF_ERROR(parse_header(text, name, h));
+  if (texture_file) *texture_file = h.texture_file;
+  report.texture_symmetry = h.symmetry;
   TAILOR_RETURN_IF_ERROR(assign_roles(h, name));
   const char* body = data.data() + h.body_offset;
   const char* end = data.data() + data.size();

@@ -51,8 +51,10 @@ class ReadProgress {
 //! progress (optional) is told the bytes parsed (PLY: per element and every 64k items of the generic
 //! loops; OBJ, OFF and ascii STL: every few MB; binary STL: the welding, every 64k corners; glTF: per
 //! primitive, in faces).
+//! PLY: texture_file (optional) gets the first `comment TextureFile NAME` line's name (MeshLab's
+//! convention, which tailor's writer follows), empty when there is none.
 Status read_ply(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,
-                ReadProgress* progress = nullptr);
+                ReadProgress* progress = nullptr, std::string* texture_file = nullptr);
 //! OBJ: material_library (optional) gets the first `mtllib` statement's file name (the rest of its
 //! line, blanks trimmed), empty when there is none.
 Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,
