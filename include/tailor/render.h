@@ -123,8 +123,9 @@ struct PreviewMaterial {
 //!              options.width by options.height pixels; left empty on failure.
 //! Fails with kInvalidArgument for bad options or array sizes, kInvalidMesh for an empty mesh or
 //! out-of-range indices, kUnsupported when no OpenGL context can be created (libOSMesa missing:
-//! the message names it and its package; or out of memory). Cost: O(F) to build vertex arrays plus the rasterisation;
-//! about a second for 1 M faces at 1024x768 on two cores. Never prints, never throws.
+//! the message names it and its package; or out of memory). Cost: O(F) to build vertex arrays
+//! plus the rasterisation; about a second for 1 M faces at 1024x768 on two cores. Never prints,
+//! never throws.
 TAILOR_API Status render_preview(const Mesh& mesh, std::span<const float> corner_uv, std::span<const uint32_t> patch,
                                  const Image* texture, const RenderOptions& options, Image& out);
 
