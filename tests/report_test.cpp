@@ -65,7 +65,12 @@ TEST(Report, MapSummaryIsOneLinePlusStability) {
   EXPECT_EQ(text.find("in.ply: 12 faces, 2 patches, 1.56 repeats across the mesh, seams 5.12% of edge length"), 0u)
       << text;
   EXPECT_EQ(text.find("axis choice"), std::string::npos);
+  EXPECT_EQ(text.find("peak"), std::string::npos);  // not measured: not said
+  EXPECT_EQ(map_report_json(run).find("peak_resident_mib"), std::string::npos);
   EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1);
+  run.peak_resident_bytes = size_t{157} << 20;
+  EXPECT_NE(map_summary(run).find(" ms, peak 157 MiB -> out.glb\n"), std::string::npos) << map_summary(run);
+  EXPECT_NE(map_report_json(run).find("\"peak_resident_mib\": 157"), std::string::npos);
   run.axis_auto = true;
   run.axis_choice_seconds = 0.0421;
   run.stability = StabilityReport{};

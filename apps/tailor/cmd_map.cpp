@@ -1,5 +1,6 @@
-// tailor map: load -> topology -> [axis choice] -> map_texture (orientation, mapping, metrics) -> export
-// (+ preview, stats).
+// tailor map: load -> [topology, axis choice] -> map_texture (orientation, mapping) -> topology ->
+// metrics -> export (+ preview, stats).
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -339,6 +340,8 @@ int run_map(const MapArgs& opt) {
   }
 
   run.total_seconds = seconds_since(start);
+  if (rusage usage{}; getrusage(RUSAGE_SELF, &usage) == 0)
+    run.peak_resident_bytes = static_cast<size_t>(usage.ru_maxrss) * 1024;  // Linux: kilobytes
 
   // === Report ===
   if (!opt.stats.empty()) {

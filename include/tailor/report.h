@@ -64,6 +64,9 @@ struct MapRun {
   double export_seconds = 0;
   double preview_seconds = 0;
   double total_seconds = 0;  //!< the whole command
+  // The process's peak resident memory (`tailor map`: getrusage at the end), 0 = not measured: then
+  // neither the JSON (`peak_resident_mib`) nor the summary says it.
+  size_t peak_resident_bytes = 0;
 };
 
 //! The texture repeats across the longest side of the mesh's bounding box as mapped, from the

@@ -139,6 +139,7 @@ std::string map_report_json(const MapRun& run) {
                   {"export", ms(run.export_seconds)},
                   {"preview", ms(run.preview_seconds)},
                   {"total", ms(run.total_seconds)}};
+  if (run.peak_resident_bytes > 0) j["peak_resident_mib"] = static_cast<double>(run.peak_resident_bytes) / (1 << 20);
   j["previews"] = run.previews;
   return internal::json_text(j);
 }
@@ -168,19 +169,23 @@ std::string map_summary(const MapRun& run) {
   const std::string axis_choice =
       run.axis_auto ? "axis choice " + std::to_string(static_cast<long>(ms(run.axis_choice_seconds))) + ", " : "";
   // In chunks every chunk orients itself inside the mapping's time (the chunks line has the stages).
+  const std::string peak =
+      run.peak_resident_bytes > 0
+          ? format_text(", peak %.0f MiB", static_cast<double>(run.peak_resident_bytes) / (1 << 20))
+          : std::string();
   const std::string orientation = run.mapping.chunks > 0 ? "orientation in the chunks"
                                                          : format_text("orientation %.1f", ms(run.orientation_seconds));
   std::string text = format_text(
       "%s: %s, %s%s, seams %.2f%% of edge length, %zu flipped, stretch %.3f, L2 %.3f, "
       "Linf %.2f, median angle %.2f deg, visible seams %.2f%% (%.0f%% of seam length invisible%s, %zu dangling ends) | "
       "load %.1f ms, topology %.1f, "
-      "%s%s, mapping %.1f, export %.1f ms -> %s\n",
+      "%s%s, mapping %.1f, export %.1f ms%s -> %s\n",
       run.input.c_str(), internal::counted(run.faces, "face", "faces").c_str(),
       internal::counted(m.patches, "patch", "patches").c_str(), repeats.c_str(), 100.0 * m.seam_length_ratio, m.flipped,
       m.stretch, m.l2_stretch, m.linf_stretch, m.distortion_deg, 100.0 * m.visible_seam_ratio,
       100.0 * m.seam_invisible_ratio, run.options.metrics.symmetry == 4 ? " up to quarter turns" : "",
       m.visible_dangling_ends, ms(run.load.load_seconds), ms(run.topology_seconds), axis_choice.c_str(),
-      orientation.c_str(), ms(run.mapping.seconds), ms(run.export_seconds), run.output.c_str());
+      orientation.c_str(), ms(run.mapping.seconds), ms(run.export_seconds), peak.c_str(), run.output.c_str());
   if (run.mapping.chunks > 0)
     text += format_text(
         "chunks: %s of side %g world units, mapped at %g texels per unit; corners farther than %g units from "

@@ -10,7 +10,7 @@ from conftest import DATA, GRAVEL, SPOT, bumpy_grid, run_cli
 
 
 def without_times(stats):
-    kept = {k: v for k, v in stats.items() if k not in ("time_ms", "output", "input", "previews")}
+    kept = {k: v for k, v in stats.items() if k not in ("time_ms", "output", "input", "previews", "peak_resident_mib")}
     if "mapping" in kept:  # each stage's time (mapping.stage_ms) differs from run to run
         kept["mapping"] = {k: v for k, v in kept["mapping"].items() if k != "stage_ms"}
     return kept
