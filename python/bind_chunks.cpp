@@ -38,12 +38,7 @@ void bind_chunks(py::module_& m) {
              options.mapping.field_following = field_following;
              options.mapping.max_stretch = max_stretch;
              if (!crack_rings.is_none()) options.mapping.crack_rings = crack_rings.cast<uint32_t>();
-             if (!chunk_split.is_none()) {
-               const long long n = chunk_split.cast<long long>();
-               if (n < 0 || n > 0xffffffffLL)
-                 raise_error("chunk_split must be None, 0 (never cut) or at least 64 faces");
-               options.chunks.split_above = static_cast<uint32_t>(n);
-             }
+             set_chunk_split(chunk_split, options.chunks.split_above);
              if (!texture_size.is_none()) {
                // The lattice of whole repeats the crack closing snaps to, as tailor.map(texture_size=...).
                const auto size = texture_size.cast<std::vector<int>>();

@@ -274,11 +274,7 @@ void bind_map(py::module_& m) {
           if (e < -60 || e > 60) raise_error("chunk_cell must be None or a whole number in -60..60");
           options.chunks.cell_exponent = e;
         }
-        if (!chunk_split.is_none()) {
-          const long long n = chunk_split.cast<long long>();
-          if (n < 0 || n > 0xffffffffLL) raise_error("chunk_split must be None, 0 (never cut) or at least 64 faces");
-          options.chunks.split_above = static_cast<uint32_t>(n);
-        }
+        set_chunk_split(chunk_split, options.chunks.split_above);
         if (smooth > 1000) raise_error("--smooth: value " + std::to_string(smooth) + " not in range [0 - 1000]");
         options.orientation.smooth_passes = smooth;
         if (texture_size <= 0) raise_error("--texture-size must be positive");

@@ -62,6 +62,10 @@ std::string describe(const py::array& array);
 //! A sequence as the CLI's text of it ("0,1,0"), for messages; other objects as str() shows them.
 std::string sequence_text(const py::handle& value);
 
+//! The chunk_split argument of map() and ChunkedMapper(): None leaves `split_above` (the library's
+//! default), else a face count in 0..2^32-1 (check_map_options then says 0 or at least 64).
+void set_chunk_split(const py::object& chunk_split, uint32_t& split_above);
+
 //! A path argument: str or os.PathLike, as a file system path.
 std::string path_of(const py::handle& path);
 

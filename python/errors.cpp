@@ -47,6 +47,13 @@ std::string sequence_text(const py::handle& value) {
   return text;
 }
 
+void set_chunk_split(const py::object& chunk_split, uint32_t& split_above) {
+  if (chunk_split.is_none()) return;
+  const long long n = chunk_split.cast<long long>();
+  if (n < 0 || n > 0xffffffffLL) raise_error("chunk_split must be None, 0 (never cut) or at least 64 faces");
+  split_above = static_cast<uint32_t>(n);
+}
+
 std::string path_of(const py::handle& path) {
   if (!py::isinstance<py::str>(path) && !py::hasattr(path, "__fspath__"))
     raise_error("expected a path (str or os.PathLike), got " + py::str(py::type::of(path)).cast<std::string>());

@@ -263,10 +263,10 @@ struct TextureMap {
 TAILOR_API Status map_texture(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options,
                               TextureMap& map);
 
-//! Step 5 of map_texture alone: fills map.metrics from map.atlas as map_texture does when
-//! options.measure is true (progress "metrics" to options.stage_progress). For a map made with
-//! options.measure false. Fails with kInvalidMesh when the topology or the atlas does not match
-//! the mesh, kCancelled, and as compute_stored_uv_metrics does. Cost: O(F).
+//! Step 5 of map_texture alone (map_texture runs it when options.measure is true; here
+//! options.measure is not read): fills map.metrics from map.atlas (progress "metrics" to
+//! options.stage_progress). For a map made with options.measure false. Fails with kInvalidMesh when the topology or the
+//! atlas does not match the mesh, kCancelled, and as compute_stored_uv_metrics does. Cost: O(F).
 TAILOR_API Status measure_texture_map(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options,
                                       TextureMap& map);
 

@@ -174,32 +174,6 @@ ProgressCallback both_progress(ProgressCallback a, ProgressCallback b) {
 
 }  // namespace
 
-namespace {
-
-// Step 6, the metrics of the result (metrics/uv_metrics.cpp), unless options.measure is off.
-Status measure_atlas(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options, TextureMap& map) {
-  if (!options.measure) return Status::ok();
-  const StageProgressCallback& stage = options.stage_progress;
-  if (stage && !stage("metrics", 0.f)) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
-  // Measured as a file holds the map (`tailor eval` of it reports the same figures): the UVs in
-  // texture repeats as the writers store them, patches as the UVs join faces.
-  // For a power-of-two texture the stored repeats scale back to the atlas's own pixels: it is
-  // measured as it is (a copy of the UVs is 24 bytes per face at the mapping's peak).
-  const float width = options.metrics.texture_width_px, height = options.metrics.texture_height_px;
-  if (internal::stored_round_trip_exact(map.atlas.corner_uv, width, height)) {
-    TAILOR_RETURN_IF_ERROR(internal::compute_stored_uv_metrics_px(mesh, &topology, map.atlas.corner_uv, options.metrics,
-                                                                  map.metrics, nullptr));
-  } else {
-    std::vector<float> stored;
-    uv_repeats_from_px(map.atlas.corner_uv, width, height, stored);
-    TAILOR_RETURN_IF_ERROR(compute_stored_uv_metrics(mesh, &topology, std::move(stored), options.metrics, map.metrics));
-  }
-  if (stage && !stage("metrics", 1.f)) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
-  return Status::ok();
-}
-
-}  // namespace
-
 Status map_texture(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options, TextureMap& map) {
   clear_atlas(map.atlas);
   map.stats = MappingStats{};
@@ -217,18 +191,32 @@ Status map_texture(const Mesh& mesh, const Topology& topology, const MapTextureO
   TAILOR_RETURN_IF_ERROR(chunked ? internal::map_chunks(mesh, options, map)
                                  : internal::map_whole_canonical(mesh, options, map));
   // === 5. Metrics of the result, on the mesh as given (metrics/uv_metrics.cpp) ===
-  return measure_atlas(mesh, topology, options, map);
+  return options.measure ? measure_texture_map(mesh, topology, options, map) : Status::ok();
 }
 
+// The metrics of the result, measured as a file holds the map (`tailor eval` of it reports the same
+// figures): the UVs in texture repeats as the writers store them, patches as the UVs join faces.
 Status measure_texture_map(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options,
                            TextureMap& map) {
   if (topology.opposite.size() != 3 * mesh.face_count())
     return Status::error(ErrorCode::kInvalidMesh, "", "topology does not match the mesh");
   if (map.atlas.corner_uv.size() != 6 * mesh.face_count())
     return Status::error(ErrorCode::kInvalidMesh, "", "the atlas does not match the mesh");
-  MapTextureOptions measured = options;
-  measured.measure = true;
-  return measure_atlas(mesh, topology, measured, map);
+  const StageProgressCallback& stage = options.stage_progress;
+  if (stage && !stage("metrics", 0.f)) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
+  // For a power-of-two texture the stored repeats scale back to the atlas's own pixels: it is
+  // measured as it is (a copy of the UVs is 24 bytes per face at the mapping's peak).
+  const float width = options.metrics.texture_width_px, height = options.metrics.texture_height_px;
+  if (internal::stored_round_trip_exact(map.atlas.corner_uv, width, height)) {
+    TAILOR_RETURN_IF_ERROR(internal::compute_stored_uv_metrics_px(mesh, &topology, map.atlas.corner_uv, options.metrics,
+                                                                  map.metrics, nullptr));
+  } else {
+    std::vector<float> stored;
+    uv_repeats_from_px(map.atlas.corner_uv, width, height, stored);
+    TAILOR_RETURN_IF_ERROR(compute_stored_uv_metrics(mesh, &topology, std::move(stored), options.metrics, map.metrics));
+  }
+  if (stage && !stage("metrics", 1.f)) return Status::error(ErrorCode::kCancelled, "", "mapping cancelled");
+  return Status::ok();
 }
 
 Status internal::map_texture_in_order(const Mesh& mesh, const Topology& topology, const MapTextureOptions& options,
@@ -321,7 +309,7 @@ Status internal::map_texture_frames(const Mesh& mesh, const Topology& topology, 
   stats.seconds = seconds_since(start);
 
   // === 6. Metrics of the result (metrics/uv_metrics.cpp) ===
-  return measure_atlas(mesh, topology, options, map);
+  return options.measure ? measure_texture_map(mesh, topology, options, map) : Status::ok();
 }
 
 }  // namespace tailor
