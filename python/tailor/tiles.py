@@ -15,7 +15,8 @@ once. --up z: Z-up coordinates, turned Y up by each .glb's node as glTF wants an
 the client as 3D Tiles prescribes; the bounding volumes follow either choice.
 
 A binary little-endian PLY of triangles is partitioned by streaming it (tailor.tiles_stream: per-tile
-files in a scratch folder, the driver never holds the whole mesh); other inputs are loaded whole.
+files in a scratch folder, the driver never holds the whole mesh; the partition's ranges of the
+file shared between the driver and the workers); other inputs are loaded whole.
 
 A tile's faces are written in a canonical order (by their corners' coordinates), so its bytes do
 not depend on the input file's face or vertex order. tailor-tiles.json records each tile's digest
@@ -27,6 +28,7 @@ failed run leaves OUTDIR as it was. With --scheduler the workers write the tiles
 OUTDIR must be on a file system every worker sees, and each worker must import the same tailor.
 """
 import argparse
+import functools
 import hashlib
 import json
 import math
@@ -37,6 +39,7 @@ import struct
 import sys
 import threading
 import time
+import warnings
 
 import numpy as np
 
@@ -46,6 +49,9 @@ from . import tiles_stream
 
 MANIFEST = "tailor-tiles.json"
 FORMAT = 1  # of the manifest: a different number means every tile is written again
+# The streamed partition's ranges of the file (at least a block each): enough for every worker of a
+# cluster to take several, so that the driver and the workers finish together.
+PARTITION_PARTS = 256
 
 
 class TilesError(Exception):
@@ -365,10 +371,74 @@ def on_worker(task, *args):
     return record
 
 
-def map_tile_file(job, path, index_dtype, params, folder, keep_from, threads, lod):
-    """A leaf from its file of the streamed partition (tiles_stream): read, then map_tile."""
-    positions, faces = tiles_stream.read_tile(path, np.dtype(index_dtype), params["cell_exponent"], params["tile_level"])
+def map_tile_file(job, paths, index_dtype, params, folder, keep_from, threads, lod):
+    """A leaf from its files of the streamed partition (tiles_stream): read, then map_tile."""
+    positions, faces = tiles_stream.read_tile(paths, np.dtype(index_dtype), params["cell_exponent"], params["tile_level"])
     return map_tile(job, positions, faces, params, folder, keep_from, threads, lod)
+
+
+def run_shared(start, prefix, function, args):
+    """function(*a) for each a of args, here and on the cluster at once: this process takes them from
+    the front while the cluster, from when it is up, takes them from the back, as many at a time as
+    it has threads (the driver need not wait for the cluster's start, nor the cluster for the
+    driver). Returns the results in the order of args; raises the failure of the earliest failed."""
+    results = [None] * len(args)
+    errors = {}
+    lock = threading.Lock()
+    ends = [0, len(args)]  # the next from the front, one past the next from the back
+
+    def claim(front):
+        with lock:
+            if ends[0] >= ends[1] or errors:
+                return None
+            if front:
+                ends[0] += 1
+                return ends[0] - 1
+            ends[1] -= 1
+            return ends[1]
+
+    def fail(k, e):
+        with lock:
+            errors[k] = e
+
+    def cluster_side():
+        try:
+            # Imported here: the client's thread may still be importing distributed, and this
+            # process's share should not wait for it.
+            from dask.distributed import as_completed
+
+            client, _ = start.result()
+            running, index = as_completed(), {}
+
+            def submit():
+                k = claim(False)
+                if k is not None:
+                    future = client.submit(function, *args[k], key="%s-%d" % (prefix, k))
+                    index[future.key] = k
+                    running.add(future)
+
+            for _ in range(sum(client.nthreads().values())):
+                submit()
+            for future in running:
+                try:
+                    results[index[future.key]] = future.result()
+                except Exception as e:
+                    fail(index[future.key], e)
+                submit()
+        except BaseException as e:  # the cluster did not start: raised after this process's share
+            fail(len(args), e)
+
+    helper = threading.Thread(target=cluster_side, name="tailor.tiles shared parts", daemon=True)
+    helper.start()
+    while (k := claim(True)) is not None:
+        try:
+            results[k] = function(*args[k])
+        except Exception as e:
+            fail(k, e)
+    helper.join()
+    if errors:
+        raise errors[min(errors)]
+    return results
 
 
 def build_parent(job, params, folder, keep_from, *children):
@@ -689,7 +759,20 @@ def start_client(args):
     # faults: 20-30 % more time on the 6.2 M-face horse). The workers here keep glibc's default.
     environ = dict(dask.config.get("distributed.nanny.pre-spawn-environ"))
     environ.pop("MALLOC_TRIM_THRESHOLD_", None)
-    dask.config.set({"distributed.nanny.pre-spawn-environ": environ})
+    # Dask's monitors wake every process of the cluster many times a second: the statistical
+    # profiler samples each task's stack every 10 ms, the event-loop watchdog ticks every 20 ms, the
+    # memory monitor reads /proc every 100 ms. Beside tasks that keep every core busy they took
+    # 11-18 % of the CPU (a worker's event loop 5.5 % of a core, the scheduler's 7.5 %); the tasks
+    # here are seconds long and need none of that resolution.
+    dask.config.set(
+        {
+            "distributed.nanny.pre-spawn-environ": environ,
+            "distributed.worker.profile.enabled": False,
+            "distributed.admin.tick.interval": "1s",
+            "distributed.admin.system-monitor.interval": "2s",
+            "distributed.worker.memory.monitor-interval": "1s",
+        }
+    )
     cluster = LocalCluster(
         n_workers=args.workers,
         threads_per_worker=1,
@@ -813,19 +896,26 @@ def run(args):
             del positions, faces, mesh
             sizes = [job[2].shape[0] for job in jobs]
         else:
-            # One pass: each face appended to its tile's file in the scratch folder.
-            counts, chunk_count = tiles_stream.partition(
-                layout, params["cell_exponent"], params["tile_level"], scratch, args.block_faces
+            # One pass: each face appended to its tile's file in the scratch folder. With a cluster
+            # the file is cut into ranges of a few blocks, shared between this process and the
+            # cluster's workers.
+            parts, run_parts = 1, None
+            if start is not None:
+                parts = PARTITION_PARTS
+                run_parts = functools.partial(run_shared, start, "partition-%s" % tmp.name)
+            counts, files, chunk_count = tiles_stream.partition_parts(
+                layout, params["cell_exponent"], params["tile_level"], scratch, parts, run_parts, args.block_faces
             )
             index_dtype = layout.index_dtype.str
             for tile in sorted(counts, key=lambda t: (t[2], t[1], t[0])):
                 name = node_name(0, tile)
-                path = str(tiles_stream.tile_file(scratch, tile))
                 if in_process:  # mapped in this process: all of them
-                    p, f = tiles_stream.read_tile(path, layout.index_dtype, params["cell_exponent"], params["tile_level"])
+                    p, f = tiles_stream.read_tile(
+                        files[tile], layout.index_dtype, params["cell_exponent"], params["tile_level"]
+                    )
                     jobs.append(({"name": name, "tile": list(tile)}, p, f, old.get(name)))
                 else:
-                    jobs.append(({"name": name, "tile": list(tile), "file": path}, None, None, old.get(name)))
+                    jobs.append(({"name": name, "tile": list(tile), "files": files[tile]}, None, None, old.get(name)))
             sizes = [counts[tuple(job[0]["tile"])] for job in jobs]
         levels = parent_levels([job[0]["tile"] for job in jobs]) if args.lod else []
         t_cut = time.monotonic()
@@ -863,14 +953,14 @@ def run(args):
             for i in order:
                 job, p, f, keep = jobs[i]
                 key = "tile-%s-%s" % (tmp.name, job["name"])
-                if "file" in job:
+                if "files" in job:
                     job = dict(job)
-                    path = job.pop("file")
+                    paths = job.pop("files")
                     futures[job["name"]] = client.submit(
                         on_worker,
                         map_tile_file,
                         job,
-                        path,
+                        paths,
                         index_dtype,
                         params,
                         folder,
@@ -880,9 +970,13 @@ def run(args):
                         key=key,
                     )
                 else:
-                    futures[job["name"]] = client.submit(
-                        on_worker, map_tile, job, p, f, params, folder, keep, threads, args.lod, key=key
-                    )
+                    # A tile loaded whole goes to its worker in the task itself (scattering it first
+                    # would send the same bytes); Dask warns about every such task of over 1 MB.
+                    with warnings.catch_warnings():
+                        warnings.filterwarnings("ignore", message="Large object of size", category=UserWarning)
+                        futures[job["name"]] = client.submit(
+                            on_worker, map_tile, job, p, f, params, folder, keep, threads, args.lod, key=key
+                        )
             del jobs[:]
             for level, groups in enumerate(levels, start=1):
                 for tile, names in groups:

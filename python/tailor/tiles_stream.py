@@ -11,7 +11,9 @@ Passes over the faces: (1) checks (counts, index range, finite coordinates), the
 referenced vertices and a histogram of the edge lengths' float bits (high 16 bits), (2) when the
 cell is automatic and the one bin that holds the median spans two cell exponents, the exact median
 from the low 16 bits of the lengths in that bin, (3) each face's tile, its three vertex ids and
-corner positions appended to the tile's file.
+corner positions appended to the tile's file. Pass (3) runs in ranges of whole blocks, each into a
+folder of its own (partition_parts: the driver and a cluster's workers share them); a tile's files
+in the ranges' order are its faces in file order.
 What tailor.load would change is done the same way: faces that repeat a vertex are dropped here,
 faces that repeat another face's vertices (the first kept) by the task that reads the tile.
 """
@@ -19,6 +21,7 @@ import math
 import mmap
 import os
 import pathlib
+import shutil
 
 import numpy as np
 
@@ -163,18 +166,20 @@ class _Body:
         self.vertices = np.ndarray(
             (layout.vertex_count,), dtype=layout.vertex_dtype, buffer=self.map, offset=layout.vertex_offset
         )
-        # x, y, z as three consecutive float32 (the usual vertex): one row gather per corner instead
-        # of one per axis, on a contiguous (V, 3) view when nothing else is in the vertex.
+        # x, y, z as three consecutive float32 (the usual vertex): one gather of 12 bytes per corner
+        # instead of one per axis. The rows are opaque 12-byte records, never float32 rows: the
+        # header's length leaves floats unaligned as often as not, and numpy copies a whole
+        # unaligned array before it gathers from it.
         fields = layout.vertex_dtype.fields
         x = fields["x"][1]
         self.rows = None
         if all(fields[a][0] == np.dtype("<f4") and fields[a][1] == x + 4 * k for k, a in enumerate("xyz")):
             self.rows = np.ndarray(
-                (layout.vertex_count, 3),
-                dtype="<f4",
+                (layout.vertex_count,),
+                dtype=np.dtype((np.void, 12)),
                 buffer=self.map,
                 offset=layout.vertex_offset + x,
-                strides=(layout.vertex_dtype.itemsize, 4),
+                strides=(layout.vertex_dtype.itemsize,),
             )
 
     def close(self):
@@ -197,14 +202,15 @@ class _Body:
             out[:, k] = v[axis]
         return out
 
-    def blocks(self, block_faces):
+    def blocks(self, block_faces, begin=0, end=None):
         """(first face, (n, 3) int64 vertex ids, (n, 3, 3) float32 corners, kept: not repeating a vertex)
-        per block of faces, checked."""
+        per block of faces [begin, end), checked."""
         layout = self.layout
         dtype = layout.face_dtype
         nv = layout.vertex_count
-        for first in range(0, layout.face_count, block_faces):
-            n = min(block_faces, layout.face_count - first)
+        end = layout.face_count if end is None else end
+        for first in range(begin, end, block_faces):
+            n = min(block_faces, end - first)
             records = np.frombuffer(self.map, dtype=dtype, count=n, offset=layout.face_offset + first * dtype.itemsize)
             bad = np.flatnonzero(records["n"] != 3)
             if bad.size:
@@ -231,9 +237,9 @@ class _Body:
                 for k, axis in enumerate("xyz"):
                     corners[:, :, k] = self.vertices[axis][ids]
             elif self.rows.flags.c_contiguous:
-                corners = self.rows.take(ids.reshape(-1), axis=0).reshape(n, 3, 3)
+                corners = self.rows.take(ids.reshape(-1)).view("<f4").reshape(n, 3, 3)
             else:  # take would copy the whole vertex element first
-                corners = self.rows[ids.reshape(-1)].reshape(n, 3, 3)
+                corners = self.rows[ids.reshape(-1)].view("<f4").reshape(n, 3, 3)
             self.release()
             yield first, ids, corners, kept
 
@@ -330,16 +336,30 @@ def tile_file(folder, tile):
     return pathlib.Path(folder) / ("%d_%d_%d.faces" % tuple(tile))
 
 
-def partition(layout, cell_exponent, tile_level, folder, block_faces=BLOCK_FACES):
-    """Appends every kept face (its vertex ids and corners, file order) to its tile's file in folder.
-    Returns ({tile: face count}, number of distinct chunk cells)."""
+def part_ranges(face_count, parts, block_faces=BLOCK_FACES):
+    """[begin, end) face ranges that cut the file into `parts` pieces of whole blocks, in file order."""
+    blocks = -(-face_count // block_faces)
+    parts = max(1, min(parts, blocks))
+    bounds = [min(face_count, (blocks * k // parts) * block_faces) for k in range(parts + 1)]
+    return list(zip(bounds[:-1], bounds[1:]))
+
+
+def part_folder(scratch, part):
+    return pathlib.Path(scratch) / ("part-%04d" % part)
+
+
+def partition(layout, cell_exponent, tile_level, folder, begin=0, end=None, block_faces=BLOCK_FACES):
+    """Appends every kept face of the faces [begin, end) (its vertex ids and corners, file order) to
+    its tile's file in folder, which is emptied first (a task run again starts over). Returns
+    ({tile: face count}, the distinct chunk cells as a sorted int64 array of packed keys)."""
     folder = pathlib.Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
+    shutil.rmtree(folder, ignore_errors=True)
+    folder.mkdir(parents=True)
     dtype = record_dtype(layout)
-    counts, cells_seen = {}, set()
+    counts, cells_seen = {}, []
     body = _Body(layout)
     try:
-        for _, ids, corners, kept in body.blocks(block_faces):
+        for _, ids, corners, kept in body.blocks(block_faces, begin, end):
             ids, corners = ids[kept], corners[kept]
             if ids.shape[0] == 0:
                 continue
@@ -349,7 +369,7 @@ def partition(layout, cell_exponent, tile_level, folder, block_faces=BLOCK_FACES
                 raise StreamError("%s: %s" % (layout.path, e)) from None
             packed = _pack(cells)
             if tile_level:
-                cells_seen.update(np.unique(packed).tolist())
+                cells_seen.append(np.unique(packed))
                 key = _pack(cells >> tile_level)
             else:
                 key = packed
@@ -366,7 +386,7 @@ def partition(layout, cell_exponent, tile_level, folder, block_faces=BLOCK_FACES
             starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
             ends = np.r_[starts[1:], key.shape[0]]
             if not tile_level:
-                cells_seen.update(key[starts].tolist())
+                cells_seen.append(key[starts])
             for s, e in zip(starts.tolist(), ends.tolist()):
                 tile = _unpack(int(key[s]))
                 with open(tile_file(folder, tile), "ab") as f:
@@ -374,15 +394,41 @@ def partition(layout, cell_exponent, tile_level, folder, block_faces=BLOCK_FACES
                 counts[tile] = counts.get(tile, 0) + (e - s)
     finally:
         body.close()
-    return counts, len(cells_seen)
+    return counts, np.unique(np.concatenate(cells_seen)) if cells_seen else np.empty(0, np.int64)
 
 
-def read_tile(path, index_dtype, cell_exponent, tile_level):
-    """A tile's file as tailor.load and plan_chunks would give the tile: faces that repeat another
-    face's vertices dropped (the first kept), faces grouped by chunk in cell order (file order
-    within a chunk), the tile's vertices in the order of their ids. Returns (positions (V, 3)
-    float32, faces (F, 3) uint32)."""
-    records = np.fromfile(path, dtype=np.dtype([("i", index_dtype, 3), ("p", "<f4", (3, 3))]))
+def partition_parts(layout, cell_exponent, tile_level, scratch, parts, run=None, block_faces=BLOCK_FACES):
+    """The partition cut into `parts` ranges of the file, each into its own folder of the scratch
+    folder; run(function, *args) -> results in order runs the parts (elsewhere: Dask), or here one
+    after the other. A tile's faces in file order are its files in the parts' order. Returns
+    ({tile: face count}, {tile: [its files, in order]}, number of distinct chunk cells)."""
+    ranges = part_ranges(layout.face_count, parts, block_faces)
+    args = [
+        (layout, cell_exponent, tile_level, str(part_folder(scratch, k)), b, e, block_faces)
+        for k, (b, e) in enumerate(ranges)
+    ]
+    results = run(partition, args) if run else [partition(*a) for a in args]
+    counts, files = {}, {}
+    for k, (part_counts, _) in enumerate(results):
+        for tile, n in part_counts.items():
+            counts[tile] = counts.get(tile, 0) + n
+            files.setdefault(tile, []).append(str(tile_file(part_folder(scratch, k), tile)))
+    cells = np.unique(np.concatenate([cells for _, cells in results]))
+    return counts, files, int(cells.shape[0])
+
+
+def read_tile(paths, index_dtype, cell_exponent, tile_level):
+    """A tile's files, one after the other, as tailor.load and plan_chunks would give the tile: faces
+    that repeat another face's vertices dropped (the first kept), faces grouped by chunk in cell
+    order (file order within a chunk), the tile's vertices in the order of their ids. Returns
+    (positions (V, 3) float32, faces (F, 3) uint32)."""
+    dtype = np.dtype([("i", index_dtype, 3), ("p", "<f4", (3, 3))])
+    sizes = [os.path.getsize(p) for p in paths]
+    records = np.empty(sum(sizes) // dtype.itemsize, dtype=dtype)
+    at = 0
+    for path, size in zip(paths, sizes):
+        with open(path, "rb") as f:
+            at += f.readinto(memoryview(records.view(np.uint8))[at : at + size])
     ids = records["i"].astype(np.int64)
     corners = records["p"]
     del records
