@@ -82,6 +82,7 @@ py::dict read_material_dict(const py::object& path_object) {
 }  // namespace
 
 void bind_simplify(py::module_& m);
+void bind_canonical(py::module_& m);
 
 void bind_tiles(py::module_& m) {
   m.def(
@@ -249,6 +250,7 @@ orm_roughness_metallic and orm_occlusion (what orm_png serves as), symmetry (4 f
 tiles, 1 or 0 otherwise), files ("role: path" of every map read) and notes (one-line warnings).
 save_uvs(material=...) takes the dict.)");
   bind_simplify(m);
+  bind_canonical(m);
 }
 
 void bind_simplify(py::module_& m) {

@@ -80,37 +80,10 @@ def texels_per_unit_of_box(lo, hi, scale):
 
 
 def canonical_tile(positions, faces):
-    """A tile's faces and vertices in an order that depends on its geometry only: each face turned so
-    that its smallest corner (by x, then y, then z) comes first, faces sorted by a 64-bit hash of
-    their nine coordinates' bits, vertices numbered by first use. O(F) but for one sort of the
-    hashes. Returns (positions (V, 3) float32, faces (F, 3) uint32)."""
-    faces = np.asarray(faces, dtype=np.int64)
-    c = positions[faces]  # (F, 3, 3)
-
-    def less(a, b):
-        return (a[:, 0] < b[:, 0]) | (
-            (a[:, 0] == b[:, 0]) & ((a[:, 1] < b[:, 1]) | ((a[:, 1] == b[:, 1]) & (a[:, 2] < b[:, 2])))
-        )
-
-    first = np.zeros(faces.shape[0], dtype=np.int64)
-    first[less(c[:, 1], c[:, 0])] = 1
-    smallest = np.take_along_axis(c, first[:, None, None], axis=1)[:, 0]
-    first[less(c[:, 2], smallest)] = 2
-    turn = (first[:, None] + np.arange(3)[None, :]) % 3
-    faces = np.take_along_axis(faces, turn, axis=1)
-    words = np.ascontiguousarray(positions[faces].reshape(-1, 9)).view(np.uint32).astype(np.uint64)
-    h = np.full(faces.shape[0], 0xCBF29CE484222325, dtype=np.uint64)  # FNV-1a over the 9 words
-    for k in range(9):
-        h = (h ^ words[:, k]) * np.uint64(0x100000001B3)
-    faces = faces[np.argsort(h, kind="stable")]
-    flat = faces.ravel()
-    first_use = np.full(positions.shape[0], flat.shape[0], dtype=np.int64)
-    first_use[flat[::-1]] = np.arange(flat.shape[0] - 1, -1, -1)  # the last write, the first use, wins
-    used = np.flatnonzero(first_use < flat.shape[0])
-    by_use = used[np.argsort(first_use[used], kind="stable")]
-    new_id = np.empty(positions.shape[0], dtype=np.uint32)
-    new_id[by_use] = np.arange(by_use.shape[0], dtype=np.uint32)
-    return np.ascontiguousarray(positions[by_use], dtype=np.float32), new_id[faces]
+    """A tile's faces and vertices in an order that depends on its geometry only (tailor.canonical_tile:
+    each face turned so that its smallest corner comes first, faces sorted by a hash of their nine
+    coordinates, vertices numbered by first use). Returns (positions (V, 3) float32, faces (F, 3) uint32)."""
+    return tailor.canonical_tile(positions, faces)
 
 
 def tile_digest(positions, faces, params):

@@ -453,6 +453,57 @@ def horse_arrays():
     return mesh.positions.astype(np.float64), mesh.faces.astype(np.int64)
 
 
+def canonical_tile_in_numpy(positions, faces):
+    """What tailor.canonical_tile is documented to do, written out in numpy."""
+    faces = np.asarray(faces, dtype=np.int64)
+    c = positions[faces]
+
+    def less(a, b):
+        return (a[:, 0] < b[:, 0]) | (
+            (a[:, 0] == b[:, 0]) & ((a[:, 1] < b[:, 1]) | ((a[:, 1] == b[:, 1]) & (a[:, 2] < b[:, 2])))
+        )
+
+    first = np.zeros(faces.shape[0], dtype=np.int64)
+    first[less(c[:, 1], c[:, 0])] = 1
+    smallest = np.take_along_axis(c, first[:, None, None], axis=1)[:, 0]
+    first[less(c[:, 2], smallest)] = 2
+    faces = np.take_along_axis(faces, (first[:, None] + np.arange(3)[None, :]) % 3, axis=1)
+    words = np.ascontiguousarray(positions[faces].reshape(-1, 9)).view(np.uint32).astype(np.uint64)
+    h = np.full(faces.shape[0], 0xCBF29CE484222325, dtype=np.uint64)
+    for k in range(9):
+        h = (h ^ words[:, k]) * np.uint64(0x100000001B3)
+    faces = faces[np.argsort(h, kind="stable")]
+    _, first_use = np.unique(faces.ravel(), return_index=True)
+    by_use = np.unique(faces.ravel())[np.argsort(first_use)]
+    new_id = np.empty(positions.shape[0], dtype=np.uint32)
+    new_id[by_use] = np.arange(by_use.shape[0], dtype=np.uint32)
+    return positions[by_use], new_id[faces]
+
+
+def test_a_tile_in_canonical_order_is_the_same_for_any_input_order():
+    positions, faces = horse_arrays()
+    positions = positions.astype(np.float32)
+    p, f = tailor.canonical_tile(positions, faces.astype(np.uint32))
+    ref_p, ref_f = canonical_tile_in_numpy(positions, faces)
+    assert p.dtype == np.float32 and f.dtype == np.uint32
+    assert np.array_equal(p, ref_p) and np.array_equal(f, ref_f)
+    # Faces shuffled, each turned, vertices renumbered, an unused vertex added: the same arrays.
+    rng = np.random.default_rng(5)
+    order = rng.permutation(faces.shape[0])
+    turn = rng.integers(0, 3, faces.shape[0])
+    shuffled = np.take_along_axis(faces[order], (turn[:, None] + np.arange(3)) % 3, axis=1)
+    renumber = rng.permutation(positions.shape[0] + 1)
+    moved = np.empty((positions.shape[0] + 1, 3), np.float32)
+    moved[renumber[: positions.shape[0]]] = positions
+    moved[renumber[-1]] = 7.0
+    p2, f2 = tailor.canonical_tile(moved, renumber[shuffled])
+    assert np.array_equal(p2, p) and np.array_equal(f2, f)
+    with pytest.raises(tailor.Error, match="face 1 has vertex 9"):
+        tailor.canonical_tile(positions[:9], np.array([[0, 1, 2], [3, 4, 9]]))
+    with pytest.raises(tailor.Error, match="positions must be a"):
+        tailor.canonical_tile(positions[:, :2], faces)
+
+
 def test_a_streamed_ply_gives_the_in_memory_tiles(tmp_path):
     # The horse as it is (float x y z, normals, uchar int lists): auto cell; then cut coarser.
     for extra in ([], ["--chunk-cell", CELL, "--tile-size", 2.0**(CELL + 1)]):
