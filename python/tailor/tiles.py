@@ -869,11 +869,11 @@ def run(args):
             del positions, faces, mesh
             sizes = [job[2].shape[0] for job in jobs]
         else:
-            # One pass: each face appended to its tile's file in the scratch folder. With a cluster
-            # the file is cut into ranges of a few blocks, shared between this process and the
-            # cluster's workers.
+            # One pass: each face appended to its tile's file in the scratch folder. With a local
+            # cluster the file is cut into ranges of a few blocks, shared between this process and
+            # the cluster's workers (a cluster of --scheduler may not see the input file).
             parts, run_parts = 1, None
-            if start is not None:
+            if start is not None and not args.scheduler:
                 parts = PARTITION_PARTS
                 run_parts = functools.partial(run_shared, start, "partition-%s" % tmp.name)
             counts, files, chunk_count = tiles_stream.partition_parts(
