@@ -79,13 +79,6 @@ def texels_per_unit_of_box(lo, hi, scale):
     return math.ldexp(1.0, int(math.copysign(math.floor(abs(x) + 0.5), x)))  # std::round: half away from 0
 
 
-def canonical_tile(positions, faces):
-    """A tile's faces and vertices in an order that depends on its geometry only (tailor.canonical_tile:
-    each face turned so that its smallest corner comes first, faces sorted by a hash of their nine
-    coordinates, vertices numbered by first use). Returns (positions (V, 3) float32, faces (F, 3) uint32)."""
-    return tailor.canonical_tile(positions, faces)
-
-
 def tile_digest(positions, faces, params):
     h = hashlib.sha256()
     h.update(json.dumps(params, sort_keys=True).encode())
@@ -314,7 +307,7 @@ def leaf_record(job, positions, faces, params):
 def map_tile(job, positions, faces, params, folder, keep_from, threads, lod):
     """A leaf: puts the tile in its canonical order, maps its chunks and writes tiles/<name>.glb, or
     links the previous run's files when the digest is the same. Returns the node's record."""
-    positions, faces = canonical_tile(positions, faces)
+    positions, faces = tailor.canonical_tile(positions, faces)
     record = leaf_record(job, positions, faces, params)
     if kept(keep_from, record["digest"], folder, job["name"], lod):
         record["coarse_error"] = keep_from.get("coarse_error", 0.0)
@@ -456,7 +449,7 @@ def map_in_process(jobs, order, params, folder, threads, lod):
     jobs = list(jobs)
     for i in order:
         job, p, f, keep = jobs[i]
-        p, f = canonical_tile(p, f)
+        p, f = tailor.canonical_tile(p, f)
         jobs[i] = (job, p, f, keep)
         if keep and keep.get("digest") == tile_digest(p, f, params):
             yield i, map_tile(job, p, f, params, folder, keep, threads, lod)
