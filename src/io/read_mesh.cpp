@@ -188,12 +188,6 @@ bool read_file_start(const std::filesystem::path& path, size_t max_bytes, std::s
   return true;
 }
 
-std::string_view trimmed(std::string_view text) {
-  const size_t b = text.find_first_not_of(" \t\r");
-  if (b == std::string_view::npos) return {};
-  return text.substr(b, text.find_last_not_of(" \t\r") + 1 - b);
-}
-
 // The texture a mesh file names (an image next to it): report.texture_width/height from the
 // image's header (never decoded), texture_file and texture_path. A missing or unreadable image
 // leaves them as they are: the mesh itself loaded, and its texture is optional.
@@ -231,11 +225,11 @@ void read_obj_material(const std::filesystem::path& folder, const std::string& l
   std::string_view rest = mtl;
   while (!rest.empty()) {
     const size_t end = rest.find('\n');
-    const std::string_view line = trimmed(rest.substr(0, end));
+    const std::string_view line = internal::trimmed(rest.substr(0, end));
     rest = end == std::string_view::npos ? std::string_view{} : rest.substr(end + 1);
     if (line == "# tailor symmetry 4") symmetry = 4;
     if (!texture.empty() || (line.substr(0, 7) != "map_Kd " && line.substr(0, 7) != "map_Kd\t")) continue;
-    const std::string_view name = trimmed(line.substr(7));
+    const std::string_view name = internal::trimmed(line.substr(7));
     // The name, unless options (-s 1 1 1, -clamp on, ...) come first: then its last word.
     const size_t last_blank = name.find_last_of(" \t");
     texture =

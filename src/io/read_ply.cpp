@@ -171,9 +171,7 @@ Status parse_header(std::string_view data, const std::string& name, PlyHeader& h
     }
     if (w.size() >= 3 && w[0] == "comment" && w[1] == "TextureFile" && h.texture_file.empty()) {
       // The name is the rest of the line (it may hold blanks), trimmed.
-      const size_t at = line.find("TextureFile") + 11;
-      const size_t b = line.find_first_not_of(" \t\r", at), e = line.find_last_not_of(" \t\r");
-      if (b != std::string_view::npos && e >= b) h.texture_file = std::string(line.substr(b, e + 1 - b));
+      h.texture_file = std::string(trimmed(line.substr(line.find("TextureFile") + 11)));
       continue;
     }
     if (w.size() == 4 && w[0] == "comment" && w[1] == "tailor" && w[2] == "symmetry" && w[3] == "4") h.symmetry = 4;

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <string_view>
 
 #include "tailor/image.h"
 #include "tailor/mesh.h"
@@ -15,6 +16,14 @@
 #include "tailor/status.h"
 
 namespace tailor::internal {
+
+//! `text` without the blanks (spaces, tabs, carriage returns) at either end: names on the rest of
+//! a header line (an .mtl's map_Kd, a PLY's TextureFile).
+inline std::string_view trimmed(std::string_view text) {
+  const size_t b = text.find_first_not_of(" \t\r");
+  if (b == std::string_view::npos) return {};
+  return text.substr(b, text.find_last_not_of(" \t\r") + 1 - b);
+}
 
 //! A reader's progress, as the share of its input parsed, for load_mesh's callback: at() is cheap
 //! enough to call per element, and calls the callback only every kStep units (bytes, or whatever
