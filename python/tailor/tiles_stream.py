@@ -22,6 +22,7 @@ import mmap
 import os
 import pathlib
 import shutil
+import tempfile
 
 import numpy as np
 
@@ -350,11 +351,29 @@ def part_folder(scratch, part):
 
 def partition(layout, cell_exponent, tile_level, folder, begin=0, end=None, block_faces=BLOCK_FACES):
     """Appends every kept face of the faces [begin, end) (its vertex ids and corners, file order) to
-    its tile's file in folder, which is emptied first (a task run again starts over). Returns
-    ({tile: face count}, the distinct chunk cells as a sorted int64 array of packed keys)."""
+    its tile's file in folder. Returns ({tile: face count}, the distinct chunk cells as a sorted int64
+    array of packed keys).
+
+    The files are written into a folder of this call's own and renamed into place when complete:
+    a range run twice at once (a task Dask retried while its first worker, declared lost, still
+    runs) or again (a retry) never mixes two runs' appends, and a folder in place is always whole.
+    When another run put the folder in place first, this one's is dropped (it holds the same bytes)."""
     folder = pathlib.Path(folder)
-    shutil.rmtree(folder, ignore_errors=True)
-    folder.mkdir(parents=True)
+    folder.parent.mkdir(parents=True, exist_ok=True)
+    own = pathlib.Path(tempfile.mkdtemp(prefix=folder.name + ".run-", dir=folder.parent))
+    try:
+        result = _partition_into(layout, cell_exponent, tile_level, own, begin, end, block_faces)
+        if not folder.exists():
+            try:
+                os.rename(own, folder)
+            except OSError:  # another run's folder came first (not empty): it holds the same bytes
+                pass
+        return result
+    finally:
+        shutil.rmtree(own, ignore_errors=True)
+
+
+def _partition_into(layout, cell_exponent, tile_level, folder, begin, end, block_faces):
     dtype = record_dtype(layout)
     counts, cells_seen = {}, []
     body = _Body(layout)

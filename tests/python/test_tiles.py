@@ -3,6 +3,7 @@ byte, whatever the worker count; re-runs keep unchanged tiles; errors leave noth
 import json
 import os
 import pathlib
+import shutil
 import struct
 import subprocess
 import sys
@@ -553,7 +554,7 @@ def test_a_streamed_ply_gives_the_in_memory_tiles(tmp_path):
 def test_the_partition_in_parts_is_the_partition_in_one(tmp_path):
     # The file cut into ranges (as the driver and a cluster's workers share it): each tile's files,
     # read one after the other, hold the faces the one-range partition gives it, in the same order;
-    # a range partitioned again (a task retried) starts its folder over.
+    # a range partitioned again (a task retried, or run twice at once) leaves a whole folder in place.
     from tailor import tiles_stream
 
     layout = tiles_stream.read_layout(str(HORSE))
@@ -570,6 +571,11 @@ def test_the_partition_in_parts_is_the_partition_in_one(tmp_path):
     again = tiles_stream.partition(layout, CELL, 1, folder, first, end, 10000)
     assert {p.name: p.read_bytes() for p in folder.iterdir()} == before
     assert sum(again[0].values()) == end - first
+    shutil.rmtree(folder)
+    counts, cells = tiles_stream.partition(layout, CELL, 1, folder, first, end, 10000)
+    assert counts == again[0] and np.array_equal(cells, again[1])
+    assert {p.name: p.read_bytes() for p in folder.iterdir()} == before
+    assert sorted(p.name for p in folder.parent.iterdir()) == ["part-%04d" % k for k in range(4)]
 
 
 def test_a_bad_streamed_ply_is_one_line_and_leaves_nothing(tmp_path):
