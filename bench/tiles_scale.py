@@ -130,6 +130,12 @@ def time_runs(path, binary):
                 extra += ", largest worker %d" % (summary["worker_peak_rss"] >> 20)
             extra += ")"
         print("%-48s %7.1f s%s" % (name, s, extra))
+    wall = {name: s for name, s, _ in rows}
+    w0 = wall["tailor.tiles --workers 0 --threads 1 --no-lod"]
+    w1 = wall["tailor.tiles --workers 1 --threads 1 --no-lod"]
+    w2 = wall["tailor.tiles --workers 2 --threads 1 --no-lod"]
+    print("2 workers over 1: %.2fx; 1 worker over the same tiles without Dask (--workers 0): %+.0f %%" % (
+        w1 / w2, 100 * (w1 / w0 - 1)))
     print("tile folders identical for workers 0/1/2 and threads 1/2: %s" % same)
     print("load average: %s" % " ".join("%.2f" % x for x in os.getloadavg()))
     shutil.rmtree(work)
