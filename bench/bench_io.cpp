@@ -43,13 +43,14 @@ BENCHMARK(BM_LoadAsciiObj)->Unit(benchmark::kMillisecond)->MinTime(1.0)->UseReal
 
 void BM_Topology(benchmark::State& state) {
   const tailor::Mesh& mesh = subdivided_horse();
+  const auto threads = static_cast<uint32_t>(state.range(0));
   for (auto _ : state) {
-    tailor::Topology t = tailor::build_topology(mesh);
+    tailor::Topology t = tailor::build_topology(mesh, {}, threads);
     benchmark::DoNotOptimize(t.opposite.data());
   }
   set_faces_rate(state, mesh.face_count());
 }
-BENCHMARK(BM_Topology)->Unit(benchmark::kMillisecond)->MinTime(1.0)->UseRealTime();
+BENCHMARK(BM_Topology)->ArgName("threads")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->MinTime(1.0)->UseRealTime();
 
 // The atlas of `tailor map --no-crack-closing` (seams on about 5% of the edges), mapped once.
 const tailor::Atlas& subdivided_horse_atlas() {

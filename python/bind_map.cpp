@@ -352,7 +352,7 @@ void bind_map(py::module_& m) {
           // reports, hence Ctrl-C, from the start).
           Topology topology;
           if (run.axis_auto) {
-            topology = build_topology(mesh.mesh);
+            topology = build_topology(mesh.mesh, {}, options.mapping.threads);
             const auto axis_start = std::chrono::steady_clock::now();
             mapping.progress = [&report_progress](float f) { return report_progress(f); };
             AxisChoice choice;
@@ -371,7 +371,7 @@ void bind_map(py::module_& m) {
             status = map_texture(mesh.mesh, topology, unmeasured, map);
           }
           if (status) {
-            if (topology.opposite.empty()) topology = build_topology(mesh.mesh);
+            if (topology.opposite.empty()) topology = build_topology(mesh.mesh, {}, options.mapping.threads);
             status = measure_texture_map(mesh.mesh, topology, options, map);
           }
           if (status) {

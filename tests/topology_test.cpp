@@ -37,6 +37,21 @@ void expect_consistent(const Mesh& mesh, const Topology& t) {
   }
 }
 
+// The topology on several threads is the one-thread topology (every array and count).
+void expect_same_on_threads(const Mesh& mesh, const Topology& one) {
+  for (const uint32_t threads : {2u, 3u, 7u}) {
+    const Topology t = build_topology(mesh, {}, threads);
+    EXPECT_EQ(t.opposite, one.opposite) << threads << " threads";
+    EXPECT_EQ(t.face_component, one.face_component) << threads << " threads";
+    EXPECT_EQ(t.edge_components, one.edge_components);
+    EXPECT_EQ(t.vertex_components, one.vertex_components);
+    EXPECT_EQ(t.edges, one.edges);
+    EXPECT_EQ(t.boundary_edges, one.boundary_edges);
+    EXPECT_EQ(t.nonmanifold_edges, one.nonmanifold_edges);
+    EXPECT_EQ(t.inconsistent_edges, one.inconsistent_edges);
+  }
+}
+
 struct Expected {
   const char* file;
   size_t faces;
@@ -55,8 +70,9 @@ TEST_P(RealMeshTopology, MatchesManifest) {
   LoadReport report;
   const Status s = load_mesh(std::string(TAILOR_TEST_DATA) + "/meshes/" + x.file, mesh, &report);
   ASSERT_TRUE(s.is_ok()) << s.message();
-  const Topology t = build_topology(mesh);
+  const Topology t = build_topology(mesh, {}, 1);
   expect_consistent(mesh, t);
+  expect_same_on_threads(mesh, t);
   EXPECT_EQ(mesh.face_count(), x.faces);
   EXPECT_EQ(t.vertex_components, x.components);
   EXPECT_EQ(t.boundary_edges, x.boundary_edges);
@@ -99,6 +115,7 @@ TEST(Topology, BowTieVertexJoinsByVertexOnly) {
   // Two triangles touching at vertex 2 only.
   const Mesh m = make_mesh({0, 0, 0, 1, 0, 0, 0.5f, 1, 0, 0, 2, 0, 1, 2, 0}, {0, 1, 2, 2, 3, 4});
   const Topology t = build_topology(m);
+  expect_same_on_threads(m, t);
   EXPECT_EQ(t.vertex_components, 1u);
   EXPECT_EQ(t.edge_components, 2u);
   EXPECT_EQ(t.boundary_edges, 6u);
@@ -110,6 +127,7 @@ TEST(Topology, FinEdgeWithThreeFacesIsCutAndCounted) {
   // Faces 0,1,2 all use edge 0-1.
   const Mesh m = make_mesh({0, 0, 0, 1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1}, {0, 1, 2, 1, 0, 3, 0, 1, 4});
   const Topology t = build_topology(m);
+  expect_same_on_threads(m, t);
   EXPECT_EQ(t.nonmanifold_edges, 1u);
   EXPECT_EQ(t.opposite[0], kInvalid);
   EXPECT_EQ(t.opposite[3], kInvalid);
@@ -123,6 +141,7 @@ TEST(Topology, FlippedFaceIsInconsistentNotPaired) {
   // Both faces run 1 -> 2.
   const Mesh m = make_mesh({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0}, {0, 1, 2, 1, 2, 3});
   const Topology t = build_topology(m);
+  expect_same_on_threads(m, t);
   EXPECT_EQ(t.inconsistent_edges, 1u);
   for (uint32_t o : t.opposite) EXPECT_EQ(o, kInvalid);
   EXPECT_EQ(t.edge_components, 2u);

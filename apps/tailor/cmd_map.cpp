@@ -184,7 +184,8 @@ int run_map(const MapArgs& opt) {
   Topology topology;
   const auto connect = [&] {
     Progress connecting("topology", opt.quiet);
-    topology = build_topology(mesh, [&connecting](float f) { return connecting.update(f); });
+    topology = build_topology(
+        mesh, [&connecting](float f) { return connecting.update(f); }, mapping.threads);
     connecting.done();
     if (topology.nonmanifold_edges || topology.inconsistent_edges)
       warn(opt.quiet, opt.input + ": " + std::to_string(topology.nonmanifold_edges) + " non-manifold and " +

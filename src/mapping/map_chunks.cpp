@@ -75,7 +75,7 @@ Status map_chunk(const MapTextureOptions& options, const std::array<double, 3>& 
     return Status::error(ErrorCode::kInvalidArgument, "",
                          "the texel density gives " + std::to_string(chunk_scale) +
                              " pixels per chunk cell, outside 0.001 to 1e7: give another chunk cell or scale");
-  const Topology topology = build_topology(w.mesh);
+  const Topology topology = build_topology(w.mesh, {}, threads);
   MapTextureOptions o = chunk_map_options(options, origin, size, texels_per_unit);
   o.mapping.progress = std::move(progress);
   o.mapping.threads = threads;
@@ -111,7 +111,7 @@ Status map_whole_canonical(const Mesh& mesh, const MapTextureOptions& options, T
   build_chunk_mesh(mesh, all, origin, side, options.mapping.seam_faces, w);
   std::vector<uint32_t>().swap(all);
   {
-    const Topology topology = build_topology(w.mesh);
+    const Topology topology = build_topology(w.mesh, {}, options.mapping.threads);
     MapTextureOptions o = options;
     o.mapping.seam_faces = w.seam_flags;
     o.measure = false;  // map_texture measures the result on the mesh as given

@@ -9,10 +9,12 @@
 #include <algorithm>
 #include <chrono>
 #include <numeric>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
 #include "util/huge_pages.h"
+#include "util/parallel_chunks.h"
 
 namespace tailor {
 namespace {
@@ -21,23 +23,31 @@ namespace {
 // (a fan of a million faces around one vertex must not take 10^12 steps).
 constexpr size_t kLinearMatchLimit = 32;
 
+// Edge counts of one slice of lower vertices (summed into Topology after the matching).
+struct EdgeCounts {
+  size_t edges = 0, boundary = 0, nonmanifold = 0, inconsistent = 0;
+};
+
+// Faces per thread of the edge passes: below this, starting a thread costs more than it saves.
+constexpr size_t kFacesPerThread = 250000;
+
 // Decides the fate of one undirected edge, given its uses sorted by (direction, edge id).
-void match_group(const uint64_t* uses, size_t count, Topology& t) {
+void match_group(const uint64_t* uses, size_t count, uint32_t* opposite, EdgeCounts& counts) {
   if (count == 1) {
-    ++t.boundary_edges;
+    ++counts.boundary;
   } else if (count == 2) {
     const uint32_t e0 = static_cast<uint32_t>(uses[0]);
     const uint32_t e1 = static_cast<uint32_t>(uses[1]);
     if (((uses[0] ^ uses[1]) >> 32) & 1) {
-      t.opposite[e0] = e1;
-      t.opposite[e1] = e0;
+      opposite[e0] = e1;
+      opposite[e1] = e0;
     } else {
-      ++t.inconsistent_edges;  // both faces run the edge the same way: left unpaired
+      ++counts.inconsistent;  // both faces run the edge the same way: left unpaired
     }
   } else {
-    ++t.nonmanifold_edges;  // three or more faces: all uses left unpaired
+    ++counts.nonmanifold;  // three or more faces: all uses left unpaired
   }
-  ++t.edges;
+  ++counts.edges;
 }
 
 uint32_t find_root(uint32_t* parent, uint32_t x) {
@@ -50,9 +60,13 @@ uint32_t find_root(uint32_t* parent, uint32_t x) {
 
 }  // namespace
 
-Topology build_topology(const Mesh& mesh) { return build_topology(mesh, {}); }
+Topology build_topology(const Mesh& mesh) { return build_topology(mesh, {}, 0); }
 
 Topology build_topology(const Mesh& mesh, const ProgressCallback& progress) {
+  return build_topology(mesh, progress, 0);
+}
+
+Topology build_topology(const Mesh& mesh, const ProgressCallback& progress, uint32_t threads) {
   auto reached = [&progress](float done) {
     if (progress) (void)progress(done);
   };
@@ -66,73 +80,134 @@ Topology build_topology(const Mesh& mesh, const ProgressCallback& progress) {
   internal::reserve_huge(t.opposite, corner_count);
   t.opposite.assign(corner_count, kInvalid);
 
+  // The edge passes on several threads, each owning a range of lower vertices: it reads every
+  // face but counts, places and matches only the edges whose lower vertex is its own, so no two
+  // threads write the same entry and the result does not depend on the count (a vertex's list is
+  // sorted before matching). Reading all faces per thread is sequential and cheap next to the
+  // scattered writes it divides.
+  const size_t slices = std::min(internal::parallel_threads(corner_count / 3, threads, kFacesPerThread),
+                                 std::max<size_t>(vertex_count, 1));
+  const auto slice_begin = [&](size_t s) { return static_cast<uint32_t>(vertex_count * s / slices); };
+  const auto each_slice = [&](auto body) {
+    internal::for_each_chunk(
+        slices, slices, [&](size_t s, size_t, size_t) { body(slice_begin(s), slice_begin(s + 1), s); }, 1);
+  };
+
   // === Group edge uses by their lower vertex (counting sort) ===
   // Each entry is (higher vertex << 33) | (runs lower -> higher) << 32 | edge id, so grouping and
   // the direction check need no further index lookups (vertex ids < 2^31, see kMaxVertices).
   std::vector<uint32_t> offsets(vertex_count + 1, 0);
-  for (size_t f = 0; f < corner_count; f += 3) {
-    const uint32_t a = indices[f], b = indices[f + 1], c = indices[f + 2];
-    ++offsets[std::min(a, b) + 1];
-    ++offsets[std::min(b, c) + 1];
-    ++offsets[std::min(c, a) + 1];
-  }
+  // `sliced` (std::true_type with several slices) compiles the range test in; one slice runs without.
+  const auto ours = [](auto sliced, uint32_t low, uint32_t lo, uint32_t hi) {
+    if constexpr (decltype(sliced)::value) return low >= lo && low < hi;
+    return true;
+  };
+  const auto count_uses = [&](auto sliced, uint32_t lo, uint32_t hi) {
+    const auto count = [&](uint32_t low) {
+      if (ours(sliced, low, lo, hi)) ++offsets[low + 1];
+    };
+    for (size_t f = 0; f < corner_count; f += 3) {
+      const uint32_t a = indices[f], b = indices[f + 1], c = indices[f + 2];
+      count(std::min(a, b));
+      count(std::min(b, c));
+      count(std::min(c, a));
+    }
+  };
+  each_slice([&](uint32_t lo, uint32_t hi, size_t) {
+    slices == 1 ? count_uses(std::false_type{}, lo, hi) : count_uses(std::true_type{}, lo, hi);
+  });
   for (size_t v = 0; v < vertex_count; ++v) offsets[v + 1] += offsets[v];
   internal::HugeArray<uint64_t> sorted = internal::huge_uninitialized<uint64_t>(corner_count);
   {
     std::vector<uint32_t> cursor(offsets.begin(), offsets.end() - 1);
-    for (size_t f = 0; f < corner_count; f += 3) {
-      const uint32_t v[3] = {indices[f], indices[f + 1], indices[f + 2]};
-      for (uint32_t k = 0; k < 3; ++k) {
-        const uint32_t a = v[k], b = v[k == 2 ? 0 : k + 1];
-        sorted[cursor[std::min(a, b)]++] =
-            (uint64_t{std::max(a, b)} << 33) | (uint64_t{a < b} << 32) | static_cast<uint32_t>(f + k);
+    const auto place_uses = [&](auto sliced, uint32_t lo, uint32_t hi) {
+      for (size_t f = 0; f < corner_count; f += 3) {
+        const uint32_t v[3] = {indices[f], indices[f + 1], indices[f + 2]};
+        for (uint32_t k = 0; k < 3; ++k) {
+          const uint32_t a = v[k], b = v[k == 2 ? 0 : k + 1], low = std::min(a, b);
+          if (!ours(sliced, low, lo, hi)) continue;
+          sorted[cursor[low]++] =
+              (uint64_t{std::max(a, b)} << 33) | (uint64_t{a < b} << 32) | static_cast<uint32_t>(f + k);
+        }
       }
-    }
+    };
+    each_slice([&](uint32_t lo, uint32_t hi, size_t) {
+      slices == 1 ? place_uses(std::false_type{}, lo, hi) : place_uses(std::true_type{}, lo, hi);
+    });
   }
 
   reached(0.3f);
   // === Match the uses of each undirected edge (same lower and higher vertex) ===
   // Sorting a vertex's entries puts the uses of one edge next to each other, ordered by edge id,
   // so the pairing does not depend on anything but the mesh. Lists are short (~6 on average):
-  // insertion sort, with std::sort for the rare high-valence vertex.
-  for (size_t v = 0; v < vertex_count; ++v) {
-    uint64_t* list = sorted.get() + offsets[v];
-    const size_t n = offsets[v + 1] - offsets[v];
-    if (n <= kLinearMatchLimit) {
-      for (size_t i = 1; i < n; ++i) {
-        const uint64_t x = list[i];
-        size_t j = i;
-        for (; j > 0 && list[j - 1] > x; --j) list[j] = list[j - 1];
-        list[j] = x;
+  // insertion sort, with std::sort for the rare high-valence vertex. Each slice counts its edges
+  // apart; the counts are summed after.
+  std::vector<EdgeCounts> counts(slices);
+  each_slice([&](uint32_t lo, uint32_t hi, size_t s) {
+    for (size_t v = lo; v < hi; ++v) {
+      uint64_t* list = sorted.get() + offsets[v];
+      const size_t n = offsets[v + 1] - offsets[v];
+      if (n <= kLinearMatchLimit) {
+        for (size_t i = 1; i < n; ++i) {
+          const uint64_t x = list[i];
+          size_t j = i;
+          for (; j > 0 && list[j - 1] > x; --j) list[j] = list[j - 1];
+          list[j] = x;
+        }
+      } else {
+        std::sort(list, list + n);
       }
-    } else {
-      std::sort(list, list + n);
+      for (size_t i = 0; i < n;) {
+        size_t end = i + 1;
+        while (end < n && (list[end] >> 33) == (list[i] >> 33)) ++end;
+        match_group(list + i, end - i, t.opposite.data(), counts[s]);
+        i = end;
+      }
     }
-    for (size_t i = 0; i < n;) {
-      size_t end = i + 1;
-      while (end < n && (list[end] >> 33) == (list[i] >> 33)) ++end;
-      match_group(list + i, end - i, t);
-      i = end;
-    }
+  });
+  for (const EdgeCounts& c : counts) {
+    t.edges += c.edges;
+    t.boundary_edges += c.boundary;
+    t.nonmanifold_edges += c.nonmanifold;
+    t.inconsistent_edges += c.inconsistent;
   }
 
   reached(0.6f);
   // === Components through paired edges ===
   // Union-find in face order rather than a flood fill: neighbouring faces are mostly near each
   // other in file order, so this pass reads opposite[] sequentially and parent[] with good
-  // locality. Roots are always the lowest face of their set, so numbering roots in face order
-  // numbers components by their lowest face.
+  // locality. Roots are always the lowest face of their set (the larger root goes under the
+  // smaller), so the sets do not depend on the order of the unions, and numbering roots in face
+  // order numbers components by their lowest face. With several slices of faces, each slice
+  // joins the pairs inside it on its own thread (they touch only its faces' entries), then one
+  // thread joins the pairs that cross slices.
   const size_t face_count = mesh.face_count();
   internal::HugeArray<uint32_t> face_parent = internal::huge_uninitialized<uint32_t>(face_count);
-  for (size_t f = 0; f < face_count; ++f) face_parent[f] = static_cast<uint32_t>(f);
-  for (size_t f = 0; f < face_count; ++f) {
-    for (uint32_t k = 0; k < 3; ++k) {
-      const uint32_t g = neighbour_face(t, static_cast<uint32_t>(3 * f + k));
-      if (g == kInvalid || g < f) continue;  // each pair once
-      const uint32_t a = find_root(face_parent.get(), static_cast<uint32_t>(f));
-      const uint32_t b = find_root(face_parent.get(), g);
-      if (a != b) face_parent[std::max(a, b)] = std::min(a, b);
-    }
+  const auto face_begin = [&](size_t s) { return static_cast<uint32_t>(face_count * s / slices); };
+  const auto join = [&face_parent](uint32_t f, uint32_t g) {
+    const uint32_t a = find_root(face_parent.get(), f);
+    const uint32_t b = find_root(face_parent.get(), g);
+    if (a != b) face_parent[std::max(a, b)] = std::min(a, b);
+  };
+  internal::for_each_chunk(
+      slices, slices,
+      [&](size_t s, size_t, size_t) {
+        const uint32_t lo = face_begin(s), hi = face_begin(s + 1);
+        for (uint32_t f = lo; f < hi; ++f) face_parent[f] = f;
+        for (uint32_t f = lo; f < hi; ++f)
+          for (uint32_t k = 0; k < 3; ++k) {
+            const uint32_t g = neighbour_face(t, 3 * f + k);
+            if (g != kInvalid && g > f && g < hi) join(f, g);  // each pair once
+          }
+      },
+      1);
+  for (size_t s = 0; s + 1 < slices; ++s) {
+    const uint32_t lo = face_begin(s), hi = face_begin(s + 1);
+    for (uint32_t f = lo; f < hi; ++f)
+      for (uint32_t k = 0; k < 3; ++k) {
+        const uint32_t g = neighbour_face(t, 3 * f + k);
+        if (g != kInvalid && g >= hi) join(f, g);
+      }
   }
   internal::reserve_huge(t.face_component, face_count);
   t.face_component.resize(face_count);
