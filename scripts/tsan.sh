@@ -3,7 +3,8 @@
 # once, which must never touch the same vertex), the metrics' and the orientation's chunked
 # passes, the integer-grid map's field and relaxation (symmetry 4), the export's second thread,
 # the chunked engine (one chunk per thread, progress from every worker) and the edit session's
-# chunk updates (the touched chunks on parallel threads).
+# chunk updates (the touched chunks on parallel threads), and the topology's slices of vertices
+# and faces.
 #
 #   scripts/tsan.sh   # make tsan
 #
@@ -18,13 +19,14 @@ jobs="${JOBS:-2}"
 export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1"
 
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTAILOR_TSAN=ON -DTAILOR_BUILD_BENCH=OFF >/dev/null
-cmake --build "$build" -j "$jobs" --target tailor mapping_test metrics_test orientation_test chunks_test edit_session_test >/dev/null
+cmake --build "$build" -j "$jobs" --target tailor mapping_test metrics_test orientation_test chunks_test edit_session_test topology_test >/dev/null
 
 "$build/mapping_test" --gtest_brief=1 --gtest_filter='Mapping.CrackClosingIsTheSameOnAnyThreadCount:Mapping.RelaxationLowersAngleDistortion:Mapping.ProgressCanCancel:Mapping.SymmetryFourGivesInvisibleSeams'
 "$build/metrics_test" --gtest_brief=1 --gtest_filter='Metrics.ThreadCountDoesNotChangeAnyFigure'
 "$build/orientation_test" --gtest_brief=1
 "$build/chunks_test" --gtest_brief=1 --gtest_filter='ChunkedMapping.SameBitsForAnyThreadCountAndQualityKept:ChunkedMapping.CancelsAndRefusesWhatNeedsTheWholeMesh'
 "$build/edit_session_test" --gtest_brief=1 --gtest_filter='EditSession.ChunkedLocalUpdatesAreTheSameForAnyThreadCount'
+"$build/topology_test" --gtest_brief=1
 tmp="$(mktemp -d "${TMPDIR:-/tmp}/tailor-tsan.XXXXXX")"
 trap 'rm -rf "$tmp"' EXIT
 for mesh in horse.ply fertility.off blobby-3cc.off; do
