@@ -83,6 +83,7 @@ py::dict read_material_dict(const py::object& path_object) {
 
 void bind_simplify(py::module_& m);
 void bind_canonical(py::module_& m);
+void bind_compact(py::module_& m);
 
 void bind_tiles(py::module_& m) {
   m.def(
@@ -251,6 +252,7 @@ tiles, 1 or 0 otherwise), files ("role: path" of every map read) and notes (one-
 save_uvs(material=...) takes the dict.)");
   bind_simplify(m);
   bind_canonical(m);
+  bind_compact(m);
 }
 
 void bind_simplify(py::module_& m) {

@@ -451,24 +451,14 @@ def read_tile(paths, index_dtype, cell_exponent, tile_level):
     ids = records["i"].astype(np.int64)
     corners = records["p"]
     del records
-    s = np.sort(ids, axis=1)
-    order = np.lexsort((s[:, 2], s[:, 1], s[:, 0]))  # stable: the first of equals is the earliest
-    s = s[order]
-    repeat = np.flatnonzero((s[1:] == s[:-1]).all(axis=1)) + 1
-    del s
-    if repeat.size:
-        keep = np.ones(ids.shape[0], dtype=bool)
-        keep[order[repeat]] = False
-        ids, corners = ids[keep], corners[keep]
-    del order
+    # The vertices numbered in the order of their ids, the repeated faces dropped (the first kept).
+    positions, faces, kept = tailor._tailor._compact_tile(ids, corners)
+    del ids
     if tile_level > 0:
-        cells = tailor.chunk_cells(corners, cell_exponent).astype(np.int64)
+        cells = tailor.chunk_cells(corners[kept], cell_exponent).astype(np.int64)
         key = ((cells[:, 2] + (1 << 20)) << 42) | ((cells[:, 1] + (1 << 20)) << 21) | (cells[:, 0] + (1 << 20))
-        order = np.argsort(key, kind="stable")
-        ids, corners = ids[order], corners[order]
-    used, first, compact = np.unique(ids.ravel(), return_index=True, return_inverse=True)
-    positions = np.ascontiguousarray(corners.reshape(-1, 3)[first])
-    return positions, compact.reshape(-1, 3).astype(np.uint32)
+        faces = faces[np.argsort(key, kind="stable")]
+    return positions, faces
 
 
 def texels_per_unit(lo, hi, scale):

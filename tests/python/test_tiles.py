@@ -481,6 +481,42 @@ def canonical_tile_in_numpy(positions, faces):
     return positions[by_use], new_id[faces]
 
 
+def compact_tile_in_numpy(ids, corners):
+    """What tailor._compact_tile is documented to do, written out in numpy (read_tile's former form)."""
+    s = np.sort(ids, axis=1)
+    order = np.lexsort((s[:, 2], s[:, 1], s[:, 0]))  # stable: the first of equals is the earliest
+    s = s[order]
+    keep = np.ones(ids.shape[0], dtype=bool)
+    keep[order[np.flatnonzero((s[1:] == s[:-1]).all(axis=1)) + 1]] = False
+    kept = np.flatnonzero(keep)
+    used, first, compact = np.unique(ids[kept].ravel(), return_index=True, return_inverse=True)
+    positions = corners[kept].reshape(-1, 3)[first]
+    return positions, compact.reshape(-1, 3).astype(np.uint32), kept
+
+
+def test_a_streamed_tile_is_read_back_with_its_ids_compacted_and_repeated_faces_dropped():
+    positions, faces = horse_arrays()
+    # Faces that repeat others (turned, and with the other winding) after them, and a fan of 40
+    # faces around a new lowest vertex with two repeats (a list longer than the short lists' path).
+    fan = np.array([[0, 2 + i, 3 + i] for i in range(40)] + [[3, 0, 2], [12, 11, 0]], dtype=np.int64)
+    fan[fan > 0] += faces.max()  # the fan's own vertices, above the horse's
+    ring = np.array([[0.0, 0.0, -1.0]] + [[np.cos(a), np.sin(a), -1.0] for a in np.linspace(0, 6, 42)])
+    positions = np.concatenate([positions, ring[1:]])
+    positions = np.concatenate([ring[:1], positions])  # vertex 0 is the fan's centre
+    ids = np.concatenate([faces + 1, np.roll(faces[:50] + 1, 1, axis=1), faces[100:120, ::-1] + 1, fan])
+    ids = ids[np.random.default_rng(3).permutation(ids.shape[0])]
+    corners = positions[ids].astype(np.float32)
+    want = compact_tile_in_numpy(ids, corners)
+    assert want[2].shape[0] == ids.shape[0] - 72
+    for spread in (1, 1000):  # ids over a short range (a table), then too spread for one (a sort)
+        got = tailor._tailor._compact_tile(ids * spread, corners)
+        assert got[0].dtype == np.float32 and got[1].dtype == np.uint32 and got[2].dtype == np.int64
+        for a, b in zip(got, want):
+            assert np.array_equal(a, b)
+    empty = tailor._tailor._compact_tile(np.empty((0, 3), np.int64), np.empty((0, 3, 3), np.float32))
+    assert [a.shape[0] for a in empty] == [0, 0, 0]
+
+
 def test_a_tile_in_canonical_order_is_the_same_for_any_input_order():
     positions, faces = horse_arrays()
     positions = positions.astype(np.float32)
