@@ -133,7 +133,8 @@ void bind_compact(py::module_& m) {
             hi = *b;
           }
           const uint64_t range = corner_count ? static_cast<uint64_t>(hi) - static_cast<uint64_t>(lo) + 1 : 0;
-          if (range <= 4 * uint64_t{corner_count} + kTableEntries) {
+          // (range is 0 with faces only when the ids span all 2^64 values: a sort then.)
+          if (corner_count == 0 || (range != 0 && range <= 4 * uint64_t{corner_count} + kTableEntries)) {
             // A table over the ids' range (at most 16 bytes per corner, or 64 MB): mark, number in
             // id order. A tile's ids span most of a mesh's vertex numbering as often as not.
             std::vector<uint32_t> slot(range, kNone);

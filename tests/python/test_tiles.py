@@ -515,6 +515,9 @@ def test_a_streamed_tile_is_read_back_with_its_ids_compacted_and_repeated_faces_
             assert np.array_equal(a, b)
     empty = tailor._tailor._compact_tile(np.empty((0, 3), np.int64), np.empty((0, 3, 3), np.float32))
     assert [a.shape[0] for a in empty] == [0, 0, 0]
+    extreme = np.array([[np.iinfo(np.int64).min, 0, np.iinfo(np.int64).max]], dtype=np.int64)
+    p, f, kept = tailor._tailor._compact_tile(extreme, np.zeros((1, 3, 3), np.float32))
+    assert f.tolist() == [[0, 1, 2]] and p.shape == (3, 3) and kept.tolist() == [0]
 
 
 def test_a_tile_in_canonical_order_is_the_same_for_any_input_order():
