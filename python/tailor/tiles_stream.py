@@ -456,8 +456,7 @@ def read_tile(paths, index_dtype, cell_exponent, tile_level):
     del ids
     if tile_level > 0:
         cells = tailor.chunk_cells(corners[kept], cell_exponent).astype(np.int64)
-        key = ((cells[:, 2] + (1 << 20)) << 42) | ((cells[:, 1] + (1 << 20)) << 21) | (cells[:, 0] + (1 << 20))
-        faces = faces[np.argsort(key, kind="stable")]
+        faces = faces[np.argsort(_pack(cells), kind="stable")]
     return positions, faces
 
 
