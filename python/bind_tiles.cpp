@@ -194,7 +194,7 @@ chunk k's face ids are faces[chunk_start[k]:chunk_start[k+1]].)");
   m.def(
       "save_uvs",
       [](const py::object& path_object, const PyMesh& mesh, const py::array& corner_uvs, const py::sequence& size,
-         const py::object& texture, const py::object& material, const std::string& up) {
+         const py::object& texture, const py::object& material, const std::string& up, const py::dict& image_uris) {
         const std::string path = path_of(path_object);
         const size_t faces = mesh.mesh.face_count();
         const auto uv = corner_uv_array(corner_uvs, faces);
@@ -214,6 +214,16 @@ chunk k's face ids are faces[chunk_start[k]:chunk_start[k+1]].)");
         } else if (!material.is_none()) {
           material_from_dict(read_material_dict(material), options);
         }
+        for (const auto& [key, value] : image_uris) {
+          const std::string role = py::str(key);
+          std::string* uri = role == "color"    ? &options.image_uris.color
+                             : role == "normal" ? &options.image_uris.normal
+                             : role == "orm"    ? &options.image_uris.orm
+                                                : nullptr;
+          if (!uri) raise_error("image_uris: a role is color, normal or orm, got '" + role + "'");
+          *uri = py::str(value);
+          if (uri->empty()) raise_error("image_uris: the URI of " + role + " is empty");
+        }
         Atlas atlas;
         atlas.corner_uv.assign(uv.data(), uv.data() + 6 * faces);
         atlas.patch.assign(faces, 0);
@@ -226,8 +236,8 @@ chunk k's face ids are faces[chunk_start[k]:chunk_start[k+1]].)");
         if (!status) raise_status(status);
       },
       py::arg("path"), py::arg("mesh"), py::arg("corner_uvs"), py::arg("texture_size"), py::arg("texture") = py::none(),
-      py::arg("material") = py::none(), py::arg("up") = "y",
-      R"(save_uvs(path, mesh, corner_uvs, texture_size, texture=None, material=None, up='y') -> None
+      py::arg("material") = py::none(), py::arg("up") = "y", py::arg("image_uris") = py::dict(),
+      R"(save_uvs(path, mesh, corner_uvs, texture_size, texture=None, material=None, up='y', image_uris={}) -> None
 
 Writes the mesh with per-corner UVs given in texture pixels ((F, 3, 2), as ChunkedMapper.chunk()
 gives them), divided by texture_size = (width, height) into texture repeats exactly as `tailor
@@ -236,7 +246,9 @@ map -o` does: .glb, .obj or .ply, atomically. texture: a PNG or JPEG to embed (.
 as `tailor map --material` (.glb: base colour, normal map with tangents, metallicRoughness,
 occlusion): a folder or JSON, or what tailor.load_material returned (read once for many files);
 its size must be texture_size. up: 'z' for Z-up coordinates, turned Y-up by the .glb node's
-rotation as `tailor map --up z`.)");
+rotation as `tailor map --up z`. image_uris: {role: URI} for maps the .glb names (relative to
+itself) instead of embedding, roles 'color' (the texture or the material's colour map, then not
+read), 'normal' and 'orm' (the material's maps): many tiles then share one copy of the images.)");
 
   m.def(
       "load_material", [](const py::object& path_object) { return read_material_dict(path_object); }, py::arg("path"),

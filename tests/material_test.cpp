@@ -10,6 +10,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "support/fixtures.h"
@@ -88,11 +89,13 @@ std::vector<float> float_accessor(const Glb& g, size_t index, size_t components)
   return out;
 }
 
-void expect_valid_gltf(const std::string& file) {
+// flags: "--allow-external" reads images named by URI beside the file.
+void expect_valid_gltf(const std::string& file, const std::string& flags = "") {
   std::string out;
   if (test::run_command("command -v node", out) != 0) GTEST_SKIP() << "node not installed";
   const int rc = test::run_command(
-      std::string("node ") + TAILOR_SOURCE_DIR + "/tests/tools/validate_gltf.mjs --strict '" + file + "'", out);
+      std::string("node ") + TAILOR_SOURCE_DIR + "/tests/tools/validate_gltf.mjs --strict " + flags + " '" + file + "'",
+      out);
   EXPECT_EQ(rc, 0) << out;
 }
 
@@ -364,6 +367,72 @@ TEST_F(MaterialTest, SixteenBitMapsStaySixteenBit) {
   for (size_t i = 0; i < rough.pixels.size(); i += 17) {
     ASSERT_EQ(orm.pixels[3 * i + 1], rough.pixels[i]) << i;
     ASSERT_EQ(orm.pixels[3 * i + 2], metal_.pixels[i] * 257) << i;
+  }
+}
+
+// Files that share one material (the tiles of python3 -m tailor.tiles) name its images by URI
+// instead of each embedding a copy: the same material, tangents and geometry, no image in the BIN
+// chunk, the colour map's file not read; a URI for a map the export lacks, or a non-.glb, fails.
+TEST_F(MaterialTest, ImagesNamedByUriAreNotEmbedded) {
+  MaterialMaps maps;
+  ASSERT_TRUE(load_material(dir_, maps).is_ok());
+  Mesh mesh;
+  ASSERT_TRUE(load_mesh(std::string(TAILOR_SOURCE_DIR) + "/examples/spot.obj", mesh).is_ok());
+  Atlas atlas;  // planar UVs (x, y), one patch
+  for (uint32_t c : mesh.indices) {
+    atlas.corner_uv.push_back(mesh.positions[3 * c] * 300.f);
+    atlas.corner_uv.push_back(mesh.positions[3 * c + 1] * 300.f);
+  }
+  atlas.patch.assign(mesh.face_count(), 0);
+  atlas.patch_count = 1;
+  ExportOptions embedded;
+  embedded.texture_path = maps.color;
+  embedded.texture_width = maps.width;
+  embedded.texture_height = maps.height;
+  embedded.material = maps.textures;
+  ExportOptions named = embedded;
+  named.texture_path = dir_ + "/not_read.png";  // absent: a colour map named by URI is not read
+  named.image_uris = {"../color.png", "../normal.png", "../orm.png"};
+  fs::copy_file(maps.color, dir_ + "/color.png");
+  std::ofstream(dir_ + "/normal.png", std::ios::binary) << maps.textures.normal_png;
+  std::ofstream(dir_ + "/orm.png", std::ios::binary) << maps.textures.orm_png;
+  fs::create_directory(dir_ + "/tiles");
+  for (const MeshCompression compression : {MeshCompression::kNone, MeshCompression::kMeshopt}) {
+    SCOPED_TRACE(static_cast<int>(compression));
+    embedded.compression = named.compression = compression;
+    const std::string a = dir_ + "/embedded.glb", b = dir_ + "/tiles/named.glb";
+    ASSERT_TRUE(export_mesh(a, mesh, atlas, embedded).is_ok());
+    ASSERT_TRUE(export_mesh(b, mesh, atlas, named).is_ok());
+    const Glb ga = read_glb(a), gb = read_glb(b);
+    ASSERT_EQ(gb.json["images"].size(), 3u);
+    for (const Json& image : gb.json["images"]) EXPECT_FALSE(image.contains("bufferView")) << image.dump();
+    const Json& m = gb.json["materials"][0];
+    auto uri = [&](const Json& ref) {
+      return gb.json["images"][gb.json["textures"][ref["index"].get<size_t>()]["source"].get<size_t>()]["uri"];
+    };
+    EXPECT_EQ(uri(m["pbrMetallicRoughness"]["baseColorTexture"]), "../color.png");
+    EXPECT_EQ(uri(m["normalTexture"]), "../normal.png");
+    EXPECT_EQ(uri(m["pbrMetallicRoughness"]["metallicRoughnessTexture"]), "../orm.png");
+    EXPECT_EQ(m, ga.json["materials"][0]);
+    EXPECT_EQ(gb.json["meshes"], ga.json["meshes"]);
+    auto padded = [](size_t bytes) { return (bytes + 3) / 4 * 4; };
+    EXPECT_EQ(ga.bin.size() - gb.bin.size(), padded(fs::file_size(maps.color)) +
+                                                 padded(maps.textures.normal_png.size()) +
+                                                 padded(maps.textures.orm_png.size()));
+    EXPECT_EQ(ga.bin.compare(0, gb.bin.size(), gb.bin), 0);  // the geometry's bytes, the images after them
+    expect_valid_gltf(b, "--allow-external");
+  }
+  // A URI for a map the export does not have, or for a format without images: an error, no file.
+  for (const auto& [path, uris, material] :
+       {std::tuple{dir_ + "/x.glb", ImageUris{"", "../normal.png", ""}, MaterialTextures{}},
+        std::tuple{dir_ + "/x.obj", ImageUris{"../color.png", "", ""}, MaterialTextures{}}}) {
+    ExportOptions bad = embedded;
+    bad.compression = MeshCompression::kNone;
+    bad.material = material;
+    bad.image_uris = uris;
+    const Status s = export_mesh(path, mesh, atlas, bad);
+    EXPECT_EQ(s.code(), ErrorCode::kInvalidArgument) << s.message();
+    EXPECT_FALSE(fs::exists(path));
   }
 }
 

@@ -74,6 +74,16 @@ struct MaterialTextures {
   bool empty() const { return normal_png.empty() && orm_png.empty(); }
 };
 
+//! Where a .glb's images are when they are not embedded: a URI relative to the .glb per map (empty
+//! = embedded). Many files that share one material (the tiles of a 3D Tiles set) name its files
+//! once instead of each carrying a copy.
+struct ImageUris {
+  std::string color;   //!< the base colour (ExportOptions::texture_path, then not read)
+  std::string normal;  //!< MaterialTextures::normal_png
+  std::string orm;     //!< MaterialTextures::orm_png
+  bool empty() const { return color.empty() && normal.empty() && orm.empty(); }
+};
+
 struct ExportOptions {
   std::string texture_path;  //!< PNG or JPEG: embedded as is (.glb) or referenced by map_Kd (.mtl); empty = no texture
   int texture_width = 512;   //!< pixels per texture repeat along u (> 0), usually the texture's width
@@ -83,6 +93,8 @@ struct ExportOptions {
   int uv_set = 0;             //!< .glb: the mapped UVs go to TEXCOORD_<uv_set> (0..7); the file's other sets are kept
   SceneUp up = SceneUp::kY;   //!< .glb: kZ turns the scene Y-up as glTF wants (-90 degrees about x, on the node)
   MaterialTextures material;  //!< .glb: normal, metallic-roughness and occlusion maps (kInvalidArgument otherwise)
+  ImageUris image_uris;       //!< .glb: maps named by URI instead of embedded; each needs its map (texture_path,
+                              //!< normal_png, orm_png), else kInvalidArgument
   uint32_t symmetry = 1;      //!< .glb: 4 records in the material ("extras": {"tailor": {"symmetry": 4}}) that
                               //!< the map is 4-fold (MappingOptions::symmetry), so that eval, render and the
                               //!< viewer count quarter-turn seams as invisible without being told; .obj with a

@@ -316,6 +316,16 @@ Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas
     return Status::error(ErrorCode::kInvalidArgument, path, "a UV set other than 0 needs a .glb output");
   if (!options.material.empty() && format != ExportFormat::kGlb)
     return Status::error(ErrorCode::kInvalidArgument, path, "material maps need a .glb output");
+  if (!options.image_uris.empty() && format != ExportFormat::kGlb)
+    return Status::error(ErrorCode::kInvalidArgument, path, "images named by URI need a .glb output");
+  const ImageUris& uris = options.image_uris;
+  const char* unmatched = !uris.color.empty() && options.texture_path.empty()           ? "colour map"
+                          : !uris.normal.empty() && options.material.normal_png.empty() ? "normal map"
+                          : !uris.orm.empty() && options.material.orm_png.empty()       ? "ORM map"
+                                                                                        : nullptr;
+  if (unmatched)
+    return Status::error(ErrorCode::kInvalidArgument, path,
+                         std::string("an image URI is given for the ") + unmatched + " but the export has none");
   if (options.texture_width <= 0 || options.texture_height <= 0)
     return Status::error(ErrorCode::kInvalidArgument, path, "texture size must be positive");
   // Branch-free scans first (they vectorize); the exact culprit is looked for only on failure.

@@ -59,26 +59,33 @@ size_t add_view(nlohmann::json& views, size_t offset, size_t length, int target)
 }  // namespace
 
 void add_glb_material(nlohmann::json& gltf, nlohmann::json& views, size_t blob_offset, std::string& blob,
-                      const std::string& base_color, const std::string& mime_type, const MaterialTextures& material,
-                      int uv_set, uint32_t symmetry) {
+                      const std::string& base_color, const std::string& mime_type, const ExportOptions& options,
+                      int uv_set) {
+  const MaterialTextures& material = options.material;
   nlohmann::json pbr = {{"metallicFactor", 0.0}, {"roughnessFactor", 1.0}};
   nlohmann::json out = {{"name", "tailor"}};
   nlohmann::json images = nlohmann::json::array(), textures = nlohmann::json::array();
-  // One image, texture and view per map; returns the texture's reference.
-  auto add = [&](const std::string& bytes, const std::string& mime) {
-    const size_t view = add_view(views, blob_offset + blob.size(), bytes.size(), 0);
-    blob += bytes;
-    pad_to_4(blob, '\0');
-    images.push_back({{"bufferView", view}, {"mimeType", mime}});
+  // One image and texture per map, its bytes in a view of their own unless it is named by URI;
+  // returns the texture's reference.
+  auto add = [&](const std::string& bytes, const std::string& mime, const std::string& uri) {
+    if (uri.empty()) {
+      const size_t view = add_view(views, blob_offset + blob.size(), bytes.size(), 0);
+      blob += bytes;
+      pad_to_4(blob, '\0');
+      images.push_back({{"bufferView", view}, {"mimeType", mime}});
+    } else {
+      images.push_back({{"uri", uri}});
+    }
     textures.push_back({{"sampler", 0}, {"source", images.size() - 1}});
     nlohmann::json ref = {{"index", textures.size() - 1}};
     if (uv_set != 0) ref["texCoord"] = uv_set;
     return ref;
   };
-  if (!base_color.empty()) pbr["baseColorTexture"] = add(base_color, mime_type);
-  if (!material.normal_png.empty()) out["normalTexture"] = add(material.normal_png, "image/png");
+  const ImageUris& uris = options.image_uris;
+  if (!options.texture_path.empty()) pbr["baseColorTexture"] = add(base_color, mime_type, uris.color);
+  if (!material.normal_png.empty()) out["normalTexture"] = add(material.normal_png, "image/png", uris.normal);
   if (!material.orm_png.empty()) {
-    const nlohmann::json ref = add(material.orm_png, "image/png");
+    const nlohmann::json ref = add(material.orm_png, "image/png", uris.orm);
     if (material.orm_roughness_metallic) {
       pbr["metallicRoughnessTexture"] = ref;
       pbr["metallicFactor"] = 1.0;  // the B channel says how metallic (0 where no metallic map was given)
@@ -92,7 +99,7 @@ void add_glb_material(nlohmann::json& gltf, nlohmann::json& views, size_t blob_o
     gltf["textures"] = textures;
   }
   out["pbrMetallicRoughness"] = pbr;
-  if (symmetry == 4) out["extras"] = {{"tailor", {{"symmetry", 4}}}};
+  if (options.symmetry == 4) out["extras"] = {{"tailor", {{"symmetry", 4}}}};
   gltf["materials"] = {out};
 }
 
@@ -106,7 +113,7 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
     return Status::error(ErrorCode::kLimit, path, "mesh too large for a .glb buffer (4 GiB)");
 
   std::string texture_bytes, mime_type;
-  if (!options.texture_path.empty())
+  if (!options.texture_path.empty() && options.image_uris.color.empty())
     TAILOR_RETURN_IF_ERROR(read_texture_bytes(options.texture_path, texture_bytes, mime_type));
   // One primitive per part (a glTF scene's), each over its own range of split vertices and indices.
   std::vector<ExportPart> parts = data.parts;
@@ -177,8 +184,7 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
   if (options.up == SceneUp::kZ) node["rotation"] = {-kHalfSqrt2, 0.0, 0.0, kHalfSqrt2};
   nlohmann::json gltf;
   std::string images;  // the material's images, after the indices
-  add_glb_material(gltf, views, bin_size, images, texture_bytes, mime_type, options.material, data.uv_set,
-                   options.symmetry);
+  add_glb_material(gltf, views, bin_size, images, texture_bytes, mime_type, options, data.uv_set);
   add_glb_scene(gltf, data, node, std::move(primitives));
   texture_bytes = {};
   if (images.size() > std::numeric_limits<uint32_t>::max() - bin_size)

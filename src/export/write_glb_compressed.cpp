@@ -397,7 +397,7 @@ Status write_glb_compressed(const std::string& path, const ExportData& data, con
       data.split.indices.size() > std::numeric_limits<uint32_t>::max() / 4)
     return Status::error(ErrorCode::kLimit, path, "mesh too large for a .glb buffer (4 GiB)");
   std::string texture_bytes, mime_type;
-  if (!options.texture_path.empty())
+  if (!options.texture_path.empty() && options.image_uris.color.empty())
     TAILOR_RETURN_IF_ERROR(read_texture_bytes(options.texture_path, texture_bytes, mime_type));
 
   Arrays arrays = gather(data);
@@ -492,8 +492,7 @@ Status write_glb_compressed(const std::string& path, const ExportData& data, con
   nlohmann::json gltf = {{"extensionsUsed", used}, {"extensionsRequired", used}};
   pad_to_4(bin);
   std::string images;
-  add_glb_material(gltf, views, bin.size(), images, texture_bytes, mime_type, options.material, data.uv_set,
-                   options.symmetry);
+  add_glb_material(gltf, views, bin.size(), images, texture_bytes, mime_type, options, data.uv_set);
   add_glb_scene(gltf, data, node, std::move(primitives));
   bin += images;
   if (buffers.empty()) buffers.push_back(nullptr);

@@ -116,8 +116,8 @@ Status texture_name_beside(const std::string& texture_path, const std::string& b
 //! blob_offset of buffer 0; a REPEAT sampler; textures read through TEXCOORD_<uv_set>; with
 //! symmetry 4, the extras that say the map is 4-fold (ExportOptions::symmetry).
 void add_glb_material(nlohmann::json& gltf, nlohmann::json& views, size_t blob_offset, std::string& blob,
-                      const std::string& base_color, const std::string& mime_type, const MaterialTextures& material,
-                      int uv_set, uint32_t symmetry);
+                      const std::string& base_color, const std::string& mime_type, const ExportOptions& options,
+                      int uv_set);
 
 Status write_glb(const std::string& path, const ExportData& data, const ExportOptions& options);
 //! .glb with options.compression (quantize, meshopt or draco): the arrays are built in memory.
