@@ -374,7 +374,7 @@ def partition(layout, cell_exponent, tile_level, folder, begin=0, end=None, bloc
 
 
 def _partition_into(layout, cell_exponent, tile_level, folder, begin, end, block_faces):
-    dtype = record_dtype(layout)
+    index_bytes = layout.index_dtype.itemsize
     counts, cells_seen = {}, []
     body = _Body(layout)
     try:
@@ -382,35 +382,21 @@ def _partition_into(layout, cell_exponent, tile_level, folder, begin, end, block
             ids, corners = ids[kept], corners[kept]
             if ids.shape[0] == 0:
                 continue
+            # The block's records (record_dtype) grouped by tile, file order within a tile.
             try:
-                cells = tailor.chunk_cells(corners, cell_exponent).astype(np.int64)
+                records, tiles, starts, cells = tailor._tailor._partition_block(
+                    ids, corners, cell_exponent, tile_level, index_bytes
+                )
             except tailor.Error as e:
                 raise StreamError("%s: %s" % (layout.path, e)) from None
-            packed = _pack(cells)
-            if tile_level:
-                cells_seen.append(np.unique(packed))
-                key = _pack(cells >> tile_level)
-            else:
-                key = packed
-            del cells, packed
-            order = np.argsort(key, kind="stable")
-            records = np.empty(ids.shape[0], dtype=dtype)
-            records["i"] = ids
-            del ids
-            records["p"] = corners
-            del corners
-            records = records.view(np.uint8).reshape(order.shape[0], -1).take(order, axis=0)  # whole records
-            key = key[order]
-            del order
-            starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
-            ends = np.r_[starts[1:], key.shape[0]]
-            if not tile_level:
-                cells_seen.append(key[starts])
-            for s, e in zip(starts.tolist(), ends.tolist()):
-                tile = _unpack(int(key[s]))
+            del ids, corners
+            cells_seen.append(cells)
+            starts = starts.tolist()
+            for k, key in enumerate(tiles.tolist()):
+                tile = _unpack(key)
                 with open(tile_file(folder, tile), "ab") as f:
-                    f.write(records[s:e])
-                counts[tile] = counts.get(tile, 0) + (e - s)
+                    f.write(records[starts[k] : starts[k + 1]])
+                counts[tile] = counts.get(tile, 0) + (starts[k + 1] - starts[k])
     finally:
         body.close()
     return counts, np.unique(np.concatenate(cells_seen)) if cells_seen else np.empty(0, np.int64)

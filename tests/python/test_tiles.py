@@ -520,6 +520,50 @@ def test_a_streamed_tile_is_read_back_with_its_ids_compacted_and_repeated_faces_
     assert f.tolist() == [[0, 1, 2]] and p.shape == (3, 3) and kept.tolist() == [0]
 
 
+def partition_block_in_numpy(ids, corners, e, level, index_dtype):
+    """What tailor._partition_block is documented to do, written out in numpy (the partition's former form)."""
+    from tailor import tiles_stream
+
+    cells = tailor.chunk_cells(corners, e).astype(np.int64)
+    packed = tiles_stream._pack(cells)
+    key = tiles_stream._pack(cells >> level) if level else packed
+    order = np.argsort(key, kind="stable")
+    records = np.empty(ids.shape[0], dtype=[("i", index_dtype, 3), ("p", "<f4", (3, 3))])
+    records["i"], records["p"] = ids, corners
+    key = key[order]
+    starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+    grouped = records[order].view(np.uint8).reshape(ids.shape[0], -1)
+    return grouped, key[starts], np.r_[starts, key.shape[0]], np.unique(packed)
+
+
+def test_a_block_of_the_partition_is_its_records_grouped_by_tile():
+    positions, faces = horse_arrays()
+    positions = (positions - positions.mean(axis=0)).astype(np.float32)  # cells on both sides of zero
+    order = np.random.default_rng(11).permutation(faces.shape[0])
+    corners = np.ascontiguousarray(positions[faces[order]])
+    # A face's cell is its centroid's: the corners summed smallest first in doubles, exactly.
+    for e in (CELL, CELL - 3):
+        sorted_corners = np.sort(corners.astype(np.float64), axis=1)
+        thrice = (sorted_corners[:, 0] + sorted_corners[:, 1]) + sorted_corners[:, 2]
+        want = np.floor(thrice * (2.0**-e / 3.0) - 0.41421356237309503)  # the grid's offset (chunks.h)
+        assert np.array_equal(tailor.chunk_cells(corners, e), want)
+        assert (want < 0).any() and (want >= 0).any()
+    for index_dtype, base in (("<u4", 0), ("<u8", 1 << 33)):  # the wide ids of a mesh past 2^32 vertices
+        ids = faces[order] + base
+        for e in (CELL, CELL - 3):
+            for level in (0, 1, 3):
+                got = tailor._tailor._partition_block(ids, corners, e, level, np.dtype(index_dtype).itemsize)
+                want = partition_block_in_numpy(ids, corners, e, level, index_dtype)
+                assert [a.dtype for a in got] == [np.uint8, np.int64, np.int64, np.int64]
+                for a, b in zip(got, want):
+                    assert np.array_equal(a, b)
+                assert got[1].shape[0] > 1
+    empty = tailor._tailor._partition_block(np.empty((0, 3), np.int64), np.empty((0, 3, 3), np.float32), CELL, 1, 4)
+    assert [a.shape[0] for a in empty] == [0, 0, 1, 0]
+    with pytest.raises(tailor.Error, match="more than 2.21 chunk cells"):
+        tailor._tailor._partition_block(ids[:1], corners[:1] * np.float32(1e30), -60, 0, 8)
+
+
 def test_a_tile_in_canonical_order_is_the_same_for_any_input_order():
     positions, faces = horse_arrays()
     positions = positions.astype(np.float32)
