@@ -97,11 +97,11 @@ def time_runs(path, binary):
     # The single-process chunked map, as the CLI runs it: the same options as the tiles.
     s, _ = timed(
         [binary, "map", str(path), "-o", str(work / "whole.glb"), "--texture", texture, "--chunks", "on",
-         "--chunk-cell", str(cell), "--field-following", "1", "--threads", "2"], env)
+         "--chunk-cell", str(cell), "--threads", "2"], env)
     rows.append(("tailor map --chunks on (2 threads, one .glb)", s, None))
     s, _ = timed(
         [binary, "map", str(path), "-o", str(work / "whole1.glb"), "--texture", texture, "--chunks", "on",
-         "--chunk-cell", str(cell), "--field-following", "1", "--threads", "1"], env)
+         "--chunk-cell", str(cell), "--threads", "1"], env)
     rows.append(("tailor map --chunks on (1 thread, one .glb)", s, None))
     for workers, threads, lod in ((0, 1, False), (0, 2, False), (1, 1, False), (2, 1, False), (2, 1, True)):
         out = work / ("w%d_t%d%s" % (workers, threads, "_lod" if lod else ""))
