@@ -84,7 +84,7 @@ py::dict read_material_dict(const py::object& path_object) {
 void bind_simplify(py::module_& m);
 void bind_canonical(py::module_& m);
 void bind_compact(py::module_& m);
-void bind_partition(py::module_& m);
+void bind_stream_blocks(py::module_& m);
 
 void bind_tiles(py::module_& m) {
   m.def(
@@ -266,7 +266,7 @@ save_uvs(material=...) takes the dict.)");
   bind_simplify(m);
   bind_canonical(m);
   bind_compact(m);
-  bind_partition(m);
+  bind_stream_blocks(m);
 }
 
 void bind_simplify(py::module_& m) {

@@ -1,6 +1,6 @@
 // The Python module `tailor`: what the binding files share. One file per entry point
 // (bind_mesh.cpp, bind_map.cpp, bind_tile.cpp, bind_eval.cpp, bind_save.cpp, bind_chunks.cpp,
-// bind_tiles.cpp, bind_canonical.cpp, bind_partition.cpp); errors and the progress bridge in errors.cpp and
+// bind_tiles.cpp, bind_canonical.cpp, bind_stream_blocks.cpp); errors and the progress bridge in errors.cpp and
 // progress.cpp. Every call releases the GIL while the library works.
 #pragma once
 

@@ -272,13 +272,7 @@ def survey(layout, chunk_cell, block_faces=BLOCK_FACES):
             if corners.shape[0] == 0:
                 continue
             faces += corners.shape[0]
-            flat = corners.reshape(-1, 3)
-            for k in range(3):  # a column at a time: numpy's reduction along axis 0 of 3 columns is slow
-                lo[k] = min(lo[k], flat[:, k].min())
-                hi[k] = max(hi[k], flat[:, k].max())
-            if chunk_cell is None:
-                bits = tailor.chunk_edge_lengths(corners).view(np.uint32).ravel()
-                coarse += np.bincount(bits >> 16, minlength=1 << 16)
+            tailor._tailor._survey_block(corners, lo, hi, coarse if chunk_cell is None else None)
         if faces == 0:
             raise StreamError("%s: mesh has no faces" % layout.path)
         median = None

@@ -564,6 +564,40 @@ def test_a_block_of_the_partition_is_its_records_grouped_by_tile():
         tailor._tailor._partition_block(ids[:1], corners[:1] * np.float32(1e30), -60, 0, 8)
 
 
+def test_the_survey_gives_the_box_and_the_cell_that_loading_gives(tmp_path):
+    # The first streaming pass: the box of the referenced vertices and plan_chunks' cell. The horse
+    # as it is (the coarse histogram's bin decides the cell), then scaled so that its median edge
+    # sits on a boundary of the rounding to a power of two (the bin spans two cells: the second
+    # pass finds the exact median), with an unused vertex far away that the box leaves out.
+    from tailor import tiles_stream
+
+    positions, faces = horse_arrays()
+    positions = positions.astype(np.float32)
+    corners = positions[faces].astype(np.float32)
+    lengths = np.sort(tailor.chunk_edge_lengths(np.ascontiguousarray(corners)).ravel())
+    median = float(lengths[lengths.shape[0] // 2])
+    boundary = 2.0 ** (round(np.log2(256 * median)) + 0.5) / 256  # where the cell's exponent changes
+    for scale, second_pass in ((1.0, False), (boundary / median, True)):
+        scaled = (positions * np.float32(scale)).astype(np.float32)
+        path = tmp_path / "h.ply"
+        write_ply(path, np.concatenate([scaled, [[50.0, 50.0, 50.0]]]), faces)
+        layout = tiles_stream.read_layout(str(path))
+        for block_faces in (tiles_stream.BLOCK_FACES, 7000):
+            survey = tiles_stream.survey(layout, None, block_faces)
+            mesh = tailor.load(str(path))
+            assert survey["faces"] == mesh.face_count
+            assert np.array_equal(survey["lo"], scaled.min(axis=0))
+            assert np.array_equal(survey["hi"], scaled.max(axis=0))
+            assert survey["cell_exponent"] == tailor.plan_chunks(mesh)["cell_exponent"]
+            assert (survey["median_edge"] is not None) == second_pass
+            if second_pass:
+                want = np.sort(tailor.chunk_edge_lengths(np.ascontiguousarray(scaled[faces])).ravel())
+                assert survey["median_edge"] == float(want[want.shape[0] // 2])
+    assert tiles_stream.survey(layout, -3)["cell_exponent"] == -3
+    with pytest.raises(tailor.Error, match="histogram must be"):
+        tailor._tailor._survey_block(corners, np.zeros(3, np.float32), np.zeros(3, np.float32), np.zeros(10, np.int64))
+
+
 def test_a_tile_in_canonical_order_is_the_same_for_any_input_order():
     positions, faces = horse_arrays()
     positions = positions.astype(np.float32)

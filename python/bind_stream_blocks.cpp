@@ -1,14 +1,16 @@
-// tailor._partition_block: one block of the streamed partition (tiles_stream._partition_into) cut
-// by tile in one pass: each face's chunk cell, its tile's key, the faces' records grouped by tile
-// (file order within a tile) and the block's distinct cells. Written here rather than in numpy:
-// the numpy form (the cells packed twice, np.unique, a stable argsort, the records assembled and
-// then taken in that order) was most of the partition's processor time, which the driver spends
-// before any tile can be mapped.
+// The per-block work of the streamed input (tiles_stream), which the driver does before any tile
+// can be mapped: tailor._survey_block (the first pass: the bounding box and the histogram of the
+// edge lengths' high bits) and tailor._partition_block (a block cut by tile: each face's chunk
+// cell, its tile's key, the faces' records grouped by tile in file order, the distinct cells).
+// Written here rather than in numpy: numpy's forms (reductions a column at a time and bincount;
+// the cells packed twice, np.unique, a stable argsort, the records assembled and then taken in
+// that order) were most of those passes' processor time.
 #include <algorithm>
 #include <bit>
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "bindings.h"
@@ -25,9 +27,49 @@ int64_t pack_cell(int32_t x, int32_t y, int32_t z) {
   return ((int64_t{z} + kBias) << 42) | ((int64_t{y} + kBias) << 21) | (int64_t{x} + kBias);
 }
 
+// A float32 (3,) or int64 (65536,) array that the call updates in place, checked.
+template <class T>
+T* writable(const py::array& a, py::ssize_t size, const char* what) {
+  if (!py::isinstance<py::array_t<T>>(a) || a.ndim() != 1 || a.shape(0) != size || !a.writeable() ||
+      !(a.flags() & py::array::c_style))
+    raise_error(std::string(what) + " must be a writable contiguous array of " + std::to_string(size) + " " +
+                (sizeof(T) == 4 ? "float32" : "int64") + ", got " + describe(a));
+  return static_cast<T*>(py::array(a).mutable_data());
+}
+
 }  // namespace
 
-void bind_partition(py::module_& m) {
+void bind_stream_blocks(py::module_& m) {
+  m.def(
+      "_survey_block",
+      [](const py::array& corners_in, const py::array& lo_out, const py::array& hi_out, const py::object& histogram) {
+        const auto corners = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(corners_in);
+        if (!corners || corners.ndim() != 3 || corners.shape(1) != 3 || corners.shape(2) != 3)
+          raise_error("corners must be an (F, 3, 3) array, got " + describe(corners_in));
+        float* lo = writable<float>(lo_out, 3, "lo");
+        float* hi = writable<float>(hi_out, 3, "hi");
+        int64_t* counts = histogram.is_none() ? nullptr : writable<int64_t>(histogram, 1 << 16, "histogram");
+        const size_t face_count = static_cast<size_t>(corners.shape(0));
+        const float* p = corners.data();
+        const py::gil_scoped_release release;
+        for (size_t c = 0; c < 3 * face_count; ++c)
+          for (size_t k = 0; k < 3; ++k) {
+            lo[k] = std::min(lo[k], p[3 * c + k]);
+            hi[k] = std::max(hi[k], p[3 * c + k]);
+          }
+        if (!counts) return;
+        std::vector<float> lengths(3 * face_count);
+        (void)chunk_edge_lengths({p, 9 * face_count}, lengths);  // the sizes match: no error
+        for (const float length : lengths) {
+          uint32_t bits = 0;
+          std::memcpy(&bits, &length, sizeof bits);
+          ++counts[bits >> 16];
+        }
+      },
+      py::arg("corners"), py::arg("lo"), py::arg("hi"), py::arg("histogram"),
+      "_survey_block(corners, lo, hi, histogram) -> None: for tailor.tiles: lo and hi ((3,) float32) take\n"
+      "the corners' smallest and largest coordinates, and histogram ((65536,) int64, or None) counts the\n"
+      "high 16 bits of each face's edge lengths as chunk_edge_lengths gives them");
   m.def(
       "_partition_block",
       [](const py::array& ids_in, const py::array& corners_in, int cell_exponent, int tile_level, int index_bytes) {
