@@ -52,11 +52,14 @@ void bind_stream_blocks(py::module_& m) {
         const size_t face_count = static_cast<size_t>(corners.shape(0));
         const float* p = corners.data();
         const py::gil_scoped_release release;
+        float low[3] = {lo[0], lo[1], lo[2]}, high[3] = {hi[0], hi[1], hi[2]};  // in registers: no aliasing
         for (size_t c = 0; c < 3 * face_count; ++c)
           for (size_t k = 0; k < 3; ++k) {
-            lo[k] = std::min(lo[k], p[3 * c + k]);
-            hi[k] = std::max(hi[k], p[3 * c + k]);
+            low[k] = std::min(low[k], p[3 * c + k]);
+            high[k] = std::max(high[k], p[3 * c + k]);
           }
+        std::copy(low, low + 3, lo);
+        std::copy(high, high + 3, hi);
         if (!counts) return;
         std::vector<float> lengths(3 * face_count);
         (void)chunk_edge_lengths({p, 9 * face_count}, lengths);  // the sizes match: no error
