@@ -222,7 +222,8 @@ chunk k's face ids are faces[chunk_start[k]:chunk_start[k+1]].)");
                              : role == "orm"    ? &options.image_uris.orm
                                                 : nullptr;
           if (!uri) raise_error("image_uris: a role is color, normal or orm, got '" + role + "'");
-          *uri = py::str(value);
+          if (!py::isinstance<py::str>(value)) raise_error("image_uris: the URI of " + role + " must be a str");
+          *uri = value.cast<std::string>();
           if (uri->empty()) raise_error("image_uris: the URI of " + role + " is empty");
         }
         Atlas atlas;

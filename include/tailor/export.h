@@ -65,7 +65,8 @@ inline bool mesh_compression_from_name(std::string_view name, MeshCompression& c
 enum class SceneUp { kY, kZ };
 
 //! A glTF PBR material's maps beyond the base colour (.glb only; see material.h for building them
-//! from a folder of maps). Each image is an encoded PNG (8 or 16 bit) embedded as is.
+//! from a folder of maps). Each image is an encoded PNG (8 or 16 bit), embedded as is unless
+//! ExportOptions::image_uris names it.
 struct MaterialTextures {
   std::string normal_png;               //!< tangent-space normal map, glTF (GL) convention; adds per-vertex TANGENT
   std::string orm_png;                  //!< glTF packing: R occlusion, G roughness, B metallic

@@ -111,10 +111,11 @@ Status texture_name_beside(const std::string& texture_path, const std::string& b
                            bool& copy);
 
 //! The material every .glb gets (named "tailor", not metallic, fully rough) and its images: the
-//! base colour `base_color` (PNG/JPEG bytes of type mime_type, may be empty) and the maps of
-//! `material`, appended to `blob` (each 4-byte aligned), which the caller places at byte
-//! blob_offset of buffer 0; a REPEAT sampler; textures read through TEXCOORD_<uv_set>; with
-//! symmetry 4, the extras that say the map is 4-fold (ExportOptions::symmetry).
+//! base colour when options.texture_path is set (`base_color`: its PNG/JPEG bytes of type
+//! mime_type) and the maps of options.material, each appended to `blob` (4-byte aligned), which the
+//! caller places at byte blob_offset of buffer 0, or named by its options.image_uris entry; a
+//! REPEAT sampler; textures read through TEXCOORD_<uv_set>; with options.symmetry 4, the extras
+//! that say the map is 4-fold.
 void add_glb_material(nlohmann::json& gltf, nlohmann::json& views, size_t blob_offset, std::string& blob,
                       const std::string& base_color, const std::string& mime_type, const ExportOptions& options,
                       int uv_set);

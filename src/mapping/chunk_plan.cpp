@@ -32,14 +32,17 @@ namespace {
 constexpr double kMaxCell = double{1 << 20};
 
 // The face's centroid as three times it, in doubles, the three terms added smallest first so that
-// the corners' order cannot change a rounding. Sorted by min and max rather than by swaps: the
-// swaps' branches follow the data and mispredicted about half the time (most of the cost per face).
+// the corners' order cannot change a rounding. Ordered by min and max, without branches: branches
+// on the coordinates mispredict about half the time. std::min and std::max drop a NaN in their
+// second argument, so a term that is 0 for finite corners and NaN otherwise keeps a NaN corner
+// out of every cell; the sign of a zero sum may differ with the corners' order, which the grid's
+// offset (kChunkGridOffset) makes irrelevant to the cell.
 inline void centroid3(const float* p0, const float* p1, const float* p2, double out[3]) {
   for (int k = 0; k < 3; ++k) {
     const double a = p0[k], b = p1[k], c = p2[k];
     const double low2 = std::min(a, b), high2 = std::max(a, b);
     const double low = std::min(low2, c), high = std::max(high2, c), middle = std::max(low2, std::min(high2, c));
-    out[k] = (low + middle) + high;
+    out[k] = (low + middle) + high + (a + b + c) * 0.0;
   }
 }
 

@@ -117,7 +117,23 @@ def test_save_uvs_writes_a_material_read_once(tmp_path, material_dir):
         tailor.save_uvs(tmp_path / "x.glb", mesh, uv, (512, 512), up="x")
     with pytest.raises(tailor.Error, match="no map recognised"):
         tailor.load_material(tmp_path)
-    assert not (tmp_path / "x.glb").exists()
+    # image_uris: the maps named instead of embedded; a bad role, URI or output is one error, no file.
+    uris = {"color": "../c.png", "normal": "../n.png", "orm": "../o.png"}
+    tailor.save_uvs(tmp_path / "named.glb", mesh, uv, (512, 512), material=loaded, image_uris=uris)
+    named = (tmp_path / "named.glb").read_bytes()
+    assert all(('"uri":"%s"' % u).encode() in named for u in uris.values())
+    assert loaded["normal_png"] not in named and len(named) < len(data) - len(loaded["orm_png"])
+    for bad, message in (
+        ({"colour": "c.png"}, "^image_uris: a role is color, normal or orm, got 'colour'"),
+        ({"color": None}, "^image_uris: the URI of color must be a str"),
+        ({"color": ""}, "^image_uris: the URI of color is empty"),
+        ({"normal": "n.png"}, "an image URI is given for the normal map but the export has none"),
+    ):
+        with pytest.raises(tailor.Error, match=message):
+            tailor.save_uvs(tmp_path / "x.glb", mesh, uv, (512, 512), texture=GRAVEL, image_uris=bad)
+    with pytest.raises(tailor.Error, match="images named by URI need a .glb output"):
+        tailor.save_uvs(tmp_path / "x.obj", mesh, uv, (512, 512), texture=GRAVEL, image_uris={"color": "c.png"})
+    assert not (tmp_path / "x.glb").exists() and not (tmp_path / "x.obj").exists()
 
 
 def load_addon_table():

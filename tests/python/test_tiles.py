@@ -521,7 +521,7 @@ def test_a_streamed_tile_is_read_back_with_its_ids_compacted_and_repeated_faces_
 
 
 def partition_block_in_numpy(ids, corners, e, level, index_dtype):
-    """What tailor._partition_block is documented to do, written out in numpy (the partition's former form)."""
+    """What tailor._partition_block is documented to do, written out in numpy."""
     from tailor import tiles_stream
 
     cells = tailor.chunk_cells(corners, e).astype(np.int64)
@@ -562,6 +562,13 @@ def test_a_block_of_the_partition_is_its_records_grouped_by_tile():
     assert [a.shape[0] for a in empty] == [0, 0, 1, 0]
     with pytest.raises(tailor.Error, match="more than 2.21 chunk cells"):
         tailor._tailor._partition_block(ids[:1], corners[:1] * np.float32(1e30), -60, 0, 8)
+    for corner in range(3):  # a face with a NaN coordinate has no cell, wherever the NaN is
+        bad = corners[:1].copy()
+        bad[0, corner, 1] = np.nan
+        with pytest.raises(tailor.Error, match="chunk cells"):
+            tailor.chunk_cells(bad, CELL)
+    with pytest.raises(tailor.Error, match="vertex id 4294967296 of face 0 does not fit 4 bytes"):
+        tailor._tailor._partition_block(np.array([[0, 1, 1 << 32]]), corners[:1], CELL, 0, 4)
 
 
 def test_the_survey_gives_the_box_and_the_cell_that_loading_gives(tmp_path):
