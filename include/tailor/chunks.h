@@ -80,6 +80,7 @@ struct ChunkPlan {
   int cell_exponent = 0;                       //!< cell side = 2^cell_exponent world units
   double cell_size = 0;                        //!< 2^cell_exponent
   double median_edge = 0;                      //!< median edge length of the mesh (world units) the cell came from
+                                               //!< (0 when ChunkOptions::cell_exponent gave the cell: not measured)
   double longest_edge = 0;                     //!< longest edge (world units): faces reach that far beyond their cell
   std::vector<std::array<int32_t, 3>> cells;   //!< per chunk: its cell's integer coordinates (the parts of a
                                                //!< split cell share them)

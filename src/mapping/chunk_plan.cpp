@@ -225,22 +225,35 @@ Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& pla
   const float* p = mesh.positions.data();
   const uint32_t* idx = mesh.indices.data();
 
-  // Edge lengths: each face's three (an interior edge counts twice, which leaves the median where
-  // it is on a closed surface and shifts it by a hair on an open one).
-  std::vector<float> lengths(3 * face_count);
-  float longest = 0.f;
-  for (size_t f = 0; f < face_count; ++f)
-    for (int k = 0; k < 3; ++k) {
-      const float l = edge_length(p + 3 * size_t{idx[3 * f + k]}, p + 3 * size_t{idx[3 * f + (k + 1) % 3]});
-      lengths[3 * f + static_cast<size_t>(k)] = l;
-      longest = std::max(longest, l);
-    }
-  auto middle = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
-  std::nth_element(lengths.begin(), middle, lengths.end());
-  const double median = *middle;
-  std::vector<float>().swap(lengths);
+  // The longest edge (the locality radius reaches that far beyond a cell) and, for the automatic
+  // cell only, the median edge: each face's three (an interior edge counts twice, which leaves the
+  // median where it is on a closed surface and shifts it by a hair on an open one). The longest is
+  // taken over squared lengths: the root and the rounding to float keep the order, so it is the
+  // longest of edge_length's values.
+  double median = 0.0, longest_squared = 0.0;
+  const auto squared = [&](size_t f, int k) {
+    const float* a = p + 3 * size_t{idx[3 * f + static_cast<size_t>(k)]};
+    const float* b = p + 3 * size_t{idx[3 * f + static_cast<size_t>((k + 1) % 3)]};
+    const double dx = double{a[0]} - b[0], dy = double{a[1]} - b[1], dz = double{a[2]} - b[2];
+    return dx * dx + dy * dy + dz * dz;
+  };
+  if (options.cell_exponent == kAutoCellExponent) {
+    std::vector<float> lengths(3 * face_count);
+    for (size_t f = 0; f < face_count; ++f)
+      for (int k = 0; k < 3; ++k) {
+        const double l2 = squared(f, k);
+        longest_squared = std::max(longest_squared, l2);
+        lengths[3 * f + static_cast<size_t>(k)] = static_cast<float>(std::sqrt(l2));  // as edge_length
+      }
+    auto middle = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
+    std::nth_element(lengths.begin(), middle, lengths.end());
+    median = *middle;
+  } else {
+    for (size_t f = 0; f < face_count; ++f)
+      for (int k = 0; k < 3; ++k) longest_squared = std::max(longest_squared, squared(f, k));
+  }
   plan.median_edge = median;
-  plan.longest_edge = longest;
+  plan.longest_edge = static_cast<float>(std::sqrt(longest_squared));
 
   int exponent = 0;
   TAILOR_RETURN_IF_ERROR(chunk_cell_exponent(median, options, exponent));

@@ -107,9 +107,8 @@ Status ChunkedMapper::set_mesh(const Mesh& mesh, std::vector<ChunkCell>* cells) 
   o.orientation.fixed_unit_scale = 1.f;
   o.mapping.seam_faces = mesh.seam_faces;
   TextureMap map;
-  TAILOR_RETURN_IF_ERROR(internal::map_chunks(mesh, o, map));
   ChunkPlan plan;
-  TAILOR_RETURN_IF_ERROR(plan_chunks(mesh, o.chunks, plan));
+  TAILOR_RETURN_IF_ERROR(internal::map_chunks(mesh, o, map, &plan));
   if (cells) cells->clear();
   // One result per cell: the parts of a split cell are consecutive chunks, their patches consecutive ids.
   for (size_t c = 0, end; c < plan.chunk_count(); c = end) {

@@ -178,7 +178,7 @@ double chunk_texels_per_unit(const Mesh& mesh, const MapTextureOptions& options)
   return std::exp2(std::round(std::log2(double{options.mapping.scale} / longest)));
 }
 
-Status map_chunks(const Mesh& mesh, const MapTextureOptions& options, TextureMap& map) {
+Status map_chunks(const Mesh& mesh, const MapTextureOptions& options, TextureMap& map, ChunkPlan* plan_out) {
   const auto start = std::chrono::steady_clock::now();
   map.frames = FaceFrames{};
   map.atlas.corner_uv.clear();
@@ -319,6 +319,7 @@ Status map_chunks(const Mesh& mesh, const MapTextureOptions& options, TextureMap
   map.stats.texels_per_unit = texels_per_unit;
   map.stats.locality_radius = plan.locality_radius();
   map.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (plan_out) *plan_out = std::move(plan);
   return Status::ok();
 }
 

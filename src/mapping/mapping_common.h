@@ -77,8 +77,9 @@ Status map_texture_frames(const Mesh& mesh, const Topology& topology, const MapT
 
 //! The chunked engine (map_chunks.cpp): steps 1-4 of map_texture on each chunk of the chunk rule
 //! (ChunkPlan), in parallel, written back to the mesh's corners; map.frames stays empty and
-//! map.stats holds the chunks' counters summed and the chunk grid's figures.
-Status map_chunks(const Mesh& mesh, const MapTextureOptions& options, TextureMap& map);
+//! map.stats holds the chunks' counters summed and the chunk grid's figures. plan_out (optional)
+//! receives the chunk plan the faces were mapped by.
+Status map_chunks(const Mesh& mesh, const MapTextureOptions& options, TextureMap& map, ChunkPlan* plan_out = nullptr);
 
 //! The texel density the chunks are mapped at, texture pixels per world unit: options.mapping.scale
 //! times the fixed normalisation when one is given, else per the longest side of the referenced
