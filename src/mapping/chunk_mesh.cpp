@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace tailor::internal {
 namespace {
@@ -23,6 +24,32 @@ inline bool point_less(const float* a, const float* b) {
   if (a[0] != b[0]) return a[0] < b[0];
   if (a[1] != b[1]) return a[1] < b[1];
   return a[2] < b[2];
+}
+
+// faces sorted by Morton key, stably (equal keys keep their order): least significant digit first,
+// 11 bits a pass, a pass skipped where every key has the same digit. A chunk's keys are spread
+// over their cube, so a comparison sort mispredicts about every other comparison; this does not
+// compare. `scratch` is resized to the faces' count.
+void sort_by_morton(std::vector<ChunkFace>& faces, std::vector<ChunkFace>& scratch) {
+  constexpr int kBits = 11, kPasses = 6;  // 66 bits cover the 63 of a key
+  constexpr size_t kBuckets = size_t{1} << kBits;
+  const size_t n = faces.size();
+  std::vector<uint32_t> count(kPasses * kBuckets, 0);
+  for (const ChunkFace& f : faces)
+    for (int pass = 0; pass < kPasses; ++pass)
+      ++count[pass * kBuckets + ((f.morton >> (kBits * pass)) & (kBuckets - 1))];
+  scratch.resize(n);
+  ChunkFace* from = faces.data();
+  ChunkFace* to = scratch.data();
+  for (int pass = 0; pass < kPasses; ++pass) {
+    uint32_t* bucket = &count[pass * kBuckets];
+    if (std::find(bucket, bucket + kBuckets, static_cast<uint32_t>(n)) != bucket + kBuckets) continue;  // one digit
+    uint32_t sum = 0;
+    for (size_t b = 0; b < kBuckets; ++b) sum += std::exchange(bucket[b], sum);
+    for (size_t i = 0; i < n; ++i) to[bucket[(from[i].morton >> (kBits * pass)) & (kBuckets - 1)]++] = from[i];
+    std::swap(from, to);
+  }
+  if (from != faces.data()) faces.swap(scratch);
 }
 
 }  // namespace
@@ -98,12 +125,13 @@ void build_chunk_mesh(const Mesh& mesh, std::span<const uint32_t> faces, const s
     if (point_less(p[2], p[r])) r = 2;
     uint64_t morton = 0;
     for (int k = 0; k < 3; ++k) {
-      double a = p[0][k], b = p[1][k], d = p[2][k];  // summed smallest first, as the chunk rule does
-      if (a > b) std::swap(a, b);
-      if (b > d) std::swap(b, d);
-      if (a > b) std::swap(a, b);
-      const double t = (((a + b) + d) / 3.0 - origin[static_cast<size_t>(k)]) * inverse;
-      const double q = std::clamp(std::floor(t * double{1 << 21}), 0.0, double{(1 << 21) - 1});
+      // Summed smallest first, as the chunk rule does; ordered by min and max, without branches.
+      const double a = p[0][k], b = p[1][k], d = p[2][k];
+      const double low2 = std::min(a, b), high2 = std::max(a, b);
+      const double sum = (std::min(low2, d) + std::max(low2, std::min(high2, d))) + std::max(high2, d);
+      const double t = (sum / 3.0 - origin[static_cast<size_t>(k)]) * inverse;
+      // Clamped, then truncated: the floor of what lies in range, without a call to floor.
+      const double q = std::clamp(t * double{1 << 21}, 0.0, double{(1 << 21) - 1});
       morton |= spread3(static_cast<uint64_t>(q)) << k;
     }
     w.faces[i] = ChunkFace{morton, f, r};
@@ -111,15 +139,22 @@ void build_chunk_mesh(const Mesh& mesh, std::span<const uint32_t> faces, const s
   auto corner = [&](const ChunkFace& face, uint32_t k) {
     return pos + 3 * size_t{idx[3 * size_t{face.face} + (face.rotation + k) % 3]};
   };
-  std::sort(w.faces.begin(), w.faces.end(), [&](const ChunkFace& a, const ChunkFace& b) {
-    if (a.morton != b.morton) return a.morton < b.morton;
+  // By Morton key, then (faces in one key's box, rare) by their corners, then by face.
+  sort_by_morton(w.faces, w.sorting);
+  const auto less_in_key = [&](const ChunkFace& a, const ChunkFace& b) {
     for (uint32_t k = 0; k < 3; ++k) {
       const float *pa = corner(a, k), *pb = corner(b, k);
       if (point_less(pa, pb)) return true;
       if (point_less(pb, pa)) return false;
     }
     return a.face < b.face;  // the same triangle twice: indistinguishable anyway
-  });
+  };
+  for (auto run = w.faces.begin(); run != w.faces.end();) {
+    auto end = run + 1;
+    while (end != w.faces.end() && end->morton == run->morton) ++end;
+    if (end - run > 1) std::sort(run, end, less_in_key);
+    run = end;
+  }
   const size_t n = w.faces.size();
   w.vertices.reset(n / 2 + 16);  // a surface has about half as many vertices as faces; grows when not
   w.mesh.indices.resize(3 * n);

@@ -43,7 +43,8 @@ class VertexTable {
 
 //! What one worker reuses from chunk to chunk.
 struct ChunkWorker {
-  std::vector<ChunkFace> faces;  //!< the chunk's faces in canonical order
+  std::vector<ChunkFace> faces;    //!< the chunk's faces in canonical order
+  std::vector<ChunkFace> sorting;  //!< scratch of the radix sort
   VertexTable vertices;
   Mesh mesh;  //!< the chunk's canonical mesh
   std::vector<uint8_t> seam_flags;
