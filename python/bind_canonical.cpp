@@ -106,13 +106,7 @@ void bind_compact(py::module_& m) {
   m.def(
       "_compact_tile",
       [](const py::array& ids_in, const py::array& corners_in) {
-        const auto ids = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(ids_in);
-        const auto corners = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(corners_in);
-        if (!ids || ids.ndim() != 2 || ids.shape(1) != 3)
-          raise_error("ids must be an (F, 3) array, got " + describe(ids_in));
-        if (!corners || corners.ndim() != 3 || corners.shape(0) != ids.shape(0) || corners.shape(1) != 3 ||
-            corners.shape(2) != 3)
-          raise_error("corners must be an (F, 3, 3) array beside the ids, got " + describe(corners_in));
+        const auto [ids, corners] = streamed_faces(ids_in, corners_in);
         if (ids.shape(0) > py::ssize_t{std::numeric_limits<uint32_t>::max() / 3})
           raise_error("a tile holds at most (2^32 - 1) / 3 faces");
         const size_t face_count = static_cast<size_t>(ids.shape(0)), corner_count = 3 * face_count;

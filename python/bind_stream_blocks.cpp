@@ -39,6 +39,16 @@ T* writable(const py::array& a, py::ssize_t size, const char* what) {
 
 }  // namespace
 
+std::pair<IdArray, FloatArray> streamed_faces(const py::array& ids_in, const py::array& corners_in) {
+  auto ids = IdArray::ensure(ids_in);
+  auto corners = FloatArray::ensure(corners_in);
+  if (!ids || ids.ndim() != 2 || ids.shape(1) != 3) raise_error("ids must be an (F, 3) array, got " + describe(ids_in));
+  if (!corners || corners.ndim() != 3 || corners.shape(0) != ids.shape(0) || corners.shape(1) != 3 ||
+      corners.shape(2) != 3)
+    raise_error("corners must be an (F, 3, 3) array beside the ids, got " + describe(corners_in));
+  return {std::move(ids), std::move(corners)};
+}
+
 void bind_stream_blocks(py::module_& m) {
   m.def(
       "_survey_block",
@@ -77,13 +87,7 @@ void bind_stream_blocks(py::module_& m) {
       "_partition_block",
       [](const py::array& ids_in, const py::array& corners_in, int cell_exponent, int tile_level, int index_bytes) {
         static_assert(std::endian::native == std::endian::little, "the records are little-endian");
-        const auto ids = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(ids_in);
-        const auto corners = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(corners_in);
-        if (!ids || ids.ndim() != 2 || ids.shape(1) != 3)
-          raise_error("ids must be an (F, 3) array, got " + describe(ids_in));
-        if (!corners || corners.ndim() != 3 || corners.shape(0) != ids.shape(0) || corners.shape(1) != 3 ||
-            corners.shape(2) != 3)
-          raise_error("corners must be an (F, 3, 3) array beside the ids, got " + describe(corners_in));
+        const auto [ids, corners] = streamed_faces(ids_in, corners_in);
         if (index_bytes != 4 && index_bytes != 8) raise_error("index_bytes must be 4 or 8");
         if (tile_level < 0 || tile_level > 20) raise_error("tile_level must be in 0..20");
         if (ids.shape(0) > py::ssize_t{std::numeric_limits<uint32_t>::max()})

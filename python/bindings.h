@@ -13,6 +13,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "tailor/atlas.h"
@@ -58,6 +59,13 @@ py::array readonly_view(const T* data, std::vector<py::ssize_t> shape, py::handl
 
 //! "float32 (3, 4)": the dtype and shape of an array, for error messages.
 std::string describe(const py::array& array);
+
+//! A streamed block's or tile's faces (tailor.tiles): (F, 3) int64 vertex ids and the (F, 3, 3)
+//! float32 corners beside them, checked (tailor.Error names what is wrong). Defined in
+//! bind_stream_blocks.cpp.
+using IdArray = py::array_t<int64_t, py::array::c_style | py::array::forcecast>;
+using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
+std::pair<IdArray, FloatArray> streamed_faces(const py::array& ids, const py::array& corners);
 
 //! A sequence as the CLI's text of it ("0,1,0"), for messages; other objects as str() shows them.
 std::string sequence_text(const py::handle& value);
