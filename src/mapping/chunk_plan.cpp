@@ -175,6 +175,13 @@ class CellSplitter {
     // cell's corner, clamped into the part (a centroid on the cell's edge rounds either way).
     const int child = level + 1;
     const double inverse3 = std::ldexp(1.0, child - plan_.cell_exponent) / 3.0;
+    // The cell's corner and the part's first child, in child sides (ldexp is exact: the same
+    // values as computed per face, without a call per face and axis).
+    std::array<double, 3> corner_at{}, first{};
+    for (size_t k = 0; k < 3; ++k) {
+      corner_at[k] = std::ldexp(cell[k] + kChunkGridOffset, child);
+      first[k] = 2.0 * part[k];
+    }
     std::vector<uint8_t> octant(faces.size());
     std::array<uint32_t, 9> start{};
     for (size_t i = 0; i < faces.size(); ++i) {
@@ -183,8 +190,8 @@ class CellSplitter {
       centroid3(p_ + 3 * size_t{corner[0]}, p_ + 3 * size_t{corner[1]}, p_ + 3 * size_t{corner[2]}, c);
       uint8_t o = 0;
       for (int k = 2; k >= 0; --k) {
-        const double first = 2.0 * part[static_cast<size_t>(k)];
-        const double s = c[k] * inverse3 - std::ldexp(cell[static_cast<size_t>(k)] + kChunkGridOffset, child) - first;
+        const size_t axis = static_cast<size_t>(k);
+        const double s = c[k] * inverse3 - corner_at[axis] - first[axis];
         o = static_cast<uint8_t>((o << 1) | (s >= 1.0 ? 1 : 0));
       }
       octant[i] = o;
