@@ -421,14 +421,24 @@ TEST_F(MaterialTest, ImagesNamedByUriAreNotEmbedded) {
                                                  padded(maps.textures.orm_png.size()));
     EXPECT_EQ(ga.bin.compare(0, gb.bin.size(), gb.bin), 0);  // the geometry's bytes, the images after them
     expect_valid_gltf(b, "--allow-external");
+    // Maps named by URI need no bytes: the same file without them (TANGENT still from the normal map).
+    ExportOptions unread = named;
+    unread.material.normal_png.clear();
+    unread.material.orm_png.clear();
+    const std::string c = dir_ + "/tiles/unread.glb";
+    ASSERT_TRUE(export_mesh(c, mesh, atlas, unread).is_ok());
+    EXPECT_EQ(test::read_all(c), test::read_all(b));
   }
-  // A URI for a map the export does not have, or for a format without images: an error, no file.
-  for (const auto& [path, uris, material] :
-       {std::tuple{dir_ + "/x.glb", ImageUris{"", "../normal.png", ""}, MaterialTextures{}},
-        std::tuple{dir_ + "/x.obj", ImageUris{"../color.png", "", ""}, MaterialTextures{}}}) {
+  // A URI for a colour map without a texture, for an ORM map without a role, or for a format
+  // without images: an error, no file.
+  for (const auto& [path, uris, texture] :
+       {std::tuple{dir_ + "/x.glb", ImageUris{"../color.png", "", ""}, std::string()},
+        std::tuple{dir_ + "/x.glb", ImageUris{"", "", "../orm.png"}, maps.color},
+        std::tuple{dir_ + "/x.obj", ImageUris{"../color.png", "", ""}, maps.color}}) {
     ExportOptions bad = embedded;
     bad.compression = MeshCompression::kNone;
-    bad.material = material;
+    bad.material = MaterialTextures{};
+    bad.texture_path = texture;
     bad.image_uris = uris;
     const Status s = export_mesh(path, mesh, atlas, bad);
     EXPECT_EQ(s.code(), ErrorCode::kInvalidArgument) << s.message();

@@ -77,11 +77,11 @@ struct MaterialTextures {
 
 //! Where a .glb's images are when they are not embedded: a URI relative to the .glb per map (empty
 //! = embedded). Many files that share one material (the tiles of a 3D Tiles set) name its files
-//! once instead of each carrying a copy.
+//! once instead of each carrying a copy, and need not read them.
 struct ImageUris {
-  std::string color;   //!< the base colour (ExportOptions::texture_path, then not read)
-  std::string normal;  //!< MaterialTextures::normal_png
-  std::string orm;     //!< MaterialTextures::orm_png
+  std::string color;   //!< the base colour: needs ExportOptions::texture_path (then not read)
+  std::string normal;  //!< the normal map (MaterialTextures::normal_png may then be empty): adds TANGENT
+  std::string orm;     //!< the packed map (orm_png may then be empty): needs one of its two roles set
   bool empty() const { return color.empty() && normal.empty() && orm.empty(); }
 };
 
@@ -94,8 +94,10 @@ struct ExportOptions {
   int uv_set = 0;             //!< .glb: the mapped UVs go to TEXCOORD_<uv_set> (0..7); the file's other sets are kept
   SceneUp up = SceneUp::kY;   //!< .glb: kZ turns the scene Y-up as glTF wants (-90 degrees about x, on the node)
   MaterialTextures material;  //!< .glb: normal, metallic-roughness and occlusion maps (kInvalidArgument otherwise)
-  ImageUris image_uris;       //!< .glb: maps named by URI instead of embedded; each needs its map (texture_path,
-                              //!< normal_png, orm_png), else kInvalidArgument
+  ImageUris image_uris;       //!< .glb: maps named by URI instead of embedded (kInvalidArgument for a colour
+                              //!< URI without texture_path, an ORM URI without a role, another format)
+  bool has_normal_map() const { return !material.normal_png.empty() || !image_uris.normal.empty(); }
+  bool has_orm_map() const { return !material.orm_png.empty() || !image_uris.orm.empty(); }
   uint32_t symmetry = 1;      //!< .glb: 4 records in the material ("extras": {"tailor": {"symmetry": 4}}) that
                               //!< the map is 4-fold (MappingOptions::symmetry), so that eval, render and the
                               //!< viewer count quarter-turn seams as invisible without being told; .obj with a

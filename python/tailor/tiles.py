@@ -91,23 +91,17 @@ def tile_digest(positions, faces, params):
 
 
 def tile_material(folder, params):
-    """The tile's material for tailor.save_uvs, from the images beside tileset.json (written once
-    by the driver: every task reads them from there), or None for a plain material."""
+    """The tile's material for tailor.save_uvs: the images beside tileset.json (written once by the
+    driver), which the tile names by URI (write_tile_glb) without reading them; None for a plain
+    material."""
     images = params["images"]
     if not images:
         return None
-    folder = pathlib.Path(folder)
-
-    def read(role):
-        return (folder / images[role]).read_bytes() if role in images else None
-
     roles = params.get("orm_roles", [])
     return {
-        "color": str(folder / images["color"]) if "color" in images else None,
+        "color": str(pathlib.Path(folder) / images["color"]) if "color" in images else None,
         "width": params["texture_size"][0],
         "height": params["texture_size"][1],
-        "normal_png": read("normal"),
-        "orm_png": read("orm"),
         "orm_roughness_metallic": "roughness_metallic" in roles,
         "orm_occlusion": "occlusion" in roles,
     }

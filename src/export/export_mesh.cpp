@@ -318,14 +318,12 @@ Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas
     return Status::error(ErrorCode::kInvalidArgument, path, "material maps need a .glb output");
   if (!options.image_uris.empty() && format != ExportFormat::kGlb)
     return Status::error(ErrorCode::kInvalidArgument, path, "images named by URI need a .glb output");
-  const ImageUris& uris = options.image_uris;
-  const char* unmatched = !uris.color.empty() && options.texture_path.empty()           ? "colour map"
-                          : !uris.normal.empty() && options.material.normal_png.empty() ? "normal map"
-                          : !uris.orm.empty() && options.material.orm_png.empty()       ? "ORM map"
-                                                                                        : nullptr;
-  if (unmatched)
+  if (!options.image_uris.color.empty() && options.texture_path.empty())
+    return Status::error(ErrorCode::kInvalidArgument, path, "an image URI is given for the colour map but no texture");
+  if (!options.image_uris.orm.empty() && !options.material.orm_roughness_metallic && !options.material.orm_occlusion)
     return Status::error(ErrorCode::kInvalidArgument, path,
-                         std::string("an image URI is given for the ") + unmatched + " but the export has none");
+                         "an image URI is given for the ORM map but it serves as neither metallicRoughness nor "
+                         "occlusion");
   if (options.texture_width <= 0 || options.texture_height <= 0)
     return Status::error(ErrorCode::kInvalidArgument, path, "texture size must be positive");
   // Branch-free scans first (they vectorize); the exact culprit is looked for only on failure.
@@ -416,7 +414,7 @@ Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas
     return internal::ExportProgress::cancelled(path);
   if (scene) part_ranges(data.part_sorted.face_parts, data.split, data.parts);
 
-  if (format == ExportFormat::kGlb && !options.material.normal_png.empty() && !data.normals.empty())
+  if (format == ExportFormat::kGlb && options.has_normal_map() && !data.normals.empty())
     internal::compute_tangents(*data.mesh, data.split, data.normals, data.tangents);
 
   switch (format) {

@@ -83,8 +83,8 @@ void add_glb_material(nlohmann::json& gltf, nlohmann::json& views, size_t blob_o
   };
   const ImageUris& uris = options.image_uris;
   if (!options.texture_path.empty()) pbr["baseColorTexture"] = add(base_color, mime_type, uris.color);
-  if (!material.normal_png.empty()) out["normalTexture"] = add(material.normal_png, "image/png", uris.normal);
-  if (!material.orm_png.empty()) {
+  if (options.has_normal_map()) out["normalTexture"] = add(material.normal_png, "image/png", uris.normal);
+  if (options.has_orm_map()) {
     const nlohmann::json ref = add(material.orm_png, "image/png", uris.orm);
     if (material.orm_roughness_metallic) {
       pbr["metallicRoughnessTexture"] = ref;

@@ -127,7 +127,7 @@ def test_save_uvs_writes_a_material_read_once(tmp_path, material_dir):
         ({"colour": "c.png"}, "^image_uris: a role is color, normal or orm, got 'colour'"),
         ({"color": None}, "^image_uris: the URI of color must be a str"),
         ({"color": ""}, "^image_uris: the URI of color is empty"),
-        ({"normal": "n.png"}, "an image URI is given for the normal map but the export has none"),
+        ({"orm": "o.png"}, "an image URI is given for the ORM map but it serves as neither"),
     ):
         with pytest.raises(tailor.Error, match=message):
             tailor.save_uvs(tmp_path / "x.glb", mesh, uv, (512, 512), texture=GRAVEL, image_uris=bad)
