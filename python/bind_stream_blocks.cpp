@@ -39,13 +39,19 @@ T* writable(const py::array& a, py::ssize_t size, const char* what) {
 
 }  // namespace
 
+FloatArray corner_array(const py::array& corners_in) {
+  auto corners = FloatArray::ensure(corners_in);
+  if (!corners || corners.ndim() != 3 || corners.shape(1) != 3 || corners.shape(2) != 3)
+    raise_error("corners must be an (F, 3, 3) float32 array, got " + describe(corners_in));
+  return corners;
+}
+
 std::pair<IdArray, FloatArray> streamed_faces(const py::array& ids_in, const py::array& corners_in) {
   auto ids = IdArray::ensure(ids_in);
-  auto corners = FloatArray::ensure(corners_in);
   if (!ids || ids.ndim() != 2 || ids.shape(1) != 3) raise_error("ids must be an (F, 3) array, got " + describe(ids_in));
-  if (!corners || corners.ndim() != 3 || corners.shape(0) != ids.shape(0) || corners.shape(1) != 3 ||
-      corners.shape(2) != 3)
-    raise_error("corners must be an (F, 3, 3) array beside the ids, got " + describe(corners_in));
+  auto corners = corner_array(corners_in);
+  if (corners.shape(0) != ids.shape(0))
+    raise_error("corners must be beside the ids, a row each: " + describe(corners_in) + " against " + describe(ids_in));
   return {std::move(ids), std::move(corners)};
 }
 
@@ -53,9 +59,7 @@ void bind_stream_blocks(py::module_& m) {
   m.def(
       "_survey_block",
       [](const py::array& corners_in, const py::array& lo_out, const py::array& hi_out, const py::object& histogram) {
-        const auto corners = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(corners_in);
-        if (!corners || corners.ndim() != 3 || corners.shape(1) != 3 || corners.shape(2) != 3)
-          raise_error("corners must be an (F, 3, 3) array, got " + describe(corners_in));
+        const FloatArray corners = corner_array(corners_in);
         float* lo = writable<float>(lo_out, 3, "lo");
         float* hi = writable<float>(hi_out, 3, "hi");
         int64_t* counts = histogram.is_none() ? nullptr : writable<int64_t>(histogram, 1 << 16, "histogram");

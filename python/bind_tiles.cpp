@@ -135,17 +135,10 @@ in its cell in units of 2**-level of the side), chunk_start (K+1,) uint32 and fa
 chunk k's face ids are faces[chunk_start[k]:chunk_start[k+1]].)");
 
   // The rule's arithmetic on blocks of faces, for a partition that streams the mesh (tailor.tiles).
-  using Corners = py::array_t<float, py::array::c_style | py::array::forcecast>;
-  auto corners_of = [](const py::array& corners) {
-    const Corners c = Corners::ensure(corners);
-    if (!c || c.ndim() != 3 || c.shape(1) != 3 || c.shape(2) != 3)
-      raise_error("corners must be an (F, 3, 3) float32 array, got " + describe(corners));
-    return c;
-  };
   m.def(
       "chunk_edge_lengths",
-      [corners_of](const py::array& corners) {
-        const Corners c = corners_of(corners);
+      [](const py::array& corners) {
+        const FloatArray c = corner_array(corners);
         const py::ssize_t n = c.shape(0);
         py::array_t<float> out({n, py::ssize_t{3}});
         Status status;
@@ -175,8 +168,8 @@ chunk k's face ids are faces[chunk_start[k]:chunk_start[k+1]].)");
       "of this median edge length (chunk_cell when given)");
   m.def(
       "chunk_cells",
-      [corners_of](const py::array& corners, int cell_exponent) {
-        const Corners c = corners_of(corners);
+      [](const py::array& corners, int cell_exponent) {
+        const FloatArray c = corner_array(corners);
         const py::ssize_t n = c.shape(0);
         py::array_t<int32_t> out({n, py::ssize_t{3}});
         Status status;

@@ -60,11 +60,13 @@ py::array readonly_view(const T* data, std::vector<py::ssize_t> shape, py::handl
 //! "float32 (3, 4)": the dtype and shape of an array, for error messages.
 std::string describe(const py::array& array);
 
-//! A streamed block's or tile's faces (tailor.tiles): (F, 3) int64 vertex ids and the (F, 3, 3)
-//! float32 corners beside them, checked (tailor.Error names what is wrong). Defined in
+//! Faces given by their corners, (F, 3, 3) float32 (the chunk rule's arithmetic on a streamed
+//! mesh), checked (tailor.Error names what is wrong); and a streamed block's or tile's faces
+//! (tailor.tiles): (F, 3) int64 vertex ids and their corners, a row each. Defined in
 //! bind_stream_blocks.cpp.
 using IdArray = py::array_t<int64_t, py::array::c_style | py::array::forcecast>;
 using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
+FloatArray corner_array(const py::array& corners);
 std::pair<IdArray, FloatArray> streamed_faces(const py::array& ids, const py::array& corners);
 
 //! A sequence as the CLI's text of it ("0,1,0"), for messages; other objects as str() shows them.

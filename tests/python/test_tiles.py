@@ -567,6 +567,10 @@ def test_a_block_of_the_partition_is_its_records_grouped_by_tile():
         bad[0, corner, 1] = np.nan
         with pytest.raises(tailor.Error, match="chunk cells"):
             tailor.chunk_cells(bad, CELL)
+    with pytest.raises(tailor.Error, match="corners must be beside the ids, a row each"):
+        tailor._tailor._partition_block(ids[:2], corners[:1], CELL, 0, 8)
+    with pytest.raises(tailor.Error, match="corners must be an .F, 3, 3. float32 array"):
+        tailor._tailor._partition_block(ids[:1], corners[:1, :2], CELL, 0, 8)
     with pytest.raises(tailor.Error, match="vertex id 4294967296 of face 0 does not fit 4 bytes"):
         tailor._tailor._partition_block(np.array([[0, 1, 1 << 32]]), corners[:1], CELL, 0, 4)
 
