@@ -5,6 +5,8 @@
 #include <cmath>
 #include <utility>
 
+#include "mapping/sum_smallest_first.h"
+
 namespace tailor::internal {
 namespace {
 
@@ -125,10 +127,7 @@ void build_chunk_mesh(const Mesh& mesh, std::span<const uint32_t> faces, const s
     if (point_less(p[2], p[r])) r = 2;
     uint64_t morton = 0;
     for (int k = 0; k < 3; ++k) {
-      // Summed smallest first, as the chunk rule does; ordered by min and max, without branches.
-      const double a = p[0][k], b = p[1][k], d = p[2][k];
-      const double low2 = std::min(a, b), high2 = std::max(a, b);
-      const double sum = (std::min(low2, d) + std::max(low2, std::min(high2, d))) + std::max(high2, d);
+      const double sum = sum_smallest_first(p[0][k], p[1][k], p[2][k]);  // as the chunk rule adds them
       const double t = (sum / 3.0 - origin[static_cast<size_t>(k)]) * inverse;
       // Clamped, then truncated: the floor of what lies in range, without a call to floor.
       const double q = std::clamp(t * double{1 << 21}, 0.0, double{(1 << 21) - 1});

@@ -6,6 +6,7 @@
 #include <span>
 #include <vector>
 
+#include "mapping/sum_smallest_first.h"
 #include "tailor/chunks.h"
 
 namespace tailor {
@@ -32,24 +33,19 @@ namespace {
 constexpr double kMaxCell = double{1 << 20};
 
 // The face's centroid as three times it, in doubles, the three terms added smallest first so that
-// the corners' order cannot change a rounding. Ordered by min and max, without branches: branches
-// on the coordinates mispredict about half the time. std::min and std::max drop a NaN in their
-// second argument, so a term that is 0 for finite corners and NaN otherwise keeps a NaN corner
-// out of every cell; the sign of a zero sum may differ with the corners' order, which the grid's
-// offset (kChunkGridOffset) makes irrelevant to the cell.
+// the corners' order cannot change a rounding (a NaN corner's is NaN: in no cell).
 inline void centroid3(const float* p0, const float* p1, const float* p2, double out[3]) {
-  for (int k = 0; k < 3; ++k) {
-    const double a = p0[k], b = p1[k], c = p2[k];
-    const double low2 = std::min(a, b), high2 = std::max(a, b);
-    const double low = std::min(low2, c), high = std::max(high2, c), middle = std::max(low2, std::min(high2, c));
-    out[k] = (low + middle) + high + (a + b + c) * 0.0;
-  }
+  for (int k = 0; k < 3; ++k) out[k] = internal::sum_smallest_first(p0[k], p1[k], p2[k]);
 }
 
-// An edge's length as the median is taken over: the difference in doubles, rounded to float.
-inline float edge_length(const float* a, const float* b) {
+// An edge's squared length in doubles, and its length as the median is taken over: that rounded to
+// float.
+inline double edge_length_squared(const float* a, const float* b) {
   const double dx = double{a[0]} - b[0], dy = double{a[1]} - b[1], dz = double{a[2]} - b[2];
-  return static_cast<float>(std::sqrt(dx * dx + dy * dy + dz * dz));
+  return dx * dx + dy * dy + dz * dz;
+}
+inline float edge_length(const float* a, const float* b) {
+  return static_cast<float>(std::sqrt(edge_length_squared(a, b)));
 }
 
 // The cell of a face (its corners p0, p1, p2) packed in 63 bits (21 per axis, offset to be
@@ -239,10 +235,8 @@ Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& pla
   // longest of edge_length's values.
   double median = 0.0, longest_squared = 0.0;
   const auto squared = [&](size_t f, int k) {
-    const float* a = p + 3 * size_t{idx[3 * f + static_cast<size_t>(k)]};
-    const float* b = p + 3 * size_t{idx[3 * f + static_cast<size_t>((k + 1) % 3)]};
-    const double dx = double{a[0]} - b[0], dy = double{a[1]} - b[1], dz = double{a[2]} - b[2];
-    return dx * dx + dy * dy + dz * dz;
+    return edge_length_squared(p + 3 * size_t{idx[3 * f + static_cast<size_t>(k)]},
+                               p + 3 * size_t{idx[3 * f + static_cast<size_t>((k + 1) % 3)]});
   };
   if (options.cell_exponent == kAutoCellExponent) {
     std::vector<float> lengths(3 * face_count);
