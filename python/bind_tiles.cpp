@@ -242,8 +242,9 @@ as `tailor map --material` (.glb: base colour, normal map with tangents, metalli
 occlusion): a folder or JSON, or what tailor.load_material returned (read once for many files);
 its size must be texture_size. up: 'z' for Z-up coordinates, turned Y-up by the .glb node's
 rotation as `tailor map --up z`. image_uris: {role: URI} for maps the .glb names (relative to
-itself) instead of embedding, roles 'color' (the texture or the material's colour map, then not
-read), 'normal' and 'orm' (the material's maps): many tiles then share one copy of the images.)");
+itself) instead of embedding, without reading them: roles 'color' (needs the texture or the
+material's colour map), 'normal' and 'orm' (the material's maps; the ORM map needs the roles the
+material gives it): many tiles then share one copy of the images.)");
 
   m.def(
       "load_material", [](const py::object& path_object) { return read_material_dict(path_object); }, py::arg("path"),

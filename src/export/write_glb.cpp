@@ -58,6 +58,11 @@ size_t add_view(nlohmann::json& views, size_t offset, size_t length, int target)
 
 }  // namespace
 
+Status glb_base_color(const ExportOptions& options, std::string& bytes, std::string& mime_type) {
+  if (options.texture_path.empty() || !options.image_uris.color.empty()) return Status::ok();
+  return read_texture_bytes(options.texture_path, bytes, mime_type);
+}
+
 void add_glb_material(nlohmann::json& gltf, nlohmann::json& views, size_t blob_offset, std::string& blob,
                       const std::string& base_color, const std::string& mime_type, const ExportOptions& options,
                       int uv_set) {
@@ -113,8 +118,7 @@ Status write_glb(const std::string& path, const ExportData& data, const ExportOp
     return Status::error(ErrorCode::kLimit, path, "mesh too large for a .glb buffer (4 GiB)");
 
   std::string texture_bytes, mime_type;
-  if (!options.texture_path.empty() && options.image_uris.color.empty())
-    TAILOR_RETURN_IF_ERROR(read_texture_bytes(options.texture_path, texture_bytes, mime_type));
+  TAILOR_RETURN_IF_ERROR(glb_base_color(options, texture_bytes, mime_type));
   // One primitive per part (a glTF scene's), each over its own range of split vertices and indices.
   std::vector<ExportPart> parts = data.parts;
   if (parts.empty()) parts.push_back({0, 0, vertex_count, 0, index_count});

@@ -397,8 +397,7 @@ Status write_glb_compressed(const std::string& path, const ExportData& data, con
       data.split.indices.size() > std::numeric_limits<uint32_t>::max() / 4)
     return Status::error(ErrorCode::kLimit, path, "mesh too large for a .glb buffer (4 GiB)");
   std::string texture_bytes, mime_type;
-  if (!options.texture_path.empty() && options.image_uris.color.empty())
-    TAILOR_RETURN_IF_ERROR(read_texture_bytes(options.texture_path, texture_bytes, mime_type));
+  TAILOR_RETURN_IF_ERROR(glb_base_color(options, texture_bytes, mime_type));
 
   Arrays arrays = gather(data);
   // One primitive per part (a glTF scene's), each its own streams (Draco codes one per primitive).

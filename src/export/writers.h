@@ -95,6 +95,10 @@ void compute_tangents(const Mesh& mesh, const SplitMesh& split, std::span<const 
 //! Fails with kIo (unreadable) or kInvalidImage (neither PNG nor JPEG).
 Status read_texture_bytes(const std::string& path, std::string& bytes, std::string& mime_type);
 
+//! What a .glb embeds of the base colour: read_texture_bytes of options.texture_path, or nothing
+//! without a texture or when options.image_uris.color names it (the file is then not read).
+Status glb_base_color(const ExportOptions& options, std::string& bytes, std::string& mime_type);
+
 //! Appends the shortest decimal text that reads back as exactly `value` (std::to_chars).
 void append_float(std::string& out, float value);
 
