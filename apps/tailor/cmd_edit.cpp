@@ -20,6 +20,7 @@
 #include "edit_api.h"
 #include "http_server.h"
 #include "map_shared.h"
+#include "memory_policy.h"
 #include "tailor/axis_choice.h"
 #include "tailor/io.h"
 #include "tailor/mapping.h"
@@ -142,6 +143,9 @@ int run_edit(const EditArgs& opt) {
     options.orientation = orientation_for(choice.best, options.orientation);
     warn(opt.quiet, std::string("axis auto: ") + axis_candidate_name(choice.best));
   }
+  // The first map and every stroke's remap of a few chunks reuse the chunks' scratch for the
+  // session's life (an interactive process: a chunk's scratch is tens of MB at most).
+  const KeepScratch keep;
   const auto start = std::chrono::steady_clock::now();
   if (Status s = EditSession::open(std::move(mesh), options, context.session); !s)
     return report_error(s.with_file(opt.input));

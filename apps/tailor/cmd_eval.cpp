@@ -8,6 +8,7 @@
 
 #include "cli.h"
 #include "map_shared.h"
+#include "memory_policy.h"
 #include "tailor/export.h"
 #include "tailor/gltf.h"
 #include "tailor/io.h"
@@ -49,8 +50,11 @@ int run_stability(const EvalOptions& opt) {
     mapping.mapping.use_seed_point = true;
   }
   StabilityReport r;
-  if (Status s = measure_stability(mesh, mapping, r, opt.stability_options); !s)
-    return report_error(s.with_file(opt.input));
+  {
+    const KeepScratch keep;  // three chunked mappings: each chunk's scratch reused
+    if (Status s = measure_stability(mesh, mapping, r, opt.stability_options); !s)
+      return report_error(s.with_file(opt.input));
+  }
   if (opt.json)
     std::fputs(stability_report_json(opt.input, r).c_str(), stdout);
   else if (!opt.quiet)

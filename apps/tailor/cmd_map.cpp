@@ -11,6 +11,7 @@
 
 #include "cli.h"
 #include "map_shared.h"
+#include "memory_policy.h"
 #include "tailor/axis_choice.h"
 #include "tailor/export.h"
 #include "tailor/image.h"
@@ -260,7 +261,10 @@ int run_map(const MapArgs& opt) {
   TextureMap map;
   MapTextureOptions unmeasured = options;
   unmeasured.measure = false;
-  if (Status s = map_texture(mesh, topology, unmeasured, map); !s) return report_error(s.with_file(opt.input));
+  {
+    const KeepScratch keep;  // every chunk's scratch reused, not faulted in again
+    if (Status s = map_texture(mesh, topology, unmeasured, map); !s) return report_error(s.with_file(opt.input));
+  }
   progress.done();
   if (topology.opposite.empty()) connect();
   {
@@ -283,6 +287,7 @@ int run_map(const MapArgs& opt) {
   // === Stability (optional: two more mappings) ===
   if (opt.stability) {
     StabilityReport stability;
+    const KeepScratch keep;
     if (Status s = measure_stability(mesh, options, stability); !s) return report_error(s.with_file(opt.input));
     run.stability = stability;
   }

@@ -8,11 +8,8 @@
 #include <string>
 #include <vector>
 
-#if defined(__GLIBC__)
-#include <malloc.h>
-#endif
-
 #include "cli.h"
+#include "memory_policy.h"
 #include "tailor/version.h"
 #include "util/atomic_file.h"
 
@@ -88,21 +85,10 @@ int check_stdout(int code) {
   return code == kExitOk ? kExitBadInput : code;
 }
 
-// Large buffers straight from and back to the kernel. glibc's default threshold rises to the
-// largest block freed so far (up to 32 MB), after which the mapping's per-chunk buffers come
-// from the worker threads' arenas and stay resident there once freed: on a 6.2 M-face map that
-// held 75 MB (10 %) at the export's peak. A fixed threshold keeps the peak to what is live.
-void release_large_blocks() {
-#if defined(__GLIBC__)
-  mallopt(M_MMAP_THRESHOLD, 256 * 1024);
-  mallopt(M_TRIM_THRESHOLD, 1024 * 1024);
-#endif
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
-  release_large_blocks();
+  tailor::cli::release_large_blocks();
   // Temporary output files are removed on Ctrl-C, SIGTERM and SIGHUP (the signal still ends tailor).
   tailor::internal::install_signal_cleanup();
   return check_stdout(run_command(argc, argv));
