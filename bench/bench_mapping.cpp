@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "bench_meshes.h"
+#include "tailor/chunks.h"
 #include "tailor/io.h"
 #include "tailor/mapping.h"
 #include "tailor/metrics.h"
@@ -191,6 +192,37 @@ void BM_MappingThreads(benchmark::State& state, const std::string& key, const st
   state.counters["same_bits"] = reference != one_thread_uv.end() && reference->second == map.atlas.corner_uv;
   set_faces_rate(state, p.mesh.face_count());
 }
+
+// The chunk rule alone (plan_chunks: edge lengths and their median, each face's cell, the cells cut
+// into octants) on horse_x16 with state.range(0) threads, the automatic cell (range(1) = 1) or the
+// cell it gives (0): serial work at the start of every chunked map.
+void BM_ChunkPlan(benchmark::State& state) {
+  const Prepared& p = prepared("horse_x16");
+  if (!p.ok) {
+    state.SkipWithError(p.error.c_str());
+    return;
+  }
+  tailor::ChunkOptions options;
+  options.mode = tailor::ChunkMode::kOn;
+  tailor::ChunkPlan plan;
+  if (state.range(1) == 0) {
+    if (!tailor::plan_chunks(p.mesh, options, plan).is_ok()) return state.SkipWithError("plan failed");
+    options.cell_exponent = plan.cell_exponent;
+  }
+  for (auto _ : state) {
+    if (!tailor::plan_chunks(p.mesh, options, plan, static_cast<uint32_t>(state.range(0))).is_ok())
+      return state.SkipWithError("plan failed");
+    benchmark::DoNotOptimize(plan.faces.data());
+  }
+  state.counters["chunks"] = static_cast<double>(plan.chunk_count());
+  set_faces_rate(state, p.mesh.face_count());
+}
+BENCHMARK(BM_ChunkPlan)
+    ->Name("ChunkPlan/horse_x16")
+    ->ArgNames({"threads", "auto_cell"})
+    ->ArgsProduct({{1, 2, 4}, {1, 0}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // Registers one orientation and nine mapping benchmarks per mesh at static initialisation:
 // patches mode with a texture that has a direction, or none (default options, and ten times the

@@ -148,6 +148,44 @@ TEST(ChunkPlan, OverFullCellsAreCutIntoOctantsOfTheirOwnFaces) {
   EXPECT_EQ(plan_chunks(mesh, options, plan).code(), ErrorCode::kInvalidArgument);
 }
 
+// The plan is the same for any thread count (each thread takes a range of the faces: its cells,
+// counts and writes merge in range order), and the median edge is exactly what std::nth_element
+// gives over every face's three lengths.
+TEST(ChunkPlan, SameForAnyThreadCountWithTheExactMedian) {
+  for (const char* name : {"horse.ply", "fertility.off"}) {
+    const Mesh mesh = load_test_mesh(name);
+    std::vector<float> corners(9 * mesh.face_count()), lengths(3 * mesh.face_count());
+    for (size_t i = 0; i < 3 * mesh.face_count(); ++i)
+      std::copy_n(&mesh.positions[3 * size_t{mesh.indices[i]}], 3, &corners[3 * i]);
+    ASSERT_TRUE(chunk_edge_lengths(corners, lengths).is_ok());
+    const float longest = *std::max_element(lengths.begin(), lengths.end());
+    auto middle = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
+    std::nth_element(lengths.begin(), middle, lengths.end());
+    ChunkOptions options;
+    options.mode = ChunkMode::kOn;
+    options.cell_edges = 64.f;   // several cells
+    options.split_above = 2000;  // and parts
+    ChunkPlan one;
+    ASSERT_TRUE(plan_chunks(mesh, options, one, 1).is_ok());
+    EXPECT_EQ(one.median_edge, double{*middle}) << name;
+    EXPECT_EQ(one.longest_edge, double{longest}) << name;
+    ASSERT_GT(one.chunk_count(), 8u) << name;
+    EXPECT_GT(int{*std::max_element(one.levels.begin(), one.levels.end())}, 0) << name << ": no cell was cut";
+    for (const uint32_t threads : {2u, 3u, 8u}) {
+      ChunkPlan plan;
+      ASSERT_TRUE(plan_chunks(mesh, options, plan, threads).is_ok());
+      EXPECT_EQ(plan.median_edge, one.median_edge) << name << ", " << threads << " threads";
+      EXPECT_EQ(plan.longest_edge, one.longest_edge);
+      EXPECT_EQ(plan.cell_exponent, one.cell_exponent);
+      EXPECT_EQ(plan.cells, one.cells);
+      EXPECT_EQ(plan.levels, one.levels);
+      EXPECT_EQ(plan.parts, one.parts);
+      EXPECT_EQ(plan.chunk_start, one.chunk_start);
+      EXPECT_EQ(plan.faces, one.faces) << name << ", " << threads << " threads";
+    }
+  }
+}
+
 TEST(ChunkPlan, RejectsBadOptionsAndHugeSpans) {
   const Mesh mesh = load_test_mesh("spot.obj");
   ChunkPlan plan;

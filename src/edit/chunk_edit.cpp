@@ -77,7 +77,7 @@ ChunkedEdits& ChunkedEdits::operator=(ChunkedEdits&&) noexcept = default;
 
 Status ChunkedEdits::prepare(const Mesh& mesh, const MapTextureOptions& options) {
   auto layout = std::make_shared<Layout>();
-  TAILOR_RETURN_IF_ERROR(plan_chunks(mesh, options.chunks, layout->plan));
+  TAILOR_RETURN_IF_ERROR(plan_chunks(mesh, options.chunks, layout->plan, options.mapping.threads));
   layout->texels_per_unit = chunk_texels_per_unit(mesh, options);
   const ChunkPlan& plan = layout->plan;
   const size_t chunks = plan.chunk_count();

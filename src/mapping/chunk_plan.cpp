@@ -2,12 +2,16 @@
 // from the median edge length, a face in the cell of its centroid. Everything here is a function
 // of the geometry alone: the median is order-free, the cell of a face depends on its own corners.
 #include <algorithm>
+#include <array>
+#include <atomic>
 #include <cmath>
+#include <cstring>
 #include <span>
 #include <vector>
 
 #include "mapping/sum_smallest_first.h"
 #include "tailor/chunks.h"
+#include "util/parallel_chunks.h"
 
 namespace tailor {
 
@@ -124,47 +128,67 @@ class CellTable {
   size_t size_ = 0;
 };
 
-// Cuts the cells of more than split_above faces into octants, recursively (split_cell), in place:
-// the plan's chunks become the parts, each cell's in octant order (z, then y, then x bit), the
-// faces of a part in the order they had. Only the faces of split cells are touched.
+// Cuts the cells of more than split_above faces into octants, recursively (split), in place: the
+// plan's chunks become the parts, each cell's in octant order (z, then y, then x bit), the faces of
+// a part in the order they had. A split only reorders its cell's own range of plan.faces, so the
+// cells are cut side by side, each into its own list of parts.
 class CellSplitter {
  public:
   CellSplitter(const Mesh& mesh, ChunkPlan& plan, uint32_t split_above)
       : p_(mesh.positions.data()), idx_(mesh.indices.data()), plan_(plan), split_above_(split_above) {}
 
-  void run() {
+  void run(size_t threads) {
     const size_t chunks = plan_.chunk_count();
     bool any = false;
     for (size_t c = 0; c < chunks && !any; ++c) any = plan_.chunk_start[c + 1] - plan_.chunk_start[c] > split_above_;
     plan_.levels.assign(chunks, 0);
     plan_.parts.assign(chunks, {0, 0, 0});
     if (!any) return;
-    std::vector<uint32_t> faces;
-    faces.reserve(plan_.faces.size());
-    for (size_t c = 0; c < chunks; ++c) {
-      const std::span<const uint32_t> cell(plan_.faces.data() + plan_.chunk_start[c],
-                                           plan_.chunk_start[c + 1] - plan_.chunk_start[c]);
-      std::vector<uint32_t> own(cell.begin(), cell.end());
-      split(plan_.cells[c], 0, {0, 0, 0}, own, faces);
-    }
-    plan_.faces = std::move(faces);
-    plan_.cells = std::move(cells_);
-    plan_.levels = std::move(levels_);
-    plan_.parts = std::move(parts_);
-    plan_.chunk_start = std::move(start_);
+    std::vector<Parts> parts(chunks);
+    internal::for_each_chunk(
+        chunks, threads,
+        [&](size_t c, size_t, size_t) {
+          Scratch scratch;
+          split(plan_.cells[c], 0, {0, 0, 0}, plan_.chunk_start[c], plan_.chunk_start[c + 1], scratch, parts[c]);
+        },
+        1);
+    plan_.cells.clear();
+    plan_.levels.clear();
+    plan_.parts.clear();
+    plan_.chunk_start.assign(1, 0);
+    for (const Parts& cell : parts)
+      for (size_t i = 0; i < cell.start.size(); ++i) {
+        plan_.cells.push_back(cell.cell);
+        plan_.levels.push_back(cell.level[i]);
+        plan_.parts.push_back(cell.part[i]);
+        plan_.chunk_start.push_back(i + 1 < cell.start.size() ? cell.start[i + 1] : cell.end);
+      }
   }
 
  private:
-  // Emits the part (cell, level, part) holding `faces`, or its octants when it holds too many.
-  void split(const std::array<int32_t, 3>& cell, int level, const std::array<uint16_t, 3>& part,
-             std::vector<uint32_t>& faces, std::vector<uint32_t>& out) {
-    if (faces.size() <= split_above_ || level == kMaxChunkSplitLevels) {
-      if (start_.empty()) start_.push_back(0);
-      out.insert(out.end(), faces.begin(), faces.end());
-      start_.push_back(static_cast<uint32_t>(out.size()));
-      cells_.push_back(cell);
-      levels_.push_back(static_cast<uint8_t>(level));
-      parts_.push_back(part);
+  // One cell's parts, in order: where each starts in plan.faces, its level and place.
+  struct Parts {
+    std::array<int32_t, 3> cell{};
+    uint32_t end = 0;
+    std::vector<uint32_t> start;
+    std::vector<uint8_t> level;
+    std::vector<std::array<uint16_t, 3>> part;
+  };
+  struct Scratch {
+    std::vector<uint8_t> octant;
+    std::vector<uint32_t> sorted;
+  };
+
+  // Emits the part (cell, level, part) holding plan.faces[begin, end), or cuts it into its octants
+  // when it holds too many.
+  void split(const std::array<int32_t, 3>& cell, int level, const std::array<uint16_t, 3>& part, uint32_t begin,
+             uint32_t end, Scratch& scratch, Parts& out) {
+    if (end - begin <= split_above_ || level == kMaxChunkSplitLevels) {
+      out.cell = cell;
+      out.end = end;
+      out.start.push_back(begin);
+      out.level.push_back(static_cast<uint8_t>(level));
+      out.part.push_back(part);
       return;
     }
     // Each face's octant in the part: its centroid in units of the child parts' side, from the
@@ -178,9 +202,12 @@ class CellSplitter {
       corner_at[k] = std::ldexp(cell[k] + kChunkGridOffset, child);
       first[k] = 2.0 * part[k];
     }
-    std::vector<uint8_t> octant(faces.size());
+    uint32_t* const faces = plan_.faces.data() + begin;
+    const size_t n = end - begin;
+    scratch.octant.resize(n);
+    scratch.sorted.resize(n);
     std::array<uint32_t, 9> start{};
-    for (size_t i = 0; i < faces.size(); ++i) {
+    for (size_t i = 0; i < n; ++i) {
       const uint32_t* corner = idx_ + 3 * size_t{faces[i]};
       double c[3];
       centroid3(p_ + 3 * size_t{corner[0]}, p_ + 3 * size_t{corner[1]}, p_ + 3 * size_t{corner[2]}, c);
@@ -190,22 +217,19 @@ class CellSplitter {
         const double s = c[k] * inverse3 - corner_at[axis] - first[axis];
         o = static_cast<uint8_t>((o << 1) | (s >= 1.0 ? 1 : 0));
       }
-      octant[i] = o;
+      scratch.octant[i] = o;
       ++start[o + 1u];
     }
     for (size_t o = 0; o < 8; ++o) start[o + 1] += start[o];
-    std::vector<uint32_t> sorted(faces.size());
     std::array<uint32_t, 9> fill = start;
-    for (size_t i = 0; i < faces.size(); ++i) sorted[fill[octant[i]]++] = faces[i];
-    std::vector<uint32_t>().swap(faces);
-    std::vector<uint8_t>().swap(octant);
+    for (size_t i = 0; i < n; ++i) scratch.sorted[fill[scratch.octant[i]]++] = faces[i];
+    std::memcpy(faces, scratch.sorted.data(), n * sizeof(uint32_t));
     for (uint32_t o = 0; o < 8; ++o) {
       if (start[o] == start[o + 1]) continue;
-      std::vector<uint32_t> children(sorted.begin() + start[o], sorted.begin() + start[o + 1]);
       const std::array<uint16_t, 3> child_part = {static_cast<uint16_t>(2 * part[0] + (o & 1)),
                                                   static_cast<uint16_t>(2 * part[1] + ((o >> 1) & 1)),
                                                   static_cast<uint16_t>(2 * part[2] + ((o >> 2) & 1))};
-      split(cell, child, child_part, children, out);
+      split(cell, child, child_part, begin + start[o], begin + start[o + 1], scratch, out);
     }
   }
 
@@ -213,20 +237,78 @@ class CellSplitter {
   const uint32_t* idx_;
   ChunkPlan& plan_;
   uint32_t split_above_;
-  std::vector<std::array<int32_t, 3>> cells_;
-  std::vector<uint8_t> levels_;
-  std::vector<std::array<uint16_t, 3>> parts_;
-  std::vector<uint32_t> start_;
 };
+
+// Runs body(part, begin, end) for `parts` contiguous ranges of [0, n), one per thread. For passes
+// whose per-part results are merged in part order or by sums: the plan is the same for any count.
+template <class Body>
+void for_each_part(size_t n, size_t parts, Body body) {
+  internal::for_each_chunk(
+      parts, parts, [&](size_t t, size_t, size_t) { body(t, n * t / parts, n * (t + 1) / parts); }, 1);
+}
+
+// The k-th smallest (from 0) of each face's three edge_length values, as std::nth_element over all
+// 3F of them gives it, without storing them: lengths are non-negative floats, whose bits order as
+// unsigned integers, so counting the high 16 bits finds the bin that holds it, and counting the
+// low 16 bits of that bin's lengths finds the rest. Also the longest squared length.
+float kth_edge_length(const float* p, const uint32_t* idx, size_t face_count, uint64_t k, size_t parts,
+                      double& longest_squared) {
+  constexpr size_t kBins = size_t{1} << 16;
+  std::vector<uint64_t> counts(parts * kBins);
+  std::vector<double> longest(parts, 0.0);
+  auto squared = [&](size_t f, size_t j) {
+    return edge_length_squared(p + 3 * size_t{idx[3 * f + j]}, p + 3 * size_t{idx[3 * f + (j + 1) % 3]});
+  };
+  auto bits = [](double l2) {
+    const auto l = static_cast<float>(std::sqrt(l2));  // as edge_length
+    uint32_t b;
+    std::memcpy(&b, &l, sizeof b);
+    return b;
+  };
+  auto select = [&](uint64_t& rank) {  // the bin holding the rank-th smallest counted; rank: its rank in the bin
+    uint32_t bin = 0;
+    for (;; ++bin) {
+      uint64_t in_bin = 0;
+      for (size_t t = 0; t < parts; ++t) in_bin += counts[t * kBins + bin];
+      if (rank < in_bin) return bin;
+      rank -= in_bin;
+    }
+  };
+  for_each_part(face_count, parts, [&](size_t t, size_t begin, size_t end) {
+    uint64_t* count = counts.data() + t * kBins;
+    double most = 0.0;
+    for (size_t f = begin; f < end; ++f)
+      for (size_t j = 0; j < 3; ++j) {
+        const double l2 = squared(f, j);
+        most = std::max(most, l2);
+        ++count[bits(l2) >> 16];
+      }
+    longest[t] = most;
+  });
+  longest_squared = *std::max_element(longest.begin(), longest.end());
+  const uint32_t high = select(k);
+  std::fill(counts.begin(), counts.end(), 0);
+  for_each_part(face_count, parts, [&](size_t t, size_t begin, size_t end) {
+    uint64_t* count = counts.data() + t * kBins;
+    for (size_t f = begin; f < end; ++f)
+      for (size_t j = 0; j < 3; ++j)
+        if (const uint32_t b = bits(squared(f, j)); b >> 16 == high) ++count[b & 0xFFFF];
+  });
+  const uint32_t result = high << 16 | select(k);
+  float length;
+  std::memcpy(&length, &result, sizeof length);
+  return length;
+}
 
 }  // namespace
 
-Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& plan) {
+Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& plan, uint32_t threads) {
   TAILOR_RETURN_IF_ERROR(check_chunk_options(options));
   const size_t face_count = mesh.face_count();
   if (face_count == 0) return Status::error(ErrorCode::kInvalidMesh, "", "mesh has no face");
   const float* p = mesh.positions.data();
   const uint32_t* idx = mesh.indices.data();
+  const size_t parts = internal::parallel_threads(face_count, threads);
 
   // The longest edge (the locality radius reaches that far beyond a cell) and, for the automatic
   // cell only, the median edge: each face's three (an interior edge counts twice, which leaves the
@@ -234,24 +316,19 @@ Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& pla
   // taken over squared lengths: the root and the rounding to float keep the order, so it is the
   // longest of edge_length's values.
   double median = 0.0, longest_squared = 0.0;
-  const auto squared = [&](size_t f, int k) {
-    return edge_length_squared(p + 3 * size_t{idx[3 * f + static_cast<size_t>(k)]},
-                               p + 3 * size_t{idx[3 * f + static_cast<size_t>((k + 1) % 3)]});
-  };
   if (options.cell_exponent == kAutoCellExponent) {
-    std::vector<float> lengths(3 * face_count);
-    for (size_t f = 0; f < face_count; ++f)
-      for (int k = 0; k < 3; ++k) {
-        const double l2 = squared(f, k);
-        longest_squared = std::max(longest_squared, l2);
-        lengths[3 * f + static_cast<size_t>(k)] = static_cast<float>(std::sqrt(l2));  // as edge_length
-      }
-    auto middle = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
-    std::nth_element(lengths.begin(), middle, lengths.end());
-    median = *middle;
+    median = kth_edge_length(p, idx, face_count, 3 * uint64_t{face_count} / 2, parts, longest_squared);
   } else {
-    for (size_t f = 0; f < face_count; ++f)
-      for (int k = 0; k < 3; ++k) longest_squared = std::max(longest_squared, squared(f, k));
+    std::vector<double> longest(parts, 0.0);
+    for_each_part(face_count, parts, [&](size_t t, size_t begin, size_t end) {
+      double most = 0.0;
+      for (size_t f = begin; f < end; ++f)
+        for (size_t j = 0; j < 3; ++j)
+          most = std::max(
+              most, edge_length_squared(p + 3 * size_t{idx[3 * f + j]}, p + 3 * size_t{idx[3 * f + (j + 1) % 3]}));
+      longest[t] = most;
+    });
+    longest_squared = *std::max_element(longest.begin(), longest.end());
   }
   plan.median_edge = median;
   plan.longest_edge = static_cast<float>(std::sqrt(longest_squared));
@@ -262,17 +339,29 @@ Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& pla
   plan.cell_size = std::ldexp(1.0, exponent);
   const double inverse3 = std::ldexp(1.0, -exponent) / 3.0;
 
-  // Each face's cell, packed in 63 bits (21 per axis, offset to be unsigned): x fastest.
+  // Each face's cell, packed in 63 bits (21 per axis, offset to be unsigned): x fastest; and each
+  // part's distinct cells (a run of faces in one cell is looked up once).
   std::vector<uint64_t> key(face_count);
-  for (size_t f = 0; f < face_count; ++f) {
-    const uint32_t* corner = idx + 3 * f;
-    if (!face_cell_key(p + 3 * size_t{corner[0]}, p + 3 * size_t{corner[1]}, p + 3 * size_t{corner[2]}, inverse3,
-                       key[f]))
-      return too_many_cells();
-  }
+  std::vector<CellTable> part_cells(parts);
+  std::atomic<bool> outside{false};
+  for_each_part(face_count, parts, [&](size_t t, size_t begin, size_t end) {
+    uint64_t last = CellTable::kEmpty;
+    for (size_t f = begin; f < end; ++f) {
+      const uint32_t* corner = idx + 3 * f;
+      if (!face_cell_key(p + 3 * size_t{corner[0]}, p + 3 * size_t{corner[1]}, p + 3 * size_t{corner[2]}, inverse3,
+                         key[f])) {
+        outside.store(true, std::memory_order_relaxed);
+        return;
+      }
+      if (key[f] != last) part_cells[t].insert(last = key[f]);
+    }
+  });
+  if (outside.load()) return too_many_cells();
   // The distinct cells, in key order (z, y, x).
   CellTable table;
-  for (size_t f = 0; f < face_count; ++f) table.insert(key[f]);
+  for (const CellTable& cells : part_cells)
+    for (const uint64_t k : cells.keys()) table.insert(k);
+  std::vector<CellTable>().swap(part_cells);
   std::vector<uint64_t> cells = table.keys();
   std::sort(cells.begin(), cells.end());
   const size_t chunks = cells.size();
@@ -280,20 +369,35 @@ Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& pla
   plan.cells.resize(chunks);
   for (size_t c = 0; c < chunks; ++c)
     for (int k = 0; k < 3; ++k) plan.cells[c][static_cast<size_t>(k)] = unpack_cell(cells[c], k);
-  // Faces grouped by chunk (a counting sort, file order within a chunk).
-  std::vector<uint32_t> chunk_of(face_count);
+  // Faces grouped by chunk, file order within a chunk: each part counts its faces per chunk (their
+  // chunk in place of their key), then writes them from where the parts before it end.
+  std::vector<uint32_t> count(parts * chunks, 0);
+  for_each_part(face_count, parts, [&](size_t t, size_t begin, size_t end) {
+    uint32_t* own = count.data() + t * chunks;
+    uint64_t last = CellTable::kEmpty, chunk = 0;
+    for (size_t f = begin; f < end; ++f) {
+      if (key[f] != last) chunk = table.value(last = key[f]);
+      key[f] = chunk;
+      ++own[chunk];
+    }
+  });
   plan.chunk_start.assign(chunks + 1, 0);
-  for (size_t f = 0; f < face_count; ++f) {
-    const uint32_t c = table.value(key[f]);
-    chunk_of[f] = c;
-    ++plan.chunk_start[c + 1];
+  for (size_t c = 0; c < chunks; ++c) {
+    uint32_t at = plan.chunk_start[c];
+    for (size_t t = 0; t < parts; ++t) {
+      const uint32_t faces = count[t * chunks + c];
+      count[t * chunks + c] = at;  // where part t's faces of chunk c go
+      at += faces;
+    }
+    plan.chunk_start[c + 1] = at;
   }
-  std::vector<uint64_t>().swap(key);
-  for (size_t c = 0; c < chunks; ++c) plan.chunk_start[c + 1] += plan.chunk_start[c];
   plan.faces.resize(face_count);
-  std::vector<uint32_t> fill(plan.chunk_start.begin(), plan.chunk_start.end() - 1);
-  for (size_t f = 0; f < face_count; ++f) plan.faces[fill[chunk_of[f]]++] = static_cast<uint32_t>(f);
-  CellSplitter(mesh, plan, options.split_above ? options.split_above : ~uint32_t{0}).run();
+  for_each_part(face_count, parts, [&](size_t t, size_t begin, size_t end) {
+    uint32_t* fill = count.data() + t * chunks;
+    for (size_t f = begin; f < end; ++f) plan.faces[fill[key[f]]++] = static_cast<uint32_t>(f);
+  });
+  std::vector<uint64_t>().swap(key);
+  CellSplitter(mesh, plan, options.split_above ? options.split_above : ~uint32_t{0}).run(parts);
   return Status::ok();
 }
 

@@ -62,7 +62,7 @@ Status ChunkedMapper::set_chunk(const ChunkCell& cell, const Mesh& faces) {
   rule.cell_exponent = cell_exponent_;
   rule.split_above = options_.chunks.split_above;
   ChunkPlan plan;
-  TAILOR_RETURN_IF_ERROR(plan_chunks(faces, rule, plan));
+  TAILOR_RETURN_IF_ERROR(plan_chunks(faces, rule, plan, options_.mapping.threads));
   const auto outside =
       std::find_if(plan.cells.begin(), plan.cells.end(), [&](const ChunkCell& c) { return c != cell; });
   if (outside != plan.cells.end()) {

@@ -194,7 +194,7 @@ Status map_chunks(const Mesh& mesh, const MapTextureOptions& options, TextureMap
     return Status::error(ErrorCode::kInvalidArgument, "",
                          "the skeleton axis needs the whole mesh: map it without chunks (chunks off)");
   ChunkPlan plan;
-  TAILOR_RETURN_IF_ERROR(plan_chunks(mesh, options.chunks, plan));
+  TAILOR_RETURN_IF_ERROR(plan_chunks(mesh, options.chunks, plan, options.mapping.threads));
   const double texels_per_unit = chunk_texels_per_unit(mesh, options);
   if (const double chunk_scale = texels_per_unit * plan.cell_size; !(chunk_scale >= 1e-3 && chunk_scale <= 1e7))
     return Status::error(ErrorCode::kInvalidArgument, "",
