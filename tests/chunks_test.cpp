@@ -171,7 +171,27 @@ TEST(ChunkPlan, SameForAnyThreadCountWithTheExactMedian) {
     EXPECT_EQ(one.longest_edge, double{longest}) << name;
     ASSERT_GT(one.chunk_count(), 8u) << name;
     EXPECT_GT(int{*std::max_element(one.levels.begin(), one.levels.end())}, 0) << name << ": no cell was cut";
-    for (const uint32_t threads : {2u, 3u, 8u}) {
+    // Without the cut, the reference by hand: each face's cell (chunk_cells), faces stably sorted
+    // by cell in z, y, x order.
+    {
+      ChunkOptions whole = options;
+      whole.split_above = 0;
+      ChunkPlan plan;
+      ASSERT_TRUE(plan_chunks(mesh, whole, plan, 3).is_ok());
+      std::vector<int32_t> cells(3 * mesh.face_count());
+      ASSERT_TRUE(chunk_cells(corners, plan.cell_exponent, cells).is_ok());
+      std::vector<uint32_t> faces(mesh.face_count());
+      for (uint32_t f = 0; f < faces.size(); ++f) faces[f] = f;
+      const auto cell_of = [&](uint32_t f) {
+        return std::make_tuple(cells[3 * f + 2], cells[3 * f + 1], cells[3 * f]);
+      };
+      std::stable_sort(faces.begin(), faces.end(), [&](uint32_t a, uint32_t b) { return cell_of(a) < cell_of(b); });
+      EXPECT_EQ(plan.faces, faces) << name;
+      for (size_t c = 0; c < plan.chunk_count(); ++c)
+        for (uint32_t i = plan.chunk_start[c]; i < plan.chunk_start[c + 1]; ++i)
+          ASSERT_EQ(cell_of(plan.faces[i]), std::make_tuple(plan.cells[c][2], plan.cells[c][1], plan.cells[c][0]));
+    }
+    for (const uint32_t threads : {2u, 3u, 8u, 64u}) {
       ChunkPlan plan;
       ASSERT_TRUE(plan_chunks(mesh, options, plan, threads).is_ok());
       EXPECT_EQ(plan.median_edge, one.median_edge) << name << ", " << threads << " threads";
@@ -183,6 +203,20 @@ TEST(ChunkPlan, SameForAnyThreadCountWithTheExactMedian) {
       EXPECT_EQ(plan.chunk_start, one.chunk_start);
       EXPECT_EQ(plan.faces, one.faces) << name << ", " << threads << " threads";
     }
+  }
+  // More threads than faces, and one face.
+  const Mesh horse = load_test_mesh("horse.ply");
+  for (const size_t face_count : {size_t{5}, size_t{1}}) {
+    Mesh few;
+    few.positions = horse.positions;
+    few.indices.assign(horse.indices.begin(), horse.indices.begin() + static_cast<std::ptrdiff_t>(3 * face_count));
+    ChunkPlan one, many;
+    ASSERT_TRUE(plan_chunks(few, ChunkOptions{}, one, 1).is_ok());
+    ASSERT_TRUE(plan_chunks(few, ChunkOptions{}, many, 64).is_ok());
+    EXPECT_EQ(many.faces, one.faces);
+    EXPECT_EQ(many.chunk_start, one.chunk_start);
+    EXPECT_EQ(many.median_edge, one.median_edge);
+    EXPECT_EQ(one.chunk_start.back(), face_count);
   }
 }
 

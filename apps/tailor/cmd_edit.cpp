@@ -143,12 +143,12 @@ int run_edit(const EditArgs& opt) {
     options.orientation = orientation_for(choice.best, options.orientation);
     warn(opt.quiet, std::string("axis auto: ") + axis_candidate_name(choice.best));
   }
-  // The first map and every stroke's remap of a few chunks reuse the chunks' scratch for the
-  // session's life (an interactive process: a chunk's scratch is tens of MB at most).
-  const KeepScratch keep;
   const auto start = std::chrono::steady_clock::now();
-  if (Status s = EditSession::open(std::move(mesh), options, context.session); !s)
-    return report_error(s.with_file(opt.input));
+  {
+    const KeepScratch keep;  // the first map's chunks reuse each other's scratch
+    if (Status s = EditSession::open(std::move(mesh), options, context.session); !s)
+      return report_error(s.with_file(opt.input));
+  }
   const double open_seconds = seconds_since(start);
 
   // === Serve ===
@@ -224,7 +224,8 @@ void register_edit(CLI::App& app, Runner& run) {
   handles.smooth->check(CLI::Range(0u, 1000u));  // rejected at parsing here (in `tailor map`, by the orientation)
   const CLI::Option* crack_rings = handles.crack_rings;
   cmd->add_option("--threads", mapping.threads,
-                  "Threads for the orientation, the crack closing and the metrics (0 = one per core, up to 8); "
+                  "Threads for the chunk plan, the orientation, the crack closing and the metrics (0 = one per "
+                  "core, up to 8); "
                   "the result is the same for any count")
       ->capture_default_str()
       ->check(CLI::Range(0u, 64u));

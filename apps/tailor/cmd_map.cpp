@@ -491,7 +491,8 @@ void register_map(CLI::App& app, Runner& run) {
                 "Also map the mesh again in another file order, and with ~10% of its faces removed (fresh runs, "
                 "as tailor eval --stability), and report how many UVs kept their bits and how far the others moved");
   cmd->add_option("--threads", mapping.threads,
-                  "Threads: chunks (--chunks) are mapped one per thread (0 = one per core); a mesh mapped whole uses "
+                  "Threads: chunks (--chunks) are planned on them and mapped one per thread (0 = one per core); a "
+                  "mesh mapped whole uses "
                   "them for its orientation, crack closing and metrics (0 = one per core, up to 8, where the mesh is "
                   "large enough); the output is the same for any count")
       ->capture_default_str()

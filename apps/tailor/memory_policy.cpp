@@ -30,9 +30,9 @@ void release_large_blocks() {
 
 KeepScratch::KeepScratch() {
 #if defined(__GLIBC__)
-  // The trim threshold stays: a worker thread's heap still shrinks when more than 1 MB is free at
-  // its top, since malloc_trim reaches only the free blocks inside the threads' heaps, not their
-  // tops (kept up to 32 MB, they held 30 MB more at the export's peak).
+  // The trim threshold stays: a worker thread's heap shrinks when more than 1 MB is free at its
+  // top, which malloc_trim does not reach (it releases the free blocks inside the threads' heaps
+  // only), so the threads' heaps do not stay grown after the mapping.
   mallopt(M_MMAP_THRESHOLD, kKeptThreshold);
 #endif
 }

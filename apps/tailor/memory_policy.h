@@ -8,9 +8,10 @@ namespace tailor::cli {
 void release_large_blocks();
 
 //! While one lives, freed blocks of up to 32 MB stay in the allocator for the next request; when it
-//! goes, what is free is handed back and release_large_blocks' rule holds again. The chunked
-//! mapping allocates and frees the same scratch for every chunk: handed back each time, every
-//! chunk faulted its pages in again (a seventh of `tailor map`'s time on a 1.5 M-face mesh).
+//! goes, what is free is handed back and release_large_blocks' rule holds again. For the chunked
+//! mapping, which allocates and frees the same scratch for every chunk: handed back each time, the
+//! pages of every chunk's scratch are faulted in again. Not nested: the inner one's end would
+//! restore the rule while the outer one lives.
 class KeepScratch {
  public:
   KeepScratch();

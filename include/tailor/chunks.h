@@ -117,8 +117,9 @@ TAILOR_API bool uses_chunks(const ChunkOptions& options, size_t face_count);
 //! part's faces have their centroids in its box up to rounding). Fails with kInvalidArgument on bad options and
 //! kInvalidMesh when the mesh has no face, no edge of positive length, or cells beyond 2^20 per
 //! axis (a mesh spanning more than a million cells: give a larger cell). O(F) time (the median by
-//! two counting passes), on `threads` threads (0: one per 100k faces, at most the cores and 8; the
-//! plan is the same for any count), 8 bytes per face while it runs and 4 in the result.
+//! two counting passes), on `threads` threads (0: one per 100k faces, at most the cores and 8; at
+//! most one per 65,536 faces; the plan is the same for any count), 12 bytes per face while it runs
+//! and 4 in the result.
 TAILOR_API Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& plan, uint32_t threads = 0);
 
 //! The rule's arithmetic for code that streams a mesh instead of holding it (python -m tailor.tiles

@@ -33,6 +33,9 @@ bool uses_chunks(const ChunkOptions& options, size_t face_count) {
 
 namespace {
 
+// Faces per thread of the plan at least: fewer cost more in starting threads than they save.
+constexpr size_t kFacesPerPart = size_t{1} << 16;
+
 // Cells per axis either side of the origin: cell coordinates pack into 21 bits each.
 constexpr double kMaxCell = double{1 << 20};
 
@@ -50,6 +53,15 @@ inline double edge_length_squared(const float* a, const float* b) {
 }
 inline float edge_length(const float* a, const float* b) {
   return static_cast<float>(std::sqrt(edge_length_squared(a, b)));
+}
+// Face f's three edges' squared lengths (edge j from corner j to j + 1). Its corners are read once:
+// a loop that also stores 32-bit counts would otherwise read them again after every store (which
+// may alias the indices).
+inline std::array<double, 3> face_edges_squared(const float* p, const uint32_t* idx, size_t f) {
+  const float* a = p + 3 * size_t{idx[3 * f]};
+  const float* b = p + 3 * size_t{idx[3 * f + 1]};
+  const float* c = p + 3 * size_t{idx[3 * f + 2]};
+  return {edge_length_squared(a, b), edge_length_squared(b, c), edge_length_squared(c, a)};
 }
 
 // The cell of a face (its corners p0, p1, p2) packed in 63 bits (21 per axis, offset to be
@@ -144,32 +156,43 @@ class CellSplitter {
     plan_.levels.assign(chunks, 0);
     plan_.parts.assign(chunks, {0, 0, 0});
     if (!any) return;
-    std::vector<Parts> parts(chunks);
+    std::vector<Parts> parts(chunks);  // empty for a cell kept whole
     internal::for_each_chunk(
         chunks, threads,
         [&](size_t c, size_t, size_t) {
+          if (plan_.chunk_start[c + 1] - plan_.chunk_start[c] <= split_above_) return;
           Scratch scratch;
           split(plan_.cells[c], 0, {0, 0, 0}, plan_.chunk_start[c], plan_.chunk_start[c + 1], scratch, parts[c]);
         },
         1);
-    plan_.cells.clear();
-    plan_.levels.clear();
-    plan_.parts.clear();
-    plan_.chunk_start.assign(1, 0);
-    for (const Parts& cell : parts)
-      for (size_t i = 0; i < cell.start.size(); ++i) {
-        plan_.cells.push_back(cell.cell);
-        plan_.levels.push_back(cell.level[i]);
-        plan_.parts.push_back(cell.part[i]);
-        plan_.chunk_start.push_back(i + 1 < cell.start.size() ? cell.start[i + 1] : cell.end);
+    std::vector<std::array<int32_t, 3>> cells;
+    std::vector<uint8_t> levels;
+    std::vector<std::array<uint16_t, 3>> places;
+    std::vector<uint32_t> start(1, 0);
+    for (size_t c = 0; c < chunks; ++c) {
+      const Parts& cell = parts[c];
+      if (cell.start.empty()) {
+        cells.push_back(plan_.cells[c]);
+        levels.push_back(0);
+        places.push_back({0, 0, 0});
+        start.push_back(plan_.chunk_start[c + 1]);
       }
+      for (size_t i = 0; i < cell.start.size(); ++i) {
+        cells.push_back(plan_.cells[c]);
+        levels.push_back(cell.level[i]);
+        places.push_back(cell.part[i]);
+        start.push_back(i + 1 < cell.start.size() ? cell.start[i + 1] : plan_.chunk_start[c + 1]);
+      }
+    }
+    plan_.cells = std::move(cells);
+    plan_.levels = std::move(levels);
+    plan_.parts = std::move(places);
+    plan_.chunk_start = std::move(start);
   }
 
  private:
-  // One cell's parts, in order: where each starts in plan.faces, its level and place.
+  // One cut cell's parts, in order: where each starts in plan.faces, its level and place.
   struct Parts {
-    std::array<int32_t, 3> cell{};
-    uint32_t end = 0;
     std::vector<uint32_t> start;
     std::vector<uint8_t> level;
     std::vector<std::array<uint16_t, 3>> part;
@@ -184,8 +207,6 @@ class CellSplitter {
   void split(const std::array<int32_t, 3>& cell, int level, const std::array<uint16_t, 3>& part, uint32_t begin,
              uint32_t end, Scratch& scratch, Parts& out) {
     if (end - begin <= split_above_ || level == kMaxChunkSplitLevels) {
-      out.cell = cell;
-      out.end = end;
       out.start.push_back(begin);
       out.level.push_back(static_cast<uint8_t>(level));
       out.part.push_back(part);
@@ -254,32 +275,29 @@ void for_each_part(size_t n, size_t parts, Body body) {
 float kth_edge_length(const float* p, const uint32_t* idx, size_t face_count, uint64_t k, size_t parts,
                       double& longest_squared) {
   constexpr size_t kBins = size_t{1} << 16;
-  std::vector<uint64_t> counts(parts * kBins);
+  // Counts per part (3F corners fit in 32 bits: so does a count), then summed into part 0's row.
+  std::vector<uint32_t> counts(parts * kBins);
   std::vector<double> longest(parts, 0.0);
-  auto squared = [&](size_t f, size_t j) {
-    return edge_length_squared(p + 3 * size_t{idx[3 * f + j]}, p + 3 * size_t{idx[3 * f + (j + 1) % 3]});
-  };
   auto bits = [](double l2) {
     const auto l = static_cast<float>(std::sqrt(l2));  // as edge_length
     uint32_t b;
     std::memcpy(&b, &l, sizeof b);
     return b;
   };
-  auto select = [&](uint64_t& rank) {  // the bin holding the rank-th smallest counted; rank: its rank in the bin
+  // The bin holding the rank-th smallest counted; rank becomes its rank in the bin. (The last bin
+  // if the counts fall short, which the two passes' identical arithmetic rules out.)
+  auto select = [&](uint64_t& rank) {
+    for (size_t t = 1; t < parts; ++t)
+      for (size_t b = 0; b < kBins; ++b) counts[b] += counts[t * kBins + b];
     uint32_t bin = 0;
-    for (;; ++bin) {
-      uint64_t in_bin = 0;
-      for (size_t t = 0; t < parts; ++t) in_bin += counts[t * kBins + bin];
-      if (rank < in_bin) return bin;
-      rank -= in_bin;
-    }
+    for (; bin + 1 < kBins && rank >= counts[bin]; ++bin) rank -= counts[bin];
+    return bin;
   };
   for_each_part(face_count, parts, [&](size_t t, size_t begin, size_t end) {
-    uint64_t* count = counts.data() + t * kBins;
+    uint32_t* count = counts.data() + t * kBins;
     double most = 0.0;
     for (size_t f = begin; f < end; ++f)
-      for (size_t j = 0; j < 3; ++j) {
-        const double l2 = squared(f, j);
+      for (const double l2 : face_edges_squared(p, idx, f)) {
         most = std::max(most, l2);
         ++count[bits(l2) >> 16];
       }
@@ -289,10 +307,10 @@ float kth_edge_length(const float* p, const uint32_t* idx, size_t face_count, ui
   const uint32_t high = select(k);
   std::fill(counts.begin(), counts.end(), 0);
   for_each_part(face_count, parts, [&](size_t t, size_t begin, size_t end) {
-    uint64_t* count = counts.data() + t * kBins;
+    uint32_t* count = counts.data() + t * kBins;
     for (size_t f = begin; f < end; ++f)
-      for (size_t j = 0; j < 3; ++j)
-        if (const uint32_t b = bits(squared(f, j)); b >> 16 == high) ++count[b & 0xFFFF];
+      for (const double l2 : face_edges_squared(p, idx, f))
+        if (const uint32_t b = bits(l2); b >> 16 == high) ++count[b & 0xFFFF];
   });
   const uint32_t result = high << 16 | select(k);
   float length;
@@ -308,7 +326,9 @@ Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& pla
   if (face_count == 0) return Status::error(ErrorCode::kInvalidMesh, "", "mesh has no face");
   const float* p = mesh.positions.data();
   const uint32_t* idx = mesh.indices.data();
-  const size_t parts = internal::parallel_threads(face_count, threads);
+  // Threads as asked, but no more than one per kFacesPerPart faces (each holds a 256 KB histogram).
+  const size_t parts =
+      std::min(internal::parallel_threads(face_count, threads), std::max<size_t>(1, face_count / kFacesPerPart));
 
   // The longest edge (the locality radius reaches that far beyond a cell) and, for the automatic
   // cell only, the median edge: each face's three (an interior edge counts twice, which leaves the
@@ -323,9 +343,7 @@ Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& pla
     for_each_part(face_count, parts, [&](size_t t, size_t begin, size_t end) {
       double most = 0.0;
       for (size_t f = begin; f < end; ++f)
-        for (size_t j = 0; j < 3; ++j)
-          most = std::max(
-              most, edge_length_squared(p + 3 * size_t{idx[3 * f + j]}, p + 3 * size_t{idx[3 * f + (j + 1) % 3]}));
+        for (const double l2 : face_edges_squared(p, idx, f)) most = std::max(most, l2);
       longest[t] = most;
     });
     longest_squared = *std::max_element(longest.begin(), longest.end());
@@ -370,9 +388,11 @@ Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& pla
   for (size_t c = 0; c < chunks; ++c)
     for (int k = 0; k < 3; ++k) plan.cells[c][static_cast<size_t>(k)] = unpack_cell(cells[c], k);
   // Faces grouped by chunk, file order within a chunk: each part counts its faces per chunk (their
-  // chunk in place of their key), then writes them from where the parts before it end.
-  std::vector<uint32_t> count(parts * chunks, 0);
-  for_each_part(face_count, parts, [&](size_t t, size_t begin, size_t end) {
+  // chunk in place of their key), then writes them from where the parts before it end. One part
+  // where the counts would take more than a word per face (cells of a few faces each).
+  const size_t groups = parts * chunks <= face_count ? parts : 1;
+  std::vector<uint32_t> count(groups * chunks, 0);
+  for_each_part(face_count, groups, [&](size_t t, size_t begin, size_t end) {
     uint32_t* own = count.data() + t * chunks;
     uint64_t last = CellTable::kEmpty, chunk = 0;
     for (size_t f = begin; f < end; ++f) {
@@ -384,7 +404,7 @@ Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& pla
   plan.chunk_start.assign(chunks + 1, 0);
   for (size_t c = 0; c < chunks; ++c) {
     uint32_t at = plan.chunk_start[c];
-    for (size_t t = 0; t < parts; ++t) {
+    for (size_t t = 0; t < groups; ++t) {
       const uint32_t faces = count[t * chunks + c];
       count[t * chunks + c] = at;  // where part t's faces of chunk c go
       at += faces;
@@ -392,7 +412,7 @@ Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& pla
     plan.chunk_start[c + 1] = at;
   }
   plan.faces.resize(face_count);
-  for_each_part(face_count, parts, [&](size_t t, size_t begin, size_t end) {
+  for_each_part(face_count, groups, [&](size_t t, size_t begin, size_t end) {
     uint32_t* fill = count.data() + t * chunks;
     for (size_t f = begin; f < end; ++f) plan.faces[fill[key[f]]++] = static_cast<uint32_t>(f);
   });
