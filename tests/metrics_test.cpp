@@ -135,6 +135,63 @@ TEST(Metrics, ThreadCountDoesNotChangeAnyFigure) {
   EXPECT_EQ(a.seam_edges, b.seam_edges);
 }
 
+// From 131,072 faces (and vertices) on, the median, the patches derived from the UVs and the test
+// for identical positions run on threads: the same figures as on one.
+TEST(Metrics, LargeMeshesGiveTheSameFiguresOnAnyThreadCount) {
+  const Mesh mesh = grid(520, 260, Diagonal::kFalling);  // 270,400 faces, 135,981 vertices
+  // A jitter per vertex: every face's angles differ, so a median off by one rank would show.
+  const auto jitter = [](float x, float y, float seed) {
+    const float h = std::sin(x * 12.9898f + y * 78.233f + seed) * 43758.547f;
+    return 0.3f * (h - std::floor(h));
+  };
+  auto uv = corner_uvs(mesh, [&](float x, float y) {
+    return std::pair{7 * x + 0.01f * y * y + jitter(x, y, 0.f), 6.5f * y + std::sin(x) + jitter(x, y, 1.f)};
+  });
+  for (size_t f = 0; f < mesh.face_count(); ++f)  // a cut at x = 260: seams, two patches
+    if (mesh.positions[3 * size_t{mesh.indices[3 * f]}] >= 260.f)
+      for (size_t k = 0; k < 3; ++k) uv[2 * (3 * f + k)] += 1000.f;
+  const Topology topology = build_topology(mesh);
+  std::vector<uint32_t> one_patches;
+  ASSERT_EQ(derive_patches(mesh, topology, uv, one_patches, 1), 2u);
+  SplitMesh split;  // the seam's vertices twice: identical positions to join
+  split_vertices(mesh, uv, split);
+  Mesh split_mesh;
+  split_mesh.positions = split.positions;
+  split_mesh.indices = split.indices;
+  std::vector<float> repeats(uv.size());  // as a file stores them: a power of two scales exactly
+  for (size_t i = 0; i < uv.size(); ++i) repeats[i] = uv[i] / 1024.f;
+  const auto stored_metrics = [&](const MetricsOptions& options, UvMetrics& m, StoredSurface& surface) {
+    return compute_stored_uv_metrics(split_mesh, nullptr, repeats, options, m, &surface).is_ok();
+  };
+  MetricsOptions one{1024.f, 1024.f};
+  one.threads = 1;
+  const UvMetrics a = metrics_of(mesh, uv, {}, one);
+  UvMetrics a_stored;
+  StoredSurface a_surface;
+  ASSERT_TRUE(stored_metrics(one, a_stored, a_surface));
+  EXPECT_GT(a_surface.welded_vertices, 0u);
+  EXPECT_GT(a.distortion_deg, 0.0);
+  for (const uint32_t threads : {2u, 3u, 8u}) {
+    std::vector<uint32_t> patches;
+    EXPECT_EQ(derive_patches(mesh, topology, uv, patches, threads), 2u);
+    EXPECT_EQ(patches, one_patches) << threads << " threads";
+    MetricsOptions options{1024.f, 1024.f};
+    options.threads = threads;
+    const UvMetrics b = metrics_of(mesh, uv, {}, options);
+    EXPECT_EQ(a.distortion_deg, b.distortion_deg) << threads << " threads";
+    EXPECT_EQ(a.stretch, b.stretch);
+    EXPECT_EQ(a.patches, b.patches);
+    EXPECT_EQ(a.seam_edges, b.seam_edges);
+    UvMetrics b_stored;
+    StoredSurface b_surface;
+    ASSERT_TRUE(stored_metrics(options, b_stored, b_surface));
+    EXPECT_EQ(b_surface.welded_vertices, a_surface.welded_vertices) << threads << " threads";
+    EXPECT_EQ(b_stored.seam_edges, a_stored.seam_edges);
+    EXPECT_EQ(b_stored.patches, a_stored.patches);
+    EXPECT_EQ(b_stored.distortion_deg, a_stored.distortion_deg);
+  }
+}
+
 TEST(Metrics, UnequalScalesGiveKnownStretch) {
   Mesh mesh;
   mesh.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};

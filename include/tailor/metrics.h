@@ -75,8 +75,9 @@ struct UvMetrics {
 //! Fails with kInvalidArgument when the array sizes do not match, a patch id is >= #F or the texture
 //! size is not positive (caller errors), and with kInvalidMesh when a UV is not finite, every face
 //! has zero 3D area or every non-degenerate face has zero UV area (bad data: no scale).
-//! Cost: O(F) time and memory (sort-free passes, on threads for large meshes, plus a median by
-//! nth_element). Deterministic, whatever the thread count.
+//! Cost: O(F) time and memory (sort-free passes, on threads for large meshes, the median too: a
+//! count of the values' top bits, then a selection within one bin). Deterministic, whatever the
+//! thread count.
 TAILOR_API Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<const float> corner_uv,
                                      std::span<const uint32_t> patch, const MetricsOptions& options,
                                      UvMetrics& metrics);
@@ -127,9 +128,10 @@ TAILOR_API void classify_seam_edges(const Mesh& mesh, const Topology& topology, 
 
 //! Patches = connected components of faces joined across paired edges whose two sides have
 //! bit-identical UVs at both endpoints. Fills patch (#F ids, numbered in order of lowest face) and
-//! returns the count. Precondition: corner_uv has #F*3*2 floats. Cost: O(F), union-find.
+//! returns the count. Precondition: corner_uv has #F*3*2 floats. Cost: O(F), union-find, on
+//! `threads` threads (0: one per 100k faces, at most the cores and 8; the same patches for any count).
 TAILOR_API uint32_t derive_patches(const Mesh& mesh, const Topology& topology, std::span<const float> corner_uv,
-                                   std::vector<uint32_t>& patch);
+                                   std::vector<uint32_t>& patch, uint32_t threads = 0);
 
 //! Per-face area ratio (a_f / A_f) / R for heat maps: 1 = ideal, > 1 magnified, < 1 shrunk.
 //! Faces with zero 3D area get 1 (neutral); when R is 0 every face gets 0. ratio gets #F values.

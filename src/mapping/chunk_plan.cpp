@@ -260,14 +260,6 @@ class CellSplitter {
   uint32_t split_above_;
 };
 
-// Runs body(part, begin, end) for `parts` contiguous ranges of [0, n), one per thread. For passes
-// whose per-part results are merged in part order or by sums: the plan is the same for any count.
-template <class Body>
-void for_each_part(size_t n, size_t parts, Body body) {
-  internal::for_each_chunk(
-      parts, parts, [&](size_t t, size_t, size_t) { body(t, n * t / parts, n * (t + 1) / parts); }, 1);
-}
-
 // The k-th smallest (from 0) of each face's three edge_length values, as std::nth_element over all
 // 3F of them gives it, without storing them: lengths are non-negative floats, whose bits order as
 // unsigned integers, so counting the high 16 bits finds the bin that holds it, and counting the
@@ -293,7 +285,7 @@ float kth_edge_length(const float* p, const uint32_t* idx, size_t face_count, ui
     for (; bin + 1 < kBins && rank >= counts[bin]; ++bin) rank -= counts[bin];
     return bin;
   };
-  for_each_part(face_count, parts, [&](size_t t, size_t begin, size_t end) {
+  internal::for_each_part(face_count, parts, [&](size_t t, size_t begin, size_t end) {
     uint32_t* count = counts.data() + t * kBins;
     double most = 0.0;
     for (size_t f = begin; f < end; ++f)
@@ -306,7 +298,7 @@ float kth_edge_length(const float* p, const uint32_t* idx, size_t face_count, ui
   longest_squared = *std::max_element(longest.begin(), longest.end());
   const uint32_t high = select(k);
   std::fill(counts.begin(), counts.end(), 0);
-  for_each_part(face_count, parts, [&](size_t t, size_t begin, size_t end) {
+  internal::for_each_part(face_count, parts, [&](size_t t, size_t begin, size_t end) {
     uint32_t* count = counts.data() + t * kBins;
     for (size_t f = begin; f < end; ++f)
       for (const double l2 : face_edges_squared(p, idx, f))
@@ -340,7 +332,7 @@ Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& pla
     median = kth_edge_length(p, idx, face_count, 3 * uint64_t{face_count} / 2, parts, longest_squared);
   } else {
     std::vector<double> longest(parts, 0.0);
-    for_each_part(face_count, parts, [&](size_t t, size_t begin, size_t end) {
+    internal::for_each_part(face_count, parts, [&](size_t t, size_t begin, size_t end) {
       double most = 0.0;
       for (size_t f = begin; f < end; ++f)
         for (const double l2 : face_edges_squared(p, idx, f)) most = std::max(most, l2);
@@ -362,7 +354,7 @@ Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& pla
   std::vector<uint64_t> key(face_count);
   std::vector<CellTable> part_cells(parts);
   std::atomic<bool> outside{false};
-  for_each_part(face_count, parts, [&](size_t t, size_t begin, size_t end) {
+  internal::for_each_part(face_count, parts, [&](size_t t, size_t begin, size_t end) {
     uint64_t last = CellTable::kEmpty;
     for (size_t f = begin; f < end; ++f) {
       const uint32_t* corner = idx + 3 * f;
@@ -392,7 +384,7 @@ Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& pla
   // where the counts would take more than a word per face (cells of a few faces each).
   const size_t groups = parts * chunks <= face_count ? parts : 1;
   std::vector<uint32_t> count(groups * chunks, 0);
-  for_each_part(face_count, groups, [&](size_t t, size_t begin, size_t end) {
+  internal::for_each_part(face_count, groups, [&](size_t t, size_t begin, size_t end) {
     uint32_t* own = count.data() + t * chunks;
     uint64_t last = CellTable::kEmpty, chunk = 0;
     for (size_t f = begin; f < end; ++f) {
@@ -412,7 +404,7 @@ Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& pla
     plan.chunk_start[c + 1] = at;
   }
   plan.faces.resize(face_count);
-  for_each_part(face_count, groups, [&](size_t t, size_t begin, size_t end) {
+  internal::for_each_part(face_count, groups, [&](size_t t, size_t begin, size_t end) {
     uint32_t* fill = count.data() + t * chunks;
     for (size_t f = begin; f < end; ++f) plan.faces[fill[key[f]]++] = static_cast<uint32_t>(f);
   });

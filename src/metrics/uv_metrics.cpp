@@ -10,6 +10,7 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <string>
 
@@ -173,7 +174,8 @@ EdgeSides edge_sides(size_t e, size_t o) {
   return {3 * f + k, 3 * f + (k + 1) % 3, 3 * g + (j + 1) % 3, 3 * g + j};
 }
 
-double median(std::vector<double>& values) {
+// The middle value, or the mean of the two middle ones (by selection; reorders values).
+double plain_median(std::vector<double>& values) {
   if (values.empty()) return 0;
   const size_t mid = values.size() / 2;
   std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(mid), values.end());
@@ -183,24 +185,92 @@ double median(std::vector<double>& values) {
   return 0.5 * (lower + upper);
 }
 
+// Values per thread of the median's counting pass at least.
+constexpr size_t kValuesPerPart = size_t{1} << 16;
+
+// plain_median's value, on threads: non-negative doubles order as their bits, so counting the top
+// 16 bits of every value finds the bin that holds each middle one, and only that bin's values are
+// selected among. A negative, infinite or NaN value (never one of the metrics' angles) takes the
+// plain selection.
+double median(std::vector<double>& values, size_t threads) {
+  const size_t n = values.size();
+  const size_t parts = std::min(threads, n / kValuesPerPart);
+  if (parts < 2) return plain_median(values);
+  constexpr size_t kBins = size_t{1} << 16;
+  std::vector<uint32_t> counts(parts * kBins, 0);  // per part, then summed into part 0's row
+  std::vector<uint8_t> unordered(parts, 0);
+  internal::for_each_part(n, parts, [&](size_t t, size_t begin, size_t end) {
+    uint32_t* count = counts.data() + t * kBins;
+    bool odd = false;
+    for (size_t i = begin; i < end; ++i) {
+      const auto bits = std::bit_cast<uint64_t>(values[i]);
+      odd |= (bits >> 52) >= 0x7FF;  // the sign, or an exponent of all ones
+      ++count[bits >> 48];
+    }
+    unordered[t] = odd;
+  });
+  if (std::find(unordered.begin(), unordered.end(), 1) != unordered.end()) return plain_median(values);
+  for (size_t t = 1; t < parts; ++t)
+    for (size_t b = 0; b < kBins; ++b) counts[b] += counts[t * kBins + b];
+  // The rank-th smallest value: its bin's values gathered (in any order) and selected among.
+  const auto kth = [&](size_t rank) {
+    size_t bin = 0;
+    for (; bin + 1 < kBins && rank >= counts[bin]; ++bin) rank -= counts[bin];
+    std::vector<std::vector<double>> gathered(parts);
+    internal::for_each_part(n, parts, [&](size_t t, size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i)
+        if ((std::bit_cast<uint64_t>(values[i]) >> 48) == bin) gathered[t].push_back(values[i]);
+    });
+    std::vector<double> in_bin;
+    for (const std::vector<double>& g : gathered) in_bin.insert(in_bin.end(), g.begin(), g.end());
+    if (rank >= in_bin.size()) return std::numeric_limits<double>::quiet_NaN();  // the counts are in_bin's
+    std::nth_element(in_bin.begin(), in_bin.begin() + static_cast<std::ptrdiff_t>(rank), in_bin.end());
+    return in_bin[rank];
+  };
+  const size_t mid = n / 2;
+  const double upper = kth(mid), lower = n % 2 == 1 ? upper : kth(mid - 1);
+  if (std::isnan(upper) || std::isnan(lower)) return plain_median(values);
+  return n % 2 == 1 ? upper : 0.5 * (lower + upper);
+}
+
 }  // namespace
 
 uint32_t derive_patches(const Mesh& mesh, const Topology& topology, std::span<const float> corner_uv,
-                        std::vector<uint32_t>& patch) {
+                        std::vector<uint32_t>& patch, uint32_t threads) {
   const size_t nf = mesh.face_count();
   std::vector<uint32_t> parent(nf);
-  for (size_t f = 0; f < nf; ++f) parent[f] = static_cast<uint32_t>(f);
-  for (size_t e = 0; e < 3 * nf; ++e) {
-    const uint32_t o = topology.opposite[e];
-    if (o == kInvalid || o < e) continue;
+  // Union-find through the seamless edges, a root always the lowest face of its set (so the sets'
+  // labels do not depend on the order of the unions). Each slice of faces joins the pairs inside
+  // it on its own thread (they touch only its faces' entries), then one thread the pairs across.
+  const size_t slices = std::min(internal::parallel_threads(nf, threads), std::max<size_t>(1, nf / 65536));
+  const auto slice_begin = [&](size_t s) { return static_cast<uint32_t>(nf * s / slices); };
+  const auto join_if_seamless = [&](uint32_t e, uint32_t o) {
     const EdgeSides s = edge_sides(e, o);
-    if (!same_uv(corner_uv, s.fa, s.ga) || !same_uv(corner_uv, s.fb, s.gb)) continue;
-    const uint32_t ra = find_root(parent, static_cast<uint32_t>(e / 3));
+    if (!same_uv(corner_uv, s.fa, s.ga) || !same_uv(corner_uv, s.fb, s.gb)) return;
+    const uint32_t ra = find_root(parent, e / 3);
     const uint32_t rb = find_root(parent, o / 3);
     if (ra < rb)
       parent[rb] = ra;
     else if (rb < ra)
       parent[ra] = rb;
+  };
+  internal::for_each_chunk(
+      slices, slices,
+      [&](size_t s, size_t, size_t) {
+        const uint32_t lo = slice_begin(s), hi = slice_begin(s + 1);
+        for (uint32_t f = lo; f < hi; ++f) parent[f] = f;
+        for (uint32_t e = 3 * lo; e < 3 * hi; ++e) {
+          const uint32_t o = topology.opposite[e];
+          if (o != kInvalid && o > e && o / 3 < hi) join_if_seamless(e, o);
+        }
+      },
+      1);
+  for (size_t s = 0; s + 1 < slices; ++s) {
+    const uint32_t hi = slice_begin(s + 1);
+    for (uint32_t e = 3 * slice_begin(s); e < 3 * hi; ++e) {
+      const uint32_t o = topology.opposite[e];
+      if (o != kInvalid && o / 3 >= hi) join_if_seamless(e, o);
+    }
   }
   patch.assign(nf, kInvalid);
   uint32_t count = 0;
@@ -293,7 +363,7 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
   std::vector<uint32_t> derived;
   std::span<const uint32_t> patch = patch_in;
   if (patch.empty()) {
-    derive_patches(mesh, topology, corner_uv, derived);
+    derive_patches(mesh, topology, corner_uv, derived, options.threads);
     patch = derived;
   }
   metrics.faces = nf;
@@ -410,7 +480,7 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
   }
   metrics.stretch = mean_r > 0 ? std::sqrt(var_sum / static_cast<double>(counted)) / mean_r : 0;
   metrics.stretch_area_weighted = std::sqrt(var_w_sum / sum_3d) / scale;
-  metrics.distortion_deg = median(angles);
+  metrics.distortion_deg = median(angles, threads);
   if (l2_den > 0) {
     metrics.l2_stretch = std::sqrt(l2_num / l2_den) * std::sqrt(scale);
     metrics.linf_stretch = gamma_max * std::sqrt(scale);
@@ -517,26 +587,40 @@ namespace {
 
 // True when two vertices have bit-identical positions (-0 and +0 alike), the vertices
 // weld_identical_positions would join. One open-addressing pass, 4 bytes per table slot.
-bool has_identical_positions(const Mesh& mesh) {
+bool has_identical_positions(const Mesh& mesh, uint32_t threads) {
   const size_t nv = mesh.vertex_count();
-  size_t table_size = 16;
-  while (table_size < 2 * nv) table_size *= 2;
-  const size_t mask = table_size - 1;
-  std::vector<uint32_t> table(table_size, kInvalid);
+  // Each thread keeps the vertices of its share of the hash values (a vertex and its twin hash
+  // alike), in a table of its own: every thread reads all positions, none writes another's table.
+  const size_t parts = std::min(internal::parallel_threads(nv, threads), std::max<size_t>(1, nv / 65536));
   auto bits = [](float x) { return std::bit_cast<uint32_t>(x + 0.0f); };
-  for (size_t v = 0; v < nv; ++v) {
+  auto hash = [&](size_t v) {
     const float* p = &mesh.positions[3 * v];
-    const uint32_t x = bits(p[0]), y = bits(p[1]), z = bits(p[2]);
-    uint64_t h = ((uint64_t{x} << 32) | y) * 0x9e3779b97f4a7c15ULL;
-    h = (h ^ (h >> 29) ^ z) * 0xbf58476d1ce4e5b9ULL;
-    size_t slot = static_cast<size_t>(h ^ (h >> 32)) & mask;
-    for (; table[slot] != kInvalid; slot = (slot + 1) & mask) {
-      const float* q = &mesh.positions[3 * size_t{table[slot]}];
-      if (bits(q[0]) == x && bits(q[1]) == y && bits(q[2]) == z) return true;
+    uint64_t h = ((uint64_t{bits(p[0])} << 32) | bits(p[1])) * 0x9e3779b97f4a7c15ULL;
+    h = (h ^ (h >> 29) ^ bits(p[2])) * 0xbf58476d1ce4e5b9ULL;
+    return h ^ (h >> 32);
+  };
+  std::vector<uint8_t> found(parts, 0);
+  internal::for_each_part(nv, parts, [&](size_t t, size_t, size_t) {
+    size_t table_size = 16;
+    while (table_size < 2 * nv / parts + 2) table_size *= 2;
+    const size_t mask = table_size - 1;
+    std::vector<uint32_t> table(table_size, kInvalid);
+    for (size_t v = 0; v < nv; ++v) {
+      const uint64_t h = hash(v);
+      if ((h >> 40) % parts != t) continue;
+      const float* p = &mesh.positions[3 * v];
+      size_t slot = static_cast<size_t>(h) & mask;
+      for (; table[slot] != kInvalid; slot = (slot + 1) & mask) {
+        const float* q = &mesh.positions[3 * size_t{table[slot]}];
+        if (bits(q[0]) == bits(p[0]) && bits(q[1]) == bits(p[1]) && bits(q[2]) == bits(p[2])) {
+          found[t] = 1;
+          return;
+        }
+      }
+      table[slot] = static_cast<uint32_t>(v);
     }
-    table[slot] = static_cast<uint32_t>(v);
-  }
-  return false;
+  });
+  return std::find(found.begin(), found.end(), 1) != found.end();
 }
 
 }  // namespace
@@ -585,7 +669,7 @@ Status internal::compute_stored_uv_metrics_px(const Mesh& mesh, const Topology* 
   // The surface a reader of a split file (.glb, .ply) sees: vertices at bit-identical positions joined.
   Mesh welded;
   const Mesh* measured = &mesh;
-  if (has_identical_positions(mesh)) {
+  if (has_identical_positions(mesh, options.threads)) {
     welded.positions = mesh.positions;
     welded.indices = mesh.indices;
     const size_t joined = weld_identical_positions(welded);

@@ -61,6 +61,15 @@ void for_each_chunk(size_t n, size_t threads, Body body, size_t chunk_size = kPa
   if (failure) std::rethrow_exception(failure);
 }
 
+//! Calls body(part, begin, end) for `parts` contiguous ranges of [0, n), one thread each (fewer when
+//! the system refuses a thread). For passes whose per-part results are merged in part order or by
+//! order-free reductions (counts, min, max), so the result is the same for any count.
+template <class Body>
+void for_each_part(size_t n, size_t parts, Body body) {
+  for_each_chunk(
+      parts, parts, [&](size_t t, size_t, size_t) { body(t, n * t / parts, n * (t + 1) / parts); }, 1);
+}
+
 //! Runs beside() on a second thread while main() runs on the calling one, when `threaded` and a
 //! thread can be had; else main() then beside(). For two independent jobs (they must not write
 //! what the other reads). An exception from either is rethrown here once both have stopped.
