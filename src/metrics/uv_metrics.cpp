@@ -601,8 +601,10 @@ bool has_identical_positions(const Mesh& mesh, uint32_t threads) {
   };
   std::vector<uint8_t> found(parts, 0);
   internal::for_each_part(nv, parts, [&](size_t t, size_t, size_t) {
+    size_t share = 0;  // this thread's vertices: the table holds twice as many slots, never fills
+    for (size_t v = 0; v < nv; ++v) share += (hash(v) >> 40) % parts == t;
     size_t table_size = 16;
-    while (table_size < 2 * nv / parts + 2) table_size *= 2;
+    while (table_size < 2 * share) table_size *= 2;
     const size_t mask = table_size - 1;
     std::vector<uint32_t> table(table_size, kInvalid);
     for (size_t v = 0; v < nv; ++v) {
