@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <span>
@@ -11,6 +12,7 @@
 
 #include "mapping/sum_smallest_first.h"
 #include "tailor/chunks.h"
+#include "util/bin_select.h"
 #include "util/parallel_chunks.h"
 
 namespace tailor {
@@ -32,9 +34,6 @@ bool uses_chunks(const ChunkOptions& options, size_t face_count) {
 }
 
 namespace {
-
-// Faces per thread of the plan at least: fewer cost more in starting threads than they save.
-constexpr size_t kFacesPerPart = size_t{1} << 16;
 
 // Cells per axis either side of the origin: cell coordinates pack into 21 bits each.
 constexpr double kMaxCell = double{1 << 20};
@@ -266,27 +265,13 @@ class CellSplitter {
 // low 16 bits of that bin's lengths finds the rest. Also the longest squared length.
 float kth_edge_length(const float* p, const uint32_t* idx, size_t face_count, uint64_t k, size_t parts,
                       double& longest_squared) {
-  constexpr size_t kBins = size_t{1} << 16;
-  // Counts per part (3F corners fit in 32 bits: so does a count), then summed into part 0's row.
-  std::vector<uint32_t> counts(parts * kBins);
+  using internal::kSelectBins;
+  // Counts per part (3F corners fit in 32 bits: so does a count).
+  std::vector<uint32_t> counts(parts * kSelectBins);
   std::vector<double> longest(parts, 0.0);
-  auto bits = [](double l2) {
-    const auto l = static_cast<float>(std::sqrt(l2));  // as edge_length
-    uint32_t b;
-    std::memcpy(&b, &l, sizeof b);
-    return b;
-  };
-  // The bin holding the rank-th smallest counted; rank becomes its rank in the bin. (The last bin
-  // if the counts fall short, which the two passes' identical arithmetic rules out.)
-  auto select = [&](uint64_t& rank) {
-    for (size_t t = 1; t < parts; ++t)
-      for (size_t b = 0; b < kBins; ++b) counts[b] += counts[t * kBins + b];
-    uint32_t bin = 0;
-    for (; bin + 1 < kBins && rank >= counts[bin]; ++bin) rank -= counts[bin];
-    return bin;
-  };
+  auto bits = [](double l2) { return std::bit_cast<uint32_t>(static_cast<float>(std::sqrt(l2))); };  // as edge_length
   internal::for_each_part(face_count, parts, [&](size_t t, size_t begin, size_t end) {
-    uint32_t* count = counts.data() + t * kBins;
+    uint32_t* count = counts.data() + t * kSelectBins;
     double most = 0.0;
     for (size_t f = begin; f < end; ++f)
       for (const double l2 : face_edges_squared(p, idx, f)) {
@@ -296,18 +281,17 @@ float kth_edge_length(const float* p, const uint32_t* idx, size_t face_count, ui
     longest[t] = most;
   });
   longest_squared = *std::max_element(longest.begin(), longest.end());
-  const uint32_t high = select(k);
+  internal::sum_bin_rows(counts, parts);
+  const uint32_t high = internal::select_bin(counts, k);
   std::fill(counts.begin(), counts.end(), 0);
   internal::for_each_part(face_count, parts, [&](size_t t, size_t begin, size_t end) {
-    uint32_t* count = counts.data() + t * kBins;
+    uint32_t* count = counts.data() + t * kSelectBins;
     for (size_t f = begin; f < end; ++f)
       for (const double l2 : face_edges_squared(p, idx, f))
         if (const uint32_t b = bits(l2); b >> 16 == high) ++count[b & 0xFFFF];
   });
-  const uint32_t result = high << 16 | select(k);
-  float length;
-  std::memcpy(&length, &result, sizeof length);
-  return length;
+  internal::sum_bin_rows(counts, parts);
+  return std::bit_cast<float>(high << 16 | internal::select_bin(counts, k));  // the passes count alike
 }
 
 }  // namespace
@@ -318,9 +302,8 @@ Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& pla
   if (face_count == 0) return Status::error(ErrorCode::kInvalidMesh, "", "mesh has no face");
   const float* p = mesh.positions.data();
   const uint32_t* idx = mesh.indices.data();
-  // Threads as asked, but no more than one per kFacesPerPart faces (each holds a 256 KB histogram).
-  const size_t parts =
-      std::min(internal::parallel_threads(face_count, threads), std::max<size_t>(1, face_count / kFacesPerPart));
+  // Threads as asked, but none of fewer than 65,536 faces (each holds a 256 KB histogram).
+  const size_t parts = internal::parallel_parts(face_count, threads);
 
   // The longest edge (the locality radius reaches that far beyond a cell) and, for the automatic
   // cell only, the median edge: each face's three (an interior edge counts twice, which leaves the

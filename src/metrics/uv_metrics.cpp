@@ -10,13 +10,13 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
-#include <limits>
 #include <numbers>
 #include <string>
 
 #include "metrics/stored_metrics.h"
 #include "tailor/export.h"
 #include "tailor/metrics.h"
+#include "util/bin_select.h"
 #include "util/huge_pages.h"
 #include "util/parallel_chunks.h"
 
@@ -185,22 +185,19 @@ double plain_median(std::vector<double>& values) {
   return 0.5 * (lower + upper);
 }
 
-// Values per thread of the median's counting pass at least.
-constexpr size_t kValuesPerPart = size_t{1} << 16;
-
-// plain_median's value, on threads: non-negative doubles order as their bits, so counting the top
-// 16 bits of every value finds the bin that holds each middle one, and only that bin's values are
-// selected among. A negative, infinite or NaN value (never one of the metrics' angles) takes the
-// plain selection.
+// plain_median's value, on threads (util/bin_select.h): non-negative doubles order as their bits,
+// so counting the top 16 bits of every value finds the bins of the middle ones, and only those
+// bins' values are selected among. A negative, infinite or NaN value (never one of the metrics'
+// angles) takes the plain selection.
 double median(std::vector<double>& values, size_t threads) {
+  using internal::kSelectBins;
   const size_t n = values.size();
-  const size_t parts = std::min(threads, n / kValuesPerPart);
+  const size_t parts = internal::parallel_parts(n, threads);
   if (parts < 2) return plain_median(values);
-  constexpr size_t kBins = size_t{1} << 16;
-  std::vector<uint32_t> counts(parts * kBins, 0);  // per part, then summed into part 0's row
+  std::vector<uint32_t> counts(parts * kSelectBins, 0);
   std::vector<uint8_t> unordered(parts, 0);
   internal::for_each_part(n, parts, [&](size_t t, size_t begin, size_t end) {
-    uint32_t* count = counts.data() + t * kBins;
+    uint32_t* count = counts.data() + t * kSelectBins;
     bool odd = false;
     for (size_t i = begin; i < end; ++i) {
       const auto bits = std::bit_cast<uint64_t>(values[i]);
@@ -210,27 +207,27 @@ double median(std::vector<double>& values, size_t threads) {
     unordered[t] = odd;
   });
   if (std::find(unordered.begin(), unordered.end(), 1) != unordered.end()) return plain_median(values);
-  for (size_t t = 1; t < parts; ++t)
-    for (size_t b = 0; b < kBins; ++b) counts[b] += counts[t * kBins + b];
-  // The rank-th smallest value: its bin's values gathered (in any order) and selected among.
-  const auto kth = [&](size_t rank) {
-    size_t bin = 0;
-    for (; bin + 1 < kBins && rank >= counts[bin]; ++bin) rank -= counts[bin];
-    std::vector<std::vector<double>> gathered(parts);
-    internal::for_each_part(n, parts, [&](size_t t, size_t begin, size_t end) {
-      for (size_t i = begin; i < end; ++i)
-        if ((std::bit_cast<uint64_t>(values[i]) >> 48) == bin) gathered[t].push_back(values[i]);
-    });
-    std::vector<double> in_bin;
-    for (const std::vector<double>& g : gathered) in_bin.insert(in_bin.end(), g.begin(), g.end());
-    if (rank >= in_bin.size()) return std::numeric_limits<double>::quiet_NaN();  // the counts are in_bin's
-    std::nth_element(in_bin.begin(), in_bin.begin() + static_cast<std::ptrdiff_t>(rank), in_bin.end());
-    return in_bin[rank];
-  };
-  const size_t mid = n / 2;
-  const double upper = kth(mid), lower = n % 2 == 1 ? upper : kth(mid - 1);
-  if (std::isnan(upper) || std::isnan(lower)) return plain_median(values);
-  return n % 2 == 1 ? upper : 0.5 * (lower + upper);
+  internal::sum_bin_rows(counts, parts);
+  // The lower middle value's bin and the upper one's (the same one, or the next that holds any):
+  // their values gathered in one pass, the lower bin's first, then selected among as plain_median
+  // selects among all.
+  const size_t mid = n / 2, first = n % 2 == 1 ? mid : mid - 1;
+  uint64_t rank = first, upper_rank = mid;
+  const uint64_t low = internal::select_bin(counts, rank), high = internal::select_bin(counts, upper_rank);
+  std::vector<std::vector<double>> gathered(parts);
+  internal::for_each_part(n, parts, [&](size_t t, size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i)
+      if (const uint64_t bin = std::bit_cast<uint64_t>(values[i]) >> 48; bin >= low && bin <= high)
+        gathered[t].push_back(values[i]);
+  });
+  std::vector<double> near;
+  for (const std::vector<double>& g : gathered) near.insert(near.end(), g.begin(), g.end());
+  const size_t at = static_cast<size_t>(rank) + (mid - first);  // the upper middle's rank in `near`
+  if (at >= near.size()) return plain_median(values);           // not when the counts are near's
+  const auto upper = near.begin() + static_cast<std::ptrdiff_t>(at);
+  std::nth_element(near.begin(), upper, near.end());
+  if (n % 2 == 1) return *upper;
+  return 0.5 * (*std::max_element(near.begin(), upper) + *upper);
 }
 
 }  // namespace
@@ -242,7 +239,7 @@ uint32_t derive_patches(const Mesh& mesh, const Topology& topology, std::span<co
   // Union-find through the seamless edges, a root always the lowest face of its set (so the sets'
   // labels do not depend on the order of the unions). Each slice of faces joins the pairs inside
   // it on its own thread (they touch only its faces' entries), then one thread the pairs across.
-  const size_t slices = std::min(internal::parallel_threads(nf, threads), std::max<size_t>(1, nf / 65536));
+  const size_t slices = internal::parallel_parts(nf, threads);
   const auto slice_begin = [&](size_t s) { return static_cast<uint32_t>(nf * s / slices); };
   const auto join_if_seamless = [&](uint32_t e, uint32_t o) {
     const EdgeSides s = edge_sides(e, o);
@@ -591,7 +588,7 @@ bool has_identical_positions(const Mesh& mesh, uint32_t threads) {
   const size_t nv = mesh.vertex_count();
   // Each thread keeps the vertices of its share of the hash values (a vertex and its twin hash
   // alike), in a table of its own: every thread reads all positions, none writes another's table.
-  const size_t parts = std::min(internal::parallel_threads(nv, threads), std::max<size_t>(1, nv / 65536));
+  const size_t parts = internal::parallel_parts(nv, threads);
   auto bits = [](float x) { return std::bit_cast<uint32_t>(x + 0.0f); };
   auto hash = [&](size_t v) {
     const float* p = &mesh.positions[3 * v];

@@ -26,6 +26,12 @@ inline size_t parallel_threads(size_t n, size_t requested, size_t per_thread = 1
   return std::clamp<size_t>(std::min(cores, n / per_thread), 1, 8);
 }
 
+//! Parts of a for_each_part pass over n elements: parallel_threads, but none of fewer than
+//! `min_per_part` elements (a part's fixed cost, a table or a histogram, would outweigh its share).
+inline size_t parallel_parts(size_t n, size_t requested, size_t min_per_part = size_t{1} << 16) {
+  return std::min(parallel_threads(n, requested), std::max<size_t>(1, n / min_per_part));
+}
+
 //! Number of chunks of `chunk` elements for n elements.
 inline size_t chunk_count(size_t n, size_t chunk = kParallelChunk) { return (n + chunk - 1) / chunk; }
 
