@@ -101,5 +101,14 @@ rm "$tmp/moved/fertility-water.mtl" &&
   "$tailor" eval "$tmp/spot-bark-obj/spot-bark.obj" --texture-size 64 | grep -q "texture 64x64 px, option)" && ok ||
   fail "eval of an .obj without its .mtl, or with --texture-size, did not size the texture as documented"
 
+# --threads: the same figures for any count (the large-mesh parallel paths are tests/metrics_test.cpp's).
+if "$tailor" eval "$tmp/spot-bark-glb/spot-bark.glb" --json --threads 3 >"$tmp/threads3.json" &&
+  python3 - "$tmp/spot-bark-glb.eval.json" "$tmp/threads3.json" <<'PY'; then ok; else fail "eval --threads 3 changed the figures"; fi
+import json, sys
+a, b = (json.load(open(p)) for p in sys.argv[1:])
+for d in (a, b):
+    d.pop("seconds", None)
+sys.exit(0 if a == b else 1)
+PY
 echo "map_eval_test: $passed passed, $failed failed"
 [[ $failed -eq 0 ]]

@@ -32,6 +32,7 @@ struct EvalOptions {
   bool symmetry_given = false;  // else the file's record of a 4-fold map (LoadReport::texture_symmetry) decides
   StabilityOptions stability_options;
   std::string chunks = "auto", chunk_cell = "auto";  // --chunks, --chunk-cell: the mapping --stability runs
+  uint32_t threads = 0;                              // --threads: the metrics', and the mappings of --stability
 };
 
 // --stability: the remove-a-ball experiment of thesis 2.6 on tailor's own mapping of the mesh.
@@ -42,6 +43,7 @@ int run_stability(const EvalOptions& opt) {
     if (Status s = load_mesh(opt.input, mesh); !s) return report_error(s);
   }
   MapTextureOptions mapping;
+  mapping.mapping.threads = opt.threads;
   if (Status s = parse_chunk_args(opt.chunks, opt.chunk_cell, mapping.chunks); !s) return report_error(s);
   if (!opt.seed_point.empty()) {
     if (!parse_vec3(opt.seed_point, mapping.mapping.seed_point))
@@ -104,6 +106,7 @@ int run_eval(const EvalOptions& opt) {
   UvMetrics m;
   MetricsOptions options{static_cast<float>(width), static_cast<float>(height)};
   options.symmetry = symmetry;
+  options.threads = opt.threads;
   StoredSurface surface;
   const Status metrics_status =
       compute_stored_uv_metrics(mesh, nullptr, std::move(mesh.corner_uvs), options, m, &surface);
@@ -165,6 +168,11 @@ void register_eval(CLI::App& app, Runner& run) {
                   "With --stability: " + std::string(option_doc(kMappingOptionDocs, "seed_point").help));
   add_documented(cmd, option_doc(kStabilityOptionDocs, "remove_fraction"), opt->stability_options.remove_fraction)
       ->check(CLI::Range(0.01f, 0.9f));
+  cmd->add_option("--threads", opt->threads,
+                  "Threads of the metrics (0 = one per 100k faces, up to the cores and 8) and, with --stability, of "
+                  "the mappings (0 = one per core); the figures are the same for any count")
+      ->capture_default_str()
+      ->check(CLI::Range(0u, 64u));
   cmd->footer(
       "Metrics (docs/metrics.md): patches, seams (share of edge length), flipped faces, stretch\n"
       "(coefficient of variation of UV/3D area ratio, 0 ideal), L2/Linf stretch (Sander 2001, 1 ideal),\n"

@@ -678,7 +678,7 @@ Status internal::compute_stored_uv_metrics_px(const Mesh& mesh, const Topology* 
   }
   Topology built;
   if (!topology || topology->opposite.size() != 3 * measured->face_count()) {
-    built = build_topology(*measured);
+    built = build_topology(*measured, {}, options.threads);
     topology = &built;
   }
   if (surface) {
