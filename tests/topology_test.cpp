@@ -4,9 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "tailor/io.h"
 
@@ -121,6 +123,35 @@ TEST(Topology, BowTieVertexJoinsByVertexOnly) {
   EXPECT_EQ(t.boundary_edges, 6u);
   for (uint32_t o : t.opposite) EXPECT_EQ(o, kInvalid);
   EXPECT_EQ(count_nonmanifold_vertices(m), 1u);  // vertex 2: two fans
+}
+
+// Chains of triangles that touch the next one at a vertex only: every face is its own edge
+// component and each chain one vertex component. Below and above the count of components up to
+// which the vertex pass runs on several slices, and with the chains' faces in reverse order (a
+// face's parent in the union-find then lies in another slice).
+TEST(Topology, BowTieChainsJoinAcrossVertexSlices) {
+  for (const uint32_t chain : {1000u, 70000u}) {
+    for (const bool reversed : {false, true}) {
+      std::vector<float> positions;
+      std::vector<uint32_t> indices;
+      for (uint32_t c = 0; c < 2; ++c) {  // two chains
+        const uint32_t first = static_cast<uint32_t>(positions.size() / 3);
+        for (uint32_t v = 0; v <= 2 * chain; ++v)
+          positions.insert(positions.end(), {static_cast<float>(v), static_cast<float>(v % 2 + 3 * c), 0.f});
+        for (uint32_t k = 0; k < chain; ++k)
+          indices.insert(indices.end(), {first + 2 * k, first + 2 * k + 1, first + 2 * k + 2});
+      }
+      if (reversed)
+        for (size_t f = 0, n = indices.size() / 3; f < n / 2; ++f)
+          std::swap_ranges(indices.begin() + 3 * f, indices.begin() + 3 * f + 3, indices.end() - 3 * (f + 1));
+      const Mesh m = make_mesh(positions, indices);
+      const Topology t = build_topology(m, {}, 1);
+      EXPECT_EQ(t.edge_components, 2 * chain);
+      EXPECT_EQ(t.vertex_components, 2u) << chain << (reversed ? " reversed" : "");
+      for (uint32_t f = 0; f < 2 * chain; ++f) ASSERT_EQ(t.face_component[f], f);
+      expect_same_on_threads(m, t);
+    }
+  }
 }
 
 TEST(Topology, FinEdgeWithThreeFacesIsCutAndCounted) {

@@ -30,6 +30,9 @@ struct EdgeCounts {
 
 // Faces per thread of the edge passes: below this, starting a thread costs more than it saves.
 constexpr size_t kFacesPerThread = 250000;
+// Components up to which each slice of the vertex-component pass keeps a union-find of them all
+// (4 bytes each per slice); a mesh of more (a soup of loose faces) is labelled on one thread.
+constexpr uint32_t kSlicedComponentLimit = uint32_t{1} << 16;
 
 // Decides the fate of one undirected edge, given its uses sorted by (direction, edge id).
 void match_group(const uint64_t* uses, size_t count, uint32_t* opposite, EdgeCounts& counts) {
@@ -209,37 +212,94 @@ Topology build_topology(const Mesh& mesh, const ProgressCallback& progress, uint
         if (g != kInvalid && g >= hi) join(f, g);
       }
   }
+  // Components numbered in the order of their lowest faces (the roots), slice by slice with the
+  // parents only read: each face's root (a parent is a lower face: in face order, one in the same
+  // slice already knows its root), then the roots' numbers (each slice's from the count of roots
+  // before it) in the parents' place, then each face's number from its root's.
   internal::reserve_huge(t.face_component, face_count);
   t.face_component.resize(face_count);
-  for (size_t f = 0; f < face_count; ++f) {
-    const uint32_t root = find_root(face_parent.get(), static_cast<uint32_t>(f));
-    t.face_component[f] = root == f ? t.edge_components++ : t.face_component[root];
-  }
+  uint32_t* const component = t.face_component.data();
+  uint32_t* const parents = face_parent.get();
+  std::vector<uint32_t> roots_before(slices + 1, 0);
+  internal::for_each_chunk(
+      slices, slices,
+      [&](size_t s, size_t, size_t) {
+        const uint32_t lo = face_begin(s), hi = face_begin(s + 1);
+        uint32_t roots = 0;
+        for (uint32_t f = lo; f < hi; ++f) {
+          uint32_t p = parents[f];
+          if (p == f) {
+            ++roots;
+          } else if (p >= lo) {
+            p = component[p];
+          } else {
+            while (parents[p] != p) p = parents[p];
+          }
+          component[f] = p;
+        }
+        roots_before[s + 1] = roots;
+      },
+      1);
+  for (size_t s = 0; s < slices; ++s) roots_before[s + 1] += roots_before[s];
+  t.edge_components = roots_before[slices];
+  internal::for_each_chunk(
+      slices, slices,
+      [&](size_t s, size_t, size_t) {
+        uint32_t next = roots_before[s];
+        for (uint32_t f = face_begin(s); f < face_begin(s + 1); ++f)
+          if (component[f] == f) parents[f] = next++;
+      },
+      1);
+  internal::for_each_chunk(
+      slices, slices,
+      [&](size_t s, size_t, size_t) {
+        for (uint32_t f = face_begin(s); f < face_begin(s + 1); ++f) component[f] = parents[component[f]];
+      },
+      1);
 
   reached(0.85f);
   // === Components of faces sharing a vertex ===
   // Edge components touching at a vertex (bow-ties, fins) are merged with a union-find over the
   // few edge components, labelling each vertex with the first component seen: one pass over the
-  // corners instead of a union-find over all vertices.
-  std::vector<uint32_t> parent(t.edge_components);
-  for (uint32_t c = 0; c < t.edge_components; ++c) parent[c] = c;
-  std::vector<uint32_t> vertex_label(vertex_count, kInvalid);
-  uint32_t merges = 0;
-  for (size_t c = 0; c < corner_count; ++c) {
-    const uint32_t component = t.face_component[c / 3];
-    uint32_t& label = vertex_label[indices[c]];
-    if (label == kInvalid) {
-      label = component;
-    } else if (label != component) {
-      const uint32_t a = find_root(parent.data(), label);
-      const uint32_t b = find_root(parent.data(), component);
-      if (a != b) {
-        parent[std::max(a, b)] = std::min(a, b);
-        ++merges;
+  // corners instead of a union-find over all vertices. With one edge component there is nothing
+  // to merge. Each slice of vertices labels its own and joins the components that meet there in a
+  // union-find of its own (up to kSlicedComponentLimit components; beyond, one slice), then the
+  // slices' sets are joined into the first's: the number of sets does not depend on the order.
+  t.vertex_components = t.edge_components;
+  if (t.edge_components > 1) {
+    const size_t label_slices = t.edge_components <= kSlicedComponentLimit ? slices : 1;
+    std::vector<std::vector<uint32_t>> parent(label_slices, std::vector<uint32_t>(t.edge_components));
+    std::vector<uint32_t> vertex_label(vertex_count, kInvalid);
+    internal::for_each_chunk(
+        label_slices, label_slices,
+        [&](size_t s, size_t, size_t) {
+          const uint32_t lo = static_cast<uint32_t>(vertex_count * s / label_slices);
+          const uint32_t hi = static_cast<uint32_t>(vertex_count * (s + 1) / label_slices);
+          uint32_t* const own = parent[s].data();
+          for (uint32_t c = 0; c < t.edge_components; ++c) own[c] = c;
+          for (size_t c = 0; c < corner_count; ++c) {
+            const uint32_t v = indices[c];
+            if (v < lo || v >= hi) continue;
+            const uint32_t here = component[c / 3];
+            uint32_t& label = vertex_label[v];
+            if (label == kInvalid) {
+              label = here;
+            } else if (label != here) {
+              const uint32_t a = find_root(own, label), b = find_root(own, here);
+              if (a != b) own[std::max(a, b)] = std::min(a, b);
+            }
+          }
+        },
+        1);
+    uint32_t* const joined = parent[0].data();
+    for (size_t s = 1; s < label_slices; ++s)
+      for (uint32_t c = 0; c < t.edge_components; ++c) {
+        const uint32_t a = find_root(joined, c), b = find_root(joined, find_root(parent[s].data(), c));
+        if (a != b) joined[std::max(a, b)] = std::min(a, b);
       }
-    }
+    t.vertex_components = 0;
+    for (uint32_t c = 0; c < t.edge_components; ++c) t.vertex_components += find_root(joined, c) == c;
   }
-  t.vertex_components = t.edge_components - merges;
 
   t.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   reached(1.f);
