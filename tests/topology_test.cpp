@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <numeric>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -123,6 +125,26 @@ TEST(Topology, BowTieVertexJoinsByVertexOnly) {
   EXPECT_EQ(t.boundary_edges, 6u);
   for (uint32_t o : t.opposite) EXPECT_EQ(o, kInvalid);
   EXPECT_EQ(count_nonmanifold_vertices(m), 1u);  // vertex 2: two fans
+}
+
+// Meshes with their faces shuffled: most neighbour pairs then cross the slices of the components'
+// union-find, whose links the threads make at once.
+TEST(Topology, ShuffledFacesGiveTheSameComponentsOnAnyThreadCount) {
+  for (const auto& [file, components] : {std::pair{"horse.ply", 1u}, std::pair{"blobby-3cc.off", 3u}}) {
+    Mesh mesh;
+    ASSERT_TRUE(load_mesh(std::string(TAILOR_TEST_DATA) + "/meshes/" + file, mesh).is_ok());
+    std::vector<uint32_t> order(mesh.face_count());
+    std::iota(order.begin(), order.end(), 0u);
+    std::mt19937 random(7);
+    for (size_t i = order.size() - 1; i > 0; --i) std::swap(order[i], order[random() % (i + 1)]);
+    std::vector<uint32_t> shuffled(mesh.indices.size());
+    for (size_t f = 0; f < order.size(); ++f) std::copy_n(&mesh.indices[3 * size_t{order[f]}], 3, &shuffled[3 * f]);
+    mesh.indices = std::move(shuffled);
+    const Topology t = build_topology(mesh, {}, 1);
+    EXPECT_EQ(t.vertex_components, components) << file;
+    EXPECT_EQ(t.face_component[0], 0u);
+    expect_same_on_threads(mesh, t);
+  }
 }
 
 // Chains of triangles that touch the next one at a vertex only: every face is its own edge

@@ -7,6 +7,7 @@
 #include "tailor/topology.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <numeric>
 #include <type_traits>
@@ -182,8 +183,8 @@ Topology build_topology(const Mesh& mesh, const ProgressCallback& progress, uint
   // locality. Roots are always the lowest face of their set (the larger root goes under the
   // smaller), so the sets do not depend on the order of the unions, and numbering roots in face
   // order numbers components by their lowest face. With several slices of faces, each slice
-  // joins the pairs inside it on its own thread (they touch only its faces' entries), then one
-  // thread joins the pairs that cross slices.
+  // joins the pairs inside it on its own thread (they touch only its faces' entries), then the
+  // pairs that cross slices are joined on the threads too.
   const size_t face_count = mesh.face_count();
   internal::HugeArray<uint32_t> face_parent = internal::huge_uninitialized<uint32_t>(face_count);
   const auto face_begin = [&](size_t s) { return static_cast<uint32_t>(face_count * s / slices); };
@@ -204,14 +205,41 @@ Topology build_topology(const Mesh& mesh, const ProgressCallback& progress, uint
           }
       },
       1);
-  for (size_t s = 0; s + 1 < slices; ++s) {
-    const uint32_t lo = face_begin(s), hi = face_begin(s + 1);
-    for (uint32_t f = lo; f < hi; ++f)
-      for (uint32_t k = 0; k < 3; ++k) {
-        const uint32_t g = neighbour_face(t, 3 * f + k);
-        if (g != kInvalid && g >= hi) join(f, g);
-      }
-  }
+  // The pairs that cross slices, each slice's on its thread at once: every parent read and written
+  // atomically, a root linked under the other by a compare-and-swap (retried when another thread
+  // linked it first), paths halved on the way (any ancestor is a lower face of the same set). The
+  // sets, and with them their lowest faces, do not depend on the order of the links.
+  const auto atomic_root = [&face_parent](uint32_t x) {
+    for (;;) {
+      std::atomic_ref<uint32_t> at(face_parent[x]);
+      const uint32_t p = at.load(std::memory_order_acquire);
+      if (p == x) return x;
+      const uint32_t grand = std::atomic_ref<uint32_t>(face_parent[p]).load(std::memory_order_acquire);
+      if (grand != p) at.store(grand, std::memory_order_release);
+      x = grand;
+    }
+  };
+  internal::for_each_chunk(
+      slices - 1, slices - 1,
+      [&](size_t s, size_t, size_t) {
+        const uint32_t lo = face_begin(s), hi = face_begin(s + 1);
+        for (uint32_t f = lo; f < hi; ++f)
+          for (uint32_t k = 0; k < 3; ++k) {
+            const uint32_t g = neighbour_face(t, 3 * f + k);
+            if (g == kInvalid || g < hi) continue;
+            for (uint32_t a = f, b = g;;) {
+              a = atomic_root(a);
+              b = atomic_root(b);
+              if (a == b) break;
+              if (a < b) std::swap(a, b);  // a, the higher root, goes under b
+              uint32_t expected = a;
+              if (std::atomic_ref<uint32_t>(face_parent[a])
+                      .compare_exchange_strong(expected, b, std::memory_order_acq_rel))
+                break;
+            }
+          }
+      },
+      1);
   // Components numbered in the order of their lowest faces (the roots), slice by slice with the
   // parents only read: each face's root (a parent is a lower face: in face order, one in the same
   // slice already knows its root), then the roots' numbers (each slice's from the count of roots
