@@ -17,6 +17,7 @@
 #include "tailor/export.h"
 #include "tailor/metrics.h"
 #include "util/bin_select.h"
+#include "util/face_components.h"
 #include "util/huge_pages.h"
 #include "util/parallel_chunks.h"
 
@@ -150,16 +151,6 @@ double lattice_gap(const float* fa, const float* fb, const float* ga, const floa
   return std::sqrt(std::max(ga2, gb2));
 }
 
-// Union-find with path halving; the root of a set is its lowest face (union links the larger root
-// under the smaller), so the labelling is deterministic.
-uint32_t find_root(std::vector<uint32_t>& parent, uint32_t x) {
-  while (parent[x] != x) {
-    parent[x] = parent[parent[x]];
-    x = parent[x];
-  }
-  return x;
-}
-
 bool same_uv(std::span<const float> uv, size_t c0, size_t c1) {
   return uv[2 * c0] == uv[2 * c1] && uv[2 * c0 + 1] == uv[2 * c1 + 1];
 }
@@ -235,51 +226,18 @@ double median(std::vector<double>& values, size_t threads) {
 uint32_t derive_patches(const Mesh& mesh, const Topology& topology, std::span<const float> corner_uv,
                         std::vector<uint32_t>& patch, uint32_t threads) {
   const size_t nf = mesh.face_count();
-  std::vector<uint32_t> parent(nf);
-  // Union-find through the seamless edges, a root always the lowest face of its set (so the sets'
-  // labels do not depend on the order of the unions). Each slice of faces joins the pairs inside
-  // it on its own thread (they touch only its faces' entries), then one thread the pairs across.
-  const size_t slices = internal::parallel_parts(nf, threads);
-  const auto slice_begin = [&](size_t s) { return static_cast<uint32_t>(nf * s / slices); };
-  const auto join_if_seamless = [&](uint32_t e, uint32_t o) {
-    const EdgeSides s = edge_sides(e, o);
-    if (!same_uv(corner_uv, s.fa, s.ga) || !same_uv(corner_uv, s.fb, s.gb)) return;
-    const uint32_t ra = find_root(parent, e / 3);
-    const uint32_t rb = find_root(parent, o / 3);
-    if (ra < rb)
-      parent[rb] = ra;
-    else if (rb < ra)
-      parent[ra] = rb;
-  };
-  internal::for_each_chunk(
-      slices, slices,
-      [&](size_t s, size_t, size_t) {
-        const uint32_t lo = slice_begin(s), hi = slice_begin(s + 1);
-        for (uint32_t f = lo; f < hi; ++f) parent[f] = f;
-        for (uint32_t e = 3 * lo; e < 3 * hi; ++e) {
-          const uint32_t o = topology.opposite[e];
-          if (o != kInvalid && o > e && o / 3 < hi) join_if_seamless(e, o);
-        }
-      },
-      1);
-  for (size_t s = 0; s + 1 < slices; ++s) {
-    const uint32_t hi = slice_begin(s + 1);
-    for (uint32_t e = 3 * slice_begin(s); e < 3 * hi; ++e) {
+  // Components through the seamless edges, numbered by their lowest face, the same for any count
+  // (util/face_components.h).
+  patch.resize(nf);
+  const auto seamless = [&](uint32_t f, const auto& visit) {
+    for (uint32_t e = 3 * f; e < 3 * f + 3; ++e) {
       const uint32_t o = topology.opposite[e];
-      if (o != kInvalid && o / 3 >= hi) join_if_seamless(e, o);
+      if (o == kInvalid) continue;
+      const EdgeSides s = edge_sides(e, o);
+      if (same_uv(corner_uv, s.fa, s.ga) && same_uv(corner_uv, s.fb, s.gb)) visit(o / 3);
     }
-  }
-  patch.assign(nf, kInvalid);
-  uint32_t count = 0;
-  for (size_t f = 0; f < nf; ++f) {
-    const uint32_t root = find_root(parent, static_cast<uint32_t>(f));
-    // Roots are the lowest face of their set, so a root is labelled before any other member.
-    if (root == f)
-      patch[f] = count++;
-    else
-      patch[f] = patch[root];
-  }
-  return count;
+  };
+  return internal::label_components(nf, internal::parallel_parts(nf, threads), seamless, patch.data());
 }
 
 double seam_gap_px(const float* uv_fa, const float* uv_fb, const float* uv_ga, const float* uv_gb,

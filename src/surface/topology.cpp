@@ -7,13 +7,13 @@
 #include "tailor/topology.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <numeric>
 #include <type_traits>
 #include <utility>
 #include <vector>
 
+#include "util/face_components.h"
 #include "util/huge_pages.h"
 #include "util/parallel_chunks.h"
 
@@ -179,111 +179,22 @@ Topology build_topology(const Mesh& mesh, const ProgressCallback& progress, uint
   reached(0.6f);
   // === Components through paired edges ===
   // Union-find in face order rather than a flood fill: neighbouring faces are mostly near each
-  // other in file order, so this pass reads opposite[] sequentially and parent[] with good
-  // locality. Roots are always the lowest face of their set (the larger root goes under the
-  // smaller), so the sets do not depend on the order of the unions, and numbering roots in face
-  // order numbers components by their lowest face. With several slices of faces, each slice
-  // joins the pairs inside it on its own thread (they touch only its faces' entries), then the
-  // pairs that cross slices are joined on the threads too.
+  // other in file order, so the pass reads opposite[] sequentially and the parents with good
+  // locality; components numbered by their lowest face, the same for any count
+  // (util/face_components.h).
   const size_t face_count = mesh.face_count();
-  internal::HugeArray<uint32_t> face_parent = internal::huge_uninitialized<uint32_t>(face_count);
-  const auto face_begin = [&](size_t s) { return static_cast<uint32_t>(face_count * s / slices); };
-  const auto join = [&face_parent](uint32_t f, uint32_t g) {
-    const uint32_t a = find_root(face_parent.get(), f);
-    const uint32_t b = find_root(face_parent.get(), g);
-    if (a != b) face_parent[std::max(a, b)] = std::min(a, b);
-  };
-  internal::for_each_chunk(
-      slices, slices,
-      [&](size_t s, size_t, size_t) {
-        const uint32_t lo = face_begin(s), hi = face_begin(s + 1);
-        for (uint32_t f = lo; f < hi; ++f) face_parent[f] = f;
-        for (uint32_t f = lo; f < hi; ++f)
-          for (uint32_t k = 0; k < 3; ++k) {
-            const uint32_t g = neighbour_face(t, 3 * f + k);
-            if (g != kInvalid && g > f && g < hi) join(f, g);  // each pair once
-          }
-      },
-      1);
-  // The pairs that cross slices, each slice's on its thread at once: every parent read and written
-  // atomically, a root linked under the other by a compare-and-swap (retried when another thread
-  // linked it first), paths halved on the way (any ancestor is a lower face of the same set). The
-  // sets, and with them their lowest faces, do not depend on the order of the links.
-  const auto atomic_root = [&face_parent](uint32_t x) {
-    for (;;) {
-      std::atomic_ref<uint32_t> at(face_parent[x]);
-      const uint32_t p = at.load(std::memory_order_acquire);
-      if (p == x) return x;
-      const uint32_t grand = std::atomic_ref<uint32_t>(face_parent[p]).load(std::memory_order_acquire);
-      if (grand != p) at.store(grand, std::memory_order_release);
-      x = grand;
-    }
-  };
-  internal::for_each_chunk(
-      slices - 1, slices - 1,
-      [&](size_t s, size_t, size_t) {
-        const uint32_t lo = face_begin(s), hi = face_begin(s + 1);
-        for (uint32_t f = lo; f < hi; ++f)
-          for (uint32_t k = 0; k < 3; ++k) {
-            const uint32_t g = neighbour_face(t, 3 * f + k);
-            if (g == kInvalid || g < hi) continue;
-            for (uint32_t a = f, b = g;;) {
-              a = atomic_root(a);
-              b = atomic_root(b);
-              if (a == b) break;
-              if (a < b) std::swap(a, b);  // a, the higher root, goes under b
-              uint32_t expected = a;
-              if (std::atomic_ref<uint32_t>(face_parent[a])
-                      .compare_exchange_strong(expected, b, std::memory_order_acq_rel))
-                break;
-            }
-          }
-      },
-      1);
-  // Components numbered in the order of their lowest faces (the roots), slice by slice with the
-  // parents only read: each face's root (a parent is a lower face: in face order, one in the same
-  // slice already knows its root), then the roots' numbers (each slice's from the count of roots
-  // before it) in the parents' place, then each face's number from its root's.
   internal::reserve_huge(t.face_component, face_count);
   t.face_component.resize(face_count);
   uint32_t* const component = t.face_component.data();
-  uint32_t* const parents = face_parent.get();
-  std::vector<uint32_t> roots_before(slices + 1, 0);
-  internal::for_each_chunk(
-      slices, slices,
-      [&](size_t s, size_t, size_t) {
-        const uint32_t lo = face_begin(s), hi = face_begin(s + 1);
-        uint32_t roots = 0;
-        for (uint32_t f = lo; f < hi; ++f) {
-          uint32_t p = parents[f];
-          if (p == f) {
-            ++roots;
-          } else if (p >= lo) {
-            p = component[p];
-          } else {
-            while (parents[p] != p) p = parents[p];
-          }
-          component[f] = p;
+  t.edge_components = internal::label_components(
+      face_count, slices,
+      [&t](uint32_t f, const auto& visit) {
+        for (uint32_t k = 0; k < 3; ++k) {
+          const uint32_t g = neighbour_face(t, 3 * f + k);
+          if (g != kInvalid) visit(g);
         }
-        roots_before[s + 1] = roots;
       },
-      1);
-  for (size_t s = 0; s < slices; ++s) roots_before[s + 1] += roots_before[s];
-  t.edge_components = roots_before[slices];
-  internal::for_each_chunk(
-      slices, slices,
-      [&](size_t s, size_t, size_t) {
-        uint32_t next = roots_before[s];
-        for (uint32_t f = face_begin(s); f < face_begin(s + 1); ++f)
-          if (component[f] == f) parents[f] = next++;
-      },
-      1);
-  internal::for_each_chunk(
-      slices, slices,
-      [&](size_t s, size_t, size_t) {
-        for (uint32_t f = face_begin(s); f < face_begin(s + 1); ++f) component[f] = parents[component[f]];
-      },
-      1);
+      component);
 
   reached(0.85f);
   // === Components of faces sharing a vertex ===
