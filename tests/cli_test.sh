@@ -416,6 +416,16 @@ expect_error 1 "in.png: $notreg" -- timeout 5 "$tailor" tile "$tmp/img/in.png" -
 expect_error 1 "in.png: $notreg" -- timeout 5 "$tailor" map "$mesh" --texture "$tmp/img/in.png" -o "$tmp/img/o.glb"
 expect_error 1 "in.obj: $notreg" -- timeout 5 "$tailor" map "$mesh" --seam-faces "$tmp/img/in.obj" -o "$tmp/img/o.glb"
 expect_error 1 "img: is a directory, not a regular file" -- timeout 5 "$tailor" info "$tmp/img"
+# A material or texture that a mesh names is only a FIFO: the mesh loads, its texture is unknown.
+mkdir "$tmp/named"
+mkfifo "$tmp/named/m.mtl" "$tmp/named/t.png"
+printf 'mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n' >"$tmp/named/a.obj"
+printf 'mtllib b.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n' >"$tmp/named/b.obj"
+printf 'newmtl m\nmap_Kd t.png\n' >"$tmp/named/b.mtl"
+for obj in a b; do
+  timeout 5 "$tailor" eval "$tmp/named/$obj.obj" 2>&1 | grep -q "texture 512x512 px, default)" && ok ||
+    fail "eval of an .obj whose material or texture is a FIFO did not fall back to the default size"
+done
 [[ ! -e $tmp/img/o.png && ! -e $tmp/img/o.glb ]] && ok || fail "a refused input left an output"
 
 ls "$tmp"/*.tmp-* "$tmp"/.tailor-* >/dev/null 2>&1 && fail "temporary files left behind" || ok
@@ -510,6 +520,12 @@ grep -Eq "^tailor: warning: $photo does not wrap \(wrap ratio [0-9]+\.[0-9]{2} i
 ! grep -q "does not wrap" "$tmp/wrap.err" && ok || fail "a tile from tailor tile warned: $(cat "$tmp/wrap.err")"
 grep -Eq "^examples/spot.obj: 5856 faces, [0-9]+ patch(es)?, [0-9]+\.[0-9]{2} repeats across the mesh \(600 texels per unit\), seams " \
   "$tmp/wrap.txt" && ok || fail "summary without repeats and texels per unit: $(cat "$tmp/wrap.txt")"
+# A world density given as 0 (or not a number) is refused, not taken for "not given".
+for given in "--tile-size 0" "--texels-per-unit 0" "--tile-size nan" "--texels-per-unit -2"; do
+  # shellcheck disable=SC2086 # the option and its value, two words
+  expect_error 2 "--tile-size and --texels-per-unit must be positive" -- "$tailor" map "$mesh" -o "$tmp/w0.glb" $given
+done
+[[ ! -e $tmp/w0.glb ]] && ok || fail "a refused --tile-size wrote its output"
 "$tailor" map "$mesh" -o "$tmp/small.glb" --scale 100 >"$tmp/small.txt" 2>"$tmp/small.err"
 grep -q "^tailor: warning: the 512 px texture repeats 0.20 times across the mesh" "$tmp/small.err" &&
   grep -q ", 0.20 repeats across the mesh, seams" "$tmp/small.txt" && ok ||

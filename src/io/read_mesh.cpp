@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <new>
 #include <string>
 #include <string_view>
@@ -17,6 +16,7 @@
 
 #include "io/readers.h"
 #include "tailor/io.h"
+#include "util/atomic_file.h"
 #include "util/file_view.h"
 #include "util/huge_pages.h"
 
@@ -178,14 +178,10 @@ MeshFormat mesh_format_from_path(const std::string& path) {
 
 namespace {
 
-// Up to max_bytes of a file's start; false when it cannot be opened.
+// Up to max_bytes of a file's start; false when it cannot be opened or is not a regular file (a
+// FIFO named as a material or a texture would block the read: internal::open_input refuses it).
 bool read_file_start(const std::filesystem::path& path, size_t max_bytes, std::string& out) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return false;
-  out.resize(max_bytes);
-  in.read(out.data(), static_cast<std::streamsize>(max_bytes));
-  out.resize(static_cast<size_t>(in.gcount()));
-  return true;
+  return internal::read_file_head(path.string(), max_bytes, out).is_ok();
 }
 
 // The texture a mesh file names (an image next to it): report.texture_width/height from the
