@@ -45,6 +45,7 @@ struct MapArgs {
   std::string up = ExportOptions{}.up == SceneUp::kZ ? "z" : "y";
   double tile_size = 0;        // --tile-size: scene units per texture repeat (0: not given)
   double texels_per_unit = 0;  // --texels-per-unit (0: not given)
+  bool tile_size_given = false, texels_per_unit_given = false;
   std::string preview_up = up_axis_name(RenderOptions{}.up);
   std::string stats;
   std::string preview;
@@ -97,8 +98,9 @@ int run_map(const MapArgs& opt) {
   if (opt.up != "y" && opt.up != "z") return report_error(usage_error("--up must be y or z, got '" + opt.up + "'"));
   if (opt.tile_size != 0 && opt.texels_per_unit != 0)
     return report_error(usage_error("give --tile-size or --texels-per-unit, not both"));
-  if (!(opt.tile_size >= 0 && opt.texels_per_unit >= 0) || !std::isfinite(opt.tile_size) ||
-      !std::isfinite(opt.texels_per_unit))
+  // Given, each must be a length or density (0 would mean "not given" and be ignored silently).
+  if ((opt.tile_size_given && !(opt.tile_size > 0 && std::isfinite(opt.tile_size))) ||
+      (opt.texels_per_unit_given && !(opt.texels_per_unit > 0 && std::isfinite(opt.texels_per_unit))))
     return report_error(usage_error("--tile-size and --texels-per-unit must be positive"));
   if (opt.uv_set != 0 && ext != ".glb")
     return report_error(usage_error("--uv-set needs a .glb output, got '" + opt.output + "'"));
@@ -510,7 +512,9 @@ void register_map(CLI::App& app, Runner& run) {
       "texture without a direction (gravel, grass; its isotropy is in the --stats) with rigid unfolding\n"
       "and 32 crack rings, the fewest seams; --field-following 1 keeps the orientation field, and\n"
       "the UVs of a mesh that is edited and re-mapped more stable (docs/mapping.md section 7).");
-  cmd->callback([&run, opt, crack_rings, symmetry] {
+  cmd->callback([&run, opt, crack_rings, symmetry, tile_size, texels] {
+    opt->tile_size_given = tile_size->count() > 0;
+    opt->texels_per_unit_given = texels->count() > 0;
     opt->mapping_args.crack_rings_given = crack_rings->count() > 0;
     opt->mapping_args.symmetry_given = symmetry->count() > 0;
     run = [opt] { return run_map_inputs(*opt); };

@@ -1034,6 +1034,12 @@ def parse_args(argv):
         usage_error("give --texture or --material, not both (the material's colour map is the texture)")
     if args.up not in ("y", "z"):
         usage_error("--up must be y or z, got '%s'" % args.up)
+    for name, value in (("--tile-size", args.tile_size), ("--texels-per-unit", args.texels_per_unit),
+                        ("--scale", args.scale), ("--max-stretch", args.max_stretch)):
+        if value is not None and not (0 < value < math.inf):
+            usage_error("%s must be a positive number, got %s" % (name, value))
+    if args.texture_size < 1:
+        usage_error("--texture-size must be at least 1, got %d" % args.texture_size)
     if args.workers < 0:
         p.error("--workers must be 0 or more")
     if args.threads < 0 or args.threads > 64:

@@ -414,6 +414,13 @@ def test_bounding_boxes_hold_the_content_as_a_client_places_it(tmp_path, up):
     # --up x: one line, bad usage.
     code, _, stderr = run_tiles(HORSE, "-o", tmp_path / "x", "--workers", 0, "--up", "x")
     assert code == 2 and stderr == "tailor.tiles: error: --up must be y or z, got 'x'\n"
+    # Densities and sizes that are not positive numbers: one line each, bad usage, nothing written
+    # (they reached the arithmetic before: a traceback).
+    for option, value in (("--tile-size", 0), ("--tile-size", "nan"), ("--scale", 0), ("--texels-per-unit", -1)):
+        code, _, stderr = run_tiles(HORSE, "-o", tmp_path / "bad", "--workers", 0, option, value)
+        assert code == 2 and stderr.count("\n") == 1, stderr
+        assert stderr.startswith("tailor.tiles: error: %s must be a positive number" % option), stderr
+        assert not (tmp_path / "bad").exists()
 
 
 # === The streamed input: a binary little-endian PLY partitioned without loading it whole ===
