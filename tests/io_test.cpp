@@ -654,6 +654,18 @@ TEST(Errors, HugeHeaderCountsFailBeforeAllocating) {
   EXPECT_EQ(st.code(), ErrorCode::kParse);
   st = parse("ply\nformat ascii 1.0\nelement vertex 99999999999999999999999\nend_header\n", MeshFormat::kPly, m);
   EXPECT_EQ(st.code(), ErrorCode::kParse);
+  // A count of 2^64 or more is a bad element line, not a count of 0 (a face element of 2^64 read as
+  // "no faces", an extra element of 2^64 + 3 accepted).
+  const std::string triangle_body = "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const std::string vertices =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
+  for (const char* faces : {"element face 18446744073709551616\nproperty list uchar int vertex_indices\n",
+                            "element face 1\nproperty list uchar int vertex_indices\nelement junk "
+                            "18446744073709551619\nproperty float a\n"}) {
+    st = parse(vertices + faces + triangle_body, MeshFormat::kPly, m);
+    EXPECT_EQ(st.code(), ErrorCode::kParse) << faces;
+    EXPECT_NE(st.message().find("bad PLY element line"), std::string::npos) << st.message();
+  }
   st = parse("OFF\n4000000000 4000000000 0\n0 0 0\n", MeshFormat::kOff, m);
   EXPECT_EQ(st.code(), ErrorCode::kParse);
   std::string stl(84, ' ');

@@ -19,6 +19,7 @@
 #include <cstdio>
 #include <cstring>
 #include <string_view>
+#include <system_error>
 #include <type_traits>
 #include <vector>
 
@@ -189,9 +190,10 @@ Status parse_header(std::string_view data, const std::string& name, PlyHeader& h
       have_format = true;
     } else if (w[0] == "element") {
       uint64_t count = 0;
-      if (w.size() != 3 ||
-          std::from_chars(w[2].data(), w[2].data() + w[2].size(), count).ptr != w[2].data() + w[2].size() ||
-          w[2][0] == '-') {
+      // A count past 2^64 - 1 is out of range for from_chars, which then leaves count at 0.
+      const auto parsed = w.size() == 3 ? std::from_chars(w[2].data(), w[2].data() + w[2].size(), count)
+                                        : std::from_chars_result{nullptr, std::errc::invalid_argument};
+      if (w.size() != 3 || parsed.ec != std::errc{} || parsed.ptr != w[2].data() + w[2].size() || w[2][0] == '-') {
         return Status::error(ErrorCode::kParse, name, "bad PLY element line", where);
       }
       PlyElement e;
