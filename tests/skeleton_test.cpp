@@ -116,6 +116,28 @@ TEST(Skeleton, OpenTubeIsClosedFirstAndTinyComponentsKeepPca) {
   for (float v : frames.orientation) ASSERT_TRUE(std::isfinite(v));
 }
 
+// A wavy sheet whose vertices are snapped to a coarse grid: many faces with collinear or
+// coincident corners. CGAL's inside test (the flow's medial centering) retried random rays on it
+// forever; it contracts without the centering now and every face gets a finite frame.
+TEST(Skeleton, DegenerateFacesDoNotStopTheFlow) {
+  Mesh sheet;
+  const int n = 20;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      const float x = static_cast<float>(i) / n, y = static_cast<float>(j) / n;
+      sheet.positions.insert(sheet.positions.end(), {std::round(7.f * x), std::round(7.f * y),
+                                                     std::round(1.43f * std::sin(5.f * x) * std::cos(4.f * y))});
+    }
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const auto a = static_cast<uint32_t>(j * (n + 1) + i);
+      sheet.indices.insert(sheet.indices.end(), {a, a + 1, a + n + 2, a, a + n + 2, a + n + 1});
+    }
+  const FaceFrames frames = frames_of(sheet, AxisSource::kSkeleton);
+  ASSERT_EQ(frames.orientation.size(), 3 * sheet.face_count());
+  for (float v : frames.orientation) ASSERT_TRUE(std::isfinite(v));
+}
+
 TEST(Skeleton, HorseLegsRunUpAndDownAndThreadsDoNotMatter) {
   // The shared horse stands on z, its body along y: its legs (the lowest quarter of its height)
   // should get an orientation close to vertical, which the PCA axis (the body) is not.

@@ -14,6 +14,7 @@
 #include "surface/skeleton.h"
 
 #include <CGAL/Mean_curvature_flow_skeletonization.h>
+#include <CGAL/Polygon_mesh_processing/shape_predicates.h>
 #include <CGAL/Simple_cartesian.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Count_stop_predicate.h>
@@ -55,6 +56,13 @@ using namespace skeleton_types;
 
 constexpr double kEdgeLengthFactor = 2.0;  // times the flow's shortest edge in CGAL's defaults (see below)
 constexpr size_t kFlowEdges = 300000;      // 200k faces; the horse (146k edges) goes in whole
+
+// Whether a face of `sm` has collinear or coincident corners (exact predicates).
+bool has_degenerate_face(const SurfaceMesh& sm) {
+  for (const auto f : faces(sm))
+    if (CGAL::Polygon_mesh_processing::is_degenerate_triangle_face(f, sm)) return true;
+  return false;
+}
 
 // Closes every border cycle of `sm` with a fan around its centroid; returns the number closed.
 uint32_t close_holes(SurfaceMesh& sm) {
@@ -154,6 +162,11 @@ Status compute_curve_skeleton(const Mesh& mesh, const Topology& topology, CurveS
       // 0.05 halves the time but the horse's legs then get no skeleton of their own (the
       // skeleton test checks them).
       flow.set_min_edge_length(kEdgeLengthFactor * flow.min_edge_length());
+      // The medial centering asks CGAL's inside test for every pole, and that test shoots random
+      // rays until one meets no edge or vertex of the mesh: on a component with degenerate faces
+      // (collinear or coincident corners, e.g. a scan snapped to a grid) none ever does and the
+      // flow never ends. Such a component contracts without the centering.
+      if (has_degenerate_face(sm)) flow.set_is_medially_centered(false);
       flow.contract_until_convergence();
       flow.convert_to_skeleton(graph);
     } catch (const std::exception&) {
