@@ -229,10 +229,10 @@ uint32_t derive_patches(const Mesh& mesh, const Topology& topology, std::span<co
   // Components through the seamless edges, numbered by their lowest face, the same for any count
   // (util/face_components.h).
   patch.resize(nf);
-  const auto seamless = [&](uint32_t f, const auto& visit) {
+  const auto seamless = [&](uint32_t f, const auto& wanted, const auto& visit) {
     for (uint32_t e = 3 * f; e < 3 * f + 3; ++e) {
       const uint32_t o = topology.opposite[e];
-      if (o == kInvalid) continue;
+      if (o == kInvalid || !wanted(o / 3)) continue;
       const EdgeSides s = edge_sides(e, o);
       if (same_uv(corner_uv, s.fa, s.ga) && same_uv(corner_uv, s.fb, s.gb)) visit(o / 3);
     }

@@ -188,10 +188,10 @@ Topology build_topology(const Mesh& mesh, const ProgressCallback& progress, uint
   uint32_t* const component = t.face_component.data();
   t.edge_components = internal::label_components(
       face_count, slices,
-      [&t](uint32_t f, const auto& visit) {
+      [&t](uint32_t f, const auto& wanted, const auto& visit) {
         for (uint32_t k = 0; k < 3; ++k) {
           const uint32_t g = neighbour_face(t, 3 * f + k);
-          if (g != kInvalid) visit(g);
+          if (g != kInvalid && wanted(g)) visit(g);
         }
       },
       component);

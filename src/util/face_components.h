@@ -25,10 +25,11 @@
 
 namespace tailor::internal {
 
-//! Labels the components: `joined(x, visit)` calls visit(y) for every element y joined to x (both
-//! x's and y's calls must name each other; y == x is ignored). label[x] gets the component of x,
-//! numbered from 0 in the order of their lowest elements; returns the number of components. n fits
-//! 32 bits; `slices` threads at most (at least 1).
+//! Labels the components: `joined(x, wanted, visit)` calls visit(y) for every element y joined to x
+//! for which wanted(y) holds (both x's and y's calls must name each other; y == x is ignored); it
+//! asks wanted(y) first, so a costly test of the pair is skipped for the pairs the pass does not
+//! want. label[x] gets the component of x, numbered from 0 in the order of their lowest elements;
+//! returns the number of components. n fits 32 bits; `slices` threads at most (at least 1).
 template <class Joined>
 uint32_t label_components(size_t n, size_t slices, const Joined& joined, uint32_t* label) {
   slices = std::clamp<size_t>(slices, 1, std::max<size_t>(n, 1));
@@ -45,11 +46,12 @@ uint32_t label_components(size_t n, size_t slices, const Joined& joined, uint32_
         const uint32_t lo = begin(s), hi = begin(s + 1);
         for (uint32_t x = lo; x < hi; ++x) parent[x] = x;
         for (uint32_t x = lo; x < hi; ++x)
-          joined(x, [&](uint32_t y) {
-            if (y <= x || y >= hi) return;  // each pair inside the slice once
-            const uint32_t a = find(x), b = find(y);
-            if (a != b) parent[std::max(a, b)] = std::min(a, b);
-          });
+          joined(
+              x, [x, hi](uint32_t y) { return y > x && y < hi; },  // each pair inside the slice once
+              [&](uint32_t y) {
+                const uint32_t a = find(x), b = find(y);
+                if (a != b) parent[std::max(a, b)] = std::min(a, b);
+              });
       },
       1);
   const auto atomic_root = [parent](uint32_t x) {
@@ -67,18 +69,20 @@ uint32_t label_components(size_t n, size_t slices, const Joined& joined, uint32_
       [&](size_t s, size_t, size_t) {
         const uint32_t lo = begin(s), hi = begin(s + 1);
         for (uint32_t x = lo; x < hi; ++x)
-          joined(x, [&](uint32_t y) {
-            if (y < hi) return;  // inside the slice, or seen from the other side
-            for (uint32_t a = x, b = y;;) {
-              a = atomic_root(a);
-              b = atomic_root(b);
-              if (a == b) return;
-              if (a < b) std::swap(a, b);  // a, the higher root, goes under b
-              uint32_t expected = a;
-              if (std::atomic_ref<uint32_t>(parent[a]).compare_exchange_strong(expected, b, std::memory_order_acq_rel))
-                return;
-            }
-          });
+          joined(
+              x, [hi](uint32_t y) { return y >= hi; },
+              [&](uint32_t y) {
+                for (uint32_t a = x, b = y;;) {
+                  a = atomic_root(a);
+                  b = atomic_root(b);
+                  if (a == b) return;
+                  if (a < b) std::swap(a, b);  // a, the higher root, goes under b
+                  uint32_t expected = a;
+                  if (std::atomic_ref<uint32_t>(parent[a]).compare_exchange_strong(expected, b,
+                                                                                   std::memory_order_acq_rel))
+                    return;
+                }
+              });
       },
       1);
   std::vector<uint32_t> roots_before(slices + 1, 0);
