@@ -183,8 +183,11 @@ def clean(faces, uvs):
 
 
 def simplify(positions, faces, uvs, target):
-    """tailor.simplify_uvs on arrays: the open borders (the node's sides) stay where they are."""
+    """tailor.simplify_uvs on arrays: the open borders (the node's sides) stay where they are. No
+    face left after cleaning (faces on vertices that welding joined): empty arrays."""
     faces, uvs = clean(faces, uvs)
+    if faces.shape[0] == 0:
+        return np.empty((0, 3), np.float32), faces, uvs, 0.0
     r = tailor.simplify_uvs(tailor.Mesh(positions, faces), uvs, max(int(target), 1))
     f, t = clean(r["faces"], r["corner_uvs"])
     return r["positions"], f, t, r["error"]
@@ -194,7 +197,7 @@ def kept(keep_from, digest, folder, name, lod):
     """Links the previous run's files of this node into folder when its digest is the same."""
     if not keep_from or keep_from.get("digest") != digest:
         return False
-    pairs = [(keep_from["glb"], glb_path(folder, name))]
+    pairs = [(keep_from["glb"], glb_path(folder, name))] if keep_from.get("faces", 1) > 0 else []
     if lod:
         pairs.append((keep_from["coarse"], coarse_path(folder, name)))
     if not all(os.path.exists(old) for old, _ in pairs):
@@ -369,6 +372,10 @@ def build_parent(job, params, folder, keep_from, *children):
     faces = inverse.reshape(-1)[faces].astype(np.uint32)
     p, f, t, error = simplify(positions, faces, uvs, sum(c["faces"] for c in children) / 4)
     record.update(faces=int(f.shape[0]), error=below + error)
+    if f.shape[0] == 0:  # the children's copies collapse where they are welded: a node without content
+        save_coarse(coarse_path(folder, job["name"]), p, f, t, 0.0)
+        record.update(coarse_error=0.0, written=True)
+        return record
     return finish_node(record, folder, p, f, t, params, True)
 
 
@@ -449,11 +456,9 @@ def tileset_json(records, lod, up):
     diagonal = float(np.linalg.norm(np.subtract(hi, lo)))
 
     def node(r):
-        out = {
-            "boundingVolume": box_volume(r["min"], r["max"], up),
-            "geometricError": float(r["error"]),
-            "content": {"uri": "tiles/%s.glb" % r["name"]},
-        }
+        out = {"boundingVolume": box_volume(r["min"], r["max"], up), "geometricError": float(r["error"])}
+        if r["faces"] > 0:
+            out["content"] = {"uri": "tiles/%s.glb" % r["name"]}
         if r.get("children"):
             out["refine"] = "REPLACE"
             out["children"] = [node(by_name[c]) for c in r["children"]]

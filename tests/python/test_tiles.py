@@ -155,6 +155,43 @@ def write_ply(path, positions, faces):
         f.write(rows.tobytes())
 
 
+def test_a_parent_whose_faces_collapse_when_welded_has_no_content(tmp_path):
+    # A grid, and far from it faces whose distinct vertices share one position: the leaf maps them
+    # (they are distinct vertices), the parent welds its children's copies by position, and then
+    # holds no face. That parent is a node without content, not an error, and a rerun keeps it.
+    n = 12
+    i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="xy")
+    grid = np.stack([i.ravel() / n, j.ravel() / n, 0.1 * np.sin(i.ravel() / 3.0)], axis=1)
+    a = (np.arange(n)[None, :] + (n + 1) * np.arange(n)[:, None]).ravel()
+    grid_faces = np.concatenate([np.stack([a, a + 1, a + n + 2], 1), np.stack([a, a + n + 2, a + n + 1], 1)])
+    far = np.full((12, 3), 50.0)
+    far_faces = len(grid) + np.array([[k, k + 1, k + 2] for k in range(10)])
+    mesh = tmp_path / "far.ply"
+    write_ply(mesh, np.concatenate([grid, far]), np.concatenate([grid_faces, far_faces]))
+    out = tmp_path / "tiles"
+    args = [mesh, "-o", out, "--workers", 0, "--chunk-cell", -2, "--json"]
+    code, stdout, stderr = run_tiles(*args)
+    assert code == 0, stderr
+    summary = json.loads(stdout)
+    assert summary["faces"] == len(grid_faces) + len(far_faces)
+    tileset = json.loads((out / "tileset.json").read_text())
+    nodes, empty, todo = [], [], [tileset["root"]]
+    while todo:
+        node = todo.pop()
+        todo.extend(node.get("children", []))
+        if "content" in node:
+            nodes.append(node)
+            assert (out / node["content"]["uri"]).is_file()
+        elif node is not tileset["root"]:
+            empty.append(node)
+    # The far faces' parents (one per level above their leaf), each above a node with content.
+    assert empty and all(node.get("children") for node in empty)
+    code, stdout, stderr = run_tiles(*args)
+    assert code == 0, stderr
+    again = json.loads(stdout)
+    assert again["written"] == 0 and again["kept"] == again["tiles"] == summary["tiles"]
+
+
 def test_a_rerun_rewrites_only_the_tiles_that_changed(tmp_path):
     out = tmp_path / "tiles"
     args = ["--chunk-cell", CELL, "--texture-size", 256, "--texels-per-unit", 2048, "--workers", 0, "--json"]
