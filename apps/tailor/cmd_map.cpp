@@ -279,7 +279,7 @@ int run_map(const MapArgs& opt) {
   const Atlas& atlas = map.atlas;
   run.options = options;
   add_map_results(mesh, load, topology, map, run);
-  if (map.stats.chunks > 0 && mesh.face_count() / map.stats.chunks < 1000)
+  if (map.stats.chunks > 1 && mesh.face_count() / map.stats.chunks < 1000)  // one chunk has no border
     warn(opt.quiet, opt.input + ": " + std::to_string(map.stats.chunks) + " chunks of " +
                         std::to_string(mesh.face_count() / map.stats.chunks) +
                         " faces on average: every chunk border is a seam; a larger --chunk-cell keeps more of the "
