@@ -101,6 +101,12 @@ rm "$tmp/moved/fertility-water.mtl" &&
   "$tailor" eval "$tmp/spot-bark-obj/spot-bark.obj" --texture-size 64 | grep -q "texture 64x64 px, option)" && ok ||
   fail "eval of an .obj without its .mtl, or with --texture-size, did not size the texture as documented"
 
+# A texture the .mtl names but that cannot be read: the default size, and a warning that says why.
+rm "$tmp/spot-bark-obj/"*.png &&
+  "$tailor" eval "$tmp/spot-bark-obj/spot-bark.obj" 2>"$tmp/named.err" | grep -q "texture 512x512 px, default)" &&
+  grep -q "^tailor: warning: .*spot-bark.obj: the texture it names (.*) could not be read: measured at 512x512 px" \
+    "$tmp/named.err" && ok || fail "eval of an .obj whose texture is missing: no warning: $(cat "$tmp/named.err")"
+
 # --threads: the same figures for any count (the large-mesh parallel paths are tests/metrics_test.cpp's).
 if "$tailor" eval "$tmp/spot-bark-glb/spot-bark.glb" --json --threads 3 >"$tmp/threads3.json" &&
   python3 - "$tmp/spot-bark-glb.eval.json" "$tmp/threads3.json" <<'PY'; then ok; else fail "eval --threads 3 changed the figures"; fi

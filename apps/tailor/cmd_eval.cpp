@@ -92,6 +92,10 @@ int run_eval(const EvalOptions& opt) {
     width = report.texture_width;
     height = report.texture_height;
     size_source = report.texture_file ? "texture file" : "embedded texture";
+  } else if (!report.texture_named.empty()) {
+    warn(opt.quiet || opt.json, opt.input + ": the texture it names (" + report.texture_named +
+                                    ") could not be read: measured at " + std::to_string(width) + "x" +
+                                    std::to_string(height) + " px (give --texture-size)");
   }
   // A 4-fold map says so in its .glb's material or its .obj's .mtl (tailor map --symmetry 4):
   // measured as the map was.

@@ -91,6 +91,8 @@ struct LoadReport {
                                      //!< 0: none, or no header read
   bool texture_file = false;         //!< that texture is a file next to the .gltf, .mtl or .ply (only its header read)
   std::string texture_path;          //!< OBJ and PLY: that file's path (empty: none, or no header read)
+  std::string texture_named;         //!< the base colour texture the file names, even when its header could
+                                     //!< not be read (OBJ, PLY: its path; glTF: "image N"); empty: none
   uint32_t texture_symmetry = 1;     //!< 4 where the file says the map is 4-fold (written by tailor map
                                      //!< --symmetry 4: ExportOptions::symmetry): glb: that texture's material
                                      //!< (without a texture, the first primitive's); OBJ: its .mtl; else 1

@@ -188,6 +188,7 @@ bool read_file_start(const std::filesystem::path& path, size_t max_bytes, std::s
 // image's header (never decoded), texture_file and texture_path. A missing or unreadable image
 // leaves them as they are: the mesh itself loaded, and its texture is optional.
 void read_texture_header(const std::filesystem::path& image, LoadReport& report) {
+  report.texture_named = image.string();
   std::string head;
   long width = 0, height = 0;
   for (const size_t max_bytes : {size_t{64} << 10, size_t{16} << 20}) {  // a JPEG's frame header may lie far in
