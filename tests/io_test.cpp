@@ -654,8 +654,8 @@ TEST(Errors, HugeHeaderCountsFailBeforeAllocating) {
   EXPECT_EQ(st.code(), ErrorCode::kParse);
   st = parse("ply\nformat ascii 1.0\nelement vertex 99999999999999999999999\nend_header\n", MeshFormat::kPly, m);
   EXPECT_EQ(st.code(), ErrorCode::kParse);
-  // A count of 2^64 or more is a bad element line, not a count of 0 (a face element of 2^64 read as
-  // "no faces", an extra element of 2^64 + 3 accepted).
+  // A count of 2^64 or more is a bad element line (from_chars leaves the count at 0 on overflow),
+  // in the face element and in an extra element alike.
   const std::string triangle_body = "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
   const std::string vertices =
       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n";

@@ -117,8 +117,8 @@ TEST(Skeleton, OpenTubeIsClosedFirstAndTinyComponentsKeepPca) {
 }
 
 // A wavy sheet whose vertices are snapped to a coarse grid: many faces with collinear or
-// coincident corners. CGAL's inside test (the flow's medial centering) retried random rays on it
-// forever; it contracts without the centering now and every face gets a finite frame.
+// coincident corners, on which CGAL's inside test (the flow's medial centering) finds no ray that
+// misses every edge. The flow contracts without the centering and every face gets a finite frame.
 TEST(Skeleton, DegenerateFacesDoNotStopTheFlow) {
   Mesh sheet;
   const int n = 20;

@@ -149,8 +149,8 @@ TEST(Topology, ShuffledFacesGiveTheSameComponentsOnAnyThreadCount) {
 
 // Chains of triangles that touch the next one at a vertex only: every face is its own edge
 // component and each chain one vertex component. Below and above the count of components up to
-// which the vertex pass runs on several slices, and with the chains' faces in reverse order (a
-// face's parent in the union-find then lies in another slice).
+// which the vertex pass runs on several slices, and with the chains' faces in reverse order (then
+// other component ids meet first in each slice of vertices).
 TEST(Topology, BowTieChainsJoinAcrossVertexSlices) {
   for (const uint32_t chain : {1000u, 70000u}) {
     for (const bool reversed : {false, true}) {

@@ -96,8 +96,6 @@ int run_map(const MapArgs& opt) {
   if (compression != MeshCompression::kNone && ext != ".glb")
     return report_error(usage_error("--compress needs a .glb output, got '" + opt.output + "'"));
   if (opt.up != "y" && opt.up != "z") return report_error(usage_error("--up must be y or z, got '" + opt.up + "'"));
-  if (opt.tile_size != 0 && opt.texels_per_unit != 0)
-    return report_error(usage_error("give --tile-size or --texels-per-unit, not both"));
   // Given, each must be a length or density (0 would mean "not given" and be ignored silently).
   if ((opt.tile_size_given && !(opt.tile_size > 0 && std::isfinite(opt.tile_size))) ||
       (opt.texels_per_unit_given && !(opt.texels_per_unit > 0 && std::isfinite(opt.texels_per_unit))))

@@ -1040,9 +1040,11 @@ def parse_args(argv):
     if args.up not in ("y", "z"):
         usage_error("--up must be y or z, got '%s'" % args.up)
     for name, value in (("--tile-size", args.tile_size), ("--texels-per-unit", args.texels_per_unit),
-                        ("--scale", args.scale), ("--max-stretch", args.max_stretch)):
+                        ("--scale", args.scale)):
         if value is not None and not (0 < value < math.inf):
             usage_error("%s must be a positive number, got %s" % (name, value))
+    if not (0.01 <= args.max_stretch <= 4):  # the library's range (MappingOptions::max_stretch)
+        usage_error("--max-stretch must be in 0.01..4, got %s" % args.max_stretch)
     if args.texture_size < 1:
         usage_error("--texture-size must be at least 1, got %d" % args.texture_size)
     if args.workers < 0:

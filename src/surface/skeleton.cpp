@@ -14,6 +14,7 @@
 #include "surface/skeleton.h"
 
 #include <CGAL/Mean_curvature_flow_skeletonization.h>
+#include <CGAL/Polygon_mesh_processing/measure.h>
 #include <CGAL/Polygon_mesh_processing/shape_predicates.h>
 #include <CGAL/Simple_cartesian.h>
 #include <CGAL/Surface_mesh.h>
@@ -23,6 +24,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <exception>
 
 namespace tailor::internal::skeleton_types {
@@ -57,11 +59,32 @@ using namespace skeleton_types;
 constexpr double kEdgeLengthFactor = 2.0;  // times the flow's shortest edge in CGAL's defaults (see below)
 constexpr size_t kFlowEdges = 300000;      // 200k faces; the horse (146k edges) goes in whole
 
-// Whether a face of `sm` has collinear or coincident corners (exact predicates).
-bool has_degenerate_face(const SurfaceMesh& sm) {
-  for (const auto f : faces(sm))
-    if (CGAL::Polygon_mesh_processing::is_degenerate_triangle_face(f, sm)) return true;
+// Whether a face of `mesh` has collinear or coincident corners (in doubles).
+template <class Mesh>
+bool has_degenerate_face(const Mesh& mesh) {
+  for (const auto f : faces(mesh))
+    if (CGAL::Polygon_mesh_processing::is_degenerate_triangle_face(f, mesh)) return true;
   return false;
+}
+
+// Skeletonization::contract_until_convergence, step by step (the same steps, areas and stopping
+// rule), with one check before each step: the medial centering asks CGAL's inside test for every
+// pole, and that test shoots random rays until one meets no edge or vertex of the mesh; on a mesh
+// with degenerate faces (collinear or coincident corners: a scan snapped to a grid, or faces the
+// contraction flattened) none ever does and the flow never ends. From such a step on the flow
+// contracts without the centering.
+void contract_until_convergence(Skeletonization& flow) {
+  const auto& meso = flow.meso_skeleton();
+  const double original_area = CGAL::Polygon_mesh_processing::area(meso);
+  double last_area = 0;
+  for (size_t iteration = 0;;) {
+    if (flow.is_medially_centered() && has_degenerate_face(meso)) flow.set_is_medially_centered(false);
+    flow.contract();
+    const double area = CGAL::Polygon_mesh_processing::area(meso);
+    if (std::abs(last_area - area) / original_area < flow.area_variation_factor()) break;
+    last_area = area;
+    if (++iteration >= flow.max_iterations()) break;
+  }
 }
 
 // Closes every border cycle of `sm` with a fan around its centroid; returns the number closed.
@@ -162,12 +185,7 @@ Status compute_curve_skeleton(const Mesh& mesh, const Topology& topology, CurveS
       // 0.05 halves the time but the horse's legs then get no skeleton of their own (the
       // skeleton test checks them).
       flow.set_min_edge_length(kEdgeLengthFactor * flow.min_edge_length());
-      // The medial centering asks CGAL's inside test for every pole, and that test shoots random
-      // rays until one meets no edge or vertex of the mesh: on a component with degenerate faces
-      // (collinear or coincident corners, e.g. a scan snapped to a grid) none ever does and the
-      // flow never ends. Such a component contracts without the centering.
-      if (has_degenerate_face(sm)) flow.set_is_medially_centered(false);
-      flow.contract_until_convergence();
+      contract_until_convergence(flow);
       flow.convert_to_skeleton(graph);
     } catch (const std::exception&) {
       ++skeleton.skipped_components;

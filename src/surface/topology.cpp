@@ -54,14 +54,6 @@ void match_group(const uint64_t* uses, size_t count, uint32_t* opposite, EdgeCou
   ++counts.edges;
 }
 
-uint32_t find_root(uint32_t* parent, uint32_t x) {
-  while (parent[x] != x) {
-    parent[x] = parent[parent[x]];  // path halving
-    x = parent[x];
-  }
-  return x;
-}
-
 }  // namespace
 
 Topology build_topology(const Mesh& mesh) { return build_topology(mesh, {}, 0); }
@@ -224,7 +216,7 @@ Topology build_topology(const Mesh& mesh, const ProgressCallback& progress, uint
             if (label == kInvalid) {
               label = here;
             } else if (label != here) {
-              const uint32_t a = find_root(own, label), b = find_root(own, here);
+              const uint32_t a = internal::find_root(own, label), b = internal::find_root(own, here);
               if (a != b) own[std::max(a, b)] = std::min(a, b);
             }
           }
@@ -233,11 +225,12 @@ Topology build_topology(const Mesh& mesh, const ProgressCallback& progress, uint
     uint32_t* const joined = parent[0].data();
     for (size_t s = 1; s < label_slices; ++s)
       for (uint32_t c = 0; c < t.edge_components; ++c) {
-        const uint32_t a = find_root(joined, c), b = find_root(joined, find_root(parent[s].data(), c));
+        const uint32_t a = internal::find_root(joined, c),
+                       b = internal::find_root(joined, internal::find_root(parent[s].data(), c));
         if (a != b) joined[std::max(a, b)] = std::min(a, b);
       }
     t.vertex_components = 0;
-    for (uint32_t c = 0; c < t.edge_components; ++c) t.vertex_components += find_root(joined, c) == c;
+    for (uint32_t c = 0; c < t.edge_components; ++c) t.vertex_components += internal::find_root(joined, c) == c;
   }
 
   t.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -282,8 +275,8 @@ size_t count_nonmanifold_vertices(const Mesh& mesh) {
         break;
       }
       if (end - g == 2) {
-        const uint32_t a = find_root(parent.data(), around[g].second);
-        const uint32_t b = find_root(parent.data(), around[g + 1].second);
+        const uint32_t a = internal::find_root(parent.data(), around[g].second);
+        const uint32_t b = internal::find_root(parent.data(), around[g + 1].second);
         if (a != b) {
           parent[a] = b;
           --fans;

@@ -274,10 +274,9 @@ void nearest_patch_costs(const BytePlane& source, const BytePlane& target, std::
   std::vector<uint64_t> filter((size_t{1} << kFilterBits) / 64, 0);
   auto bucket = [](uint64_t hv) { return static_cast<size_t>((hv * 0x9E3779B97F4A7C15ull) >> (64 - kFilterBits)); };
   for (const auto& entry : wanted) filter[bucket(entry.first) / 64] |= uint64_t{1} << (bucket(entry.first) % 64);
-  std::vector<uint8_t> found(count, 0);
   // The first entry of `wanted` from k on whose patch is not found yet: found entries point past
-  // themselves (paths halved on the way). A flat image has one hash for every patch: without the
-  // skip, each of its positions walked every found entry again (512 px: 24 s).
+  // themselves (paths halved on the way), so that a hash many patches share (a flat image: one
+  // hash for all of them) costs a walk over the unfound ones only, not over all at every position.
   std::vector<uint32_t> skip(count + 1);
   for (size_t k = 0; k <= count; ++k) skip[k] = static_cast<uint32_t>(k);
   auto unfound = [&skip](size_t k) {
@@ -322,7 +321,6 @@ void nearest_patch_costs(const BytePlane& source, const BytePlane& target, std::
         const int sx = ox + static_cast<int>(i % static_cast<size_t>(gx)) * stride;
         const int sy = oy + static_cast<int>(i / static_cast<size_t>(gx)) * stride;
         if (distance(sx, sy, u, v, 1.0f) == 0.0f) {
-          found[i] = 1;
           skip[k] = static_cast<uint32_t>(k + 1);
           nu[i] = u;
           nv[i] = v;

@@ -25,6 +25,12 @@
 
 namespace tailor::internal {
 
+//! The root of x in a union-find of `parent` links, with path halving.
+inline uint32_t find_root(uint32_t* parent, uint32_t x) {
+  while (parent[x] != x) x = parent[x] = parent[parent[x]];
+  return x;
+}
+
 //! Labels the components: `joined(x, wanted, visit)` calls visit(y) for every element y joined to x
 //! for which wanted(y) holds (both x's and y's calls must name each other; y == x is ignored); it
 //! asks wanted(y) first, so a costly test of the pair is skipped for the pairs the pass does not
@@ -36,10 +42,7 @@ uint32_t label_components(size_t n, size_t slices, const Joined& joined, uint32_
   HugeArray<uint32_t> parent_array = huge_uninitialized<uint32_t>(n);
   uint32_t* const parent = parent_array.get();
   const auto begin = [&](size_t s) { return static_cast<uint32_t>(n * s / slices); };
-  const auto find = [parent](uint32_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
+  const auto find = [parent](uint32_t x) { return find_root(parent, x); };
   for_each_chunk(
       slices, slices,
       [&](size_t s, size_t, size_t) {

@@ -451,8 +451,7 @@ def test_bounding_boxes_hold_the_content_as_a_client_places_it(tmp_path, up):
     # --up x: one line, bad usage.
     code, _, stderr = run_tiles(HORSE, "-o", tmp_path / "x", "--workers", 0, "--up", "x")
     assert code == 2 and stderr == "tailor.tiles: error: --up must be y or z, got 'x'\n"
-    # Densities and sizes that are not positive numbers: one line each, bad usage, nothing written
-    # (they reached the arithmetic before: a traceback).
+    # Densities and sizes that are not positive numbers: one line each, bad usage, nothing written.
     for option, value in (("--tile-size", 0), ("--tile-size", "nan"), ("--scale", 0), ("--texels-per-unit", -1)):
         code, _, stderr = run_tiles(HORSE, "-o", tmp_path / "bad", "--workers", 0, option, value)
         assert code == 2 and stderr.count("\n") == 1, stderr
