@@ -941,6 +941,16 @@ TEST(AxisChoice, ACoordinateAxisHalvesTheCadPartsSeams) {
   EXPECT_EQ(choose_orientation_axis(m.mesh, m.topology, cancel, choice).code(), ErrorCode::kCancelled);
 }
 
+// A surface without area is refused, as a map's metrics refuse it (every vertex at one point).
+TEST(Stability, ASurfaceWithoutAreaIsRefused) {
+  Mesh flat = load_test_mesh("fandisk.off");
+  for (size_t i = 0; i < flat.positions.size(); ++i) flat.positions[i] = static_cast<float>(i % 3);
+  StabilityReport report;
+  const Status s = measure_stability(flat, {}, report);
+  EXPECT_EQ(s.code(), ErrorCode::kInvalidMesh);
+  EXPECT_EQ(s.message(), "every face has zero 3D area");
+}
+
 TEST(Stability, RemovingTenPercentKeepsMostOfTheMapping) {
   const Mesh mesh = load_test_mesh("fandisk.off");
   // The thesis's experiment: both runs keep the full mesh's axis, normalisation and seed.
