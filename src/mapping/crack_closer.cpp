@@ -9,6 +9,7 @@
 
 #include "mapping/arap_kernels.h"
 #include "mapping/face_stretch.h"
+#include "util/union_find.h"
 
 namespace tailor::internal {
 namespace {
@@ -28,10 +29,7 @@ void CrackCloser::build_wedges() {
   const uint32_t corners = static_cast<uint32_t>(3 * in_.mesh.face_count());
   fresh(wedge_, corners, 0u);
   for (uint32_t c = 0; c < corners; ++c) wedge_[c] = c;
-  auto find = [this](uint32_t c) {
-    while (wedge_[c] != c) c = wedge_[c] = wedge_[wedge_[c]];
-    return c;
-  };
+  auto find = [this](uint32_t c) { return find_root(wedge_.data(), c); };
   for (uint32_t e = 0; e < corners; ++e) {
     const uint32_t o = opposite_[e];
     if (o == kInvalid || o < e) continue;

@@ -66,6 +66,7 @@
 #include "util/huge_pages.h"
 #include "util/parallel_chunks.h"
 #include "util/simd.h"
+#include "util/union_find.h"
 
 namespace tailor::internal {
 namespace {
@@ -139,10 +140,7 @@ class Relaxer {
     reserve_huge(id, corners);
     id.assign(corners, kFree);
     for (uint32_t c = 0; c < corners; ++c) root[c] = c;
-    const auto find = [&root](uint32_t c) {
-      while (root[c] != c) c = root[c] = root[root[c]];
-      return c;
-    };
+    const auto find = [&root](uint32_t c) { return find_root(root.get(), c); };
     for (uint32_t e = 0; e < corners; ++e) {
       const uint32_t o = opposite[e];
       if (o == kInvalid || o < e) continue;

@@ -16,6 +16,7 @@
 #include "util/face_components.h"
 #include "util/huge_pages.h"
 #include "util/parallel_chunks.h"
+#include "util/union_find.h"
 
 namespace tailor {
 namespace {
@@ -201,27 +202,22 @@ Topology build_topology(const Mesh& mesh, const ProgressCallback& progress, uint
     const size_t label_slices = t.edge_components <= kSlicedComponentLimit ? slices : 1;
     std::vector<std::vector<uint32_t>> parent(label_slices, std::vector<uint32_t>(t.edge_components));
     std::vector<uint32_t> vertex_label(vertex_count, kInvalid);
-    internal::for_each_chunk(
-        label_slices, label_slices,
-        [&](size_t s, size_t, size_t) {
-          const uint32_t lo = static_cast<uint32_t>(vertex_count * s / label_slices);
-          const uint32_t hi = static_cast<uint32_t>(vertex_count * (s + 1) / label_slices);
-          uint32_t* const own = parent[s].data();
-          for (uint32_t c = 0; c < t.edge_components; ++c) own[c] = c;
-          for (size_t c = 0; c < corner_count; ++c) {
-            const uint32_t v = indices[c];
-            if (v < lo || v >= hi) continue;
-            const uint32_t here = component[c / 3];
-            uint32_t& label = vertex_label[v];
-            if (label == kInvalid) {
-              label = here;
-            } else if (label != here) {
-              const uint32_t a = internal::find_root(own, label), b = internal::find_root(own, here);
-              if (a != b) own[std::max(a, b)] = std::min(a, b);
-            }
-          }
-        },
-        1);
+    internal::for_each_part(vertex_count, label_slices, [&](size_t s, size_t lo, size_t hi) {
+      uint32_t* const own = parent[s].data();
+      for (uint32_t c = 0; c < t.edge_components; ++c) own[c] = c;
+      for (size_t c = 0; c < corner_count; ++c) {
+        const uint32_t v = indices[c];
+        if (v < lo || v >= hi) continue;
+        const uint32_t here = component[c / 3];
+        uint32_t& label = vertex_label[v];
+        if (label == kInvalid) {
+          label = here;
+        } else if (label != here) {
+          const uint32_t a = internal::find_root(own, label), b = internal::find_root(own, here);
+          if (a != b) own[std::max(a, b)] = std::min(a, b);
+        }
+      }
+    });
     uint32_t* const joined = parent[0].data();
     for (size_t s = 1; s < label_slices; ++s)
       for (uint32_t c = 0; c < t.edge_components; ++c) {

@@ -22,6 +22,7 @@
 #include "tailor/image_ops.h"
 #include "tailor/tiling.h"
 #include "texture/tiling_util.h"
+#include "util/union_find.h"
 
 namespace tailor {
 
@@ -279,10 +280,7 @@ void nearest_patch_costs(const BytePlane& source, const BytePlane& target, std::
   // hash for all of them) costs a walk over the unfound ones only, not over all at every position.
   std::vector<uint32_t> skip(count + 1);
   for (size_t k = 0; k <= count; ++k) skip[k] = static_cast<uint32_t>(k);
-  auto unfound = [&skip](size_t k) {
-    while (skip[k] != k) k = skip[k] = skip[skip[k]];
-    return k;
-  };
+  auto unfound = [&skip](size_t k) { return size_t{internal::find_root(skip.data(), static_cast<uint32_t>(k))}; };
   std::vector<uint64_t> rows(static_cast<size_t>(kPatch + 1) * tx), column(static_cast<size_t>(tx), 0);
   auto row_hashes = [&](int y, uint64_t* out) {
     const uint8_t* r = target.at(0, y);

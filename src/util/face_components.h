@@ -22,14 +22,9 @@
 
 #include "util/huge_pages.h"
 #include "util/parallel_chunks.h"
+#include "util/union_find.h"
 
 namespace tailor::internal {
-
-//! The root of x in a union-find of `parent` links, with path halving.
-inline uint32_t find_root(uint32_t* parent, uint32_t x) {
-  while (parent[x] != x) x = parent[x] = parent[parent[x]];
-  return x;
-}
 
 //! Labels the components: `joined(x, wanted, visit)` calls visit(y) for every element y joined to x
 //! for which wanted(y) holds (both x's and y's calls must name each other; y == x is ignored); it
@@ -41,22 +36,18 @@ uint32_t label_components(size_t n, size_t slices, const Joined& joined, uint32_
   slices = std::clamp<size_t>(slices, 1, std::max<size_t>(n, 1));
   HugeArray<uint32_t> parent_array = huge_uninitialized<uint32_t>(n);
   uint32_t* const parent = parent_array.get();
-  const auto begin = [&](size_t s) { return static_cast<uint32_t>(n * s / slices); };
-  const auto find = [parent](uint32_t x) { return find_root(parent, x); };
-  for_each_chunk(
-      slices, slices,
-      [&](size_t s, size_t, size_t) {
-        const uint32_t lo = begin(s), hi = begin(s + 1);
-        for (uint32_t x = lo; x < hi; ++x) parent[x] = x;
-        for (uint32_t x = lo; x < hi; ++x)
-          joined(
-              x, [x, hi](uint32_t y) { return y > x && y < hi; },  // each pair inside the slice once
-              [&](uint32_t y) {
-                const uint32_t a = find(x), b = find(y);
-                if (a != b) parent[std::max(a, b)] = std::min(a, b);
-              });
-      },
-      1);
+  // Slice s is [n s / slices, n (s + 1) / slices), as for_each_part cuts it.
+  for_each_part(n, slices, [&](size_t, size_t begin, size_t end) {
+    const auto lo = static_cast<uint32_t>(begin), hi = static_cast<uint32_t>(end);
+    for (uint32_t x = lo; x < hi; ++x) parent[x] = x;
+    for (uint32_t x = lo; x < hi; ++x)
+      joined(
+          x, [x, hi](uint32_t y) { return y > x && y < hi; },  // each pair inside the slice once
+          [&](uint32_t y) {
+            const uint32_t a = find_root(parent, x), b = find_root(parent, y);
+            if (a != b) parent[std::max(a, b)] = std::min(a, b);
+          });
+  });
   const auto atomic_root = [parent](uint32_t x) {
     for (;;) {
       std::atomic_ref<uint32_t> at(parent[x]);
@@ -67,62 +58,51 @@ uint32_t label_components(size_t n, size_t slices, const Joined& joined, uint32_
       x = grand;
     }
   };
-  for_each_chunk(
-      slices - 1, slices - 1,
-      [&](size_t s, size_t, size_t) {
-        const uint32_t lo = begin(s), hi = begin(s + 1);
-        for (uint32_t x = lo; x < hi; ++x)
-          joined(
-              x, [hi](uint32_t y) { return y >= hi; },
-              [&](uint32_t y) {
-                for (uint32_t a = x, b = y;;) {
-                  a = atomic_root(a);
-                  b = atomic_root(b);
-                  if (a == b) return;
-                  if (a < b) std::swap(a, b);  // a, the higher root, goes under b
-                  uint32_t expected = a;
-                  if (std::atomic_ref<uint32_t>(parent[a]).compare_exchange_strong(expected, b,
-                                                                                   std::memory_order_acq_rel))
-                    return;
-                }
-              });
-      },
-      1);
+  // The pairs across slices, each from its lower slice's side (the last slice has none to give).
+  for_each_part(n, slices, [&](size_t s, size_t begin, size_t end) {
+    if (s + 1 == slices) return;
+    const auto hi = static_cast<uint32_t>(end);
+    for (auto x = static_cast<uint32_t>(begin); x < hi; ++x)
+      joined(
+          x, [hi](uint32_t y) { return y >= hi; },
+          [&](uint32_t y) {
+            for (uint32_t a = x, b = y;;) {
+              a = atomic_root(a);
+              b = atomic_root(b);
+              if (a == b) return;
+              if (a < b) std::swap(a, b);  // a, the higher root, goes under b
+              uint32_t expected = a;
+              if (std::atomic_ref<uint32_t>(parent[a]).compare_exchange_strong(expected, b, std::memory_order_acq_rel))
+                return;
+            }
+          });
+  });
   std::vector<uint32_t> roots_before(slices + 1, 0);
-  for_each_chunk(
-      slices, slices,
-      [&](size_t s, size_t, size_t) {
-        const uint32_t lo = begin(s), hi = begin(s + 1);
-        uint32_t roots = 0;
-        for (uint32_t x = lo; x < hi; ++x) {
-          uint32_t p = parent[x];
-          if (p == x) {
-            ++roots;
-          } else if (p >= lo) {
-            p = label[p];
-          } else {
-            while (parent[p] != p) p = parent[p];
-          }
-          label[x] = p;  // its root, for now
-        }
-        roots_before[s + 1] = roots;
-      },
-      1);
+  for_each_part(n, slices, [&](size_t s, size_t begin, size_t end) {
+    const auto lo = static_cast<uint32_t>(begin), hi = static_cast<uint32_t>(end);
+    uint32_t roots = 0;
+    for (uint32_t x = lo; x < hi; ++x) {
+      uint32_t p = parent[x];
+      if (p == x) {
+        ++roots;
+      } else if (p >= lo) {
+        p = label[p];
+      } else {
+        while (parent[p] != p) p = parent[p];
+      }
+      label[x] = p;  // its root, for now
+    }
+    roots_before[s + 1] = roots;
+  });
   for (size_t s = 0; s < slices; ++s) roots_before[s + 1] += roots_before[s];
-  for_each_chunk(
-      slices, slices,
-      [&](size_t s, size_t, size_t) {
-        uint32_t next = roots_before[s];
-        for (uint32_t x = begin(s); x < begin(s + 1); ++x)
-          if (label[x] == x) parent[x] = next++;  // the root's number, in its parent's place
-      },
-      1);
-  for_each_chunk(
-      slices, slices,
-      [&](size_t s, size_t, size_t) {
-        for (uint32_t x = begin(s); x < begin(s + 1); ++x) label[x] = parent[label[x]];
-      },
-      1);
+  for_each_part(n, slices, [&](size_t s, size_t begin, size_t end) {
+    uint32_t next = roots_before[s];
+    for (auto x = static_cast<uint32_t>(begin); x < end; ++x)
+      if (label[x] == x) parent[x] = next++;  // the root's number, in its parent's place
+  });
+  for_each_part(n, slices, [&](size_t, size_t begin, size_t end) {
+    for (size_t x = begin; x < end; ++x) label[x] = parent[label[x]];
+  });
   return roots_before[slices];
 }
 
