@@ -545,7 +545,7 @@ namespace {
 bool has_identical_positions(const Mesh& mesh, uint32_t threads) {
   const size_t nv = mesh.vertex_count();
   // Each thread keeps the vertices of its share of the hash values (a vertex and its twin hash
-  // alike), in a table of its own: every thread reads all positions, none writes another's table.
+  // alike), in a table of its own: none writes another's table.
   const size_t parts = internal::parallel_parts(nv, threads);
   auto bits = [](float x) { return std::bit_cast<uint32_t>(x + 0.0f); };
   auto hash = [&](size_t v) {
@@ -554,19 +554,27 @@ bool has_identical_positions(const Mesh& mesh, uint32_t threads) {
     h = (h ^ (h >> 29) ^ bits(p[2])) * 0xbf58476d1ce4e5b9ULL;
     return h ^ (h >> 32);
   };
+  // Each vertex's share, hashed once (parts <= 64 fit a byte), and each range's count per share.
+  std::vector<uint8_t> share_of(nv);
+  std::vector<size_t> count(parts * parts, 0);
+  internal::for_each_part(nv, parts, [&](size_t r, size_t begin, size_t end) {
+    for (size_t v = begin; v < end; ++v) {
+      share_of[v] = static_cast<uint8_t>((hash(v) >> 40) % parts);
+      ++count[r * parts + share_of[v]];
+    }
+  });
   std::vector<uint8_t> found(parts, 0);
   internal::for_each_part(nv, parts, [&](size_t t, size_t, size_t) {
     size_t share = 0;  // this thread's vertices: the table holds twice as many slots, never fills
-    for (size_t v = 0; v < nv; ++v) share += (hash(v) >> 40) % parts == t;
+    for (size_t r = 0; r < parts; ++r) share += count[r * parts + t];
     size_t table_size = 16;
     while (table_size < 2 * share) table_size *= 2;
     const size_t mask = table_size - 1;
     std::vector<uint32_t> table(table_size, kInvalid);
     for (size_t v = 0; v < nv; ++v) {
-      const uint64_t h = hash(v);
-      if ((h >> 40) % parts != t) continue;
+      if (share_of[v] != t) continue;
       const float* p = &mesh.positions[3 * v];
-      size_t slot = static_cast<size_t>(h) & mask;
+      size_t slot = static_cast<size_t>(hash(v)) & mask;
       for (; table[slot] != kInvalid; slot = (slot + 1) & mask) {
         const float* q = &mesh.positions[3 * size_t{table[slot]}];
         if (bits(q[0]) == bits(p[0]) && bits(q[1]) == bits(p[1]) && bits(q[2]) == bits(p[2])) {
