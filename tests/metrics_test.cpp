@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -495,6 +496,21 @@ TEST(Metrics, RejectsBadInput) {
   EXPECT_EQ(compute_uv_metrics(mesh, topology, nan_uv, {}, {}, m).code(), ErrorCode::kInvalidMesh);
   const std::vector<float> collapsed(uv.size(), 3.0f);
   EXPECT_EQ(compute_uv_metrics(mesh, topology, collapsed, {}, {}, m).code(), ErrorCode::kInvalidMesh);
+}
+
+// A file's UV that is finite but overflows when scaled to pixels (vt 1e38 at 512 px) is named as
+// such, at its corner, not as a UV that is not finite.
+TEST(Metrics, StoredUvTooLargeForPixelsIsNamed) {
+  const Mesh mesh = grid(1, 1, Diagonal::kFalling);
+  auto repeats = corner_uvs(mesh, [](float x, float y) { return std::pair{x, y}; });
+  repeats[2 * 4] = 1e38f;
+  UvMetrics m;
+  const Status s = compute_stored_uv_metrics(mesh, nullptr, repeats, MetricsOptions{}, m);
+  EXPECT_EQ(s.code(), ErrorCode::kInvalidMesh);
+  EXPECT_EQ(s.what(), "UV is too large to scale to the texture's pixels");
+  EXPECT_EQ(s.where(), "corner 4");
+  repeats[2 * 4] = std::numeric_limits<float>::infinity();
+  EXPECT_EQ(compute_stored_uv_metrics(mesh, nullptr, repeats, MetricsOptions{}, m).what(), "UV is not finite");
 }
 
 }  // namespace

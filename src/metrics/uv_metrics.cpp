@@ -604,8 +604,12 @@ Status compute_stored_uv_metrics(const Mesh& mesh, const Topology* topology, std
   // Repeats -> pixels in place (the float product, as a reader of the file scales them).
   const float width = options.texture_width_px, height = options.texture_height_px;
   for (size_t i = 0; i < corner_uv.size(); i += 2) {
+    const bool finite = std::isfinite(corner_uv[i]) && std::isfinite(corner_uv[i + 1]);
     corner_uv[i] *= width;
     corner_uv[i + 1] *= height;
+    if (finite && !(std::isfinite(corner_uv[i]) && std::isfinite(corner_uv[i + 1])))
+      return Status::error(ErrorCode::kInvalidMesh, "", "UV is too large to scale to the texture's pixels",
+                           "corner " + std::to_string(i / 2));
   }
   return internal::compute_stored_uv_metrics_px(mesh, topology, corner_uv, options, metrics, surface);
 }
