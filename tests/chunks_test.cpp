@@ -396,6 +396,13 @@ TEST(ChunkedMapping, CancelsAndRefusesWhatNeedsTheWholeMesh) {
   ASSERT_TRUE(map_texture(mesh, topology, skeleton, map).is_ok());
   EXPECT_EQ(map.stats.chunks, 0u);
   EXPECT_EQ(map.atlas.corner_uv.size(), 6 * mesh.face_count());
+  // A cell the texel density fills with more pixels than the mapping's scale takes (2^40 units at
+  // the fandisk's density): refused with the figure, the cell and what to change, nothing mapped.
+  const Status huge = map_texture(mesh, topology, chunked(40), map);
+  EXPECT_EQ(huge.code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(huge.what().find("pixels per chunk cell of side 2^40 units, outside 0.001 to 1e7"), std::string::npos)
+      << huge.what();
+  EXPECT_NE(huge.what().find("or map without chunks"), std::string::npos) << huge.what();
 }
 
 // The faces of `result` as a mesh of their own (vertices renumbered, in another order than the

@@ -10,7 +10,9 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -68,13 +70,28 @@ MapTextureOptions chunk_map_options(const MapTextureOptions& options, const std:
   return o;
 }
 
+namespace {
+
+// A chunk is mapped in its cell's frame at texels_per_unit * size pixels per cell side, which the
+// mapping takes within 0.001..1e7 (its scale's range). Out of range says what a user can change;
+// the cell's exponent is -60..60, so a mesh far from unit scale may need no chunks at all.
+Status check_chunk_scale(double texels_per_unit, double size) {
+  const double chunk_scale = texels_per_unit * size;
+  if (chunk_scale >= 1e-3 && chunk_scale <= 1e7) return Status::ok();
+  char figures[96];
+  std::snprintf(figures, sizeof figures, "%.3g pixels per chunk cell of side 2^%d units", chunk_scale,
+                std::ilogb(size));
+  return Status::error(ErrorCode::kInvalidArgument, "",
+                       std::string("the texel density gives ") + figures +
+                           ", outside 0.001 to 1e7: give another chunk cell (2^-60 to 2^60) or texel density, "
+                           "or map without chunks");
+}
+
+}  // namespace
+
 Status map_chunk(const MapTextureOptions& options, const std::array<double, 3>& origin, double size,
                  double texels_per_unit, uint32_t threads, ProgressCallback progress, ChunkWorker& w) {
-  const double chunk_scale = texels_per_unit * size;
-  if (!(chunk_scale >= 1e-3 && chunk_scale <= 1e7))
-    return Status::error(ErrorCode::kInvalidArgument, "",
-                         "the texel density gives " + std::to_string(chunk_scale) +
-                             " pixels per chunk cell, outside 0.001 to 1e7: give another chunk cell or scale");
+  TAILOR_RETURN_IF_ERROR(check_chunk_scale(texels_per_unit, size));
   const Topology topology = build_topology(w.mesh, {}, threads);
   MapTextureOptions o = chunk_map_options(options, origin, size, texels_per_unit);
   o.mapping.progress = std::move(progress);
@@ -196,10 +213,7 @@ Status map_chunks(const Mesh& mesh, const MapTextureOptions& options, TextureMap
   ChunkPlan plan;
   TAILOR_RETURN_IF_ERROR(plan_chunks(mesh, options.chunks, plan, options.mapping.threads));
   const double texels_per_unit = chunk_texels_per_unit(mesh, options);
-  if (const double chunk_scale = texels_per_unit * plan.cell_size; !(chunk_scale >= 1e-3 && chunk_scale <= 1e7))
-    return Status::error(ErrorCode::kInvalidArgument, "",
-                         "the texel density gives " + std::to_string(chunk_scale) +
-                             " pixels per chunk cell, outside 0.001 to 1e7: give another chunk cell or scale");
+  TAILOR_RETURN_IF_ERROR(check_chunk_scale(texels_per_unit, plan.cell_size));
 
   const size_t chunks = plan.chunk_count();
   const size_t cores = std::max<size_t>(std::thread::hardware_concurrency(), 1);
