@@ -138,6 +138,9 @@ def read_layout(path):
             break
     need = max(vertex[1] + vertex[0] * vertex[2].itemsize, face[1] + face[0] * face[2].itemsize)
     if need > size:
+        polygon = _first_polygon(path, face, size)
+        if polygon is not None:  # a face of fewer corners shortened the file: that face is the error
+            raise StreamError(_NOT_TRIANGLE % ((path,) + polygon))
         raise StreamError(
             "%s: truncated: the header's counts (%d vertices, %d triangles) need %d bytes, the file has %d"
             % (path, vertex[0], face[0], need, size)
@@ -149,6 +152,25 @@ def read_layout(path):
     if int(first["n"][0]) != 3:
         return None  # polygons: tailor.load triangulates them
     return layout
+
+
+_NOT_TRIANGLE = "%s: face %d has %d vertices: a binary PLY is streamed as triangles only"
+
+
+def _first_polygon(path, face, size):
+    """(face, vertex count) of the first face record, read as triangles, whose count is not 3 among
+    those the file's size holds; None when all are triangles. Blocks of BLOCK_FACES records."""
+    count, offset, dtype = face
+    fit = min(count, max(0, size - offset) // dtype.itemsize)
+    with open(path, "rb") as f, mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) as m:
+        for first in range(0, fit, BLOCK_FACES):
+            records = np.frombuffer(m, dtype=dtype, count=min(BLOCK_FACES, fit - first), offset=offset + first * dtype.itemsize)
+            n = records["n"].copy()  # a copy: no view of the map outlives it
+            del records
+            bad = np.flatnonzero(n != 3)
+            if bad.size:
+                return first + int(bad[0]), int(n[bad[0]])
+    return None
 
 
 def _read(path, offset, count):
@@ -216,10 +238,7 @@ class _Body:
             bad = np.flatnonzero(records["n"] != 3)
             if bad.size:
                 f = first + int(bad[0])
-                raise StreamError(
-                    "%s: face %d has %d vertices: a binary PLY is streamed as triangles only"
-                    % (layout.path, f, int(records["n"][bad[0]]))
-                )
+                raise StreamError(_NOT_TRIANGLE % (layout.path, f, int(records["n"][bad[0]])))
             ids = records["i"].astype(np.int64)
             del records
             out = (ids < 0) | (ids >= nv)

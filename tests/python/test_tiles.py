@@ -760,10 +760,18 @@ def test_a_bad_streamed_ply_is_one_line_and_leaves_nothing(tmp_path):
     bad_index[900, 1] = positions.shape[0] + 5
     counts = np.full(faces.shape[0], 3)
     counts[1000] = 4
+    # A face of two corners makes the file shorter than its header's triangles need: named, not
+    # reported as a truncated file.
+    short = np.full(faces.shape[0], 3)
+    short[2000] = 2
     cases = {
         "truncated": (write_layout_ply(tmp_path / "truncated.ply", positions, faces, cut=100, **props), "truncated"),
         "index": (write_layout_ply(tmp_path / "index.ply", positions, bad_index, **props), "out of range"),
         "quad": (write_layout_ply(tmp_path / "quad.ply", positions, faces, counts=counts, **props), "has 4 vertices"),
+        "segment": (
+            write_layout_ply(tmp_path / "segment.ply", positions, faces, counts=short, **props),
+            "face 2000 has 2 vertices",
+        ),
         "count": (
             write_layout_ply(tmp_path / "count.ply", positions, faces, header_faces=faces.shape[0] + 10, **props),
             "truncated",
