@@ -673,10 +673,6 @@ def start_client(args):
             "distributed.admin.tick.interval": "1s",
             "distributed.admin.system-monitor.interval": "2s",
             "distributed.worker.memory.monitor-interval": "1s",
-            # Worker processes forked from one server that has imported Dask and numpy once, rather
-            # than each a fresh interpreter importing them (about a second of CPU each): the workers
-            # start while the driver cuts the mesh, on the same cores.
-            "distributed.worker.multiprocessing-method": "forkserver",
         }
     )
     cluster = LocalCluster(
