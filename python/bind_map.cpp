@@ -408,6 +408,13 @@ void bind_map(py::module_& m) {
       py::arg("smooth") = OrientationOptions{}.smooth_passes, py::arg("material") = py::none(),
       py::arg("chunks") = "auto", py::arg("chunk_cell") = py::none(), py::arg("chunk_split") = py::none(),
       map_docstring().c_str());
+  // The same defaults by name, for what takes map()'s options another way (tailor.tiles' flags).
+  py::dict defaults;
+  defaults["texture_size"] = ExportOptions{}.texture_width;
+  defaults["scale"] = md.scale;
+  defaults["max_stretch"] = md.max_stretch;
+  defaults["crack_rings"] = md.crack_rings;
+  m.attr("MAP_DEFAULTS") = defaults;
 
   m.def(
       "auto_field_following",

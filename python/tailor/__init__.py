@@ -12,6 +12,7 @@ with the message the tailor command prints. See docs/python.md; `python3 -m tail
 large mesh as 3D Tiles on a Dask cluster (docs/scale.md).
 """
 from ._tailor import (
+    MAP_DEFAULTS,
     ChunkedMapper,
     Error,
     Mesh,
@@ -36,6 +37,7 @@ from ._tailor import (
 )
 
 __all__ = [
+    "MAP_DEFAULTS",
     "ChunkedMapper",
     "Error",
     "Mesh",

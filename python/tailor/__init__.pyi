@@ -6,6 +6,8 @@ import numpy as np
 import numpy.typing as npt
 
 __version__: str
+# map()'s defaults of texture_size, scale, max_stretch and crack_rings (the library's, by name).
+MAP_DEFAULTS: Dict[str, Union[int, float]]
 
 _Path = Union[str, os.PathLike[str]]
 _Progress = Callable[[float], Optional[bool]]

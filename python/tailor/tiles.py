@@ -1006,8 +1006,13 @@ def parse_args(argv):
         help="up axis of the mesh's coordinates, as tailor map --up: z (scans, CAD) gives each .glb a node rotation "
         "that turns it Y up, so the tileset's Z up is the mesh's own (default y)",
     )
-    p.add_argument("--texture-size", type=int, default=512, help="pixels of one repeat without --texture")
-    p.add_argument("--scale", type=float, default=800.0, help="as tailor map --scale (density from the bounding box)")
+    defaults = tailor.MAP_DEFAULTS  # the library's, as tailor map and tailor.map take them
+    p.add_argument(
+        "--texture-size", type=int, default=defaults["texture_size"], help="pixels of one repeat without --texture"
+    )
+    p.add_argument(
+        "--scale", type=float, default=defaults["scale"], help="as tailor map --scale (density from the bounding box)"
+    )
     p.add_argument(
         "--texels-per-unit",
         type=float,
@@ -1020,8 +1025,10 @@ def parse_args(argv):
         default="auto",
         help="as tailor map: 0..1, or auto (default: 0 with 32 crack rings for a texture without a direction, else 1)",
     )
-    p.add_argument("--max-stretch", type=float, default=0.25, help="as tailor map")
-    p.add_argument("--crack-rings", type=int, default=None, help="as tailor map (default 16)")
+    p.add_argument("--max-stretch", type=float, default=defaults["max_stretch"], help="as tailor map")
+    p.add_argument(
+        "--crack-rings", type=int, default=None, help="as tailor map (default %d)" % defaults["crack_rings"]
+    )
     p.add_argument(
         "--no-lod",
         dest="lod",

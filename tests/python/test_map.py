@@ -241,3 +241,19 @@ def test_auto_field_following_is_what_map_picks_for_a_texture():
         assert np.array_equal(auto.corner_uvs, given.corner_uvs)
     with pytest.raises(tailor.Error, match="cannot open"):
         tailor.auto_field_following(DATA / "textures" / "missing.png")
+
+
+def test_map_defaults_are_the_signature_and_the_tiles_flags():
+    # tailor.MAP_DEFAULTS: the library's defaults by name, as map() shows them and tailor.tiles takes them.
+    signature = tailor.map.__doc__.splitlines()[0]
+    for name in ("texture_size", "scale", "max_stretch"):
+        assert "%s: " % name in signature
+        shown = signature.split("%s: " % name, 1)[1].split(",", 1)[0].split(" = ", 1)[1]
+        assert float(shown) == pytest.approx(tailor.MAP_DEFAULTS[name], rel=1e-6), name
+    assert tailor.MAP_DEFAULTS["crack_rings"] == 16  # map(crack_rings=None)'s documented value
+    from tailor import tiles
+
+    args = tiles.parse_args(["in.ply", "-o", "out"])
+    assert args.texture_size == tailor.MAP_DEFAULTS["texture_size"]
+    assert args.scale == tailor.MAP_DEFAULTS["scale"]
+    assert args.max_stretch == tailor.MAP_DEFAULTS["max_stretch"]

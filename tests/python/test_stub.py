@@ -15,7 +15,8 @@ def test_stub_names_match_the_module():
     tree = stub_tree()
     functions = {n.name for n in tree.body if isinstance(n, ast.FunctionDef)}
     classes = {n.name: n for n in tree.body if isinstance(n, ast.ClassDef)}
-    assert functions | set(classes) | {"__version__"} == set(tailor.__all__)
+    variables = {n.target.id for n in tree.body if isinstance(n, ast.AnnAssign)}
+    assert functions | set(classes) | variables == set(tailor.__all__)
     for name, node in classes.items():
         members = {n.name for n in node.body if isinstance(n, ast.FunctionDef)} - {"__init__"}
         members |= {n.target.id for n in node.body if isinstance(n, ast.AnnAssign)}
@@ -27,7 +28,7 @@ def test_stub_names_match_the_module():
 
 def test_every_public_name_has_a_docstring():
     for name in tailor.__all__:
-        if name != "__version__":
+        if name not in ("__version__", "MAP_DEFAULTS"):
             assert getattr(tailor, name).__doc__, name
     for prop in ("positions", "faces", "corner_uvs"):
         assert getattr(tailor.Mesh, prop).__doc__
