@@ -202,6 +202,24 @@ TEST(GltfScene, BadHierarchiesFailWithOneLine) {
   EXPECT_TRUE(mesh.empty());
 }
 
+// A node's extras nested 100,000 levels deep (a 200 KB file) is refused in one line; copying or
+// printing such a value recursed once per level and overflowed the stack. 200 levels load.
+TEST(GltfScene, JsonNestedTooDeepIsOneLineNotACrash) {
+  const Builder b = one_triangle({{{"mesh", 0}, {"extras", "X"}}}, {{{"nodes", {0}}}});
+  const auto nested = [&b](size_t levels) {
+    std::string text = b.gltf();
+    const size_t at = text.find("\"X\"");
+    return text.replace(at, 3, std::string(levels, '[') + std::string(levels, ']'));
+  };
+  Mesh mesh;
+  const Status deep = read(nested(100000), mesh);
+  EXPECT_EQ(deep.code(), ErrorCode::kParse);
+  EXPECT_NE(deep.message().find("JSON nested more than 256 levels deep"), std::string::npos) << deep.message();
+  EXPECT_TRUE(mesh.empty());
+  EXPECT_TRUE(read(nested(200), mesh).is_ok());
+  EXPECT_EQ(mesh.face_count(), 1u);
+}
+
 TEST(GltfScene, StripsAndFansBecomeTriangles) {
   // A 4 x 1 strip of quads as a triangle strip (10 vertices, 8 triangles) and a fan of 6
   // triangles around the origin; every face must come out, counter-clockwise from +z.

@@ -960,6 +960,12 @@ TEST(Strokes, BadJsonNamesWhereAndLeavesNothing) {
             std::string::npos);
   EXPECT_NE(message(R"({"strokes": [{"points": [[0,0,0],[1,1,1]], "radius": 1, "x": 2}]})").find("unknown key"),
             std::string::npos);
+  // A number past a double's range, and a nesting too deep to copy safely: one line each.
+  EXPECT_NE(message(R"({"strokes": [{"points": [[0,0,0],[1,1,1e400]], "radius": 1}]})").find("number out of range"),
+            std::string::npos);
+  EXPECT_NE(message("{\"strokes\": " + std::string(100000, '[') + std::string(100000, ']') + "}")
+                .find("nested more than 256 levels deep"),
+            std::string::npos);
   EXPECT_EQ(load_strokes(test::temp_path("no_such_strokes.json"), back).code(), ErrorCode::kIo);
 }
 

@@ -475,6 +475,11 @@ TEST_F(MaterialTest, BadMaterialsFailWithOneLineAndNoOutput) {
   // An unreadable map.
   std::ofstream(empty + "/x_normal.png") << "not a png";
   expect_error(empty, "x_normal.png", 1);
+  // A material JSON nested too deep to copy or print safely (its "symmetry" quoted in an error).
+  const std::string deep = dir_ + "/deep.json";
+  std::ofstream(deep) << "{\"color\": \"a.png\", \"symmetry\": " << std::string(100000, '[') << std::string(100000, ']')
+                      << "}";
+  expect_error(deep, "JSON nested more than 256 levels deep");
 }
 
 }  // namespace

@@ -454,15 +454,16 @@ void register_map(CLI::App& app, Runner& run) {
       ->required();
   cmd->add_option("-t,--texture", opt->texture,
                   "Texture image (PNG/JPEG), ideally self-tileable (see 'tailor tile'); sets the texture size");
-  cmd->add_option("--material", opt->material,
-                  "PBR material instead of --texture (.glb output): a folder whose maps are recognised by name "
-                  "(NAME_color/albedo/basecolor/diffuse, _normal/_nor/_nrm with _gl or _dx, _roughness/_rough, "
-                  "_metallic/_metalness, _ao/_occlusion, _height/_disp), or a JSON naming them ({\"color\": "
-                  "\"a.png\", \"normal\": \"b.png\", ...}, or OUTDIR/material.json of 'tailor tile --set'). "
-                  "The colour map sets the texture size; all maps must share it. The .glb gets baseColor, normal "
-                  "(+ per-vertex tangents; a DX map's green is flipped), metallicRoughness (G roughness, B "
-                  "metallic) and occlusion (R); height is not a glTF map and is left out. The quarter-turn tiles "
-                  "of 'tailor tile --set --symmetry 4' are mapped with --symmetry 4 unless --symmetry says otherwise");
+  cmd->add_option(
+      "--material", opt->material,
+      "PBR material instead of --texture (.glb output): a folder whose maps are recognised by name "
+      "(NAME_color/albedo/basecolor/diffuse, _normal/_nor/_nrm, the first two with _gl or _dx, _roughness/_rough, "
+      "_metallic/_metalness, _ao/_occlusion, _height/_disp), or a JSON naming them ({\"color\": "
+      "\"a.png\", \"normal\": \"b.png\", ...}, or OUTDIR/material.json of 'tailor tile --set'). "
+      "The colour map sets the texture size; all maps must share it. The .glb gets baseColor, normal "
+      "(+ per-vertex tangents; a DX map's green is flipped), metallicRoughness (G roughness, B "
+      "metallic) and occlusion (R); height is not a glTF map and is left out. The quarter-turn tiles "
+      "of 'tailor tile --set --symmetry 4' are mapped with --symmetry 4 unless --symmetry says otherwise");
   cmd->add_option("--texture-size", opt->mapping_args.texture_size, "Texture size in pixels when no --texture is given")
       ->capture_default_str();
   add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), opt->image_options.max_pixels)
@@ -503,8 +504,8 @@ void register_map(CLI::App& app, Runner& run) {
       "  tailor tile gravel.png -o gravel_tile.png\n"
       "  tailor map bunny.ply --texture gravel_tile.png -o bunny.glb --stats bunny.json --preview bunny.png\n"
       "  tailor map bunny.ply --material bricks/ -o bunny.glb   # bricks/bricks_color.png, _normal.png, ...\n"
-      "Prints one summary line: faces, patches, seam length, flipped faces, stretch, Sander L2/Linf,\n"
-      "median angle distortion, seam gap, and the time of each stage.\n"
+      "Prints one summary line: faces, patches, repeats across the mesh, seam length, flipped faces, stretch,\n"
+      "Sander L2/Linf, median angle distortion, visible seams, the time of each stage and the peak memory.\n"
       "Trade-offs: --no-crack-closing maps 3-10x faster and keeps more UVs bit-identical when parts of\n"
       "the mesh change, with about twice the seam length. --field-following auto (the default) maps a\n"
       "texture without a direction (gravel, grass; its isotropy is in the --stats) with rigid unfolding\n"

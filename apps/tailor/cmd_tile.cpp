@@ -18,6 +18,7 @@
 #include "tailor/report.h"
 #include "tailor/tiling.h"
 #include "util/atomic_file.h"
+#include "util/bounded_json.h"
 
 namespace tailor::cli {
 namespace {
@@ -201,7 +202,9 @@ Status read_material(TileCliOptions& opt) {
   if (!in) return Status::error(ErrorCode::kIo, opt.material, "cannot open the material description");
   std::stringstream text;
   text << in.rdbuf();
-  const nlohmann::json j = nlohmann::json::parse(text.str(), nullptr, false);
+  nlohmann::json j;
+  if (const auto parsed = internal::parse_json_bounded(text.str(), j); parsed == internal::JsonParse::kTooDeep)
+    return Status::error(ErrorCode::kInvalidArgument, opt.material, internal::json_problem(parsed));
   if (j.is_discarded() || !j.is_object() || !j.contains("maps") || !j["maps"].is_array() || j["maps"].empty())
     return Status::error(ErrorCode::kInvalidArgument, opt.material,
                          "not a material description (expected {\"maps\": [{\"file\": ...}, ...]})");

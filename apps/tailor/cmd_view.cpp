@@ -16,6 +16,7 @@
 #include "cli.h"
 #include "http_server.h"
 #include "tailor/image.h"
+#include "util/bounded_json.h"
 
 namespace tailor::cli {
 namespace {
@@ -67,7 +68,9 @@ Status add_texture(const std::string& path, std::vector<Route>& routes, nlohmann
   }
   std::ifstream in(path);
   if (!in) return Status::error(ErrorCode::kIo, path, "cannot open file");
-  nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+  nlohmann::json j;
+  if (const auto parsed = internal::parse_json_bounded(in, j); parsed == internal::JsonParse::kTooDeep)
+    return Status::error(ErrorCode::kParse, path, internal::json_problem(parsed));
   if (j.is_discarded() || !j.is_object()) return Status::error(ErrorCode::kParse, path, "not a JSON object");
   if (!j.contains("files") || !j["files"].is_array() || j["files"].empty()) {
     return Status::error(ErrorCode::kParse, path, "no \"files\" list of tile variants");
@@ -102,7 +105,9 @@ Status add_tileset(const std::string& path, std::vector<Route>& routes, nlohmann
   namespace fs = std::filesystem;
   std::ifstream in(path);
   if (!in) return Status::error(ErrorCode::kIo, path, "cannot open file");
-  const nlohmann::json tileset = nlohmann::json::parse(in, nullptr, false);
+  nlohmann::json tileset;
+  if (const auto parsed = internal::parse_json_bounded(in, tileset); parsed == internal::JsonParse::kTooDeep)
+    return Status::error(ErrorCode::kParse, path, internal::json_problem(parsed));
   if (tileset.is_discarded() || !tileset.is_object() || !tileset.contains("asset") || !tileset.contains("root"))
     return Status::error(ErrorCode::kParse, path, "not a 3D Tiles tileset", "no \"asset\" and \"root\"");
   const fs::path folder = fs::path(path).has_parent_path() ? fs::path(path).parent_path() : fs::path(".");

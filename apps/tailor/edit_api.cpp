@@ -17,6 +17,7 @@
 #include "tailor/mapping.h"
 #include "tailor/texture_direction.h"
 #include "util/atomic_file.h"
+#include "util/bounded_json.h"
 
 namespace tailor::cli {
 namespace {
@@ -286,7 +287,9 @@ void EditApi::install(StaticServer& server) {
 }
 
 HttpResponse EditApi::edit(const HttpRequest& request) {
-  const json j = json::parse(request.body, nullptr, false);
+  json j;
+  if (const auto parsed = internal::parse_json_bounded(request.body, j); parsed == internal::JsonParse::kTooDeep)
+    return HttpResponse::error(400, "the body is " + internal::json_problem(parsed));
   if (j.is_discarded()) return HttpResponse::error(400, "the body is not JSON");
   if (!j.is_object()) return HttpResponse::error(400, "the body must be a JSON object");
   EditRequest edit;

@@ -9,6 +9,7 @@
 
 #include "tailor/material.h"
 #include "util/atomic_file.h"
+#include "util/bounded_json.h"
 
 namespace tailor {
 namespace {
@@ -89,13 +90,15 @@ MaterialRole material_role_from_name(const std::string& file_name, bool* directx
 
 namespace {
 
-//! The JSON in the file at `path` (discarded when it does not parse); false when it cannot be opened.
-bool read_json(const std::string& path, nlohmann::json& out) {
+//! The JSON in the file at `path` (discarded when it does not parse or nests too deep, which
+//! `result` then says); false when it cannot be opened.
+bool read_json(const std::string& path, nlohmann::json& out, internal::JsonParse* result = nullptr) {
   std::ifstream in(path);
   if (!in) return false;
   std::stringstream text;
   text << in.rdbuf();
-  out = nlohmann::json::parse(text.str(), nullptr, false);
+  const internal::JsonParse parsed = internal::parse_json_bounded(text.str(), out);
+  if (result) *result = parsed;
   return true;
 }
 
@@ -105,7 +108,8 @@ Status read_symmetry(const nlohmann::json& j, const std::string& file, int& symm
   if (!j.contains("symmetry")) return Status::ok();
   const nlohmann::json& value = j["symmetry"];
   if (!value.is_number_integer() || (value.get<int>() != 1 && value.get<int>() != 4))
-    return Status::error(ErrorCode::kInvalidArgument, file, "\"symmetry\" must be 1 or 4", value.dump());
+    return Status::error(ErrorCode::kInvalidArgument, file, "\"symmetry\" must be 1 or 4",
+                         value.is_primitive() ? value.dump().substr(0, 40) : std::string(value.type_name()));
   symmetry = value.get<int>();
   return Status::ok();
 }
@@ -149,8 +153,11 @@ Status load_material(const std::string& dir_or_json, MaterialMaps& out, const Im
     }
   } else {
     nlohmann::json j;
-    if (!read_json(dir_or_json, j))
+    internal::JsonParse parsed = internal::JsonParse::kOk;
+    if (!read_json(dir_or_json, j, &parsed))
       return Status::error(ErrorCode::kIo, dir_or_json, "cannot open the material (a folder of maps or a JSON)");
+    if (parsed == internal::JsonParse::kTooDeep)
+      return Status::error(ErrorCode::kInvalidArgument, dir_or_json, internal::json_problem(parsed));
     if (j.is_discarded() || !j.is_object())
       return Status::error(
           ErrorCode::kInvalidArgument, dir_or_json,

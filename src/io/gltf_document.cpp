@@ -10,6 +10,7 @@
 #include <type_traits>
 
 #include "util/atomic_file.h"
+#include "util/bounded_json.h"
 #include "util/text_scan.h"
 
 namespace tailor::internal {
@@ -218,7 +219,8 @@ Status GltfDocument::open(std::span<const char> data, const std::string& name, c
   } else {
     json_text = {bytes, data.size()};
   }
-  json_ = Json::parse(json_text.begin(), json_text.end(), nullptr, /*allow_exceptions=*/false);
+  if (internal::parse_json_bounded(json_text.begin(), json_text.end(), json_) == internal::JsonParse::kTooDeep)
+    return parse_error(internal::json_problem(internal::JsonParse::kTooDeep));
   if (json_.is_discarded() || !json_.is_object())
     return parse_error(binary_ ? "JSON chunk is not a valid JSON object" : "not a glTF file (not a JSON object)");
   const auto asset = json_.find("asset");
