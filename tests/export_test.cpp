@@ -465,6 +465,16 @@ TEST_F(ExportTest, TextureCopyBesideTheOutputNeverReplacesAnotherFile) {
   ASSERT_TRUE(export_mesh(path("out/e.obj"), cube_, cube_atlas_, options).is_ok());
   EXPECT_NE(read_all(path("out/e.mtl")).find("map_Kd plain.png\n"), std::string::npos);
   EXPECT_FALSE(fs::exists(path("out/plain-2.png")));
+  // A name another output of the run takes (a preview or stats file, not written yet) is skipped
+  // as a file already there is: the copy written now would be replaced by it afterwards.
+  fs::create_directories(dir_ / "fresh");
+  options.texture_path = kTexture;
+  options.other_outputs = {path("fresh/vistex-tile04-128.png"), path("elsewhere/vistex-tile04-128-2.png")};
+  ASSERT_TRUE(export_mesh(path("fresh/f.obj"), cube_, cube_atlas_, options).is_ok());
+  EXPECT_NE(read_all(path("fresh/f.mtl")).find("map_Kd vistex-tile04-128-2.png\n"), std::string::npos);
+  ASSERT_TRUE(export_mesh(path("fresh/g.ply"), cube_, cube_atlas_, options).is_ok());
+  EXPECT_NE(read_all(path("fresh/g.ply")).find("comment TextureFile vistex-tile04-128-2.png\n"), std::string::npos);
+  EXPECT_FALSE(fs::exists(path("fresh/vistex-tile04-128.png")));
   EXPECT_EQ(temporaries(), 0u);
 }
 

@@ -325,14 +325,16 @@ int run_map(const MapArgs& opt) {
   // Staged together: they land only when all of them were written (nothing on a late failure).
   internal::FileBatch batch;
   const auto export_start = std::chrono::steady_clock::now();
-  const MeshOutput output{texture_path,
-                          std::move(material.textures),
-                          tex_w,
-                          tex_h,
-                          compression,
-                          opt.uv_set,
-                          opt.up == "z" ? SceneUp::kZ : SceneUp::kY,
-                          mapping.symmetry};
+  MeshOutput output{texture_path,
+                    std::move(material.textures),
+                    tex_w,
+                    tex_h,
+                    compression,
+                    opt.uv_set,
+                    opt.up == "z" ? SceneUp::kZ : SceneUp::kY,
+                    mapping.symmetry,
+                    {}};
+  for (const OutputPath& other : output_paths(opt)) output.other_outputs.push_back(other.path);
   Progress exporting("export", opt.quiet);
   if (Status s =
           write_mapped_mesh(opt.output, mesh, atlas, output, [&exporting](float f) { return exporting.update(f); });

@@ -134,6 +134,7 @@ Status write_mapped_mesh(const std::string& path, const Mesh& mesh, const Atlas&
   export_options.uv_set = output.uv_set;
   export_options.up = output.up;
   export_options.symmetry = output.symmetry;
+  export_options.other_outputs = output.other_outputs;
   export_options.progress = progress;
   return export_mesh(path, mesh, atlas, export_options);
 }

@@ -76,6 +76,7 @@ struct MeshOutput {
   int uv_set = 0;
   SceneUp up = SceneUp::kY;
   uint32_t symmetry = 1;  //!< the map's (MappingOptions::symmetry): 4 is recorded in the .glb (ExportOptions)
+  std::vector<std::string> other_outputs;  //!< the run's other files (ExportOptions::other_outputs)
 };
 
 //! Writes `mesh` with the UVs of `atlas` to `path` (export_mesh; atomic, staged in an active FileBatch),

@@ -96,6 +96,8 @@ struct ExportOptions {
   MaterialTextures material;  //!< .glb: normal, metallic-roughness and occlusion maps (kInvalidArgument otherwise)
   ImageUris image_uris;       //!< .glb: maps named by URI instead of embedded (kInvalidArgument for a colour
                               //!< URI without texture_path, an ORM URI without a role, another format)
+  std::vector<std::string> other_outputs;  //!< .obj/.ply: files the caller writes beside (stats, previews): the
+                                           //!< texture's copy beside the output never takes their names
   bool has_normal_map() const { return !material.normal_png.empty() || !image_uris.normal.empty(); }
   bool has_orm_map() const { return !material.orm_png.empty() || !image_uris.orm.empty(); }
   uint32_t symmetry = 1;      //!< .glb: 4 records in the material ("extras": {"tailor": {"symmetry": 4}}) that

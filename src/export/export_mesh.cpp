@@ -63,6 +63,20 @@ bool holds_bytes(const std::filesystem::path& path, const std::string& bytes) {
 
 }  // namespace
 
+std::vector<std::string> names_in_folder(const std::filesystem::path& folder, const std::vector<std::string>& others,
+                                         std::initializer_list<std::string> own) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> names(own);
+  std::error_code error;
+  const fs::path here = fs::absolute(folder.empty() ? fs::path(".") : folder, error).lexically_normal();
+  for (const std::string& other : others) {
+    const fs::path path(other);
+    const fs::path there = fs::absolute(path.has_parent_path() ? path.parent_path() : fs::path("."), error);
+    if (!error && there.lexically_normal() == here) names.push_back(path.filename().string());
+  }
+  return names;
+}
+
 Status texture_name_beside(const std::string& texture_path, const std::string& bytes,
                            const std::filesystem::path& out_dir, std::span<const std::string> taken, std::string& name,
                            bool& copy) {

@@ -107,8 +107,9 @@ Status write_obj(const std::string& path, const ExportData& data, const ExportOp
   if (textured) {  // after the .obj's text, before it lands: a failure leaves none of the three
     std::string texture_name;
     bool copy = false;
-    const std::string own_files[] = {obj_path.filename().string(), mtl_name};
     const std::filesystem::path folder = obj_path.parent_path();
+    const std::vector<std::string> own_files =
+        names_in_folder(folder, options.other_outputs, {obj_path.filename().string(), mtl_name});
     TAILOR_RETURN_IF_ERROR(
         texture_name_beside(options.texture_path, texture_bytes, folder, own_files, texture_name, copy));
     if (copy) TAILOR_RETURN_IF_ERROR(write_file_atomic((folder / texture_name).string(), texture_bytes));

@@ -33,7 +33,9 @@ Status write_ply(const std::string& path, const ExportData& data, const ExportOp
   if (!options.texture_path.empty()) {
     std::string mime_type;  // fail on a missing or non-image texture like the other writers
     TAILOR_RETURN_IF_ERROR(read_texture_bytes(options.texture_path, texture_bytes, mime_type));
-    const std::string own_file[] = {std::filesystem::path(path).filename().string()};
+    const std::vector<std::string> own_file =
+        names_in_folder(std::filesystem::path(path).parent_path(), options.other_outputs,
+                        {std::filesystem::path(path).filename().string()});
     // The name the header gives, decided now; the copy beside the .ply (if any) is written at the end.
     TAILOR_RETURN_IF_ERROR(texture_name_beside(options.texture_path, texture_bytes,
                                                std::filesystem::path(path).parent_path(), own_file, texture_name,

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <filesystem>
+#include <initializer_list>
 #include <nlohmann/json.hpp>
 #include <span>
 #include <string>
@@ -102,6 +103,11 @@ Status glb_base_color(const ExportOptions& options, std::string& bytes, std::str
 //! Appends the shortest decimal text that reads back as exactly `value` (std::to_chars).
 void append_float(std::string& out, float value);
 
+//! The names of the files the writer writes in `folder`: its own (`own`) and those of `others`
+//! (ExportOptions::other_outputs) that lie there. The texture's copy must not take any of them.
+std::vector<std::string> names_in_folder(const std::filesystem::path& folder, const std::vector<std::string>& others,
+                                         std::initializer_list<std::string> own);
+
 //! The file name by which an output in the folder `out_dir` names the texture `texture_path` (its file's bytes:
 //! `bytes`): the .mtl's map_Kd, the .ply's TextureFile. The texture lies beside the output under that name, so the
 //! output folder can be moved or sent on its own. `name` is the texture's own name when the texture already lies
@@ -109,7 +115,7 @@ void append_float(std::string& out, float value);
 //! files) under the texture's name (whitespace made '_'). A file of that name beside the output holding the same
 //! bytes is used as it is; one holding anything else is never replaced (another output may name it): the copy
 //! takes the first of "<stem>-2<ext>", "<stem>-3<ext>"... that is free or holds the same bytes. Names in `taken`
-//! (the writer's own files) are skipped. Fails with kIo.
+//! (the writer's own files and the run's other outputs: names_in_folder) are skipped. Fails with kIo.
 Status texture_name_beside(const std::string& texture_path, const std::string& bytes,
                            const std::filesystem::path& out_dir, std::span<const std::string> taken, std::string& name,
                            bool& copy);
