@@ -395,6 +395,17 @@ TEST(Obj, AllCornerFormsNegativeIndicesAndIgnoredStatements) {
                   .is_ok());
   EXPECT_EQ(n.indices, (std::vector<uint32_t>{0, 1, 2, 1, 3, 2}));
   EXPECT_TRUE(n.corner_uvs.empty());
+
+  // A UTF-8 byte order mark does not hide the first line (its vertex was lost, the face shifted).
+  Mesh bom;
+  ASSERT_TRUE(parse("\xEF\xBB\xBFv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", MeshFormat::kObj, bom).is_ok());
+  EXPECT_EQ(bom.vertex_count(), 3u);
+  EXPECT_EQ(bom.positions, (std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}));
+  // A normal index without normals says normals.
+  Mesh none;
+  const Status no_normals = parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//1 2//1 3//1\n", MeshFormat::kObj, none);
+  EXPECT_NE(no_normals.message().find("normal index 1 out of range (mesh has 0 normals)"), std::string::npos)
+      << no_normals.message();
 }
 
 TEST(Obj, PolygonsAreFanTriangulated) {

@@ -27,8 +27,9 @@ struct ForwardRef {
 };
 
 std::string out_of_range_text(const char* what, int64_t index, size_t count) {
+  const std::string kind = what[0] == 'f' ? " vertices)" : what[0] == 'n' ? " normals)" : " texture coordinates)";
   return std::string(what) + " index " + std::to_string(index) + " out of range (mesh has " + std::to_string(count) +
-         (what[0] == 'f' ? " vertices)" : " texture coordinates)");
+         kind;
 }
 
 // Resolves a 1-based or negative OBJ index against the current count; returns false when it
@@ -51,6 +52,10 @@ Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh,
                 ReadProgress* progress, std::string* material_library) {
   if (material_library) material_library->clear();
   report.format = "OBJ";
+  // A UTF-8 byte order mark (editors on Windows write one) is not part of the first line.
+  if (data.size() >= 3 && static_cast<unsigned char>(data[0]) == 0xEF && static_cast<unsigned char>(data[1]) == 0xBB &&
+      static_cast<unsigned char>(data[2]) == 0xBF)
+    data = data.subspan(3);
   TextScanner s(data.data(), data.data() + data.size());
   s.set_hash_comments(true);
   s.set_line_continuation(true);
