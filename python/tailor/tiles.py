@@ -738,8 +738,19 @@ def peak_rss():
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
 
 
+def check_outdir(outdir, given):
+    """TilesError when OUTDIR cannot be written as a folder of tiles: the folder is renamed into
+    place beside it, so its parent must be a writable folder, and OUTDIR itself a folder if it
+    exists."""
+    if outdir.exists() and not outdir.is_dir():
+        raise TilesError("%s: exists and is not a folder" % given)
+    if not outdir.parent.is_dir():
+        raise TilesError("%s: the folder it would be in, %s, does not exist" % (given, outdir.parent))
+
+
 def run(args):
     outdir = pathlib.Path(args.output).resolve()
+    check_outdir(outdir, args.output)
     t0 = time.monotonic()
     # A binary little-endian PLY of triangles is partitioned by streaming it (tiles_stream); any
     # other input is loaded whole and cut in memory (--in-memory, hidden, forces that for tests).
@@ -768,7 +779,10 @@ def run(args):
 
     tmp = outdir.parent / (".%s.tmp-%d" % (outdir.name, os.getpid()))
     shutil.rmtree(tmp, ignore_errors=True)
-    (tmp / "tiles").mkdir(parents=True)
+    try:
+        (tmp / "tiles").mkdir(parents=True)
+    except OSError as e:
+        raise TilesError("%s: cannot write beside it in %s (%s)" % (args.output, outdir.parent, e.strerror)) from None
     in_process = args.workers == 0 and not args.scheduler
     start = None
     try:

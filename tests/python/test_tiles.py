@@ -266,6 +266,11 @@ def test_errors_are_one_line_and_leave_the_output_as_it_was(tmp_path):
     code, _, stderr = run_tiles(HORSE, "-o", other, "--workers", 0)
     assert code == 1 and "not a folder of tiles" in stderr
     assert (other / "keep.txt").read_text() == "mine"
+    # OUTDIR a file, or in a folder that does not exist: one line naming it, nothing written.
+    for given, message in ((other / "keep.txt", "exists and is not a folder"), (other / "no" / "t", "does not exist")):
+        code, _, stderr = run_tiles(HORSE, "-o", given, "--workers", 0)
+        assert code == 1 and stderr.count("\n") == 1 and str(given) in stderr and message in stderr, stderr
+    assert sorted(p.name for p in other.iterdir()) == ["keep.txt"]
 
 
 @pytest.mark.filterwarnings("ignore:make_current is deprecated:DeprecationWarning")  # Debian's tornado and Dask
