@@ -220,6 +220,28 @@ TEST(GltfScene, JsonNestedTooDeepIsOneLineNotACrash) {
   EXPECT_EQ(mesh.face_count(), 1u);
 }
 
+// Every instance keeps its node's and mesh's name and extras: a 100 KB mesh name under 3,000 nodes
+// (300 MB of copies from a 200 KB file) is refused by the decode budget; under 10 nodes it loads.
+TEST(GltfScene, NamesCopiedPerInstanceCountAgainstTheBudget) {
+  const auto scene_of = [](size_t nodes) {
+    Json list = Json::array(), roots = Json::array();
+    for (size_t i = 0; i < nodes; ++i) {
+      list.push_back({{"mesh", 0}});
+      roots.push_back(i);
+    }
+    Builder b = one_triangle(list, {{{"nodes", roots}}});
+    b.json["meshes"][0]["name"] = std::string(100000, 'n');
+    return b;
+  };
+  Mesh mesh;
+  const Status many = read(scene_of(3000).glb(), mesh);
+  EXPECT_EQ(many.code(), ErrorCode::kLimit) << many.message();
+  EXPECT_TRUE(mesh.empty());
+  LoadReport report;
+  ASSERT_TRUE(read(scene_of(10).glb(), mesh, &report).is_ok());
+  EXPECT_EQ(report.mesh_instances, 10u);
+}
+
 TEST(GltfScene, StripsAndFansBecomeTriangles) {
   // A 4 x 1 strip of quads as a triangle strip (10 vertices, 8 triangles) and a fan of 6
   // triangles around the origin; every face must come out, counter-clockwise from +z.

@@ -674,6 +674,12 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
     const uint32_t instance_id = static_cast<uint32_t>(scene.instances.size());
     const size_t first_part = scene.parts.size();
     scene.instances.push_back({name_of(node), extras_of(node), name_of(&m), extras_of(&m)});
+    // Each instance keeps its own copy of these texts: charged, so that a long mesh name or extras
+    // under thousands of instances cannot grow memory past the file's bound.
+    const auto& kept_texts = scene.instances.back();
+    TAILOR_RETURN_IF_ERROR(doc.charge(kept_texts.node_name.size() + kept_texts.node_extras.size() +
+                                          kept_texts.mesh_name.size() + kept_texts.mesh_extras.size(),
+                                      "mesh " + std::to_string(mi)));
     const auto primitives = m.is_object() ? m.find("primitives") : m.end();
     if (!m.is_object() || primitives == m.end() || !primitives->is_array())
       return doc.parse_error("mesh without primitives", "mesh " + std::to_string(mi));
