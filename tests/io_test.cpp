@@ -648,6 +648,25 @@ TEST(Errors, FaceWithTwoVertices) {
   EXPECT_EQ(s.where(), "line 13");
 }
 
+// An ascii PLY record is one line: a line with more values than the element's properties is an
+// error at that line (it was read on as the next record's values: a face "3 0 1 2 3" gave a
+// second, shifted face; a vertex line of four numbers shifted every vertex after it).
+TEST(Errors, AsciiPlyLineWithMoreValuesThanProperties) {
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 2\nproperty list uchar int vertex_indices\nend_header\n";
+  Mesh m;
+  Status s = parse(header + "0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2 3\n3 1 3 2\n", MeshFormat::kPly, m);
+  EXPECT_EQ(s.what(), "more values on the line than PLY element 'face' has properties");
+  EXPECT_EQ(s.where(), "line 14");
+  s = parse(header + "0 0 0\n1 0 0 7\n0 1 0\n1 1 0\n3 0 1 2\n3 1 3 2\n", MeshFormat::kPly, m);
+  EXPECT_EQ(s.what(), "more values on the line than PLY element 'vertex' has properties");
+  EXPECT_EQ(s.where(), "line 11");
+  // Blank space and CR line ends after a record are fine.
+  ASSERT_TRUE(parse(header + "0 0 0 \r\n1 0 0\t\n0 1 0\n1 1 0\n3 0 1 2\n3 1 3 2", MeshFormat::kPly, m).is_ok());
+  EXPECT_EQ(m.face_count(), 2u);
+}
+
 TEST(Errors, HugeHeaderCountsFailBeforeAllocating) {
   Mesh m;
   std::string s =

@@ -347,6 +347,7 @@ class BinarySource {
   const char* pos() const { return p_; }
   void advance(size_t n) { p_ += n; }
   std::string where(const PlyElement& e, uint64_t i) const { return e.name + " " + std::to_string(i); }
+  bool record_ends() { return true; }  // a binary record is its properties' bytes
   // Lower bound of the bytes a list of n items of type t takes.
   uint64_t list_min_bytes(uint64_t n, PlyType t) const { return mul_sat(n, type_size(t)); }
 
@@ -410,6 +411,10 @@ class AsciiSource {
   static constexpr bool kBinary = false;
   size_t remaining() const { return s_.remaining(); }
   std::string where(const PlyElement&, uint64_t) const { return "line " + std::to_string(s_.line() + first_line_); }
+  // An ascii record is one line: true when nothing but blanks is left on it (the next value read
+  // skips the line end); else the line holds more values than the header's properties (or a
+  // record was short and the values read ran into the next line).
+  bool record_ends() { return s_.at_line_end(); }
   // Every ascii value takes at least one character and one separator.
   uint64_t list_min_bytes(uint64_t n, PlyType) const { return n == 0 ? 0 : mul_sat(n, 2) - 1; }
 
@@ -475,6 +480,14 @@ class BodyReader {
                          src_.where(e, i));
   }
 
+  // The record i of e ends where its properties do (ascii: its line holds nothing more).
+  Status end_record(const PlyElement& e, uint64_t i) {
+    if (src_.record_ends()) return Status::ok();
+    return Status::error(ErrorCode::kParse, name_,
+                         "more values on the line than PLY element " + quote_input(e.name) + " has properties",
+                         src_.where(e, i));
+  }
+
   // Reads a list count, checking that the items can fit in the bytes left.
   Status list_count(const PlyElement& e, uint64_t i, const PlyProperty& p, uint64_t& n) {
     double d;
@@ -526,6 +539,7 @@ class BodyReader {
     }
     for (uint64_t i = 0; i < e.count; ++i) {
       for (const PlyProperty& p : e.props) TAILOR_RETURN_IF_ERROR(skip_property(e, i, p));
+      TAILOR_RETURN_IF_ERROR(end_record(e, i));
     }
     return Status::ok();
   }
@@ -577,6 +591,7 @@ class BodyReader {
           default: break;
         }
       }
+      TAILOR_RETURN_IF_ERROR(end_record(e, i));
     }
     return Status::ok();
   }
@@ -664,6 +679,7 @@ class BodyReader {
           TAILOR_RETURN_IF_ERROR(skip_property(e, i, p));
         }
       }
+      TAILOR_RETURN_IF_ERROR(end_record(e, i));
       const size_t n = poly_.size();
       if (n < 3) {
         return Status::error(ErrorCode::kInvalidMesh, name_, "face with " + std::to_string(n) + " vertices",
@@ -785,6 +801,7 @@ class BodyReader {
           ++run;
         }
       }
+      TAILOR_RETURN_IF_ERROR(end_record(e, i));
     }
     return Status::ok();
   }
