@@ -176,7 +176,8 @@ expect_error 2 "crack-rings.*\(run 'tailor map --help'\)$" -- "$tailor" map "$me
 expect_error 2 "\(run 'tailor map --help'\)$" -- "$tailor" map
 expect_error 2 "\(run 'tailor eval --help'\)$" -- "$tailor" eval "$tmp/a.glb" --frobnicate
 expect_error 2 "\(run 'tailor tile --help'\)$" -- "$tailor" tile "$texture"
-expect_error 2 "\(run 'tailor --help'\)$" -- "$tailor" frobnicate
+# A misspelt command is named, with the commands there are.
+expect_error 2 "unknown command 'frobnicate' \(commands: info, map, eval, tile, eval-tile, render, view, edit\)$" -- "$tailor" frobnicate
 expect_error 2 "\(run 'tailor --help'\)$" -- "$tailor"
 # --symmetry 4 (experimental): the same bytes for any thread count, the metrics count quarter turns
 # (in the report and in eval); it needs a square texture (a 64x48 render here) and eval takes 1 or 4.

@@ -242,6 +242,20 @@ TEST(GltfScene, NamesCopiedPerInstanceCountAgainstTheBudget) {
   EXPECT_EQ(report.mesh_instances, 10u);
 }
 
+// A rotation that is not a unit quaternion is read as its direction (viewers do; glTF requires
+// unit length): [0, 0, 5, 5] turns the triangle a quarter about z and does not scale it by 50.
+// One without a direction is a parse error.
+TEST(GltfScene, RotationsAreUnitQuaternions) {
+  Mesh mesh;
+  Builder turned = one_triangle({{{"mesh", 0}, {"rotation", {0, 0, 5, 5}}}}, {{{"nodes", {0}}}});
+  ASSERT_TRUE(read(turned.glb(), mesh).is_ok());
+  const std::vector<float> expected = {0, 0, 0, 0, 1, 0, -1, 0, 0};  // (1,0,0) -> (0,1,0), (0,1,0) -> (-1,0,0)
+  ASSERT_EQ(mesh.positions.size(), expected.size());
+  for (size_t i = 0; i < expected.size(); ++i) EXPECT_NEAR(mesh.positions[i], expected[i], 1e-6) << i;
+  Builder none = one_triangle({{{"mesh", 0}, {"rotation", {0, 0, 0, 0}}}}, {{{"nodes", {0}}}});
+  EXPECT_EQ(read(none.glb(), mesh).code(), ErrorCode::kParse);
+}
+
 TEST(GltfScene, StripsAndFansBecomeTriangles) {
   // A 4 x 1 strip of quads as a triangle strip (10 vertices, 8 triangles) and a fan of 6
   // triangles around the origin; every face must come out, counter-clockwise from +z.

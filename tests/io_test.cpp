@@ -401,6 +401,10 @@ TEST(Obj, AllCornerFormsNegativeIndicesAndIgnoredStatements) {
   ASSERT_TRUE(parse("\xEF\xBB\xBFv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", MeshFormat::kObj, bom).is_ok());
   EXPECT_EQ(bom.vertex_count(), 3u);
   EXPECT_EQ(bom.positions, (std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}));
+  // Lines ending in CR alone are said, not read as one line ("mesh has no faces").
+  Mesh cr;
+  EXPECT_NE(parse("v 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 3\r", MeshFormat::kObj, cr).message().find("end in CR alone"),
+            std::string::npos);
   // A normal index without normals says normals.
   Mesh none;
   const Status no_normals = parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//1 2//1 3//1\n", MeshFormat::kObj, none);

@@ -12,6 +12,7 @@
 #include "memory_policy.h"
 #include "tailor/version.h"
 #include "util/atomic_file.h"
+#include "util/text_scan.h"
 
 namespace {
 
@@ -54,6 +55,14 @@ int run_command(int argc, char** argv) {
     // Point to the help of the command whose options were wrong: 'tailor map --help'.
     const std::vector<CLI::App*> commands = app.get_subcommands();
     const std::string help = commands.empty() ? "tailor --help" : "tailor " + commands.back()->get_name() + " --help";
+    if (commands.empty() && argc > 1 && argv[1][0] != '-') {  // 'tailor mpa x.ply': a command misspelt
+      std::string names;
+      for (const CLI::App* command : app.get_subcommands([](const CLI::App*) { return true; }))
+        names += (names.empty() ? "" : ", ") + command->get_name();
+      std::fprintf(stderr, "tailor: error: unknown command %s (commands: %s)\n",
+                   tailor::internal::quote_input(argv[1]).c_str(), names.c_str());
+      return kExitUsage;
+    }
     std::fprintf(stderr, "tailor: error: %s (run '%s')\n", e.what(), help.c_str());
     return kExitUsage;
   }

@@ -970,8 +970,16 @@ def usage_error(message):
     sys.exit(2)
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse whose errors are one line, as the tool's other errors (argparse prints the whole
+    usage block first)."""
+
+    def error(self, message):
+        usage_error("%s (run python3 -m tailor.tiles --help)" % message)
+
+
 def parse_args(argv):
-    p = argparse.ArgumentParser(
+    p = _Parser(
         prog="python3 -m tailor.tiles",
         description="Maps a mesh as tiles (Dask tasks) and writes OGC 3D Tiles 1.1: OUTDIR/tileset.json, "
         "OUTDIR/tiles/*.glb and the shared texture.",

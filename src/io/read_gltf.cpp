@@ -76,6 +76,15 @@ bool get_numbers(const Json& node, const char* key, double* out, size_t n, bool&
   return true;
 }
 
+// Scales the quaternion q (x y z w) to unit length, as glTF requires it and as viewers read one
+// that is not (quantized rotations are only nearly so); false when it has no direction.
+bool unit_quaternion(double* q) {
+  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (!(norm > 0) || !std::isfinite(norm)) return false;
+  for (int k = 0; k < 4; ++k) q[k] /= norm;
+  return true;
+}
+
 // translation * rotation (unit quaternion x y z w) * scale.
 Matrix trs_matrix(const double* t, const double* q, const double* s) {
   Matrix m = kIdentity;
@@ -96,7 +105,7 @@ bool local_transform(const Json& node, Matrix& m) {
   if (present) return true;
   double t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
   if (!get_numbers(node, "translation", t, 3, present) || !get_numbers(node, "rotation", q, 4, present) ||
-      !get_numbers(node, "scale", s, 3, present))
+      !get_numbers(node, "scale", s, 3, present) || !unit_quaternion(q))
     return false;
   m = trs_matrix(t, q, s);
   return true;
@@ -137,6 +146,9 @@ Status gpu_instances(GltfDocument& doc, const Json& extension, size_t mesh, cons
     for (size_t c = 0; c < 3 && !values[0].empty(); ++c) t[c] = values[0][3 * i + c];
     for (size_t c = 0; c < 4 && !values[1].empty(); ++c) q[c] = values[1][4 * i + c];
     for (size_t c = 0; c < 3 && !values[2].empty(); ++c) s[c] = values[2][3 * i + c];
+    if (!unit_quaternion(q))
+      return doc.parse_error("EXT_mesh_gpu_instancing ROTATION without a direction",
+                             where + " instance " + std::to_string(i));
     instances.push_back({mesh, multiply(world, trs_matrix(t, q, s)), node});
   }
   return Status::ok();

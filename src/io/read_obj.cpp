@@ -56,6 +56,9 @@ Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh,
   if (data.size() >= 3 && static_cast<unsigned char>(data[0]) == 0xEF && static_cast<unsigned char>(data[1]) == 0xBB &&
       static_cast<unsigned char>(data[2]) == 0xBF)
     data = data.subspan(3);
+  // Lines that end in CR alone (classic Mac OS) would read as one line: said, not misread.
+  if (std::memchr(data.data(), '\n', data.size()) == nullptr && std::memchr(data.data(), '\r', data.size()) != nullptr)
+    return Status::error(ErrorCode::kParse, name, "its lines end in CR alone (classic Mac OS): convert them to LF");
   TextScanner s(data.data(), data.data() + data.size());
   s.set_hash_comments(true);
   s.set_line_continuation(true);

@@ -64,7 +64,8 @@ Status check_inputs(const Mesh& mesh, std::span<const float> corner_uv, std::spa
   if (!(o.fov_degrees >= 5.0f && o.fov_degrees <= 120.0f)) return bad("field of view must be 5..120 degrees");
   if (!(o.pitch_degrees >= -89.0f && o.pitch_degrees <= 89.0f)) return bad("pitch must be -89..89 degrees");
   if (!std::isfinite(o.yaw_degrees)) return bad("yaw must be finite");
-  if (!(o.checker_squares > 0.0f && o.checker_squares < 1e6f)) return bad("checker squares must be positive");
+  if (!(o.checker_squares > 0.0f && o.checker_squares < 1e6f))
+    return bad("checker squares must be above 0 and below 1e6");
   if (!(o.distortion_range > 0.0f && o.distortion_range < 64.0f)) return bad("distortion range must be positive");
   if (mesh.empty()) return Status::error(ErrorCode::kInvalidMesh, "", "mesh has no faces");
   if (mesh.positions.size() % 3 != 0 || mesh.indices.size() % 3 != 0) {
