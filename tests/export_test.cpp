@@ -475,6 +475,12 @@ TEST_F(ExportTest, TextureCopyBesideTheOutputNeverReplacesAnotherFile) {
   ASSERT_TRUE(export_mesh(path("fresh/g.ply"), cube_, cube_atlas_, options).is_ok());
   EXPECT_NE(read_all(path("fresh/g.ply")).find("comment TextureFile vistex-tile04-128-2.png\n"), std::string::npos);
   EXPECT_FALSE(fs::exists(path("fresh/vistex-tile04-128.png")));
+  // The same folder spelt another way (relative against absolute, with a "." in it) is the same.
+  fs::create_directories(dir_ / "mixed");
+  const fs::path relative = fs::relative(dir_ / "mixed", fs::current_path());
+  options.other_outputs = {(dir_ / "mixed" / "." / "vistex-tile04-128.png").string()};
+  ASSERT_TRUE(export_mesh((relative / "h.obj").string(), cube_, cube_atlas_, options).is_ok());
+  EXPECT_NE(read_all(path("mixed/h.mtl")).find("map_Kd vistex-tile04-128-2.png\n"), std::string::npos);
   EXPECT_EQ(temporaries(), 0u);
 }
 

@@ -202,8 +202,8 @@ TEST(GltfScene, BadHierarchiesFailWithOneLine) {
   EXPECT_TRUE(mesh.empty());
 }
 
-// A node's extras nested 100,000 levels deep (a 200 KB file) is refused in one line; copying or
-// printing such a value recursed once per level and overflowed the stack. 200 levels load.
+// A node's extras nested 100,000 levels deep (a 200 KB file) is refused in one line: copying or
+// printing such a value recurses once per level and would overflow the stack. 200 levels load.
 TEST(GltfScene, JsonNestedTooDeepIsOneLineNotACrash) {
   const Builder b = one_triangle({{{"mesh", 0}, {"extras", "X"}}}, {{{"nodes", {0}}}});
   const auto nested = [&b](size_t levels) {

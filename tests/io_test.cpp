@@ -18,6 +18,7 @@
 
 #include "support/fixtures.h"
 #include "util/atomic_file.h"
+#include "util/bounded_json.h"
 
 namespace tailor {
 namespace {
@@ -396,7 +397,7 @@ TEST(Obj, AllCornerFormsNegativeIndicesAndIgnoredStatements) {
   EXPECT_EQ(n.indices, (std::vector<uint32_t>{0, 1, 2, 1, 3, 2}));
   EXPECT_TRUE(n.corner_uvs.empty());
 
-  // A UTF-8 byte order mark does not hide the first line (its vertex was lost, the face shifted).
+  // A UTF-8 byte order mark does not hide the first line (its vertex would be lost, the face shifted).
   Mesh bom;
   ASSERT_TRUE(parse("\xEF\xBB\xBFv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", MeshFormat::kObj, bom).is_ok());
   EXPECT_EQ(bom.vertex_count(), 3u);
@@ -653,8 +654,8 @@ TEST(Errors, FaceWithTwoVertices) {
 }
 
 // An ascii PLY record is one line: a line with more values than the element's properties is an
-// error at that line (it was read on as the next record's values: a face "3 0 1 2 3" gave a
-// second, shifted face; a vertex line of four numbers shifted every vertex after it).
+// error at that line, not values of the next record (a face "3 0 1 2 3" would give a second,
+// shifted face; a vertex line of four numbers would shift every vertex after it).
 TEST(Errors, AsciiPlyLineWithMoreValuesThanProperties) {
   const std::string header =
       "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
@@ -666,6 +667,10 @@ TEST(Errors, AsciiPlyLineWithMoreValuesThanProperties) {
   s = parse(header + "0 0 0\n1 0 0 7\n0 1 0\n1 1 0\n3 0 1 2\n3 1 3 2\n", MeshFormat::kPly, m);
   EXPECT_EQ(s.what(), "more values on the line than PLY element 'vertex' has properties");
   EXPECT_EQ(s.where(), "line 11");
+  // A short record whose values run onto the next line: said at the line it started on.
+  s = parse(header + "0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1\n3 1 3 2\n", MeshFormat::kPly, m);
+  EXPECT_EQ(s.what(), "a record of PLY element 'face' runs onto the next line (fewer values than its properties)");
+  EXPECT_EQ(s.where(), "line 14");
   // Blank space and CR line ends after a record are fine.
   ASSERT_TRUE(parse(header + "0 0 0 \r\n1 0 0\t\n0 1 0\n1 1 0\n3 0 1 2\n3 1 3 2", MeshFormat::kPly, m).is_ok());
   EXPECT_EQ(m.face_count(), 2u);
@@ -970,6 +975,23 @@ TEST(Strokes, JsonRoundTripsBitForBit) {
   }
   ASSERT_TRUE(parse_strokes(R"({"strokes": []})", "mem", back).is_ok());
   EXPECT_TRUE(back.empty());
+}
+
+// The nesting bound: 256 levels parse, 257 do not, counted outside strings; a long array of
+// objects parses (the depth is counted before the parse, in one pass).
+TEST(Json, NestingBoundIsExactAndIgnoresStrings) {
+  const auto nested = [](int levels) { return std::string(levels, '[') + std::string(levels, ']'); };
+  nlohmann::json j;
+  EXPECT_EQ(internal::parse_json_bounded(nested(256), j), internal::JsonParse::kOk);
+  EXPECT_EQ(internal::parse_json_bounded(nested(257), j), internal::JsonParse::kTooDeep);
+  EXPECT_TRUE(j.is_discarded());
+  EXPECT_EQ(internal::parse_json_bounded("[\"" + std::string(1000, '[') + "\\\"\"]", j), internal::JsonParse::kOk);
+  EXPECT_EQ(j[0].get<std::string>().size(), 1001u);
+  EXPECT_EQ(internal::parse_json_bounded("[1,", j), internal::JsonParse::kInvalid);
+  std::string objects = "[";
+  for (int k = 0; k < 200000; ++k) objects += k ? ",{}" : "{}";
+  EXPECT_EQ(internal::parse_json_bounded(objects + "]", j), internal::JsonParse::kOk);
+  EXPECT_EQ(j.size(), 200000u);
 }
 
 TEST(Strokes, BadJsonNamesWhereAndLeavesNothing) {

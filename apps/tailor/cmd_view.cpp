@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -68,8 +69,9 @@ Status add_texture(const std::string& path, std::vector<Route>& routes, nlohmann
   }
   std::ifstream in(path);
   if (!in) return Status::error(ErrorCode::kIo, path, "cannot open file");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   nlohmann::json j;
-  if (const auto parsed = internal::parse_json_bounded(in, j); parsed == internal::JsonParse::kTooDeep)
+  if (const auto parsed = internal::parse_json_bounded(text, j); parsed == internal::JsonParse::kTooDeep)
     return Status::error(ErrorCode::kParse, path, internal::json_problem(parsed));
   if (j.is_discarded() || !j.is_object()) return Status::error(ErrorCode::kParse, path, "not a JSON object");
   if (!j.contains("files") || !j["files"].is_array() || j["files"].empty()) {
@@ -105,8 +107,9 @@ Status add_tileset(const std::string& path, std::vector<Route>& routes, nlohmann
   namespace fs = std::filesystem;
   std::ifstream in(path);
   if (!in) return Status::error(ErrorCode::kIo, path, "cannot open file");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   nlohmann::json tileset;
-  if (const auto parsed = internal::parse_json_bounded(in, tileset); parsed == internal::JsonParse::kTooDeep)
+  if (const auto parsed = internal::parse_json_bounded(text, tileset); parsed == internal::JsonParse::kTooDeep)
     return Status::error(ErrorCode::kParse, path, internal::json_problem(parsed));
   if (tileset.is_discarded() || !tileset.is_object() || !tileset.contains("asset") || !tileset.contains("root"))
     return Status::error(ErrorCode::kParse, path, "not a 3D Tiles tileset", "no \"asset\" and \"root\"");

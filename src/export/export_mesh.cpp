@@ -66,13 +66,26 @@ bool holds_bytes(const std::filesystem::path& path, const std::string& bytes) {
 std::vector<std::string> names_in_folder(const std::filesystem::path& folder, const std::vector<std::string>& others,
                                          std::initializer_list<std::string> own) {
   namespace fs = std::filesystem;
+  // One folder however it is spelt: the same directory when both exist (symlinks, relative and
+  // absolute names), else the same normalised absolute path, without a trailing separator.
+  const auto spelt = [](const fs::path& p) {
+    std::error_code error;
+    fs::path normal = fs::absolute(p, error).lexically_normal();
+    if (!normal.has_filename() && normal.has_parent_path() && normal != normal.root_path())
+      normal = normal.parent_path();
+    return normal;
+  };
+  const auto same_folder = [&spelt](const fs::path& a, const fs::path& b) {
+    std::error_code error;
+    const bool same = fs::equivalent(a, b, error);
+    return error ? spelt(a) == spelt(b) : same;
+  };
+  const fs::path here = folder.empty() ? fs::path(".") : folder;
   std::vector<std::string> names(own);
-  std::error_code error;
-  const fs::path here = fs::absolute(folder.empty() ? fs::path(".") : folder, error).lexically_normal();
   for (const std::string& other : others) {
     const fs::path path(other);
-    const fs::path there = fs::absolute(path.has_parent_path() ? path.parent_path() : fs::path("."), error);
-    if (!error && there.lexically_normal() == here) names.push_back(path.filename().string());
+    if (same_folder(here, path.has_parent_path() ? path.parent_path() : fs::path(".")))
+      names.push_back(path.filename().string());
   }
   return names;
 }

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "export/writers.h"
+#include "util/bounded_json.h"
 
 namespace tailor::internal {
 namespace {
@@ -17,8 +18,8 @@ using Json = nlohmann::json;
 // `text` (JSON kept by the reader) as a value, or null when empty or unreadable.
 Json parsed(const std::string& text) {
   if (text.empty()) return nullptr;
-  Json j = Json::parse(text, nullptr, false);
-  return j.is_discarded() ? Json(nullptr) : j;
+  Json j;
+  return internal::parse_json_bounded(text, j) == internal::JsonParse::kOk ? j : Json(nullptr);
 }
 
 // Sets object[key] to the JSON text `text` when it holds a value.

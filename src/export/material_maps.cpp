@@ -10,6 +10,7 @@
 #include "tailor/material.h"
 #include "util/atomic_file.h"
 #include "util/bounded_json.h"
+#include "util/text_scan.h"
 
 namespace tailor {
 namespace {
@@ -108,8 +109,9 @@ Status read_symmetry(const nlohmann::json& j, const std::string& file, int& symm
   if (!j.contains("symmetry")) return Status::ok();
   const nlohmann::json& value = j["symmetry"];
   if (!value.is_number_integer() || (value.get<int>() != 1 && value.get<int>() != 4))
-    return Status::error(ErrorCode::kInvalidArgument, file, "\"symmetry\" must be 1 or 4",
-                         value.is_primitive() ? value.dump().substr(0, 40) : std::string(value.type_name()));
+    return Status::error(
+        ErrorCode::kInvalidArgument, file, "\"symmetry\" must be 1 or 4",
+        value.is_primitive() ? internal::quote_input(value.dump(), 40) : std::string(value.type_name()));
   symmetry = value.get<int>();
   return Status::ok();
 }

@@ -219,7 +219,8 @@ Status GltfDocument::open(std::span<const char> data, const std::string& name, c
   } else {
     json_text = {bytes, data.size()};
   }
-  if (internal::parse_json_bounded(json_text.begin(), json_text.end(), json_) == internal::JsonParse::kTooDeep)
+  const std::string_view json_chars(reinterpret_cast<const char*>(json_text.data()), json_text.size());
+  if (internal::parse_json_bounded(json_chars, json_) == internal::JsonParse::kTooDeep)
     return parse_error(internal::json_problem(internal::JsonParse::kTooDeep));
   if (json_.is_discarded() || !json_.is_object())
     return parse_error(binary_ ? "JSON chunk is not a valid JSON object" : "not a glTF file (not a JSON object)");

@@ -79,8 +79,14 @@ bool get_numbers(const Json& node, const char* key, double* out, size_t n, bool&
 // Scales the quaternion q (x y z w) to unit length, as glTF requires it and as viewers read one
 // that is not (quantized rotations are only nearly so); false when it has no direction.
 bool unit_quaternion(double* q) {
+  double largest = 0;  // scaled by it first, so that huge or tiny finite components neither overflow nor vanish
+  for (int k = 0; k < 4; ++k) {
+    if (!std::isfinite(q[k])) return false;
+    largest = std::max(largest, std::abs(q[k]));
+  }
+  if (!(largest > 0)) return false;
+  for (int k = 0; k < 4; ++k) q[k] /= largest;
   const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-  if (!(norm > 0) || !std::isfinite(norm)) return false;
   for (int k = 0; k < 4; ++k) q[k] /= norm;
   return true;
 }

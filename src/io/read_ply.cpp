@@ -347,7 +347,10 @@ class BinarySource {
   const char* pos() const { return p_; }
   void advance(size_t n) { p_ += n; }
   std::string where(const PlyElement& e, uint64_t i) const { return e.name + " " + std::to_string(i); }
-  bool record_ends() { return true; }  // a binary record is its properties' bytes
+  // A binary record is its properties' bytes: it always ends where they do.
+  enum class RecordEnd { kEnds, kMoreValues, kSpansLines };
+  RecordEnd record_ends() { return RecordEnd::kEnds; }
+  std::string record_where(const PlyElement& e, uint64_t i) const { return where(e, i); }
   // Lower bound of the bytes a list of n items of type t takes.
   uint64_t list_min_bytes(uint64_t n, PlyType t) const { return mul_sat(n, type_size(t)); }
 
@@ -411,15 +414,28 @@ class AsciiSource {
   static constexpr bool kBinary = false;
   size_t remaining() const { return s_.remaining(); }
   std::string where(const PlyElement&, uint64_t) const { return "line " + std::to_string(s_.line() + first_line_); }
-  // An ascii record is one line: true when nothing but blanks is left on it (the next value read
-  // skips the line end); else the line holds more values than the header's properties (or a
-  // record was short and the values read ran into the next line).
-  bool record_ends() { return s_.at_line_end(); }
+  // An ascii record is one line: it ends when nothing but blanks is left on the line it started
+  // on (the next value read skips the line end). A record whose values ran onto the next line
+  // was short of values; one whose line goes on has more than its properties.
+  enum class RecordEnd { kEnds, kMoreValues, kSpansLines };
+  RecordEnd record_ends() {
+    const size_t started = record_line_;
+    record_line_ = kNoLine;
+    if (started != kNoLine && s_.line() != started) {
+      record_line_ = started;  // for record_where, until the next value
+      return RecordEnd::kSpansLines;
+    }
+    return s_.at_line_end() ? RecordEnd::kEnds : RecordEnd::kMoreValues;
+  }
+  std::string record_where(const PlyElement&, uint64_t) const {
+    return "line " + std::to_string((record_line_ != kNoLine ? record_line_ : s_.line()) + first_line_);
+  }
   // Every ascii value takes at least one character and one separator.
   uint64_t list_min_bytes(uint64_t n, PlyType) const { return n == 0 ? 0 : mul_sat(n, 2) - 1; }
 
   bool value(PlyType t, double& out) {
     s_.skip_space();
+    if (record_line_ == kNoLine) record_line_ = s_.line();
     if (t == PlyType::kFloat32) {
       // Decimal -> float directly: decimal -> double -> float can round twice.
       float f;
@@ -435,8 +451,10 @@ class AsciiSource {
   }
 
  private:
+  static constexpr size_t kNoLine = SIZE_MAX;
   TextScanner s_;
   size_t first_line_;
+  size_t record_line_ = kNoLine;  // the line the current record's first value is on
 };
 
 // ================================================================================================
@@ -482,10 +500,15 @@ class BodyReader {
 
   // The record i of e ends where its properties do (ascii: its line holds nothing more).
   Status end_record(const PlyElement& e, uint64_t i) {
-    if (src_.record_ends()) return Status::ok();
+    using End = typename Source::RecordEnd;
+    const End end = src_.record_ends();
+    if (end == End::kEnds) return Status::ok();
     return Status::error(ErrorCode::kParse, name_,
-                         "more values on the line than PLY element " + quote_input(e.name) + " has properties",
-                         src_.where(e, i));
+                         end == End::kMoreValues
+                             ? "more values on the line than PLY element " + quote_input(e.name) + " has properties"
+                             : "a record of PLY element " + quote_input(e.name) +
+                                   " runs onto the next line (fewer values than its properties)",
+                         src_.record_where(e, i));
   }
 
   // Reads a list count, checking that the items can fit in the bytes left.

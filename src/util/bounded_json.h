@@ -2,12 +2,14 @@
 // printing a value recurses once per level: a file of 100,000 nested brackets (a few hundred KB)
 // parses, then overflows the stack where the value is copied or printed (a glTF's extras, a
 // material JSON's field quoted in an error). Every file or request the tools parse goes through
-// here.
+// here. The depth is counted in one pass over the text before the parse (a parser callback would
+// do it too, but nlohmann's callback parser rescans a container's members each time an object in
+// it closes: quadratic in an array of objects).
 #pragma once
 
 #include <nlohmann/json.hpp>
 #include <string>
-#include <utility>
+#include <string_view>
 
 namespace tailor::internal {
 
@@ -17,38 +19,38 @@ inline constexpr int kMaxJsonDepth = 256;
 //! What parse_json_bounded found.
 enum class JsonParse { kOk, kInvalid, kTooDeep };
 
-namespace json_detail {
-template <class Parse>
-JsonParse parse_bounded(Parse&& parse, nlohmann::json& out) {
-  bool too_deep = false;
-  // A value deeper than the bound is dropped as it is read (the callback's false), so the document
-  // built stays shallow whatever the input holds.
-  out = parse([&too_deep](int depth, nlohmann::json::parse_event_t, nlohmann::json&) {
-    if (depth > kMaxJsonDepth) too_deep = true;
-    return depth <= kMaxJsonDepth;
-  });
-  if (too_deep) {
+//! Whether arrays and objects in `text` nest more than `limit` levels, counted outside strings
+//! (an invalid text is the parser's to refuse; this only bounds what it would build).
+inline bool json_nests_deeper_than(std::string_view text, int limit) {
+  int depth = 0;
+  bool in_string = false;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\')
+        ++i;  // the escaped character, a quote included
+      else if (c == '"')
+        in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > limit) return true;
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return false;
+}
+
+//! Parses `text` into `out` without exceptions: kInvalid when it is not JSON, kTooDeep when arrays
+//! and objects nest more than kMaxJsonDepth levels (out is discarded in both cases).
+inline JsonParse parse_json_bounded(std::string_view text, nlohmann::json& out) {
+  if (json_nests_deeper_than(text, kMaxJsonDepth)) {
     out = nlohmann::json(nlohmann::json::value_t::discarded);
     return JsonParse::kTooDeep;
   }
+  out = nlohmann::json::parse(text, nullptr, false);
   return out.is_discarded() ? JsonParse::kInvalid : JsonParse::kOk;
-}
-}  // namespace json_detail
-
-//! Parses `input` (a string, a string_view or a stream) into `out` without exceptions: kInvalid
-//! when it is not JSON, kTooDeep when arrays and objects nest more than kMaxJsonDepth levels (out
-//! is discarded in both cases).
-template <class Input>
-JsonParse parse_json_bounded(Input&& input, nlohmann::json& out) {
-  return json_detail::parse_bounded(
-      [&input](auto callback) { return nlohmann::json::parse(std::forward<Input>(input), callback, false); }, out);
-}
-
-//! The same over the characters [first, last).
-template <class Iterator>
-JsonParse parse_json_bounded(Iterator first, Iterator last, nlohmann::json& out) {
-  return json_detail::parse_bounded(
-      [first, last](auto callback) { return nlohmann::json::parse(first, last, callback, false); }, out);
 }
 
 //! The words an error says for a document that is not kOk.

@@ -462,7 +462,7 @@ def test_bounding_boxes_hold_the_content_as_a_client_places_it(tmp_path, up):
         assert code == 2 and stderr.count("\n") == 1, stderr
         assert stderr.startswith("tailor.tiles: error: %s must be a positive number" % option), stderr
         assert not (tmp_path / "bad").exists()
-    # What argparse itself rejects is one line too (it printed the whole usage block first).
+    # What argparse itself rejects is one line too, without argparse's usage block.
     for args in (("--workers", "abc"), ("--threads",)):
         code, _, stderr = run_tiles(HORSE, "-o", tmp_path / "bad", *args)
         assert code == 2 and stderr.count("\n") == 1 and stderr.startswith("tailor.tiles: error: argument "), stderr
