@@ -417,6 +417,8 @@ TEST(GltfScene, TextureSizeIsReadFromItsHeaderWhereverItIs) {
     std::ofstream(dir + "/file.gltf") << f.gltf();
     EXPECT_EQ(size_of(dir + "/file.gltf", report), size) << uri;
     EXPECT_EQ(report.texture_file, size != "0x0") << uri;
+    // The file's path, which tailor render loads and draws.
+    EXPECT_EQ(report.texture_path, size != "0x0" ? (fs::path(dir) / uri).string() : "") << uri;
   }
   fs::remove_all(dir);
 }

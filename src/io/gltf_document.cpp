@@ -255,6 +255,17 @@ bool GltfDocument::image_uri_bytes(uint64_t index, size_t max_file_bytes, std::s
   return read_file_head((std::filesystem::path(base_dir_) / relative).string(), max_file_bytes, bytes).is_ok();
 }
 
+std::string GltfDocument::image_file(uint64_t index) const {
+  const Json* image = get_element(json_, "images", index);
+  if (!image) return {};
+  const auto uri_it = image->find("uri");
+  std::string relative;
+  if (uri_it == image->end() || !uri_it->is_string() || base_dir_.empty() ||
+      !relative_file_uri(uri_it->get_ref<const std::string&>(), relative))
+    return {};
+  return (std::filesystem::path(base_dir_) / relative).string();
+}
+
 Status GltfDocument::load_buffers(std::span<const unsigned char> bin) {
   const auto buffers = json_.find("buffers");
   if (buffers == json_.end()) return Status::ok();

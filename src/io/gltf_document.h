@@ -63,6 +63,9 @@ class GltfDocument {
   //! .gltf's folder (the same rule as buffers; never with an empty base_dir). `file` tells which.
   //! False when the image has no such URI or it cannot be read (the caller then has no size).
   bool image_uri_bytes(uint64_t index, size_t max_file_bytes, std::string& bytes, bool& file) const;
+  //! The path of the file that image `index`'s relative URI names (the rule above), or "" when it
+  //! names none.
+  std::string image_file(uint64_t index) const;
 
   //! The description of accessor `index`.
   Status accessor_info(uint64_t index, AccessorInfo& info);

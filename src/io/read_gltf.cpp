@@ -798,6 +798,7 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
         if (sized || head.size() < max_bytes) break;
       }
       report.texture_file = sized && file;
+      if (report.texture_file) report.texture_path = doc.image_file(first_image);  // what render draws
     }
     if (sized && width <= INT_MAX && height <= INT_MAX) {
       report.texture_width = static_cast<int>(width);
