@@ -249,10 +249,10 @@ bool GltfDocument::image_uri_bytes(uint64_t index, size_t max_file_bytes, std::s
     return comma != std::string::npos && comma >= 7 && uri.compare(comma - 7, 7, ";base64") == 0 &&
            decode_base64(std::string_view(uri).substr(comma + 1), bytes);
   }
-  std::string relative;
-  if (base_dir_.empty() || !relative_file_uri(uri, relative)) return false;
+  const std::string path = image_file(index);
+  if (path.empty()) return false;
   file = true;
-  return read_file_head((std::filesystem::path(base_dir_) / relative).string(), max_file_bytes, bytes).is_ok();
+  return read_file_head(path, max_file_bytes, bytes).is_ok();
 }
 
 std::string GltfDocument::image_file(uint64_t index) const {

@@ -19,6 +19,7 @@
 #include "util/atomic_file.h"
 #include "util/file_view.h"
 #include "util/huge_pages.h"
+#include "util/zero_area.h"
 
 namespace tailor {
 namespace {
@@ -72,16 +73,7 @@ inline uint64_t sorted_pair(const uint32_t* idx, size_t f, uint32_t& lo) {
   return uint64_t{b} << 32 | c;
 }
 
-// True when triangle (a, b, c) has exactly zero area. The cross product in double from float
-// inputs is exact for all but extreme exponent ranges, so "zero" means exactly collinear.
-inline bool is_zero_area(const float* pos, uint32_t a, uint32_t b, uint32_t c) {
-  const double ux = double{pos[3 * b]} - pos[3 * a], uy = double{pos[3 * b + 1]} - pos[3 * a + 1],
-               uz = double{pos[3 * b + 2]} - pos[3 * a + 2];
-  const double vx = double{pos[3 * c]} - pos[3 * a], vy = double{pos[3 * c + 1]} - pos[3 * a + 1],
-               vz = double{pos[3 * c + 2]} - pos[3 * a + 2];
-  const double cx = uy * vz - uz * vy, cy = uz * vx - ux * vz, cz = ux * vy - uy * vx;
-  return cx == 0.0 && cy == 0.0 && cz == 0.0;
-}
+using internal::is_zero_area;
 
 // Per smallest vertex: 1 + the last kept face with that smallest vertex (0: none, so that an
 // all-zero array from calloc is a set of empty chains), and a 32-bit signature (one bit per face,

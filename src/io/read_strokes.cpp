@@ -61,19 +61,15 @@ Status strokes_from_json(const nlohmann::json& array, const std::string& name, s
 
 Status parse_strokes(std::string_view text, const std::string& name, std::vector<OrientationStroke>& strokes) {
   strokes.clear();
+  if (internal::json_nests_deeper_than(text, internal::kMaxJsonDepth))
+    return Status::error(ErrorCode::kParse, name, internal::json_problem(internal::JsonParse::kTooDeep));
   nlohmann::json document;
-  const internal::JsonParse parsed = internal::parse_json_bounded(text, document);
-  if (parsed == internal::JsonParse::kTooDeep)
-    return Status::error(ErrorCode::kParse, name, internal::json_problem(parsed));
-  if (parsed == internal::JsonParse::kInvalid) {
-    try {  // again with exceptions, for where it fails
-      [[maybe_unused]] const nlohmann::json again = nlohmann::json::parse(text);
-    } catch (const nlohmann::json::parse_error& e) {
-      return Status::error(ErrorCode::kParse, name, "not valid JSON", "byte " + std::to_string(e.byte));
-    } catch (const nlohmann::json::exception&) {  // a number out of range (1e400)
-      return Status::error(ErrorCode::kParse, name, "not valid JSON (a number out of range)");
-    }
-    return Status::error(ErrorCode::kParse, name, "not valid JSON");
+  try {  // with exceptions: they say where it fails
+    document = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    return Status::error(ErrorCode::kParse, name, "not valid JSON", "byte " + std::to_string(e.byte));
+  } catch (const nlohmann::json::exception&) {  // a number out of range (1e400)
+    return Status::error(ErrorCode::kParse, name, "not valid JSON (a number out of range)");
   }
   if (!document.is_object() || !document.contains("strokes"))
     return Status::error(ErrorCode::kParse, name, "expected an object {\"strokes\": [...]}", "top level");

@@ -16,6 +16,7 @@
 #include "tailor/mapping.h"
 #include "tailor/topology.h"
 #include "util/mesh_bounds.h"
+#include "util/zero_area.h"
 
 namespace tailor {
 namespace {
@@ -81,16 +82,9 @@ Status measure_stability(const Mesh& mesh, const MapTextureOptions& options, Sta
     return Status::error(ErrorCode::kInvalidArgument, "", "remove fraction must be in (0, 0.9]");
   // As the metrics of a map refuse it: a surface without area has no UVs to keep.
   bool has_area = false;
-  for (size_t f = 0; f < face_count && !has_area; ++f) {
-    double e[2][3];
-    const float* p0 = &mesh.positions[3 * size_t{mesh.indices[3 * f]}];
-    for (size_t k = 0; k < 2; ++k)
-      for (size_t a = 0; a < 3; ++a)
-        e[k][a] = double{mesh.positions[3 * size_t{mesh.indices[3 * f + k + 1]} + a]} - p0[a];
-    const double cx = e[0][1] * e[1][2] - e[0][2] * e[1][1], cy = e[0][2] * e[1][0] - e[0][0] * e[1][2],
-                 cz = e[0][0] * e[1][1] - e[0][1] * e[1][0];
-    has_area = cx * cx + cy * cy + cz * cz > 0;
-  }
+  for (size_t f = 0; f < face_count && !has_area; ++f)
+    has_area = !internal::is_zero_area(mesh.positions.data(), mesh.indices[3 * f], mesh.indices[3 * f + 1],
+                                       mesh.indices[3 * f + 2]);
   if (!has_area) return Status::error(ErrorCode::kInvalidMesh, "", "every face has zero 3D area");
 
   const Topology topology = build_topology(mesh);
