@@ -179,6 +179,10 @@ expect_error 2 "\(run 'tailor tile --help'\)$" -- "$tailor" tile "$texture"
 # A misspelt command is named, with the commands there are.
 expect_error 2 "unknown command 'frobnicate' \(commands: info, map, eval, tile, eval-tile, render, view, edit\)$" -- "$tailor" frobnicate
 expect_error 2 "\(run 'tailor --help'\)$" -- "$tailor"
+# An unknown argument is named, before any required one it may have hidden (a misspelt -o).
+expect_error 2 "unknown argument '--bogus' \(run 'tailor --help'\)$" -- "$tailor" --bogus
+expect_error 2 "unknown argument '--ouput' \(run 'tailor map --help'\)$" -- "$tailor" map "$mesh" --ouput "$tmp/x.glb"
+expect_error 2 "unknown argument '--nope' \(run 'tailor map --help'\)$" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --nope
 # --symmetry 4 (experimental): the same bytes for any thread count, the metrics count quarter turns
 # (in the report and in eval); it needs a square texture (a 64x48 render here) and eval takes 1 or 4.
 "$tailor" map "$mesh" --texture "$texture" -o "$tmp/s4a.glb" --symmetry 4 --threads 1 --stats "$tmp/s4.json" -q &&
