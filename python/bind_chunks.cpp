@@ -9,7 +9,9 @@ namespace {
 
 ChunkCell cell_of(const py::sequence& cell) {
   if (py::len(cell) != 3) raise_error("cell must be three whole numbers (x, y, z), got " + sequence_text(cell));
-  return {cell[0].cast<int32_t>(), cell[1].cast<int32_t>(), cell[2].cast<int32_t>()};
+  ChunkCell c;
+  for (size_t k = 0; k < 3; ++k) c[k] = static_cast<int32_t>(whole_number(cell[k], "cell", INT32_MIN, INT32_MAX));
+  return c;
 }
 
 py::tuple cell_tuple(const ChunkCell& cell) { return py::make_tuple(cell[0], cell[1], cell[2]); }
@@ -37,13 +39,16 @@ void bind_chunks(py::module_& m) {
              options.mapping.threads = threads;
              options.mapping.field_following = field_following;
              options.mapping.max_stretch = max_stretch;
-             if (!crack_rings.is_none()) options.mapping.crack_rings = crack_rings.cast<uint32_t>();
+             if (!crack_rings.is_none())
+               options.mapping.crack_rings = static_cast<uint32_t>(whole_number(crack_rings, "crack_rings", 2, 64));
              set_chunk_split(chunk_split, options.chunks.split_above);
              if (!texture_size.is_none()) {
                // The lattice of whole repeats the crack closing snaps to, as tailor.map(texture_size=...).
-               const auto size = texture_size.cast<std::vector<int>>();
-               if (size.size() != 2 || size[0] <= 0 || size[1] <= 0)
+               if (!py::isinstance<py::sequence>(texture_size) || py::len(texture_size) != 2)
                  raise_error("texture_size must be (width, height), positive, got " + sequence_text(texture_size));
+               const py::sequence pair = texture_size.cast<py::sequence>();
+               const int size[2] = {static_cast<int>(whole_number(pair[0], "texture_size's width", 1, INT32_MAX)),
+                                    static_cast<int>(whole_number(pair[1], "texture_size's height", 1, INT32_MAX))};
                if (const Status s = set_map_texture_size(options, size[0], size[1]); !s) raise_status(s);
              }
              auto mapper = std::make_unique<ChunkedMapper>(options, cell_exponent, texels_per_unit);

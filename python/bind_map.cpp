@@ -230,7 +230,8 @@ void bind_map(py::module_& m) {
         mapping.hop_age = hop_age;
         mapping.shorten_seams = shorten_seams;
         mapping.close_cracks = close_cracks;
-        if (!crack_rings.is_none()) mapping.crack_rings = crack_rings.cast<uint32_t>();  // else as auto decides
+        if (!crack_rings.is_none())  // else as auto decides
+          mapping.crack_rings = static_cast<uint32_t>(whole_number(crack_rings, "crack_rings", 2, 64));
         mapping.relax_iterations = relax_iterations;
         mapping.threshold_px = threshold;
         if (!symmetry.is_none()) {
@@ -270,8 +271,7 @@ void bind_map(py::module_& m) {
         else
           raise_error("chunks must be 'auto', 'on' or 'off', got '" + chunks + "'");
         if (!chunk_cell.is_none()) {
-          const int e = chunk_cell.cast<int>();
-          if (e < -60 || e > 60) raise_error("chunk_cell must be None or a whole number in -60..60");
+          const int e = static_cast<int>(whole_number(chunk_cell, "chunk_cell", -60, 60));
           options.chunks.cell_exponent = e;
         }
         set_chunk_split(chunk_split, options.chunks.split_above);
@@ -439,6 +439,24 @@ void bind_map(py::module_& m) {
       "What field_following='auto' (tailor.map, tailor map) picks for a texture: (0.0, 32) for one\n"
       "without a direction (gravel, grass), else (1.0, 16). For callers that set the options\n"
       "themselves (ChunkedMapper, tailor.tiles).");
+  m.def(
+      "image_size",
+      [](const py::object& texture) {
+        const std::string path = path_of(texture);
+        Image image;
+        Status s;
+        {
+          const py::gil_scoped_release release;
+          s = load_image(path, image);
+        }
+        if (!s) raise_status(s);
+        return py::make_tuple(image.width, image.height);
+      },
+      py::arg("texture"),
+      "image_size(texture) -> (width, height)\n\n"
+      "The size of an image file, decoded whole as tailor map reads a texture: tailor.Error when it\n"
+      "cannot be (missing, truncated or corrupt, too large). For callers that name a texture\n"
+      "without mapping with it (tailor.tiles).");
 }
 
 }  // namespace tailor::python

@@ -93,8 +93,7 @@ void bind_tiles(py::module_& m) {
         ChunkOptions options;
         options.mode = ChunkMode::kOn;
         if (!chunk_cell.is_none()) {
-          const int e = chunk_cell.cast<int>();
-          if (e < -60 || e > 60) raise_error("chunk_cell must be None or a whole number in -60..60");
+          const int e = static_cast<int>(whole_number(chunk_cell, "chunk_cell", -60, 60));
           options.cell_exponent = e;
         }
         ChunkPlan plan;
@@ -157,7 +156,8 @@ chunk k's face ids are faces[chunk_start[k]:chunk_start[k+1]].)");
       "chunk_cell_exponent",
       [](double median_edge, const py::object& chunk_cell) {
         ChunkOptions options;
-        if (!chunk_cell.is_none()) options.cell_exponent = chunk_cell.cast<int>();
+        if (!chunk_cell.is_none())
+          options.cell_exponent = static_cast<int>(whole_number(chunk_cell, "chunk_cell", -60, 60));
         if (const Status s = check_chunk_options(options); !s) raise_status(s);
         int exponent = 0;
         if (const Status s = chunk_cell_exponent(median_edge, options, exponent); !s) raise_status(s);

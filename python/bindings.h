@@ -48,6 +48,10 @@ struct PyResult {
 [[noreturn]] void raise_status(const Status& status);
 //! Raises tailor.Error with `what` (a bad argument found by the binding itself).
 [[noreturn]] void raise_error(const std::string& what);
+//! `value` (an int, or anything with __index__ such as numpy's integers) when it is a whole number
+//! in lo..hi; else tailor.Error naming `name` (pybind11's own casts raise a RuntimeError that names
+//! neither the argument nor the range).
+int64_t whole_number(const py::handle& value, const std::string& name, int64_t lo, int64_t hi);
 
 //! A read-only numpy view of `data` (shape given) that keeps `owner` alive: no copy.
 template <class T>

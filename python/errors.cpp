@@ -33,6 +33,26 @@ void raise_status(const Status& status) { raise_with_code(status.message(), code
 
 void raise_error(const std::string& what) { raise_with_code(what, code_name(ErrorCode::kInvalidArgument)); }
 
+int64_t whole_number(const py::handle& value, const std::string& name, int64_t lo, int64_t hi) {
+  const auto refuse = [&] {
+    raise_error(name + " must be a whole number in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got " +
+                py::repr(value).cast<std::string>());
+  };
+  const py::object index = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
+  if (!index) {
+    PyErr_Clear();
+    refuse();
+  }
+  int overflow = 0;
+  const long long v = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
+  if (overflow != 0 || (v == -1 && PyErr_Occurred())) {
+    PyErr_Clear();
+    refuse();
+  }
+  if (v < lo || v > hi) refuse();
+  return v;
+}
+
 std::string describe(const py::array& array) {
   std::string text = py::str(array.dtype()).cast<std::string>() + " (";
   for (py::ssize_t i = 0; i < array.ndim(); ++i) text += (i ? ", " : "") + std::to_string(array.shape(i));

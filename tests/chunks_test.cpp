@@ -467,6 +467,10 @@ TEST(ChunkedMapper, AChunkAloneMapsAsInsideTheMeshAndReplacingItTouchesNoOther) 
   EXPECT_EQ(wrong.code(), ErrorCode::kInvalidArgument);
   EXPECT_NE(wrong.message().find("outside the chunk's cell"), std::string::npos) << wrong.message();
   EXPECT_EQ(whole.chunk(other)->corner_uv, before[cells[0] == big ? 1 : 0]);
+  // A cell 2^21 away (beyond the grid's +-2^20) is no other cell: cells are kept in 21 bits each.
+  const ChunkCell aliased{big[0] + (1 << 21), big[1], big[2]};
+  EXPECT_EQ(whole.chunk(aliased), nullptr);
+  EXPECT_FALSE(whole.remove_chunk(aliased));
   EXPECT_TRUE(whole.remove_chunk(big));
   EXPECT_FALSE(whole.remove_chunk(big));
   EXPECT_EQ(whole.chunk(big), nullptr);

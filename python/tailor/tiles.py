@@ -29,12 +29,15 @@ OUTDIR must be on a file system every worker sees, and each worker must import t
 """
 import argparse
 import functools
+import glob
 import hashlib
 import json
 import math
 import os
 import pathlib
+import re
 import shutil
+import signal
 import struct
 import sys
 import threading
@@ -52,6 +55,9 @@ FORMAT = 1  # of the manifest: a different number means every tile is written ag
 # The streamed partition's ranges of the file (at least a block each): enough for every worker of a
 # cluster to take several, so that the driver and the workers finish together.
 PARTITION_PARTS = 256
+# A tile is at most 2^20 chunk cells on a side: the streamed partition packs its coordinates in 21 bits
+# (_partition_block); the in-memory path keeps the same limit, so that both cut the same tiles.
+MAX_TILE_LEVEL = 20
 
 
 class TilesError(Exception):
@@ -487,24 +493,23 @@ def tileset_json(records, lod, up):
 # === The run ===
 
 
-def image_size(path):
-    """(width, height) of a PNG or JPEG, from its header."""
-    with open(path, "rb") as f:
-        head = f.read(32)
-        if head[:8] == b"\x89PNG\r\n\x1a\n" and head[12:16] == b"IHDR":
-            return struct.unpack(">II", head[16:24])
-        if head[:2] == b"\xff\xd8":
-            f.seek(2)
-            while True:
-                marker = f.read(2)
-                if len(marker) < 2 or marker[0] != 0xFF:
-                    break
-                (length,) = struct.unpack(">H", f.read(2))
-                if marker[1] in (0xC0, 0xC1, 0xC2, 0xC3, 0xC5, 0xC6, 0xC7, 0xC9, 0xCA, 0xCB, 0xCD, 0xCE, 0xCF):
-                    height, width = struct.unpack(">xHH", f.read(5))
-                    return width, height
-                f.seek(length - 2, 1)
-    raise TilesError("%s: not a PNG or JPEG image" % path)
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def texture_image(path):
+    """(suffix, bytes, [width, height]) of an image every tile names by URI: decoded whole as tailor map
+    reads a texture (a truncated or corrupt file is an error here, not in a client's viewer), and PNG
+    or JPEG, the images glTF allows, named by what its bytes are rather than by its file name."""
+    try:
+        width, height = tailor.image_size(path)
+    except tailor.Error as e:
+        raise TilesError(str(e)) from None
+    data = pathlib.Path(path).read_bytes()
+    if data.startswith(PNG_SIGNATURE):
+        return ".png", data, [width, height]
+    if data.startswith(b"\xff\xd8\xff"):
+        return ".jpg", data, [width, height]
+    raise TilesError("%s: texture is neither PNG nor JPEG" % path)
 
 
 def read_look(args):
@@ -513,12 +518,9 @@ def read_look(args):
     pixels, None without a texture) and colour (the colour map's path, for --field-following auto)."""
     look = {"images": {}, "orm_roles": [], "size": None, "colour": None, "notes": []}
     if args.texture:
-        if not os.path.isfile(args.texture):
-            raise TilesError("%s: no such file" % args.texture)
-        look["size"] = list(image_size(args.texture))
+        suffix, data, look["size"] = texture_image(args.texture)
         look["colour"] = args.texture
-        name = "texture" + pathlib.Path(args.texture).suffix.lower()
-        look["images"]["color"] = (name, pathlib.Path(args.texture).read_bytes())
+        look["images"]["color"] = ("texture" + suffix, data)
     elif args.material:
         m = tailor.load_material(args.material)
         look["size"] = [m["width"], m["height"]]
@@ -530,8 +532,8 @@ def read_look(args):
             )
         if m["color"]:
             look["colour"] = m["color"]
-            name = "material_color" + pathlib.Path(m["color"]).suffix.lower()
-            look["images"]["color"] = (name, pathlib.Path(m["color"]).read_bytes())
+            suffix, data, _ = texture_image(m["color"])
+            look["images"]["color"] = ("material_color" + suffix, data)
         if m["normal_png"]:
             look["images"]["normal"] = ("material_normal.png", m["normal_png"])
         if m["orm_png"]:
@@ -567,6 +569,11 @@ def tile_params(args, look, e, density):
                 "--tile-size must be the chunk cell (%g) times a power of two, got %g" % (math.ldexp(1.0, e), args.tile_size)
             )
         level = int(t) - e
+        if level > MAX_TILE_LEVEL:
+            raise TilesError(
+                "--tile-size %g is 2^%d chunk cells of %g; at most 2^%d" % (args.tile_size, level, math.ldexp(1.0, e),
+                                                                             MAX_TILE_LEVEL)
+            )
     tpu = args.texels_per_unit if args.texels_per_unit is not None else density()
     width, height = look["size"] if look["size"] else (args.texture_size, args.texture_size)
     field_following, crack_rings = resolve_field_following(args, look["colour"])
@@ -591,14 +598,8 @@ def tile_params(args, look, e, density):
 def resolve_field_following(args, colour):
     """(field_following, crack_rings) as tailor map resolves them: auto follows the direction of the
     texture (or of the material's colour map)."""
-    if args.field_following != "auto":
-        try:
-            value = float(args.field_following)
-        except ValueError:
-            raise TilesError("--field-following must be auto or a number in [0, 1], got %r" % args.field_following)
-        if not 0.0 <= value <= 1.0:
-            raise TilesError("--field-following must be auto or a number in [0, 1], got %g" % value)
-        return value, args.crack_rings
+    if args.field_following != "auto":  # a number in [0, 1] (parse_args)
+        return float(args.field_following), args.crack_rings
     if not colour:
         return 1.0, args.crack_rings
     value, rings = tailor.auto_field_following(colour)
@@ -626,26 +627,102 @@ class Progress:
             sys.stderr.flush()
 
 
+# What a folder of tiles holds: anything else in OUTDIR is not this tool's, and a run (which replaces
+# the folder) refuses to delete it.
+OWN_ENTRIES = {MANIFEST, "tileset.json", "tiles", "lod"}
+OWN_IMAGES = re.compile(r"(texture|material_color|material_normal|material_orm)\.[a-z]+")
+
+
 def previous_output(outdir, params):
-    """{tile name: {digest, path}} of an earlier run into outdir with the same parameters."""
-    manifest = outdir / MANIFEST
+    """{tile name: its record and paths} of an earlier run into outdir with the same parameters (a
+    record of the wrong shape is left out: that tile is written again). TilesError when outdir holds
+    anything such a run does not write: replacing the folder would delete it."""
     if not outdir.exists():
         return {}
-    if not manifest.exists():
+    manifest = outdir / MANIFEST
+    if not manifest.is_file():
         if any(outdir.iterdir()):
             raise TilesError("%s exists and is not a folder of tiles written by tailor.tiles" % outdir)
         return {}
+    for entry in sorted(outdir.iterdir()):
+        if entry.name not in OWN_ENTRIES and not OWN_IMAGES.fullmatch(entry.name):
+            raise TilesError(
+                "%s holds %s, which is not part of its tileset (a run replaces the folder): move it, or write "
+                "the tiles elsewhere" % (outdir, entry.name)
+            )
     try:
         old = json.loads(manifest.read_text())
     except ValueError:
         return {}
-    if old.get("params") != params:
+    if not isinstance(old, dict) or old.get("params") != params or not isinstance(old.get("tiles"), dict):
         return {}
     out = {}
-    for name, r in old.get("tiles", {}).items():
-        if isinstance(r, dict):
+    for name, r in old["tiles"].items():
+        if is_record(r):
             out[name] = dict(r, glb=str(glb_path(outdir, name)), coarse=str(coarse_path(outdir, name)))
     return out
+
+
+def is_record(r):
+    """Whether a manifest's tile record has the fields a kept tile reuses, of their types."""
+
+    def number(x):
+        return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+
+    return (
+        isinstance(r, dict)
+        and isinstance(r.get("digest"), str)
+        and isinstance(r.get("faces"), int)
+        and not isinstance(r.get("faces"), bool)
+        and r["faces"] >= 0
+        and number(r.get("error"))
+        and number(r.get("coarse_error"))
+    )
+
+
+def lock_outdir(outdir, given):
+    """Takes an exclusive lock on OUTDIR's lock file beside it (.NAME.lock) for the run: two runs into
+    one folder would each link the other's tiles as their own. Returns (descriptor, path) for
+    unlock_outdir; TilesError when another run holds it."""
+    import fcntl
+
+    path = outdir.parent / (".%s.lock" % outdir.name)
+    while True:
+        try:
+            fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
+        except OSError as e:
+            raise TilesError("%s: cannot write beside it in %s (%s)" % (given, outdir.parent, e.strerror)) from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            os.close(fd)
+            raise TilesError("%s: another tailor.tiles run is writing it" % given) from None
+        try:
+            if os.stat(path).st_ino == os.fstat(fd).st_ino:
+                return fd, path
+        except FileNotFoundError:
+            pass
+        os.close(fd)  # the run that held it removed the file meanwhile: lock the one there now
+
+
+def unlock_outdir(lock):
+    """Removes the lock file, then releases it (a run that opened the removed file sees that and
+    takes the new one)."""
+    fd, path = lock
+    try:
+        os.unlink(path)
+    except OSError:
+        pass
+    os.close(fd)
+
+
+def remove_stale(outdir):
+    """The temporary and set-aside folders a run killed beside OUTDIR left (.NAME.tmp-PID,
+    .NAME.old-PID): with the lock held, no live run owns them."""
+    for kind in ("tmp", "old"):
+        for path in outdir.parent.glob(".%s.%s-*" % (glob.escape(outdir.name), kind)):
+            if path.name.rsplit("-", 1)[1].isdigit() and path.is_dir() and not path.is_symlink():
+                shutil.rmtree(path, ignore_errors=True)
 
 
 def start_client(args):
@@ -655,7 +732,10 @@ def start_client(args):
     from dask.distributed import Client, LocalCluster
 
     if args.scheduler:
-        return Client(args.scheduler), None
+        try:
+            return Client(args.scheduler), None
+        except (ValueError, OSError, TimeoutError) as e:
+            raise TilesError("--scheduler %s: %s" % (args.scheduler, e)) from None
     # Dask starts workers with MALLOC_TRIM_THRESHOLD_=65536, which turns off glibc's adaptive mmap
     # threshold: every large buffer of the mapping is then mapped and unmapped per tile (page
     # faults: 20-30 % more time on the 6.2 M-face horse). The workers here keep glibc's default.
@@ -749,8 +829,21 @@ def check_outdir(outdir, given):
 
 
 def run(args):
+    """The whole command (main() without its printing): the summary."""
     outdir = pathlib.Path(args.output).resolve()
     check_outdir(outdir, args.output)
+    source = pathlib.Path(args.input).resolve()
+    if source == outdir or outdir in source.parents:
+        raise TilesError("%s is inside %s, which a run replaces" % (args.input, args.output))
+    lock = lock_outdir(outdir, args.output)
+    try:
+        remove_stale(outdir)
+        return run_locked(args, outdir)
+    finally:
+        unlock_outdir(lock)
+
+
+def run_locked(args, outdir):
     t0 = time.monotonic()
     # A binary little-endian PLY of triangles is partitioned by streaming it (tiles_stream); any
     # other input is loaded whole and cut in memory (--in-memory, hidden, forces that for tests).
@@ -1076,6 +1169,18 @@ def parse_args(argv):
         usage_error("--max-stretch must be in 0.01..4, got %s" % args.max_stretch)
     if args.texture_size < 1:
         usage_error("--texture-size must be at least 1, got %d" % args.texture_size)
+    if args.chunk_cell is not None and not -60 <= args.chunk_cell <= 60:  # the library's (ChunkOptions)
+        usage_error("--chunk-cell must be a whole number in -60..60 (the cell side is 2^N world units), got %d"
+                    % args.chunk_cell)
+    if args.crack_rings is not None and not 2 <= args.crack_rings <= 64:  # MappingOptions::crack_rings
+        usage_error("--crack-rings must be in 2..64, got %d" % args.crack_rings)
+    if args.field_following != "auto":
+        try:
+            value = float(args.field_following)
+        except ValueError:
+            value = float("nan")
+        if not 0.0 <= value <= 1.0:
+            usage_error("--field-following must be auto or a number in [0, 1], got '%s'" % args.field_following)
     if args.workers < 0:
         p.error("--workers must be 0 or more")
     if args.threads < 0 or args.threads > 64:
@@ -1083,8 +1188,23 @@ def parse_args(argv):
     return args
 
 
+class Terminated(BaseException):
+    """SIGTERM or SIGHUP (timeout, systemd, a batch scheduler): raised in the main thread, so that
+    the run removes its temporary folder and closes its cluster, as on Ctrl-C."""
+
+    def __init__(self, signum):
+        super().__init__(signum)
+        self.signum = signum
+
+
+def _terminate(signum, frame):
+    raise Terminated(signum)
+
+
 def main(argv=None):
     args = parse_args(argv)
+    for signum in (signal.SIGTERM, signal.SIGHUP):
+        signal.signal(signum, _terminate)
     try:
         summary = run(args)
     except TilesError as e:
@@ -1099,6 +1219,10 @@ def main(argv=None):
     except KeyboardInterrupt:
         print("tailor.tiles: interrupted; %s left as it was" % args.output, file=sys.stderr)
         return 130
+    except Terminated as e:
+        print("tailor.tiles: terminated (%s); %s left as it was" % (signal.Signals(e.signum).name, args.output),
+              file=sys.stderr)
+        return 128 + e.signum
     if args.json:
         print(json.dumps(summary, indent=1))
     elif not args.quiet:

@@ -22,6 +22,7 @@ import mmap
 import os
 import pathlib
 import shutil
+import stat
 import tempfile
 
 import numpy as np
@@ -59,6 +60,10 @@ def read_layout(path):
     counts need more bytes than the file has."""
     path = str(path)
     try:
+        # Opening a FIFO would wait for a writer: anything but a regular file is tailor.load's to
+        # refuse (it names what it is).
+        if not stat.S_ISREG(os.stat(path).st_mode):
+            return None
         with open(path, "rb") as f:
             head = f.read(1 << 20)
             size = os.fstat(f.fileno()).st_size

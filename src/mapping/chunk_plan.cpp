@@ -89,7 +89,8 @@ inline int32_t unpack_cell(uint64_t key, int axis) {
 
 Status too_many_cells() {
   return Status::error(ErrorCode::kInvalidMesh, "",
-                       "the mesh spans more than 2^21 chunk cells along an axis: give a larger chunk cell");
+                       "a face's centroid lies 2^20 chunk cells or more from the origin along an axis, or is not "
+                       "finite: give a larger chunk cell");
 }
 
 // A set of cell keys (open addressing, linear probing): the distinct cells are few (one per ~100k

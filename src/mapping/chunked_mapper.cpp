@@ -14,6 +14,12 @@
 namespace tailor {
 namespace {
 
+// Whether a cell can hold faces: the rule's cells lie within 2^20 of the origin on each axis (21
+// bits each, as pack keeps them); any other would alias one of them.
+bool in_grid(const ChunkCell& cell) {
+  return std::all_of(cell.begin(), cell.end(), [](int32_t c) { return c >= -(1 << 20) && c < (1 << 20); });
+}
+
 uint64_t pack(const ChunkCell& cell) {
   uint64_t key = 0;
   for (int k = 2; k >= 0; --k) key = (key << 21) | (static_cast<uint64_t>(cell[static_cast<size_t>(k)]) & 0x1FFFFF);
@@ -136,9 +142,10 @@ Status ChunkedMapper::set_mesh(const Mesh& mesh, std::vector<ChunkCell>* cells) 
   return Status::ok();
 }
 
-bool ChunkedMapper::remove_chunk(const ChunkCell& cell) { return chunks_.erase(pack(cell)) > 0; }
+bool ChunkedMapper::remove_chunk(const ChunkCell& cell) { return in_grid(cell) && chunks_.erase(pack(cell)) > 0; }
 
 const ChunkResult* ChunkedMapper::chunk(const ChunkCell& cell) const {
+  if (!in_grid(cell)) return nullptr;
   const auto it = chunks_.find(pack(cell));
   return it == chunks_.end() ? nullptr : &it->second;
 }

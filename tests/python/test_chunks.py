@@ -50,3 +50,29 @@ def test_cells_cut_into_parts_match_the_map_with_the_same_split():
         tailor.ChunkedMapper(-3, 4096.0, chunk_split=10)
     with pytest.raises(tailor.Error, match="chunk_split must be None"):
         tailor.map(mesh, chunk_split=-1)
+
+
+def test_bad_arguments_are_tailor_errors_naming_them():
+    mesh = tailor.load(DATA / "meshes" / "horse.ply")
+    for call, message in (
+        (lambda: tailor.ChunkedMapper(-4, 4096.0).chunk((2**31, 0, 0)), r"^cell must be a whole number in"),
+        (lambda: tailor.ChunkedMapper(-4, 4096.0).chunk((0.5, 0, 0)), r"^cell must be a whole number in .*got 0\.5$"),
+        (lambda: tailor.ChunkedMapper(-4, 4096.0, texture_size=(1.5, 2)), r"^texture_size's width must be a whole"),
+        (lambda: tailor.ChunkedMapper(-4, 4096.0, crack_rings=10**12), r"^crack_rings must be a whole number in 2\.\.64"),
+        (lambda: tailor.plan_chunks(mesh, 2**40), r"^chunk_cell must be a whole number in -60\.\.60"),
+        (lambda: tailor.chunk_cell_exponent(0.01, 2**40), r"^chunk_cell must be a whole number in -60\.\.60"),
+        (lambda: tailor.map(mesh, chunks="on", chunk_cell=61), r"^chunk_cell must be a whole number in -60\.\.60"),
+    ):
+        with pytest.raises(tailor.Error, match=message):
+            call()
+    # numpy's integers are whole numbers too.
+    assert tailor.ChunkedMapper(-4, 4096.0, texture_size=(np.int64(256), 256)).chunk((np.int32(1), 0, 0)) is None
+
+
+def test_a_cell_beyond_the_grid_is_no_other_cell():
+    # Cells are kept by 21 bits a coordinate: one 2^21 away must not find (or remove) this one.
+    mapper = tailor.ChunkedMapper(-2, 100.0)
+    cell = mapper.set_mesh(tailor.load(DATA / "meshes" / "horse.ply"))[0]
+    far = (cell[0] + 2**21, cell[1], cell[2])
+    assert mapper.chunk(far) is None and not mapper.remove_chunk(far)
+    assert mapper.chunk(cell) is not None

@@ -256,7 +256,7 @@ def test_errors_are_one_line_and_leave_the_output_as_it_was(tmp_path):
     bad = tmp_path / "bad.png"
     bad.write_bytes(b"not an image")
     code, _, stderr = run_tiles(HORSE, "-o", out, "--workers", 0, "--texture", bad)
-    assert code == 1 and "not a PNG or JPEG" in stderr and stderr.count("\n") == 1
+    assert code == 1 and "bad.png: not a readable PNG, JPEG" in stderr and stderr.count("\n") == 1
     assert folder_bytes(out) == good
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.png", "tiles"]
     # A folder of something else is not replaced.
@@ -613,7 +613,7 @@ def test_a_block_of_the_partition_is_its_records_grouped_by_tile():
                 assert got[1].shape[0] > 1
     empty = tailor._tailor._partition_block(np.empty((0, 3), np.int64), np.empty((0, 3, 3), np.float32), CELL, 1, 4)
     assert [a.shape[0] for a in empty] == [0, 0, 1, 0]
-    with pytest.raises(tailor.Error, match="more than 2.21 chunk cells"):
+    with pytest.raises(tailor.Error, match="2.20 chunk cells or more from the origin"):
         tailor._tailor._partition_block(ids[:1], corners[:1] * np.float32(1e30), -60, 0, 8)
     for corner in range(3):  # a face with a NaN coordinate has no cell, wherever the NaN is
         bad = corners[:1].copy()
@@ -787,11 +787,11 @@ def test_a_bad_streamed_ply_is_one_line_and_leaves_nothing(tmp_path):
             "truncated",
         ),
     }
-    # A cell so small that the mesh spans more than 2^21 cells: found while partitioning, after
-    # the temporary folder (and its scratch folder) exist.
-    cases["cells"] = (HORSE, "more than 2^21 chunk cells")
+    # A cell so small that the mesh reaches 2^20 cells from the origin: found while partitioning,
+    # after the temporary folder (and its scratch folder) exist.
+    cases["cells"] = (HORSE, "2^20 chunk cells or more from the origin")
     # The same, found by the partition's tasks on a cluster (the file cut into two ranges).
-    cases["cells on a cluster"] = (HORSE, "more than 2^21 chunk cells")
+    cases["cells on a cluster"] = (HORSE, "2^20 chunk cells or more from the origin")
     for name, (ply, message) in cases.items():
         extra = ["--chunk-cell", -40] if name.startswith("cells") else []
         if name == "cells on a cluster":
@@ -834,3 +834,124 @@ def test_the_streamed_driver_holds_a_block_not_the_mesh(tmp_path):
     assert not (tmp_path / "out").exists()
     # The interpreter, numpy and tailor take about 45 MB; a block of 32768 faces about 10 MB more.
     assert peaks["streamed"] < 80e6 and peaks["streamed"] < peaks["in memory"] / 2, peaks
+
+
+def test_one_run_at_a_time_writes_a_folder_and_nothing_but_its_tileset_is_replaced(tmp_path):
+    import fcntl
+
+    out = tmp_path / "out"
+    common = [HORSE, "-o", out, "--workers", 0, "--chunk-cell", CELL, "--no-lod", "-q"]
+    assert run_tiles(*common)[0] == 0
+    good = folder_bytes(out)
+    # While another run holds OUTDIR's lock (beside it), a second one refuses at once: it would link
+    # that run's tiles as its own.
+    lock = os.open(tmp_path / ".out.lock", os.O_RDWR | os.O_CREAT)
+    fcntl.flock(lock, fcntl.LOCK_EX)
+    code, _, stderr = run_tiles(*common, "--texture-size", 256)
+    os.close(lock)
+    assert code == 1 and stderr == "tailor.tiles: error: %s: another tailor.tiles run is writing it\n" % out
+    assert folder_bytes(out) == good
+    # A run removes its lock file, and what runs killed beside OUTDIR left (a pid's temporary folder).
+    (tmp_path / ".out.tmp-999999" / "tiles").mkdir(parents=True)
+    assert run_tiles(*common)[0] == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+    # A file OUTDIR holds besides its tileset is never deleted: the run refuses, naming it.
+    (out / "index.html").write_text("a viewer page")
+    code, _, stderr = run_tiles(*common)
+    assert code == 1 and "holds index.html, which is not part of its tileset" in stderr
+    assert (out / "index.html").read_text() == "a viewer page"
+    (out / "index.html").unlink()
+    # Nor is the input, when it lies in OUTDIR.
+    shutil.copy(HORSE, out / "scan.ply")
+    code, _, stderr = run_tiles(out / "scan.ply", *common[1:])
+    assert code == 1 and "scan.ply is inside" in stderr and (out / "scan.ply").is_file()
+    (out / "scan.ply").unlink()
+    # A manifest of the wrong shape keeps nothing: every tile is written again, the same bytes.
+    manifest = json.loads((out / "tailor-tiles.json").read_text())
+    manifest["tiles"] = {name: dict(r, faces="many") for name, r in manifest["tiles"].items()}
+    (out / "tailor-tiles.json").write_text(json.dumps(manifest))
+    code, stdout, stderr = run_tiles(*common[:-1], "--json")
+    assert code == 0, stderr
+    assert json.loads(stdout)["kept"] == 0 and folder_bytes(out) == good
+
+
+def test_a_terminated_run_cleans_up_like_an_interrupted_one(tmp_path):
+    import signal
+    import time
+
+    # A 300k-face height field, so that the run is still mapping when the signal comes.
+    n = 390
+    x, y = np.meshgrid(np.arange(n + 1, dtype=np.float32), np.arange(n + 1, dtype=np.float32))
+    positions = np.stack([x.ravel(), y.ravel(), np.sin(x * 0.1).ravel() * np.cos(y * 0.13).ravel()], axis=1)
+    i = (np.arange(n)[None, :] + (n + 1) * np.arange(n)[:, None]).ravel()
+    faces = np.concatenate([np.stack([i, i + 1, i + n + 2], 1), np.stack([i, i + n + 2, i + n + 1], 1)])
+    mesh = tmp_path / "field.ply"
+    records = np.zeros(faces.shape[0], dtype=[("n", "u1"), ("v", "<i4", 3)])
+    records["n"], records["v"] = 3, faces
+    header = (
+        "ply\nformat binary_little_endian 1.0\nelement vertex %d\nproperty float x\nproperty float y\n"
+        "property float z\nelement face %d\nproperty list uchar int vertex_indices\nend_header\n"
+        % (positions.shape[0], faces.shape[0])
+    )
+    mesh.write_bytes(header.encode() + positions.astype("<f4").tobytes() + records.tobytes())
+    out = tmp_path / "out"
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    run = subprocess.Popen(
+        [sys.executable, "-m", "tailor.tiles", str(mesh), "-o", str(out), "--workers", "0", "--threads", "1", "-q"],
+        env=env, stderr=subprocess.PIPE, text=True,
+    )
+    deadline = time.monotonic() + 120
+    while not list(tmp_path.glob(".out.tmp-*")) and run.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.005)
+    run.send_signal(signal.SIGTERM)
+    _, stderr = run.communicate(timeout=120)
+    assert run.returncode == 128 + signal.SIGTERM, stderr
+    assert stderr == "tailor.tiles: terminated (SIGTERM); %s left as it was\n" % out
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["field.ply"]
+
+
+def test_textures_are_read_as_tailor_map_reads_them(tmp_path):
+    out = tmp_path / "out"
+    common = [HORSE, "-o", out, "--workers", 0, "--chunk-cell", CELL, "--no-lod", "-q"]
+    # Decoded whole, whatever --field-following says: a truncated image is refused, not copied.
+    truncated = tmp_path / "truncated.png"
+    truncated.write_bytes(GRAVEL.read_bytes()[:100])
+    code, _, stderr = run_tiles(*common, "--texture", truncated, "--field-following", 1)
+    assert code == 1 and "truncated.png: truncated or corrupt image data" in stderr and not out.exists()
+    # A BMP colour map is readable but not a glTF image: refused, as tailor map refuses it.
+    bmp = tmp_path / "colour.bmp"
+    row = bytes(3 * 8)
+    bmp.write_bytes(
+        b"BM" + struct.pack("<IHHI", 54 + 8 * len(row), 0, 0, 54)
+        + struct.pack("<IiiHHIIiiII", 40, 8, 8, 1, 24, 0, 8 * len(row), 2835, 2835, 0, 0) + row * 8
+    )
+    material = tmp_path / "material.json"
+    material.write_text(json.dumps({"maps": [{"file": "colour.bmp", "role": "color"}]}))
+    code, _, stderr = run_tiles(*common, "--material", material)
+    assert code == 1 and "colour.bmp: texture is neither PNG nor JPEG" in stderr and not out.exists()
+    # Named by what the bytes are: a PNG called .jpg is written as texture.png.
+    disguised = tmp_path / "gravel.jpg"
+    shutil.copy(GRAVEL, disguised)
+    assert run_tiles(*common, "--texture", disguised)[0] == 0
+    assert (out / "texture.png").read_bytes() == GRAVEL.read_bytes() and not (out / "texture.jpg").exists()
+
+
+def test_options_out_of_range_are_usage_errors(tmp_path):
+    out = tmp_path / "out"
+    for option, value, message in (
+        ("--chunk-cell", 61, "--chunk-cell must be a whole number in -60..60"),
+        ("--crack-rings", 1, "--crack-rings must be in 2..64"),
+        ("--field-following", 2, "--field-following must be auto or a number in [0, 1]"),
+    ):
+        code, _, stderr = run_tiles(HORSE, "-o", out, "--workers", 0, option, value)
+        assert code == 2 and message in stderr and stderr.count("\n") == 1, stderr
+    # A tile of more than 2^20 cells: refused naming --tile-size, loaded whole or streamed alike.
+    for extra in ([], ["--in-memory"]):
+        code, _, stderr = run_tiles(HORSE, "-o", out, "--workers", 0, "--chunk-cell", CELL, "--tile-size", 131072, *extra)
+        assert code == 1 and "--tile-size 131072 is 2^21 chunk cells of 0.0625; at most 2^20" in stderr, stderr
+    # A FIFO is refused as tailor map refuses it (opening it would wait for a writer).
+    fifo = tmp_path / "pipe.ply"
+    os.mkfifo(fifo)
+    code, _, stderr = run_tiles(fifo, "-o", out, "--workers", 0)
+    assert code == 1 and "not a regular file" in stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["pipe.ply"]
