@@ -54,6 +54,7 @@ Status ChunkedMapper::check() const {
                          "texels per unit must be positive and give 0.001 to 1e7 pixels per chunk cell");
   if (options_.orientation.axis == AxisSource::kSkeleton)
     return Status::error(ErrorCode::kInvalidArgument, "", "the skeleton axis needs the whole mesh, not chunks");
+  TAILOR_RETURN_IF_ERROR(internal::check_mapping_values(options_.mapping));
   return check_map_options(options_);
 }
 

@@ -89,6 +89,23 @@ Status check_mapping_inputs(const Mesh& mesh, const Topology& topology, const Fa
   if (frames.face_count() != face_count || frames.local.size() != 6 * face_count ||
       frames.variation.size() != face_count || frames.anchor.size() != 2 * face_count)
     return Status::error(ErrorCode::kInvalidMesh, "", "face frames do not match the mesh");
+  if (!options.seam_faces.empty() && options.seam_faces.size() != face_count)
+    return Status::error(ErrorCode::kInvalidArgument, "", "seam face flags must hold one entry per face");
+  return internal::check_mapping_values(options);
+}
+
+// Cleared, not freed: a caller mapping again reuses the memory (no page faults on 37 MB).
+void clear_atlas(Atlas& atlas) {
+  atlas.corner_uv.clear();
+  atlas.patch.clear();
+  atlas.patch_count = 0;
+}
+
+}  // namespace
+
+namespace internal {
+
+Status check_mapping_values(const MappingOptions& options) {
   if (!(options.scale > 0.f) || !std::isfinite(options.scale) || options.scale > 1e7f)
     return Status::error(ErrorCode::kInvalidArgument, "", "scale must be a positive finite number of pixels (<= 1e7)");
   if (!(options.max_stretch >= 0.01f && options.max_stretch <= 4.f))
@@ -108,8 +125,6 @@ Status check_mapping_inputs(const Mesh& mesh, const Topology& topology, const Fa
     return Status::error(ErrorCode::kInvalidArgument, "", "relax iterations must be at most 1000");
   if (!std::isfinite(options.factor_step) || options.factor_step > 1.0)
     return Status::error(ErrorCode::kInvalidArgument, "", "factor step must be finite and at most 1");
-  if (!options.seam_faces.empty() && options.seam_faces.size() != face_count)
-    return Status::error(ErrorCode::kInvalidArgument, "", "seam face flags must hold one entry per face");
   if (options.use_seed_point && !(std::isfinite(options.seed_point[0]) && std::isfinite(options.seed_point[1]) &&
                                   std::isfinite(options.seed_point[2])))
     return Status::error(ErrorCode::kInvalidArgument, "", "seed point must be finite");
@@ -121,17 +136,6 @@ Status check_mapping_inputs(const Mesh& mesh, const Topology& topology, const Fa
                          "symmetry 4 needs the patches mode and a texture period >= 1 px");
   return Status::ok();
 }
-
-// Cleared, not freed: a caller mapping again reuses the memory (no page faults on 37 MB).
-void clear_atlas(Atlas& atlas) {
-  atlas.corner_uv.clear();
-  atlas.patch.clear();
-  atlas.patch_count = 0;
-}
-
-}  // namespace
-
-namespace internal {
 
 double factor_step_for(const MappingOptions& options, size_t face_count) {
   const bool thesis = options.mode == MappingMode::kThesis;

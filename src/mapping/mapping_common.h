@@ -86,6 +86,10 @@ Status map_chunks(const Mesh& mesh, const MapTextureOptions& options, TextureMap
 //! vertices' bounding box rounded to a power of two (0 for a mesh without extent).
 double chunk_texels_per_unit(const Mesh& mesh, const MapTextureOptions& options);
 
+//! The option values map_texture refuses (kInvalidArgument naming the first), for callers that
+//! check them before they have a mesh (ChunkedMapper::check).
+Status check_mapping_values(const MappingOptions& options);
+
 //! The growth's age per placed face: the option, or the mode's default (MappingOptions::factor_step).
 double factor_step_for(const MappingOptions& options, size_t face_count);
 

@@ -947,7 +947,7 @@ def test_options_out_of_range_are_usage_errors(tmp_path):
         assert code == 2 and message in stderr and stderr.count("\n") == 1, stderr
     # A tile of more than 2^20 cells: refused naming --tile-size, loaded whole or streamed alike.
     for extra in ([], ["--in-memory"]):
-        code, _, stderr = run_tiles(HORSE, "-o", out, "--workers", 0, "--chunk-cell", CELL, "--tile-size", 131072, *extra)
+        code, _, stderr = run_tiles(HORSE, "-o", out, "--workers", 0, "--chunk-cell", CELL, "--tile-size", 2**17, *extra)
         assert code == 1 and "--tile-size 131072 is 2^21 chunk cells of 0.0625; at most 2^20" in stderr, stderr
     # A FIFO is refused as tailor map refuses it (opening it would wait for a writer).
     fifo = tmp_path / "pipe.ply"
