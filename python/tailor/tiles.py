@@ -1213,8 +1213,9 @@ def main(argv=None):
     except (tailor.Error, tiles_stream.StreamError) as e:
         print("tailor.tiles: error: %s" % e, file=sys.stderr)
         return 1
-    except OSError as e:
-        print("tailor.tiles: error: %s" % e, file=sys.stderr)
+    except OSError as e:  # a write of the output (a full disk): name the file, or the folder
+        where = e.filename if e.filename is not None else args.output
+        print("tailor.tiles: error: %s: %s" % (where, e.strerror or e), file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         print("tailor.tiles: interrupted; %s left as it was" % args.output, file=sys.stderr)

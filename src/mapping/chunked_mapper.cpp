@@ -48,10 +48,9 @@ ChunkedMapper::ChunkedMapper(const MapTextureOptions& options, int cell_exponent
 Status ChunkedMapper::check() const {
   if (cell_exponent_ < -60 || cell_exponent_ > 60)
     return Status::error(ErrorCode::kInvalidArgument, "", "chunk cell exponent must be in -60..60");
-  const double per_cell = texels_per_unit_ * cell_size_;
-  if (!(texels_per_unit_ > 0) || !std::isfinite(texels_per_unit_) || !(per_cell >= 1e-3 && per_cell <= 1e7))
-    return Status::error(ErrorCode::kInvalidArgument, "",
-                         "texels per unit must be positive and give 0.001 to 1e7 pixels per chunk cell");
+  if (!(texels_per_unit_ > 0) || !std::isfinite(texels_per_unit_))
+    return Status::error(ErrorCode::kInvalidArgument, "", "texels per unit must be a positive number");
+  TAILOR_RETURN_IF_ERROR(internal::check_chunk_scale(texels_per_unit_, cell_size_));
   if (options_.orientation.axis == AxisSource::kSkeleton)
     return Status::error(ErrorCode::kInvalidArgument, "", "the skeleton axis needs the whole mesh, not chunks");
   TAILOR_RETURN_IF_ERROR(internal::check_mapping_values(options_.mapping));

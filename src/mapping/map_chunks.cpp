@@ -70,8 +70,6 @@ MapTextureOptions chunk_map_options(const MapTextureOptions& options, const std:
   return o;
 }
 
-namespace {
-
 // A chunk is mapped in its cell's frame at texels_per_unit * size pixels per cell side, which the
 // mapping takes within 0.001..1e7 (its scale's range). Out of range says what a user can change;
 // the cell's exponent is -60..60, so a mesh far from unit scale may need no chunks at all.
@@ -86,8 +84,6 @@ Status check_chunk_scale(double texels_per_unit, double size) {
                            ", outside 0.001 to 1e7: give another chunk cell (2^-60 to 2^60) or texel density, "
                            "or map without chunks");
 }
-
-}  // namespace
 
 Status map_chunk(const MapTextureOptions& options, const std::array<double, 3>& origin, double size,
                  double texels_per_unit, uint32_t threads, ProgressCallback progress, ChunkWorker& w) {

@@ -89,6 +89,10 @@ double chunk_texels_per_unit(const Mesh& mesh, const MapTextureOptions& options)
 //! The option values map_texture refuses (kInvalidArgument naming the first), for callers that
 //! check them before they have a mesh (ChunkedMapper::check).
 Status check_mapping_values(const MappingOptions& options);
+//! Whether chunks of side `size` (world units) map at texels_per_unit: their scale,
+//! texels_per_unit * size pixels a cell, must be in the mapping's 0.001..1e7 (kInvalidArgument
+//! saying what to change otherwise).
+Status check_chunk_scale(double texels_per_unit, double size);
 
 //! The growth's age per placed face: the option, or the mode's default (MappingOptions::factor_step).
 double factor_step_for(const MappingOptions& options, size_t face_count);
