@@ -694,9 +694,13 @@ def lock_outdir(outdir, given):
             raise TilesError("%s: cannot write beside it in %s (%s)" % (given, outdir.parent, e.strerror)) from None
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
+        except BlockingIOError:
             os.close(fd)
             raise TilesError("%s: another tailor.tiles run is writing it" % given) from None
+        except OSError as e:  # a file system without locks: the run goes on, unguarded
+            print("tailor.tiles: warning: %s: cannot lock %s (%s): make sure no other run writes it"
+                  % (given, path, e.strerror), file=sys.stderr)
+            return fd, path
         try:
             if os.stat(path).st_ino == os.fstat(fd).st_ino:
                 return fd, path
@@ -1198,6 +1202,8 @@ class Terminated(BaseException):
 
 
 def _terminate(signum, frame):
+    for other in (signal.SIGTERM, signal.SIGHUP):  # a second signal must not cut the clean-up short
+        signal.signal(other, signal.SIG_IGN)
     raise Terminated(signum)
 
 
