@@ -60,10 +60,11 @@ class TAILOR_API ChunkedMapper {
   //! changed when it fails.
   Status set_mesh(const Mesh& mesh, std::vector<ChunkCell>* cells = nullptr);
 
-  //! Drops a chunk; false when it held nothing.
+  //! Drops a chunk; false when it held nothing (as a cell 2^20 or more from the origin always does).
   bool remove_chunk(const ChunkCell& cell);
 
-  //! The chunk's mapping, or nullptr when it holds nothing. Valid until that chunk is set or removed.
+  //! The chunk's mapping, or nullptr when it holds nothing (as a cell 2^20 or more from the origin
+  //! always does). Valid until that chunk is set or removed.
   const ChunkResult* chunk(const ChunkCell& cell) const;
 
   //! The cells that hold a chunk, in cell order.
