@@ -183,6 +183,16 @@ expect_error 2 "\(run 'tailor --help'\)$" -- "$tailor"
 expect_error 2 "unknown argument '--bogus' \(run 'tailor --help'\)$" -- "$tailor" --bogus
 expect_error 2 "unknown argument '--ouput' \(run 'tailor map --help'\)$" -- "$tailor" map "$mesh" --ouput "$tmp/x.glb"
 expect_error 2 "unknown argument '--nope' \(run 'tailor map --help'\)$" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --nope
+# render writes a .png where it can, checked before any work, never over a file it draws from: its
+# --texture, or the texture the mesh names (an .obj's .mtl).
+mkdir -p "$tmp/render"
+cp "$texture" "$tmp/render/own.png"
+"$tailor" map "$mesh" --texture "$texture" -o "$tmp/render/m.obj" -q && ok || fail "map to .obj for render"
+expect_error 2 "output must be a .png file" -- "$tailor" render "$tmp/render/m.obj" -o "$tmp/render/m.jpg"
+expect_error 2 "directory of the output \(--output\) does not exist" -- "$tailor" render "$tmp/render/m.obj" -o "$tmp/render/no/m.png"
+expect_error 2 "would overwrite an input" -- "$tailor" render "$tmp/render/m.obj" -o "$tmp/render/own.png" --texture "$tmp/render/own.png"
+expect_error 2 "would overwrite an input" -- "$tailor" render "$tmp/render/m.obj" -o "$tmp/render/$(basename "$texture")"
+cmp -s "$tmp/render/own.png" "$texture" && cmp -s "$tmp/render/$(basename "$texture")" "$texture" && ok || fail "render replaced an input"
 # --symmetry 4 (experimental): the same bytes for any thread count, the metrics count quarter turns
 # (in the report and in eval); it needs a square texture (a 64x48 render here) and eval takes 1 or 4.
 "$tailor" map "$mesh" --texture "$texture" -o "$tmp/s4a.glb" --symmetry 4 --threads 1 --stats "$tmp/s4.json" -q &&

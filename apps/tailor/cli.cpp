@@ -5,7 +5,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -94,6 +96,14 @@ std::atomic<bool>& stop_requested() {
   }();
   (void)installed;
   return g_stop;
+}
+
+bool ends_with_png(const std::string& path) {
+  if (path.size() < 4) return false;
+  std::string ext = path.substr(path.size() - 4);
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  return ext == ".png";
 }
 
 Status check_outputs(const std::vector<OutputPath>& outputs, const std::vector<std::string>& inputs) {

@@ -65,6 +65,9 @@ struct OutputPath {
   std::string option;  //!< e.g. "--output", "--preview"
 };
 
+//! Whether a path ends in .png, in any case (what tile and render write).
+bool ends_with_png(const std::string& path);
+
 //! Before any work: every output goes to an existing directory and is not itself a directory, no
 //! two outputs share a path, and no output overwrites one of `inputs` (empty entries ignored).
 //! Fails with kInvalidArgument (exit 2), so a refused run writes nothing.

@@ -58,6 +58,13 @@ int run_render(const RenderArgs& args) {
         Status::error(ErrorCode::kInvalidArgument, "", "bad --up '" + args.up + "'", "use x, y, z, -x, -y or -z"));
   }
 
+  // Before any work, as map and tile do: a picture never replaces the mesh, a texture or a normal
+  // map it was drawn from, and lands where it can be written.
+  if (!ends_with_png(args.output))
+    return report_error(Status::error(ErrorCode::kInvalidArgument, args.output, "output must be a .png file"));
+  if (Status s = check_outputs({{args.output, "--output"}}, {args.input, args.texture, args.normal_map}); !s)
+    return report_error(s);
+
   Mesh mesh;
   Image texture;
   GltfMaterialMaps maps;  // a .glb's normal and occlusion maps, and its tangents
@@ -84,6 +91,8 @@ int run_render(const RenderArgs& args) {
           difference >= 0 && difference <= kQuarterTurnNoiseLevels && shift_x == 0 && shift_y == 0 ? 4 : 1;
     }
   }
+  // The texture file the mesh names (.mtl, a .ply's TextureFile, a .gltf's image URI) is an input too.
+  if (Status s = check_outputs({{args.output, "--output"}}, {report.texture_path}); !s) return report_error(s);
   if (args.texture.empty() && texture.empty() && !report.texture_path.empty()) {
     // The texture an .obj's .mtl or a .ply's TextureFile names, next to it (as tailor map writes).
     status = load_image(report.texture_path, texture, args.image_options);

@@ -58,13 +58,6 @@ int judge_tiles(const std::vector<TileQuality>& tiles, const TileCliOptions& opt
 //! Whether the run measures its tiles: for the summary line, --json, or the verdict.
 bool measures(const TileCliOptions& opt) { return !opt.quiet || !opt.json.empty() || !opt.allow_misses; }
 
-bool ends_with_png(const std::string& path) {
-  if (path.size() < 4) return false;
-  std::string ext = path.substr(path.size() - 4);
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
-  return ext == ".png";
-}
 
 int run_tile_set(TileCliOptions opt);
 
