@@ -326,8 +326,9 @@ if [[ -w /dev/full ]]; then
 fi
 # 4. SIGTERM while an output is written: no temporary file left, exit 143 (killed by the signal).
 # The horse OBJ from above takes ~0.2 s to export; the signal is sent as soon as its temporary
-# file shows. (Background jobs of a script ignore SIGINT; the unit test atomic_file_test covers
-# SIGINT and SIGHUP.)
+# file shows, twice (as `timeout` does: the process, then its group; a second signal must not end
+# the process half-way through the clean-up). (Background jobs of a script ignore SIGINT; the unit
+# test atomic_file_test covers SIGINT and SIGHUP.)
 mkdir "$tmp/sig"
 "$tailor" map "$tmp/horse.obj" -o "$tmp/sig/h.obj" --no-crack-closing -q 2>/dev/null &
 pid=$!
@@ -335,6 +336,7 @@ sent=0
 for _ in $(seq 20000); do
   if compgen -G "$tmp/sig/.tailor-*" >/dev/null; then
     kill -TERM "$pid" && sent=1
+    kill -TERM "$pid" 2>/dev/null
     break
   fi
   kill -0 "$pid" 2>/dev/null || break

@@ -62,8 +62,15 @@ void discard_temporary(const std::string& temporary, int slot) {
 extern "C" void on_terminating_signal(int signal) {
   const int saved_errno = errno;
   remove_temporaries_on_signal();
-  // SA_RESETHAND restored the default action; the signal is blocked while this handler runs, so it
-  // is delivered (and ends the process) as soon as the handler returns.
+  // The default action only now, after the clean-up: a second signal meanwhile (Ctrl-C twice,
+  // `timeout` signalling the process and then its group) is blocked here or runs this handler on
+  // another thread, where a default action reset on entry let it end the process half-way through
+  // (temporary files left). The signal is blocked while this handler runs, so it is delivered (and
+  // ends the process) as soon as the handler returns.
+  struct sigaction default_action {};
+  default_action.sa_handler = SIG_DFL;
+  sigemptyset(&default_action.sa_mask);
+  sigaction(signal, &default_action, nullptr);
   raise(signal);
   errno = saved_errno;
 }
@@ -138,8 +145,8 @@ void install_signal_cleanup() {
     if (sigaction(signal, nullptr, &old) != 0 || old.sa_handler == SIG_IGN) continue;  // nohup, background jobs
     struct sigaction action {};
     action.sa_handler = on_terminating_signal;
-    action.sa_flags = SA_RESETHAND;
-    sigemptyset(&action.sa_mask);
+    sigemptyset(&action.sa_mask);  // the three blocked while one is handled on this thread
+    for (const int other : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&action.sa_mask, other);
     sigaction(signal, &action, nullptr);
   }
 }
