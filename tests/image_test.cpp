@@ -49,8 +49,10 @@ std::string chunk(const std::string& type, const std::string& data) {
   return be32(static_cast<uint32_t>(data.size())) + type + data + be32(crc32(type + data));
 }
 
-//! A PNG with the given header fields and raw (unfiltered) scanline bytes.
-std::string make_png(uint32_t width, uint32_t height, int depth, int color_type, const std::string& raw) {
+//! A PNG with the given header fields and raw (unfiltered) scanline bytes; `extra`: chunks between
+//! the header and the data.
+std::string make_png(uint32_t width, uint32_t height, int depth, int color_type, const std::string& raw,
+                     const std::string& extra = "") {
   std::string ihdr = be32(width) + be32(height);
   ihdr += static_cast<char>(depth);
   ihdr += static_cast<char>(color_type);
@@ -61,7 +63,7 @@ std::string make_png(uint32_t width, uint32_t height, int depth, int color_type,
       stbi_zlib_compress(reinterpret_cast<unsigned char*>(copy.data()), static_cast<int>(copy.size()), &zlen, 8);
   std::string idat(reinterpret_cast<char*>(z), static_cast<size_t>(zlen));
   std::free(z);
-  return std::string("\x89PNG\r\n\x1a\n", 8) + chunk("IHDR", ihdr) + chunk("IDAT", idat) + chunk("IEND", "");
+  return std::string("\x89PNG\r\n\x1a\n", 8) + chunk("IHDR", ihdr) + extra + chunk("IDAT", idat) + chunk("IEND", "");
 }
 
 TEST(ImageIo, ReadsGreyPng) {
@@ -116,6 +118,25 @@ TEST(ImageIo, ReadsTgaAndBmp) {
     EXPECT_EQ(back.channels, 3);
     EXPECT_EQ(back.pixels, im.pixels) << path;
   }
+}
+
+TEST(ImageIo, ReadsGreyAndRgbPngsWithATransparentColour) {
+  // A tRNS chunk makes one colour transparent: the decoder adds the alpha channel the header does
+  // not count (such files were refused as "header and data disagree").
+  const std::string rgb_raw = std::string("\0", 1) + std::string("\x10\x20\x30\x40\x50\x60", 6);
+  const std::string rgb = temp_path("transparent_rgb.png");
+  write_bytes(rgb, make_png(2, 1, 8, 2, rgb_raw, chunk("tRNS", std::string("\0\x10\0\x20\0\x30", 6))));
+  Image im;
+  Status s = load_image(rgb, im);
+  ASSERT_TRUE(s.is_ok()) << s.message();
+  ASSERT_EQ(im.channels, 4);
+  EXPECT_EQ(im.pixels, (std::vector<uint8_t>{0x10, 0x20, 0x30, 0, 0x40, 0x50, 0x60, 255}));
+  const std::string grey = temp_path("transparent_grey.png");
+  write_bytes(grey, make_png(2, 1, 8, 0, std::string("\0\x07\x09", 3), chunk("tRNS", std::string("\0\x07", 2))));
+  s = load_image(grey, im);
+  ASSERT_TRUE(s.is_ok()) << s.message();
+  ASSERT_EQ(im.channels, 2);
+  EXPECT_EQ(im.pixels, (std::vector<uint8_t>{7, 0, 9, 255}));
 }
 
 TEST(ImageIo, Reads16BitPngAsEightBit) {

@@ -184,6 +184,11 @@ Status load_pixels(const std::string& path, Image& image, Image16* deep, const I
     return Status::error(ErrorCode::kUnsupported, path, "unsupported channel count " + std::to_string(channels));
 
   int w = 0, h = 0, c = 0;
+  // A grey or RGB PNG with a tRNS chunk (one colour transparent) decodes with an alpha channel its
+  // header does not count: the sizes must agree, the channels may be one more.
+  const auto disagrees = [&] {
+    return w != width || h != height || !(c == channels || ((channels == 1 || channels == 3) && c == channels + 1));
+  };
   if (deep && stbi_is_16_bit_from_memory(data, length)) {
     stbi_us* samples = stbi_load_16_from_memory(data, length, &w, &h, &c, 0);
     if (samples == nullptr) {
@@ -191,7 +196,7 @@ Status load_pixels(const std::string& path, Image& image, Image16* deep, const I
       return Status::error(ErrorCode::kInvalidImage, path, "truncated or corrupt image data",
                            std::string("decoder: ") + (reason ? reason : "unknown error"));
     }
-    if (w != width || h != height || c != channels) {
+    if (disagrees()) {
       stbi_image_free(samples);
       return Status::error(ErrorCode::kInvalidImage, path, "image header and data disagree on the size");
     }
@@ -211,7 +216,7 @@ Status load_pixels(const std::string& path, Image& image, Image16* deep, const I
     return Status::error(ErrorCode::kInvalidImage, path, "truncated or corrupt image data",
                          std::string("decoder: ") + (reason ? reason : "unknown error"));
   }
-  if (w != width || h != height || c != channels) {
+  if (disagrees()) {
     stbi_image_free(pixels);
     return Status::error(ErrorCode::kInvalidImage, path, "image header and data disagree on the size");
   }
