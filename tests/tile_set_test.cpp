@@ -400,6 +400,17 @@ TEST(TileSetCli, SetAndMaterialWriteTheInputNamesIntoTheFolder) {
   const nlohmann::json j2 = nlohmann::json::parse(jf2, nullptr, false);
   EXPECT_EQ(j2["normal_convention"], "dx");
   EXPECT_EQ(j2["maps"][1]["normal"], true);
+  // A "normal" that is not true or false is refused: read as false, the normal map was tiled as colour.
+  {
+    std::ofstream m(dir + "/bad.json");
+    m << R"({"maps": [{"file": "bark_color.png"}, {"file": "bark_normal.png", "normal": "yes"}]})";
+  }
+  EXPECT_EQ(test::run_command(std::string(TAILOR_BINARY) + " tile --material " + dir + "/bad.json -o " + dir +
+                                  "/out3 --quiet --allow-misses",
+                              out, &err),
+            2);
+  EXPECT_NE(err.find("\"normal\" must be true or false (maps[1])"), std::string::npos) << err;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/out3"));
   std::filesystem::remove_all(dir);
 }
 

@@ -58,7 +58,6 @@ int judge_tiles(const std::vector<TileQuality>& tiles, const TileCliOptions& opt
 //! Whether the run measures its tiles: for the summary line, --json, or the verdict.
 bool measures(const TileCliOptions& opt) { return !opt.quiet || !opt.json.empty() || !opt.allow_misses; }
 
-
 int run_tile_set(TileCliOptions opt);
 
 //! A 16-bit PNG input: tiled as a set of one map (make_tileable_set keeps the 16 bits).
@@ -210,7 +209,14 @@ Status read_material(TileCliOptions& opt) {
     std::string file = m["file"].get<std::string>();
     if (file.empty() || file[0] != '/') file = dir + "/" + file;
     opt.set.push_back(file);
-    const bool normal = (m.contains("normal") && m["normal"].is_boolean() && m["normal"].get<bool>()) ||
+    // A "normal" that is not true or false ("yes") would silently tile a normal map as colour.
+    if (m.contains("normal") && !m["normal"].is_boolean())
+      return Status::error(ErrorCode::kInvalidArgument, opt.material, "\"normal\" must be true or false",
+                           "maps[" + std::to_string(i) + "]");
+    if (m.contains("type") && !m["type"].is_string())
+      return Status::error(ErrorCode::kInvalidArgument, opt.material, "\"type\" must be a string",
+                           "maps[" + std::to_string(i) + "]");
+    const bool normal = (m.contains("normal") && m["normal"].get<bool>()) ||
                         (m.contains("type") && m["type"].is_string() && m["type"].get<std::string>() == "normal");
     if (normal) opt.normal_maps.push_back(file);
   }
