@@ -178,6 +178,29 @@ head -c $((17 * 1024 * 1024)) /dev/zero >"$tmp/big.json"
   || fail "a body over 16 MiB is not refused"
 [ "$(status_of -H 'Content-Type: application/json' -d '{}' "${url}api/status")" = 405 ] || fail "POST to a GET route is not 405"
 [ "$(status_of -X POST "${url}")" = 405 ] || fail "POST / is not 405"
+# 70 POSTs whose bodies never finish (more than the server's 64 connections): a real request is
+# still answered at once (the oldest unfinished one is dropped), not after the 30 s body deadline.
+python3 - "$port" <<'EOF' || fail "slow POST bodies locked a real request out"
+import socket, sys, time
+port = int(sys.argv[1])
+head = ("POST /api/edit HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nContent-Type: application/json\r\n"
+        "Content-Length: 1000\r\n\r\n{" % port).encode()
+slow = []
+for _ in range(70):
+    s = socket.create_connection(("127.0.0.1", port), timeout=5)
+    s.sendall(head)
+    slow.append(s)
+time.sleep(0.3)
+start = time.monotonic()
+with socket.create_connection(("127.0.0.1", port), timeout=2) as s:
+    s.sendall(("GET /api/status HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nConnection: close\r\n\r\n" % port).encode())
+    answer = s.recv(100)
+took = time.monotonic() - start
+for s in slow:
+    s.close()
+if not (answer.startswith(b"HTTP/1.1 200") and took < 1.0):
+    sys.exit("answer %r after %.2f s" % (answer[:40], took))
+EOF
 python3 - "$repo/web/index.html" "$repo/web/edit.html" <<'EOF' || fail "edit.html's importmap differs from index.html's (the CSP allows that one's hash)"
 import re, sys
 maps = [re.search(r'<script type="importmap">(.*?)</script>', open(p, encoding="utf-8").read(), re.S).group(1) for p in sys.argv[1:]]

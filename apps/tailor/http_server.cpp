@@ -35,7 +35,8 @@ constexpr int kStallSeconds = 30;            // a client that accepts no byte of
 constexpr size_t kMaxBodyBytes = 16u << 20;  // a POST body (tailor edit: face lists and strokes) at most 16 MiB
 constexpr int kBodySeconds = 30;             // a POST body must arrive within this
 constexpr size_t kMaxWorkers = 64;           // connections served at once; when full, the oldest one still
-                                             // waiting for its request is dropped; 503 only when none is waiting
+                                             // waiting for its request (or a POST's body) is dropped; 503 only
+                                             // when none is waiting
 
 // Content-Security-Policy of every answer: scripts, styles, images and fetches from this server only.
 // The one inline script, index.html's importmap, is allowed by its SHA-256 (tests/viewer_test.sh
@@ -413,7 +414,10 @@ void StaticServer::handle(Connection& conn, const std::atomic<bool>& stop) const
     if (n <= 0) return;
     request.append(buf.data(), static_cast<size_t>(n));
   }
-  if (!conn.start_serving()) return;  // dropped for a newer connection just now
+  // A POST stays droppable until its body has arrived too: 64 slow bodies would otherwise lock
+  // real requests out for their whole body deadline, as slow headers cannot.
+  const bool post = request.compare(0, 5, "POST ") == 0;
+  if (!post && !conn.start_serving()) return;  // dropped for a newer connection just now
   const size_t line_end = request.find("\r\n");
   const std::string line = request.substr(0, line_end);
   const size_t sp1 = line.find(' ');
@@ -459,6 +463,7 @@ void StaticServer::handle(Connection& conn, const std::atomic<bool>& stop) const
       req.body.append(buf.data(), static_cast<size_t>(n));
     }
     if (req.body.size() > length) req.body.resize(length);
+    if (!conn.start_serving()) return;  // dropped for a newer connection while its body came
     return answer(client, call_handler(*handler, req), false, stop);
   }
   if (handler != nullptr) {
