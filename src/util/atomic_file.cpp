@@ -198,6 +198,17 @@ Status AtomicFileWriter::open() {
     error_ = s;
     return error_;
   }
+  // A file already there keeps its mode, and one the user may not write is not replaced (a plain
+  // open for writing would fail): the rename would swap in a new file whatever its permissions.
+  mode_t mode = 0666 & ~process_umask();  // what a plain open(O_CREAT, 0666) gives
+  struct stat existing;
+  if (::stat(target_.c_str(), &existing) == 0) {
+    if (access(target_.c_str(), W_OK) != 0) {
+      error_ = io_error(path_, "cannot write file", errno);
+      return error_;
+    }
+    mode = existing.st_mode & 07777;
+  }
   // Created and registered with the cleanup signals blocked: a signal in between would leave it.
   std::string tmp = temporary_template(target_);
   sigset_t cleanup_signals, previous;
@@ -214,8 +225,7 @@ Status AtomicFileWriter::open() {
   }
   temporary_ = tmp;
   slot_ = slot;
-  // The mode a plain open(O_CREAT, 0666) gives: what the user's umask allows.
-  if (fchmod(fd, 0666 & ~process_umask()) != 0 || !(file_ = fdopen(fd, "wb"))) {
+  if (fchmod(fd, mode) != 0 || !(file_ = fdopen(fd, "wb"))) {
     const int err = errno;
     close(fd);
     discard_temporary(temporary_, slot_);
