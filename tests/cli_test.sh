@@ -183,6 +183,9 @@ expect_error 2 "\(run 'tailor --help'\)$" -- "$tailor"
 expect_error 2 "unknown argument '--bogus' \(run 'tailor --help'\)$" -- "$tailor" --bogus
 expect_error 2 "unknown argument '--ouput' \(run 'tailor map --help'\)$" -- "$tailor" map "$mesh" --ouput "$tmp/x.glb"
 expect_error 2 "unknown argument '--nope' \(run 'tailor map --help'\)$" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --nope
+# Whole numbers are whole: no 0 pixels, no negative seed read as 2^64 - 1.
+expect_error 2 "--max-image-pixels: must be a whole number, at least 1 \(run 'tailor tile --help'\)$" -- "$tailor" tile "$texture" -o "$tmp/t.png" --max-image-pixels 0
+expect_error 2 "--seed: must be a whole number, 0 to 2\^64 - 1" -- "$tailor" tile "$texture" -o "$tmp/t.png" --seed -1
 # render writes a .png where it can, checked before any work, never over a file it draws from: its
 # --texture, or the texture the mesh names (an .obj's .mtl).
 mkdir -p "$tmp/render"

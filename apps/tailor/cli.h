@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <array>
 #include <atomic>
+#include <charconv>
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -80,6 +81,29 @@ template <class T>
 CLI::Option* add_documented(CLI::App* app, const OptionDoc& doc, T& field) {
   return app->add_option(std::string(doc.flag), field, std::string(doc.help))->capture_default_str();
 }
+
+//! Whether `text` is a whole number that fits 64 bits unsigned (CLI11 reads "-1" into one as
+//! 2^64 - 1, and saturates a longer one).
+inline bool whole_uint64(const std::string& text, uint64_t& value) {
+  const char* end = text.data() + text.size();
+  const auto [stop, error] = std::from_chars(text.data(), end, value);
+  return !text.empty() && error == std::errc() && stop == end;
+}
+//! A whole number of 64 bits (--seed).
+inline const CLI::Validator kWholeNumber(
+    [](std::string& text) -> std::string {
+      uint64_t value = 0;
+      return whole_uint64(text, value) ? std::string() : "must be a whole number, 0 to 2^64 - 1";
+    },
+    "");
+//! A whole number of at least 1 (--max-image-pixels; CLI11's PositiveNumber said "Value 0 not in
+//! range 0.000000 to 1797...").
+inline const CLI::Validator kAtLeastOne(
+    [](std::string& text) -> std::string {
+      uint64_t value = 0;
+      return whole_uint64(text, value) && value > 0 ? std::string() : "must be a whole number, at least 1";
+    },
+    "POSITIVE");
 
 //! Adds --symmetry (1 or 4) of eval and render, documented by `doc`: when it is not given, a .glb
 //! from tailor map --symmetry 4 decides (LoadReport::texture_symmetry; the caller reads

@@ -82,7 +82,7 @@ void register_eval_tile(CLI::App& app, Runner& run) {
   cmd->add_option("tile", opt->tile, "The tile to check (.png .jpg .tga .bmp)")->required();
   cmd->add_option("exemplar", opt->exemplar, "The exemplar it was made from (enables histogram, gradient, coherence)");
   add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), opt->image_options.max_pixels)
-      ->check(CLI::PositiveNumber);
+      ->check(kAtLeastOne);
   cmd->add_flag("--json", opt->json, "Print a JSON object instead of text");
   cmd->add_flag("-q,--quiet", opt->quiet, "Print only whether the targets are met");
   cmd->footer("Example:\n  tailor tile bricks.jpg -o bricks_tile.png && tailor eval-tile bricks_tile.png bricks.jpg");

@@ -469,7 +469,7 @@ void register_map(CLI::App& app, Runner& run) {
   cmd->add_option("--texture-size", opt->mapping_args.texture_size, "Texture size in pixels when no --texture is given")
       ->capture_default_str();
   add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), opt->image_options.max_pixels)
-      ->check(CLI::PositiveNumber);
+      ->check(kAtLeastOne);
   add_documented(cmd, option_doc(kExportOptionDocs, "compression"), opt->compress);
   add_documented(cmd, option_doc(kExportOptionDocs, "uv_set"), opt->uv_set)->check(CLI::Range(0, 7));
   add_documented(cmd, option_doc(kExportOptionDocs, "up"), opt->up);

@@ -160,7 +160,7 @@ void register_render(CLI::App& app, Runner& run) {
   add_symmetry_option(cmd, option_doc(kRenderOptionDocs, "seam_symmetry"), args->options.seam_symmetry,
                       "; with --texture, 4 when that texture is unchanged by a quarter turn");
   add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), args->image_options.max_pixels)
-      ->check(CLI::PositiveNumber);
+      ->check(kAtLeastOne);
   cmd->add_flag("-q,--quiet", args->quiet, "print nothing but errors");
   cmd->footer(
       "Examples:\n"

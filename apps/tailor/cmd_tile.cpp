@@ -401,7 +401,7 @@ void register_tile(CLI::App& app, Runner& run) {
   add_documented(cmd, option_doc(kTileOptionDocs, "block"), options.block)->check(CLI::Range(8, 256));
   const OptionDoc& overlap = option_doc(kTileOptionDocs, "overlap");  // its default, 0, stands for block/4
   cmd->add_option(std::string(overlap.flag), options.overlap, std::string(overlap.help))->check(CLI::Range(1, 127));
-  add_documented(cmd, option_doc(kTileOptionDocs, "seed"), options.seed);
+  add_documented(cmd, option_doc(kTileOptionDocs, "seed"), options.seed)->check(kWholeNumber);
   cmd->add_option("--variants", opt->variants, "Number of tiles with identical borders, different interiors")
       ->capture_default_str()
       ->check(CLI::Range(1, 64));
@@ -412,7 +412,7 @@ void register_tile(CLI::App& app, Runner& run) {
   const OptionDoc& same_size = option_doc(kTileOptionDocs, "same_size");
   cmd->add_flag(std::string(same_size.flag), options.same_size, std::string(same_size.help));
   add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), opt->image_options.max_pixels)
-      ->check(CLI::PositiveNumber);
+      ->check(kAtLeastOne);
   cmd->add_option("--json", opt->json, "Write the metrics and settings as JSON to this file");
   cmd->add_flag("-q,--quiet", opt->quiet, "Print nothing but errors");
   cmd->add_flag("--allow-misses", opt->allow_misses,
