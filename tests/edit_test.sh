@@ -176,6 +176,8 @@ status_of() { curl -s -o /dev/null -w '%{http_code}' --max-time 10 "$@"; }
 head -c $((17 * 1024 * 1024)) /dev/zero >"$tmp/big.json"
 [ "$(status_of -H 'Content-Type: application/json' --data-binary "@$tmp/big.json" "${url}api/edit")" = 413 ] \
   || fail "a body over 16 MiB is not refused"
+[ "$(status_of -H 'Content-Type: application/json' -H 'Content-Length: 99999999999999999999' -d '{}' "${url}api/edit")" = 413 ] \
+  || fail "a Content-Length past 2^64 is not refused as too large"
 [ "$(status_of -H 'Content-Type: application/json' -d '{}' "${url}api/status")" = 405 ] || fail "POST to a GET route is not 405"
 [ "$(status_of -X POST "${url}")" = 405 ] || fail "POST / is not 405"
 # 70 POSTs whose bodies never finish (more than the server's 64 connections): a real request is

@@ -449,6 +449,9 @@ void StaticServer::handle(Connection& conn, const std::atomic<bool>& stop) const
     const auto [end, error] = std::from_chars(length_text.data(), length_text.data() + length_text.size(), length);
     // No Content-Length and no Transfer-Encoding: no body (RFC 9112; `curl -X POST` sends neither).
     // Chunked bodies are refused: the length must be known before anything is read.
+    // A length past 2^64 is a body over the limit, not a missing length.
+    if (error == std::errc::result_out_of_range && end == length_text.data() + length_text.size())
+      return answer(client, HttpResponse::error(413, "body over 16 MiB"), false, stop);
     if ((!length_text.empty() && (error != std::errc() || end != length_text.data() + length_text.size())) ||
         !header_value(request, "transfer-encoding").empty())
       return answer(client, HttpResponse::error(411, "POST needs a Content-Length"), false, stop);
