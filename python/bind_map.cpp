@@ -150,6 +150,20 @@ const std::string& map_docstring() {
   return text;
 }
 
+// An image file decoded as tailor map reads a texture, without the GIL (tailor.Error when it
+// cannot be).
+Image read_image(const py::object& file) {
+  const std::string path = path_of(file);  // with the GIL: it reads a Python object
+  Image image;
+  Status s;
+  {
+    const py::gil_scoped_release release;
+    s = load_image(path, image);
+  }
+  if (!s) raise_status(s);
+  return image;
+}
+
 }  // namespace
 
 void bind_map(py::module_& m) {
@@ -419,14 +433,7 @@ void bind_map(py::module_& m) {
   m.def(
       "auto_field_following",
       [](const py::object& texture) {
-        const std::string path = path_of(texture);  // with the GIL: it reads a Python object
-        Image image;
-        Status s;
-        {
-          const py::gil_scoped_release release;
-          s = load_image(path, image);
-        }
-        if (!s) raise_status(s);
+        const Image image = read_image(texture);
         MappingOptions mapping;
         {
           const py::gil_scoped_release release;
@@ -442,14 +449,7 @@ void bind_map(py::module_& m) {
   m.def(
       "image_size",
       [](const py::object& texture) {
-        const std::string path = path_of(texture);
-        Image image;
-        Status s;
-        {
-          const py::gil_scoped_release release;
-          s = load_image(path, image);
-        }
-        if (!s) raise_status(s);
+        const Image image = read_image(texture);
         return py::make_tuple(image.width, image.height);
       },
       py::arg("texture"),
