@@ -414,10 +414,6 @@ void StaticServer::handle(Connection& conn, const std::atomic<bool>& stop) const
     if (n <= 0) return;
     request.append(buf.data(), static_cast<size_t>(n));
   }
-  // A POST stays droppable until its body has arrived too: 64 slow bodies would otherwise lock
-  // real requests out for their whole body deadline, as slow headers cannot.
-  const bool post = request.compare(0, 5, "POST ") == 0;
-  if (!post && !conn.start_serving()) return;  // dropped for a newer connection just now
   const size_t line_end = request.find("\r\n");
   const std::string line = request.substr(0, line_end);
   const size_t sp1 = line.find(' ');
@@ -427,6 +423,9 @@ void StaticServer::handle(Connection& conn, const std::atomic<bool>& stop) const
   // name as Host. Only the loopback names with this port are answered.
   if (!host_allowed(header_value(request, "host"))) return send_status(client, 403, "Forbidden", stop);
   const std::string method = line.substr(0, sp1);
+  // A POST stays droppable until its body has arrived too: 64 slow bodies would otherwise lock
+  // real requests out for their whole body deadline, as slow headers cannot.
+  if (method != "POST" && !conn.start_serving()) return;  // dropped for a newer connection just now
   const std::string target = line.substr(sp1 + 1, sp2 - sp1 - 1);
   if (method != "GET" && method != "HEAD" && method != "POST")
     return send_status(client, 405, "Method Not Allowed", stop);

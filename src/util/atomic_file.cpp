@@ -22,6 +22,9 @@ namespace tailor::internal {
 namespace {
 thread_local FileBatch* active_batch = nullptr;
 
+// The signals that remove the temporary files before ending the process.
+constexpr int kCleanupSignals[] = {SIGINT, SIGTERM, SIGHUP};
+
 // The registry of live temporary files, for the signal handler: fixed slots (no allocation), each
 // claimed with a lock-free compare-exchange (0 free, 1 being filled, 2 live: the handler unlinks
 // only live ones). Paths longer than a slot, or a 257th live file, are simply not registered (the
@@ -140,13 +143,13 @@ void remove_temporaries_on_signal() {
 }
 
 void install_signal_cleanup() {
-  for (const int signal : {SIGINT, SIGTERM, SIGHUP}) {
+  for (const int signal : kCleanupSignals) {
     struct sigaction old {};
     if (sigaction(signal, nullptr, &old) != 0 || old.sa_handler == SIG_IGN) continue;  // nohup, background jobs
     struct sigaction action {};
     action.sa_handler = on_terminating_signal;
     sigemptyset(&action.sa_mask);  // the three blocked while one is handled on this thread
-    for (const int other : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&action.sa_mask, other);
+    for (const int other : kCleanupSignals) sigaddset(&action.sa_mask, other);
     sigaction(signal, &action, nullptr);
   }
 }
@@ -213,7 +216,7 @@ Status AtomicFileWriter::open() {
   std::string tmp = temporary_template(target_);
   sigset_t cleanup_signals, previous;
   sigemptyset(&cleanup_signals);
-  for (const int signal : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&cleanup_signals, signal);
+  for (const int signal : kCleanupSignals) sigaddset(&cleanup_signals, signal);
   pthread_sigmask(SIG_BLOCK, &cleanup_signals, &previous);
   const int fd = mkstemp(tmp.data());  // O_CREAT|O_EXCL, mode 0600, a random name
   const int mkstemp_errno = errno;
