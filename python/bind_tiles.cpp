@@ -12,6 +12,7 @@
 #include "bindings.h"
 #include "tailor/chunks.h"
 #include "tailor/export.h"
+#include "tailor/map_warnings.h"
 #include "tailor/material.h"
 
 namespace tailor::python {
@@ -166,6 +167,10 @@ chunk k's face ids are faces[chunk_start[k]:chunk_start[k+1]].)");
       py::arg("median_edge"), py::arg("chunk_cell") = py::none(),
       "chunk_cell_exponent(median_edge, chunk_cell=None) -> int: the cell exponent plan_chunks takes for a mesh\n"
       "of this median edge length (chunk_cell when given)");
+  m.def("_far_from_origin_warning", py::overload_cast<double, double>(&far_from_origin_warning),
+        py::arg("largest_coordinate"), py::arg("median_edge"),
+        "_far_from_origin_warning(largest_coordinate, median_edge) -> str: for tailor.tiles: what tailor map says\n"
+        "of positions that 32-bit floats round by more than 1 % of the median edge ('' when they do not)");
   m.def(
       "chunk_cells",
       [](const py::array& corners, int cell_exponent) {

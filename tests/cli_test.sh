@@ -527,6 +527,15 @@ evaluated = evaluated.get("metrics", evaluated)["visible_seam_ratio"]
 assert abs(mapped - evaluated) < 1e-9, (mapped, evaluated)
 PY
 
+# --- positions far from the origin (a georeferenced scan): 32-bit floats round the shape, and map says so ---
+awk '/^v /{printf "v %.3f %.3f %.3f\n", $2 * 50 + 500000, $3 * 50 + 4000000, $4 * 50} /^f /{gsub(/\/[^ ]*/, ""); print}' "$mesh" >"$tmp/utm.obj"
+awk '/^v /{printf "v %.3f %.3f %.3f\n", $2 * 50, $3 * 50, $4 * 50} /^f /{gsub(/\/[^ ]*/, ""); print}' "$mesh" >"$tmp/local.obj"
+"$tailor" map "$tmp/utm.obj" -o "$tmp/utm.glb" 2>"$tmp/utm.err" >/dev/null || fail "map of a mesh far from the origin"
+grep -Eq "^tailor: warning: positions reach 4e\+06 units from the origin, where 32-bit floats are 0\.25 apart \([0-9]+ % of the median edge, [0-9.]+\): the shape is rounded" \
+  "$tmp/utm.err" && ok || fail "no warning for positions far from the origin: $(cat "$tmp/utm.err")"
+"$tailor" map "$tmp/local.obj" -o "$tmp/local.glb" 2>"$tmp/local.err" >/dev/null && [[ ! -s $tmp/local.err ]] && ok ||
+  fail "the same mesh near the origin warned: $(cat "$tmp/local.err")"
+
 # --- a texture that does not wrap, and fewer than one repeat: one warning line each, and the summary's repeats ---
 photo=tests/data/textures/water-caustics-300.jpg
 "$tailor" map "$mesh" -t "$photo" -o "$tmp/wrap.glb" >"$tmp/wrap.txt" 2>"$tmp/wrap.err" || fail "map with a photo"

@@ -19,8 +19,22 @@ namespace tailor {
 //! sqrt(2) of this); MapRun's summary states the figure the map used. O(V).
 TAILOR_API double map_repeats(const Mesh& mesh, const MapTextureOptions& options);
 
+//! Coordinates above this share of the median edge apart (the float32 step at the largest |x|)
+//! make far_from_origin_warning speak: at 1 % a face's normal already tilts by about half a degree.
+constexpr double kFarFromOriginStep = 0.01;
+
+//! The sentence about positions so far from the origin, against the size of the mesh's edges (the
+//! median of a sample of up to 65,536 faces), that 32-bit floats round its shape by more than
+//! kFarFromOriginStep of an edge: georeferenced scans (UTM or ECEF coordinates, a glTF node's
+//! large translation applied on loading). Empty when the floats keep the shape. O(V).
+TAILOR_API std::string far_from_origin_warning(const Mesh& mesh);
+//! The same from the largest |coordinate| and the median edge length (tailor.tiles' survey of a
+//! streamed file). Empty when either is not positive and finite.
+TAILOR_API std::string far_from_origin_warning(double largest_coordinate, double median_edge);
+
 //! The warnings of mapping `mesh` with `options` under `texture` (may be empty: not looked at),
-//! one sentence each, empty when there is nothing to say. Any mode: the texture does not wrap
+//! one sentence each, empty when there is nothing to say. Any mode: positions far from the origin
+//! (far_from_origin_warning); the texture does not wrap
 //! (a wrap ratio, eval-tile's measure, above kWrapRatioSeamless: every repeat shows a cut; the
 //! sentence names the `tailor tile` command that fixes it); the texture repeats less than once
 //! across the mesh (map_repeats; part of it is never seen). With symmetry 4: the texture is not

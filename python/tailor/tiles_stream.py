@@ -283,7 +283,8 @@ def survey(layout, chunk_cell, block_faces=BLOCK_FACES):
     and the chunk rule's cell exponent from the median edge length (exact: plan_chunks takes element
     n // 2 of the 3F lengths). The second pass, for the median's low 16 bits, runs only when the bin
     of the coarse histogram that holds the median spans two exponents. Returns {faces, lo, hi,
-    median_edge (None when the bin decided, or with chunk_cell), cell_exponent}."""
+    median_edge (None when the bin decided, or with chunk_cell), about_median (the median, or the
+    low end of its bin when that decided; None with chunk_cell), cell_exponent}."""
     body = _Body(layout)
     try:
         _check_finite(body, block_faces)
@@ -299,7 +300,7 @@ def survey(layout, chunk_cell, block_faces=BLOCK_FACES):
             tailor._tailor._survey_block(corners, lo, hi, coarse if chunk_cell is None else None)
         if faces == 0:
             raise StreamError("%s: mesh has no faces" % layout.path)
-        median = None
+        median = decided = None
         if chunk_cell is None:
             rank = (3 * faces) // 2
             cumulative = np.cumsum(coarse)
@@ -321,7 +322,8 @@ def survey(layout, chunk_cell, block_faces=BLOCK_FACES):
             exponent = tailor.chunk_cell_exponent(decided if chunk_cell is None else 0.0, chunk_cell)
         except tailor.Error as e:
             raise StreamError("%s: %s" % (layout.path, e)) from None
-        return {"faces": faces, "lo": lo, "hi": hi, "median_edge": median, "cell_exponent": exponent}
+        return {"faces": faces, "lo": lo, "hi": hi, "median_edge": median, "about_median": decided,
+                "cell_exponent": exponent}
     finally:
         body.close()
 

@@ -5,6 +5,9 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "tailor/tiling.h"
 
@@ -24,9 +27,59 @@ double map_repeats(const Mesh& mesh, const MapTextureOptions& options) {
   return options.mapping.scale * extent / options.mapping.texture_period_px;
 }
 
+namespace {
+
+// The median length of the nonzero edges of up to 65,536 faces spread over the mesh (0: none).
+double sampled_median_edge(const Mesh& mesh) {
+  const size_t faces = mesh.face_count();
+  const size_t stride = std::max<size_t>(1, faces / 65536);
+  std::vector<double> lengths;
+  lengths.reserve(3 * std::min<size_t>(faces, 65536 + 1));
+  for (size_t f = 0; f < faces; f += stride)
+    for (size_t k = 0; k < 3; ++k) {
+      const float* a = &mesh.positions[3 * size_t{mesh.indices[3 * f + k]}];
+      const float* b = &mesh.positions[3 * size_t{mesh.indices[3 * f + (k + 1) % 3]}];
+      const double dx = double{a[0]} - b[0], dy = double{a[1]} - b[1], dz = double{a[2]} - b[2];
+      const double length = std::sqrt(dx * dx + dy * dy + dz * dz);
+      if (length > 0.0) lengths.push_back(length);
+    }
+  if (lengths.empty()) return 0.0;
+  std::nth_element(lengths.begin(), lengths.begin() + lengths.size() / 2, lengths.end());
+  return lengths[lengths.size() / 2];
+}
+
+}  // namespace
+
+std::string far_from_origin_warning(const Mesh& mesh) {
+  float largest = 0.f;
+  for (const float x : mesh.positions) largest = std::max(largest, std::fabs(x));
+  return far_from_origin_warning(largest, sampled_median_edge(mesh));
+}
+
+std::string far_from_origin_warning(double largest, double median) {
+  if (!(largest > 0.0) || !std::isfinite(largest) || !(median > 0.0) || !std::isfinite(median)) return {};
+  // Floats in [2^e, 2^(e+1)) are 2^(e-23) apart: the step every coordinate there was rounded to.
+  const double step = std::ldexp(1.0, std::ilogb(static_cast<float>(largest)) - 23);
+  if (step <= kFarFromOriginStep * median) return {};
+  const double ratio = step / median;
+  char share[64];
+  if (ratio < 1.0)
+    std::snprintf(share, sizeof share, "%.0f %% of", 100.0 * ratio);
+  else
+    std::snprintf(share, sizeof share, "%.3g times", ratio);
+  char line[480];
+  std::snprintf(line, sizeof line,
+                "positions reach %.3g units from the origin, where 32-bit floats are %.3g apart (%s the median "
+                "edge, %.3g): the shape is rounded to that step and the map follows it; give the mesh in a frame "
+                "near its own centre (a local origin, as scanning tools export with a coordinate offset)",
+                static_cast<double>(largest), step, share, median);
+  return line;
+}
+
 std::vector<std::string> map_warnings(const Mesh& mesh, const MapTextureOptions& options, const Image& texture,
                                       const std::string& texture_name) {
   std::vector<std::string> warnings;
+  if (std::string far = far_from_origin_warning(mesh); !far.empty()) warnings.push_back(std::move(far));
   const MappingOptions& mapping = options.mapping;
   // A texture whose wrap is a cut (eval-tile's wrap ratio above its target): every repeat shows it.
   double wrap_x = 0.0, wrap_y = 0.0;

@@ -955,3 +955,18 @@ def test_options_out_of_range_are_usage_errors(tmp_path):
     code, _, stderr = run_tiles(fifo, "-o", out, "--workers", 0)
     assert code == 1 and "not a regular file" in stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["pipe.ply"]
+
+
+def test_positions_far_from_the_origin_are_warned_of(tmp_path):
+    # A georeferenced scan (UTM coordinates) in 32-bit floats: its shape is rounded to 0.25 units
+    # there, half an edge of this horse; tiles says so as tailor map does, streamed or loaded whole.
+    mesh = tailor.load(HORSE)
+    scaled = mesh.positions.astype(np.float64) * 500
+    for name, offset, warned in (("utm.ply", (500000.0, 4000000.0, 100.0), True), ("local.ply", (0.0, 0.0, 0.0), False)):
+        path = tmp_path / name
+        write_ply(path, scaled + offset, mesh.faces)
+        for extra in ([], ["--in-memory"]):
+            code, _, stderr = run_tiles(path, "-o", tmp_path / "out", "--workers", 0, "--no-lod", *extra)
+            assert code == 0, stderr
+            found = "warning: positions reach 4e+06 units from the origin, where 32-bit floats are 0.25 apart" in stderr
+            assert found == warned, stderr
