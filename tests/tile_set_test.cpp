@@ -411,6 +411,26 @@ TEST(TileSetCli, SetAndMaterialWriteTheInputNamesIntoTheFolder) {
             2);
   EXPECT_NE(err.find("\"normal\" must be true or false (maps[1])"), std::string::npos) << err;
   EXPECT_FALSE(std::filesystem::exists(dir + "/out3"));
+  // A key tile does not know is named (a typo would be ignored without a word); the material.json
+  // tile writes, given back to it, has none.
+  {
+    std::ofstream m(dir + "/typo.json");
+    m << R"({"maps": [{"file": "bark_color.png"}, {"file": "bark_normal.png", "nomal": true}], "colour": 1})";
+  }
+  ASSERT_EQ(test::run_command(std::string(TAILOR_BINARY) + " tile --material " + dir + "/typo.json -o " + dir +
+                                  "/out4 --allow-misses",
+                              out, &err),
+            0)
+      << err;
+  EXPECT_NE(err.find("typo.json: unknown key 'colour' ignored (known: maps, "), std::string::npos) << err;
+  EXPECT_NE(err.find("typo.json: maps[1]: unknown key 'nomal' ignored (known: file, normal, "), std::string::npos)
+      << err;
+  ASSERT_EQ(test::run_command(std::string(TAILOR_BINARY) + " tile --material " + dir + "/out2/material.json -o " + dir +
+                                  "/out5 --allow-misses",
+                              out, &err),
+            0)
+      << err;
+  EXPECT_EQ(err.find("unknown key"), std::string::npos) << err;
   std::filesystem::remove_all(dir);
 }
 

@@ -6,10 +6,12 @@
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
+#include <initializer_list>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "cli.h"
@@ -19,6 +21,7 @@
 #include "tailor/tiling.h"
 #include "util/atomic_file.h"
 #include "util/bounded_json.h"
+#include "util/text_scan.h"
 
 namespace tailor::cli {
 namespace {
@@ -187,6 +190,20 @@ int run_tile(const TileCliOptions& opt) {
   return judge_tiles(run.tiles, opt);
 }
 
+//! A key of the material JSON that read_material does not know ("nomal": true) would be ignored
+//! without a word: a warning names it. What tile writes in its material.json (source, bits, ...)
+//! and map's "role" are known.
+void warn_unknown_keys(const TileCliOptions& opt, const nlohmann::json& object,
+                       std::initializer_list<std::string_view> known, const std::string& where) {
+  for (const auto& item : object.items()) {
+    if (std::find(known.begin(), known.end(), item.key()) != known.end()) continue;
+    std::string list;
+    for (const std::string_view key : known) list += (list.empty() ? "" : ", ") + std::string(key);
+    warn(opt.quiet, opt.material + ": " + where + "unknown key " + internal::quote_input(item.key()) +
+                        " ignored (known: " + list + ")");
+  }
+}
+
 //! --material JSON: {"maps": [{"file": "color.png"}, {"file": "normal.png", "normal": true}, ...],
 //! "normal_convention": "gl"}; files relative to the JSON's folder. Fills opt.set / normal_maps.
 Status read_material(TileCliOptions& opt) {
@@ -201,11 +218,14 @@ Status read_material(TileCliOptions& opt) {
     return Status::error(ErrorCode::kInvalidArgument, opt.material,
                          "not a material description (expected {\"maps\": [{\"file\": ...}, ...]})");
   const std::string dir = dir_name(opt.material);
+  warn_unknown_keys(opt, j, {"maps", "normal_convention", "symmetry", "width", "height"}, "");
   for (size_t i = 0; i < j["maps"].size(); ++i) {
     const nlohmann::json& m = j["maps"][i];
     if (!m.is_object() || !m.contains("file") || !m["file"].is_string())
       return Status::error(ErrorCode::kInvalidArgument, opt.material, "map without a \"file\" string",
                            "maps[" + std::to_string(i) + "]");
+    warn_unknown_keys(opt, m, {"file", "normal", "type", "role", "source", "bits", "channels", "variants"},
+                      "maps[" + std::to_string(i) + "]: ");
     std::string file = m["file"].get<std::string>();
     if (file.empty() || file[0] != '/') file = dir + "/" + file;
     opt.set.push_back(file);
