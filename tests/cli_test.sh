@@ -196,6 +196,12 @@ expect_error 2 "directory of the output \(--output\) does not exist" -- "$tailor
 expect_error 2 "would overwrite an input" -- "$tailor" render "$tmp/render/m.obj" -o "$tmp/render/own.png" --texture "$tmp/render/own.png"
 expect_error 2 "would overwrite an input" -- "$tailor" render "$tmp/render/m.obj" -o "$tmp/render/$(basename "$texture")"
 cmp -s "$tmp/render/own.png" "$texture" && cmp -s "$tmp/render/$(basename "$texture")" "$texture" && ok || fail "render replaced an input"
+# A texture the mesh names that is not there is named in the warning (not "no texture in").
+mv "$tmp/render/$(basename "$texture")" "$tmp/render/gone.png"
+"$tailor" render "$tmp/render/m.obj" -o "$tmp/render/r.png" --size 64x48 2>"$tmp/render/r.err" >/dev/null &&
+  grep -q "^tailor: warning: cannot read the texture $tmp/render/m.obj names (.*$(basename "$texture")): showing a neutral checker$" \
+    "$tmp/render/r.err" && [[ $(wc -l <"$tmp/render/r.err") -eq 1 ]] && ok ||
+  fail "render of a mesh whose texture is gone: $(cat "$tmp/render/r.err")"
 # --symmetry 4 (experimental): the same bytes for any thread count, the metrics count quarter turns
 # (in the report and in eval); it needs a square texture (a 64x48 render here) and eval takes 1 or 4.
 "$tailor" map "$mesh" --texture "$texture" -o "$tmp/s4a.glb" --symmetry 4 --threads 1 --stats "$tmp/s4.json" -q &&

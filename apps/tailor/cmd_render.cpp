@@ -117,7 +117,11 @@ int run_render(const RenderArgs& args) {
                                       "run 'tailor map' first, or use --view patches"));
   }
   if (options.view == PreviewView::kTexture && texture.empty()) {
-    warn(args.quiet, "no texture in " + args.input + " and no --texture: showing a neutral checker");
+    if (report.texture_path.empty() && !report.texture_named.empty())  // named, but its header unread
+      warn(args.quiet, "cannot read the texture " + args.input + " names (" + report.texture_named +
+                           "): showing a neutral checker");
+    else if (report.texture_path.empty())
+      warn(args.quiet, "no texture in " + args.input + " and no --texture: showing a neutral checker");
   }
 
   Image picture;

@@ -92,11 +92,12 @@ struct LoadReport {
   bool texture_file = false;         //!< that texture is a file next to the .gltf, .mtl or .ply (only its header read)
   std::string texture_path;          //!< OBJ, PLY and a .gltf's image file: that file's path (empty: none, or no
                                      //!< header read)
-  std::string texture_named;         //!< the base colour texture the file names, even when its header could
-                                     //!< not be read (OBJ, PLY: its path; glTF: "image N"); empty: none
-  uint32_t texture_symmetry = 1;     //!< 4 where the file says the map is 4-fold (written by tailor map
-                                     //!< --symmetry 4: ExportOptions::symmetry): glb: that texture's material
-                                     //!< (without a texture, the first primitive's); OBJ: its .mtl; else 1
+  std::string
+      texture_named;  //!< the base colour texture the file names, even when its header could
+                      //!< not be read (OBJ, PLY, a .gltf's image file: its path; else glTF: "image N"); empty: none
+  uint32_t texture_symmetry = 1;  //!< 4 where the file says the map is 4-fold (written by tailor map
+                                  //!< --symmetry 4: ExportOptions::symmetry): glb: that texture's material
+                                  //!< (without a texture, the first primitive's); OBJ: its .mtl; else 1
   double load_seconds = 0.0;
 };
 

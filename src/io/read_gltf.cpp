@@ -785,7 +785,10 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
   // (the one decoded when asked), else the first base colour image given by a URI (a data: URI, or a
   // file next to the .gltf, of which only the first bytes are read).
   if (texture_bytes) {
-    if (first_image != UINT64_MAX) report.texture_named = "image " + std::to_string(first_image);
+    if (first_image != UINT64_MAX) {  // its file when a URI names one beside the .gltf
+      report.texture_named = doc.image_file(first_image);
+      if (report.texture_named.empty()) report.texture_named = "image " + std::to_string(first_image);
+    }
     long width = 0, height = 0;
     bool sized = !texture_bytes->empty() && internal::image_header_size(*texture_bytes, width, height);
     if (!sized && texture_bytes->empty() && first_image != UINT64_MAX) {
