@@ -178,6 +178,15 @@ head -c $((17 * 1024 * 1024)) /dev/zero >"$tmp/big.json"
   || fail "a body over 16 MiB is not refused"
 [ "$(status_of -H 'Content-Type: application/json' -H 'Content-Length: 99999999999999999999' -d '{}' "${url}api/edit")" = 413 ] \
   || fail "a Content-Length past 2^64 is not refused as too large"
+# Two Content-Length headers (even equal ones) are refused: the body's end would depend on the reader.
+python3 - "$port" <<'PY' || fail "two Content-Length headers are not refused"
+import socket, sys
+s = socket.create_connection(("127.0.0.1", int(sys.argv[1])), timeout=10)
+s.sendall(b"POST /api/edit HTTP/1.1\r\nHost: 127.0.0.1:%s\r\nContent-Type: application/json\r\n"
+          b"Content-Length: 2\r\nContent-Length: 2\r\n\r\n{}" % sys.argv[1].encode())
+answer = s.recv(4096)
+assert answer.startswith(b"HTTP/1.1 400 ") and b"more than one Content-Length" in answer, answer
+PY
 [ "$(status_of -H 'Content-Type: application/json' -d '{}' "${url}api/status")" = 405 ] || fail "POST to a GET route is not 405"
 [ "$(status_of -X POST "${url}")" = 405 ] || fail "POST / is not 405"
 # 70 POSTs whose bodies never finish (more than the server's 64 connections): a real request is

@@ -23,6 +23,8 @@
 #include <mutex>
 #include <string_view>
 #include <thread>
+#include <utility>
+#include <vector>
 
 namespace tailor::cli {
 namespace {
@@ -119,10 +121,12 @@ int hex_value(char c) {
   return -1;
 }
 
-// The value of header `name` (lower case) in a request head, blanks trimmed; "" when absent.
-std::string header_value(const std::string& request, const std::string& name) {
+// The values of header `name` (lower case) in a request head, blanks trimmed, in order (at most
+// `most` of them).
+std::vector<std::string> header_values(const std::string& request, const std::string& name, size_t most) {
+  std::vector<std::string> values;
   size_t pos = request.find("\r\n");
-  while (pos != std::string::npos && pos + 2 < request.size()) {
+  while (pos != std::string::npos && pos + 2 < request.size() && values.size() < most) {
     const size_t start = pos + 2;
     const size_t end = request.find("\r\n", start);
     if (end == std::string::npos || end == start) break;
@@ -136,12 +140,18 @@ std::string header_value(const std::string& request, const std::string& name) {
         size_t b = colon + 1, e = end;
         while (b < e && (request[b] == ' ' || request[b] == '\t')) ++b;
         while (e > b && (request[e - 1] == ' ' || request[e - 1] == '\t')) --e;
-        return request.substr(b, e - b);
+        values.push_back(request.substr(b, e - b));
       }
     }
     pos = end;
   }
-  return {};
+  return values;
+}
+
+// The value of header `name` (lower case), its first; "" when absent.
+std::string header_value(const std::string& request, const std::string& name) {
+  std::vector<std::string> values = header_values(request, name, 1);
+  return values.empty() ? std::string() : std::move(values[0]);
 }
 
 // A handler that throws (out of memory) answers 500 instead of ending the process from a worker thread.
@@ -443,7 +453,12 @@ void StaticServer::handle(Connection& conn, const std::atomic<bool>& stop) const
     const std::string type = header_value(request, "content-type");
     if (type.compare(0, 16, "application/json") != 0)
       return answer(client, HttpResponse::error(415, "POST needs Content-Type: application/json"), false, stop);
-    const std::string length_text = header_value(request, "content-length");
+    // Two lengths (even equal ones) leave the body's end open to how each reader picks: refused
+    // (RFC 9112, 6.3), as a request smuggled past a proxy would carry them.
+    const std::vector<std::string> lengths = header_values(request, "content-length", 2);
+    if (lengths.size() > 1)
+      return answer(client, HttpResponse::error(400, "more than one Content-Length"), false, stop);
+    const std::string length_text = lengths.empty() ? std::string() : lengths[0];
     uint64_t length = 0;
     const auto [end, error] = std::from_chars(length_text.data(), length_text.data() + length_text.size(), length);
     // No Content-Length and no Transfer-Encoding: no body (RFC 9112; `curl -X POST` sends neither).
