@@ -533,6 +533,21 @@ evaluated = evaluated.get("metrics", evaluated)["visible_seam_ratio"]
 assert abs(mapped - evaluated) < 1e-9, (mapped, evaluated)
 PY
 
+# --- --uv-set N: refused before mapping where it would leave a gap below it; eval measures the set the texture reads ---
+expect_error 2 "the UVs would go to TEXCOORD_1 but the mesh has no TEXCOORD_0 to keep below it .*use --uv-set 0" -- \
+  "$tailor" map "$mesh" --uv-set 1 -o "$tmp/uv1.glb"
+[[ ! -e $tmp/uv1.glb ]] && ok || fail "a refused --uv-set wrote its output"
+"$tailor" map "$mesh" -o "$tmp/uv0.glb" -q && "$tailor" map "$tmp/uv0.glb" --uv-set 1 -t "$texture" -o "$tmp/uv1.glb" \
+  --stats "$tmp/uv1.json" -q || fail "map into TEXCOORD_1"
+python3 - "$tmp/uv1.json" "$tmp/uv1.glb" "$tailor" <<'PY' && ok || fail "eval of --uv-set 1 measures another set than map"
+import json, subprocess, sys
+mapped = json.load(open(sys.argv[1]))["metrics"]
+out = json.loads(subprocess.run([sys.argv[3], "eval", sys.argv[2], "--json"], capture_output=True, text=True, check=True).stdout)
+evaluated = out.get("metrics", out)
+for key in ("visible_seam_ratio", "seam_length_ratio", "flipped"):
+    assert mapped[key] == evaluated[key], (key, mapped[key], evaluated[key])
+PY
+
 # --- positions far from the origin (a georeferenced scan): 32-bit floats round the shape, and map says so ---
 awk '/^v /{printf "v %.3f %.3f %.3f\n", $2 * 50 + 500000, $3 * 50 + 4000000, $4 * 50} /^f /{gsub(/\/[^ ]*/, ""); print}' "$mesh" >"$tmp/utm.obj"
 awk '/^v /{printf "v %.3f %.3f %.3f\n", $2 * 50, $3 * 50, $4 * 50} /^f /{gsub(/\/[^ ]*/, ""); print}' "$mesh" >"$tmp/local.obj"

@@ -771,6 +771,35 @@ TEST(GltfKept, NormalsColoursAndOtherUvSetsSurviveAMapping) {
       }
     }
   }
+  // Under a texture the material reads TEXCOORD_1, and so does the reader: the mesh's UVs are the
+  // mapped ones (what eval measures and render draws), not TEXCOORD_0.
+  {
+    ExportOptions options;
+    options.uv_set = 1;
+    options.texture_path = std::string(TAILOR_SOURCE_DIR) + "/tests/data/textures/vistex-sand05-128.png";
+    const std::string file = dir + "/textured.glb";
+    ASSERT_TRUE(export_mesh(file, mesh, atlas, options).is_ok());
+    Mesh back;
+    ASSERT_TRUE(load_mesh(file, back).is_ok());
+    const CornerAttribute* uv1 = attribute(back, "TEXCOORD_1");
+    ASSERT_TRUE(uv1 != nullptr);
+    ASSERT_EQ(back.corner_uvs.size(), uv1->values.size());
+    for (size_t k = 0; k < back.corner_uvs.size(); k += 2) {
+      EXPECT_EQ(back.corner_uvs[k], uv1->values[k]);
+      EXPECT_EQ(back.corner_uvs[k + 1], -uv1->values[k + 1]);  // v up in Mesh, down in glTF
+    }
+  }
+  // Without a TEXCOORD_0 to keep, TEXCOORD_1 alone would be a gap glTF does not allow: refused.
+  {
+    Mesh bare = mesh;
+    std::erase_if(bare.corner_attributes, [](const CornerAttribute& a) { return a.name == "TEXCOORD_0"; });
+    ExportOptions options;
+    options.uv_set = 1;
+    const Status s = export_mesh(dir + "/gap.glb", bare, atlas, options);
+    EXPECT_EQ(s.code(), ErrorCode::kInvalidArgument);
+    EXPECT_NE(s.message().find("no TEXCOORD_0 to keep below it"), std::string::npos) << s.message();
+    EXPECT_FALSE(fs::exists(dir + "/gap.glb"));
+  }
   fs::remove_all(dir);
 }
 

@@ -164,6 +164,7 @@ int run_map(const MapArgs& opt) {
     if (Status s = load_mesh(opt.input, mesh, &load, [&loading](float f) { return loading.update(f); }); !s)
       return report_error(s);
   }
+  if (Status s = check_uv_set(mesh, opt.uv_set, opt.input); !s) return report_error(s);
   if (load.degenerate_faces)
     warn(opt.quiet, opt.input + ": dropped " + std::to_string(load.degenerate_faces) + " degenerate faces");
   if (load.duplicate_faces)

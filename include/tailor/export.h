@@ -133,6 +133,12 @@ inline constexpr OptionDoc kExportOptionDocs[] = {
 TAILOR_API Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas,
                               const ExportOptions& options);
 
+//! kInvalidArgument naming `path` when the .glb written from `mesh` with the mapped UVs in
+//! TEXCOORD_<uv_set> would leave a gap in its texture coordinate sets (glTF numbers them from 0
+//! without gaps): uv_set N > 0 needs TEXCOORD_0..N-1 among the mesh's kept attributes (a glTF
+//! input's). export_mesh checks it; `tailor map` before mapping. O(attributes).
+TAILOR_API Status check_uv_set(const Mesh& mesh, int uv_set, const std::string& path);
+
 //! A mesh whose vertices are split so that each vertex has one UV.
 struct SplitMesh {
   std::vector<float> positions;   //!< #S by 3

@@ -326,6 +326,19 @@ constexpr size_t kThreadedFaces = 100000;
 
 }  // namespace
 
+Status check_uv_set(const Mesh& mesh, int uv_set, const std::string& path) {
+  for (int set = 0; set < uv_set; ++set) {
+    const std::string name = "TEXCOORD_" + std::to_string(set);
+    if (std::none_of(mesh.corner_attributes.begin(), mesh.corner_attributes.end(),
+                     [&](const CornerAttribute& a) { return a.name == name; }))
+      return Status::error(ErrorCode::kInvalidArgument, path,
+                           "the UVs would go to TEXCOORD_" + std::to_string(uv_set) + " but the mesh has no " + name +
+                               " to keep below it (glTF numbers the sets from 0 without gaps)",
+                           "use --uv-set " + std::to_string(set));
+  }
+  return Status::ok();
+}
+
 Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas, const ExportOptions& options) {
   const ExportFormat format = export_format(path);
   if (format == ExportFormat::kUnknown)
@@ -341,6 +354,7 @@ Status export_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas
     return Status::error(ErrorCode::kInvalidArgument, path, "the UV set must be 0 to 7");
   if (options.uv_set != 0 && format != ExportFormat::kGlb)
     return Status::error(ErrorCode::kInvalidArgument, path, "a UV set other than 0 needs a .glb output");
+  TAILOR_RETURN_IF_ERROR(check_uv_set(mesh, options.uv_set, path));
   if (!options.material.empty() && format != ExportFormat::kGlb)
     return Status::error(ErrorCode::kInvalidArgument, path, "material maps need a .glb output");
   if (!options.image_uris.empty() && format != ExportFormat::kGlb)

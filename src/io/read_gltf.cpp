@@ -10,7 +10,8 @@
 // scene) walked from its root nodes; each node that uses a mesh places an instance of it with the
 // node's world transform (matrix or TRS, parents first) applied to the positions, winding flipped
 // where the transform mirrors. Triangles, strips and fans become triangles; points and lines are
-// skipped and counted (LoadReport::skipped_primitives). POSITION and TEXCOORD_0 of any component
+// skipped and counted (LoadReport::skipped_primitives). POSITION and the base colour texture's
+// TEXCOORD set (TEXCOORD_0 by default) of any component
 // type (KHR_mesh_quantization), sparse accessors, EXT_meshopt_compression buffer views and
 // KHR_draco_mesh_compression primitives, EXT_mesh_gpu_instancing nodes. A required extension outside those is an error
 // naming it. Reference: glTF 2.0 specification, sections 3.5 (scenes, nodes), 3.7 (meshes).
@@ -288,6 +289,20 @@ Status triangulate(const GltfDocument& doc, uint64_t mode, const std::vector<uin
   return Status::ok();
 }
 
+// The texture coordinate set a material's base colour texture reads (its "texCoord", 0 to 7): the
+// UVs a viewer draws the texture with, so the ones Mesh::corner_uvs holds (tailor map --uv-set N
+// writes N there). 0 without a material or texture.
+uint64_t base_colour_uv_set(const Json& json, uint64_t material) {
+  const Json* m = get_element(json, "materials", material);
+  if (!m || !m->is_object()) return 0;
+  const auto pbr = m->find("pbrMetallicRoughness");
+  if (pbr == m->end() || !pbr->is_object()) return 0;
+  const auto base = pbr->find("baseColorTexture");
+  uint64_t set = 0;
+  if (base == pbr->end() || !base->is_object() || !get_uint(*base, "texCoord", set) || set > 7) return 0;
+  return set;
+}
+
 // Reads primitive `pi` of mesh `mi` (mode already known to be triangles, strip or fan).
 Status read_primitive(GltfDocument& doc, const Json& prim, uint64_t mode, const std::string& where, bool tangents,
                       Primitive& out) {
@@ -296,7 +311,8 @@ Status read_primitive(GltfDocument& doc, const Json& prim, uint64_t mode, const 
   if (attributes == prim.end() || !get_uint(*attributes, "POSITION", position_index))
     return doc.parse_error("primitive without POSITION", where);
   if (get_uint(prim, "material", material)) out.material = material;
-  const bool has_uv = get_uint(*attributes, "TEXCOORD_0", uv_index);
+  const std::string uv_name = "TEXCOORD_" + std::to_string(base_colour_uv_set(doc.json(), out.material));
+  const bool has_uv = get_uint(*attributes, uv_name.c_str(), uv_index);
   std::vector<uint32_t> corners;
   const auto extensions = prim.find("extensions");
   const Json* draco = nullptr;
@@ -306,7 +322,7 @@ Status read_primitive(GltfDocument& doc, const Json& prim, uint64_t mode, const 
   }
   if (draco) {
     internal::DracoPrimitive decoded;
-    std::vector<std::string> names = {"POSITION", "TEXCOORD_0"};
+    std::vector<std::string> names = {"POSITION", uv_name};
     for (const auto& item : attributes->items())
       if (is_kept_attribute(item.key(), tangents)) names.push_back(item.key());
     TAILOR_RETURN_IF_ERROR(internal::decode_draco_primitive(doc, prim, *draco, names, where, decoded));
@@ -326,8 +342,8 @@ Status read_primitive(GltfDocument& doc, const Json& prim, uint64_t mode, const 
     if (has_uv) {
       AccessorInfo uv_info;
       TAILOR_RETURN_IF_ERROR(doc.read_floats(uv_index, out.uv, uv_info));
-      if (uv_info.components != 2) return doc.parse_error("TEXCOORD_0 must be VEC2", where);
-      if (uv_info.count != info.count) return doc.parse_error("TEXCOORD_0 and POSITION counts differ", where);
+      if (uv_info.components != 2) return doc.parse_error(uv_name + " must be VEC2", where);
+      if (uv_info.count != info.count) return doc.parse_error(uv_name + " and POSITION counts differ", where);
     }
     for (const auto& item : attributes->items()) {
       uint64_t index = 0;
