@@ -280,6 +280,32 @@ TEST(Metrics, SeamGapIsTheToroidalDistance) {
   EXPECT_EQ(m.seam_invisible_ratio, 1.0);
 }
 
+// A face wound against its neighbours: the topology leaves its three interior edges unpaired, yet
+// the surface goes on across them. With the same UVs on both sides they are no seam; with its own
+// UVs, half a repeat off, they are visible seams, counted once each in the total edge length.
+TEST(Metrics, FacesWoundAgainstTheirNeighboursStillHaveSeams) {
+  Mesh mesh = grid(3, 3, Diagonal::kFalling);
+  const size_t flipped = 8;  // the middle cell's first triangle: all three edges interior
+  std::swap(mesh.indices[3 * flipped + 1], mesh.indices[3 * flipped + 2]);
+  const Topology topology = build_topology(mesh);
+  ASSERT_EQ(topology.inconsistent_edges, 3u);
+  auto uv = corner_uvs(mesh, [](float x, float y) { return std::pair{100 * x, 100 * y}; });
+  UvMetrics m = metrics_of(mesh, uv);
+  EXPECT_EQ(m.seam_edges, 0u);
+  EXPECT_EQ(m.visible_seam_ratio, 0.0);
+  const UvMetrics continuous = m;
+  for (size_t c = 3 * flipped; c < 3 * flipped + 3; ++c) uv[2 * c] += 256;  // half a 512 px repeat
+  m = metrics_of(mesh, uv);
+  EXPECT_EQ(m.seam_edges, 3u);
+  EXPECT_NEAR(m.seam_gap_px, 256.0, 1e-9);
+  EXPECT_GT(m.visible_seam_ratio, 0.0);
+  EXPECT_EQ(m.visible_seam_ratio, m.seam_length_ratio);
+  // The edge lengths sum as if the face were wound as its neighbours: 2 + sqrt(2) of seams over
+  // 24 unit edges and 9 diagonals.
+  EXPECT_NEAR(m.seam_length_ratio, (2 + std::sqrt(2.0)) / (24 + 9 * std::sqrt(2.0)), 1e-9);
+  EXPECT_EQ(continuous.seam_length_ratio, 0.0);
+}
+
 // The lattice gap takes one whole-repeat offset for both ends of an edge, and the larger end.
 TEST(Metrics, SeamGapUsesOneLatticeOffsetForBothEnds) {
   const MetricsOptions options;  // 512 x 512 px

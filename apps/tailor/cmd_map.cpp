@@ -192,7 +192,12 @@ int run_map(const MapArgs& opt) {
     if (topology.nonmanifold_edges || topology.inconsistent_edges)
       warn(opt.quiet, opt.input + ": " + std::to_string(topology.nonmanifold_edges) + " non-manifold and " +
                           std::to_string(topology.inconsistent_edges) +
-                          " inconsistently oriented edges treated as boundary");
+                          " inconsistently oriented edges treated as boundary" +
+                          (topology.inconsistent_edges
+                               ? std::string(" (faces wound against their neighbours are mapped apart and their "
+                                             "edges counted as seams: orient the faces coherently for a continuous "
+                                             "texture)")
+                               : std::string()));
   };
   if (auto_axis) connect();
   // World units: the texel density is per scene unit, the same for every mesh (the mapping works

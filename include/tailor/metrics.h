@@ -45,15 +45,16 @@ struct UvMetrics {
   size_t single_face_patches = 0;  //!< patches holding exactly one face
   size_t degenerate_faces = 0;     //!< faces with zero 3D area, skipped by the per-face metrics
   double stretch = 0;  //!< thesis ch.4: coefficient of variation of r_f = a_f / A_f (population std / mean); 0 ideal
-  double stretch_area_weighted = 0;    //!< same, mean and variance weighted by A_f; 0 ideal
-  double distortion_deg = 0;           //!< median over faces of sum_k |angle_uv_k - angle_3d_k|, degrees; 0 ideal
-  double l2_stretch = 0;               //!< Sander et al. 2001 L2 stretch times sqrt(R); 1 ideal, >= 1
-  double linf_stretch = 0;             //!< Sander et al. 2001 max singular value over faces times sqrt(R); 1 ideal
-  size_t flipped = 0;                  //!< faces whose signed UV area has the opposite sign to the majority of their
-                                       //!< patch (zero-area UV faces count as flipped; degenerate 3D faces are skipped)
-  size_t zero_uv_area_faces = 0;       //!< non-degenerate faces with zero UV area (included in `flipped`,
-                                       //!< excluded from l2/linf where their stretch is infinite)
-  size_t seam_edges = 0;               //!< paired edges whose two faces disagree on the UV of a shared vertex
+  double stretch_area_weighted = 0;  //!< same, mean and variance weighted by A_f; 0 ideal
+  double distortion_deg = 0;         //!< median over faces of sum_k |angle_uv_k - angle_3d_k|, degrees; 0 ideal
+  double l2_stretch = 0;             //!< Sander et al. 2001 L2 stretch times sqrt(R); 1 ideal, >= 1
+  double linf_stretch = 0;           //!< Sander et al. 2001 max singular value over faces times sqrt(R); 1 ideal
+  size_t flipped = 0;                //!< faces whose signed UV area has the opposite sign to the majority of their
+                                     //!< patch (zero-area UV faces count as flipped; degenerate 3D faces are skipped)
+  size_t zero_uv_area_faces = 0;     //!< non-degenerate faces with zero UV area (included in `flipped`,
+                                     //!< excluded from l2/linf where their stretch is infinite)
+  size_t seam_edges =
+      0;  //!< edges of two faces (paired, or running the same way) whose faces disagree on the UV of a shared vertex
   double seam_length_ratio = 0;        //!< 3D length of seam edges / 3D length of all distinct edges
   double seam_gap_px = 0;              //!< 3D-length-weighted mean over seam edges of their lattice gap (px; see
                                        //!< seam_gap_px() below)

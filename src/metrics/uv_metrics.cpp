@@ -12,6 +12,8 @@
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "metrics/stored_metrics.h"
 #include "tailor/export.h"
@@ -219,6 +221,30 @@ double median(std::vector<double>& values, size_t threads) {
   std::nth_element(near.begin(), upper, near.end());
   if (n % 2 == 1) return *upper;
   return 0.5 * (*std::max_element(near.begin(), upper) + *upper);
+}
+
+// The edges that exactly two faces share running the same way (the topology's inconsistent
+// edges, left unpaired): (edge of the lower face, edge of the other), in edge order. Only the
+// unpaired edges are sorted, so a mesh without them costs one pass.
+std::vector<std::pair<size_t, size_t>> same_way_edge_pairs(const Mesh& mesh, const Topology& topology) {
+  std::vector<std::pair<size_t, size_t>> pairs;
+  if (topology.inconsistent_edges == 0) return pairs;
+  std::vector<std::pair<uint64_t, size_t>> loose;  // (lower vertex << 32 | upper vertex, edge)
+  for (size_t e = 0; e < topology.opposite.size(); ++e) {
+    if (topology.opposite[e] != kInvalid) continue;
+    const uint64_t a = mesh.indices[e], b = mesh.indices[3 * (e / 3) + (e % 3 + 1) % 3];
+    loose.emplace_back(std::min(a, b) << 32 | std::max(a, b), e);
+  }
+  std::sort(loose.begin(), loose.end());
+  for (size_t i = 0; i < loose.size();) {
+    size_t end = i + 1;
+    while (end < loose.size() && loose[end].first == loose[i].first) ++end;
+    const size_t e = loose[i].second;
+    if (end - i == 2 && mesh.indices[e] == mesh.indices[loose[i + 1].second])
+      pairs.emplace_back(e, loose[i + 1].second);
+    i = end;
+  }
+  return pairs;
 }
 
 }  // namespace
@@ -452,6 +478,33 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
   const double sharp_cos = std::cos(options.sharp_angle_deg * (std::numbers::pi / 180.0));
   std::vector<uint8_t> visible(corners, 0);
   std::vector<SeamSums> seam_sums(internal::chunk_count(corners));
+  // An edge of `length` between faces f and g whose sides are `s`: a seam when their UVs disagree,
+  // visible unless a whole-repeat offset joins them. True when it is a visible seam.
+  const auto add_seam = [&](SeamSums& sums, const EdgeSides& s, size_t f, size_t g, double length, bool same_way) {
+    if (same_uv(corner_uv, s.fa, s.ga) && same_uv(corner_uv, s.fb, s.gb)) return false;
+    ++sums.seam_edges;
+    sums.seam_length += length;
+    const float* uv = corner_uv.data();
+    const double gap = seam_gap_px(uv + 2 * s.fa, uv + 2 * s.fb, uv + 2 * s.ga, uv + 2 * s.gb, options);
+    sums.gap_weighted += length * gap;
+    sums.gap_plain += gap;
+    if (gap < options.invisible_gap_px) {
+      sums.invisible_length += length;
+      ++sums.invisible_count;
+      return false;
+    }
+    sums.visible_length += length;
+    const Face face_f = load_face(mesh, corner_uv, f), face_g = load_face(mesh, corner_uv, g);
+    const Vec3 nf3 = cross(sub(face_f.p[1], face_f.p[0]), sub(face_f.p[2], face_f.p[0]));
+    const Vec3 ng3 = cross(sub(face_g.p[1], face_g.p[0]), sub(face_g.p[2], face_g.p[0]));
+    const double nn = norm(nf3) * norm(ng3);
+    // Faces wound against each other have opposite normals on a smooth surface: compared as if g
+    // were wound as f.
+    const double turn = same_way ? -1.0 : 1.0;
+    const bool sharp = nn > 0 && turn * dot(nf3, ng3) < sharp_cos * nn;
+    if (!sharp) sums.visible_off_sharp += length;
+    return true;
+  };
   internal::for_each_chunk(corners, threads, [&](size_t begin, size_t end, size_t chunk) {
     SeamSums sums;
     for (size_t e = begin; e < end; ++e) {
@@ -462,30 +515,23 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
           norm(sub(position(mesh, mesh.indices[3 * f + (k + 1) % 3]), position(mesh, mesh.indices[3 * f + k])));
       sums.total_length += length;
       if (o == kInvalid) continue;
-      const EdgeSides s = edge_sides(e, o);
-      if (same_uv(corner_uv, s.fa, s.ga) && same_uv(corner_uv, s.fb, s.gb)) continue;
-      ++sums.seam_edges;
-      sums.seam_length += length;
-      const float* uv = corner_uv.data();
-      const double gap = seam_gap_px(uv + 2 * s.fa, uv + 2 * s.fb, uv + 2 * s.ga, uv + 2 * s.gb, options);
-      sums.gap_weighted += length * gap;
-      sums.gap_plain += gap;
-      if (gap < options.invisible_gap_px) {
-        sums.invisible_length += length;
-        ++sums.invisible_count;
-        continue;
-      }
-      visible[e] = 1;
-      sums.visible_length += length;
-      const Face face_f = load_face(mesh, corner_uv, f), face_g = load_face(mesh, corner_uv, o / 3);
-      const Vec3 nf3 = cross(sub(face_f.p[1], face_f.p[0]), sub(face_f.p[2], face_f.p[0]));
-      const Vec3 ng3 = cross(sub(face_g.p[1], face_g.p[0]), sub(face_g.p[2], face_g.p[0]));
-      const double nn = norm(nf3) * norm(ng3);
-      const bool sharp = nn > 0 && dot(nf3, ng3) < sharp_cos * nn;
-      if (!sharp) sums.visible_off_sharp += length;
+      if (add_seam(sums, edge_sides(e, o), f, o / 3, length, false)) visible[e] = 1;
     }
     seam_sums[chunk] = sums;
   });
+  // Edges that two faces share running the same way (a face wound against its neighbours): the
+  // topology leaves both unpaired, as boundary, yet the surface goes on across them and the texture
+  // breaks there when the faces' UVs disagree. They are seams like paired edges (and one edge, not
+  // two, in the total), so faces wound the wrong way cannot hide their seams.
+  seam_sums.push_back({});
+  for (const auto& [e, g_edge] : same_way_edge_pairs(mesh, topology)) {
+    SeamSums& sums = seam_sums.back();
+    const size_t f = e / 3, k = e % 3, g = g_edge / 3, j = g_edge % 3;
+    const double length =
+        norm(sub(position(mesh, mesh.indices[3 * f + (k + 1) % 3]), position(mesh, mesh.indices[3 * f + k])));
+    sums.total_length -= length;  // counted once for each face above
+    add_seam(sums, {e, 3 * f + (k + 1) % 3, g_edge, 3 * g + (j + 1) % 3}, f, g, length, true);
+  }
   double total_length = 0, seam_length = 0, gap_weighted = 0, gap_plain = 0, invisible_length = 0;
   double visible_length = 0, visible_off_sharp = 0;
   size_t invisible_count = 0;
