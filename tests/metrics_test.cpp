@@ -504,6 +504,32 @@ TEST(Metrics, DegenerateFacesAreSkippedWithoutNaN) {
   EXPECT_NEAR(ratio[0], 1.0f, 1e-6f);
 }
 
+// A sliver whose height (2^-21) is below what floats resolve at its coordinates (2^-22 x 3): its
+// orientation is its corners' rounding, so reversed UVs do not make it flipped, nor its area ratio
+// the stretch. The same sliver moved near the origin, where floats resolve it, is measured.
+TEST(Metrics, SliversBelowFloatResolutionAreDegenerate) {
+  Mesh mesh = grid(2, 1, Diagonal::kFalling);  // 4 faces over [0,2] x [0,1]
+  const uint32_t base = static_cast<uint32_t>(mesh.vertex_count());
+  mesh.positions.insert(mesh.positions.end(), {2.f, 3.f, 0.f, 3.f, 3.f, 0.f, 2.5f, 3.f + 0x1p-21f, 0.f});
+  mesh.indices.insert(mesh.indices.end(), {base, base + 1, base + 2});
+  auto uv = corner_uvs(mesh, [](float x, float y) { return std::pair{50 * x, 50 * y}; });
+  uv[2 * 14 + 1] -= 20;  // the sliver's apex below its base in UV: wide, and reversed
+  const std::vector<uint32_t> one_patch(5, 0);
+  UvMetrics m = metrics_of(mesh, uv, one_patch);
+  EXPECT_EQ(m.degenerate_faces, 1u);
+  EXPECT_EQ(m.flipped, 0u);
+  EXPECT_NEAR(m.stretch, 0.0, 1e-6);
+  EXPECT_NEAR(m.linf_stretch, 1.0, 1e-6);
+  for (size_t v = base; v < mesh.vertex_count(); ++v) {  // to x in [0.25, 1.25], y = 0.25: exact moves
+    mesh.positions[3 * v] -= 1.75f;
+    mesh.positions[3 * v + 1] -= 2.75f;
+  }
+  ASSERT_EQ(mesh.positions[3 * (base + 2) + 1], 0.25f + 0x1p-21f);
+  m = metrics_of(mesh, uv, one_patch);
+  EXPECT_EQ(m.degenerate_faces, 0u);
+  EXPECT_EQ(m.flipped, 1u);
+}
+
 TEST(Metrics, RejectsBadInput) {
   const Mesh mesh = grid(1, 1, Diagonal::kFalling);
   const Topology topology = build_topology(mesh);

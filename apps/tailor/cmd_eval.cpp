@@ -119,7 +119,8 @@ int run_eval(const EvalOptions& opt) {
 
   if (m.degenerate_faces > 0)
     warn(opt.quiet || opt.json,
-         std::to_string(m.degenerate_faces) + " faces with zero 3D area skipped by the per-face metrics");
+         std::to_string(m.degenerate_faces) +
+             " faces with no 3D area that 32-bit floats resolve skipped by the per-face metrics");
   if (m.zero_uv_area_faces > 0)
     warn(opt.quiet || opt.json, std::to_string(m.zero_uv_area_faces) + " faces with zero UV area (counted as flipped)");
 

@@ -43,7 +43,7 @@ struct UvMetrics {
   size_t faces = 0;                //!< faces in the mesh (degenerate included)
   uint32_t patches = 0;            //!< distinct patch ids (given, or derived from UV connectivity)
   size_t single_face_patches = 0;  //!< patches holding exactly one face
-  size_t degenerate_faces = 0;     //!< faces with zero 3D area, skipped by the per-face metrics
+  size_t degenerate_faces = 0;     //!< faces with no 3D area floats resolve, skipped by the per-face metrics
   double stretch = 0;  //!< thesis ch.4: coefficient of variation of r_f = a_f / A_f (population std / mean); 0 ideal
   double stretch_area_weighted = 0;  //!< same, mean and variance weighted by A_f; 0 ideal
   double distortion_deg = 0;         //!< median over faces of sum_k |angle_uv_k - angle_3d_k|, degrees; 0 ideal

@@ -30,6 +30,11 @@ namespace {
 // (a needle whose height is 1e-12 of its length): its angles and ratios carry no information and
 // would otherwise divide by zero.
 constexpr double kDegenerateRelativeHeight = 1e-12;
+// ... or when its height is below what 32-bit floats resolve where it lies (4 half-steps at its
+// largest coordinate, 2^-22 of it): its orientation and shape are the rounding of its corners,
+// so its UVs' orientation and area ratio are noise (a sliver whose third corner was moved onto
+// the opposite edge, a decimation's leftover).
+constexpr double kFloatResolvedHeight = 0x1p-22;
 
 struct Vec3 {
   double x, y, z;
@@ -63,8 +68,11 @@ Face load_face(const Mesh& mesh, std::span<const float> corner_uv, size_t f) {
   const Vec3 e1 = sub(face.p[1], face.p[0]), e2 = sub(face.p[2], face.p[0]), e3 = sub(face.p[2], face.p[1]);
   const double twice_area = norm(cross(e1, e2));
   const double longest2 = std::max({dot(e1, e1), dot(e2, e2), dot(e3, e3)});
+  double largest = 0;
+  for (const Vec3& p : face.p) largest = std::max({largest, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
   face.area3d = 0.5 * twice_area;
-  face.degenerate = !(twice_area > kDegenerateRelativeHeight * longest2);
+  face.degenerate = !(twice_area > std::max(kDegenerateRelativeHeight * longest2,
+                                            kFloatResolvedHeight * largest * std::sqrt(longest2)));
   face.area_uv =
       0.5 * ((face.u[1] - face.u[0]) * (face.v[2] - face.v[0]) - (face.u[2] - face.u[0]) * (face.v[1] - face.v[0]));
   return face;
