@@ -196,6 +196,11 @@ expect_error 2 "directory of the output \(--output\) does not exist" -- "$tailor
 expect_error 2 "would overwrite an input" -- "$tailor" render "$tmp/render/m.obj" -o "$tmp/render/own.png" --texture "$tmp/render/own.png"
 expect_error 2 "would overwrite an input" -- "$tailor" render "$tmp/render/m.obj" -o "$tmp/render/$(basename "$texture")"
 cmp -s "$tmp/render/own.png" "$texture" && cmp -s "$tmp/render/$(basename "$texture")" "$texture" && ok || fail "render replaced an input"
+# An .obj whose name holds a blank gets an .mtl without one (mtllib takes a list of names).
+mkdir -p "$tmp/render/with blank"
+"$tailor" map "$mesh" --texture "$texture" -o "$tmp/render/with blank/o x.obj" -q &&
+  grep -qx "mtllib o_x.mtl" "$tmp/render/with blank/o x.obj" && [[ -f "$tmp/render/with blank/o_x.mtl" ]] && ok ||
+  fail "the .mtl of an .obj named with a blank: $(ls "$tmp/render/with blank")"
 # A texture the mesh names that is not there is named in the warning (not "no texture in").
 mv "$tmp/render/$(basename "$texture")" "$tmp/render/gone.png"
 "$tailor" render "$tmp/render/m.obj" -o "$tmp/render/r.png" --size 64x48 2>"$tmp/render/r.err" >/dev/null &&

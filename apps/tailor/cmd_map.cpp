@@ -78,7 +78,7 @@ std::vector<std::pair<PreviewView, std::string>> preview_paths(const MapArgs& op
 std::vector<OutputPath> output_paths(const MapArgs& opt) {
   std::vector<OutputPath> outputs = {{opt.output, "--output"}};
   if (std::filesystem::path(opt.output).extension() == ".obj")
-    outputs.push_back({std::filesystem::path(opt.output).replace_extension(".mtl").string(), "the .mtl of --output"});
+    outputs.push_back({obj_material_path(opt.output), "the .mtl of --output"});
   if (!opt.stats.empty()) outputs.push_back({opt.stats, "--stats"});
   for (const auto& view_path : preview_paths(opt)) outputs.push_back({view_path.second, "--preview"});
   return outputs;

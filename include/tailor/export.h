@@ -125,7 +125,7 @@ inline constexpr OptionDoc kExportOptionDocs[] = {
 //! vertices split where they differ; .obj: NORMAL), its NORMAL instead of computed normals.
 //! Writes `mesh` with the UVs of `atlas` (atlas.corner_uv: #F*3 by 2 pixels) to `path`, the format
 //! chosen by the extension (case-insensitive): .glb (binary glTF 2.0, texture embedded, sampler
-//! REPEAT), .obj (+ <stem>.mtl next to it when a texture is given, map_Kd relative to the .obj),
+//! REPEAT), .obj (+ obj_material_path's .mtl when a texture is given, map_Kd relative to the .obj),
 //! .ply (binary little endian, per-vertex x y z s t after splitting).
 //! Fails with kInvalidArgument on an unsupported extension, mismatched atlas size or a texture size
 //! <= 0; kInvalidImage when the texture is neither PNG nor JPEG; kIo when a file cannot be read or
@@ -138,6 +138,11 @@ TAILOR_API Status export_mesh(const std::string& path, const Mesh& mesh, const A
 //! without gaps): uv_set N > 0 needs TEXCOORD_0..N-1 among the mesh's kept attributes (a glTF
 //! input's). export_mesh checks it; `tailor map` before mapping. O(attributes).
 TAILOR_API Status check_uv_set(const Mesh& mesh, int uv_set, const std::string& path);
+
+//! The .mtl export_mesh writes beside the .obj at `obj_path` when it has a texture: the .obj's stem
+//! with blanks and tabs as '_' (`mtllib` takes a list of names, so most readers would split a
+//! blank), then .mtl, in the .obj's folder.
+TAILOR_API std::string obj_material_path(const std::string& obj_path);
 
 //! A mesh whose vertices are split so that each vertex has one UV.
 struct SplitMesh {

@@ -7,6 +7,7 @@
 #include <limits>
 #include <new>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "export/writers.h"
@@ -325,6 +326,14 @@ void part_ranges(const std::vector<uint32_t>& face_parts, const SplitMesh& split
 constexpr size_t kThreadedFaces = 100000;
 
 }  // namespace
+
+std::string obj_material_path(const std::string& obj_path) {
+  std::filesystem::path path(obj_path);
+  std::string stem = path.stem().string();
+  std::replace_if(
+      stem.begin(), stem.end(), [](char c) { return c == ' ' || c == '\t'; }, '_');
+  return path.replace_filename(stem + ".mtl").string();
+}
 
 Status check_uv_set(const Mesh& mesh, int uv_set, const std::string& path) {
   for (int set = 0; set < uv_set; ++set) {

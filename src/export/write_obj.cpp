@@ -1,10 +1,10 @@
 // Wavefront OBJ writer: `v` per source vertex (`v x y z r g b` when the mesh kept colours, COLOR_0) (so the reloaded
 // mesh keeps its connectivity), `vt` per split vertex (one per distinct (vertex, uv) pair, in texture repeats, t up),
-// `vn` per source vertex when normals are on, faces `f v/vt[/vn]` (1-based). With a texture, a <stem>.mtl next to the
-// .obj holds one material whose map_Kd is the texture's bare file name: the texture lies beside the .mtl (copied
-// there when it is elsewhere, texture_name_beside), so the output folder can be moved whole; a 4-fold map
-// (ExportOptions::symmetry 4) adds the comment line `# tailor symmetry 4` to it. Numbers are written with
-// std::to_chars (shortest text that reads back bit-exact).
+// `vn` per source vertex when normals are on, faces `f v/vt[/vn]` (1-based). With a texture, a <stem>.mtl
+// (obj_material_path) next to the .obj holds one material whose map_Kd is the texture's bare file name: the texture
+// lies beside the .mtl (copied there when it is elsewhere, texture_name_beside), so the output folder can be moved
+// whole; a 4-fold map (ExportOptions::symmetry 4) adds the comment line `# tailor symmetry 4` to it. Numbers are
+// written with std::to_chars (shortest text that reads back bit-exact).
 #include <filesystem>
 
 #include "export/writers.h"
@@ -22,7 +22,7 @@ Status write_obj(const std::string& path, const ExportData& data, const ExportOp
   const SplitMesh& split = data.split;
   const std::filesystem::path obj_path(path);
   const bool textured = !options.texture_path.empty();
-  const std::string mtl_name = obj_path.stem().string() + ".mtl";
+  const std::string mtl_name = std::filesystem::path(obj_material_path(path)).filename().string();
   std::string texture_bytes;
   if (textured) {
     std::string mime_type;  // fail early on a missing or non-image texture
