@@ -201,6 +201,10 @@ mkdir -p "$tmp/render/with blank"
 "$tailor" map "$mesh" --texture "$texture" -o "$tmp/render/with blank/o x.obj" -q &&
   grep -qx "mtllib o_x.mtl" "$tmp/render/with blank/o x.obj" && [[ -f "$tmp/render/with blank/o_x.mtl" ]] && ok ||
   fail "the .mtl of an .obj named with a blank: $(ls "$tmp/render/with blank")"
+# Output extensions in capitals are the same formats (as inputs are).
+"$tailor" map "$mesh" -o "$tmp/render/CAPS.GLB" -q && "$tailor" eval "$tmp/render/CAPS.GLB" -q >/dev/null &&
+  "$tailor" map "$mesh" --texture "$texture" -o "$tmp/render/Caps.Obj" -q && [[ -f $tmp/render/Caps.mtl ]] && ok ||
+  fail "an output extension in capitals"
 # A texture the mesh names that is not there is named in the warning (not "no texture in").
 mv "$tmp/render/$(basename "$texture")" "$tmp/render/gone.png"
 "$tailor" render "$tmp/render/m.obj" -o "$tmp/render/r.png" --size 64x48 2>"$tmp/render/r.err" >/dev/null &&

@@ -77,8 +77,7 @@ std::vector<std::pair<PreviewView, std::string>> preview_paths(const MapArgs& op
 // Every file this run will write, with the option that names it.
 std::vector<OutputPath> output_paths(const MapArgs& opt) {
   std::vector<OutputPath> outputs = {{opt.output, "--output"}};
-  if (std::filesystem::path(opt.output).extension() == ".obj")
-    outputs.push_back({obj_material_path(opt.output), "the .mtl of --output"});
+  if (extension_of(opt.output) == "obj") outputs.push_back({obj_material_path(opt.output), "the .mtl of --output"});
   if (!opt.stats.empty()) outputs.push_back({opt.stats, "--stats"});
   for (const auto& view_path : preview_paths(opt)) outputs.push_back({view_path.second, "--preview"});
   return outputs;
@@ -87,7 +86,7 @@ std::vector<OutputPath> output_paths(const MapArgs& opt) {
 int run_map(const MapArgs& opt) {
   const auto start = std::chrono::steady_clock::now();
   // === Options (checked before any work) ===
-  const std::string ext = std::filesystem::path(opt.output).extension().string();
+  const std::string ext = "." + extension_of(opt.output);  // lower case, as export_mesh reads it
   if (ext != ".glb" && ext != ".obj" && ext != ".ply")
     return report_error(usage_error("output must end in .glb, .obj or .ply, got '" + opt.output + "'"));
   MeshCompression compression = MeshCompression::kNone;
