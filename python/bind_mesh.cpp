@@ -90,6 +90,7 @@ py::dict load_report_dict(const LoadReport& r) {
   d["format"] = r.format;
   d["source_faces"] = r.source_faces;
   d["polygons_triangulated"] = r.polygons_triangulated;
+  d["concave_polygons"] = r.concave_polygons;
   d["degenerate_faces"] = r.degenerate_faces;
   d["duplicate_faces"] = r.duplicate_faces;
   d["zero_area_faces"] = r.zero_area_faces;

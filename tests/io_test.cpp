@@ -332,6 +332,53 @@ TEST(Ply, FastPathFallsBackForPolygonsMidFile) {
   EXPECT_EQ(r.polygons_triangulated, 1u);
 }
 
+// An L-shaped hexagon (area 3) fanned from its reflex-adjacent first corner overlaps itself (one
+// triangle turns back, the fan covers 4): it is cut into ears, each corner keeping its UV; a
+// convex polygon keeps its fan.
+TEST(Polygons, ConcavePolygonsAreCutIntoEars) {
+  const std::string corners = "v 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\nv 0 0 0\nv 2 0 0\n";
+  for (const auto& [text, format] :
+       {std::pair{corners + "vt 2 1\nvt 1 1\nvt 1 2\nvt 0 2\nvt 0 0\nvt 2 0\nf 1/1 2/2 3/3 4/4 5/5 6/6\n",
+                  MeshFormat::kObj},
+        std::pair{std::string("OFF\n6 1 0\n2 1 0\n1 1 0\n1 2 0\n0 2 0\n0 0 0\n2 0 0\n6 0 1 2 3 4 5\n"),
+                  MeshFormat::kOff},
+        std::pair{std::string("ply\nformat ascii 1.0\nelement vertex 6\nproperty float x\nproperty float y\n"
+                              "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+                              "end_header\n2 1 0\n1 1 0\n1 2 0\n0 2 0\n0 0 0\n2 0 0\n6 0 1 2 3 4 5\n"),
+                  MeshFormat::kPly}}) {
+    SCOPED_TRACE(text);
+    Mesh m;
+    LoadReport r;
+    ASSERT_TRUE(parse(text, format, m, &r).is_ok());
+    ASSERT_EQ(m.face_count(), 4u);
+    EXPECT_EQ(r.polygons_triangulated, 1u);
+    EXPECT_EQ(r.concave_polygons, 1u);
+    double total = 0;
+    for (size_t f = 0; f < 4; ++f) {
+      const float* a = &m.positions[3 * m.indices[3 * f]];
+      const float* b = &m.positions[3 * m.indices[3 * f + 1]];
+      const float* c = &m.positions[3 * m.indices[3 * f + 2]];
+      const double area = 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
+      EXPECT_GT(area, 0.0) << "face " << f;  // the polygon's winding, no triangle turned back
+      total += area;
+    }
+    EXPECT_DOUBLE_EQ(total, 3.0);
+    if (format == MeshFormat::kObj) {
+      ASSERT_EQ(m.corner_uvs.size(), 24u);
+      for (size_t c = 0; c < 12; ++c) {  // each corner's vt is its vertex's x y
+        EXPECT_EQ(m.corner_uvs[2 * c], m.positions[3 * m.indices[c]]);
+        EXPECT_EQ(m.corner_uvs[2 * c + 1], m.positions[3 * m.indices[c] + 1]);
+      }
+    }
+  }
+  // A convex pentagon keeps its fan from the first corner.
+  Mesh m;
+  LoadReport r;
+  ASSERT_TRUE(parse("v 0 0 0\nv 2 0 0\nv 3 1 0\nv 1 2 0\nv -1 1 0\nf 1 2 3 4 5\n", MeshFormat::kObj, m, &r).is_ok());
+  EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3, 0, 3, 4}));
+  EXPECT_EQ(r.concave_polygons, 0u);
+}
+
 TEST(Ply, TexcoordsAndSeamsFollowDroppedFaces) {
   // Per-face texcoord lists and seam flags; face 2 is degenerate and face 3 duplicates face 0
   // (other winding): both dropped, the uvs and seams of the kept faces stay with them.

@@ -48,6 +48,7 @@ int run_info(const InfoOptions& opt) {
     j["faces"] = mesh.face_count();
     j["source_faces"] = report.source_faces;
     j["polygons_triangulated"] = report.polygons_triangulated;
+    j["concave_polygons"] = report.concave_polygons;
     j["components"] = topology.vertex_components;
     j["edge_components"] = topology.edge_components;
     j["edges"] = topology.edges;
@@ -73,8 +74,8 @@ int run_info(const InfoOptions& opt) {
   std::printf("%s\n", opt.input.c_str());
   std::printf("  format                 %s (%zu bytes)\n", report.format.c_str(), report.file_bytes);
   std::printf("  vertices               %zu\n", mesh.vertex_count());
-  std::printf("  faces                  %zu (after triangulation; %zu in file, %zu polygons split)\n",
-              mesh.face_count(), report.source_faces, report.polygons_triangulated);
+  std::printf("  faces                  %zu (after triangulation; %zu in file, %zu polygons split, %zu concave)\n",
+              mesh.face_count(), report.source_faces, report.polygons_triangulated, report.concave_polygons);
   std::printf("  components             %u (faces sharing a vertex; %u through manifold edges)\n",
               topology.vertex_components, topology.edge_components);
   std::printf("  edges                  %zu\n", topology.edges);

@@ -74,6 +74,7 @@ struct LoadReport {
   size_t file_bytes = 0;
   size_t source_faces = 0;           //!< faces/polygons/strip triangles as stored in the file
   size_t polygons_triangulated = 0;  //!< source polygons with more than 3 vertices (fan-triangulated)
+  size_t concave_polygons = 0;       //!< of those, concave ones cut into ears instead (a fan would overlap)
   size_t degenerate_faces = 0;       //!< triangles with a repeated vertex index: dropped
   size_t duplicate_faces = 0;        //!< triangles with the same vertex set as an earlier one: dropped
   size_t zero_area_faces = 0;        //!< distinct vertices but zero area: kept

@@ -241,12 +241,13 @@ Status read_mesh_in(std::span<const char> data, MeshFormat format, const std::st
   internal::ReadProgress progress(callback, data.size());
   std::string material_library;  // OBJ: its mtllib (the texture's size is read from it)
   std::string texture_name;      // PLY: its TextureFile comment (the same)
+  internal::PolygonFans fans;    // PLY, OBJ, OFF: the polygons cut into fans
   // The parsers never throw by design; only an allocation of a (checked, but large) size can.
   try {
     switch (format) {
-      case MeshFormat::kPly: s = internal::read_ply(data, name, mesh, r, &progress, &texture_name); break;
-      case MeshFormat::kObj: s = internal::read_obj(data, name, mesh, r, &progress, &material_library); break;
-      case MeshFormat::kOff: s = internal::read_off(data, name, mesh, r, &progress); break;
+      case MeshFormat::kPly: s = internal::read_ply(data, name, mesh, r, &progress, &texture_name, &fans); break;
+      case MeshFormat::kObj: s = internal::read_obj(data, name, mesh, r, &progress, &material_library, &fans); break;
+      case MeshFormat::kOff: s = internal::read_off(data, name, mesh, r, &progress, &fans); break;
       case MeshFormat::kStl: s = internal::read_stl(data, name, mesh, r, &progress); break;
       case MeshFormat::kGlb:
       case MeshFormat::kGltf: s = internal::read_gltf(data, name, base_dir, mesh, r, &progress); break;
@@ -255,6 +256,7 @@ Status read_mesh_in(std::span<const char> data, MeshFormat format, const std::st
         break;
     }
     if (s.is_ok() && !progress.repairs(0.f)) s = progress.cancelled(name);
+    if (s.is_ok()) r.concave_polygons = internal::retriangulate_concave_fans(mesh, fans);
     if (s.is_ok()) s = finalize_mesh(name, mesh, r);
     if (s.is_ok() && !base_dir.empty() && !material_library.empty()) read_obj_material(base_dir, material_library, r);
     if (s.is_ok() && !base_dir.empty() && !texture_name.empty())

@@ -1,9 +1,9 @@
 // Wavefront OBJ reader: `v`, `vt` and `f` statements (v, v/vt, v//vn, v/vt/vn corners, negative
-// indices relative to the current counts), polygons fan-triangulated, `\r\n` line ends, `#`
-// comments, backslash line continuation. Vertex colours (`v x y z r g b`) and normals (`vn`, when
-// every corner names one) are kept as COLOR_0 and NORMAL corner attributes. `o`, `g`, `s`,
-// `usemtl`, `l`, `p` and any other statement are ignored; the first `mtllib`'s file name is handed
-// back (load_mesh reads that .mtl's texture size, read_mesh.cpp).
+// indices relative to the current counts), polygons fan-triangulated (concave ones cut again: polygon_fans.h), `\r\n`
+// line ends, `#` comments, backslash line continuation. Vertex colours (`v x y z r g b`) and normals (`vn`, when every
+// corner names one) are kept as COLOR_0 and NORMAL corner attributes. `o`, `g`, `s`, `usemtl`, `l`, `p` and any other
+// statement are ignored; the first `mtllib`'s file name is handed back (load_mesh reads that .mtl's texture size,
+// read_mesh.cpp).
 //
 // Hand-written instead of tinyobjloader (which Debian ships): tinyobjloader reports bad indices as
 // warnings without line numbers (or silently clamps them), stores per-shape index structs that we
@@ -49,7 +49,7 @@ bool resolve(int64_t raw, size_t count, uint64_t& out) {
 }  // namespace
 
 Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,
-                ReadProgress* progress, std::string* material_library) {
+                ReadProgress* progress, std::string* material_library, PolygonFans* fans) {
   if (material_library) material_library->clear();
   report.format = "OBJ";
   // A UTF-8 byte order mark (editors on Windows write one) is not part of the first line.
@@ -149,6 +149,7 @@ Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh,
       }
       ++report.source_faces;
       if (n > 3) ++report.polygons_triangulated;
+      if (n > 3 && fans) fans->add(mesh.face_count(), n);
       for (size_t k = 1; k + 1 < n; ++k) mesh.indices.insert(mesh.indices.end(), {poly[0], poly[k], poly[k + 1]});
       if (corners_without_vt == 0) {
         for (uint32_t t : poly_vt) corners_without_vt += t == kInvalid;

@@ -1,7 +1,7 @@
 // OFF reader (Geomview Object File Format): OFF, COFF, NOFF, CNOFF, STOFF, ... keywords, counts on
 // the keyword line or the next, `#` comments, one vertex per line (extra values such as normals,
-// colours or texture coordinates ignored), polygon faces fan-triangulated, optional colour values
-// after the face indices ignored. 4D (4OFF, nOFF with n != 3) and binary OFF are rejected.
+// colours or texture coordinates ignored), polygon faces fan-triangulated (concave ones cut again: polygon_fans.h),
+// optional colour values after the face indices ignored. 4D (4OFF, nOFF with n != 3) and binary OFF are rejected.
 #include <string_view>
 #include <vector>
 
@@ -20,7 +20,7 @@ constexpr uint64_t kMinFaceBytes = 8;
 }  // namespace
 
 Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,
-                ReadProgress* progress) {
+                ReadProgress* progress, PolygonFans* fans) {
   TextScanner s(data.data(), data.data() + data.size());
   s.set_hash_comments(true);
   s.skip_space();
@@ -136,6 +136,7 @@ Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh,
     }
     ++report.source_faces;
     if (n > 3) ++report.polygons_triangulated;
+    if (n > 3 && fans) fans->add(mesh.face_count(), n);
     for (size_t k = 1; k + 1 < n; ++k) mesh.indices.insert(mesh.indices.end(), {poly[0], poly[k], poly[k + 1]});
     if (mesh.indices.size() / 3 > kMaxFaces) return Status::error(ErrorCode::kLimit, name, "too many faces", s.where());
     s.next_line();

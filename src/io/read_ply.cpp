@@ -467,8 +467,15 @@ template <class Source>
 class BodyReader {
  public:
   BodyReader(Source& src, const PlyHeader& h, const std::string& name, Mesh& mesh, LoadReport& report,
-             ReadProgress& progress)
-      : src_(src), h_(h), name_(name), mesh_(mesh), report_(report), progress_(progress), total_(src.remaining()) {
+             ReadProgress& progress, PolygonFans* fans)
+      : src_(src),
+        h_(h),
+        name_(name),
+        mesh_(mesh),
+        report_(report),
+        progress_(progress),
+        fans_(fans),
+        total_(src.remaining()) {
     for (const PlyElement& e : h.elements) {
       if (e.kind == ElementKind::kVertex) vertex_count_ = e.count;
     }
@@ -717,7 +724,8 @@ class BodyReader {
       if (tc_.empty()) face_uv_complete_ = false;
       ++report_.source_faces;
       if (n > 3) ++report_.polygons_triangulated;
-      for (size_t k = 1; k + 1 < n; ++k) {  // fan triangulation
+      if (n > 3 && fans_) fans_->add(mesh_.face_count(), n);
+      for (size_t k = 1; k + 1 < n; ++k) {  // fan triangulation (concave polygons cut again: polygon_fans.h)
         mesh_.indices.insert(mesh_.indices.end(), {poly_[0], poly_[k], poly_[k + 1]});
         if (have_seam) seams_.push_back(seam);
         if (face_uv_complete_) {
@@ -866,7 +874,8 @@ class BodyReader {
   Mesh& mesh_;
   LoadReport& report_;
   ReadProgress& progress_;
-  size_t total_ = 0;  // bytes of the body
+  PolygonFans* fans_;  // null: not recorded
+  size_t total_ = 0;   // bytes of the body
   uint64_t vertex_count_ = 0;
   std::vector<uint32_t> poly_;
   std::vector<float> tc_;
@@ -914,7 +923,7 @@ Status check_counts(const PlyHeader& h, size_t body_bytes, const std::string& na
 }  // namespace
 
 Status read_ply(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,
-                ReadProgress* progress, std::string* texture_file) {
+                ReadProgress* progress, std::string* texture_file, PolygonFans* fans) {
   ReadProgress none;
   ReadProgress& p = progress ? *progress : none;
   const std::string_view text(data.data(), data.size());
@@ -930,26 +939,26 @@ Status read_ply(std::span<const char> data, const std::string& name, Mesh& mesh,
     case PlyFormat::kAscii: {
       report.format = "PLY ascii";
       AsciiSource src(body, end, h.header_lines);
-      return BodyReader<AsciiSource>(src, h, name, mesh, report, p).run();
+      return BodyReader<AsciiSource>(src, h, name, mesh, report, p, fans).run();
     }
     case PlyFormat::kBinaryLe: {
       report.format = "PLY binary_little_endian";
       if constexpr (std::endian::native == std::endian::little) {
         BinarySource<false> src(body, end);
-        return BodyReader<BinarySource<false>>(src, h, name, mesh, report, p).run();
+        return BodyReader<BinarySource<false>>(src, h, name, mesh, report, p, fans).run();
       } else {
         BinarySource<true> src(body, end);
-        return BodyReader<BinarySource<true>>(src, h, name, mesh, report, p).run();
+        return BodyReader<BinarySource<true>>(src, h, name, mesh, report, p, fans).run();
       }
     }
     case PlyFormat::kBinaryBe: {
       report.format = "PLY binary_big_endian";
       if constexpr (std::endian::native == std::endian::big) {
         BinarySource<false> src(body, end);
-        return BodyReader<BinarySource<false>>(src, h, name, mesh, report, p).run();
+        return BodyReader<BinarySource<false>>(src, h, name, mesh, report, p, fans).run();
       } else {
         BinarySource<true> src(body, end);
-        return BodyReader<BinarySource<true>>(src, h, name, mesh, report, p).run();
+        return BodyReader<BinarySource<true>>(src, h, name, mesh, report, p, fans).run();
       }
     }
   }

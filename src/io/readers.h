@@ -10,6 +10,7 @@
 #include <string>
 #include <string_view>
 
+#include "io/polygon_fans.h"
 #include "tailor/image.h"
 #include "tailor/mesh.h"
 #include "tailor/progress.h"
@@ -60,16 +61,18 @@ class ReadProgress {
 //! progress (optional) is told the bytes parsed (PLY: per element and every 64k items of the generic
 //! loops; OBJ, OFF and ascii STL: every few MB; binary STL: the welding, every 64k corners; glTF: per
 //! primitive, in faces).
+//! PLY, OBJ, OFF: fans (optional) records the triangles of each polygon's fan, for
+//! retriangulate_concave_fans once the positions are all read.
 //! PLY: texture_file (optional) gets the first `comment TextureFile NAME` line's name (MeshLab's
 //! convention, which tailor's writer follows), empty when there is none.
 Status read_ply(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,
-                ReadProgress* progress = nullptr, std::string* texture_file = nullptr);
+                ReadProgress* progress = nullptr, std::string* texture_file = nullptr, PolygonFans* fans = nullptr);
 //! OBJ: material_library (optional) gets the first `mtllib` statement's file name (the rest of its
 //! line, blanks trimmed), empty when there is none.
 Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,
-                ReadProgress* progress = nullptr, std::string* material_library = nullptr);
+                ReadProgress* progress = nullptr, std::string* material_library = nullptr, PolygonFans* fans = nullptr);
 Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,
-                ReadProgress* progress = nullptr);
+                ReadProgress* progress = nullptr, PolygonFans* fans = nullptr);
 Status read_stl(std::span<const char> data, const std::string& name, Mesh& mesh, LoadReport& report,
                 ReadProgress* progress = nullptr);
 //! glTF 2.0 (.glb or .gltf): the default scene's mesh instances in world space, TEXCOORD_0 into
