@@ -557,6 +557,12 @@ for key in ("visible_seam_ratio", "seam_length_ratio", "flipped"):
     assert mapped[key] == evaluated[key], (key, mapped[key], evaluated[key])
 PY
 
+# --- eval joins a file's vertices at identical positions: a face that then repeats one is dropped, and it says so ---
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\nf 2 5 4\n' >"$tmp/dup.obj"
+"$tailor" map "$tmp/dup.obj" -o "$tmp/dup.glb" -q && "$tailor" eval "$tmp/dup.glb" 2>"$tmp/dup.err" >/dev/null &&
+  grep -q "^tailor: warning: $tmp/dup.glb: dropped 1 faces whose corners share a position once its vertices at identical positions were joined" \
+    "$tmp/dup.err" && ok || fail "eval dropped a face without a word: $(cat "$tmp/dup.err")"
+
 # --- positions far from the origin (a georeferenced scan): 32-bit floats round the shape, and map says so ---
 awk '/^v /{printf "v %.3f %.3f %.3f\n", $2 * 50 + 500000, $3 * 50 + 4000000, $4 * 50} /^f /{gsub(/\/[^ ]*/, ""); print}' "$mesh" >"$tmp/utm.obj"
 awk '/^v /{printf "v %.3f %.3f %.3f\n", $2 * 50, $3 * 50, $4 * 50} /^f /{gsub(/\/[^ ]*/, ""); print}' "$mesh" >"$tmp/local.obj"

@@ -117,6 +117,13 @@ int run_eval(const EvalOptions& opt) {
   if (!metrics_status) return report_error(metrics_status.with_file(opt.input));
   const double seconds = seconds_since(start);
 
+  // The file's split vertices are joined where their positions are identical (so that seams are
+  // edges again); a face whose corners were distinct vertices at one position then repeats a
+  // vertex and is dropped, where map, which had the mesh's own vertices, measured it.
+  if (report.degenerate_faces > 0 && report.welded_vertices > 0)
+    warn(opt.quiet || opt.json, opt.input + ": dropped " + std::to_string(report.degenerate_faces) +
+                                    " faces whose corners share a position once its vertices at identical "
+                                    "positions were joined (tailor map measured them on the mesh it mapped)");
   if (m.degenerate_faces > 0)
     warn(opt.quiet || opt.json,
          std::to_string(m.degenerate_faces) +
