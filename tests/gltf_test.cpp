@@ -866,6 +866,29 @@ TEST(GltfKept, ObjColoursAndNormalsReachTheGlb) {
   fs::remove_all(dir);
 }
 
+// An OBJ's `v x y z r g b a` (some writers add alpha) keeps its colours with their alpha, and an
+// .mtl's keyword in lower case (`map_kd`) still names the texture.
+TEST(GltfKept, ObjAlphaColoursAndLowerCaseMapKd) {
+  const std::string dir = test::empty_temp_dir("gltf_obj_alpha");
+  std::ofstream(dir + "/c.obj") << "mtllib c.mtl\nv 0 0 0 1 0 0 0.25\nv 1 0 0 0 1 0 0.5\nv 0 1 0 0 0 1 1\nf 1 2 3\n";
+  std::ofstream(dir + "/c.mtl") << "newmtl m\nmap_kd t.png\n";
+  fs::copy_file(std::string(TAILOR_SOURCE_DIR) + "/tests/data/textures/vistex-sand05-128.png", dir + "/t.png");
+  Mesh mesh;
+  LoadReport report;
+  ASSERT_TRUE(load_mesh(dir + "/c.obj", mesh, &report).is_ok());
+  const CornerAttribute* colour = attribute(mesh, "COLOR_0");
+  ASSERT_TRUE(colour != nullptr);
+  ASSERT_EQ(colour->values.size(), 12u);
+  EXPECT_EQ(colour->values[3], 0.25f);
+  EXPECT_EQ(colour->values[4], 0.f);
+  EXPECT_EQ(colour->values[5], 1.f);
+  EXPECT_EQ(colour->values[7], 0.5f);
+  EXPECT_EQ(colour->values[11], 1.f);
+  EXPECT_EQ(report.texture_width, 128);
+  EXPECT_EQ(report.texture_named, dir + "/t.png");
+  fs::remove_all(dir);
+}
+
 // The names, extras and materials of a scene made by glTF-Transform reach the output: two
 // instances of one mesh (named nodes with extras), two materials (factors, doubleSided, alphaMode,
 // emissive, extras), the scene's and the asset's extras; plain, meshopt and Draco inputs, every

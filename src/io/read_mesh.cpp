@@ -2,6 +2,7 @@
 // validation / repair pass shared by all of them (finalize_mesh). See include/tailor/io.h.
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <climits>
 #include <cmath>
@@ -217,7 +218,10 @@ void read_obj_material(const std::filesystem::path& folder, const std::string& l
     const std::string_view line = internal::trimmed(rest.substr(0, end));
     rest = end == std::string_view::npos ? std::string_view{} : rest.substr(end + 1);
     if (line == "# tailor symmetry 4") symmetry = 4;
-    if (!texture.empty() || (line.substr(0, 7) != "map_Kd " && line.substr(0, 7) != "map_Kd\t")) continue;
+    // The keyword in any case: some writers put map_kd.
+    std::string keyword(line.substr(0, 7));
+    for (char& c : keyword) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (!texture.empty() || (keyword != "map_kd " && keyword != "map_kd\t")) continue;
     const std::string_view name = internal::trimmed(line.substr(7));
     // The name, unless options (-s 1 1 1, -clamp on, ...) come first: then its last word.
     const size_t last_blank = name.find_last_of(" \t");

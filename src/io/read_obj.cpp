@@ -1,8 +1,8 @@
 // Wavefront OBJ reader: `v`, `vt` and `f` statements (v, v/vt, v//vn, v/vt/vn corners, negative
 // indices relative to the current counts), polygons fan-triangulated (concave ones cut again: polygon_fans.h), `\r\n`
-// line ends, `#` comments, backslash line continuation. Vertex colours (`v x y z r g b`) and normals (`vn`, when every
-// corner names one) are kept as COLOR_0 and NORMAL corner attributes. `o`, `g`, `s`, `usemtl`, `l`, `p` and any other
-// statement are ignored; the first `mtllib`'s file name is handed back (load_mesh reads that .mtl's texture size,
+// line ends, `#` comments, backslash line continuation. Vertex colours (`v x y z r g b [a]`) and normals (`vn`, when
+// every corner names one) are kept as COLOR_0 and NORMAL corner attributes. `o`, `g`, `s`, `usemtl`, `l`, `p` and any
+// other statement are ignored; the first `mtllib`'s file name is handed back (load_mesh reads that .mtl's texture size,
 // read_mesh.cpp).
 //
 // Hand-written instead of tinyobjloader (which Debian ships): tinyobjloader reports bad indices as
@@ -68,9 +68,9 @@ Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh,
   std::vector<ForwardRef> forward_v, forward_vt;
   std::vector<uint32_t> poly, poly_vt;
   size_t corners_without_vt = 0;  // once nonzero, corner_vt is dropped and no longer filled
-  // Kept attributes: vertex colours (`v x y z r g b`, when every vertex has them) and normals
+  // Kept attributes: vertex colours (`v x y z r g b [a]`, when every vertex has them) and normals
   // (`vn`, referenced by every face corner as v/vt/vn or v//vn).
-  std::vector<float> colours, normals;  // #V by 3, #VN by 3
+  std::vector<float> colours, normals;  // #V by 4 (alpha 1 when not given), #VN by 3
   size_t vertices_without_colour = 0;
   std::vector<uint32_t> corner_vn, poly_vn;
   std::vector<ForwardRef> forward_vn;
@@ -89,11 +89,11 @@ Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh,
         return Status::error(ErrorCode::kParse, name, "bad vertex line (expected 3 numbers)", s.where());
       }
       mesh.positions.insert(mesh.positions.end(), {x, y, z});
-      float rgb[3];
+      float rgba[4] = {0.f, 0.f, 0.f, 1.f};
       int extra = 0;
-      while (extra < 3 && !s.at_line_end() && s.read_float(rgb[extra])) ++extra;
-      if (extra == 3 && s.at_line_end())
-        colours.insert(colours.end(), rgb, rgb + 3);
+      while (extra < 4 && !s.at_line_end() && s.read_float(rgba[extra])) ++extra;
+      if ((extra == 3 || extra == 4) && s.at_line_end())
+        colours.insert(colours.end(), rgba, rgba + 4);
       else
         ++vertices_without_colour;
     } else if (w == "vn") {
@@ -211,13 +211,11 @@ Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh,
     a.values.resize(3 * corner_vn.size());
     for (size_t c = 0; c < corner_vn.size(); ++c) std::memcpy(&a.values[3 * c], &normals[3 * corner_vn[c]], 12);
   }
-  if (!mesh.indices.empty() && vertices_without_colour == 0 && colours.size() == mesh.positions.size()) {
+  if (!mesh.indices.empty() && vertices_without_colour == 0 && 3 * colours.size() == 4 * mesh.positions.size()) {
     CornerAttribute& a = mesh.corner_attributes.emplace_back(CornerAttribute{"COLOR_0", 4, {}});
     a.values.resize(4 * mesh.indices.size());
-    for (size_t c = 0; c < mesh.indices.size(); ++c) {
-      std::memcpy(&a.values[4 * c], &colours[3 * size_t{mesh.indices[c]}], 12);
-      a.values[4 * c + 3] = 1.0f;
-    }
+    for (size_t c = 0; c < mesh.indices.size(); ++c)
+      std::memcpy(&a.values[4 * c], &colours[4 * size_t{mesh.indices[c]}], 16);
   }
   // Corner uvs only when every corner has one: a partial set cannot be used as a mapping.
   if (!mesh.indices.empty() && corners_without_vt == 0) {
