@@ -30,10 +30,12 @@ namespace {
 // (a needle whose height is 1e-12 of its length): its angles and ratios carry no information and
 // would otherwise divide by zero.
 constexpr double kDegenerateRelativeHeight = 1e-12;
-// ... or when its height is below what 32-bit floats resolve where it lies (4 half-steps at its
-// largest coordinate, 2^-22 of it): its orientation and shape are the rounding of its corners,
-// so its UVs' orientation and area ratio are noise (a sliver whose third corner was moved onto
-// the opposite edge, a decimation's leftover).
+// ... or when it is a sliver (twice its area below 2^-10 of its longest edge squared) whose height
+// is below what 32-bit floats resolve where it lies (4 half-steps, 2^-22, of its first corner's
+// largest coordinate plus its longest edge, a bound on its largest coordinate): its orientation and
+// shape are the rounding of its corners, so its UVs' orientation and area ratio are noise (a
+// corner moved onto the opposite edge, a decimation's leftover).
+constexpr double kSliverRelativeHeight = 0x1p-10;
 constexpr double kFloatResolvedHeight = 0x1p-22;
 
 struct Vec3 {
@@ -68,11 +70,13 @@ Face load_face(const Mesh& mesh, std::span<const float> corner_uv, size_t f) {
   const Vec3 e1 = sub(face.p[1], face.p[0]), e2 = sub(face.p[2], face.p[0]), e3 = sub(face.p[2], face.p[1]);
   const double twice_area = norm(cross(e1, e2));
   const double longest2 = std::max({dot(e1, e1), dot(e2, e2), dot(e3, e3)});
-  double largest = 0;
-  for (const Vec3& p : face.p) largest = std::max({largest, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
   face.area3d = 0.5 * twice_area;
-  face.degenerate = !(twice_area > std::max(kDegenerateRelativeHeight * longest2,
-                                            kFloatResolvedHeight * largest * std::sqrt(longest2)));
+  face.degenerate = !(twice_area > kDegenerateRelativeHeight * longest2);
+  if (!face.degenerate && twice_area < kSliverRelativeHeight * longest2) [[unlikely]] {
+    const double longest = std::sqrt(longest2);
+    const double far = std::max(std::max(std::abs(face.p[0].x), std::abs(face.p[0].y)), std::abs(face.p[0].z));
+    face.degenerate = !(twice_area > kFloatResolvedHeight * (far + longest) * longest);
+  }
   face.area_uv =
       0.5 * ((face.u[1] - face.u[0]) * (face.v[2] - face.v[0]) - (face.u[2] - face.u[0]) * (face.v[1] - face.v[0]));
   return face;
@@ -229,6 +233,43 @@ double median(std::vector<double>& values, size_t threads) {
   std::nth_element(near.begin(), upper, near.end());
   if (n % 2 == 1) return *upper;
   return 0.5 * (*std::max_element(near.begin(), upper) + *upper);
+}
+
+// The sums of the metrics' pass over the edges.
+struct SeamSums {
+  double total_length = 0, seam_length = 0, gap_weighted = 0, gap_plain = 0, invisible_length = 0;
+  double visible_length = 0, visible_off_sharp = 0;
+  size_t seam_edges = 0, invisible_count = 0;
+};
+
+double seam_gap_of(const float* uv, const EdgeSides& s, const MetricsOptions& options) {
+  return seam_gap_px(uv + 2 * s.fa, uv + 2 * s.fb, uv + 2 * s.ga, uv + 2 * s.gb, options);
+}
+
+// A seam edge (its faces' UVs disagree) of `length` whose sides are `s`, between face s.fa / 3 and
+// face g, into `sums`: visible unless a whole-repeat offset joins them, then on a sharp edge or not
+// (`same_way`: g is wound against the other face, so their normals are compared as if it were
+// not). True when visible.
+bool add_seam(const Mesh& mesh, std::span<const float> corner_uv, const MetricsOptions& options, double sharp_cos,
+              const EdgeSides& s, size_t g, double length, bool same_way, SeamSums& sums) {
+  ++sums.seam_edges;
+  sums.seam_length += length;
+  const double gap = seam_gap_of(corner_uv.data(), s, options);
+  sums.gap_weighted += length * gap;
+  sums.gap_plain += gap;
+  if (gap < options.invisible_gap_px) {
+    sums.invisible_length += length;
+    ++sums.invisible_count;
+    return false;
+  }
+  sums.visible_length += length;
+  const Face face_f = load_face(mesh, corner_uv, s.fa / 3), face_g = load_face(mesh, corner_uv, g);
+  const Vec3 nf3 = cross(sub(face_f.p[1], face_f.p[0]), sub(face_f.p[2], face_f.p[0]));
+  const Vec3 ng3 = cross(sub(face_g.p[1], face_g.p[0]), sub(face_g.p[2], face_g.p[0]));
+  const double nn = norm(nf3) * norm(ng3);
+  const bool sharp = nn > 0 && (same_way ? -dot(nf3, ng3) : dot(nf3, ng3)) < sharp_cos * nn;
+  if (!sharp) sums.visible_off_sharp += length;
+  return true;
 }
 
 // The edges that exactly two faces share running the same way (the topology's inconsistent
@@ -477,42 +518,10 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
 
   // Seams: over distinct edges (a paired edge once, a boundary edge once). Visible seam edges are
   // marked on their lower edge id for the vertex pass below.
-  struct SeamSums {
-    double total_length = 0, seam_length = 0, gap_weighted = 0, gap_plain = 0, invisible_length = 0;
-    double visible_length = 0, visible_off_sharp = 0;
-    size_t seam_edges = 0, invisible_count = 0;
-  };
   const size_t corners = 3 * nf;
   const double sharp_cos = std::cos(options.sharp_angle_deg * (std::numbers::pi / 180.0));
   std::vector<uint8_t> visible(corners, 0);
   std::vector<SeamSums> seam_sums(internal::chunk_count(corners));
-  // An edge of `length` between faces f and g whose sides are `s`: a seam when their UVs disagree,
-  // visible unless a whole-repeat offset joins them. True when it is a visible seam.
-  const auto add_seam = [&](SeamSums& sums, const EdgeSides& s, size_t f, size_t g, double length, bool same_way) {
-    if (same_uv(corner_uv, s.fa, s.ga) && same_uv(corner_uv, s.fb, s.gb)) return false;
-    ++sums.seam_edges;
-    sums.seam_length += length;
-    const float* uv = corner_uv.data();
-    const double gap = seam_gap_px(uv + 2 * s.fa, uv + 2 * s.fb, uv + 2 * s.ga, uv + 2 * s.gb, options);
-    sums.gap_weighted += length * gap;
-    sums.gap_plain += gap;
-    if (gap < options.invisible_gap_px) {
-      sums.invisible_length += length;
-      ++sums.invisible_count;
-      return false;
-    }
-    sums.visible_length += length;
-    const Face face_f = load_face(mesh, corner_uv, f), face_g = load_face(mesh, corner_uv, g);
-    const Vec3 nf3 = cross(sub(face_f.p[1], face_f.p[0]), sub(face_f.p[2], face_f.p[0]));
-    const Vec3 ng3 = cross(sub(face_g.p[1], face_g.p[0]), sub(face_g.p[2], face_g.p[0]));
-    const double nn = norm(nf3) * norm(ng3);
-    // Faces wound against each other have opposite normals on a smooth surface: compared as if g
-    // were wound as f.
-    const double turn = same_way ? -1.0 : 1.0;
-    const bool sharp = nn > 0 && turn * dot(nf3, ng3) < sharp_cos * nn;
-    if (!sharp) sums.visible_off_sharp += length;
-    return true;
-  };
   internal::for_each_chunk(corners, threads, [&](size_t begin, size_t end, size_t chunk) {
     SeamSums sums;
     for (size_t e = begin; e < end; ++e) {
@@ -523,7 +532,9 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
           norm(sub(position(mesh, mesh.indices[3 * f + (k + 1) % 3]), position(mesh, mesh.indices[3 * f + k])));
       sums.total_length += length;
       if (o == kInvalid) continue;
-      if (add_seam(sums, edge_sides(e, o), f, o / 3, length, false)) visible[e] = 1;
+      const EdgeSides s = edge_sides(e, o);
+      if (same_uv(corner_uv, s.fa, s.ga) && same_uv(corner_uv, s.fb, s.gb)) continue;
+      if (add_seam(mesh, corner_uv, options, sharp_cos, s, o / 3, length, false, sums)) visible[e] = 1;
     }
     seam_sums[chunk] = sums;
   });
@@ -531,14 +542,15 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
   // topology leaves both unpaired, as boundary, yet the surface goes on across them and the texture
   // breaks there when the faces' UVs disagree. They are seams like paired edges (and one edge, not
   // two, in the total), so faces wound the wrong way cannot hide their seams.
-  seam_sums.push_back({});
+  seam_sums.emplace_back();
   for (const auto& [e, g_edge] : same_way_edge_pairs(mesh, topology)) {
-    SeamSums& sums = seam_sums.back();
     const size_t f = e / 3, k = e % 3, g = g_edge / 3, j = g_edge % 3;
     const double length =
         norm(sub(position(mesh, mesh.indices[3 * f + (k + 1) % 3]), position(mesh, mesh.indices[3 * f + k])));
-    sums.total_length -= length;  // counted once for each face above
-    add_seam(sums, {e, 3 * f + (k + 1) % 3, g_edge, 3 * g + (j + 1) % 3}, f, g, length, true);
+    seam_sums.back().total_length -= length;  // counted once for each face above
+    const EdgeSides s{e, 3 * f + (k + 1) % 3, g_edge, 3 * g + (j + 1) % 3};
+    if (!same_uv(corner_uv, s.fa, s.ga) || !same_uv(corner_uv, s.fb, s.gb))
+      add_seam(mesh, corner_uv, options, sharp_cos, s, g, length, true, seam_sums.back());
   }
   double total_length = 0, seam_length = 0, gap_weighted = 0, gap_plain = 0, invisible_length = 0;
   double visible_length = 0, visible_off_sharp = 0;
