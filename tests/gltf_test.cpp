@@ -728,6 +728,14 @@ TEST(GltfKept, NormalsColoursAndOtherUvSetsSurviveAMapping) {
   LoadReport report;
   ASSERT_TRUE(read(b.glb(), mesh, &report).is_ok());
   EXPECT_EQ(mesh.vertex_count(), 8u);  // welded: the hard edges live in the corner normals
+  {  // A base colour texture that names a set the primitive lacks: its TEXCOORD_0, as without texCoord.
+    Builder named = b;
+    named.json["materials"][0]["pbrMetallicRoughness"] = {{"baseColorTexture", {{"texCoord", 1}}}};
+    Mesh other;
+    ASSERT_TRUE(read(named.glb(), other).is_ok());
+    EXPECT_EQ(other.corner_uvs, mesh.corner_uvs);
+    EXPECT_FALSE(mesh.corner_uvs.empty());
+  }
   EXPECT_EQ(report.not_kept, "") << "names and materials are kept";
   ASSERT_EQ(mesh.scene.instances.size(), 1u);
   EXPECT_EQ(mesh.scene.instances[0].node_name, "box");

@@ -80,7 +80,8 @@ int run_eval(const EvalOptions& opt) {
   if (mesh.corner_uvs.empty())
     return report_error(
         Status::error(ErrorCode::kInvalidMesh, opt.input,
-                      "mesh has no texture coordinates to evaluate (OBJ vt, PLY s/t or glTF TEXCOORD_0)"));
+                      "mesh has no texture coordinates to evaluate (OBJ vt on every corner, PLY s/t, or the glTF "
+                      "TEXCOORD set its base colour texture reads)"));
 
   int width = static_cast<int>(MetricsOptions{}.texture_width_px);
   int height = static_cast<int>(MetricsOptions{}.texture_height_px);
@@ -120,8 +121,8 @@ int run_eval(const EvalOptions& opt) {
   // The file's split vertices are joined where their positions are identical (so that seams are
   // edges again); a face whose corners were distinct vertices at one position then repeats a
   // vertex and is dropped, where map, which had the mesh's own vertices, measured it.
-  if (report.degenerate_faces > 0 && report.welded_vertices > 0)
-    warn(opt.quiet || opt.json, opt.input + ": dropped " + std::to_string(report.degenerate_faces) +
+  if (report.faces_collapsed_by_weld > 0)
+    warn(opt.quiet || opt.json, opt.input + ": dropped " + std::to_string(report.faces_collapsed_by_weld) +
                                     " faces whose corners share a position once its vertices at identical "
                                     "positions were joined (tailor map measured them on the mesh it mapped)");
   if (m.degenerate_faces > 0)

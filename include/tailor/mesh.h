@@ -72,27 +72,30 @@ struct Mesh {
 struct LoadReport {
   std::string format;  //!< e.g. "PLY binary_little_endian", "OBJ", "OFF", "STL binary"
   size_t file_bytes = 0;
-  size_t source_faces = 0;           //!< faces/polygons/strip triangles as stored in the file
-  size_t polygons_triangulated = 0;  //!< source polygons with more than 3 vertices (fan-triangulated)
-  size_t concave_polygons = 0;       //!< of those, concave ones cut into ears instead (a fan would overlap)
-  size_t degenerate_faces = 0;       //!< triangles with a repeated vertex index: dropped
-  size_t duplicate_faces = 0;        //!< triangles with the same vertex set as an earlier one: dropped
-  size_t zero_area_faces = 0;        //!< distinct vertices but zero area: kept
-  size_t unreferenced_vertices = 0;  //!< vertices no face uses: kept, so vertex ids match the file
-  size_t welded_vertices = 0;        //!< STL: corners merged into shared vertices (bit-identical positions)
-  size_t mesh_instances = 0;         //!< glTF: meshes placed by the scene's nodes (world transforms applied)
-  size_t skipped_primitives = 0;     //!< glTF: point and line primitives of those instances, not read
-  std::string not_kept;              //!< what the file has that the output will not (", "-separated), e.g.
-                                     //!< "material textures, TANGENT"; empty when nothing is lost
-  int texture_width = 0;             //!< the base colour texture's size, read from its header without decoding
-  int texture_height = 0;            //!< it, any size. glTF (read_glb_file): embedded, or given by a URI (a
-                                     //!< data: URI, a file next to the .gltf); OBJ (load_mesh of a path): the
-                                     //!< first map_Kd of the .mtl its mtllib names; PLY (load_mesh of a path):
-                                     //!< its `comment TextureFile` (MeshLab's, and tailor's .ply writer's).
-                                     //!< 0: none, or no header read
-  bool texture_file = false;         //!< that texture is a file next to the .gltf, .mtl or .ply (only its header read)
-  std::string texture_path;          //!< OBJ, PLY and a .gltf's image file: that file's path (empty: none, or no
-                                     //!< header read)
+  size_t source_faces = 0;             //!< faces/polygons/strip triangles as stored in the file
+  size_t polygons_triangulated = 0;    //!< source polygons with more than 3 vertices (fan-triangulated)
+  size_t concave_polygons = 0;         //!< of those, concave ones cut into ears instead (a fan would overlap)
+  size_t degenerate_faces = 0;         //!< triangles with a repeated vertex index: dropped
+  size_t duplicate_faces = 0;          //!< triangles with the same vertex set as an earlier one: dropped
+  size_t zero_area_faces = 0;          //!< distinct vertices but zero area: kept
+  size_t unreferenced_vertices = 0;    //!< vertices no face uses: kept, so vertex ids match the file
+  size_t welded_vertices = 0;          //!< STL: corners merged into shared vertices (bit-identical positions)
+  size_t faces_collapsed_by_weld = 0;  //!< glTF: faces whose corners were distinct vertices at one position, so
+                                       //!< repeat a vertex once the split vertices are welded (counted in
+                                       //!< degenerate_faces and dropped)
+  size_t mesh_instances = 0;           //!< glTF: meshes placed by the scene's nodes (world transforms applied)
+  size_t skipped_primitives = 0;       //!< glTF: point and line primitives of those instances, not read
+  std::string not_kept;                //!< what the file has that the output will not (", "-separated), e.g.
+                                       //!< "material textures, TANGENT"; empty when nothing is lost
+  int texture_width = 0;               //!< the base colour texture's size, read from its header without decoding
+  int texture_height = 0;              //!< it, any size. glTF (read_glb_file): embedded, or given by a URI (a
+                                       //!< data: URI, a file next to the .gltf); OBJ (load_mesh of a path): the
+                                       //!< first map_Kd of the .mtl its mtllib names; PLY (load_mesh of a path):
+                                       //!< its `comment TextureFile` (MeshLab's, and tailor's .ply writer's).
+                                       //!< 0: none, or no header read
+  bool texture_file = false;  //!< that texture is a file next to the .gltf, .mtl or .ply (only its header read)
+  std::string texture_path;   //!< OBJ, PLY and a .gltf's image file: that file's path (empty: none, or no
+                              //!< header read)
   std::string
       texture_named;  //!< the base colour texture the file names, even when its header could
                       //!< not be read (OBJ, PLY, a .gltf's image file: its path; else glTF: "image N"); empty: none

@@ -866,6 +866,10 @@ def run_locked(args, outdir):
         plan, params, tiles = plan_tiles(mesh, args, look)
         chunk_count, cell_size = int(plan["cells"].shape[0]), plan["cell_size"]
         largest, median = float(np.abs(mesh.positions).max(initial=0.0)), plan["median_edge"]
+        if not median:  # --chunk-cell: the plan measured none; a sample's median serves the warning
+            sample = mesh.faces[:: max(1, mesh.faces.shape[0] // 65536)]
+            lengths = tailor.chunk_edge_lengths(mesh.positions[sample]).ravel()
+            median = float(np.median(lengths)) if lengths.size else 0.0
     else:
         survey = tiles_stream.survey(layout, args.chunk_cell, args.block_faces)
         largest = float(max(np.abs(survey["lo"]).max(), np.abs(survey["hi"]).max()))

@@ -284,7 +284,7 @@ def survey(layout, chunk_cell, block_faces=BLOCK_FACES):
     n // 2 of the 3F lengths). The second pass, for the median's low 16 bits, runs only when the bin
     of the coarse histogram that holds the median spans two exponents. Returns {faces, lo, hi,
     median_edge (None when the bin decided, or with chunk_cell), about_median (the median, or the
-    low end of its bin when that decided; None with chunk_cell), cell_exponent}."""
+    low end of its bin of the coarse histogram), cell_exponent}."""
     body = _Body(layout)
     try:
         _check_finite(body, block_faces)
@@ -297,27 +297,29 @@ def survey(layout, chunk_cell, block_faces=BLOCK_FACES):
             if corners.shape[0] == 0:
                 continue
             faces += corners.shape[0]
-            tailor._tailor._survey_block(corners, lo, hi, coarse if chunk_cell is None else None)
+            tailor._tailor._survey_block(corners, lo, hi, coarse)
         if faces == 0:
             raise StreamError("%s: mesh has no faces" % layout.path)
-        median = decided = None
-        if chunk_cell is None:
-            rank = (3 * faces) // 2
-            cumulative = np.cumsum(coarse)
-            top = int(np.searchsorted(cumulative, rank, side="right"))
-            below = int(cumulative[top - 1]) if top else 0
-            bin_ends = np.array([top << 16, (top << 16) | 0xFFFF], dtype=np.uint32).view(np.float32)
-            if _same_exponent(float(bin_ends[0]), float(bin_ends[1])):
-                decided = float(bin_ends[0])  # every length of the bin gives the median's exponent
-            else:
-                fine = np.zeros(1 << 16, dtype=np.int64)
-                for _, _, corners, kept in body.blocks(block_faces):
-                    bits = tailor.chunk_edge_lengths(corners[kept]).view(np.uint32).ravel()
-                    bits = bits[(bits >> 16) == top]
-                    fine += np.bincount(bits & 0xFFFF, minlength=1 << 16)
-                low = int(np.searchsorted(np.cumsum(fine), rank - below, side="right"))
-                median = float(np.array([(top << 16) | low], dtype=np.uint32).view(np.float32)[0])
-                decided = median
+        median = None
+        # The median's bin of the coarse histogram (top 16 bits of the lengths' float bits): its
+        # low end is the median to 2^-7, enough for the far-from-origin warning.
+        rank = (3 * faces) // 2
+        cumulative = np.cumsum(coarse)
+        top = int(np.searchsorted(cumulative, rank, side="right"))
+        below = int(cumulative[top - 1]) if top else 0
+        bin_ends = np.array([top << 16, (top << 16) | 0xFFFF], dtype=np.uint32).view(np.float32)
+        decided = float(bin_ends[0])
+        # The automatic cell needs the exact median only when the bin spans two of its exponents
+        # (otherwise every length of the bin gives the median's exponent): a second pass.
+        if chunk_cell is None and not _same_exponent(float(bin_ends[0]), float(bin_ends[1])):
+            fine = np.zeros(1 << 16, dtype=np.int64)
+            for _, _, corners, kept in body.blocks(block_faces):
+                bits = tailor.chunk_edge_lengths(corners[kept]).view(np.uint32).ravel()
+                bits = bits[(bits >> 16) == top]
+                fine += np.bincount(bits & 0xFFFF, minlength=1 << 16)
+            low = int(np.searchsorted(np.cumsum(fine), rank - below, side="right"))
+            median = float(np.array([(top << 16) | low], dtype=np.uint32).view(np.float32)[0])
+            decided = median
         try:
             exponent = tailor.chunk_cell_exponent(decided if chunk_cell is None else 0.0, chunk_cell)
         except tailor.Error as e:

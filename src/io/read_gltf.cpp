@@ -311,8 +311,14 @@ Status read_primitive(GltfDocument& doc, const Json& prim, uint64_t mode, const 
   if (attributes == prim.end() || !get_uint(*attributes, "POSITION", position_index))
     return doc.parse_error("primitive without POSITION", where);
   if (get_uint(prim, "material", material)) out.material = material;
-  const std::string uv_name = "TEXCOORD_" + std::to_string(base_colour_uv_set(doc.json(), out.material));
-  const bool has_uv = get_uint(*attributes, uv_name.c_str(), uv_index);
+  // The set the base colour texture reads; TEXCOORD_0 when the primitive lacks it (a file that names
+  // a set it does not have: as it was read before texCoord was followed).
+  std::string uv_name = "TEXCOORD_" + std::to_string(base_colour_uv_set(doc.json(), out.material));
+  bool has_uv = get_uint(*attributes, uv_name.c_str(), uv_index);
+  if (!has_uv && uv_name != "TEXCOORD_0") {
+    uv_name = "TEXCOORD_0";
+    has_uv = get_uint(*attributes, uv_name.c_str(), uv_index);
+  }
   std::vector<uint32_t> corners;
   const auto extensions = prim.find("extensions");
   const Json* draco = nullptr;
@@ -826,8 +832,20 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
       report.texture_file = false;
     }
   }
-  // glTF splits vertices on UV seams; weld them so that seams are edges between faces again.
+  // glTF splits vertices on UV seams; weld them so that seams are edges between faces again. A face
+  // whose corners were distinct vertices at one position then repeats one (finalize_mesh drops it):
+  // counted apart from the file's own degenerate faces.
+  const auto repeating = [&mesh] {
+    size_t count = 0;
+    for (size_t f = 0; f < mesh.face_count(); ++f) {
+      const uint32_t* v = &mesh.indices[3 * f];
+      count += v[0] == v[1] || v[1] == v[2] || v[2] == v[0];
+    }
+    return count;
+  };
+  const size_t repeating_before = repeating();
   report.welded_vertices = weld_identical_positions(mesh);
+  if (report.welded_vertices > 0) report.faces_collapsed_by_weld = repeating() - repeating_before;
   return Status::ok();
 }
 

@@ -965,8 +965,9 @@ def test_positions_far_from_the_origin_are_warned_of(tmp_path):
     for name, offset, warned in (("utm.ply", (500000.0, 4000000.0, 100.0), True), ("local.ply", (0.0, 0.0, 0.0), False)):
         path = tmp_path / name
         write_ply(path, scaled + offset, mesh.faces)
-        for extra in ([], ["--in-memory"]):
+        # Streamed or loaded whole, the automatic cell or a given one (no median measured for it).
+        for extra in ([], ["--in-memory"], ["--chunk-cell", 5], ["--in-memory", "--chunk-cell", 5]):
             code, _, stderr = run_tiles(path, "-o", tmp_path / "out", "--workers", 0, "--no-lod", *extra)
             assert code == 0, stderr
             found = "warning: positions reach 4e+06 units from the origin, where 32-bit floats are 0.25 apart" in stderr
-            assert found == warned, stderr
+            assert found == warned, (extra, stderr)
