@@ -172,6 +172,9 @@ chunk k's face ids are faces[chunk_start[k]:chunk_start[k+1]].)");
         "_far_from_origin_warning(largest_coordinate, median_edge) -> str: for tailor.tiles: what tailor map says\n"
         "of positions that 32-bit floats round by more than 1 % of the median edge ('' when they do not)");
   m.def(
+      "_far_from_origin_warning", [](const PyMesh& mesh) { return far_from_origin_warning(mesh.mesh); },
+      py::arg("mesh"), "_far_from_origin_warning(mesh) -> str: the same, of a loaded mesh (a sample's median edge)");
+  m.def(
       "chunk_cells",
       [](const py::array& corners, int cell_exponent) {
         const FloatArray c = corner_array(corners);

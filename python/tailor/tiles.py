@@ -865,20 +865,15 @@ def run_locked(args, outdir):
     if mesh is not None:
         plan, params, tiles = plan_tiles(mesh, args, look)
         chunk_count, cell_size = int(plan["cells"].shape[0]), plan["cell_size"]
-        largest, median = float(np.abs(mesh.positions).max(initial=0.0)), plan["median_edge"]
-        if not median:  # --chunk-cell: the plan measured none; a sample's median serves the warning
-            sample = mesh.faces[:: max(1, mesh.faces.shape[0] // 65536)]
-            lengths = tailor.chunk_edge_lengths(mesh.positions[sample]).ravel()
-            median = float(np.median(lengths)) if lengths.size else 0.0
+        far = tailor._tailor._far_from_origin_warning(mesh)
     else:
         survey = tiles_stream.survey(layout, args.chunk_cell, args.block_faces)
         largest = float(max(np.abs(survey["lo"]).max(), np.abs(survey["hi"]).max()))
-        median = survey["about_median"]
+        far = tailor._tailor._far_from_origin_warning(largest, survey["about_median"])
         params = tile_params(
             args, look, survey["cell_exponent"], lambda: texels_per_unit_of_box(survey["lo"], survey["hi"], args.scale)
         )
         cell_size = math.ldexp(1.0, survey["cell_exponent"])
-    far = tailor._tailor._far_from_origin_warning(largest, median or 0.0)
     if far and not args.quiet:
         print("tailor.tiles: warning: %s" % far, file=sys.stderr)
     old = previous_output(outdir, params)

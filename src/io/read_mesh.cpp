@@ -2,7 +2,6 @@
 // validation / repair pass shared by all of them (finalize_mesh). See include/tailor/io.h.
 #include <algorithm>
 #include <atomic>
-#include <cctype>
 #include <chrono>
 #include <climits>
 #include <cmath>
@@ -27,14 +26,19 @@ namespace {
 
 constexpr const char* kSupported = "supported: .ply .obj .off .stl .glb .gltf";
 
-bool ends_with_ci(const std::string& s, std::string_view suffix) {
-  if (s.size() < suffix.size()) return false;
-  for (size_t i = 0; i < suffix.size(); ++i) {
-    char c = s[s.size() - suffix.size() + i];
+// Whether `s` at `at` reads `lower` (lower case) in any case (ASCII).
+bool reads_ci(std::string_view s, size_t at, std::string_view lower) {
+  if (at > s.size() || s.size() - at < lower.size()) return false;
+  for (size_t i = 0; i < lower.size(); ++i) {
+    char c = s[at + i];
     if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
-    if (c != suffix[i]) return false;
+    if (c != lower[i]) return false;
   }
   return true;
+}
+
+bool ends_with_ci(std::string_view s, std::string_view suffix) {
+  return s.size() >= suffix.size() && reads_ci(s, s.size() - suffix.size(), suffix);
 }
 
 // True when the first word of the data is an OFF keyword: [ST][C][N][4][n]OFF.
@@ -219,9 +223,7 @@ void read_obj_material(const std::filesystem::path& folder, const std::string& l
     rest = end == std::string_view::npos ? std::string_view{} : rest.substr(end + 1);
     if (line == "# tailor symmetry 4") symmetry = 4;
     // The keyword in any case: some writers put map_kd.
-    std::string keyword(line.substr(0, 7));
-    for (char& c : keyword) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (!texture.empty() || (keyword != "map_kd " && keyword != "map_kd\t")) continue;
+    if (!texture.empty() || !(reads_ci(line, 0, "map_kd ") || reads_ci(line, 0, "map_kd\t"))) continue;
     const std::string_view name = internal::trimmed(line.substr(7));
     // The name, unless options (-s 1 1 1, -clamp on, ...) come first: then its last word.
     const size_t last_blank = name.find_last_of(" \t");
