@@ -5,6 +5,7 @@
 
 #include "bindings.h"
 #include "tailor/io.h"
+#include "tailor/topology.h"
 
 namespace tailor::python {
 namespace {
@@ -96,6 +97,7 @@ py::dict load_report_dict(const LoadReport& r) {
   d["zero_area_faces"] = r.zero_area_faces;
   d["unreferenced_vertices"] = r.unreferenced_vertices;
   d["welded_vertices"] = r.welded_vertices;
+  d["faces_turned"] = r.faces_turned;
   return d;
 }
 
@@ -170,6 +172,21 @@ void bind_mesh(py::module_& m) {
                (mesh.source.empty() ? std::string() : " from '" + mesh.source + "'") + ">";
       });
 
+  m.def(
+      "orient_faces",
+      [](const PyMesh& mesh) {
+        auto turned = std::make_unique<PyMesh>(mesh);
+        {
+          const py::gil_scoped_release release;
+          turned->load.faces_turned = orient_faces_coherently(turned->mesh, build_topology(turned->mesh));
+        }
+        return turned;
+      },
+      py::arg("mesh"),
+      "orient_faces(mesh) -> Mesh\n\nA copy of the mesh whose faces wound against their neighbours are turned to "
+      "run as the surface around them (their corners' UVs with them), as `tailor map` does unless --keep-winding; "
+      "load_report['faces_turned'] says how many. Mapped as they are, such faces are cut apart and their edges "
+      "counted as seams.");
   m.def(
       "load",
       [](const py::object& path_object) {

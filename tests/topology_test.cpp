@@ -247,5 +247,75 @@ TEST(Topology, HighValenceFanUsesSortedMatching) {
   }
 }
 
+// The faces of a real mesh turned against their neighbours (every 97th, with their UVs) are turned
+// back: the mesh comes out bit-identical, every shared edge paired.
+TEST(OrientFaces, TurnsBackAMinorityOfTurnedFaces) {
+  Mesh clean;
+  ASSERT_TRUE(load_mesh(std::string(TAILOR_TEST_DATA) + "/meshes/spot.obj", clean).is_ok());
+  ASSERT_FALSE(clean.corner_uvs.empty());
+  Mesh mesh = clean;
+  size_t turned = 0;
+  for (size_t f = 0; f < mesh.face_count(); f += 97, ++turned) {
+    std::swap(mesh.indices[3 * f + 1], mesh.indices[3 * f + 2]);
+    for (size_t k = 0; k < 2; ++k) std::swap(mesh.corner_uvs[6 * f + 2 + k], mesh.corner_uvs[6 * f + 4 + k]);
+  }
+  const Topology before = build_topology(mesh);
+  EXPECT_GT(before.inconsistent_edges, 0u);
+  EXPECT_EQ(orient_faces_coherently(mesh, before), turned);
+  EXPECT_EQ(mesh.indices, clean.indices);
+  EXPECT_EQ(mesh.corner_uvs, clean.corner_uvs);
+  const Topology after = build_topology(mesh);
+  EXPECT_EQ(after.inconsistent_edges, 0u);
+  EXPECT_EQ(after.edge_components, 1u);
+  EXPECT_EQ(orient_faces_coherently(mesh, after), 0u);  // nothing left to turn
+}
+
+// Every second face turned: half the area each way. The side without the lowest face turns, so
+// the surface runs one way again, and the same way whatever the order of the faces.
+TEST(OrientFaces, HalfTurnedSurfaceRunsOneWayInAnyFaceOrder) {
+  Mesh mesh;
+  ASSERT_TRUE(load_mesh(std::string(TAILOR_TEST_DATA) + "/meshes/fandisk.off", mesh).is_ok());
+  for (size_t f = 1; f < mesh.face_count(); f += 2) std::swap(mesh.indices[3 * f + 1], mesh.indices[3 * f + 2]);
+  Mesh reversed = mesh;  // the same faces in the opposite order
+  for (size_t f = 0; f < mesh.face_count(); ++f)
+    for (size_t k = 0; k < 3; ++k) reversed.indices[3 * f + k] = mesh.indices[3 * (mesh.face_count() - 1 - f) + k];
+  const size_t turned = orient_faces_coherently(mesh, build_topology(mesh));
+  const size_t turned_reversed = orient_faces_coherently(reversed, build_topology(reversed));
+  EXPECT_GT(turned, 0u);
+  EXPECT_LT(turned, mesh.face_count());
+  EXPECT_EQ(turned + turned_reversed, mesh.face_count() / 2 * 2) << "one turns the odd faces, the other the even";
+  const Topology t = build_topology(mesh);
+  EXPECT_EQ(t.inconsistent_edges, 0u);
+  EXPECT_EQ(t.edge_components, 1u);
+  EXPECT_EQ(build_topology(reversed).inconsistent_edges, 0u);
+}
+
+// A Moebius strip cannot run one way: one edge stays unpaired, and nothing else is harmed.
+TEST(OrientFaces, MoebiusStripKeepsOneEdgeUnpaired) {
+  constexpr uint32_t kSegments = 12;
+  std::vector<float> p;
+  std::vector<uint32_t> idx;
+  for (uint32_t i = 0; i < kSegments; ++i) {
+    const float a = 6.2831853f * static_cast<float>(i) / kSegments, half = a / 2;
+    for (const float s : {-0.3f, 0.3f}) {
+      const float r = 1 + s * std::cos(half);
+      p.insert(p.end(), {r * std::cos(a), r * std::sin(a), s * std::sin(half)});
+    }
+  }
+  for (uint32_t i = 0; i < kSegments; ++i) {
+    const uint32_t a = 2 * i, b = 2 * i + 1;
+    // The last segment joins the first one's sides swapped: the half twist.
+    const uint32_t c = i + 1 < kSegments ? 2 * i + 2 : 1, d = i + 1 < kSegments ? 2 * i + 3 : 0;
+    idx.insert(idx.end(), {a, c, b, b, c, d});
+  }
+  Mesh mesh = make_mesh(p, idx);
+  const Topology t = build_topology(mesh);
+  ASSERT_GT(t.inconsistent_edges, 0u);
+  orient_faces_coherently(mesh, t);
+  const Topology after = build_topology(mesh);
+  EXPECT_EQ(after.inconsistent_edges, 1u);
+  EXPECT_EQ(after.boundary_edges, t.boundary_edges);
+}
+
 }  // namespace
 }  // namespace tailor

@@ -53,6 +53,7 @@ struct MapArgs {
   MapTextureOptions options;
   MappingArgs mapping_args;  // the mapping options given as text (map_shared.h)
   bool stability = false;
+  bool keep_winding = false;  // --keep-winding: faces wound against their neighbours stay as they are
   bool quiet = false;
 };
 
@@ -188,17 +189,38 @@ int run_map(const MapArgs& opt) {
     topology = build_topology(
         mesh, [&connecting](float f) { return connecting.update(f); }, mapping.threads);
     connecting.done();
-    if (topology.nonmanifold_edges || topology.inconsistent_edges)
-      warn(opt.quiet, opt.input + ": " + std::to_string(topology.nonmanifold_edges) + " non-manifold and " +
-                          std::to_string(topology.inconsistent_edges) +
-                          " inconsistently oriented edges treated as boundary" +
-                          (topology.inconsistent_edges
-                               ? std::string(" (faces wound against their neighbours are mapped apart and their "
-                                             "edges counted as seams: orient the faces coherently for a continuous "
-                                             "texture)")
-                               : std::string()));
   };
-  if (auto_axis) connect();
+  // Faces wound against their neighbours turn to run as the surface around them (unless
+  // --keep-winding): mapped as they are, they would be cut apart with their edges counted as seams.
+  // The topology that finds them is built after the mapping (unless the axis choice needs it first),
+  // so a mesh that has them is mapped again after the turn: nothing is spent on meshes without.
+  const auto turn_wound_faces = [&]() -> bool {
+    if (opt.keep_winding || topology.inconsistent_edges == 0) return false;
+    load.faces_turned = orient_faces_coherently(mesh, topology);
+    if (load.faces_turned == 0) return false;
+    warn(opt.quiet, opt.input + ": turned " + std::to_string(load.faces_turned) +
+                        " faces wound against their neighbours, so that the surface runs one way (--keep-winding "
+                        "keeps them as they are)");
+    topology = Topology{};
+    return true;
+  };
+  const auto warn_unpaired = [&] {
+    if (topology.nonmanifold_edges || topology.inconsistent_edges)
+      warn(opt.quiet,
+           opt.input + ": " + std::to_string(topology.nonmanifold_edges) + " non-manifold and " +
+               std::to_string(topology.inconsistent_edges) + " inconsistently oriented edges treated as boundary" +
+               (topology.inconsistent_edges
+                    ? std::string(opt.keep_winding ? " (faces wound against their neighbours are mapped apart and "
+                                                     "their edges counted as seams: without --keep-winding they turn)"
+                                                   : " (a band whose two sides meet turned, as in a Moebius strip: "
+                                                     "no winding runs one way across it)")
+                    : std::string()));
+  };
+  if (auto_axis) {
+    connect();
+    if (turn_wound_faces()) connect();
+    warn_unpaired();
+  }
   // World units: the texel density is per scene unit, the same for every mesh (the mapping works
   // in the unit cube: its scale becomes texels per unit times the normalisation's length).
   double texels_per_unit = opt.texels_per_unit;
@@ -260,18 +282,27 @@ int run_map(const MapArgs& opt) {
     }
   }
   // === Orientation, mapping, metrics ===
-  Progress progress("orientation", opt.quiet);  // then mapping, closing, relaxing, metrics: a bar each
-  mapping.progress = nullptr;
-  options.stage_progress = [&progress](std::string_view stage, float f) { return progress.update(stage, f); };
   TextureMap map;
+  mapping.progress = nullptr;
   MapTextureOptions unmeasured = options;
   unmeasured.measure = false;
-  {
+  const auto map_mesh = [&]() -> Status {
+    Progress progress("orientation", opt.quiet);  // then mapping, closing, relaxing: a bar each
+    unmeasured.stage_progress = [&progress](std::string_view stage, float f) { return progress.update(stage, f); };
     const KeepScratch keep;  // every chunk's scratch reused, not faulted in again
-    if (Status s = map_texture(mesh, topology, unmeasured, map); !s) return report_error(s.with_file(opt.input));
+    Status s = map_texture(mesh, topology, unmeasured, map);
+    if (s) progress.done();
+    return s;
+  };
+  if (Status s = map_mesh(); !s) return report_error(s.with_file(opt.input));
+  if (topology.opposite.empty()) {
+    connect();
+    if (turn_wound_faces()) {
+      if (Status s = map_mesh(); !s) return report_error(s.with_file(opt.input));
+      connect();
+    }
+    warn_unpaired();
   }
-  progress.done();
-  if (topology.opposite.empty()) connect();
   {
     Progress measuring("metrics", opt.quiet);
     MapTextureOptions measured = options;
@@ -505,6 +536,10 @@ void register_map(CLI::App& app, Runner& run) {
                   "large enough); the output is the same for any count")
       ->capture_default_str()
       ->check(CLI::Range(0u, 64u));
+  cmd->add_flag("--keep-winding", opt->keep_winding,
+                "Keep faces wound against their neighbours as they are (mapped apart, their edges counted as "
+                "seams); by default they turn to run as the surface around them, in the output too, and the "
+                "mesh is mapped again");
   cmd->add_flag("-q,--quiet", opt->quiet, "Print nothing but errors");
   cmd->footer(
       "Example:\n"

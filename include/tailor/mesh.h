@@ -83,6 +83,8 @@ struct LoadReport {
   size_t faces_collapsed_by_weld = 0;  //!< glTF: faces whose corners were distinct vertices at one position, so
                                        //!< repeat a vertex once the split vertices are welded (counted in
                                        //!< degenerate_faces and dropped)
+  size_t faces_turned = 0;             //!< tailor map: faces wound against their neighbours, turned to run as
+                                       //!< the surface around them (orient_faces_coherently)
   size_t mesh_instances = 0;           //!< glTF: meshes placed by the scene's nodes (world transforms applied)
   size_t skipped_primitives = 0;       //!< glTF: point and line primitives of those instances, not read
   std::string not_kept;                //!< what the file has that the output will not (", "-separated), e.g.

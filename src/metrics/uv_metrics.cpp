@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "metrics/stored_metrics.h"
+#include "surface/face_winding.h"
 #include "tailor/export.h"
 #include "tailor/metrics.h"
 #include "util/bin_select.h"
@@ -272,30 +273,6 @@ bool add_seam(const Mesh& mesh, std::span<const float> corner_uv, const MetricsO
   return true;
 }
 
-// The edges that exactly two faces share running the same way (the topology's inconsistent
-// edges, left unpaired): (edge of the lower face, edge of the other), in edge order. Only the
-// unpaired edges are sorted, so a mesh without them costs one pass.
-std::vector<std::pair<size_t, size_t>> same_way_edge_pairs(const Mesh& mesh, const Topology& topology) {
-  std::vector<std::pair<size_t, size_t>> pairs;
-  if (topology.inconsistent_edges == 0) return pairs;
-  std::vector<std::pair<uint64_t, size_t>> loose;  // (lower vertex << 32 | upper vertex, edge)
-  for (size_t e = 0; e < topology.opposite.size(); ++e) {
-    if (topology.opposite[e] != kInvalid) continue;
-    const uint64_t a = mesh.indices[e], b = mesh.indices[3 * (e / 3) + (e % 3 + 1) % 3];
-    loose.emplace_back(std::min(a, b) << 32 | std::max(a, b), e);
-  }
-  std::sort(loose.begin(), loose.end());
-  for (size_t i = 0; i < loose.size();) {
-    size_t end = i + 1;
-    while (end < loose.size() && loose[end].first == loose[i].first) ++end;
-    const size_t e = loose[i].second;
-    if (end - i == 2 && mesh.indices[e] == mesh.indices[loose[i + 1].second])
-      pairs.emplace_back(e, loose[i + 1].second);
-    i = end;
-  }
-  return pairs;
-}
-
 }  // namespace
 
 uint32_t derive_patches(const Mesh& mesh, const Topology& topology, std::span<const float> corner_uv,
@@ -543,7 +520,7 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
   // breaks there when the faces' UVs disagree. They are seams like paired edges (and one edge, not
   // two, in the total), so faces wound the wrong way cannot hide their seams.
   seam_sums.emplace_back();
-  for (const auto& [e, g_edge] : same_way_edge_pairs(mesh, topology)) {
+  for (const auto& [e, g_edge] : internal::same_way_edge_pairs(mesh, topology)) {
     const size_t f = e / 3, k = e % 3, g = g_edge / 3, j = g_edge % 3;
     const double length =
         norm(sub(position(mesh, mesh.indices[3 * f + (k + 1) % 3]), position(mesh, mesh.indices[3 * f + k])));

@@ -74,6 +74,7 @@ std::string map_report_json(const MapRun& run) {
                {"inconsistent_edges", run.inconsistent_edges},
                {"degenerate_faces_dropped", run.load.degenerate_faces},
                {"duplicate_faces_dropped", run.load.duplicate_faces},
+               {"faces_turned", run.load.faces_turned},
                {"unreferenced_vertices", run.load.unreferenced_vertices}};
   j["mapping"] = {{"patches", stats.patches},
                   {"patches_before_absorb", stats.patches_before_absorb},

@@ -68,6 +68,19 @@ def test_degenerate_and_duplicate_faces_are_dropped_and_counted():
     assert mesh.load_report["degenerate_faces"] == 1 and mesh.load_report["duplicate_faces"] == 1
 
 
+def test_orient_faces_turns_back_faces_wound_against_their_neighbours():
+    clean = tailor.load(SPOT)
+    faces = np.array(clean.faces)
+    faces[::97] = faces[::97][:, [0, 2, 1]]
+    mesh = tailor.Mesh(np.array(clean.positions), faces)
+    turned = tailor.orient_faces(mesh)
+    assert turned.load_report["faces_turned"] == len(faces[::97])
+    assert np.array_equal(turned.faces, clean.faces)
+    assert np.array_equal(mesh.faces, faces)  # the argument is left as it was
+    again = tailor.orient_faces(turned)
+    assert again.load_report["faces_turned"] == 0 and np.array_equal(again.faces, clean.faces)
+
+
 GOOD_POSITIONS = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
 GOOD_FACES = np.array([[0, 1, 2]], np.int32)
 
