@@ -1,6 +1,8 @@
 // tailor.Mesh (from numpy arrays or a file) and tailor.load. The arrays are validated and repaired
 // by finalize_mesh, the same pass every file reader runs, so a Mesh from arrays and one from a
 // file obey the same rules (and raise the same messages).
+#include <cmath>
+#include <cstdio>
 #include <cstring>
 
 #include "bindings.h"
@@ -21,15 +23,31 @@ void copy_positions(const py::array& positions, std::vector<float>& out) {
   const size_t count = static_cast<size_t>(positions.shape(0)) * 3;
   if (count / 3 > kMaxVertices) raise_status(Status::error(ErrorCode::kLimit, kArraysName, "too many vertices"));
   out.resize(count);
-  if (positions.dtype().equal(py::dtype::of<float>())) {
+  // By kind and size, so that either byte order is taken (forcecast swaps a big-endian array's).
+  const char kind = positions.dtype().kind();
+  const py::ssize_t size = positions.dtype().itemsize();
+  if (kind == 'f' && size == 4) {
     const auto typed = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(positions);
     const py::gil_scoped_release release;
     if (count) std::memcpy(out.data(), typed.data(), count * sizeof(float));
-  } else if (positions.dtype().equal(py::dtype::of<double>())) {
+  } else if (kind == 'f' && size == 8) {
     const auto typed = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(positions);
     const double* in = typed.data();
-    const py::gil_scoped_release release;
-    for (size_t i = 0; i < count; ++i) out[i] = static_cast<float>(in[i]);
+    size_t beyond = count;
+    {
+      const py::gil_scoped_release release;
+      for (size_t i = 0; i < count; ++i) {
+        out[i] = static_cast<float>(in[i]);
+        if (std::isfinite(in[i]) && !std::isfinite(out[i]) && beyond == count) beyond = i;
+      }
+    }
+    if (beyond != count) {
+      char value[32];
+      std::snprintf(value, sizeof value, "%g", in[beyond]);
+      raise_status(Status::error(ErrorCode::kInvalidMesh, kArraysName,
+                                 std::string("vertex coordinate ") + value + " beyond the range of 32-bit floats",
+                                 "vertex " + std::to_string(beyond / 3)));
+    }
   } else {
     raise_error("positions must be float32 or float64, got " + describe(positions));
   }
@@ -107,7 +125,8 @@ void bind_mesh(py::module_& m) {
   py::class_<PyMesh>(m, "Mesh",
                      "A triangle mesh: positions (V, 3) float32 and faces (F, 3) uint32, counter-clockwise.\n\n"
                      "Mesh(positions, faces): positions float32 or float64 (V, 3), faces int32, int64, uint32 or\n"
-                     "uint64 (F, 3). float32 and uint32 arrays in C order are copied with one memcpy into the\n"
+                     "uint64 (F, 3), in either byte order. Native float32 and uint32 arrays in C order are copied with "
+                     "one memcpy into the\n"
                      "library's arrays (no conversion); other dtypes are converted. The arrays are checked\n"
                      "as every file reader checks them: non-finite coordinates and indices out of range raise\n"
                      "tailor.Error; faces with a repeated vertex and exact duplicate faces are dropped and\n"
@@ -162,14 +181,17 @@ void bind_mesh(py::module_& m) {
       .def_property_readonly(
           "face_count", [](const PyMesh& mesh) { return mesh.mesh.face_count(); }, "number of faces")
       .def_property_readonly(
-          "source", [](const PyMesh& mesh) { return mesh.source; }, "the file it was loaded from ('' for arrays)")
+          "source", [](const PyMesh& mesh) { return path_text(mesh.source); },
+          "the file it was loaded from ('' for arrays)")
       .def_property_readonly(
           "load_report", [](const PyMesh& mesh) { return load_report_dict(mesh.load); },
           "what loading found and repaired: format, source_faces, degenerate_faces, duplicate_faces, ...")
       .def("__repr__", [](const PyMesh& mesh) {
-        return "<tailor.Mesh " + std::to_string(mesh.mesh.vertex_count()) + " vertices, " +
-               std::to_string(mesh.mesh.face_count()) + " faces" +
-               (mesh.source.empty() ? std::string() : " from '" + mesh.source + "'") + ">";
+        const std::string text = "<tailor.Mesh " + std::to_string(mesh.mesh.vertex_count()) + " vertices, " +
+                                 std::to_string(mesh.mesh.face_count()) + " faces" +
+                                 (mesh.source.empty() ? std::string() : " from '" + mesh.source + "'") + ">";
+        return py::reinterpret_steal<py::object>(
+            PyUnicode_DecodeUTF8(text.data(), py::ssize_t(text.size()), "backslashreplace"));
       });
 
   m.def(

@@ -17,6 +17,14 @@
 namespace tailor::python {
 namespace {
 
+// Whether two paths name one file: the same device and inode when both exist, else the same
+// normalised absolute path (as the command's output checks compare them).
+bool same_file(const std::string& a, const std::string& b) {
+  std::error_code ea, eb;
+  if (std::filesystem::exists(a, ea) && std::filesystem::exists(b, eb)) return std::filesystem::equivalent(a, b, ea);
+  return std::filesystem::absolute(a, ea).lexically_normal() == std::filesystem::absolute(b, eb).lexically_normal();
+}
+
 // (H, W) or (H, W, C) uint8 with C in 1..4 -> Image (rows top first, interleaved channels).
 Image image_from_array(const py::array& array) {
   if (!array.dtype().equal(py::dtype::of<uint8_t>()))
@@ -123,8 +131,7 @@ void bind_tile_set(py::module_& m) {
   m.def(
       "tile_set",
       [](const std::vector<py::object>& map_paths, const py::object& output, const std::vector<py::object>& normal_maps,
-         int block, int overlap, uint64_t seed, int symmetry, bool same_size,
-         const py::object& progress) -> std::vector<std::string> {
+         int block, int overlap, uint64_t seed, int symmetry, bool same_size, const py::object& progress) -> py::list {
         std::vector<std::string> paths, normals, written;
         for (const py::object& p : map_paths) paths.push_back(path_of(p));
         for (const py::object& p : normal_maps) normals.push_back(path_of(p));
@@ -141,6 +148,16 @@ void bind_tile_set(py::module_& m) {
                                        "two maps of the set would be written to the same file name", out));
           written.push_back(out);
         }
+        std::error_code ec;
+        if (std::filesystem::exists(folder, ec) && !std::filesystem::is_directory(folder, ec))
+          raise_status(Status::error(ErrorCode::kInvalidArgument, folder, "the output is not a folder"));
+        // The outputs must not replace the maps they are made from (the command refuses that too).
+        std::vector<std::string> outputs = written;
+        outputs.push_back(folder + "/material.json");
+        for (const std::string& out : outputs)
+          for (const std::string& in : paths)
+            if (same_file(in, out))
+              raise_status(Status::error(ErrorCode::kInvalidArgument, out, "the output would overwrite an input"));
         std::vector<TileMap> maps(paths.size());
         TileOptions options = tile_options(block, overlap, seed, symmetry, same_size);
         ProgressBridge bridge(progress);
@@ -155,9 +172,16 @@ void bind_tile_set(py::module_& m) {
             bool dx_name = false;  // a *_normal_dx map turns the other way round with symmetry 4
             material_role_from_name(paths[i], &dx_name);
             maps[i].directx = maps[i].normal && dx_name;
+            if (status && (maps[i].image.width != maps[0].image.width || maps[i].image.height != maps[0].image.height))
+              status = Status::error(ErrorCode::kInvalidImage, paths[i], "every map of a set must have the same size",
+                                     std::to_string(maps[i].image.width) + "x" + std::to_string(maps[i].image.height) +
+                                         ", but " + paths[0] + " is " + std::to_string(maps[0].image.width) + "x" +
+                                         std::to_string(maps[0].image.height));
           }
           if (status) status = make_tileable_set(maps, options, 1, tiles).with_file(paths[0]);
-          if (status && !std::filesystem::is_directory(folder) && !std::filesystem::create_directories(folder))
+          std::error_code created;
+          if (status && !std::filesystem::is_directory(folder, created) &&
+              !std::filesystem::create_directories(folder, created))
             status = Status::error(ErrorCode::kIo, folder, "cannot create the output folder");
           for (size_t i = 0; i < written.size() && status; ++i) status = write_png16(written[i], tiles[0][i]);
           if (status) {  // material.json, as the command writes it (tailor.map(material=folder) reads it)
@@ -176,7 +200,9 @@ void bind_tile_set(py::module_& m) {
           }
         }
         bridge.finish(status);
-        return written;
+        py::list paths_written;
+        for (const std::string& path : written) paths_written.append(path_text(path));
+        return paths_written;
       },
       py::arg("maps"), py::arg("output"), py::arg("normal_maps") = std::vector<py::object>{},
       py::arg("block") = d.block, py::arg("overlap") = d.overlap, py::arg("seed") = d.seed,

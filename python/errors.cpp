@@ -22,7 +22,10 @@ const char* code_name(ErrorCode code) {
 }
 
 [[noreturn]] void raise_with_code(const std::string& message, const char* code) {
-  py::object error = py::reinterpret_borrow<py::object>(error_type)(message);
+  // A file name that is not UTF-8 shows as U+FFFD in the message (a str cannot hold its bytes).
+  const py::object text =
+      py::reinterpret_steal<py::object>(PyUnicode_DecodeUTF8(message.data(), py::ssize_t(message.size()), "replace"));
+  py::object error = py::reinterpret_borrow<py::object>(error_type)(text);
   error.attr("code") = code;
   PyErr_SetObject(error_type, error.ptr());
   throw py::error_already_set();
@@ -77,7 +80,13 @@ void set_chunk_split(const py::object& chunk_split, uint32_t& split_above) {
 std::string path_of(const py::handle& path) {
   if (!py::isinstance<py::str>(path) && !py::hasattr(path, "__fspath__"))
     raise_error("expected a path (str or os.PathLike), got " + py::str(py::type::of(path)).cast<std::string>());
-  return py::module_::import("os").attr("fsdecode")(path).cast<std::string>();
+  // The file system's bytes (os.fsencode): a name that is not UTF-8 (decoded by Python with
+  // surrogate escapes) names the same file, where a UTF-8 cast of the str would fail.
+  return py::module_::import("os").attr("fsencode")(path).cast<py::bytes>().cast<std::string>();
+}
+
+py::object path_text(const std::string& path) {
+  return py::reinterpret_steal<py::object>(PyUnicode_DecodeFSDefaultAndSize(path.data(), py::ssize_t(path.size())));
 }
 
 py::object json_to_dict(const std::string& text) { return py::module_::import("json").attr("loads")(text); }

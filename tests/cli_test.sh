@@ -608,9 +608,14 @@ grep -Eq "^tailor: warning: positions reach 4e\+06 units from the origin, where 
 # --- a texture that does not wrap, and fewer than one repeat: one warning line each, and the summary's repeats ---
 photo=tests/data/textures/water-caustics-300.jpg
 "$tailor" map "$mesh" -t "$photo" -o "$tmp/wrap.glb" >"$tmp/wrap.txt" 2>"$tmp/wrap.err" || fail "map with a photo"
-grep -Eq "^tailor: warning: $photo does not wrap \(wrap ratio [0-9]+\.[0-9]{2} in x, [0-9]+\.[0-9]{2} in y; seamless is 0\.8-1\.2\): .*'tailor tile $photo -o tests/data/textures/water-caustics-300_tile\.png'$" \
+grep -Eq "^tailor: warning: $photo does not wrap \(wrap ratio [0-9]+\.[0-9]{2} in x, [0-9]+\.[0-9]{2} in y; seamless is 0\.8-1\.2\): .*make it tileable with: tailor tile $photo -o tests/data/textures/water-caustics-300_tile\.png$" \
   "$tmp/wrap.err" && [[ $(grep -c "does not wrap" "$tmp/wrap.err") -eq 1 ]] && ok ||
   fail "no wrap warning for a photo: $(cat "$tmp/wrap.err")"
+# The suggested command pastes into a shell: a name with a space is quoted.
+cp "$photo" "$tmp/my photo.jpg"
+"$tailor" map "$mesh" -t "$tmp/my photo.jpg" -o "$tmp/wrap.glb" >/dev/null 2>"$tmp/wrap.err" &&
+  grep -qF "make it tileable with: tailor tile '$tmp/my photo.jpg' -o '$tmp/my photo_tile.png'" "$tmp/wrap.err" && ok ||
+  fail "the suggested tile command is not quoted: $(cat "$tmp/wrap.err")"
 "$tailor" map "$mesh" -t "$photo" -o "$tmp/wrap.glb" -q 2>"$tmp/wrap.err" >/dev/null && [[ ! -s $tmp/wrap.err ]] && ok ||
   fail "--quiet printed a warning: $(cat "$tmp/wrap.err")"
 "$tailor" tile "$photo" -o "$tmp/photo_tile.png" -q || fail "tile the photo"

@@ -189,6 +189,22 @@ TEST(ImageIo, TextFileNamedPngIsAClearError) {
   EXPECT_NE(s.message().find("not a readable PNG, JPEG, TGA or BMP"), std::string::npos) << s.message();
 }
 
+// A Radiance .hdr (2 x 1 pixels, flat RGBE scanlines): stb would clip its light to 8 bits.
+TEST(ImageIo, HighDynamicRangeImageIsRefusedNotClipped) {
+  const std::string path = temp_path("light.hdr");
+  std::string bytes = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 2\n";
+  for (int k = 0; k < 2; ++k) bytes += std::string("\x80\x80\x80\x84", 4);  // 8.0 in each channel
+  write_bytes(path, bytes);
+  Image im;
+  const Status s = load_image(path, im);
+  ASSERT_FALSE(s.is_ok());
+  EXPECT_EQ(s.code(), ErrorCode::kUnsupported);
+  EXPECT_NE(s.message().find("high dynamic range (Radiance .hdr) images are not read"), std::string::npos)
+      << s.message();
+  Image16 deep;
+  EXPECT_FALSE(load_image16(path, deep).is_ok());
+}
+
 TEST(ImageIo, AbsurdHeaderSizeIsRejectedBeforeDecoding) {
   // A valid-looking 100000 x 100000 RGB header with a few bytes of data: decoding would need 30 GB.
   const std::string path = temp_path("huge.png");

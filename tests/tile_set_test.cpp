@@ -431,6 +431,27 @@ TEST(TileSetCli, SetAndMaterialWriteTheInputNamesIntoTheFolder) {
             0)
       << err;
   EXPECT_EQ(err.find("unknown key"), std::string::npos) << err;
+  // "role" names a normal map as `tailor map --material` reads it (any case, role words).
+  {
+    std::ofstream m(dir + "/role.json");
+    m << R"({"maps": [{"file": "bark_color.png"}, {"file": "bark_normal.png", "role": "Normal"}]})";
+  }
+  ASSERT_EQ(test::run_command(std::string(TAILOR_BINARY) + " tile --material " + dir + "/role.json -o " + dir +
+                                  "/out6 --quiet --allow-misses",
+                              out, &err),
+            0)
+      << err;
+  std::ifstream jf6(dir + "/out6/material.json");
+  EXPECT_EQ(nlohmann::json::parse(jf6, nullptr, false)["maps"][1]["normal"], true);
+  {
+    std::ofstream m(dir + "/convention.json");
+    m << R"({"maps": [{"file": "bark_color.png"}], "normal_convention": 5})";
+  }
+  EXPECT_EQ(test::run_command(std::string(TAILOR_BINARY) + " tile --material " + dir + "/convention.json -o " + dir +
+                                  "/out7 --quiet --allow-misses",
+                              out, &err),
+            2);
+  EXPECT_NE(err.find("normal_convention must be \"gl\" or \"dx\""), std::string::npos) << err;
   std::filesystem::remove_all(dir);
 }
 

@@ -233,15 +233,21 @@ Status read_material(TileCliOptions& opt) {
     if (m.contains("normal") && !m["normal"].is_boolean())
       return Status::error(ErrorCode::kInvalidArgument, opt.material, "\"normal\" must be true or false",
                            "maps[" + std::to_string(i) + "]");
-    if (m.contains("type") && !m["type"].is_string())
-      return Status::error(ErrorCode::kInvalidArgument, opt.material, "\"type\" must be a string",
-                           "maps[" + std::to_string(i) + "]");
-    const bool normal = (m.contains("normal") && m["normal"].get<bool>()) ||
-                        (m.contains("type") && m["type"].is_string() && m["type"].get<std::string>() == "normal");
+    // "role" or "type" names the map as `tailor map --material` reads them (role words as in file
+    // names: "normal", "normal_dx", "Normal"...).
+    bool normal = m.contains("normal") && m["normal"].get<bool>();
+    for (const char* key : {"role", "type"}) {
+      if (!m.contains(key)) continue;
+      if (!m[key].is_string())
+        return Status::error(ErrorCode::kInvalidArgument, opt.material, std::string("\"") + key + "\" must be a string",
+                             "maps[" + std::to_string(i) + "]");
+      normal = normal || material_role_from_name(m[key].get<std::string>()) == MaterialRole::kNormal;
+    }
     if (normal) opt.normal_maps.push_back(file);
   }
-  if (j.contains("normal_convention") && j["normal_convention"].is_string())
-    opt.normal_convention = j["normal_convention"].get<std::string>();
+  if (j.contains("normal_convention") && !j["normal_convention"].is_string())
+    return Status::error(ErrorCode::kInvalidArgument, opt.material, "normal_convention must be \"gl\" or \"dx\"");
+  if (j.contains("normal_convention")) opt.normal_convention = j["normal_convention"].get<std::string>();
   if (opt.normal_convention != "gl" && opt.normal_convention != "dx")
     return Status::error(ErrorCode::kInvalidArgument, opt.material, "normal_convention must be \"gl\" or \"dx\"");
   return Status::ok();

@@ -319,7 +319,8 @@ Status write_tile_set_record(const std::string& folder, const TileSetRecord& rec
   }
   material["width"] = record.width;
   material["height"] = record.height;
-  return internal::write_file_atomic(folder + "/material.json", material.dump(2) + "\n");
+  return internal::write_file_atomic(folder + "/material.json",
+                                     material.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
 }
 
 }  // namespace tailor

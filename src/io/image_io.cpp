@@ -179,6 +179,11 @@ Status load_pixels(const std::string& path, Image& image, Image16* deep, const I
     return Status::error(ErrorCode::kInvalidImage, path, "not a readable PNG, JPEG, TGA or BMP image",
                          std::string("header: ") + (reason ? reason : "unknown format"));
   }
+  // stb reads Radiance .hdr files too, clipping their light values to 8 bits without a word: a
+  // tile of one would be a white picture.
+  if (stbi_is_hdr_from_memory(data, length))
+    return Status::error(ErrorCode::kUnsupported, path,
+                         "high dynamic range (Radiance .hdr) images are not read: tone-map it to a PNG first");
   TAILOR_RETURN_IF_ERROR(internal::check_image_header({data, bytes.size()}, width, height, options, path));
   if (channels < 1 || channels > 4)
     return Status::error(ErrorCode::kUnsupported, path, "unsupported channel count " + std::to_string(channels));

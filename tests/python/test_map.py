@@ -194,7 +194,7 @@ def test_symmetry_4_warns_as_the_cli(tmp_path, tailor_binary):
 def test_a_texture_that_does_not_wrap_warns_as_the_cli(tmp_path, tailor_binary):
     mesh = tailor.load(SPOT)
     # The gravel photo's wrap is a cut (eval-tile's wrap ratio 2.89 / 3.63): the warning names the figure and the fix.
-    with pytest.warns(UserWarning, match=r"gravel.png does not wrap \(wrap ratio 2.89 in x, 3.63 in y; .*'tailor tile "):
+    with pytest.warns(UserWarning, match=r"gravel.png does not wrap \(wrap ratio 2.89 in x, 3.63 in y; .*with: tailor tile "):
         tailor.map(mesh, texture=GRAVEL, relax_iterations=0)
     tile = tmp_path / "gravel_tile.png"
     code, _, err = run_cli(tailor_binary, "tile", GRAVEL, "-o", tile, "-q")

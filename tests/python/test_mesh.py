@@ -1,5 +1,7 @@
 """tailor.load and tailor.Mesh: round trips, dtypes, views, and bad arrays as errors."""
+import os
 import pickle
+import shutil
 
 import numpy as np
 import pytest
@@ -31,8 +33,8 @@ def test_arrays_round_trip_and_views_are_read_only():
         view[0, 0] = 1.0
 
 
-@pytest.mark.parametrize("position_type", [np.float32, np.float64])
-@pytest.mark.parametrize("face_type", [np.int32, np.int64, np.uint32, np.uint64])
+@pytest.mark.parametrize("position_type", [np.float32, np.float64, ">f4", ">f8"])
+@pytest.mark.parametrize("face_type", [np.int32, np.int64, np.uint32, np.uint64, ">u4", ">i8"])
 def test_every_accepted_dtype_gives_the_same_map(position_type, face_type):
     positions, faces = bumpy_grid(24)
     reference = tailor.map(tailor.Mesh(positions, faces))
@@ -81,6 +83,22 @@ def test_orient_faces_turns_back_faces_wound_against_their_neighbours():
     assert again.load_report["faces_turned"] == 0 and np.array_equal(again.faces, clean.faces)
 
 
+def test_file_names_that_are_not_utf8(tmp_path):
+    # Python names such files with surrogate escapes (os.fsdecode); they must reach the same file.
+    name = os.fsdecode(bytes(tmp_path) + b"/spot\xff.obj")
+    shutil.copy(SPOT, name)
+    mesh = tailor.load(name)
+    assert mesh.source == name and mesh.face_count == tailor.load(SPOT).face_count
+    assert "spot\\xff.obj" in repr(mesh)
+    with pytest.raises(tailor.Error, match="missing\ufffd.ply: cannot open file"):
+        tailor.load(os.fsdecode(bytes(tmp_path) + b"/missing\xff.ply"))
+    image = os.fsdecode(bytes(tmp_path) + b"/sand\xfe.png")
+    shutil.copy(DATA / "textures" / "vistex-sand05-128.png", image)
+    folder = os.fsdecode(bytes(tmp_path) + b"/set\xfd")
+    written = tailor.tile_set([image], folder)
+    assert written == [os.path.join(folder, os.path.basename(image))] and os.path.exists(written[0])
+
+
 GOOD_POSITIONS = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
 GOOD_FACES = np.array([[0, 1, 2]], np.int32)
 
@@ -94,7 +112,8 @@ GOOD_FACES = np.array([[0, 1, 2]], np.int32)
         (GOOD_POSITIONS, GOOD_FACES.astype(np.float32), "faces must be int32, int64, uint32 or uint64"),
         (np.array([[0, 0, 0], [1, 0, 0], [0, np.nan, 0]]), GOOD_FACES,
          r"^tailor.Mesh: non-finite vertex coordinate \(vertex 2\)$"),
-        (np.array([[0, 0, 0], [1e39, 0, 0], [0, 1, 0]]), GOOD_FACES, "non-finite vertex coordinate"),
+        (np.array([[0, 0, 0], [1e39, 0, 0], [0, 1, 0]]), GOOD_FACES,
+         r"^tailor.Mesh: vertex coordinate 1e\+39 beyond the range of 32-bit floats \(vertex 1\)$"),
         (GOOD_POSITIONS, np.array([[0, 1, 3]]),
          r"^tailor.Mesh: face index 3 out of range \(mesh has 3 vertices\) \(face 0\)$"),
         (GOOD_POSITIONS, np.array([[0, 1, 2], [0, -1, 2]]), r"face index -1 out of range .*\(face 1\)"),

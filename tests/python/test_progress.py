@@ -2,6 +2,7 @@
 import _thread
 import json
 import os
+import shutil
 import struct
 import threading
 import time
@@ -131,9 +132,20 @@ def test_tile_set_writes_the_maps_as_the_cli_does(tmp_path, tailor_binary):
     assert code == 0, err
     for name in ("vistex-sand05-128.png", "vistex-bark11-128.png", "material.json"):
         assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes(), name
-    with pytest.raises(tailor.Error, match="same size"):
+    with pytest.raises(tailor.Error, match="water-caustics-300.jpg: every map of a set must have the same size"):
         tailor.tile_set([sand, textures + "water-caustics-300.jpg"], tmp_path / "bad")
     assert not (tmp_path / "bad").exists()
+    # The maps' own folder: the tiles would replace them, which is refused before any work.
+    own = tmp_path / "own"
+    own.mkdir()
+    shutil.copy(sand, own / "vistex-sand05-128.png")
+    before = (own / "vistex-sand05-128.png").read_bytes()
+    with pytest.raises(tailor.Error, match="would overwrite an input"):
+        tailor.tile_set([own / "vistex-sand05-128.png"], own)
+    assert (own / "vistex-sand05-128.png").read_bytes() == before
+    (tmp_path / "a_file").write_text("")
+    with pytest.raises(tailor.Error, match="not a folder"):
+        tailor.tile_set([sand], tmp_path / "a_file")
     with pytest.raises(tailor.Error, match="normal_maps"):
         tailor.tile_set([sand], tmp_path / "bad", normal_maps=[bark])
     # With symmetry 4: one quarter-turn tile for both, the command's bytes; the tiles twice the side.
