@@ -125,10 +125,10 @@ void bind_mesh(py::module_& m) {
   py::class_<PyMesh>(m, "Mesh",
                      "A triangle mesh: positions (V, 3) float32 and faces (F, 3) uint32, counter-clockwise.\n\n"
                      "Mesh(positions, faces): positions float32 or float64 (V, 3), faces int32, int64, uint32 or\n"
-                     "uint64 (F, 3), in either byte order. Native float32 and uint32 arrays in C order are copied with "
-                     "one memcpy into the\n"
-                     "library's arrays (no conversion); other dtypes are converted. The arrays are checked\n"
-                     "as every file reader checks them: non-finite coordinates and indices out of range raise\n"
+                     "uint64 (F, 3), in either byte order. Native float32 and uint32 arrays in C order are\n"
+                     "copied with one memcpy into the library's arrays (no conversion); other dtypes are\n"
+                     "converted. The arrays are checked as every file reader checks them: non-finite\n"
+                     "coordinates and indices out of range raise\n"
                      "tailor.Error; faces with a repeated vertex and exact duplicate faces are dropped and\n"
                      "counted in load_report (compare face_count with len(faces)).")
       .def(py::init([](const py::array& positions, const py::array& faces) {
