@@ -152,6 +152,35 @@ TEST(TileSet, OutputNormalsAreUnitLength) {
   }
 }
 
+// Up to the size planned whole, a map tiled alone, as a set or at 16 bits gets exactly the cut
+// make_tileable gives its 8-bit copy: no second cut, no blending across it (a 0/255 mask keeps
+// its two values).
+TEST(TileSet, SetsAndSixteenBitMapsGetTheSameCutAsMakeTileable) {
+  for (const char* name : {"gravel-gray-512.png", "vistex-bark11-128.png", "brick-gray-512.png"}) {
+    const Image a = load(name);
+    Image direct;
+    ASSERT_TRUE(make_tileable(a, TileOptions{}, direct).is_ok());
+    TileMap m;
+    m.image = to_image16(a);
+    std::vector<std::vector<Image16>> tiles;
+    ASSERT_TRUE(make_tileable_set({m}, TileOptions{}, 1, tiles).is_ok());
+    EXPECT_EQ(tiles[0][0].pixels, to_image16(direct).pixels) << name;
+    for (uint16_t& v : m.image.pixels) v = static_cast<uint16_t>(v * 257);
+    m.image.bits = 16;
+    ASSERT_TRUE(make_tileable_set({m}, TileOptions{}, 1, tiles).is_ok());
+    std::vector<uint16_t> deep = to_image16(direct).pixels;
+    for (uint16_t& v : deep) v = static_cast<uint16_t>(v * 257);
+    EXPECT_EQ(tiles[0][0].pixels, deep) << name;
+  }
+  Image mask = to_grey(load("vistex-sand05-128.png"));
+  for (uint8_t& v : mask.pixels) v = v < 128 ? 0 : 255;
+  std::vector<std::vector<Image16>> tiles;
+  ASSERT_TRUE(
+      make_tileable_set({map_of(load("vistex-sand05-128.png")), map_of(mask)}, TileOptions{}, 1, tiles).is_ok());
+  EXPECT_TRUE(
+      std::all_of(tiles[0][1].pixels.begin(), tiles[0][1].pixels.end(), [](uint16_t v) { return v == 0 || v == 255; }));
+}
+
 TEST(TileSet, SixteenBitMapsStaySixteenBit) {
   const Image a = load("gravel-gray-512.png");
   TileMap m;

@@ -154,8 +154,10 @@ Status plan_and_replay(Image& guide, bool all_channels, const TileOptions& optio
   // Upsampled-looking content is smooth at full size: a hard cut between two sources that agree
   // only to within a reduced pixel shows as a straight step (bark resampled to 4096 px: worst seam
   // 1.96 with 1 px, 1.65 with 2, 1.54 with 4 against the photo's 1.56; gradient ratio 1.007).
-  out.feather = std::max(1, static_cast<int>(std::lround(out.scale / 2.0)));
-  refiner.choose_wrap(plan.shift_x, plan.shift_y);
+  // At full size the plan is the tile: its wrap and cuts are replayed as they are, unblended, so a
+  // map set or a 16-bit map gets the cut make_tileable gives its 8-bit guide.
+  out.feather = out.scale > 1.0 ? std::max(1, static_cast<int>(std::lround(out.scale / 2.0))) : 0;
+  if (out.scale > 1.0) refiner.choose_wrap(plan.shift_x, plan.shift_y);
   out.sources.clear();
   for (size_t s = 0; s < plan.sessions.size(); ++s) {
     refiner.replay(plan, s, s == 0 ? nullptr : &out.sources[0], radius);
