@@ -181,6 +181,34 @@ TEST(TileSet, SetsAndSixteenBitMapsGetTheSameCutAsMakeTileable) {
       std::all_of(tiles[0][1].pixels.begin(), tiles[0][1].pixels.end(), [](uint16_t v) { return v == 0 || v == 255; }));
 }
 
+// A strip too thin to tile is refused naming its own size, not its planned copy's; a strip that
+// is reduced keeps its aspect (1000 x 40 planned at 800 x 32, not squashed to 512 x 32).
+TEST(TileSet, StripsAreNamedAndPlannedAtTheirOwnAspect) {
+  const Image gravel = load("gravel-gray-512.png");
+  const auto strip = [&](int w, int h) {
+    Image s{w, h, 1, std::vector<uint8_t>(static_cast<size_t>(w) * h)};
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        s.pixels[static_cast<size_t>(y) * w + x] = gravel.pixels[(static_cast<size_t>(y % 512) * 512 + x % 512) * 1];
+    return s;
+  };
+  Image tile;
+  const Status thin = make_tileable(strip(4000, 16), TileOptions{}, tile);
+  ASSERT_FALSE(thin.is_ok());
+  EXPECT_NE(thin.message().find("image too small to make tileable (at least 32 px a side) (4000x16)"),
+            std::string::npos)
+      << thin.message();
+  TileReport report;
+  TileOptions plain;
+  plain.auto_period = false;  // the strip repeats the 512 px photo: a period fit would resize it
+  ASSERT_TRUE(make_tileable(strip(1000, 40), plain, tile, &report).is_ok());
+  EXPECT_EQ(tile.width, 1000);
+  EXPECT_EQ(tile.height, 40);
+  EXPECT_TRUE(std::any_of(report.warnings.begin(), report.warnings.end(), [](const std::string& w) {
+    return w.find("planned on a 800x32 px copy") == 0;
+  })) << (report.warnings.empty() ? std::string() : report.warnings[0]);
+}
+
 TEST(TileSet, SixteenBitMapsStaySixteenBit) {
   const Image a = load("gravel-gray-512.png");
   TileMap m;

@@ -19,6 +19,9 @@ using internal::TilePlan;
 
 namespace {
 
+// The smallest side of a plan's reduced copy: the least a tile is made of (tiling.cpp).
+constexpr int kPlanMinSide = 32;
+
 //! Crops or extends (never resamples) to fw x fh: a pixel beyond the input is copied from a whole
 //! number of periods (px, py) before it (tiling.cpp's fit_to_period at full size).
 template <typename T>
@@ -48,15 +51,25 @@ struct Replayed {
   int period_message = 0;  // auto_period: 0 none, 1 fitted, 2 kept
 };
 
+//! The reduction of a w x h map for its plan: the larger side to kPlanSide when above `above`,
+//! unless that takes the smaller side below kPlanMinSide (a strip keeps its aspect: 1000 x 40 is
+//! planned at 800 x 32, not squashed to 512 x 32, and 4000 x 16 at its own size, which the
+//! quilting refuses naming that size). 1: planned at its own size.
+double plan_scale(int w, int h, int above) {
+  const int side = std::max(w, h);
+  if (side <= above) return 1.0;
+  const double scale = std::min(static_cast<double>(side) / kPlanSide, std::min(w, h) / double{kPlanMinSide});
+  return std::max(1.0, scale);
+}
+
 //! auto_period: whether `image` has a strong period (kStrongPeriod) on an axis that changes its
 //! fitted size; estimated on a copy of at most kPlanSide px (periods scaled back).
 bool strong_period(const Image& image, PeriodEstimate& period) {
   Image small;
-  const int side = std::max(image.width, image.height);
-  const double scale = side > kPlanSide ? static_cast<double>(side) / kPlanSide : 1.0;
+  const double scale = plan_scale(image.width, image.height, kPlanSide);
   if (scale > 1.0) {
-    const int w = std::max(32, static_cast<int>(std::lround(image.width / scale)));
-    const int h = std::max(32, static_cast<int>(std::lround(image.height / scale)));
+    const int w = std::max(kPlanMinSide, static_cast<int>(std::lround(image.width / scale)));
+    const int h = std::max(kPlanMinSide, static_cast<int>(std::lround(image.height / scale)));
     if (!resize_image(image, w, h, small).is_ok()) return false;
   }
   period = estimate_period(scale > 1.0 ? small : image);
@@ -98,12 +111,11 @@ Status plan_and_replay(Image& guide, bool all_channels, const TileOptions& optio
                        Replayed& out) {
   TAILOR_RETURN_IF_ERROR(check_image(guide));
   const int w = guide.width, h = guide.height;
-  const int side = std::max(w, h);
-  out.scale = side > kPlanMaxSide ? static_cast<double>(side) / kPlanSide : 1.0;
+  out.scale = plan_scale(w, h, kPlanMaxSide);
   Image reduced;
   if (out.scale > 1.0) {
-    const int rw = std::max(32, static_cast<int>(std::lround(w / out.scale)));
-    const int rh = std::max(32, static_cast<int>(std::lround(h / out.scale)));
+    const int rw = std::max(kPlanMinSide, static_cast<int>(std::lround(w / out.scale)));
+    const int rh = std::max(kPlanMinSide, static_cast<int>(std::lround(h / out.scale)));
     TAILOR_RETURN_IF_ERROR(resize_image(guide, std::min(rw, w), std::min(rh, h), reduced));
   } else {
     reduced = guide;
