@@ -384,6 +384,8 @@ TEST_F(ExportTest, GlbEmbedsJpegAndWorksWithoutTexture) {
   ASSERT_NE(pixels, nullptr);
   const std::string jpeg = path("texture.jpg");
   ASSERT_NE(stbi_write_jpg(jpeg.c_str(), w, h, n, pixels, 90), 0);
+  const std::string wide = path("wide.jpg");  // its upper half: w x h / 2
+  ASSERT_NE(stbi_write_jpg(wide.c_str(), w, h / 2, n, pixels, 90), 0);
   stbi_image_free(pixels);
 
   ExportOptions options;
@@ -395,6 +397,19 @@ TEST_F(ExportTest, GlbEmbedsJpegAndWorksWithoutTexture) {
   ASSERT_TRUE(read_glb_file(path("jpeg.glb"), back, &texture).is_ok());
   EXPECT_EQ(texture.width, w);
   expect_valid_gltf(path("jpeg.glb"));
+  // The same photo stored wide with an EXIF quarter turn (a phone's portrait shot): the .glb holds
+  // its upright pixels as PNG, h / 2 wide and w high, since glTF viewers show the stored rows.
+  {
+    std::ofstream f(path("turned.jpg"), std::ios::binary);
+    f << test::with_exif_orientation(read_all(wide), 6);
+  }
+  options.texture_path = path("turned.jpg");
+  ASSERT_TRUE(export_mesh(path("turned.glb"), cube_, cube_atlas_, options).is_ok());
+  EXPECT_EQ(glb_json(read_all(path("turned.glb")))["images"][0]["mimeType"], "image/png");
+  ASSERT_TRUE(read_glb_file(path("turned.glb"), back, &texture).is_ok());
+  EXPECT_EQ(texture.width, h / 2);
+  EXPECT_EQ(texture.height, w);
+  expect_valid_gltf(path("turned.glb"));
 
   options = ExportOptions{};
   options.normals = false;

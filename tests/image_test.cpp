@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "io/readers.h"
 #include "support/fixtures.h"
 #include "tailor/image_ops.h"
 #include "util/atomic_file.h"
@@ -84,6 +85,43 @@ TEST(ImageIo, ReadsRgbPngAndProgressiveJpeg) {
   EXPECT_EQ(jpg.width, 300);  // EXIF says 535x534: the decoder must not trust it
   EXPECT_EQ(jpg.height, 300);
   EXPECT_EQ(jpg.channels, 3);
+}
+
+// A camera's JPEG: stored rows plus an EXIF Orientation tag. A 32 x 16 picture dark in its top-left
+// quadrant only, tagged 1..8 (both TIFF byte orders), reads as viewers show it: the dark quadrant
+// where EXIF puts it, width and height swapped for 5..8.
+TEST(ImageIo, JpegExifOrientationIsApplied) {
+  constexpr int kW = 32, kH = 16;
+  std::vector<uint8_t> pixels(kW * kH, 230);
+  for (int y = 0; y < kH / 2; ++y)
+    for (int x = 0; x < kW / 2; ++x) pixels[static_cast<size_t>(y) * kW + x] = 20;
+  const std::string plain = temp_path("upright.jpg");
+  ASSERT_NE(stbi_write_jpg(plain.c_str(), kW, kH, 1, pixels.data(), 100), 0);
+  std::ifstream in(plain, std::ios::binary);
+  const std::string jpeg((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // Where the dark quadrant shows, per orientation: 0 top-left, 1 top-right, 2 bottom-right, 3 bottom-left.
+  const int corner[9] = {0, 0, 1, 2, 3, 0, 1, 2, 3};
+  for (const bool little : {true, false})
+    for (int orientation = 1; orientation <= 8; ++orientation) {
+      const std::string path = temp_path("turned" + std::to_string(orientation) + ".jpg");
+      const std::string tagged = test::with_exif_orientation(jpeg, orientation, little);
+      write_bytes(path, tagged);
+      long header_w = 0, header_h = 0;  // the size a glTF's texture is measured by, without decoding
+      ASSERT_TRUE(internal::image_header_size({reinterpret_cast<const unsigned char*>(tagged.data()), tagged.size()},
+                                              header_w, header_h));
+      EXPECT_EQ(header_w, orientation >= 5 ? kH : kW);
+      Image im;
+      ASSERT_TRUE(load_image(path, im).is_ok());
+      const bool swapped = orientation >= 5;
+      ASSERT_EQ(im.width, swapped ? kH : kW) << orientation;
+      ASSERT_EQ(im.height, swapped ? kW : kH) << orientation;
+      const int qw = im.width / 2, qh = im.height / 2;
+      for (int q = 0; q < 4; ++q) {
+        const int cx = (q == 1 || q == 2) ? qw + qw / 2 : qw / 2, cy = q >= 2 ? qh + qh / 2 : qh / 2;
+        const uint8_t v = im.pixels[(static_cast<size_t>(cy) * im.width + cx) * static_cast<size_t>(im.channels)];
+        EXPECT_EQ(v < 128, q == corner[orientation]) << "orientation " << orientation << ", quadrant " << q;
+      }
+    }
 }
 
 TEST(ImageIo, PngRoundTripIsExactForOneToFourChannels) {

@@ -1,9 +1,9 @@
 // Binary glTF 2.0 writer (.glb): one node, one mesh, one triangle primitive with POSITION (with
 // min/max), NORMAL (optional), TEXCOORD_0 and uint32 indices, one material whose base colour
-// texture is the given PNG/JPEG embedded byte for byte, sampled with REPEAT and trilinear
-// filtering. The JSON is built with nlohmann::json (keys sorted, so the output is deterministic)
-// rather than through tinygltf's writer, which would decode and re-encode the image.
-// Reference: the glTF 2.0 specification, sections 3.6 (buffers), 3.7 (geometry), 4.4 (GLB layout).
+// texture is the given PNG/JPEG embedded byte for byte (a JPEG that EXIF turns: upright, as PNG), sampled with REPEAT
+// and trilinear filtering. The JSON is built with nlohmann::json (keys sorted, so the output is deterministic) rather
+// than through tinygltf's writer, which would decode and re-encode the image. Reference: the glTF 2.0 specification,
+// sections 3.6 (buffers), 3.7 (geometry), 4.4 (GLB layout).
 #include <algorithm>
 #include <bit>
 #include <cstring>
@@ -13,7 +13,9 @@
 #include <vector>
 
 #include "export/writers.h"
+#include "io/exif_orientation.h"
 #include "io/glb_format.h"
+#include "tailor/image.h"
 #include "util/atomic_file.h"
 
 namespace tailor::internal {
@@ -60,7 +62,17 @@ size_t add_view(nlohmann::json& views, size_t offset, size_t length, int target)
 
 Status glb_base_color(const ExportOptions& options, std::string& bytes, std::string& mime_type) {
   if (options.texture_path.empty() || !options.image_uris.color.empty()) return Status::ok();
-  return read_texture_bytes(options.texture_path, bytes, mime_type);
+  TAILOR_RETURN_IF_ERROR(read_texture_bytes(options.texture_path, bytes, mime_type));
+  // A JPEG that EXIF turns was mapped upright (load_image turns it), but glTF viewers show a
+  // texture's stored rows: the upright pixels go in as PNG instead.
+  if (mime_type == "image/jpeg" &&
+      jpeg_exif_orientation({reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size()}) != 1) {
+    Image upright;
+    TAILOR_RETURN_IF_ERROR(load_image(options.texture_path, upright));
+    TAILOR_RETURN_IF_ERROR(encode_png16(to_image16(upright), bytes));
+    mime_type = "image/png";
+  }
+  return Status::ok();
 }
 
 void add_glb_material(nlohmann::json& gltf, nlohmann::json& views, size_t blob_offset, std::string& blob,

@@ -14,7 +14,9 @@
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <utility>
 
+#include "io/exif_orientation.h"
 #include "io/readers.h"
 #include "tailor/image.h"
 #include "util/atomic_file.h"
@@ -125,6 +127,7 @@ bool image_header_size(std::span<const unsigned char> bytes, long& width, long& 
     width = w;
     height = h;
   }
+  if (jpeg_exif_orientation(bytes) >= 5) std::swap(width, height);  // shown turned a quarter
   return width > 0 && height > 0;
 }
 
@@ -230,6 +233,8 @@ Status load_pixels(const std::string& path, Image& image, Image16* deep, const I
   image.channels = c;
   image.pixels.assign(pixels, pixels + static_cast<size_t>(w) * h * c);
   stbi_image_free(pixels);
+  // A camera's JPEG shown upright, as viewers show it (stb decodes the stored rows).
+  internal::apply_exif_orientation(internal::jpeg_exif_orientation({data, bytes.size()}), image);
   return Status::ok();
 }
 

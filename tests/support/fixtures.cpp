@@ -138,4 +138,20 @@ int run_command(const std::string& command, std::string& out, std::string* err) 
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+std::string with_exif_orientation(const std::string& jpeg, int orientation, bool little_endian) {
+  const auto u16 = [&](int v) {
+    return little_endian ? std::string{static_cast<char>(v & 255), static_cast<char>(v >> 8)}
+                         : std::string{static_cast<char>(v >> 8), static_cast<char>(v & 255)};
+  };
+  // TIFF header (byte order, 42, IFD0 at 8), IFD0: one entry (tag, SHORT, count 1, value), no next.
+  std::string tiff = little_endian ? std::string("II\x2a\0\x08\0\0\0", 8) : std::string("MM\0\x2a\0\0\0\x08", 8);
+  tiff += u16(1) + u16(0x0112) + u16(3) + (little_endian ? std::string("\1\0\0\0", 4) : std::string("\0\0\0\1", 4)) +
+          u16(orientation) + u16(0) + std::string(4, '\0');
+  const std::string body = std::string("Exif\0\0", 6) + tiff;
+  const size_t length = body.size() + 2;
+  const std::string app1 =
+      std::string("\xff\xe1") + static_cast<char>(length >> 8) + static_cast<char>(length & 255) + body;
+  return jpeg.substr(0, 2) + app1 + jpeg.substr(2);
+}
+
 }  // namespace tailor::test

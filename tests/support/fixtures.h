@@ -52,6 +52,10 @@ std::string empty_temp_dir(const std::string& name);
 //! The whole file; a failed read is a test failure (an empty string returned).
 std::string read_all(const std::string& file);
 
+//! A JPEG file's bytes with an EXIF block (APP1 after the start marker) whose IFD0 holds only the
+//! Orientation tag, 1..8, in little- or big-endian TIFF order: what a phone writes.
+std::string with_exif_orientation(const std::string& jpeg, int orientation, bool little_endian = true);
+
 //! Runs a shell command and returns its exit status (-1 if it did not exit). Without `err` its
 //! stdout and stderr both go to `out`; with it, stderr goes to *err.
 int run_command(const std::string& command, std::string& out, std::string* err = nullptr);
