@@ -96,6 +96,9 @@ grep -Eq '"cracks_closed": [1-9][0-9]*' "$tmp/a.json" && ok || fail "stats: no c
 "$tailor" eval tests/data/meshes/fertility.off --stability --json >"$tmp/stab.json" 2>&1 &&
   grep -q '"removed_faces"' "$tmp/stab.json" && ok || fail "eval --stability: $(cat "$tmp/stab.json")"
 expect_error 1 "no texture coordinates" -- "$tailor" eval tests/data/meshes/fandisk.off
+# vt on some faces only: the message says how many lack them.
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\nf 2 4 3\n' >"$tmp/some_vt.obj"
+expect_error 1 "some_vt.obj: 1 of 2 faces have no texture coordinates \\(OBJ vt\\)" -- "$tailor" eval "$tmp/some_vt.obj"
 # Chunks: the same surface in another order keeps every UV bit, and so does everything beyond the
 # locality radius of a cut (the horse in cells of 1/16 unit: a dozen chunks).
 "$tailor" eval tests/data/meshes/horse.ply --stability --chunks on --chunk-cell -4 >"$tmp/chunks.txt" 2>&1 &&

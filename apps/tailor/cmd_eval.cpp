@@ -77,6 +77,11 @@ int run_eval(const EvalOptions& opt) {
     return glb ? read_glb_file(opt.input, mesh, nullptr, &report) : load_mesh(opt.input, mesh, &report);
   }();
   if (!status) return report_error(status);
+  if (mesh.corner_uvs.empty() && report.faces_without_uv > 0)
+    return report_error(Status::error(
+        ErrorCode::kInvalidMesh, opt.input,
+        std::to_string(report.faces_without_uv) + " of " + std::to_string(report.source_faces) +
+            " faces have no texture coordinates (OBJ vt): a map must give every corner one to be evaluated"));
   if (mesh.corner_uvs.empty())
     return report_error(
         Status::error(ErrorCode::kInvalidMesh, opt.input,

@@ -9,6 +9,7 @@
 // warnings without line numbers (or silently clamps them), stores per-shape index structs that we
 // would copy again, and its float parser is slower than fast_float. This reader is a single pass
 // over the bytes with exact float parsing (fast_float) and line-accurate errors.
+#include <algorithm>
 #include <cstring>
 #include <string_view>
 #include <vector>
@@ -68,6 +69,7 @@ Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh,
   std::vector<ForwardRef> forward_v, forward_vt;
   std::vector<uint32_t> poly, poly_vt;
   size_t corners_without_vt = 0;  // once nonzero, corner_vt is dropped and no longer filled
+  size_t faces_lacking_vt = 0;    // source faces with a corner without vt
   // Kept attributes: vertex colours (`v x y z r g b [a]`, when every vertex has them) and normals
   // (`vn`, referenced by every face corner as v/vt/vn or v//vn).
   std::vector<float> colours, normals;  // #V by 4 (alpha 1 when not given), #VN by 3
@@ -151,6 +153,8 @@ Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh,
       if (n > 3) ++report.polygons_triangulated;
       if (n > 3 && fans) fans->add(mesh.face_count(), n);
       for (size_t k = 1; k + 1 < n; ++k) mesh.indices.insert(mesh.indices.end(), {poly[0], poly[k], poly[k + 1]});
+      const bool lacks_vt = std::find(poly_vt.begin(), poly_vt.end(), kInvalid) != poly_vt.end();
+      faces_lacking_vt += lacks_vt;
       if (corners_without_vt == 0) {
         for (uint32_t t : poly_vt) corners_without_vt += t == kInvalid;
         if (corners_without_vt == 0) {
@@ -218,6 +222,7 @@ Status read_obj(std::span<const char> data, const std::string& name, Mesh& mesh,
       std::memcpy(&a.values[4 * c], &colours[4 * size_t{mesh.indices[c]}], 16);
   }
   // Corner uvs only when every corner has one: a partial set cannot be used as a mapping.
+  if (faces_lacking_vt < report.source_faces) report.faces_without_uv = faces_lacking_vt;
   if (!mesh.indices.empty() && corners_without_vt == 0) {
     mesh.corner_uvs.resize(2 * corner_vt.size());
     for (size_t c = 0; c < corner_vt.size(); ++c) {
