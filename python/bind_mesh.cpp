@@ -115,6 +115,7 @@ py::dict load_report_dict(const LoadReport& r) {
   d["zero_area_faces"] = r.zero_area_faces;
   d["unreferenced_vertices"] = r.unreferenced_vertices;
   d["welded_vertices"] = r.welded_vertices;
+  d["faces_without_uv"] = r.faces_without_uv;
   d["faces_turned"] = r.faces_turned;
   return d;
 }

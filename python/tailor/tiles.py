@@ -766,7 +766,19 @@ def start_client(args):
         dashboard_address=None,
         silence_logs=logging.ERROR,
     )
-    return Client(cluster), cluster
+    client = Client(cluster)
+    client.register_worker_plugin(_DriverAnswersInterrupts(), name="tailor-driver-answers-interrupts")
+    return client, cluster
+
+
+class _DriverAnswersInterrupts:
+    """A Dask worker plugin for the local cluster's worker processes: Ctrl-C reaches every process
+    of the terminal's group, and each worker printed a KeyboardInterrupt traceback while the driver
+    closed the cluster. The driver alone answers it (setup runs on the worker's event loop, its
+    process's main thread)."""
+
+    def setup(self, worker):
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 class ClientStart:

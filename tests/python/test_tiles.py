@@ -910,6 +910,29 @@ def test_a_terminated_run_cleans_up_like_an_interrupted_one(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["field.ply"]
 
 
+def test_ctrl_c_on_a_cluster_prints_one_line(tmp_path):
+    import signal
+    import time
+
+    # Ctrl-C reaches the terminal's whole process group: the driver and every Dask worker. The
+    # workers leave it to the driver, which closes the cluster and says so in one line.
+    out = tmp_path / "out"
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    run = subprocess.Popen(
+        [sys.executable, "-m", "tailor.tiles", str(HORSE), "-o", str(out), "--workers", "2", "--chunk-cell", str(CELL),
+         "--no-lod", "-q"],
+        env=env, stderr=subprocess.PIPE, text=True, start_new_session=True,
+    )
+    deadline = time.monotonic() + 120
+    while not list(tmp_path.glob(".out.tmp-*/**/*.glb")) and run.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.005)
+    os.killpg(run.pid, signal.SIGINT)
+    _, stderr = run.communicate(timeout=120)
+    assert run.returncode == 130, stderr
+    assert stderr == "tailor.tiles: interrupted; %s left as it was\n" % out
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
+
+
 def test_textures_are_read_as_tailor_map_reads_them(tmp_path):
     out = tmp_path / "out"
     common = [HORSE, "-o", out, "--workers", 0, "--chunk-cell", CELL, "--no-lod", "-q"]
