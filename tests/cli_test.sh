@@ -72,7 +72,8 @@ LD_DEBUG=libs "$tailor" map "$mesh" -o "$tmp/e.glb" --preview "$tmp/e.png" --qui
 awk '/^f /{if (n++ % 97 == 0) {print $1, $2, $4, $3; next}} {print}' "$mesh" >"$tmp/turned.obj"
 "$tailor" map "$tmp/turned.obj" --texture "$texture" -o "$tmp/turned.glb" --stats "$tmp/turned.json" >"$tmp/turned.txt" 2>&1 &&
   cmp -s "$tmp/a.glb" "$tmp/turned.glb" && grep -q "turned 61 faces wound against their neighbours" "$tmp/turned.txt" &&
-  grep -q '"faces_turned": 61' "$tmp/turned.json" && grep -q '"inconsistent_edges": 0' "$tmp/turned.json" && ok ||
+  grep -q '"faces_turned": 61' "$tmp/turned.json" && grep -q '"inconsistent_edges": 0' "$tmp/turned.json" &&
+  grep -Eq '"turning": ([1-9]|0\.[0-9]*[1-9])' "$tmp/turned.json" && grep -q '^mapping again with the faces turned$' "$tmp/turned.txt" && ok ||
   fail "faces wound against their neighbours: $(cat "$tmp/turned.txt")"
 "$tailor" map "$tmp/turned.obj" -o "$tmp/kept.glb" --keep-winding --stats "$tmp/kept.json" >"$tmp/kept.txt" 2>&1 &&
   grep -q "183 inconsistently oriented edges .* without --keep-winding they turn" "$tmp/kept.txt" &&

@@ -108,8 +108,16 @@ TEST(ImageIo, JpegExifOrientationIsApplied) {
       write_bytes(path, tagged);
       long header_w = 0, header_h = 0;  // the size a glTF's texture is measured by, without decoding
       ASSERT_TRUE(internal::image_header_size({reinterpret_cast<const unsigned char*>(tagged.data()), tagged.size()},
-                                              header_w, header_h));
+                                              header_w, header_h, true));
       EXPECT_EQ(header_w, orientation >= 5 ? kH : kW);
+      ASSERT_TRUE(internal::image_header_size({reinterpret_cast<const unsigned char*>(tagged.data()), tagged.size()},
+                                              header_w, header_h, false));
+      EXPECT_EQ(header_w, kW);  // a glTF's texture: its stored rows
+      Image stored;
+      ImageLoadOptions as_stored;
+      as_stored.exif_orientation = false;
+      ASSERT_TRUE(load_image(path, stored, as_stored).is_ok());
+      EXPECT_EQ(stored.width, kW);
       Image im;
       ASSERT_TRUE(load_image(path, im).is_ok());
       const bool swapped = orientation >= 5;

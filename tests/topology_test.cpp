@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "support/fixtures.h"
 #include "tailor/io.h"
 
 namespace tailor {
@@ -270,24 +271,36 @@ TEST(OrientFaces, TurnsBackAMinorityOfTurnedFaces) {
   EXPECT_EQ(orient_faces_coherently(mesh, after), 0u);  // nothing left to turn
 }
 
-// Every second face turned: half the area each way. The side without the lowest face turns, so
-// the surface runs one way again, and the same way whatever the order of the faces.
-TEST(OrientFaces, HalfTurnedSurfaceRunsOneWayInAnyFaceOrder) {
-  Mesh mesh;
-  ASSERT_TRUE(load_mesh(std::string(TAILOR_TEST_DATA) + "/meshes/fandisk.off", mesh).is_ok());
-  for (size_t f = 1; f < mesh.face_count(); f += 2) std::swap(mesh.indices[3 * f + 1], mesh.indices[3 * f + 2]);
-  Mesh reversed = mesh;  // the same faces in the opposite order
-  for (size_t f = 0; f < mesh.face_count(); ++f)
-    for (size_t k = 0; k < 3; ++k) reversed.indices[3 * f + k] = mesh.indices[3 * (mesh.face_count() - 1 - f) + k];
-  const size_t turned = orient_faces_coherently(mesh, build_topology(mesh));
-  const size_t turned_reversed = orient_faces_coherently(reversed, build_topology(reversed));
-  EXPECT_GT(turned, 0u);
-  EXPECT_LT(turned, mesh.face_count());
-  EXPECT_EQ(turned + turned_reversed, mesh.face_count() / 2 * 2) << "one turns the odd faces, the other the even";
-  const Topology t = build_topology(mesh);
-  EXPECT_EQ(t.inconsistent_edges, 0u);
-  EXPECT_EQ(t.edge_components, 1u);
-  EXPECT_EQ(build_topology(reversed).inconsistent_edges, 0u);
+// Every second face turned, and a flat grid with its left half turned (the same area each way,
+// exactly): the same faces turn whatever the order of the faces, so the surface runs one way, the
+// same way.
+TEST(OrientFaces, TheSameFacesTurnInAnyFaceOrder) {
+  Mesh fandisk;
+  ASSERT_TRUE(load_mesh(std::string(TAILOR_TEST_DATA) + "/meshes/fandisk.off", fandisk).is_ok());
+  for (size_t f = 1; f < fandisk.face_count(); f += 2)
+    std::swap(fandisk.indices[3 * f + 1], fandisk.indices[3 * f + 2]);
+  Mesh grid = test::grid(8, 4, test::Diagonal::kRising);
+  for (size_t f = 0; f < grid.face_count(); ++f)
+    if (grid.positions[3 * grid.indices[3 * f]] + grid.positions[3 * grid.indices[3 * f + 1]] +
+            grid.positions[3 * grid.indices[3 * f + 2]] <
+        12.f)  // the cells left of x = 4
+      std::swap(grid.indices[3 * f + 1], grid.indices[3 * f + 2]);
+  for (Mesh* mesh : {&fandisk, &grid}) {
+    const size_t nf = mesh->face_count();
+    Mesh reversed = *mesh;  // the same faces in the opposite order
+    for (size_t f = 0; f < nf; ++f)
+      for (size_t k = 0; k < 3; ++k) reversed.indices[3 * f + k] = mesh->indices[3 * (nf - 1 - f) + k];
+    const size_t turned = orient_faces_coherently(*mesh, build_topology(*mesh));
+    EXPECT_GT(turned, 0u);
+    EXPECT_LT(turned, nf);
+    EXPECT_EQ(orient_faces_coherently(reversed, build_topology(reversed)), turned);
+    for (size_t f = 0; f < nf; ++f)
+      for (size_t k = 0; k < 3; ++k)
+        ASSERT_EQ(reversed.indices[3 * f + k], mesh->indices[3 * (nf - 1 - f) + k]) << "face " << f;
+    const Topology t = build_topology(*mesh);
+    EXPECT_EQ(t.inconsistent_edges, 0u);
+    EXPECT_EQ(t.edge_components, 1u);
+  }
 }
 
 // A Moebius strip cannot run one way: one edge stays unpaired, and nothing else is harmed.

@@ -108,6 +108,7 @@ int run_edit(const EditArgs& opt) {
     routes.push_back({context.texture_url, opt.texture, "", ""});
   }
   output.texture_path = opt.texture;
+  if (!context.texture.empty()) output.texture_image = &context.texture;
   output.texture_width = !context.texture.empty() ? context.texture.width : args.texture_size;
   output.texture_height = !context.texture.empty() ? context.texture.height : args.texture_size;
   if (Status s = set_map_texture_size(options, output.texture_width, output.texture_height); !s) return report_error(s);
@@ -136,6 +137,16 @@ int run_edit(const EditArgs& opt) {
     mapping.seam_faces = seam_faces;
   }
   context.topology = build_topology(mesh);
+  // As `tailor map` does (its replay command must give the same file): faces wound against their
+  // neighbours turn; face ids do not change, so seam faces and strokes still name the same faces.
+  if (context.topology.inconsistent_edges > 0) {
+    load.faces_turned = orient_faces_coherently(mesh, context.topology);
+    if (load.faces_turned > 0) {
+      warn(opt.quiet, opt.input + ": turned " + std::to_string(load.faces_turned) +
+                          " faces wound against their neighbours, so that the surface runs one way");
+      context.topology = build_topology(mesh);
+    }
+  }
   if (auto_axis) {
     AxisChoice choice;
     if (Status s = choose_orientation_axis(mesh, context.topology, options, choice); !s)

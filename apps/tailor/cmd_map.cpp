@@ -204,6 +204,7 @@ int run_map(const MapArgs& opt) {
     topology = Topology{};
     return true;
   };
+  double turning_seconds = 0;  // the turn, and a mapping before it that found the faces (MapRun)
   const auto warn_unpaired = [&] {
     if (topology.nonmanifold_edges || topology.inconsistent_edges)
       warn(opt.quiet,
@@ -218,7 +219,9 @@ int run_map(const MapArgs& opt) {
   };
   if (auto_axis) {
     connect();
+    const auto turning_start = std::chrono::steady_clock::now();
     if (turn_wound_faces()) connect();
+    turning_seconds = seconds_since(turning_start);
     warn_unpaired();
   }
   // World units: the texel density is per scene unit, the same for every mesh (the mapping works
@@ -294,10 +297,13 @@ int run_map(const MapArgs& opt) {
     if (s) progress.done();
     return s;
   };
+  const auto first_map_start = std::chrono::steady_clock::now();
   if (Status s = map_mesh(); !s) return report_error(s.with_file(opt.input));
   if (topology.opposite.empty()) {
     connect();
     if (turn_wound_faces()) {
+      turning_seconds = seconds_since(first_map_start);  // the mapping that found them, spent
+      if (!opt.quiet) std::fprintf(stderr, "mapping again with the faces turned\n");
       if (Status s = map_mesh(); !s) return report_error(s.with_file(opt.input));
       connect();
     }
@@ -312,6 +318,7 @@ int run_map(const MapArgs& opt) {
   }
   const Atlas& atlas = map.atlas;
   run.options = options;
+  run.turning_seconds = turning_seconds;
   add_map_results(mesh, load, topology, map, run);
   if (map.stats.chunks > 1 && mesh.face_count() / map.stats.chunks < 1000)  // one chunk has no border
     warn(opt.quiet, opt.input + ": " + std::to_string(map.stats.chunks) + " chunks of " +
@@ -371,6 +378,7 @@ int run_map(const MapArgs& opt) {
                     mapping.symmetry,
                     {}};
   for (const OutputPath& other : output_paths(opt)) output.other_outputs.push_back(other.path);
+  if (!texture.empty()) output.texture_image = &texture;
   Progress exporting("export", opt.quiet);
   if (Status s =
           write_mapped_mesh(opt.output, mesh, atlas, output, [&exporting](float f) { return exporting.update(f); });

@@ -69,9 +69,9 @@ int run_render(const RenderArgs& args) {
   Image texture;
   GltfMaterialMaps maps;  // a .glb's normal and occlusion maps, and its tangents
   LoadReport report;
+  const MeshFormat format = mesh_format_from_path(args.input);
   Status status = [&] {
     const ReadingInput reading(args.input);
-    const MeshFormat format = mesh_format_from_path(args.input);
     return format == MeshFormat::kGlb || format == MeshFormat::kGltf
                ? read_glb_with_material(args.input, mesh, &texture, args.no_material ? nullptr : &maps, &report,
                                         args.image_options)
@@ -94,8 +94,11 @@ int run_render(const RenderArgs& args) {
   // The texture file the mesh names (.mtl, a .ply's TextureFile, a .gltf's image URI) is an input too.
   if (Status s = check_outputs({{args.output, "--output"}}, {report.texture_path}); !s) return report_error(s);
   if (args.texture.empty() && texture.empty() && !report.texture_path.empty()) {
-    // The texture an .obj's .mtl or a .ply's TextureFile names, next to it (as tailor map writes).
-    status = load_image(report.texture_path, texture, args.image_options);
+    // The texture an .obj's .mtl or a .ply's TextureFile names, next to it (as tailor map writes), or
+    // a .gltf's image file: glTF viewers show a texture's stored rows, whatever its EXIF says.
+    ImageLoadOptions image_options = args.image_options;
+    image_options.exif_orientation = format != MeshFormat::kGlb && format != MeshFormat::kGltf;
+    status = load_image(report.texture_path, texture, image_options);
     if (!status) {
       texture = Image{};
       warn(args.quiet, "cannot read the texture " + args.input + " names (" + status.message() + ")");

@@ -127,6 +127,7 @@ Status write_mapped_mesh(const std::string& path, const Mesh& mesh, const Atlas&
                          const ProgressCallback& progress) {
   ExportOptions export_options;
   export_options.texture_path = output.texture_path;
+  export_options.texture_image = output.texture_image;
   export_options.material = output.material;
   export_options.texture_width = output.texture_width;
   export_options.texture_height = output.texture_height;

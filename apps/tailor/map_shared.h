@@ -77,6 +77,7 @@ struct MeshOutput {
   SceneUp up = SceneUp::kY;
   uint32_t symmetry = 1;  //!< the map's (MappingOptions::symmetry): 4 is recorded in the .glb (ExportOptions)
   std::vector<std::string> other_outputs;  //!< the run's other files (ExportOptions::other_outputs)
+  const Image* texture_image = nullptr;    //!< texture_path's pixels, as loaded (ExportOptions::texture_image)
 };
 
 //! Writes `mesh` with the UVs of `atlas` to `path` (export_mesh; atomic, staged in an active FileBatch),

@@ -23,6 +23,7 @@
 
 #include "tailor/api.h"
 #include "tailor/atlas.h"
+#include "tailor/image.h"
 #include "tailor/mesh.h"
 #include "tailor/option_doc.h"
 #include "tailor/progress.h"
@@ -87,9 +88,12 @@ struct ImageUris {
 
 struct ExportOptions {
   std::string texture_path;  //!< PNG or JPEG: embedded as is (.glb) or referenced by map_Kd (.mtl); empty = no texture
-  int texture_width = 512;   //!< pixels per texture repeat along u (> 0), usually the texture's width
-  int texture_height = 512;  //!< pixels per texture repeat along v (> 0), usually the texture's height
-  bool normals = true;       //!< .glb/.obj: write smooth per-vertex normals (area-weighted, shared across seams)
+  const Image* texture_image = nullptr;  //!< optional: texture_path's pixels as the caller loaded them (load_image):
+                                         //!< a JPEG that EXIF turns is embedded in a .glb from them, as PNG (else
+                                         //!< the file is decoded again)
+  int texture_width = 512;               //!< pixels per texture repeat along u (> 0), usually the texture's width
+  int texture_height = 512;              //!< pixels per texture repeat along v (> 0), usually the texture's height
+  bool normals = true;  //!< .glb/.obj: write smooth per-vertex normals (area-weighted, shared across seams)
   MeshCompression compression = MeshCompression::kNone;  //!< .glb only (kInvalidArgument for .obj/.ply)
   int uv_set = 0;             //!< .glb: the mapped UVs go to TEXCOORD_<uv_set> (0..7); the file's other sets are kept
   SceneUp up = SceneUp::kY;   //!< .glb: kZ turns the scene Y-up as glTF wants (-90 degrees about x, on the node)

@@ -55,6 +55,8 @@ TAILOR_API Status check_image(const Image& image);
 //! Limits on the images a reader accepts, checked from the header before anything is decoded.
 struct ImageLoadOptions {
   uint64_t max_pixels = uint64_t{64} << 20;  //!< largest width x height (64 Mpx: 8192 x 8192)
+  bool exif_orientation = true;              //!< a JPEG turned upright as its EXIF orientation says, as photo viewers
+                                             //!< show it; false: its stored rows, as glTF viewers show a texture
 };
 
 //! Flags and help of the ImageLoadOptions a user sets (option_doc.h).
@@ -84,6 +86,9 @@ TAILOR_API Status write_png16(const std::string& path, const Image16& image);
 
 //! The PNG file's bytes of an 8- or 16-bit image (as write_png16 writes, in memory): for embedding.
 TAILOR_API Status encode_png16(const Image16& image, std::string& encoded);
+
+//! The PNG file's bytes of an 8-bit image (as write_png writes, in memory).
+TAILOR_API Status encode_png(const Image& image, std::string& encoded);
 
 //! The 8-bit image of an Image16: 16-bit samples scaled by 255 / 65535 and rounded.
 TAILOR_API Image to_image8(const Image16& image);

@@ -61,6 +61,8 @@ struct MapRun {
   double topology_seconds = 0;
   double axis_choice_seconds = 0;
   double orientation_seconds = 0;
+  double turning_seconds = 0;  //!< faces wound against their neighbours turned, and a mapping before it
+                               //!< that found them (then done again), topology included
   double export_seconds = 0;
   double preview_seconds = 0;
   double total_seconds = 0;  //!< the whole command

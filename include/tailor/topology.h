@@ -57,9 +57,11 @@ TAILOR_API size_t count_nonmanifold_vertices(const Mesh& mesh);
 //! way in one face and the other way in the other: the topology's components (each runs one way)
 //! that share an edge running the same way are joined, and in each group so joined the side of
 //! the lesser area turns (its faces' corners 1 and 2 swap, with their UVs and attributes); on a
-//! tie, the side without the group's lowest face. A group whose sides meet both ways (a Moebius
-//! strip) keeps one of the edges unpaired. Returns the number of faces turned; the topology no
-//! longer describes the mesh when it is not 0. O(F) time, plus a sort of the unpaired edges.
+//! tie, the side whose least face (by its corners' positions) is the greater. Neither depends on
+//! the order of the faces. A group whose sides meet both ways (a Moebius strip) keeps one of the
+//! edges unpaired. Returns the number of faces turned (0 when `topology` is not the mesh's); the
+//! topology no longer describes the mesh when it is not 0. O(F) time, plus a sort of the unpaired
+//! edges.
 TAILOR_API size_t orient_faces_coherently(Mesh& mesh, const Topology& topology);
 
 //! The neighbour face across edge e, or kInvalid.

@@ -67,9 +67,10 @@ Status glb_base_color(const ExportOptions& options, std::string& bytes, std::str
   // texture's stored rows: the upright pixels go in as PNG instead.
   if (mime_type == "image/jpeg" &&
       jpeg_exif_orientation({reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size()}) != 1) {
-    Image upright;
-    TAILOR_RETURN_IF_ERROR(load_image(options.texture_path, upright));
-    TAILOR_RETURN_IF_ERROR(encode_png16(to_image16(upright), bytes));
+    Image decoded;
+    if (options.texture_image == nullptr) TAILOR_RETURN_IF_ERROR(load_image(options.texture_path, decoded));
+    TAILOR_RETURN_IF_ERROR(encode_png(options.texture_image != nullptr ? *options.texture_image : decoded, bytes)
+                               .with_file(options.texture_path));
     mime_type = "image/png";
   }
   return Status::ok();

@@ -117,7 +117,7 @@ uint64_t min_file_bytes(std::span<const unsigned char> b, uint64_t width, uint64
 
 namespace internal {
 
-bool image_header_size(std::span<const unsigned char> bytes, long& width, long& height) {
+bool image_header_size(std::span<const unsigned char> bytes, long& width, long& height, bool exif_orientation) {
   width = height = 0;
   if (!claimed_size(bytes, width, height)) {
     int w = 0, h = 0, channels = 0;
@@ -127,7 +127,7 @@ bool image_header_size(std::span<const unsigned char> bytes, long& width, long& 
     width = w;
     height = h;
   }
-  if (jpeg_exif_orientation(bytes) >= 5) std::swap(width, height);  // shown turned a quarter
+  if (exif_orientation && jpeg_exif_orientation(bytes) >= 5) std::swap(width, height);  // shown turned a quarter
   return width > 0 && height > 0;
 }
 
@@ -234,7 +234,8 @@ Status load_pixels(const std::string& path, Image& image, Image16* deep, const I
   image.pixels.assign(pixels, pixels + static_cast<size_t>(w) * h * c);
   stbi_image_free(pixels);
   // A camera's JPEG shown upright, as viewers show it (stb decodes the stored rows).
-  internal::apply_exif_orientation(internal::jpeg_exif_orientation({data, bytes.size()}), image);
+  if (options.exif_orientation)
+    internal::apply_exif_orientation(internal::jpeg_exif_orientation({data, bytes.size()}), image);
   return Status::ok();
 }
 
@@ -399,13 +400,17 @@ Status encode_png16(const Image16& image, std::string& encoded) {
       encoded);
 }
 
-Status write_png(const std::string& path, const Image& image) {
-  TAILOR_RETURN_IF_ERROR(check_image(image).with_file(path));
+Status encode_png(const Image& image, std::string& encoded) {
+  TAILOR_RETURN_IF_ERROR(check_image(image));
   const size_t row = static_cast<size_t>(image.width) * image.channels;
+  return encode_png(
+      std::string(), image.width, image.height, image.channels, 8,
+      [&](int y, unsigned char* out) { std::copy_n(&image.pixels[row * y], row, out); }, encoded);
+}
+
+Status write_png(const std::string& path, const Image& image) {
   std::string encoded;
-  TAILOR_RETURN_IF_ERROR(encode_png(
-      path, image.width, image.height, image.channels, 8,
-      [&](int y, unsigned char* out) { std::copy_n(&image.pixels[row * y], row, out); }, encoded));
+  TAILOR_RETURN_IF_ERROR(encode_png(image, encoded).with_file(path));
   return internal::write_file_atomic(path, std::span<const char>(encoded.data(), encoded.size()));
 }
 

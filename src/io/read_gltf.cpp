@@ -812,14 +812,14 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
       if (report.texture_named.empty()) report.texture_named = "image " + std::to_string(first_image);
     }
     long width = 0, height = 0;
-    bool sized = !texture_bytes->empty() && internal::image_header_size(*texture_bytes, width, height);
+    bool sized = !texture_bytes->empty() && internal::image_header_size(*texture_bytes, width, height, false);
     if (!sized && texture_bytes->empty() && first_image != UINT64_MAX) {
       std::string head;
       bool file = false;
       for (const size_t max_bytes : {size_t{64} << 10, size_t{16} << 20}) {  // a JPEG's frame header may lie far in
         if (!doc.image_uri_bytes(first_image, max_bytes, head, file)) break;
         sized = internal::image_header_size({reinterpret_cast<const unsigned char*>(head.data()), head.size()}, width,
-                                            height);
+                                            height, false);
         if (sized || head.size() < max_bytes) break;
       }
       report.texture_file = sized && file;

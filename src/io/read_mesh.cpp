@@ -190,7 +190,8 @@ void read_texture_header(const std::filesystem::path& image, LoadReport& report)
   long width = 0, height = 0;
   for (const size_t max_bytes : {size_t{64} << 10, size_t{16} << 20}) {  // a JPEG's frame header may lie far in
     if (!read_file_start(image, max_bytes, head)) return;
-    if (internal::image_header_size({reinterpret_cast<const unsigned char*>(head.data()), head.size()}, width, height))
+    if (internal::image_header_size({reinterpret_cast<const unsigned char*>(head.data()), head.size()}, width, height,
+                                    true))
       break;
     if (head.size() < max_bytes) return;
   }

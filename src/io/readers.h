@@ -83,8 +83,10 @@ Status read_gltf(std::span<const char> data, const std::string& name, const std:
 //! The size an image's header claims, read without decoding anything: PNG (IHDR), JPEG (the first
 //! start-of-frame marker) and BMP directly, whatever the size; other formats stb_image reads (TGA,
 //! GIF, PSD, HDR, PNM) through stbi_info_from_memory. False when no header is recognised (a JPEG
-//! whose frame header lies beyond `bytes`, a truncated PNG) or it claims no pixels.
-bool image_header_size(std::span<const unsigned char> bytes, long& width, long& height);
+//! whose frame header lies beyond `bytes`, a truncated PNG) or it claims no pixels. exif_orientation:
+//! a JPEG that EXIF turns a quarter has its sides swapped (as load_image reads a file; a glTF's
+//! textures are shown as stored).
+bool image_header_size(std::span<const unsigned char> bytes, long& width, long& height, bool exif_orientation);
 
 //! Checks the size an image header claims (width x height, read by stbi_info_from_memory) before
 //! decoding `bytes`: each side within kMaxImageSide, width x height within options.max_pixels, and

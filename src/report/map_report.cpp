@@ -134,6 +134,7 @@ std::string map_report_json(const MapRun& run) {
   j["time_ms"] = {{"load", ms(run.load.load_seconds)},
                   {"topology", ms(run.topology_seconds)},
                   {"axis_choice", ms(run.axis_choice_seconds)},
+                  {"turning", ms(run.turning_seconds)},
                   {"orientation", ms(run.orientation_seconds)},
                   {"mapping", ms(stats.seconds)},
                   {"metrics", ms(metrics.seconds)},

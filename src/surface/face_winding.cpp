@@ -3,6 +3,7 @@
 #include "surface/face_winding.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <utility>
@@ -96,9 +97,38 @@ double face_area(const Mesh& mesh, size_t f) {
   return std::sqrt(x * x + y * y + z * z);
 }
 
+// A face by its corners' positions, sorted (x, then y, then z): the same whatever the order of the
+// faces, the vertices or the corners.
+using FaceKey = std::array<float, 9>;
+FaceKey face_key(const Mesh& mesh, size_t f) {
+  std::array<std::array<float, 3>, 3> corners;
+  for (size_t k = 0; k < 3; ++k)
+    for (size_t d = 0; d < 3; ++d) corners[k][d] = mesh.positions[3 * size_t{mesh.indices[3 * f + k]} + d];
+  std::sort(corners.begin(), corners.end());
+  FaceKey key;
+  for (size_t k = 0; k < 3; ++k)
+    for (size_t d = 0; d < 3; ++d) key[3 * k + d] = corners[k][d];
+  return key;
+}
+
+// What decides which side of a group turns: its area, summed exactly (each face's area in units of
+// 2^-32 of the largest face's, added as integers, so that no order of the faces rounds differently;
+// under 2^32 faces of up to 2^32 units cannot overflow 64 bits), and its least face key for a tie.
+struct Side {
+  uint64_t area = 0;
+  FaceKey least{};
+  bool any = false;
+  void add(uint64_t a, const FaceKey& key) {
+    area += a;
+    if (!any || key < least) least = key;
+    any = true;
+  }
+};
+
 }  // namespace
 
 size_t orient_faces_coherently(Mesh& mesh, const Topology& topology) {
+  if (topology.opposite.size() != mesh.indices.size() || topology.face_component.size() != mesh.face_count()) return 0;
   const auto pairs = internal::same_way_edge_pairs(mesh, topology);
   if (pairs.empty()) return 0;
   // The topology's components run one way each (joined through edges that run both ways); an
@@ -107,23 +137,35 @@ size_t orient_faces_coherently(Mesh& mesh, const Topology& topology) {
   WindingClasses classes(components);
   for (const auto& [e, g] : pairs) classes.join(topology.face_component[e / 3], topology.face_component[g / 3], 1);
   // In each group of joined components, the side of the lesser area turns; on a tie, the side
-  // without the group's lowest face. Neither depends on the order of the faces in the file.
-  std::vector<double> area(components, 0.0);
-  for (size_t f = 0; f < mesh.face_count(); ++f) area[topology.face_component[f]] += face_area(mesh, f);
-  std::vector<double> side_area(2 * size_t{components}, 0.0);  // per root: parity 0, parity 1
-  std::vector<uint8_t> side(components), lowest_side(components, 2);
-  for (uint32_t c = 0; c < components; ++c) {  // components are numbered by their lowest face
+  // whose least face key is the greater. Neither depends on the order of the faces in the file.
+  const size_t faces = mesh.face_count();
+  double largest = 0.0;
+  for (size_t f = 0; f < faces; ++f) largest = std::max(largest, face_area(mesh, f));
+  const double unit = largest > 0.0 ? std::ldexp(1.0, 32) / largest : 0.0;
+  // Each component's group (numbered in order of the groups' lowest components) and side.
+  std::vector<uint32_t> group(components), group_of_root(components, kInvalid);
+  std::vector<uint8_t> side(components);
+  uint32_t groups = 0;
+  for (uint32_t c = 0; c < components; ++c) {
     const auto [root, parity] = classes.find(c);
+    if (group_of_root[root] == kInvalid) group_of_root[root] = groups++;
+    group[c] = group_of_root[root];
     side[c] = parity;
-    side_area[2 * size_t{root} + parity] += area[c];
-    if (lowest_side[root] == 2) lowest_side[root] = parity;
+  }
+  std::vector<uint32_t>().swap(group_of_root);
+  std::vector<Side> sides(2 * size_t{groups});  // per group: parity 0, parity 1
+  for (size_t f = 0; f < faces; ++f) {
+    const uint32_t c = topology.face_component[f];
+    sides[2 * size_t{group[c]} + side[c]].add(static_cast<uint64_t>(std::llround(face_area(mesh, f) * unit)),
+                                              face_key(mesh, f));
   }
   std::vector<uint8_t> turns(components, 0);
   for (uint32_t c = 0; c < components; ++c) {
-    const uint32_t root = classes.find(c).first;
-    const double a0 = side_area[2 * size_t{root}], a1 = side_area[2 * size_t{root} + 1];
-    const uint8_t turned_side = a0 < a1 ? 0 : a1 < a0 ? 1 : static_cast<uint8_t>(1 - lowest_side[root]);
-    turns[c] = side[c] == turned_side;
+    const Side& s0 = sides[2 * size_t{group[c]}];
+    const Side& s1 = sides[2 * size_t{group[c]} + 1];
+    if (!s1.any) continue;  // a component no same-way edge joins: nothing to turn
+    const bool turn_0 = s0.area != s1.area ? s0.area < s1.area : s1.least < s0.least;
+    turns[c] = side[c] == (turn_0 ? 0 : 1);
   }
   size_t turned = 0;
   for (size_t f = 0; f < mesh.face_count(); ++f)
