@@ -309,7 +309,7 @@ void bind_map(py::module_& m) {
             s = load_material(material_path, maps);
           }
           if (!s) raise_status(s);
-          for (const std::string& note : maps.notes) PyErr_WarnEx(PyExc_UserWarning, note.c_str(), 1);
+          for (const std::string& note : maps.notes) warn(note);
           run.texture = maps.color;
           // Quarter-turn tiles (`tailor tile --set --symmetry 4`) are mapped for them unless told.
           if (maps.symmetry == 4 && symmetry.is_none() && mapping.mode == MappingMode::kPatches) mapping.symmetry = 4;
@@ -333,8 +333,7 @@ void bind_map(py::module_& m) {
         if (Status s = set_map_texture_size(options, width, height); !s) raise_status(s);
         // Symmetry 4 under a texture that is not a 4-fold tile, or repeating less than once: what
         // `tailor map` prints, as UserWarning (an error where the warnings filter says so).
-        for (const std::string& line : map_warnings(mesh.mesh, options, image, run.texture))
-          if (PyErr_WarnEx(PyExc_UserWarning, line.c_str(), 1) != 0) throw py::error_already_set();
+        for (const std::string& line : map_warnings(mesh.mesh, options, image, run.texture)) warn(line);
         std::vector<uint8_t> seams;
         if (!seam_faces.is_none()) {
           const py::array seam_array = py::array::ensure(seam_faces);

@@ -195,7 +195,8 @@ void bind_tile_set(py::module_& m) {
                                      maps[i].normal,
                                      maps[i].image.bits,
                                      maps[i].image.channels,
-                                     {}});
+                                     {},
+                                     maps[i].directx});
             status = write_tile_set_record(folder, record);
           }
         }

@@ -54,7 +54,7 @@ py::dict material_dict(const MaterialMaps& maps) {
     return b.empty() ? py::object(py::none()) : py::object(py::bytes(b));
   };
   py::dict d;
-  d["color"] = maps.color.empty() ? py::object(py::none()) : py::object(py::str(maps.color));
+  d["color"] = maps.color.empty() ? py::object(py::none()) : path_text(maps.color);
   d["width"] = maps.width;
   d["height"] = maps.height;
   d["normal_png"] = bytes_or_none(maps.textures.normal_png);
@@ -62,8 +62,13 @@ py::dict material_dict(const MaterialMaps& maps) {
   d["orm_roughness_metallic"] = maps.textures.orm_roughness_metallic;
   d["orm_occlusion"] = maps.textures.orm_occlusion;
   d["symmetry"] = maps.symmetry;
-  d["files"] = maps.files;
-  d["notes"] = maps.notes;
+  py::list files, notes;
+  for (const std::string& file : maps.files) files.append(path_text(file));
+  for (const std::string& note : maps.notes)
+    notes.append(
+        py::reinterpret_steal<py::object>(PyUnicode_DecodeUTF8(note.data(), py::ssize_t(note.size()), "replace")));
+  d["files"] = files;
+  d["notes"] = notes;
   return d;
 }
 

@@ -83,6 +83,10 @@ void set_chunk_split(const py::object& chunk_split, uint32_t& split_above);
 //! A path argument: str or os.PathLike, as a file system path.
 std::string path_of(const py::handle& path);
 
+//! Issues a UserWarning with `text` (bytes that are not UTF-8 replaced); throws what a warnings
+//! filter that makes it an error raises.
+void warn(const std::string& text);
+
 //! A path the library gives back, as Python names files: os.fsdecode of its bytes (a name that is
 //! not UTF-8 keeps its bytes as surrogate escapes, so that open() finds the file).
 py::object path_text(const std::string& path);

@@ -85,6 +85,14 @@ std::string path_of(const py::handle& path) {
   return py::module_::import("os").attr("fsencode")(path).cast<py::bytes>().cast<std::string>();
 }
 
+void warn(const std::string& text) {
+  // Valid UTF-8 first (a file name that is not shows as U+FFFD): PyErr_WarnEx decodes strictly.
+  const py::object decoded =
+      py::reinterpret_steal<py::object>(PyUnicode_DecodeUTF8(text.data(), py::ssize_t(text.size()), "replace"));
+  if (!decoded || PyErr_WarnEx(PyExc_UserWarning, PyUnicode_AsUTF8(decoded.ptr()), 1) != 0)
+    throw py::error_already_set();
+}
+
 py::object path_text(const std::string& path) {
   return py::reinterpret_steal<py::object>(PyUnicode_DecodeFSDefaultAndSize(path.data(), py::ssize_t(path.size())));
 }

@@ -500,6 +500,20 @@ TEST(TileSetCli, SetAndMaterialWriteTheInputNamesIntoTheFolder) {
       << err;
   std::ifstream jf6(dir + "/out6/material.json");
   EXPECT_EQ(nlohmann::json::parse(jf6, nullptr, false)["maps"][1]["normal"], true);
+  // A DirectX role is kept for `tailor map --material`, which reads its green the other way.
+  {
+    std::ofstream m(dir + "/role_dx.json");
+    m << R"({"maps": [{"file": "bark_color.png"}, {"file": "bark_normal.png", "role": "normal_dx"}]})";
+  }
+  ASSERT_EQ(test::run_command(std::string(TAILOR_BINARY) + " tile --material " + dir + "/role_dx.json -o " + dir +
+                                  "/out8 --quiet --allow-misses",
+                              out, &err),
+            0)
+      << err;
+  std::ifstream jf8(dir + "/out8/material.json");
+  const nlohmann::json j8 = nlohmann::json::parse(jf8, nullptr, false);
+  EXPECT_EQ(j8["maps"][1]["role"], "normal_dx");
+  EXPECT_FALSE(j8["maps"][0].contains("role"));
   {
     std::ofstream m(dir + "/convention.json");
     m << R"({"maps": [{"file": "bark_color.png"}], "normal_convention": 5})";

@@ -29,10 +29,11 @@ namespace {
 struct TileCliOptions {
   std::string input;
   std::string output;
-  std::vector<std::string> set;          // --set: the maps of a material set (-o is then a folder)
-  std::string material;                  // --material: a JSON naming the maps (alternative to --set)
-  std::vector<std::string> normal_maps;  // --normal-map: which of the set's maps are normal maps
-  std::string normal_convention = "gl";  // --normal-convention gl|dx (recorded in OUTDIR/material.json)
+  std::vector<std::string> set;           // --set: the maps of a material set (-o is then a folder)
+  std::string material;                   // --material: a JSON naming the maps (alternative to --set)
+  std::vector<std::string> normal_maps;   // --normal-map: which of the set's maps are normal maps
+  std::vector<std::string> directx_maps;  // --material: normal maps whose role says DirectX ("normal_dx")
+  std::string normal_convention = "gl";   // --normal-convention gl|dx (recorded in OUTDIR/material.json)
   std::string json;
   TileOptions options;             // bound to --block, --overlap, --seed, --fit-period (defaults: TileOptions')
   ImageLoadOptions image_options;  // --max-image-pixels (default: ImageLoadOptions')
@@ -235,15 +236,20 @@ Status read_material(TileCliOptions& opt) {
                            "maps[" + std::to_string(i) + "]");
     // "role" or "type" names the map as `tailor map --material` reads them (role words as in file
     // names: "normal", "normal_dx", "Normal"...).
-    bool normal = m.contains("normal") && m["normal"].get<bool>();
+    bool normal = m.contains("normal") && m["normal"].get<bool>(), directx = false;
     for (const char* key : {"role", "type"}) {
       if (!m.contains(key)) continue;
       if (!m[key].is_string())
         return Status::error(ErrorCode::kInvalidArgument, opt.material, std::string("\"") + key + "\" must be a string",
                              "maps[" + std::to_string(i) + "]");
-      normal = normal || material_role_from_name(m[key].get<std::string>()) == MaterialRole::kNormal;
+      bool dx = false;
+      if (material_role_from_name(m[key].get<std::string>(), &dx) == MaterialRole::kNormal) {
+        normal = true;
+        directx = directx || dx;
+      }
     }
     if (normal) opt.normal_maps.push_back(file);
+    if (normal && directx) opt.directx_maps.push_back(file);
   }
   if (j.contains("normal_convention") && !j["normal_convention"].is_string())
     return Status::error(ErrorCode::kInvalidArgument, opt.material, "normal_convention must be \"gl\" or \"dx\"");
@@ -300,7 +306,9 @@ int run_tile_set(TileCliOptions opt) {
     // DirectX normal maps (their +y down) turn the other way round with --symmetry 4.
     bool dx_name = false;
     material_role_from_name(opt.set[m], &dx_name);
-    maps[m].directx = maps[m].normal && (opt.normal_convention == "dx" || dx_name);
+    maps[m].directx = maps[m].normal && (opt.normal_convention == "dx" || dx_name ||
+                                         std::find(opt.directx_maps.begin(), opt.directx_maps.end(), opt.set[m]) !=
+                                             opt.directx_maps.end());
     if (maps[m].image.width != maps[0].image.width || maps[m].image.height != maps[0].image.height)
       return report_error(
           Status::error(ErrorCode::kInvalidImage, opt.set[m], "every map of a set must have the same size",
@@ -348,6 +356,7 @@ int run_tile_set(TileCliOptions opt) {
       entry.file = names[m];
       entry.source = opt.set[m];
       entry.normal = maps[m].normal;
+      entry.directx = maps[m].directx;
       entry.bits = maps[m].image.bits;
       entry.channels = maps[m].image.channels;
       if (opt.variants > 1)

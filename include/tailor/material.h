@@ -59,6 +59,7 @@ struct TileSetRecord {
     bool normal = false;                //!< a normal map
     int bits = 8, channels = 0;         //!< the input's (the tile keeps them)
     std::vector<std::string> variants;  //!< the variants' file names in order; empty for one tile
+    bool directx = false;               //!< a DirectX normal map (+y down): recorded as "role": "normal_dx"
   };
   std::vector<Map> maps;
   std::string normal_convention = "gl";  //!< "gl" or "dx"

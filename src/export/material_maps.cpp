@@ -312,6 +312,7 @@ Status write_tile_set_record(const std::string& folder, const TileSetRecord& rec
     entry["file"] = map.file;
     entry["source"] = map.source;
     entry["normal"] = map.normal;
+    if (map.normal && map.directx) entry["role"] = "normal_dx";  // load_material reads it so
     entry["bits"] = map.bits;
     entry["channels"] = map.channels;
     if (!map.variants.empty()) entry["variants"] = map.variants;

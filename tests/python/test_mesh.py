@@ -92,11 +92,17 @@ def test_file_names_that_are_not_utf8(tmp_path):
     assert "spot\\xff.obj" in repr(mesh)
     with pytest.raises(tailor.Error, match="missing\ufffd.ply: cannot open file"):
         tailor.load(os.fsdecode(bytes(tmp_path) + b"/missing\xff.ply"))
-    image = os.fsdecode(bytes(tmp_path) + b"/sand\xfe.png")
+    image = os.fsdecode(bytes(tmp_path) + b"/sand\xfe_color.png")
     shutil.copy(DATA / "textures" / "vistex-sand05-128.png", image)
     folder = os.fsdecode(bytes(tmp_path) + b"/set\xfd")
     written = tailor.tile_set([image], folder)
     assert written == [os.path.join(folder, os.path.basename(image))] and os.path.exists(written[0])
+    # A folder of maps recognised by name (material.json, being JSON, holds such names with U+FFFD).
+    os.remove(os.path.join(folder, "material.json"))
+    assert tailor.load_material(folder)["color"] == written[0]
+    # A warning naming such a file (the photo does not wrap) is a warning, not a UnicodeDecodeError.
+    with pytest.warns(UserWarning, match="sand\ufffd_color.png does not wrap"):
+        tailor.map(mesh, texture=image)
 
 
 GOOD_POSITIONS = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
