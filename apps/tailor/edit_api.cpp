@@ -18,6 +18,7 @@
 #include "tailor/texture_direction.h"
 #include "util/atomic_file.h"
 #include "util/bounded_json.h"
+#include "util/shell_word.h"
 
 namespace tailor::cli {
 namespace {
@@ -199,17 +200,6 @@ json strokes_array(const std::vector<OrientationStroke>& strokes) {
   return list;
 }
 
-// Single quotes for the shell when a word needs them.
-std::string shell_word(const std::string& word) {
-  bool plain = !word.empty();
-  for (char c : word)
-    plain = plain && (std::isalnum(static_cast<unsigned char>(c)) || std::strchr("/._-+,=:", c) != nullptr);
-  if (plain) return word;
-  std::string quoted = "'";
-  for (char c : word) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return quoted + "'";
-}
-
 std::string number(double x) {
   char text[32];
   std::snprintf(text, sizeof text, "%.9g", x);
@@ -227,18 +217,19 @@ Status read_file(const std::string& path, std::string& out) {
 
 std::string replay_command(const EditContext& c, const MapTextureOptions& options) {
   const MappingOptions& m = options.mapping;
-  std::string cmd = "tailor map " + shell_word(c.input);
+  std::string cmd = "tailor map " + internal::shell_word(c.input);
   if (!c.texture_arg.empty())
-    cmd += " --texture " + shell_word(c.texture_arg);
+    cmd += " --texture " + internal::shell_word(c.texture_arg);
   else
     cmd += " --texture-size " + std::to_string(c.output.texture_width);
-  cmd += " --seam-faces " + shell_word(c.seam_faces_path) + " --strokes " + shell_word(c.strokes_path);
+  cmd +=
+      " --seam-faces " + internal::shell_word(c.seam_faces_path) + " --strokes " + internal::shell_word(c.strokes_path);
   // Every mapping option explicitly (--field-following as a number: auto was resolved when chosen).
   cmd += " --mode " + std::string(mapping_mode_name(m.mode)) + " --scale " + number(m.scale) + " --max-stretch " +
          number(m.max_stretch) + " --field-following " + number(m.field_following) + " --min-patch-faces " +
          std::to_string(m.min_patch_faces) + " --hop-age " + number(m.hop_age) + " --crack-rings " +
          std::to_string(m.crack_rings) + " --relax-iterations " + std::to_string(m.relax_iterations) + " --threshold " +
-         number(m.threshold_px) + " --axis " + shell_word(axis_text(options.orientation)) + " --smooth " +
+         number(m.threshold_px) + " --axis " + internal::shell_word(axis_text(options.orientation)) + " --smooth " +
          std::to_string(options.orientation.smooth_passes) + " --symmetry " + std::to_string(m.symmetry);
   // The session maps as map_texture does with its chunk options (chunked from the threshold on).
   const ChunkOptions& chunks = options.chunks;
@@ -254,7 +245,7 @@ std::string replay_command(const EditContext& c, const MapTextureOptions& option
     cmd += " --compress " + std::string(mesh_compression_name(c.output.compression));
   if (c.output.uv_set != 0) cmd += " --uv-set " + std::to_string(c.output.uv_set);
   if (c.output.up == SceneUp::kZ) cmd += " --up z";
-  return cmd + " -o " + shell_word(c.glb_path);
+  return cmd + " -o " + internal::shell_word(c.glb_path);
 }
 
 EditApi::EditApi(EditContext& context) : context_(context) {

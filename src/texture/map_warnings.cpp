@@ -2,16 +2,15 @@
 #include "tailor/map_warnings.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "tailor/tiling.h"
+#include "util/shell_word.h"
 
 namespace tailor {
 
@@ -30,18 +29,6 @@ double map_repeats(const Mesh& mesh, const MapTextureOptions& options) {
 }
 
 namespace {
-
-// A path as a shell takes it, so that the command a warning suggests can be pasted: single-quoted
-// unless every character is one a shell leaves alone.
-std::string shell_word(const std::string& path) {
-  const bool plain = !path.empty() && std::all_of(path.begin(), path.end(), [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) || std::strchr("_-./+,:@%", c) != nullptr;
-  });
-  if (plain) return path;
-  std::string quoted = "'";
-  for (const char c : path) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return quoted + "'";
-}
 
 // The median length of the nonzero edges of up to 65,536 faces spread over the mesh (0: none).
 double sampled_median_edge(const Mesh& mesh) {
@@ -106,7 +93,7 @@ std::vector<std::string> map_warnings(const Mesh& mesh, const MapTextureOptions&
     std::snprintf(figures, sizeof figures, " does not wrap (wrap ratio %.2f in x, %.2f in y; seamless is 0.8-1.2)",
                   wrap_x, wrap_y);
     warnings.push_back(texture_name + figures + ": every repeat shows a cut; make it tileable with: tailor tile " +
-                       shell_word(name.string()) + " -o " + shell_word(tile));
+                       internal::shell_word(name.string()) + " -o " + internal::shell_word(tile));
   }
   // The texture repeats less than once across the mesh's longest side: part of the picture is
   // never seen, and with symmetry 4 quarter-turn seams land on the lattice less often.
