@@ -488,40 +488,35 @@ TEST(TileSetCli, SetAndMaterialWriteTheInputNamesIntoTheFolder) {
             0)
       << err;
   EXPECT_EQ(err.find("unknown key"), std::string::npos) << err;
+  // A material JSON written as `name` and tiled into `folder`: the command's exit status.
+  const auto tile_material = [&](const std::string& name, const std::string& json, const std::string& folder) {
+    std::ofstream(dir + "/" + name) << json;
+    return test::run_command(std::string(TAILOR_BINARY) + " tile --material " + dir + "/" + name + " -o " + dir + "/" +
+                                 folder + " --quiet --allow-misses",
+                             out, &err);
+  };
+  const auto material_of = [&](const std::string& folder) {
+    std::ifstream in(dir + "/" + folder + "/material.json");
+    return nlohmann::json::parse(in, nullptr, false);
+  };
   // "role" names a normal map as `tailor map --material` reads it (any case, role words).
-  {
-    std::ofstream m(dir + "/role.json");
-    m << R"({"maps": [{"file": "bark_color.png"}, {"file": "bark_normal.png", "role": "Normal"}]})";
-  }
-  ASSERT_EQ(test::run_command(std::string(TAILOR_BINARY) + " tile --material " + dir + "/role.json -o " + dir +
-                                  "/out6 --quiet --allow-misses",
-                              out, &err),
-            0)
+  ASSERT_EQ(
+      tile_material("role.json",
+                    R"({"maps": [{"file": "bark_color.png"}, {"file": "bark_normal.png", "role": "Normal"}]})", "out6"),
+      0)
       << err;
-  std::ifstream jf6(dir + "/out6/material.json");
-  EXPECT_EQ(nlohmann::json::parse(jf6, nullptr, false)["maps"][1]["normal"], true);
+  EXPECT_EQ(material_of("out6")["maps"][1]["normal"], true);
   // A DirectX role is kept for `tailor map --material`, which reads its green the other way.
-  {
-    std::ofstream m(dir + "/role_dx.json");
-    m << R"({"maps": [{"file": "bark_color.png"}, {"file": "bark_normal.png", "role": "normal_dx"}]})";
-  }
-  ASSERT_EQ(test::run_command(std::string(TAILOR_BINARY) + " tile --material " + dir + "/role_dx.json -o " + dir +
-                                  "/out8 --quiet --allow-misses",
-                              out, &err),
+  ASSERT_EQ(tile_material("role_dx.json",
+                          R"({"maps": [{"file": "bark_color.png"}, {"file": "bark_normal.png", "role": "normal_dx"}]})",
+                          "out8"),
             0)
       << err;
-  std::ifstream jf8(dir + "/out8/material.json");
-  const nlohmann::json j8 = nlohmann::json::parse(jf8, nullptr, false);
+  const nlohmann::json j8 = material_of("out8");
   EXPECT_EQ(j8["maps"][1]["role"], "normal_dx");
   EXPECT_FALSE(j8["maps"][0].contains("role"));
-  {
-    std::ofstream m(dir + "/convention.json");
-    m << R"({"maps": [{"file": "bark_color.png"}], "normal_convention": 5})";
-  }
-  EXPECT_EQ(test::run_command(std::string(TAILOR_BINARY) + " tile --material " + dir + "/convention.json -o " + dir +
-                                  "/out7 --quiet --allow-misses",
-                              out, &err),
-            2);
+  EXPECT_EQ(
+      tile_material("convention.json", R"({"maps": [{"file": "bark_color.png"}], "normal_convention": 5})", "out7"), 2);
   EXPECT_NE(err.find("normal_convention must be \"gl\" or \"dx\""), std::string::npos) << err;
   std::filesystem::remove_all(dir);
 }
