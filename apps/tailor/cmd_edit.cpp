@@ -139,14 +139,7 @@ int run_edit(const EditArgs& opt) {
   context.topology = build_topology(mesh);
   // As `tailor map` does (its replay command must give the same file): faces wound against their
   // neighbours turn; face ids do not change, so seam faces and strokes still name the same faces.
-  if (context.topology.inconsistent_edges > 0) {
-    load.faces_turned = orient_faces_coherently(mesh, context.topology);
-    if (load.faces_turned > 0) {
-      warn(opt.quiet, opt.input + ": turned " + std::to_string(load.faces_turned) +
-                          " faces wound against their neighbours, so that the surface runs one way");
-      context.topology = build_topology(mesh);
-    }
-  }
+  if (turn_wound_faces(opt.input, mesh, context.topology, load, opt.quiet)) context.topology = build_topology(mesh);
   if (auto_axis) {
     AxisChoice choice;
     if (Status s = choose_orientation_axis(mesh, context.topology, options, choice); !s)

@@ -194,13 +194,10 @@ int run_map(const MapArgs& opt) {
   // --keep-winding): mapped as they are, they would be cut apart with their edges counted as seams.
   // The topology that finds them is built after the mapping (unless the axis choice needs it first),
   // so a mesh that has them is mapped again after the turn: nothing is spent on meshes without.
-  const auto turn_wound_faces = [&]() -> bool {
-    if (opt.keep_winding || topology.inconsistent_edges == 0) return false;
-    load.faces_turned = orient_faces_coherently(mesh, topology);
-    if (load.faces_turned == 0) return false;
-    warn(opt.quiet, opt.input + ": turned " + std::to_string(load.faces_turned) +
-                        " faces wound against their neighbours, so that the surface runs one way (--keep-winding "
-                        "keeps them as they are)");
+  const auto turn_faces = [&]() -> bool {
+    if (opt.keep_winding ||
+        !turn_wound_faces(opt.input, mesh, topology, load, opt.quiet, " (--keep-winding keeps them as they are)"))
+      return false;
     topology = Topology{};
     return true;
   };
@@ -220,7 +217,7 @@ int run_map(const MapArgs& opt) {
   if (auto_axis) {
     connect();
     const auto turning_start = std::chrono::steady_clock::now();
-    if (turn_wound_faces()) connect();
+    if (turn_faces()) connect();
     turning_seconds = seconds_since(turning_start);
     warn_unpaired();
   }
@@ -301,7 +298,7 @@ int run_map(const MapArgs& opt) {
   if (Status s = map_mesh(); !s) return report_error(s.with_file(opt.input));
   if (topology.opposite.empty()) {
     connect();
-    if (turn_wound_faces()) {
+    if (turn_faces()) {
       turning_seconds = seconds_since(first_map_start);  // the mapping that found them, spent
       if (!opt.quiet) std::fprintf(stderr, "mapping again with the faces turned\n");
       if (Status s = map_mesh(); !s) return report_error(s.with_file(opt.input));

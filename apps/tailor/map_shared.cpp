@@ -140,4 +140,13 @@ Status write_mapped_mesh(const std::string& path, const Mesh& mesh, const Atlas&
   return export_mesh(path, mesh, atlas, export_options);
 }
 
+bool turn_wound_faces(const std::string& input, Mesh& mesh, const Topology& topology, LoadReport& load, bool quiet,
+                      const std::string& hint) {
+  load.faces_turned = orient_faces_coherently(mesh, topology);
+  if (load.faces_turned == 0) return false;
+  warn(quiet, input + ": turned " + std::to_string(load.faces_turned) +
+                  " faces wound against their neighbours, so that the surface runs one way" + hint);
+  return true;
+}
+
 }  // namespace tailor::cli

@@ -11,6 +11,7 @@
 #include "tailor/mesh.h"
 #include "tailor/orientation.h"
 #include "tailor/status.h"
+#include "tailor/topology.h"
 
 namespace CLI {
 class Option;
@@ -84,5 +85,11 @@ struct MeshOutput {
 //! reporting to `progress` (optional; ExportOptions::progress).
 Status write_mapped_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas, const MeshOutput& output,
                          const ProgressCallback& progress = {});
+
+//! Turns the faces of `mesh` wound against their neighbours (orient_faces_coherently over
+//! `topology`, the mesh's), counts them in load.faces_turned and says how many in one warning line
+//! ending in `hint`. True when any turned: `topology` then no longer describes the mesh.
+bool turn_wound_faces(const std::string& input, Mesh& mesh, const Topology& topology, LoadReport& load, bool quiet,
+                      const std::string& hint = {});
 
 }  // namespace tailor::cli

@@ -60,16 +60,15 @@ struct WindingClasses {
     }
     return {c, to_root};
   }
-  // Joins a and b with the given parity; false when they are joined already with the other one
-  // (a band whose two sides meet turned: a Moebius strip).
-  bool join(uint32_t a, uint32_t b, uint8_t wanted) {
+  // Joins a and b with the given parity; nothing when they are joined already (with the other
+  // parity: a band whose two sides meet turned, a Moebius strip, whose edge stays unpaired).
+  void join(uint32_t a, uint32_t b, uint8_t wanted) {
     const auto [ra, pa] = find(a);
     const auto [rb, pb] = find(b);
-    if (ra == rb) return (pa ^ pb) == wanted;
+    if (ra == rb) return;
     const uint32_t lo = std::min(ra, rb), hi = std::max(ra, rb);
     parent[hi] = lo;
     parity[hi] = pa ^ pb ^ wanted;
-    return true;
   }
 };
 
