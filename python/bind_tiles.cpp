@@ -64,9 +64,7 @@ py::dict material_dict(const MaterialMaps& maps) {
   d["symmetry"] = maps.symmetry;
   py::list files, notes;
   for (const std::string& file : maps.files) files.append(path_text(file));
-  for (const std::string& note : maps.notes)
-    notes.append(
-        py::reinterpret_steal<py::object>(PyUnicode_DecodeUTF8(note.data(), py::ssize_t(note.size()), "replace")));
+  for (const std::string& note : maps.notes) notes.append(utf8_text(note));
   d["files"] = files;
   d["notes"] = notes;
   return d;

@@ -83,6 +83,9 @@ void set_chunk_split(const py::object& chunk_split, uint32_t& split_above);
 //! A path argument: str or os.PathLike, as a file system path.
 std::string path_of(const py::handle& path);
 
+//! `text` as a str, bytes that are not UTF-8 (a file name's) shown as U+FFFD: a str cannot hold them.
+py::object utf8_text(const std::string& text);
+
 //! Issues a UserWarning with `text` (bytes that are not UTF-8 replaced); throws what a warnings
 //! filter that makes it an error raises.
 void warn(const std::string& text);

@@ -22,10 +22,7 @@ const char* code_name(ErrorCode code) {
 }
 
 [[noreturn]] void raise_with_code(const std::string& message, const char* code) {
-  // A file name that is not UTF-8 shows as U+FFFD in the message (a str cannot hold its bytes).
-  const py::object text =
-      py::reinterpret_steal<py::object>(PyUnicode_DecodeUTF8(message.data(), py::ssize_t(message.size()), "replace"));
-  py::object error = py::reinterpret_borrow<py::object>(error_type)(text);
+  py::object error = py::reinterpret_borrow<py::object>(error_type)(utf8_text(message));
   error.attr("code") = code;
   PyErr_SetObject(error_type, error.ptr());
   throw py::error_already_set();
@@ -85,12 +82,16 @@ std::string path_of(const py::handle& path) {
   return py::module_::import("os").attr("fsencode")(path).cast<py::bytes>().cast<std::string>();
 }
 
-void warn(const std::string& text) {
-  // Valid UTF-8 first (a file name that is not shows as U+FFFD): PyErr_WarnEx decodes strictly.
+py::object utf8_text(const std::string& text) {
   const py::object decoded =
       py::reinterpret_steal<py::object>(PyUnicode_DecodeUTF8(text.data(), py::ssize_t(text.size()), "replace"));
-  if (!decoded || PyErr_WarnEx(PyExc_UserWarning, PyUnicode_AsUTF8(decoded.ptr()), 1) != 0)
-    throw py::error_already_set();
+  if (!decoded) throw py::error_already_set();
+  return decoded;
+}
+
+void warn(const std::string& text) {
+  // Valid UTF-8 first: PyErr_WarnEx decodes its message strictly.
+  if (PyErr_WarnEx(PyExc_UserWarning, PyUnicode_AsUTF8(utf8_text(text).ptr()), 1) != 0) throw py::error_already_set();
 }
 
 py::object path_text(const std::string& path) {
