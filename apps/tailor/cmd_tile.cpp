@@ -251,9 +251,8 @@ Status read_material(TileCliOptions& opt) {
     if (normal) opt.normal_maps.push_back(file);
     if (normal && directx) opt.directx_maps.push_back(file);
   }
-  if (j.contains("normal_convention") && !j["normal_convention"].is_string())
-    return Status::error(ErrorCode::kInvalidArgument, opt.material, "normal_convention must be \"gl\" or \"dx\"");
-  if (j.contains("normal_convention")) opt.normal_convention = j["normal_convention"].get<std::string>();
+  if (j.contains("normal_convention"))  // not a string: "", which the check below refuses
+    opt.normal_convention = j["normal_convention"].is_string() ? j["normal_convention"].get<std::string>() : "";
   if (opt.normal_convention != "gl" && opt.normal_convention != "dx")
     return Status::error(ErrorCode::kInvalidArgument, opt.material, "normal_convention must be \"gl\" or \"dx\"");
   return Status::ok();

@@ -67,10 +67,13 @@ Status glb_base_color(const ExportOptions& options, std::string& bytes, std::str
   // texture's stored rows: the upright pixels go in as PNG instead.
   if (mime_type == "image/jpeg" &&
       jpeg_exif_orientation({reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size()}) != 1) {
+    const Image* upright = options.texture_image;
     Image decoded;
-    if (options.texture_image == nullptr) TAILOR_RETURN_IF_ERROR(load_image(options.texture_path, decoded));
-    TAILOR_RETURN_IF_ERROR(encode_png(options.texture_image != nullptr ? *options.texture_image : decoded, bytes)
-                               .with_file(options.texture_path));
+    if (upright == nullptr) {
+      TAILOR_RETURN_IF_ERROR(load_image(options.texture_path, decoded));
+      upright = &decoded;
+    }
+    TAILOR_RETURN_IF_ERROR(encode_png(*upright, bytes).with_file(options.texture_path));
     mime_type = "image/png";
   }
   return Status::ok();
