@@ -482,6 +482,29 @@ TEST(Metrics, StoredMetricsJoinIdenticalPositionsAndDerivePatches) {
   EXPECT_EQ(joined.visible_branch_points, reference.visible_branch_points);
 }
 
+// A double-sided sheet (a leaf, a cloth): the grid and its reversed copy on vertices of their own at
+// the same positions. Joined by position its inner edges have four faces; its own vertex ids still
+// pair each side, and the two sides meet along the rim: one patch without seams (144 single-face
+// patches when the four-face edges are left unpaired).
+TEST(Metrics, StoredMetricsKeepBothSidesOfADoubleSidedSheet) {
+  const Mesh side = grid(6, 6, Diagonal::kRising);
+  Mesh sheet = side;
+  const uint32_t offset = static_cast<uint32_t>(side.vertex_count());
+  sheet.positions.insert(sheet.positions.end(), side.positions.begin(), side.positions.end());
+  for (size_t f = 0; f < side.face_count(); ++f)
+    for (const int k : {0, 2, 1}) sheet.indices.push_back(side.indices[3 * f + static_cast<size_t>(k)] + offset);
+  const std::vector<float> repeats = corner_uvs(sheet, [](float x, float y) { return std::pair{x / 8, y / 8}; });
+  UvMetrics m;
+  StoredSurface surface;
+  ASSERT_TRUE(compute_stored_uv_metrics(sheet, nullptr, repeats, MetricsOptions{}, m, &surface).is_ok());
+  EXPECT_EQ(surface.welded_vertices, side.vertex_count());
+  EXPECT_GT(surface.nonmanifold_edges, 0u);  // true of the joined surface
+  EXPECT_EQ(m.patches, 1u);
+  EXPECT_EQ(m.single_face_patches, 0u);
+  EXPECT_EQ(m.seam_edges, 0u);
+  EXPECT_EQ(m.visible_seam_ratio, 0.0);
+}
+
 TEST(Metrics, DegenerateFacesAreSkippedWithoutNaN) {
   Mesh mesh = grid(2, 1, Diagonal::kFalling);
   // A zero-area face on three collinear vertices (0,0) (1,0) (2,0).

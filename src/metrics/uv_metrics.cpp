@@ -669,6 +669,25 @@ bool internal::stored_round_trip_exact(std::span<const float> uv_px, float width
   return exact;
 }
 
+namespace {
+
+// Joining bit-identical positions lays two sheets at one place (a double-sided leaf, both sides of
+// a cloth) on edges of four faces, which the joined topology leaves unpaired: every face there
+// would be a patch of its own. Where the file's own vertex ids pair an edge, that pair stands (the
+// joined topology leaves an edge unpaired when the own ids pair it only if it has more than two
+// faces, so the pairs stay mutual).
+void keep_own_pairs(const Mesh& mesh, const Topology* own, uint32_t threads, Topology& joined) {
+  Topology built;
+  if (!own || own->opposite.size() != joined.opposite.size()) {
+    built = build_topology(mesh, {}, threads);
+    own = &built;
+  }
+  for (size_t e = 0; e < joined.opposite.size(); ++e)
+    if (joined.opposite[e] == kInvalid) joined.opposite[e] = own->opposite[e];
+}
+
+}  // namespace
+
 Status internal::compute_stored_uv_metrics_px(const Mesh& mesh, const Topology* topology,
                                               std::span<const float> corner_uv, const MetricsOptions& options,
                                               UvMetrics& metrics, StoredSurface* surface) {
@@ -681,6 +700,7 @@ Status internal::compute_stored_uv_metrics_px(const Mesh& mesh, const Topology* 
   // The surface a reader of a split file (.glb, .ply) sees: vertices at bit-identical positions joined.
   Mesh welded;
   const Mesh* measured = &mesh;
+  const Topology* own = topology;
   if (has_identical_positions(mesh, options.threads)) {
     welded.positions = mesh.positions;
     welded.indices = mesh.indices;
@@ -692,6 +712,7 @@ Status internal::compute_stored_uv_metrics_px(const Mesh& mesh, const Topology* 
   Topology built;
   if (!topology || topology->opposite.size() != 3 * measured->face_count()) {
     built = build_topology(*measured, {}, options.threads);
+    if (measured == &welded && built.nonmanifold_edges > 0) keep_own_pairs(mesh, own, options.threads, built);
     topology = &built;
   }
   if (surface) {
