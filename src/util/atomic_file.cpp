@@ -143,6 +143,10 @@ void remove_temporaries_on_signal() {
 }
 
 void install_signal_cleanup() {
+  // A write beyond the file size limit (ulimit -f) then fails with EFBIG on the ordinary error path
+  // (one error line, the temporary removed) instead of the process being killed mid-write.
+  struct sigaction size_limit {};
+  if (sigaction(SIGXFSZ, nullptr, &size_limit) == 0 && size_limit.sa_handler == SIG_DFL) std::signal(SIGXFSZ, SIG_IGN);
   for (const int signal : kCleanupSignals) {
     struct sigaction old {};
     if (sigaction(signal, nullptr, &old) != 0 || old.sa_handler == SIG_IGN) continue;  // nohup, background jobs
