@@ -483,6 +483,7 @@ TEST(Off, KeywordVariantsColoursAndComments) {
       "STOFF\n3 1 0\n0 0 0 0 0\n1 0 0 1 0\n0 1 0 0 1\n3 0 1 2\n",
       "nOFF\n3\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
       "3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+      "off\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",  // lower case, as some writers give it
   };
   for (const std::string& c : cases) {
     SCOPED_TRACE(c.substr(0, 6));
@@ -509,6 +510,20 @@ TEST(Stl, AsciiPolygonLoopsAndBinaryStartingWithSolid) {
   EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3}));
   EXPECT_EQ(r.welded_vertices, 2u);
   EXPECT_EQ(r.polygons_triangulated, 1u);
+
+  // Keywords in upper case (some CAD exporters), and a corner written as -0: the same point as 0.
+  const std::string upper =
+      "SOLID square\n FACET NORMAL 0 0 1\n  OUTER LOOP\n   VERTEX 0 0 0\n   VERTEX 1 0 0\n   VERTEX 1 1 0\n"
+      "  ENDLOOP\n ENDFACET\n FACET NORMAL 0 0 1\n  OUTER LOOP\n   VERTEX -0 0 0\n   VERTEX 1 1 0\n"
+      "   VERTEX 0 1 -0.0\n  ENDLOOP\n ENDFACET\nENDSOLID square\n";
+  Mesh u;
+  ASSERT_TRUE(parse(upper, MeshFormat::kStl, u, &r).is_ok());
+  EXPECT_EQ(r.format, "STL ascii");
+  EXPECT_EQ(u.vertex_count(), 4u);
+  EXPECT_EQ(u.indices, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3}));
+  // Text that is not STL at all (an OBJ named .stl): said so, not read as a binary count.
+  const std::string obj(100, 'v');
+  EXPECT_EQ(parse(obj, MeshFormat::kStl, u).what(), "not an STL file: text without the 'solid' keyword of ascii STL");
 
   // Binary whose 80-byte header starts with "solid": decided by the size rule.
   std::string bin = "solid but actually binary";

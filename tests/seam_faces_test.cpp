@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "support/fixtures.h"
+#include "tailor/io.h"
 #include "tailor/mapping.h"
 #include "tailor/metrics.h"
 #include "tailor/topology.h"
@@ -89,6 +90,28 @@ TEST(SeamFaces, MarkingTheUndersideMovesTheVisibleSeamsThere) {
     const Measured m = measure(name, up);
     EXPECT_GT(m.after.marked, 1.5 * m.before.marked) << name;
   }
+}
+
+// The list as editors write it: a byte order mark, CRLF, comments on their own lines and after an
+// index, blank lines. Anything else on a line is an error naming it.
+TEST(SeamFaces, ListReadsCommentsAndAByteOrderMark) {
+  const std::string path = testing::TempDir() + "seam_faces_list.txt";
+  const auto load = [&](const std::string& text, std::vector<uint8_t>& marked) {
+    std::FILE* f = std::fopen(path.c_str(), "wb");
+    EXPECT_NE(f, nullptr);
+    std::fwrite(text.data(), 1, text.size(), f);
+    std::fclose(f);
+    return load_seam_faces(path, 8, marked);
+  };
+  std::vector<uint8_t> marked;
+  const Status s = load("\xEF\xBB\xBF# faces to cut\r\n3 # the handle\r\n\r\n  5\t# and its twin\r\n7\r\n", marked);
+  ASSERT_TRUE(s.is_ok()) << s.message();
+  EXPECT_EQ(marked, (std::vector<uint8_t>{0, 0, 0, 1, 0, 1, 0, 1}));
+  const Status bad = load("3\n4 5\n", marked);
+  EXPECT_EQ(bad.code(), ErrorCode::kParse);
+  EXPECT_NE(bad.message().find("line 2"), std::string::npos) << bad.message();
+  EXPECT_EQ(load("8\n", marked).code(), ErrorCode::kParse);  // out of range
+  std::remove(path.c_str());
 }
 
 }  // namespace

@@ -48,7 +48,7 @@ bool starts_with_off_keyword(std::string_view s) {
   size_t j = i;
   while (j < s.size() && j - i < 16 && s[j] > ' ') ++j;
   const std::string_view w = s.substr(i, j - i);
-  return w.size() >= 3 && w.substr(w.size() - 3) == "OFF" && w.size() <= 9;
+  return (w.size() >= 3 && w.substr(w.size() - 3) == "OFF" && w.size() <= 9) || w == "off";
 }
 
 MeshFormat sniff_format(std::span<const char> data) {
@@ -298,6 +298,9 @@ Status load_mesh(const std::string& path, Mesh& mesh, LoadReport* report, const 
   TAILOR_RETURN_IF_ERROR(internal::view_file(path, file));
   const std::span<const char> bytes = file.bytes();
   MeshFormat format = mesh_format_from_path(path);
+  // A PLY or binary glTF header is unmistakable: such a file is read as what it holds, whatever
+  // its name says (a .ply saved as .obj would otherwise read as an OBJ without faces).
+  if (const MeshFormat held = sniff_format(bytes); held == MeshFormat::kPly || held == MeshFormat::kGlb) format = held;
   if (format == MeshFormat::kUnknown) {
     format = sniff_format(bytes);
     if (format == MeshFormat::kUnknown) {

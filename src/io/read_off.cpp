@@ -29,7 +29,7 @@ Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh,
   const TextScanner start = s;
   const std::string_view kw = s.word();
   bool dimension_follows = false;
-  if (kw.size() >= 3 && kw.substr(kw.size() - 3) == "OFF") {
+  if ((kw.size() >= 3 && kw.substr(kw.size() - 3) == "OFF") || kw == "off") {  // some writers use lower case
     std::string_view prefix = kw.substr(0, kw.size() - 3);
     if (prefix.substr(0, 2) == "ST") prefix.remove_prefix(2);
     if (!prefix.empty() && prefix[0] == 'C') prefix.remove_prefix(1);
@@ -43,7 +43,7 @@ Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh,
     }
     if (!prefix.empty())
       return Status::error(ErrorCode::kParse, name, "unknown OFF keyword " + quote_input(kw), s.where());
-    report.format = kw == "OFF" ? "OFF" : "OFF (" + std::string(kw) + ")";
+    report.format = kw == "OFF" || kw == "off" ? "OFF" : "OFF (" + std::string(kw) + ")";
     if (s.peek() == 'B') {
       return Status::error(ErrorCode::kUnsupported, name, "binary OFF files are not supported", s.where());
     }

@@ -1,6 +1,6 @@
 // STL reader, ascii and binary. STL stores three positions per facet and no shared vertices, so
-// corners with bit-identical positions are welded into one vertex (a flat open-addressing hash
-// keyed on the 12 position bytes; -0.0 and 0.0 stay distinct, as in MANIFEST.md's counts).
+// corners with identical positions are welded into one vertex (a flat open-addressing hash keyed
+// on the 12 position bytes, -0.0 read as 0.0).
 //
 // Binary or ascii is decided by size, not by the "solid" prefix: many binary files start their
 // 80-byte header with "solid". A file is binary when 84 + 50 * n == size (n = the count at byte
@@ -32,24 +32,33 @@ Status weld(const std::vector<float>& corners, const std::string& name, Mesh& me
     if (progress && c % 65536 == 0 && !progress->at(kBinaryHeader + c / 3 * kBinaryFacet)) {
       return progress->cancelled(name);
     }
+    // + 0.0f turns -0 into +0: the same point, which exporters write either way.
+    const float p[3] = {corners[3 * c] + 0.0f, corners[3 * c + 1] + 0.0f, corners[3 * c + 2] + 0.0f};
     uint32_t bits[3];
-    std::memcpy(bits, &corners[3 * c], 12);
+    std::memcpy(bits, p, 12);
     const uint64_t h = hash_mix((uint64_t{bits[0]} << 32 | bits[1]) ^ hash_mix(bits[2]));
     const uint32_t next = static_cast<uint32_t>(mesh.positions.size() / 3);
     const uint32_t id = table.find_or_insert(
         h, next, [&](uint32_t stored) { return std::memcmp(&mesh.positions[3 * size_t{stored}], bits, 12) == 0; });
-    if (id == next)
-      mesh.positions.insert(mesh.positions.end(), {corners[3 * c], corners[3 * c + 1], corners[3 * c + 2]});
+    if (id == next) mesh.positions.insert(mesh.positions.end(), {p[0], p[1], p[2]});
     mesh.indices[c] = id;
   }
   report.welded_vertices = nc - mesh.positions.size() / 3;
   return Status::ok();
 }
 
+// ASCII STL keywords in any case: some CAD exporters write SOLID, FACET, VERTEX.
+bool is_keyword(std::string_view w, std::string_view keyword) {
+  if (w.size() != keyword.size()) return false;
+  for (size_t i = 0; i < w.size(); ++i)
+    if ((w[i] >= 'A' && w[i] <= 'Z' ? w[i] - 'A' + 'a' : w[i]) != keyword[i]) return false;
+  return true;
+}
+
 bool starts_with_solid(std::string_view s) {
   size_t i = 0;
   while (i < s.size() && (is_blank(s[i]) || s[i] == '\n')) ++i;
-  return s.substr(i, 5) == "solid";
+  return is_keyword(s.substr(i, 5), "solid");
 }
 
 Status read_binary(std::span<const char> data, const std::string& name, std::vector<float>& corners,
@@ -59,6 +68,9 @@ Status read_binary(std::span<const char> data, const std::string& name, std::vec
   std::memcpy(&n, data.data() + 80, 4);
   const uint64_t need = kBinaryHeader + kBinaryFacet * uint64_t{n};
   if (need > data.size()) {
+    // Text is not a binary STL whose count is off: say what it lacks to be ascii STL.
+    if (std::memchr(data.data(), '\0', data.size()) == nullptr)
+      return Status::error(ErrorCode::kParse, name, "not an STL file: text without the 'solid' keyword of ascii STL");
     return Status::error(ErrorCode::kParse, name,
                          "binary STL header declares " + std::to_string(n) + " triangles (" + std::to_string(need) +
                              " bytes) but the file has " + std::to_string(data.size()) + " bytes");
@@ -79,7 +91,7 @@ Status read_ascii(std::span<const char> data, const std::string& name, std::vect
   auto expect = [&](std::string_view word) -> Status {
     s.skip_space();
     const std::string_view w = s.word();
-    if (w != word) {
+    if (!is_keyword(w, word)) {
       return Status::error(ErrorCode::kParse, name,
                            "expected '" + std::string(word) + "' in ascii STL, found " + quote_input(w, 32), s.where());
     }
@@ -91,11 +103,11 @@ Status read_ascii(std::span<const char> data, const std::string& name, std::vect
     s.skip_space();
     if (s.at_end()) break;
     const std::string_view w = s.word();
-    if (w == "solid" || w == "endsolid") {
+    if (is_keyword(w, "solid") || is_keyword(w, "endsolid")) {
       s.next_line();  // the solid's name, if any
       continue;
     }
-    if (w != "facet") {
+    if (!is_keyword(w, "facet")) {
       return Status::error(ErrorCode::kParse, name, "expected 'facet' in ascii STL, found " + quote_input(w, 32),
                            s.where());
     }
@@ -110,8 +122,8 @@ Status read_ascii(std::span<const char> data, const std::string& name, std::vect
     for (;;) {
       s.skip_space();
       const std::string_view v = s.word();
-      if (v == "endloop") break;
-      if (v != "vertex") {
+      if (is_keyword(v, "endloop")) break;
+      if (!is_keyword(v, "vertex")) {
         return Status::error(ErrorCode::kParse, name, "expected 'vertex' or 'endloop' in ascii STL", s.where());
       }
       float x, y, z;

@@ -1,4 +1,5 @@
 // Seam-face lists (thesis 2.5): which faces the user wants seams on.
+#include <algorithm>
 #include <charconv>
 
 #include "tailor/io.h"
@@ -12,7 +13,7 @@ Status load_seam_faces(const std::string& path, size_t face_count, std::vector<u
   TAILOR_RETURN_IF_ERROR(internal::read_file(path, text));
   seam_faces.assign(face_count, 0);
   size_t line = 0;
-  size_t pos = 0;
+  size_t pos = text.starts_with("\xEF\xBB\xBF") ? 3 : 0;  // a UTF-8 byte order mark, as editors may write
   while (pos < text.size()) {
     ++line;
     size_t end = text.find('\n', pos);
@@ -20,9 +21,10 @@ Status load_seam_faces(const std::string& path, size_t face_count, std::vector<u
     const char* first = text.data() + pos;
     const char* last = text.data() + end;
     pos = end + 1;
+    last = std::find(first, last, '#');  // a comment, on its own line or after the index
     while (first < last && (*first == ' ' || *first == '\t')) ++first;
     while (last > first && (last[-1] == ' ' || last[-1] == '\t' || last[-1] == '\r')) --last;
-    if (first == last || *first == '#') continue;
+    if (first == last) continue;
     uint64_t face = 0;
     const auto [ptr, ec] = std::from_chars(first, last, face);
     if (ec != std::errc() || ptr != last) {
