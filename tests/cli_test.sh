@@ -48,6 +48,10 @@ printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\
   fail "info bowtie.obj: $(cat "$tmp/bowtie.txt")"
 "$tailor" info "$tmp/fin.obj" --json >"$tmp/fin.json" && grep -q '"nonmanifold_vertices": 2' "$tmp/fin.json" &&
   grep -q '"nonmanifold_edges": 1' "$tmp/fin.json" && ok || fail "info fin.obj: $(cat "$tmp/fin.json")"
+# A PLY saved under another name is read as the PLY it is.
+cp tests/data/meshes/horse.ply "$tmp/horse_ply.obj"
+"$tailor" info "$tmp/horse_ply.obj" | grep -q "^  format                 PLY binary_little_endian" && ok ||
+  fail "a PLY named .obj: $("$tailor" info "$tmp/horse_ply.obj" 2>&1 | head -3)"
 
 # --- map: summary line, outputs, stats; determinism (bit-identical files) ---
 "$tailor" map "$mesh" --texture "$texture" -o "$tmp/a.glb" --stats "$tmp/a.json" >"$tmp/map.txt" 2>&1 ||
@@ -168,6 +172,17 @@ expect_error 2 "overwrite an input" -- "$tailor" map "$mesh" -o "$tmp/z.obj" --t
 expect_error 2 "does not exist" -- "$tailor" map "$mesh" -o "$tmp/ok.glb" --stats "$tmp/missing/s.json"
 expect_error 2 "needs a .glb output" -- "$tailor" map "$mesh" -o "$tmp/cx.obj" --compress draco
 expect_error 2 "--compress must be" -- "$tailor" map "$mesh" -o "$tmp/cx.glb" --compress zip
+# Options that would be taken and do nothing are refused, naming why.
+expect_error 2 "--up z needs a .glb output" -- "$tailor" map "$mesh" -o "$tmp/up.obj" --up z
+expect_error 2 "--max-stretch has no effect with --mode thesis" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --mode thesis --max-stretch 3
+expect_error 2 "--no-crack-closing has no effect with --mode thesis" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --mode thesis --no-crack-closing
+expect_error 2 "--threshold is read by --mode thesis only" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --threshold 5
+expect_error 2 "--tile-size excludes --scale" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --scale 5000 --tile-size 1
+expect_error 2 "--preview-all requires --preview" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --preview-all
+expect_error 2 "--texture-size" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --texture-size 70000
+expect_error 2 "--pin-frame requires --stability" -- "$tailor" eval "$mesh" --pin-frame
+expect_error 2 "--chunks requires --stability" -- "$tailor" eval "$mesh" --chunks on
+[[ ! -e $tmp/up.obj && ! -e $tmp/x.glb ]] && ok || fail "a refused option left an output"
 [[ ! -e $tmp/cx.obj && ! -e $tmp/cx.glb ]] && ok || fail "output left after a bad --compress"
 [[ ! -e $tmp/ok.glb && ! -e $tmp/same.glb ]] && ok || fail "outputs written although the run was refused"
 expect_error 2 "scale" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --scale 1e-30
@@ -385,6 +400,12 @@ if [[ $sent -eq 1 ]]; then
 else
   echo "note: the map ended before its temporary file showed (exit $code); SIGTERM not checked"
 fi
+# A write beyond the file size limit (ulimit -f, 100 KiB here) is an error line, not a kill by
+# SIGXFSZ that leaves the temporary file.
+mkdir "$tmp/fsz"
+expect_error 1 "h\.obj: cannot write file: File too large" -- bash -c 'ulimit -f 100; exec "$0" map "$1" -o "$2" --no-crack-closing -q' \
+  "$tailor" "$tmp/horse.obj" "$tmp/fsz/h.obj"
+[[ -z $(ls -A "$tmp/fsz") ]] && ok || fail "a write beyond the file size limit left: $(ls -A "$tmp/fsz")"
 
 # --- hardening of inputs (docs/hardening.md, "inputs") ---
 # 7. Image sizes: a 30-byte TGA / 31-byte PPM claiming 16000 x 16000 px is over the pixel limit; raised,
@@ -620,6 +641,13 @@ cp "$photo" "$tmp/my photo.jpg"
 "$tailor" map "$mesh" -t "$tmp/my photo.jpg" -o "$tmp/wrap.glb" >/dev/null 2>"$tmp/wrap.err" &&
   grep -qF "make it tileable with: tailor tile '$tmp/my photo.jpg' -o '$tmp/my photo_tile.png'" "$tmp/wrap.err" && ok ||
   fail "the suggested tile command is not quoted: $(cat "$tmp/wrap.err")"
+# A name starting with '-' is not read as an option when pasted: the command runs as printed.
+mkdir -p "$tmp/dash" && cp "$photo" "$tmp/dash/-photo.jpg"
+abs_mesh="$PWD/$mesh" abs_tailor="$(realpath "$tailor")"
+suggested="$(cd "$tmp/dash" && "$abs_tailor" map "$abs_mesh" -t ./-photo.jpg -o wrap.glb 2>&1 >/dev/null |
+  sed -n 's/.*make it tileable with: tailor //p')"
+[[ $suggested == "tile ./-photo.jpg -o ./-photo_tile.png" ]] && (cd "$tmp/dash" && eval "'$abs_tailor' $suggested -q") &&
+  [[ -s $tmp/dash/-photo_tile.png ]] && ok || fail "the suggested tile command for a name starting with '-': $suggested"
 "$tailor" map "$mesh" -t "$photo" -o "$tmp/wrap.glb" -q 2>"$tmp/wrap.err" >/dev/null && [[ ! -s $tmp/wrap.err ]] && ok ||
   fail "--quiet printed a warning: $(cat "$tmp/wrap.err")"
 "$tailor" tile "$photo" -o "$tmp/photo_tile.png" -q || fail "tile the photo"

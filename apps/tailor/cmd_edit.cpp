@@ -226,7 +226,6 @@ void register_edit(CLI::App& app, Runner& run) {
   auto* group = cmd->add_option_group("Mapping (as 'tailor map'; the page changes them too)");
   const MappingOptionHandles handles = add_mapping_options(group, opt->mapping_args, opt->options, false);
   handles.smooth->check(CLI::Range(0u, 1000u));  // rejected at parsing here (in `tailor map`, by the orientation)
-  const CLI::Option* crack_rings = handles.crack_rings;
   cmd->add_option("--threads", mapping.threads,
                   "Threads for the chunk plan, the orientation, the crack closing and the metrics (0 = one per "
                   "core, up to 8); "
@@ -247,8 +246,8 @@ void register_edit(CLI::App& app, Runner& run) {
       "Examples:\n"
       "  tailor edit bunny.ply --texture gravel_tile.png -o bunny.glb\n"
       "  tailor edit horse.ply --axis skeleton --port 8080");
-  cmd->callback([&run, opt, crack_rings] {
-    opt->mapping_args.crack_rings_given = crack_rings->count() > 0;
+  cmd->callback([&run, opt, handles] {
+    note_given_options(handles, opt->mapping_args);
     run = [opt] { return run_edit(*opt); };
   });
 }

@@ -172,20 +172,26 @@ void register_eval(CLI::App& app, Runner& run) {
   add_symmetry_option(cmd, option_doc(kMetricsOptionDocs, "symmetry"), opt->symmetry);
   cmd->add_flag("--json", opt->json, "Print the full report as a JSON object");
   cmd->add_flag("-q,--quiet", opt->quiet, "Print nothing but the result and errors");
-  cmd->add_flag("--stability", opt->stability,
-                "Instead: map the mesh afresh with tailor's defaults three times (as given; with its faces, vertices "
-                "and corners in another order; with the faces in a ball holding ~10% of them removed) and report the "
-                "share of corners whose UVs keep their bits (all, and farther than the locality radius from the "
-                "cut) and how far the others moved (thesis 2.6)");
-  cmd->add_flag("--pin-frame", opt->stability_options.pin_frame,
-                "With --stability: the thesis's experiment instead: both runs keep the full mesh's axis, "
-                "normalisation and seed point (no reordered run)");
-  add_documented(cmd, option_doc(kChunkOptionDocs, "mode"), opt->chunks);
-  add_documented(cmd, option_doc(kChunkOptionDocs, "cell_exponent"), opt->chunk_cell);
-  cmd->add_option("--seed-point", opt->seed_point,
-                  "With --stability: " + std::string(option_doc(kMappingOptionDocs, "seed_point").help));
-  add_documented(cmd, option_doc(kStabilityOptionDocs, "remove_fraction"), opt->stability_options.remove_fraction)
-      ->check(CLI::Range(0.01f, 0.9f));
+  auto* stability = cmd->add_flag(
+      "--stability", opt->stability,
+      "Instead: map the mesh afresh with tailor's defaults three times (as given; with its faces, vertices "
+      "and corners in another order; with the faces in a ball holding ~10% of them removed) and report the "
+      "share of corners whose UVs keep their bits (all, and farther than the locality radius from the "
+      "cut) and how far the others moved (thesis 2.6)");
+  // The options of --stability's mappings: refused without it, where they would do nothing.
+  const auto with_stability = [stability](CLI::Option* o) {
+    o->description("With --stability: " + o->get_description())->needs(stability);
+  };
+  with_stability(cmd->add_flag("--pin-frame", opt->stability_options.pin_frame,
+                               "the thesis's experiment instead: both runs keep the full mesh's axis, "
+                               "normalisation and seed point (no reordered run)"));
+  with_stability(add_documented(cmd, option_doc(kChunkOptionDocs, "mode"), opt->chunks));
+  with_stability(add_documented(cmd, option_doc(kChunkOptionDocs, "cell_exponent"), opt->chunk_cell));
+  with_stability(
+      cmd->add_option("--seed-point", opt->seed_point, std::string(option_doc(kMappingOptionDocs, "seed_point").help)));
+  with_stability(
+      add_documented(cmd, option_doc(kStabilityOptionDocs, "remove_fraction"), opt->stability_options.remove_fraction)
+          ->check(CLI::Range(0.01f, 0.9f)));
   cmd->add_option("--threads", opt->threads,
                   "Threads of the metrics (0 = one per 100k faces, up to the cores and 8) and, with --stability, of "
                   "the mappings (0 = one per core); the figures are the same for any count")

@@ -96,6 +96,9 @@ int run_map(const MapArgs& opt) {
   if (compression != MeshCompression::kNone && ext != ".glb")
     return report_error(usage_error("--compress needs a .glb output, got '" + opt.output + "'"));
   if (opt.up != "y" && opt.up != "z") return report_error(usage_error("--up must be y or z, got '" + opt.up + "'"));
+  if (opt.up == "z" && ext != ".glb")
+    return report_error(usage_error("--up z needs a .glb output (OBJ and PLY keep the positions as they are), got '" +
+                                    opt.output + "'"));
   // Given, each must be a length or density (0 would mean "not given" and be ignored silently).
   if ((opt.tile_size_given && !(opt.tile_size > 0 && std::isfinite(opt.tile_size))) ||
       (opt.texels_per_unit_given && !(opt.texels_per_unit > 0 && std::isfinite(opt.texels_per_unit))))
@@ -507,8 +510,10 @@ void register_map(CLI::App& app, Runner& run) {
       "(+ per-vertex tangents; a DX map's green is flipped), metallicRoughness (G roughness, B "
       "metallic) and occlusion (R); height is not a glTF map and is left out. The quarter-turn tiles "
       "of 'tailor tile --set --symmetry 4' are mapped with --symmetry 4 unless --symmetry says otherwise");
-  cmd->add_option("--texture-size", opt->mapping_args.texture_size, "Texture size in pixels when no --texture is given")
-      ->capture_default_str();
+  cmd->add_option("--texture-size", opt->mapping_args.texture_size,
+                  "Texture size in pixels when no --texture is given (at most 65536, as 'tailor eval' reads)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1 << 16));
   add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), opt->image_options.max_pixels)
       ->check(kAtLeastOne);
   add_documented(cmd, option_doc(kExportOptionDocs, "compression"), opt->compress);
@@ -522,15 +527,17 @@ void register_map(CLI::App& app, Runner& run) {
                                  "--scale");
   tile_size->excludes(texels);
   cmd->add_option("--stats", opt->stats, "Write a JSON report (mesh, mapping counters, metrics, timings)");
-  cmd->add_option("--preview", opt->preview, "Render a 3/4 view of the textured mesh to this PNG");
+  auto* preview = cmd->add_option("--preview", opt->preview, "Render a 3/4 view of the textured mesh to this PNG");
   cmd->add_flag("--preview-all", opt->preview_all,
                 "With --preview, also write <name>_patches.png, <name>_distortion.png, <name>_checker.png and "
-                "<name>_seams.png");
+                "<name>_seams.png")
+      ->needs(preview);
   cmd->add_option("--preview-up", opt->preview_up, std::string(option_doc(kRenderOptionDocs, "up").help))
       ->capture_default_str();
   auto* group = cmd->add_option_group("Mapping");
   const MappingOptionHandles handles = add_mapping_options(group, opt->mapping_args, opt->options, true);
-  const CLI::Option *crack_rings = handles.crack_rings, *symmetry = handles.symmetry;
+  tile_size->excludes(handles.scale);
+  texels->excludes(handles.scale);
   cmd->add_flag("--stability", opt->stability,
                 "Also map the mesh again in another file order, and with ~10% of its faces removed (fresh runs, "
                 "as tailor eval --stability), and report how many UVs kept their bits and how far the others moved");
@@ -558,11 +565,10 @@ void register_map(CLI::App& app, Runner& run) {
       "texture without a direction (gravel, grass; its isotropy is in the --stats) with rigid unfolding\n"
       "and 32 crack rings, the fewest seams; --field-following 1 keeps the orientation field, and\n"
       "the UVs of a mesh that is edited and re-mapped more stable (docs/mapping.md section 7).");
-  cmd->callback([&run, opt, crack_rings, symmetry, tile_size, texels] {
+  cmd->callback([&run, opt, handles, tile_size, texels] {
     opt->tile_size_given = tile_size->count() > 0;
     opt->texels_per_unit_given = texels->count() > 0;
-    opt->mapping_args.crack_rings_given = crack_rings->count() > 0;
-    opt->mapping_args.symmetry_given = symmetry->count() > 0;
+    note_given_options(handles, opt->mapping_args);
     run = [opt] { return run_map_inputs(*opt); };
   });
 }

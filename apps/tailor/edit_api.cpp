@@ -217,19 +217,27 @@ Status read_file(const std::string& path, std::string& out) {
 
 std::string replay_command(const EditContext& c, const MapTextureOptions& options) {
   const MappingOptions& m = options.mapping;
-  std::string cmd = "tailor map " + internal::shell_word(c.input);
+  std::string cmd = "tailor map " + internal::shell_path(c.input);
   if (!c.texture_arg.empty())
-    cmd += " --texture " + internal::shell_word(c.texture_arg);
+    cmd += " --texture " + internal::shell_path(c.texture_arg);
   else
     cmd += " --texture-size " + std::to_string(c.output.texture_width);
   cmd +=
-      " --seam-faces " + internal::shell_word(c.seam_faces_path) + " --strokes " + internal::shell_word(c.strokes_path);
-  // Every mapping option explicitly (--field-following as a number: auto was resolved when chosen).
-  cmd += " --mode " + std::string(mapping_mode_name(m.mode)) + " --scale " + number(m.scale) + " --max-stretch " +
-         number(m.max_stretch) + " --field-following " + number(m.field_following) + " --min-patch-faces " +
-         std::to_string(m.min_patch_faces) + " --hop-age " + number(m.hop_age) + " --crack-rings " +
-         std::to_string(m.crack_rings) + " --relax-iterations " + std::to_string(m.relax_iterations) + " --threshold " +
-         number(m.threshold_px) + " --axis " + internal::shell_word(axis_text(options.orientation)) + " --smooth " +
+      " --seam-faces " + internal::shell_path(c.seam_faces_path) + " --strokes " + internal::shell_path(c.strokes_path);
+  // Every mapping option the mode reads, explicitly (--field-following as a number: auto was
+  // resolved when chosen).
+  cmd += " --mode " + std::string(mapping_mode_name(m.mode)) + " --scale " + number(m.scale);
+  if (m.mode == MappingMode::kThesis) {
+    cmd += " --threshold " + number(m.threshold_px);
+  } else {
+    cmd += " --max-stretch " + number(m.max_stretch) + " --field-following " + number(m.field_following) +
+           " --min-patch-faces " + std::to_string(m.min_patch_faces) + " --hop-age " + number(m.hop_age) +
+           " --crack-rings " + std::to_string(m.crack_rings) + " --relax-iterations " +
+           std::to_string(m.relax_iterations);
+    if (!m.shorten_seams) cmd += " --no-seam-shortening";
+    if (!m.close_cracks) cmd += " --no-crack-closing";
+  }
+  cmd += " --axis " + internal::shell_word(axis_text(options.orientation)) + " --smooth " +
          std::to_string(options.orientation.smooth_passes) + " --symmetry " + std::to_string(m.symmetry);
   // The session maps as map_texture does with its chunk options (chunked from the threshold on).
   const ChunkOptions& chunks = options.chunks;
@@ -239,13 +247,11 @@ std::string replay_command(const EditContext& c, const MapTextureOptions& option
   if (chunks.cell_exponent != kAutoCellExponent) cmd += " --chunk-cell " + std::to_string(chunks.cell_exponent);
   if (m.use_seed_point)
     cmd += " --seed-point " + number(m.seed_point[0]) + "," + number(m.seed_point[1]) + "," + number(m.seed_point[2]);
-  if (!m.shorten_seams) cmd += " --no-seam-shortening";
-  if (!m.close_cracks) cmd += " --no-crack-closing";
   if (c.output.compression != MeshCompression::kNone)
     cmd += " --compress " + std::string(mesh_compression_name(c.output.compression));
   if (c.output.uv_set != 0) cmd += " --uv-set " + std::to_string(c.output.uv_set);
   if (c.output.up == SceneUp::kZ) cmd += " --up z";
-  return cmd + " -o " + internal::shell_word(c.glb_path);
+  return cmd + " -o " + internal::shell_path(c.glb_path);
 }
 
 EditApi::EditApi(EditContext& context) : context_(context) {

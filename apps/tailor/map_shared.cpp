@@ -71,21 +71,25 @@ MappingOptionHandles add_mapping_options(CLI::Option_group* group, MappingArgs& 
   MappingOptions& mapping = options.mapping;
   MappingOptionHandles handles;
   add_documented(group, option_doc(kMappingOptionDocs, "mode"), args.mode);
-  add_documented(group, option_doc(kMappingOptionDocs, "scale"), mapping.scale);
-  add_documented(group, option_doc(kMappingOptionDocs, "max_stretch"), mapping.max_stretch);
-  group
-      ->add_option("--field-following", args.field_following,
-                   std::string(option_doc(kMappingOptionDocs, "field_following").help))
-      ->capture_default_str();
-  add_documented(group, option_doc(kMappingOptionDocs, "min_patch_faces"), mapping.min_patch_faces);
-  add_documented(group, option_doc(kMappingOptionDocs, "hop_age"), mapping.hop_age);
-  add_off_switch(group, option_doc(kMappingOptionDocs, "shorten_seams"), mapping.shorten_seams);
-  add_off_switch(group, option_doc(kMappingOptionDocs, "close_cracks"), mapping.close_cracks);
+  handles.scale = add_documented(group, option_doc(kMappingOptionDocs, "scale"), mapping.scale);
+  std::vector<CLI::Option*>& patches_only = handles.patches_only;
+  patches_only.push_back(add_documented(group, option_doc(kMappingOptionDocs, "max_stretch"), mapping.max_stretch));
+  patches_only.push_back(group
+                             ->add_option("--field-following", args.field_following,
+                                          std::string(option_doc(kMappingOptionDocs, "field_following").help))
+                             ->capture_default_str());
+  patches_only.push_back(
+      add_documented(group, option_doc(kMappingOptionDocs, "min_patch_faces"), mapping.min_patch_faces));
+  patches_only.push_back(add_documented(group, option_doc(kMappingOptionDocs, "hop_age"), mapping.hop_age));
+  patches_only.push_back(add_off_switch(group, option_doc(kMappingOptionDocs, "shorten_seams"), mapping.shorten_seams));
+  patches_only.push_back(add_off_switch(group, option_doc(kMappingOptionDocs, "close_cracks"), mapping.close_cracks));
   handles.crack_rings = add_documented(group, option_doc(kMappingOptionDocs, "crack_rings"), mapping.crack_rings)
                             ->check(CLI::Range(2u, 64u));
-  add_documented(group, option_doc(kMappingOptionDocs, "relax_iterations"), mapping.relax_iterations)
-      ->check(CLI::Range(0u, 1000u));
-  add_documented(group, option_doc(kMappingOptionDocs, "threshold_px"), mapping.threshold_px);
+  patches_only.push_back(handles.crack_rings);
+  patches_only.push_back(
+      add_documented(group, option_doc(kMappingOptionDocs, "relax_iterations"), mapping.relax_iterations)
+          ->check(CLI::Range(0u, 1000u)));
+  handles.threshold = add_documented(group, option_doc(kMappingOptionDocs, "threshold_px"), mapping.threshold_px);
   add_documented(group, option_doc(kOrientationOptionDocs, "axis"), args.axis);
   handles.smooth =
       add_documented(group, option_doc(kOrientationOptionDocs, "smooth_passes"), options.orientation.smooth_passes);
@@ -102,6 +106,15 @@ MappingOptionHandles add_mapping_options(CLI::Option_group* group, MappingArgs& 
   return handles;
 }
 
+void note_given_options(const MappingOptionHandles& handles, MappingArgs& args) {
+  args.crack_rings_given = handles.crack_rings->count() > 0;
+  args.symmetry_given = handles.symmetry->count() > 0;
+  args.threshold_given = handles.threshold->count() > 0;
+  args.patches_only_given.clear();
+  for (const CLI::Option* o : handles.patches_only)
+    if (o->count() > 0 && args.patches_only_given.empty()) args.patches_only_given = o->get_name();
+}
+
 Status apply_mapping_args(const MappingArgs& args, MapTextureOptions& options) {
   const auto usage_error = [](const std::string& what) { return Status::error(ErrorCode::kInvalidArgument, "", what); };
   if (!args.auto_axis()) {
@@ -110,6 +123,12 @@ Status apply_mapping_args(const MappingArgs& args, MapTextureOptions& options) {
   MappingOptions& mapping = options.mapping;
   if (!mapping_mode_from_name(args.mode, mapping.mode))
     return usage_error("--mode must be patches or thesis, got '" + args.mode + "'");
+  // An option the chosen mode does not read would be taken and do nothing.
+  if (mapping.mode == MappingMode::kThesis && !args.patches_only_given.empty())
+    return usage_error(args.patches_only_given +
+                       " has no effect with --mode thesis (one UV per vertex, placed by --threshold; no seam work)");
+  if (mapping.mode != MappingMode::kThesis && args.threshold_given)
+    return usage_error("--threshold is read by --mode thesis only (--mode patches bounds its faces by --max-stretch)");
   if (!args.seed_point.empty()) {
     if (!parse_vec3(args.seed_point, mapping.seed_point))
       return usage_error("--seed-point must be three numbers X,Y,Z, got '" + args.seed_point + "'");

@@ -37,6 +37,8 @@ struct MappingArgs {
   std::string chunk_cell = "auto";                     // --chunk-cell: a power-of-two exponent, or auto
   bool crack_rings_given = false;                      // --crack-rings on the command line (kept over auto's)
   bool symmetry_given = false;                         // --symmetry on the command line (kept over a material's)
+  std::string patches_only_given;                      // the first option given that only --mode patches reads
+  bool threshold_given = false;                        // --threshold (only --mode thesis reads it)
   std::string seed_point;
   std::string seam_faces;                            // --seam-faces: a file of face ids
   std::string strokes;                               // --strokes: orientation strokes, JSON (read_strokes.cpp)
@@ -51,7 +53,13 @@ struct MappingOptionHandles {
   CLI::Option* crack_rings = nullptr;  // its count() sets MappingArgs::crack_rings_given
   CLI::Option* smooth = nullptr;
   CLI::Option* symmetry = nullptr;  // its count() sets MappingArgs::symmetry_given
+  CLI::Option* scale = nullptr;
+  CLI::Option* threshold = nullptr;
+  std::vector<CLI::Option*> patches_only;  // what the thesis mode does not read (its growth has no bound)
 };
+
+//! After parsing: which of the handles' options the command line gave (MappingArgs' *_given).
+void note_given_options(const MappingOptionHandles& handles, MappingArgs& args);
 
 //! Adds the mapping options (--mode ... --symmetry) to `group`, in the order of --help, bound to `args`
 //! and `options`. `with_input_files`: --seam-faces and --strokes go in the group too (before

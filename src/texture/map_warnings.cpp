@@ -93,7 +93,7 @@ std::vector<std::string> map_warnings(const Mesh& mesh, const MapTextureOptions&
     std::snprintf(figures, sizeof figures, " does not wrap (wrap ratio %.2f in x, %.2f in y; seamless is 0.8-1.2)",
                   wrap_x, wrap_y);
     warnings.push_back(texture_name + figures + ": every repeat shows a cut; make it tileable with: tailor tile " +
-                       internal::shell_word(name.string()) + " -o " + internal::shell_word(tile));
+                       internal::shell_path(name.string()) + " -o " + internal::shell_path(tile));
   }
   // The texture repeats less than once across the mesh's longest side: part of the picture is
   // never seen, and with symmetry 4 quarter-turn seams land on the lattice less often.

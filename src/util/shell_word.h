@@ -20,4 +20,10 @@ inline std::string shell_word(const std::string& word) {
   return quoted + "'";
 }
 
+//! A path as a word of a command: shell_word, with "./" before a relative path that starts with
+//! '-' (the command would read it as an option).
+inline std::string shell_path(const std::string& path) {
+  return shell_word(!path.empty() && path[0] == '-' ? "./" + path : path);
+}
+
 }  // namespace tailor::internal
