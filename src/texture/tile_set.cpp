@@ -62,16 +62,19 @@ double plan_scale(int w, int h, int above) {
   return std::max(1.0, scale);
 }
 
+//! `image` resized by 1 / scale (scale from plan_scale, > 1): its plan copy.
+Status plan_copy(const Image& image, double scale, Image& copy) {
+  const int w = std::max(kPlanMinSide, static_cast<int>(std::lround(image.width / scale)));
+  const int h = std::max(kPlanMinSide, static_cast<int>(std::lround(image.height / scale)));
+  return resize_image(image, w, h, copy);
+}
+
 //! auto_period: whether `image` has a strong period (kStrongPeriod) on an axis that changes its
 //! fitted size; estimated on a copy of at most kPlanSide px (periods scaled back).
 bool strong_period(const Image& image, PeriodEstimate& period) {
   Image small;
   const double scale = plan_scale(image.width, image.height, kPlanSide);
-  if (scale > 1.0) {
-    const int w = std::max(kPlanMinSide, static_cast<int>(std::lround(image.width / scale)));
-    const int h = std::max(kPlanMinSide, static_cast<int>(std::lround(image.height / scale)));
-    if (!resize_image(image, w, h, small).is_ok()) return false;
-  }
+  if (scale > 1.0 && !plan_copy(image, scale, small).is_ok()) return false;
   period = estimate_period(scale > 1.0 ? small : image);
   period.found_x = period.found_x && period.confidence_x >= kStrongPeriod;
   period.found_y = period.found_y && period.confidence_y >= kStrongPeriod;
@@ -113,13 +116,10 @@ Status plan_and_replay(Image& guide, bool all_channels, const TileOptions& optio
   const int w = guide.width, h = guide.height;
   out.scale = plan_scale(w, h, kPlanMaxSide);
   Image reduced;
-  if (out.scale > 1.0) {
-    const int rw = std::max(kPlanMinSide, static_cast<int>(std::lround(w / out.scale)));
-    const int rh = std::max(kPlanMinSide, static_cast<int>(std::lround(h / out.scale)));
-    TAILOR_RETURN_IF_ERROR(resize_image(guide, std::min(rw, w), std::min(rh, h), reduced));
-  } else {
+  if (out.scale > 1.0)
+    TAILOR_RETURN_IF_ERROR(plan_copy(guide, out.scale, reduced));
+  else
     reduced = guide;
-  }
   std::vector<Image> plan_tiles;
   TilePlan plan;
   TAILOR_RETURN_IF_ERROR(internal::plan_tile_variants(reduced, options, count, all_channels, plan_tiles, &rep, &plan));
