@@ -425,7 +425,10 @@ Status compute_uv_metrics(const Mesh& mesh, const Topology& topology, std::span<
     if (patch_faces[p] > 0) ++metrics.patches;
     if (patch_faces[p] == 1) ++metrics.single_face_patches;
   }
-  if (!(sum_3d > 0)) return Status::error(ErrorCode::kInvalidMesh, "", "every face has zero 3D area");
+  if (!(sum_3d > 0))
+    return Status::error(ErrorCode::kInvalidMesh, "",
+                         "every face has zero 3D area or is a sliver thinner than 32-bit floats resolve at its "
+                         "coordinates");
   if (!(sum_uv > 0)) return Status::error(ErrorCode::kInvalidMesh, "", "every face has zero UV area");
   const double scale = sum_uv / sum_3d;  // R
   metrics.uv_scale = scale;
