@@ -298,16 +298,13 @@ Status load_mesh(const std::string& path, Mesh& mesh, LoadReport* report, const 
   TAILOR_RETURN_IF_ERROR(internal::view_file(path, file));
   const std::span<const char> bytes = file.bytes();
   MeshFormat format = mesh_format_from_path(path);
-  // A PLY or binary glTF header is unmistakable: such a file is read as what it holds, whatever
-  // its name says (a .ply saved as .obj would otherwise read as an OBJ without faces).
-  if (const MeshFormat held = sniff_format(bytes); held == MeshFormat::kPly || held == MeshFormat::kGlb) format = held;
-  if (format == MeshFormat::kUnknown) {
-    format = sniff_format(bytes);
-    if (format == MeshFormat::kUnknown) {
-      return Status::error(ErrorCode::kUnsupported, path,
-                           std::string("unknown mesh file extension and content (") + kSupported + ")");
-    }
-  }
+  // By content when the name says nothing; and a PLY or binary glTF header is unmistakable: such a
+  // file is read as what it holds, whatever its name (a .ply saved as .obj read as an OBJ without faces).
+  const MeshFormat held = sniff_format(bytes);
+  if (format == MeshFormat::kUnknown || held == MeshFormat::kPly || held == MeshFormat::kGlb) format = held;
+  if (format == MeshFormat::kUnknown)
+    return Status::error(ErrorCode::kUnsupported, path,
+                         std::string("unknown mesh file extension and content (") + kSupported + ")");
   LoadReport local;
   LoadReport& r = report ? *report : local;
   const std::filesystem::path folder = std::filesystem::path(path).parent_path();
