@@ -360,6 +360,36 @@ TEST(GltfScene, GltfWithDataUriAndBinFile) {
   fs::remove_all(dir);
 }
 
+TEST(GltfScene, OneBufferFileNamedManyTimesIsReadOnceAndCharged) {
+  // 600 buffers name one 64 KiB .bin (as "big.bin", "./big.bin" and a hard link): read once, it
+  // widens the budget once (64 x its size), so an 80 MB TEXCOORD_1 of zeros is over the budget.
+  // Read per entry, the budget grew by 64 x 600 x 64 KiB and the accessor was allocated.
+  Builder b = one_triangle({{{"mesh", 0}}}, {{{"nodes", {0}}}});
+  b.json["accessors"].push_back({{"componentType", 5126}, {"type", "VEC2"}, {"count", 10'000'000}});
+  b.json["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_1"] = b.json["accessors"].size() - 1;
+  b.bin.resize(64 << 10, '\0');
+  const std::string dir = test::empty_temp_dir("gltf_many_buffers");
+  std::ofstream(dir + "/big.bin", std::ios::binary) << b.bin;
+  fs::create_hard_link(dir + "/big.bin", dir + "/alias.bin");
+  Json j = Json::parse(b.gltf("big.bin"));
+  for (int k = 1; k < 600; ++k)
+    j["buffers"].push_back({{"byteLength", 100 + k},
+                            {"uri", k % 3 == 0   ? "big.bin"
+                                    : k % 3 == 1 ? "./big.bin"
+                                                 : "alias.bin"}});
+  std::ofstream(dir + "/many.gltf") << j.dump();
+  Mesh mesh;
+  const Status s = load_mesh(dir + "/many.gltf", mesh);
+  EXPECT_EQ(s.code(), ErrorCode::kLimit) << s.message();
+  EXPECT_NE(s.message().find("more decoded data than its size allows"), std::string::npos) << s.message();
+  // Without the bomb the same buffers load, each entry reading its own length of the shared bytes.
+  j["meshes"][0]["primitives"][0]["attributes"].erase("TEXCOORD_1");
+  std::ofstream(dir + "/many.gltf") << j.dump();
+  EXPECT_TRUE(load_mesh(dir + "/many.gltf", mesh).is_ok());
+  EXPECT_EQ(mesh.face_count(), 1u);
+  fs::remove_all(dir);
+}
+
 // The first bytes of a PNG claiming width x height (IHDR only: enough for its header).
 std::string png_header(uint32_t width, uint32_t height) {
   std::string png("\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR", 16);

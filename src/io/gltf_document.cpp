@@ -2,6 +2,7 @@
 #include "io/gltf_document.h"
 
 #include <meshoptimizer.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <climits>
@@ -230,7 +231,7 @@ Status GltfDocument::open(std::span<const char> data, const std::string& name, c
     if (version != asset->end() && version->is_string() && !version->get<std::string>().starts_with("2."))
       return unsupported("unsupported glTF version " + quote_input(version->get<std::string>()));
   }
-  // Output is bounded by a multiple of the input (external buffers added as they are read), so
+  // Output is bounded by a multiple of the input (each external buffer file added once, as it is read), so
   // repeated references to one large accessor or a meshopt stream of zeros cannot exhaust memory.
   budget_ = 64 * data.size() + (size_t{64} << 20);
   return load_buffers(bin);
@@ -266,6 +267,35 @@ std::string GltfDocument::image_file(uint64_t index) const {
   return (std::filesystem::path(base_dir_) / relative).string();
 }
 
+Status GltfDocument::external_buffer(const std::string& uri, const std::string& where, const std::string*& content) {
+  std::string relative;
+  if (!relative_file_uri(uri, relative))
+    return unsupported("buffer URI " + quote_input(uri) + " is not a file next to the .gltf", where);
+  if (base_dir_.empty())
+    return unsupported("external buffer " + quote_input(uri) + " needs the file's path (read from memory)", where);
+  const std::string path = (std::filesystem::path(base_dir_) / relative).string();
+  // The same file under any name (repeated, "./x.bin", a link) is read once and its bytes shared:
+  // a .gltf listing one large .bin a thousand times would otherwise hold a thousand copies.
+  struct stat st;
+  const bool known = ::stat(path.c_str(), &st) == 0;
+  if (known)
+    for (const ExternalFile& f : external_files_)
+      if (f.device == st.st_dev && f.inode == st.st_ino) {
+        content = &owned_[f.owned];
+        return Status::ok();
+      }
+  std::string& bytes = owned_.emplace_back();
+  if (Status s = read_file(path, bytes); !s)
+    return Status::error(s.code(), name_, "buffer " + quote_input(uri) + ": " + s.what(), where);
+  // The file is input as the .gltf is, so it widens the budget as the .gltf's own bytes do, once;
+  // its bytes, held in memory, are charged against it like any decoded data.
+  budget_ += 64 * bytes.size();
+  TAILOR_RETURN_IF_ERROR(charge(bytes.size(), where));
+  if (known) external_files_.push_back({st.st_dev, st.st_ino, owned_.size() - 1});
+  content = &bytes;
+  return Status::ok();
+}
+
 Status GltfDocument::load_buffers(std::span<const unsigned char> bin) {
   const auto buffers = json_.find("buffers");
   if (buffers == json_.end()) return Status::ok();
@@ -289,25 +319,20 @@ Status GltfDocument::load_buffers(std::span<const unsigned char> bin) {
     }
     if (!uri_it->is_string()) return parse_error("buffer uri is not a string", where);
     const std::string& uri = uri_it->get_ref<const std::string&>();
-    owned_.emplace_back();
-    std::string& content = owned_.back();
+    const std::string* held = nullptr;
     if (uri.starts_with("data:")) {
+      std::string& content = owned_.emplace_back();
       const size_t comma = uri.find(',');
       if (comma == std::string::npos || comma < 12 || uri.compare(comma - 7, 7, ";base64") != 0)
         return unsupported("data URI is not base64", where);
       if (!decode_base64(std::string_view(uri).substr(comma + 1), content))
         return parse_error("data URI is not valid base64", where);
+      TAILOR_RETURN_IF_ERROR(charge(content.size(), where));
+      held = &content;
     } else {
-      std::string relative;
-      if (!relative_file_uri(uri, relative))
-        return unsupported("buffer URI " + quote_input(uri) + " is not a file next to the .gltf", where);
-      if (base_dir_.empty())
-        return unsupported("external buffer " + quote_input(uri) + " needs the file's path (read from memory)", where);
-      const std::string path = (std::filesystem::path(base_dir_) / relative).string();
-      if (Status s = read_file(path, content); !s)
-        return Status::error(s.code(), name_, "buffer " + quote_input(uri) + ": " + s.what(), where);
-      budget_ += 64 * content.size();
+      TAILOR_RETURN_IF_ERROR(external_buffer(uri, where, held));
     }
+    const std::string& content = *held;
     if (length > content.size())
       return parse_error(
           "buffer holds " + std::to_string(content.size()) + " bytes, byteLength says " + std::to_string(length),

@@ -80,6 +80,8 @@ class GltfDocument {
 
  private:
   Status load_buffers(std::span<const unsigned char> bin);
+  //! The bytes of the file a buffer's relative URI names (read once per distinct file), in owned_.
+  Status external_buffer(const std::string& uri, const std::string& where, const std::string*& content);
   Status decode_meshopt(uint64_t index, const Json& extension, std::span<const unsigned char>& bytes);
   template <class T>
   Status read_accessor(uint64_t index, std::vector<T>& out, AccessorInfo& info);
@@ -89,8 +91,13 @@ class GltfDocument {
   std::string base_dir_;
   bool binary_ = false;
   size_t budget_ = 0;
-  std::vector<std::span<const unsigned char>> buffers_;    // per buffer: its bytes (empty: no data)
-  std::vector<std::string> owned_;                         // buffers decoded from data: URIs or read from files
+  std::vector<std::span<const unsigned char>> buffers_;  // per buffer: its bytes (empty: no data)
+  std::vector<std::string> owned_;                       // buffers decoded from data: URIs or read from files
+  struct ExternalFile {
+    uint64_t device = 0, inode = 0;
+    size_t owned = 0;  // its bytes: owned_[owned]
+  };
+  std::vector<ExternalFile> external_files_;               // the files read so far, by identity
   std::vector<std::vector<unsigned char>> decoded_views_;  // per buffer view: its meshopt-decoded bytes
   std::vector<uint8_t> view_decoded_;                      // per buffer view: 1 once decoded
   ReadProgress* progress_ = nullptr;
