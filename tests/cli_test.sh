@@ -478,6 +478,62 @@ limited "$tailor" eval "$tmp/img/file.gltf" >"$tmp/img/eval.txt" 2>&1 &&
 rm "$tmp/img/tex.png"
 "$tailor" eval "$tmp/img/file.gltf" >"$tmp/img/eval.txt" 2>&1 &&
   grep -q "texture 512x512 px, default)" "$tmp/img/eval.txt" && ok || fail "eval file.gltf without its texture: $(cat "$tmp/img/eval.txt")"
+# --- a glTF's base colour image in render: a data: URI image is drawn; one that does not decode is
+# one warning and the checker (nothing at all with --texture or a view without it); a
+# KHR_texture_transform, not applied, is one warning in eval, render and map; a primitive without
+# the UVs the others have is named; tailor's own .glb mapped again does not warn of its nodes ---
+mkdir -p "$tmp/gl"
+python3 - "$tmp/a.glb" "$tmp/gl" <<'EOF'
+import base64, json, struct, sys
+data = open(sys.argv[1], "rb").read()
+length = struct.unpack_from("<I", data, 12)[0]
+doc = json.loads(data[20:20 + length])
+bin_chunk = data[20 + length + 8:]
+view = doc["bufferViews"][doc["images"][0]["bufferView"]]
+start = view.get("byteOffset", 0)
+png = bin_chunk[start:start + view["byteLength"]]
+open(sys.argv[2] + "/tex.png", "wb").write(png)
+
+
+def glb(doc, binary, name):
+    text = json.dumps(doc).encode()
+    text += b" " * (-len(text) % 4)
+    total = 12 + 8 + len(text) + 8 + len(binary)
+    out = struct.pack("<III", 0x46546C67, 2, total) + struct.pack("<II", len(text), 0x4E4F534A) + text
+    open(sys.argv[2] + "/" + name, "wb").write(out + struct.pack("<II", len(binary), 0x004E4942) + bytes(binary))
+
+
+def copy(doc):
+    return json.loads(json.dumps(doc))
+
+
+uri = copy(doc)
+uri["images"][0] = {"uri": "data:image/png;base64," + base64.b64encode(png).decode()}
+glb(uri, bin_chunk, "datauri.glb")
+bad = bytearray(bin_chunk)
+bad[start:start + 16] = b"not an image!!!!"
+glb(doc, bad, "notimage.glb")
+moved = copy(doc)
+moved["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"] = {
+    "KHR_texture_transform": {"scale": [4, 1]}}
+moved["extensionsUsed"] = moved.get("extensionsUsed", []) + ["KHR_texture_transform"]
+glb(moved, bin_chunk, "transform.glb")
+partial = copy(doc)  # the primitive twice, the first without TEXCOORD_0
+first = partial["meshes"][0]["primitives"][0]
+partial["meshes"][0]["primitives"].append(copy(first))
+del first["attributes"]["TEXCOORD_0"]
+glb(partial, bin_chunk, "partial.glb")
+EOF
+for args in "" "--no-material"; do
+  # shellcheck disable=SC2086 # no option, or one
+  "$tailor" render "$tmp/gl/notimage.glb" --size 160x120 $args -o "$tmp/gl/bad.png" >/dev/null 2>"$tmp/gl/err.txt" &&
+    [[ $(wc -l <"$tmp/gl/err.txt") -eq 1 && -s $tmp/gl/bad.png ]] &&
+    grep -qF "tailor: warning: cannot read the texture $tmp/gl/notimage.glb names (image 0: embedded texture cannot be decoded): showing a neutral checker" \
+      "$tmp/gl/err.txt" && ok || fail "render of an undecodable embedded image $args: $(cat "$tmp/gl/err.txt")"
+done
+"$tailor" render "$tmp/gl/notimage.glb" --size 160x120 --texture "$tmp/gl/tex.png" -o "$tmp/gl/t.png" 2>"$tmp/gl/err.txt" >/dev/null &&
+  "$tailor" render "$tmp/gl/notimage.glb" --size 160x120 --view patches -o "$tmp/gl/p.png" 2>>"$tmp/gl/err.txt" >/dev/null &&
+  [[ ! -s $tmp/gl/err.txt ]] && ok || fail "render --texture / --view patches of an undecodable image: $(cat "$tmp/gl/err.txt")"
 # 9. and 10. Only regular files are read: /dev/zero, a FIFO without a writer (it would block), a
 # directory are refused at once with one line, for every kind of input.
 mkfifo "$tmp/img/in.obj" "$tmp/img/in.png"

@@ -453,6 +453,58 @@ TEST(GltfScene, TextureSizeIsReadFromItsHeaderWhereverItIs) {
   fs::remove_all(dir);
 }
 
+// One textured triangle (TEXCOORD_0, material 0 with a base colour texture of image 0); the caller
+// gives the image.
+Builder textured_triangle() {
+  Builder b = one_triangle({{{"mesh", 0}}}, {{{"nodes", {0}}}});
+  const size_t uv = b.accessor(std::vector<float>{0, 0, 1, 0, 0, 1}, 5126, "VEC2", 3);
+  b.json["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = uv;
+  b.json["meshes"][0]["primitives"][0]["material"] = 0;
+  b.json["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}};
+  b.json["textures"] = {{{"source", 0}}};
+  return b;
+}
+
+// `bytes` as image 0 in a buffer view of `b`'s buffer.
+void embed_image(Builder& b, const std::string& bytes) {
+  while (b.bin.size() % 4) b.bin.push_back('\0');
+  b.json["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", b.bin.size()}, {"byteLength", bytes.size()}});
+  b.bin += bytes;
+  b.json["images"] = {{{"bufferView", b.json["bufferViews"].size() - 1}, {"mimeType", "image/png"}}};
+}
+
+TEST(GltfScene, BaseColourImageThatDoesNotDecodeLeavesTheMeshReadAndSaysWhy) {
+  const std::string png = test::read_all(std::string(TAILOR_SOURCE_DIR) + "/tests/data/textures/vistex-tile04-128.png");
+  std::string corrupt = png;  // a good header, broken pixel data
+  for (size_t i = 64; i < corrupt.size(); ++i) corrupt[i] = static_cast<char>(i * 7);
+  const std::string dir = test::empty_temp_dir("gltf_bad_image");
+  for (const std::string& bytes : {std::string("not an image at all"), corrupt}) {
+    Builder b = textured_triangle();
+    embed_image(b, bytes);
+    std::ofstream(dir + "/bad.glb", std::ios::binary) << b.glb();
+    Mesh mesh;
+    Image texture;
+    LoadReport report;
+    const Status s = read_glb_file(dir + "/bad.glb", mesh, &texture, &report);
+    ASSERT_TRUE(s.is_ok()) << s.message();
+    EXPECT_EQ(mesh.face_count(), 1u);
+    EXPECT_EQ(mesh.corner_uvs.size(), 6u);
+    EXPECT_TRUE(texture.empty());
+    EXPECT_EQ(report.texture_problem, "embedded texture cannot be decoded");
+    EXPECT_EQ(report.texture_named, "image 0");
+  }
+  // An image over the pixel limit is still refused: the limit is the caller's, with a flag to raise it.
+  Builder b = textured_triangle();
+  embed_image(b, png);
+  std::ofstream(dir + "/big.glb", std::ios::binary) << b.glb();
+  Mesh mesh;
+  Image texture;
+  ImageLoadOptions small;
+  small.max_pixels = 100;
+  EXPECT_EQ(read_glb_file(dir + "/big.glb", mesh, &texture, nullptr, small).code(), ErrorCode::kInvalidImage);
+  fs::remove_all(dir);
+}
+
 // === Files made by glTF-Transform =================================================================
 
 std::string gltf_transform() {

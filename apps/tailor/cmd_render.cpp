@@ -70,11 +70,15 @@ int run_render(const RenderArgs& args) {
   GltfMaterialMaps maps;  // a .glb's normal and occlusion maps, and its tangents
   LoadReport report;
   const MeshFormat format = mesh_format_from_path(args.input);
+  // The file's base colour image is decoded only where it is drawn (the texture view) or sized (the
+  // seams view) and --texture does not replace it.
+  const bool file_texture =
+      args.texture.empty() && (options.view == PreviewView::kTexture || options.view == PreviewView::kSeams);
   Status status = [&] {
     const ReadingInput reading(args.input);
     return format == MeshFormat::kGlb || format == MeshFormat::kGltf
-               ? read_glb_with_material(args.input, mesh, &texture, args.no_material ? nullptr : &maps, &report,
-                                        args.image_options)
+               ? read_glb_with_material(args.input, mesh, file_texture ? &texture : nullptr,
+                                        args.no_material ? nullptr : &maps, &report, args.image_options)
                : load_mesh(args.input, mesh, &report);
   }();
   if (!status) return report_error(status.with_file(args.input));
@@ -120,7 +124,10 @@ int run_render(const RenderArgs& args) {
                                       "run 'tailor map' first, or use --view patches"));
   }
   if (options.view == PreviewView::kTexture && texture.empty()) {
-    if (report.texture_path.empty() && !report.texture_named.empty())  // named, but its header unread
+    if (!report.texture_problem.empty())  // embedded, but its bytes do not decode
+      warn(args.quiet, "cannot read the texture " + args.input + " names (" + report.texture_named + ": " +
+                           report.texture_problem + "): showing a neutral checker");
+    else if (report.texture_path.empty() && !report.texture_named.empty())  // named, but its header unread
       warn(args.quiet, "cannot read the texture " + args.input + " names (" + report.texture_named +
                            "): showing a neutral checker");
     else if (report.texture_path.empty())

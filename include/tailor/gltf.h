@@ -45,10 +45,11 @@ namespace tailor {
 
 //! Reads `path` (.glb or .gltf) into `mesh` (finalized as load_mesh does) and, when `texture` is not null,
 //! decodes the base colour texture of the first textured material (PNG or JPEG) into it (left
-//! empty when there is none). report may be null. Fails with kIo, kParse (not a glb, bad chunk,
-//! bad accessor), kUnsupported (no triangle primitive, a required extension, a URI outside the folder),
-//! kInvalidMesh, kInvalidImage (texture present but undecodable, or larger than image_options
-//! allow: checked from its header before decoding). Cost: O(file size).
+//! empty when there is none, and when its bytes do not decode: the reason is then in
+//! LoadReport::texture_problem and the mesh is read). report may be null. Fails with kIo, kParse
+//! (not a glb, bad chunk, bad accessor), kUnsupported (no triangle primitive, a required extension,
+//! a URI outside the folder), kInvalidMesh, kInvalidImage (texture larger than image_options allow:
+//! checked from its header before decoding). Cost: O(file size).
 TAILOR_API Status read_glb_file(const std::string& path, Mesh& mesh, Image* texture, LoadReport* report = nullptr,
                                 const ImageLoadOptions& image_options = {});
 

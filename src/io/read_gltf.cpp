@@ -419,19 +419,25 @@ uint32_t material_symmetry(GltfDocument& doc, uint64_t material) {
   return symmetry == 4 ? 4 : 1;
 }
 
+// Decodes an embedded image. `undecodable` (may be null) tells a failure of the bytes themselves
+// (not an image, corrupt data) apart from an image over `options`' limits.
 Status decode_texture(std::span<const unsigned char> bytes, const std::string& name, const ImageLoadOptions& options,
-                      Image& image) {
+                      Image& image, bool* undecodable = nullptr) {
   image = Image{};
+  if (undecodable) *undecodable = false;
   if (bytes.size() > size_t{INT_MAX})
     return Status::error(ErrorCode::kInvalidImage, name, "embedded texture too large");
   const int length = static_cast<int>(bytes.size());
   int width = 0, height = 0, channels = 0;
-  if (!stbi_info_from_memory(bytes.data(), length, &width, &height, &channels))
+  const auto cannot_decode = [&] {
+    if (undecodable) *undecodable = true;
     return Status::error(ErrorCode::kInvalidImage, name, "embedded texture cannot be decoded");
+  };
+  if (!stbi_info_from_memory(bytes.data(), length, &width, &height, &channels)) return cannot_decode();
   if (Status s = internal::check_image_header(bytes, width, height, options, name); !s)
     return Status::error(ErrorCode::kInvalidImage, name, "embedded texture: " + s.what(), s.where());
   unsigned char* pixels = stbi_load_from_memory(bytes.data(), length, &width, &height, &channels, 0);
-  if (!pixels) return Status::error(ErrorCode::kInvalidImage, name, "embedded texture cannot be decoded");
+  if (!pixels) return cannot_decode();
   image.width = width;
   image.height = height;
   image.channels = channels;
@@ -898,8 +904,16 @@ Status read_gltf_with_texture(std::span<const char> data, const std::string& nam
       for (const auto& [bytes, image] : maps)
         if (s.is_ok() && !bytes.empty()) s = decode_texture(bytes, name, image_options, *image);
     }
-    if (s.is_ok() && texture && !texture_bytes.empty())
-      s = decode_texture(texture_bytes, name, image_options, *texture);
+    if (s.is_ok() && texture && !texture_bytes.empty()) {
+      // A base colour image that does not decode leaves the mesh good (its UVs are what eval
+      // measures and render draws a checker on): noted, not fatal. Over the limits stays an error.
+      bool undecodable = false;
+      s = decode_texture(texture_bytes, name, image_options, *texture, &undecodable);
+      if (undecodable) {
+        r.texture_problem = s.what();
+        s = Status::ok();
+      }
+    }
   } catch (const std::bad_alloc&) {
     s = Status::error(ErrorCode::kLimit, name, "not enough memory to load the mesh");
   } catch (...) {
