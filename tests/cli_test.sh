@@ -524,6 +524,10 @@ partial["meshes"][0]["primitives"].append(copy(first))
 del first["attributes"]["TEXCOORD_0"]
 glb(partial, bin_chunk, "partial.glb")
 EOF
+"$tailor" render "$tmp/gl/datauri.glb" --size 160x120 -o "$tmp/gl/uri.png" -q 2>"$tmp/gl/err.txt" &&
+  "$tailor" render "$tmp/gl/datauri.glb" --size 160x120 --texture "$tmp/gl/tex.png" -o "$tmp/gl/given.png" -q &&
+  [[ ! -s $tmp/gl/err.txt ]] && cmp -s "$tmp/gl/uri.png" "$tmp/gl/given.png" && ok ||
+  fail "render did not draw a data: URI image as that image given with --texture: $(cat "$tmp/gl/err.txt")"
 for args in "" "--no-material"; do
   # shellcheck disable=SC2086 # no option, or one
   "$tailor" render "$tmp/gl/notimage.glb" --size 160x120 $args -o "$tmp/gl/bad.png" >/dev/null 2>"$tmp/gl/err.txt" &&

@@ -473,6 +473,39 @@ void embed_image(Builder& b, const std::string& bytes) {
   b.json["images"] = {{{"bufferView", b.json["bufferViews"].size() - 1}, {"mimeType", "image/png"}}};
 }
 
+std::string data_uri(const std::string& bytes, const char* type) {
+  Builder holder;
+  holder.bin = bytes;
+  return std::string("data:") + type + ";base64," + holder.base64();
+}
+
+TEST(GltfScene, BaseColourImagesDecodeEmbeddedOrFromDataUris) {
+  const std::string png = test::read_all(std::string(TAILOR_SOURCE_DIR) + "/tests/data/textures/vistex-tile04-128.png");
+  const std::string dir = test::empty_temp_dir("gltf_image_uri");
+  const auto decoded = [](const std::string& file, LoadReport& report) {
+    Mesh mesh;
+    Image texture;
+    const Status s = read_glb_file(file, mesh, &texture, &report);
+    EXPECT_TRUE(s.is_ok()) << file << ": " << s.message();
+    return std::to_string(texture.width) + "x" + std::to_string(texture.height);
+  };
+  LoadReport report;
+  // A data: URI image in a .glb and in a .gltf.
+  Builder b = textured_triangle();
+  b.json["images"] = {{{"uri", data_uri(png, "image/png")}}};
+  std::ofstream(dir + "/uri.glb", std::ios::binary) << b.glb();
+  std::ofstream(dir + "/uri.gltf") << b.gltf();
+  EXPECT_EQ(decoded(dir + "/uri.glb", report), "128x128");
+  EXPECT_EQ(decoded(dir + "/uri.gltf", report), "128x128");
+  // A buffer view of a .gltf's data: URI buffer (the document's own bytes, gone after parsing).
+  Builder v = textured_triangle();
+  embed_image(v, png);
+  std::ofstream(dir + "/view.gltf") << v.gltf();
+  EXPECT_EQ(decoded(dir + "/view.gltf", report), "128x128");
+  EXPECT_EQ(report.texture_problem, "");
+  fs::remove_all(dir);
+}
+
 TEST(GltfScene, BaseColourImageThatDoesNotDecodeLeavesTheMeshReadAndSaysWhy) {
   const std::string png = test::read_all(std::string(TAILOR_SOURCE_DIR) + "/tests/data/textures/vistex-tile04-128.png");
   std::string corrupt = png;  // a good header, broken pixel data

@@ -21,15 +21,16 @@
 //
 // Safe for untrusted input: the only files opened are buffers named by a relative URI inside the
 // .gltf's folder (no scheme, no absolute path, no '..'; none at all from memory) and, by the same
-// rule, the base colour image's file for the first bytes of its header; images with a URI are never
-// decoded; every accessor is bounds-checked against its buffer view and buffer before it
-// is read, every index against the vertex count; all decoded output (accessors, meshopt and Draco
-// data, instances) is charged against a budget of 64 times the input's size plus 64 MiB before it
-// is allocated; images larger than kMaxImageSide a side or ImageLoadOptions{}.max_pixels in all
-// are rejected before decoding, and nothing throws (allocation failure -> kLimit). The texture's
-// size is read from its header into LoadReport::texture_width/height whether or not it is decoded, at
-// any size: from the buffer view, a data: URI, or the first bytes of a file next to the .gltf (the
-// buffers' rule: no scheme, no absolute path, no '..'), which is never decoded.
+// rule, the base colour image's file for the first bytes of its header; image files are never
+// decoded (an embedded or data: URI image is, when a texture is asked for); every accessor is
+// bounds-checked against its buffer view and buffer before it is read, every index against the
+// vertex count; all decoded output (accessors, meshopt and Draco data, instances) is charged
+// against a budget of 64 times the input's size plus 64 MiB before it is allocated; images larger
+// than kMaxImageSide a side or ImageLoadOptions{}.max_pixels in all are rejected before decoding,
+// and nothing throws (allocation failure -> kLimit). The texture's size is read from its header
+// into LoadReport::texture_width/height whether or not it is decoded, at any size: from the buffer
+// view, a data: URI, or the first bytes of a file next to the .gltf (the buffers' rule: no scheme,
+// no absolute path, no '..'), which is never decoded.
 #pragma once
 
 #include <span>

@@ -392,18 +392,31 @@ uint64_t texture_image(const GltfDocument& doc, uint64_t material, const char* k
   return source;
 }
 
-// The encoded image of a material's texture `key` (texture_image), if it is stored in a buffer
-// view (URIs are never decoded).
-void find_texture(GltfDocument& doc, uint64_t material, const char* key, std::span<const unsigned char>& bytes) {
-  bytes = {};
+// The encoded image of a material's texture `key` (texture_image), if it is stored in the file: in
+// a buffer view, or as a data: URI. Copied, since a .gltf's buffers go with the document. An image
+// file's URI is not followed here (its path is LoadReport::texture_path, which render loads).
+void find_texture(GltfDocument& doc, uint64_t material, const char* key, std::string& bytes) {
+  bytes.clear();
   const uint64_t source = texture_image(doc, material, key);
   if (source == UINT64_MAX) return;
   uint64_t view = 0, stride = 0;
   const Json* image = get_element(doc.json(), "images", source);
-  if (!image || !get_uint(*image, "bufferView", view)) return;
-  std::span<const unsigned char> view_bytes;
-  if (!doc.view_bytes(view, view_bytes, stride).is_ok()) return;
-  bytes = view_bytes;
+  if (!image) return;
+  if (get_uint(*image, "bufferView", view)) {
+    std::span<const unsigned char> view_bytes;
+    if (doc.view_bytes(view, view_bytes, stride).is_ok())
+      bytes.assign(reinterpret_cast<const char*>(view_bytes.data()), view_bytes.size());
+    return;
+  }
+  const auto uri = image->find("uri");
+  bool file = false;
+  if (uri != image->end() && uri->is_string() && uri->get_ref<const std::string&>().starts_with("data:") &&
+      !doc.image_uri_bytes(source, 0, bytes, file))
+    bytes.clear();
+}
+
+std::span<const unsigned char> as_bytes(const std::string& bytes) {
+  return {reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size()};
 }
 
 // 4 where a material's extras say its map is 4-fold ({"tailor": {"symmetry": 4}}, written by
@@ -663,14 +676,14 @@ void not_kept(const GltfDocument& doc, const std::vector<Instance>& instances, s
 
 // The encoded images of the first textured material's other maps (read_glb_with_material).
 struct MaterialBytes {
-  std::span<const unsigned char> normal, occlusion, metallic_roughness;
+  std::string normal, occlusion, metallic_roughness;
 };
 
 // Parses the file into mesh (not finalized); the base colour texture bytes go to `texture_bytes`,
 // the other maps of the same material to `material` (which also keeps TANGENT in the mesh's
 // corner attributes).
 Status parse_gltf(std::span<const char> data, const std::string& name, const std::string& base_dir, Mesh& mesh,
-                  LoadReport& report, std::span<const unsigned char>* texture_bytes, internal::ReadProgress* progress,
+                  LoadReport& report, std::string* texture_bytes, internal::ReadProgress* progress,
                   MaterialBytes* material = nullptr) {
   GltfDocument doc;
   TAILOR_RETURN_IF_ERROR(doc.open(data, name, base_dir));
@@ -818,7 +831,7 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
       if (report.texture_named.empty()) report.texture_named = "image " + std::to_string(first_image);
     }
     long width = 0, height = 0;
-    bool sized = !texture_bytes->empty() && internal::image_header_size(*texture_bytes, width, height, false);
+    bool sized = !texture_bytes->empty() && internal::image_header_size(as_bytes(*texture_bytes), width, height, false);
     if (!sized && texture_bytes->empty() && first_image != UINT64_MAX) {
       std::string head;
       bool file = false;
@@ -885,7 +898,7 @@ Status read_gltf_with_texture(std::span<const char> data, const std::string& nam
   r.file_bytes = data.size();
   Status s;
   try {
-    std::span<const unsigned char> texture_bytes;
+    std::string texture_bytes;
     MaterialBytes material_bytes;
     s = parse_gltf(data, name, base_dir, mesh, r, &texture_bytes, nullptr, material ? &material_bytes : nullptr);
     if (s.is_ok()) s = finalize_mesh(name, mesh, r);
@@ -897,18 +910,18 @@ Status read_gltf_with_texture(std::span<const char> data, const std::string& nam
         mesh.corner_attributes.erase(mesh.corner_attributes.begin() + static_cast<std::ptrdiff_t>(slot));
         break;
       }
-      const std::pair<std::span<const unsigned char>, Image*> maps[] = {
+      const std::pair<const std::string&, Image*> maps[] = {
           {material_bytes.normal, &material->normal},
           {material_bytes.occlusion, &material->occlusion},
           {material_bytes.metallic_roughness, &material->metallic_roughness}};
       for (const auto& [bytes, image] : maps)
-        if (s.is_ok() && !bytes.empty()) s = decode_texture(bytes, name, image_options, *image);
+        if (s.is_ok() && !bytes.empty()) s = decode_texture(as_bytes(bytes), name, image_options, *image);
     }
     if (s.is_ok() && texture && !texture_bytes.empty()) {
       // A base colour image that does not decode leaves the mesh good (its UVs are what eval
       // measures and render draws a checker on): noted, not fatal. Over the limits stays an error.
       bool undecodable = false;
-      s = decode_texture(texture_bytes, name, image_options, *texture, &undecodable);
+      s = decode_texture(as_bytes(texture_bytes), name, image_options, *texture, &undecodable);
       if (undecodable) {
         r.texture_problem = s.what();
         s = Status::ok();
