@@ -104,9 +104,11 @@ void copy_faces(const py::array& faces, size_t vertex_count, std::vector<uint32_
     raise_error("faces must be int32, int64, uint32 or uint64, got " + describe(faces));
 }
 
+// LoadReport's fields by their C++ names. Texts may quote the file (names, paths): not always UTF-8.
 py::dict load_report_dict(const LoadReport& r) {
   py::dict d;
-  d["format"] = r.format;
+  d["format"] = utf8_text(r.format);
+  d["file_bytes"] = r.file_bytes;
   d["source_faces"] = r.source_faces;
   d["polygons_triangulated"] = r.polygons_triangulated;
   d["concave_polygons"] = r.concave_polygons;
@@ -115,8 +117,20 @@ py::dict load_report_dict(const LoadReport& r) {
   d["zero_area_faces"] = r.zero_area_faces;
   d["unreferenced_vertices"] = r.unreferenced_vertices;
   d["welded_vertices"] = r.welded_vertices;
+  d["faces_collapsed_by_weld"] = r.faces_collapsed_by_weld;
   d["faces_without_uv"] = r.faces_without_uv;
   d["faces_turned"] = r.faces_turned;
+  d["mesh_instances"] = r.mesh_instances;
+  d["skipped_primitives"] = r.skipped_primitives;
+  d["not_kept"] = utf8_text(r.not_kept);
+  d["texture_width"] = r.texture_width;
+  d["texture_height"] = r.texture_height;
+  d["texture_file"] = r.texture_file;
+  d["texture_path"] = utf8_text(r.texture_path);
+  d["texture_named"] = utf8_text(r.texture_named);
+  d["texture_problem"] = utf8_text(r.texture_problem);
+  d["texture_symmetry"] = r.texture_symmetry;
+  d["load_seconds"] = r.load_seconds;
   return d;
 }
 
@@ -186,7 +200,8 @@ void bind_mesh(py::module_& m) {
           "the file it was loaded from ('' for arrays)")
       .def_property_readonly(
           "load_report", [](const PyMesh& mesh) { return load_report_dict(mesh.load); },
-          "what loading found and repaired: format, source_faces, degenerate_faces, duplicate_faces, ...")
+          "what loading found and repaired: tailor::LoadReport's fields by name (format, source_faces, "
+          "degenerate_faces, duplicate_faces, not_kept, skipped_primitives, mesh_instances, ...)")
       .def("__repr__", [](const PyMesh& mesh) {
         const std::string text = "<tailor.Mesh " + std::to_string(mesh.mesh.vertex_count()) + " vertices, " +
                                  std::to_string(mesh.mesh.face_count()) + " faces" +

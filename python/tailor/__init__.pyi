@@ -36,7 +36,12 @@ class Mesh:
     @property
     def source(self) -> str: ...
     @property
-    def load_report(self) -> dict: ...
+    def load_report(self) -> Dict[str, Any]:
+        """LoadReport's fields by name: format, file_bytes, source_faces, polygons_triangulated,
+        concave_polygons, degenerate_faces, duplicate_faces, zero_area_faces, unreferenced_vertices,
+        welded_vertices, faces_collapsed_by_weld, faces_without_uv, faces_turned,
+        mesh_instances, skipped_primitives, not_kept, texture_width, texture_height, texture_file,
+        texture_path, texture_named, texture_problem, texture_symmetry, load_seconds."""
 
 class Result:
     """What map() returns."""

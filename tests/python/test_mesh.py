@@ -1,13 +1,16 @@
 """tailor.load and tailor.Mesh: round trips, dtypes, views, and bad arrays as errors."""
+import base64
+import json
 import os
 import pickle
 import shutil
+import struct
 
 import numpy as np
 import pytest
 
 import tailor
-from conftest import DATA, SPOT, bumpy_grid
+from conftest import DATA, SPOT, bumpy_grid, run_cli
 
 
 def test_load_counts_match_the_manifest():
@@ -18,6 +21,34 @@ def test_load_counts_match_the_manifest():
     assert mesh.source == str(SPOT)
     assert mesh.load_report["format"] == "OBJ"
     assert mesh.corner_uvs is not None and mesh.corner_uvs.shape == (5856, 3, 2)  # spot.obj has vt
+
+
+def write_scene_gltf(path):
+    """A .gltf with a data: URI buffer: a triangle placed by a parent and a child node, a point
+    primitive beside it, and a TANGENT attribute (what a mapping does not keep)."""
+    data = struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0) + struct.pack("<12f", *[1, 0, 0, 1] * 3)
+    uri = "data:application/octet-stream;base64," + base64.b64encode(data).decode()
+    gltf = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+            "nodes": [{"children": [1], "translation": [5, 0, 0]}, {"mesh": 0, "scale": [1, 2, 1]}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TANGENT": 1}},
+                                       {"attributes": {"POSITION": 0}, "mode": 0}]}],
+            "buffers": [{"byteLength": len(data), "uri": uri}],
+            "bufferViews": [{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 48}],
+            "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"},
+                          {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC4"}]}
+    path.write_text(json.dumps(gltf))
+
+
+def test_load_report_has_what_the_command_warns_about(tmp_path, tailor_binary):
+    path = tmp_path / "scene.gltf"
+    write_scene_gltf(path)
+    report = tailor.load(path).load_report
+    assert report["mesh_instances"] == 1 and report["skipped_primitives"] == 1
+    assert "TANGENT" in report["not_kept"] and "node transforms" in report["not_kept"]
+    # The command's warning line quotes the same text.
+    code, _, err = run_cli(tailor_binary, "map", path, "-o", tmp_path / "out.glb")
+    assert code == 0, err
+    assert f"tailor: warning: {path}: not kept in the output: {report['not_kept']}\n" in err
 
 
 def test_arrays_round_trip_and_views_are_read_only():
