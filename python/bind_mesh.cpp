@@ -129,6 +129,7 @@ py::dict load_report_dict(const LoadReport& r) {
   d["texture_path"] = utf8_text(r.texture_path);
   d["texture_named"] = utf8_text(r.texture_named);
   d["texture_problem"] = utf8_text(r.texture_problem);
+  d["texture_transform"] = r.texture_transform;
   d["texture_symmetry"] = r.texture_symmetry;
   d["load_seconds"] = r.load_seconds;
   return d;

@@ -538,6 +538,14 @@ done
 "$tailor" render "$tmp/gl/notimage.glb" --size 160x120 --texture "$tmp/gl/tex.png" -o "$tmp/gl/t.png" 2>"$tmp/gl/err.txt" >/dev/null &&
   "$tailor" render "$tmp/gl/notimage.glb" --size 160x120 --view patches -o "$tmp/gl/p.png" 2>>"$tmp/gl/err.txt" >/dev/null &&
   [[ ! -s $tmp/gl/err.txt ]] && ok || fail "render --texture / --view patches of an undecodable image: $(cat "$tmp/gl/err.txt")"
+transform_warning="tailor: warning: $tmp/gl/transform.glb: the base colour texture's KHR_texture_transform (offset, rotation, scale) is not applied: its texture coordinates are used as stored"
+"$tailor" eval "$tmp/gl/transform.glb" >/dev/null 2>"$tmp/gl/eval.err" &&
+  "$tailor" render "$tmp/gl/transform.glb" --size 160x120 -o "$tmp/gl/tt.png" >/dev/null 2>"$tmp/gl/render.err" &&
+  "$tailor" map "$tmp/gl/transform.glb" -o "$tmp/gl/tt.glb" >/dev/null 2>"$tmp/gl/map.err" &&
+  [[ $(grep -cF "$transform_warning" "$tmp/gl/eval.err") -eq 1 && $(grep -cF "$transform_warning" "$tmp/gl/render.err") -eq 1 &&
+    $(grep -cF "$transform_warning" "$tmp/gl/map.err") -eq 1 ]] &&
+  ! "$tailor" eval "$tmp/a.glb" 2>&1 >/dev/null | grep -q "KHR_texture_transform" && ok ||
+  fail "KHR_texture_transform is not one warning in eval, render and map: $(cat "$tmp/gl/eval.err" "$tmp/gl/render.err" "$tmp/gl/map.err")"
 # 9. and 10. Only regular files are read: /dev/zero, a FIFO without a writer (it would block), a
 # directory are refused at once with one line, for every kind of input.
 mkfifo "$tmp/img/in.obj" "$tmp/img/in.png"

@@ -538,6 +538,19 @@ TEST(GltfScene, BaseColourImageThatDoesNotDecodeLeavesTheMeshReadAndSaysWhy) {
   fs::remove_all(dir);
 }
 
+TEST(GltfScene, TextureTransformOnTheBaseColourIsReported) {
+  Builder b = textured_triangle();
+  Mesh mesh;
+  LoadReport report;
+  ASSERT_TRUE(read(b.glb(), mesh, &report).is_ok());
+  EXPECT_FALSE(report.texture_transform);
+  b.json["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"] = {
+      {"KHR_texture_transform", {{"scale", {4, 1}}}}};
+  b.json["extensionsUsed"] = {"KHR_texture_transform"};
+  ASSERT_TRUE(read(b.glb(), mesh, &report).is_ok());
+  EXPECT_TRUE(report.texture_transform);
+}
+
 // === Files made by glTF-Transform =================================================================
 
 std::string gltf_transform() {

@@ -62,6 +62,13 @@ void warn(bool quiet, const std::string& text) {
   if (!quiet) std::fprintf(stderr, "tailor: warning: %s\n", text.c_str());
 }
 
+void warn_texture_transform(bool quiet, const std::string& input, bool transformed) {
+  if (transformed)
+    warn(quiet, input +
+                    ": the base colour texture's KHR_texture_transform (offset, rotation, scale) is not applied: "
+                    "its texture coordinates are used as stored");
+}
+
 Status usage_error(const std::string& what) { return Status::error(ErrorCode::kInvalidArgument, "", what); }
 
 std::string base_name(const std::string& path) {

@@ -43,6 +43,11 @@ class ReadingInput {
 //! Prints "tailor: warning: <text>" on stderr unless quiet.
 void warn(bool quiet, const std::string& text);
 
+//! Warns, unless quiet, when `transformed` (LoadReport::texture_transform): the glTF's base colour
+//! texture carries KHR_texture_transform, which eval, render and map do not apply. One sentence
+//! for the three.
+void warn_texture_transform(bool quiet, const std::string& input, bool transformed);
+
 //! A bad command line: reported by report_error with exit code 2.
 Status usage_error(const std::string& what);
 

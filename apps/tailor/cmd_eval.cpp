@@ -88,6 +88,8 @@ int run_eval(const EvalOptions& opt) {
                       "mesh has no texture coordinates to evaluate (OBJ vt on every corner, PLY s/t, or the glTF "
                       "TEXCOORD set its base colour texture reads)"));
 
+  warn_texture_transform(opt.quiet || opt.json, opt.input, report.texture_transform);
+
   int width = static_cast<int>(MetricsOptions{}.texture_width_px);
   int height = static_cast<int>(MetricsOptions{}.texture_height_px);
   const char* size_source = "default";

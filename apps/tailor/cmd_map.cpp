@@ -176,6 +176,7 @@ int run_map(const MapArgs& opt) {
   if (load.skipped_primitives)
     warn(opt.quiet, opt.input + ": skipped " + std::to_string(load.skipped_primitives) +
                         " point and line primitives (only triangles are mapped)");
+  warn_texture_transform(opt.quiet, opt.input, load.texture_transform);
   std::vector<uint8_t> seam_faces;
   if (!args.seam_faces.empty()) {
     if (Status s = load_seam_faces(args.seam_faces, mesh.face_count(), seam_faces); !s) return report_error(s);

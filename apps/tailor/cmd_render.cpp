@@ -123,6 +123,7 @@ int run_render(const RenderArgs& args) {
     return report_error(Status::error(ErrorCode::kInvalidMesh, args.input, "mesh has no texture coordinates",
                                       "run 'tailor map' first, or use --view patches"));
   }
+  if (options.view == PreviewView::kTexture) warn_texture_transform(args.quiet, args.input, report.texture_transform);
   if (options.view == PreviewView::kTexture && texture.empty()) {
     if (!report.texture_problem.empty())  // embedded, but its bytes do not decode
       warn(args.quiet, "cannot read the texture " + args.input + " names (" + report.texture_named + ": " +

@@ -103,12 +103,14 @@ struct LoadReport {
   std::string
       texture_named;  //!< the base colour texture the file names, even when its header could
                       //!< not be read (OBJ, PLY, a .gltf's image file: its path; else glTF: "image N"); empty: none
-  std::string texture_problem;    //!< glTF read with its texture (read_glb_file): why the embedded base colour
-                                  //!< image was not decoded (its bytes are not an image, or corrupt); the
-                                  //!< texture is then left empty. Empty: decoded, or none
-  uint32_t texture_symmetry = 1;  //!< 4 where the file says the map is 4-fold (written by tailor map
-                                  //!< --symmetry 4: ExportOptions::symmetry): glb: that texture's material
-                                  //!< (without a texture, the first primitive's); OBJ: its .mtl; else 1
+  std::string texture_problem;     //!< glTF read with its texture (read_glb_file): why the embedded base colour
+                                   //!< image was not decoded (its bytes are not an image, or corrupt); the
+                                   //!< texture is then left empty. Empty: decoded, or none
+  bool texture_transform = false;  //!< glTF: the base colour texture carries KHR_texture_transform, which is
+                                   //!< not applied (UVs are read, measured and drawn as stored)
+  uint32_t texture_symmetry = 1;   //!< 4 where the file says the map is 4-fold (written by tailor map
+                                   //!< --symmetry 4: ExportOptions::symmetry): glb: that texture's material
+                                   //!< (without a texture, the first primitive's); OBJ: its .mtl; else 1
   double load_seconds = 0.0;
 };
 

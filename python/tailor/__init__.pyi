@@ -41,7 +41,7 @@ class Mesh:
         concave_polygons, degenerate_faces, duplicate_faces, zero_area_faces, unreferenced_vertices,
         welded_vertices, faces_collapsed_by_weld, faces_without_uv, faces_turned,
         mesh_instances, skipped_primitives, not_kept, texture_width, texture_height, texture_file,
-        texture_path, texture_named, texture_problem, texture_symmetry, load_seconds."""
+        texture_path, texture_named, texture_problem, texture_transform, texture_symmetry, load_seconds."""
 
 class Result:
     """What map() returns."""

@@ -289,18 +289,32 @@ Status triangulate(const GltfDocument& doc, uint64_t mode, const std::vector<uin
   return Status::ok();
 }
 
+// A material's pbrMetallicRoughness.baseColorTexture object, or null.
+const Json* base_colour_texture(const Json& json, uint64_t material) {
+  const Json* m = get_element(json, "materials", material);
+  if (!m) return nullptr;
+  const auto pbr = m->find("pbrMetallicRoughness");
+  if (pbr == m->end() || !pbr->is_object()) return nullptr;
+  const auto base = pbr->find("baseColorTexture");
+  return base != pbr->end() && base->is_object() ? &*base : nullptr;
+}
+
 // The texture coordinate set a material's base colour texture reads (its "texCoord", 0 to 7): the
 // UVs a viewer draws the texture with, so the ones Mesh::corner_uvs holds (tailor map --uv-set N
 // writes N there). 0 without a material or texture.
 uint64_t base_colour_uv_set(const Json& json, uint64_t material) {
-  const Json* m = get_element(json, "materials", material);
-  if (!m || !m->is_object()) return 0;
-  const auto pbr = m->find("pbrMetallicRoughness");
-  if (pbr == m->end() || !pbr->is_object()) return 0;
-  const auto base = pbr->find("baseColorTexture");
+  const Json* base = base_colour_texture(json, material);
   uint64_t set = 0;
-  if (base == pbr->end() || !base->is_object() || !get_uint(*base, "texCoord", set) || set > 7) return 0;
+  if (!base || !get_uint(*base, "texCoord", set) || set > 7) return 0;
   return set;
+}
+
+// True when material's base colour texture carries KHR_texture_transform: its offset, rotation
+// and scale are not applied (eval measures and render draws the UVs as stored).
+bool base_colour_transformed(const Json& json, uint64_t material) {
+  const Json* base = base_colour_texture(json, material);
+  const auto extensions = base ? base->find("extensions") : json.end();
+  return base && extensions != base->end() && extensions->is_object() && extensions->contains("KHR_texture_transform");
 }
 
 // Reads primitive `pi` of mesh `mi` (mode already known to be triangles, strip or fan).
@@ -786,6 +800,7 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
       ++triangle_primitives;
       with_uv += !p.uv.empty();
       report.source_faces += p.source_faces;
+      if (p.material != UINT64_MAX && base_colour_transformed(doc.json(), p.material)) report.texture_transform = true;
       // A 4-fold map's record is in its material: the textured one's, or without a texture the first.
       if (!symmetry_read && p.material != UINT64_MAX) {
         report.texture_symmetry = material_symmetry(doc, p.material);
