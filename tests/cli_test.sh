@@ -546,6 +546,10 @@ transform_warning="tailor: warning: $tmp/gl/transform.glb: the base colour textu
     $(grep -cF "$transform_warning" "$tmp/gl/map.err") -eq 1 ]] &&
   ! "$tailor" eval "$tmp/a.glb" 2>&1 >/dev/null | grep -q "KHR_texture_transform" && ok ||
   fail "KHR_texture_transform is not one warning in eval, render and map: $(cat "$tmp/gl/eval.err" "$tmp/gl/render.err" "$tmp/gl/map.err")"
+"$tailor" map "$mesh" -o "$tmp/gl/upz.glb" --up z --compress meshopt -q &&
+  "$tailor" map "$tmp/gl/upz.glb" -o "$tmp/gl/again.glb" 2>"$tmp/gl/again.err" >/dev/null &&
+  "$tailor" map "$tmp/a.glb" -o "$tmp/gl/again2.glb" 2>>"$tmp/gl/again.err" >/dev/null &&
+  ! grep -q "node transforms" "$tmp/gl/again.err" && ok || fail "re-mapping tailor's .glb warned of its nodes: $(cat "$tmp/gl/again.err")"
 # 9. and 10. Only regular files are read: /dev/zero, a FIFO without a writer (it would block), a
 # directory are refused at once with one line, for every kind of input.
 mkfifo "$tmp/img/in.obj" "$tmp/img/in.png"

@@ -644,6 +644,39 @@ void write_glb_with_json(const std::string& file, const Json& j, const std::stri
   std::ofstream(out, std::ios::binary) << header_bytes + text + bin_chunk;
 }
 
+TEST(GltfScene, TailorsOwnHierarchyIsNotReportedAsLost) {
+  // Two instances of a triangle, one moved: their transforms are lost (flattened) on a mapping.
+  Builder b = one_triangle({{{"mesh", 0}}, {{"mesh", 0}, {"translation", {3, 0, 0}}}}, {{{"nodes", {0, 1}}}});
+  Mesh mesh;
+  LoadReport report;
+  ASSERT_TRUE(read(b.glb(), mesh, &report).is_ok());
+  EXPECT_NE(report.not_kept.find("node transforms"), std::string::npos) << report.not_kept;
+  // tailor's output of it (a root node and one plain child per instance; the root turned by --up z
+  // and scaled by the quantization) read again: the layout tailor writes again, nothing lost.
+  const std::string dir = test::empty_temp_dir("gltf_own_layout");
+  const Atlas atlas = patterned_atlas(mesh.face_count(), 3, 16.f);
+  for (const MeshCompression method : {MeshCompression::kNone, MeshCompression::kQuantize, MeshCompression::kMeshopt}) {
+    for (const SceneUp up : {SceneUp::kY, SceneUp::kZ}) {
+      SCOPED_TRACE(std::string(mesh_compression_name(method)) + (up == SceneUp::kZ ? " up z" : ""));
+      ExportOptions options;
+      options.compression = method;
+      options.up = up;
+      ASSERT_TRUE(export_mesh(dir + "/out.glb", mesh, atlas, options).is_ok());
+      Mesh back;
+      LoadReport again;
+      ASSERT_TRUE(load_mesh(dir + "/out.glb", back, &again).is_ok());
+      EXPECT_EQ(again.not_kept.find("node transforms"), std::string::npos) << again.not_kept;
+      // The same file with a transform on a child is not tailor's layout.
+      Json j = glb_json_of(dir + "/out.glb");
+      j["nodes"][1]["translation"] = {0, 1, 0};
+      write_glb_with_json(dir + "/out.glb", j, dir + "/moved.glb");
+      ASSERT_TRUE(load_mesh(dir + "/moved.glb", back, &again).is_ok());
+      EXPECT_NE(again.not_kept.find("node transforms"), std::string::npos) << again.not_kept;
+    }
+  }
+  fs::remove_all(dir);
+}
+
 class GltfTransformTest : public ::testing::Test {
  protected:
   void SetUp() override {

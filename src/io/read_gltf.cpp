@@ -650,6 +650,45 @@ std::string kept_material(const Json& material, std::vector<std::string>& lost) 
   return out.dump(-1, ' ', false, Json::error_handler_t::replace);
 }
 
+// True when node `index` has no transform (or the identity), no children and no GPU instances.
+bool plain_leaf(const Json& json, const Json& index) {
+  const Json* node = index.is_number_unsigned() ? get_element(json, "nodes", index.get<uint64_t>()) : nullptr;
+  Matrix local;
+  return node && !node->contains("children") && !node->contains("extensions") && local_transform(*node, local) &&
+         local == kIdentity;
+}
+
+// True when the default scene is laid out as tailor writes it (src/export/glb_scene.cpp): one root
+// node whose transform is at most a translation, a uniform scale and the quarter turn of --up z,
+// and whose children are plain leaves (one per mesh instance). Re-mapped, such a file gets that
+// layout again (the root's transform baked into world space, or written anew by --up z and
+// --compress), so its hierarchy is not reported as lost.
+bool tailor_layout(const Json& json) {
+  uint64_t scene = 0;
+  get_uint(json, "scene", scene);
+  const Json* root_scene = get_element(json, "scenes", scene);
+  const auto roots = root_scene ? root_scene->find("nodes") : json.end();
+  if (!root_scene || roots == root_scene->end() || !roots->is_array() || roots->size() != 1) return false;
+  const Json& root_index = (*roots)[0];
+  const Json* root = root_index.is_number_unsigned() ? get_element(json, "nodes", root_index.get<uint64_t>()) : nullptr;
+  if (!root || root->contains("matrix") || root->contains("extensions")) return false;
+  double t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
+  bool present = false;
+  if (!get_numbers(*root, "translation", t, 3, present) || !get_numbers(*root, "rotation", q, 4, present) ||
+      !get_numbers(*root, "scale", s, 3, present) || !(s[0] > 0) || s[1] != s[0] || s[2] != s[0])
+    return false;
+  // The --up z rotation, -90 degrees about x, as write_glb writes it (%.9g).
+  constexpr double kTolerance = 1e-6, kHalfSqrt2 = 0.70710678118654752;
+  const bool identity = q[0] == 0 && q[1] == 0 && q[2] == 0 && q[3] == 1;
+  const bool up_z =
+      std::abs(q[0] + kHalfSqrt2) < kTolerance && q[1] == 0 && q[2] == 0 && std::abs(q[3] - kHalfSqrt2) < kTolerance;
+  if (!identity && !up_z) return false;
+  const auto children = root->find("children");
+  if (children == root->end()) return true;
+  if (!children->is_array() || root->contains("mesh")) return false;
+  return std::all_of(children->begin(), children->end(), [&](const Json& child) { return plain_leaf(json, child); });
+}
+
 // What the output cannot carry: material textures and extensions (see kept_material), extras of
 // other objects, attributes other than the kept ones, skins, animations, cameras; the node
 // hierarchy is written flat (one node per mesh instance, in world space).
@@ -684,7 +723,8 @@ void not_kept(const GltfDocument& doc, const std::vector<Instance>& instances, s
     if (non_empty(array)) lost.push_back(array);
   const bool moved =
       std::any_of(instances.begin(), instances.end(), [](const Instance& i) { return i.world != kIdentity; });
-  if (moved || any("nodes", [](const Json& n) { return n.is_object() && n.contains("children"); }))
+  if ((moved || any("nodes", [](const Json& n) { return n.is_object() && n.contains("children"); })) &&
+      !tailor_layout(json))
     lost.push_back("node transforms and hierarchy (one node per mesh instance, in world space)");
 }
 
