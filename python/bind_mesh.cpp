@@ -119,6 +119,7 @@ py::dict load_report_dict(const LoadReport& r) {
   d["welded_vertices"] = r.welded_vertices;
   d["faces_collapsed_by_weld"] = r.faces_collapsed_by_weld;
   d["faces_without_uv"] = r.faces_without_uv;
+  d["primitive_without_uv"] = utf8_text(r.primitive_without_uv);
   d["faces_turned"] = r.faces_turned;
   d["mesh_instances"] = r.mesh_instances;
   d["skipped_primitives"] = r.skipped_primitives;

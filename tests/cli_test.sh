@@ -546,6 +546,8 @@ transform_warning="tailor: warning: $tmp/gl/transform.glb: the base colour textu
     $(grep -cF "$transform_warning" "$tmp/gl/map.err") -eq 1 ]] &&
   ! "$tailor" eval "$tmp/a.glb" 2>&1 >/dev/null | grep -q "KHR_texture_transform" && ok ||
   fail "KHR_texture_transform is not one warning in eval, render and map: $(cat "$tmp/gl/eval.err" "$tmp/gl/render.err" "$tmp/gl/map.err")"
+expect_error 1 "partial.glb: [0-9]+ of [0-9]+ faces have no texture coordinates \(mesh 0 primitive 0 has none of the TEXCOORD set the others have\)" -- \
+  "$tailor" eval "$tmp/gl/partial.glb"
 "$tailor" map "$mesh" -o "$tmp/gl/upz.glb" --up z --compress meshopt -q &&
   "$tailor" map "$tmp/gl/upz.glb" -o "$tmp/gl/again.glb" 2>"$tmp/gl/again.err" >/dev/null &&
   "$tailor" map "$tmp/a.glb" -o "$tmp/gl/again2.glb" 2>>"$tmp/gl/again.err" >/dev/null &&

@@ -551,6 +551,25 @@ TEST(GltfScene, TextureTransformOnTheBaseColourIsReported) {
   EXPECT_TRUE(report.texture_transform);
 }
 
+TEST(GltfScene, APrimitiveWithoutTheUvsOthersHaveIsNamed) {
+  // Mesh 0 "rock": primitive 0 with TEXCOORD_0, primitive 1 (a second triangle) without.
+  Builder b = textured_triangle();
+  const size_t p = b.positions({2, 0, 0, 3, 0, 0, 2, 1, 0});
+  b.json["meshes"][0]["name"] = "rock";
+  b.json["meshes"][0]["primitives"].push_back({{"attributes", {{"POSITION", p}}}});
+  Mesh mesh;
+  LoadReport report;
+  ASSERT_TRUE(read(b.glb(), mesh, &report).is_ok());
+  EXPECT_TRUE(mesh.corner_uvs.empty()) << "all or nothing";
+  EXPECT_EQ(report.faces_without_uv, 1u);
+  EXPECT_EQ(report.primitive_without_uv, "mesh 0 'rock' primitive 1");
+  // None with UVs: nothing to name.
+  b.json["meshes"][0]["primitives"][0]["attributes"].erase("TEXCOORD_0");
+  ASSERT_TRUE(read(b.glb(), mesh, &report).is_ok());
+  EXPECT_EQ(report.faces_without_uv, 0u);
+  EXPECT_EQ(report.primitive_without_uv, "");
+}
+
 // === Files made by glTF-Transform =================================================================
 
 std::string gltf_transform() {

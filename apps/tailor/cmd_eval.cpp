@@ -77,11 +77,16 @@ int run_eval(const EvalOptions& opt) {
     return glb ? read_glb_file(opt.input, mesh, nullptr, &report) : load_mesh(opt.input, mesh, &report);
   }();
   if (!status) return report_error(status);
-  if (mesh.corner_uvs.empty() && report.faces_without_uv > 0)
-    return report_error(Status::error(
-        ErrorCode::kInvalidMesh, opt.input,
-        std::to_string(report.faces_without_uv) + " of " + std::to_string(report.source_faces) +
-            " faces have no texture coordinates (OBJ vt): a map must give every corner one to be evaluated"));
+  if (mesh.corner_uvs.empty() && report.faces_without_uv > 0) {
+    // glTF: UVs are all or nothing across the triangle primitives; name the first that lacks them.
+    const std::string which = report.primitive_without_uv.empty()
+                                  ? "OBJ vt"
+                                  : report.primitive_without_uv + " has none of the TEXCOORD set the others have";
+    return report_error(Status::error(ErrorCode::kInvalidMesh, opt.input,
+                                      std::to_string(report.faces_without_uv) + " of " +
+                                          std::to_string(report.source_faces) + " faces have no texture coordinates (" +
+                                          which + "): a map must give every corner one to be evaluated"));
+  }
   if (mesh.corner_uvs.empty())
     return report_error(
         Status::error(ErrorCode::kInvalidMesh, opt.input,

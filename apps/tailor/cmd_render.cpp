@@ -120,7 +120,9 @@ int run_render(const RenderArgs& args) {
   if (!maps.occlusion.empty()) material.occlusion = &maps.occlusion;
   material.corner_tangents = maps.corner_tangents;
   if (mesh.corner_uvs.empty() && options.view != PreviewView::kPatches) {
-    return report_error(Status::error(ErrorCode::kInvalidMesh, args.input, "mesh has no texture coordinates",
+    const std::string lacking =
+        report.primitive_without_uv.empty() ? "" : " (" + report.primitive_without_uv + " has none, others have)";
+    return report_error(Status::error(ErrorCode::kInvalidMesh, args.input, "mesh has no texture coordinates" + lacking,
                                       "run 'tailor map' first, or use --view patches"));
   }
   if (options.view == PreviewView::kTexture) warn_texture_transform(args.quiet, args.input, report.texture_transform);

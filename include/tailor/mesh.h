@@ -83,8 +83,11 @@ struct LoadReport {
   size_t faces_collapsed_by_weld = 0;  //!< glTF: faces whose corners were distinct vertices at one position, so
                                        //!< repeat a vertex once the split vertices are welded (counted in
                                        //!< degenerate_faces and dropped)
-  size_t faces_without_uv = 0;         //!< OBJ: faces without vt where other faces have them (then no face
-                                       //!< keeps its texture coordinates: corner_uvs is empty)
+  size_t faces_without_uv = 0;         //!< OBJ: faces without vt where other faces have them; glTF: faces of the
+                                       //!< triangle primitives without the TEXCOORD set others have (then no
+                                       //!< face keeps its texture coordinates: corner_uvs is empty)
+  std::string primitive_without_uv;    //!< glTF: the first of those primitives, e.g. "mesh 1 'rock' primitive 0"
+                                       //!< (the mesh's name when it has one); empty when none
   size_t faces_turned = 0;             //!< tailor map: faces wound against their neighbours, turned to run as
                                        //!< the surface around them (orient_faces_coherently)
   size_t mesh_instances = 0;           //!< glTF: meshes placed by the scene's nodes (world transforms applied)

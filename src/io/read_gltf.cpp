@@ -237,6 +237,7 @@ struct Primitive {
   std::vector<CornerAttribute> kept;  // NORMAL, COLOR_0 (as RGBA), TEXCOORD_n: #V by components
   size_t source_faces = 0;
   uint64_t material = UINT64_MAX;
+  size_t index = 0;  // in its mesh's primitives
 };
 
 // The vertex attributes kept beside POSITION and TEXCOORD_0 (what export can write back), and
@@ -758,7 +759,8 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
   const Json& meshes = meshes_it != doc.json().end() && meshes_it->is_array() ? *meshes_it : kNoMeshes;
   // Each mesh is decoded once, however many nodes use it.
   std::vector<std::optional<std::vector<Primitive>>> decoded(meshes.size());
-  size_t triangle_primitives = 0, with_uv = 0;
+  size_t triangle_primitives = 0, with_uv = 0, without_uv_faces = 0;
+  std::string without_uv;  // the first triangle primitive without UVs
   bool texture_found = false;
   uint64_t first_image = UINT64_MAX;  // the first base colour texture's image, embedded or not
   bool symmetry_read = false;         // report.texture_symmetry: of the first material, until a texture's
@@ -807,7 +809,7 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
         if (prim.contains("mode") && !get_uint(prim, "mode", mode)) return doc.parse_error("bad primitive mode", where);
         if (mode < kTriangles) continue;  // counted per instance below
         if (mode > kFan) return doc.parse_error("unknown primitive mode " + std::to_string(mode), where);
-        decoded[mi]->emplace_back();
+        decoded[mi]->emplace_back().index = pi;
         TAILOR_RETURN_IF_ERROR(read_primitive(doc, prim, mode, where, material != nullptr, decoded[mi]->back()));
       }
     }
@@ -839,6 +841,14 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
       append_kept(p, instance.world, base, first, mesh, incomplete);
       ++triangle_primitives;
       with_uv += !p.uv.empty();
+      if (p.uv.empty()) {
+        without_uv_faces += nf;
+        if (without_uv.empty()) {
+          const std::string mesh_name = name_of(&m);
+          without_uv = "mesh " + std::to_string(mi) + (mesh_name.empty() ? "" : " " + quote_input(mesh_name)) +
+                       " primitive " + std::to_string(p.index);
+        }
+      }
       report.source_faces += p.source_faces;
       if (p.material != UINT64_MAX && base_colour_transformed(doc.json(), p.material)) report.texture_transform = true;
       // A 4-fold map's record is in its material: the textured one's, or without a texture the first.
@@ -870,6 +880,10 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
                              : std::string("no triangle primitive in the scene"));
   // All or nothing: UVs are only meaningful when every primitive has them; the same for the rest.
   if (with_uv != triangle_primitives) mesh.corner_uvs.clear();
+  if (with_uv > 0 && with_uv != triangle_primitives) {  // some have them: say which lacks them
+    report.faces_without_uv = without_uv_faces;
+    report.primitive_without_uv = without_uv;
+  }
   for (size_t slot = mesh.corner_attributes.size(); slot-- > 0;) {
     if (!incomplete[slot]) continue;
     lost.push_back(mesh.corner_attributes[slot].name + " (not on every primitive)");

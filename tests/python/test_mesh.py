@@ -45,7 +45,7 @@ def test_load_report_has_what_the_command_warns_about(tmp_path, tailor_binary):
     report = tailor.load(path).load_report
     assert report["mesh_instances"] == 1 and report["skipped_primitives"] == 1
     assert "TANGENT" in report["not_kept"] and "node transforms" in report["not_kept"]
-    assert report["texture_transform"] is False
+    assert report["texture_transform"] is False and report["primitive_without_uv"] == ""
     # The command's warning line quotes the same text.
     code, _, err = run_cli(tailor_binary, "map", path, "-o", tmp_path / "out.glb")
     assert code == 0, err
