@@ -51,6 +51,9 @@ import tailor
 from . import tiles_stream
 
 MANIFEST = "tailor-tiles.json"
+# Seconds the driver waits, when it stops, for the cluster's start to end before it exits anyway (a
+# start takes a few seconds).
+CLIENT_CLOSE_WAIT = 10
 FORMAT = 1  # of the manifest: a different number means every tile is written again
 # The streamed partition's ranges of the file (at least a block each): enough for every worker of a
 # cluster to take several, so that the driver and the workers finish together.
@@ -496,14 +499,17 @@ def tileset_json(records, lod, up):
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
 
-def texture_image(path):
+def texture_image(path, notes):
     """(suffix, bytes, [width, height]) of an image every tile names by URI: decoded whole as tailor map
     reads a texture (a truncated or corrupt file is an error here, not in a client's viewer), and PNG
-    or JPEG, the images glTF allows, named by what its bytes are rather than by its file name."""
+    or JPEG, the images glTF allows, named by what its bytes are rather than by its file name. What
+    tailor map says of a texture that does not wrap goes to notes."""
     try:
-        width, height = tailor.image_size(path)
+        width, height, wrap = tailor._tailor._texture_look(path, os.fsdecode(path))
     except tailor.Error as e:
         raise TilesError(str(e)) from None
+    if wrap:
+        notes.append(wrap)
     data = pathlib.Path(path).read_bytes()
     if data.startswith(PNG_SIGNATURE):
         return ".png", data, [width, height]
@@ -518,7 +524,7 @@ def read_look(args):
     pixels, None without a texture) and colour (the colour map's path, for --field-following auto)."""
     look = {"images": {}, "orm_roles": [], "size": None, "colour": None, "notes": []}
     if args.texture:
-        suffix, data, look["size"] = texture_image(args.texture)
+        suffix, data, look["size"] = texture_image(args.texture, look["notes"])
         look["colour"] = args.texture
         look["images"]["color"] = ("texture" + suffix, data)
     elif args.material:
@@ -532,7 +538,7 @@ def read_look(args):
             )
         if m["color"]:
             look["colour"] = m["color"]
-            suffix, data, _ = texture_image(m["color"])
+            suffix, data, _ = texture_image(m["color"], look["notes"])
             look["images"]["color"] = ("material_color" + suffix, data)
         if m["normal_png"]:
             look["images"]["normal"] = ("material_normal.png", m["normal_png"])
@@ -629,8 +635,25 @@ class Progress:
 
 # What a folder of tiles holds: anything else in OUTDIR is not this tool's, and a run (which replaces
 # the folder) refuses to delete it.
-OWN_ENTRIES = {MANIFEST, "tileset.json", "tiles", "lod"}
-OWN_IMAGES = re.compile(r"(texture|material_color|material_normal|material_orm)\.[a-z]+")
+OWN_ENTRIES = {MANIFEST, "tileset.json"}
+OWN_IMAGES = re.compile(r"(texture|material_color|material_normal|material_orm)\.(png|jpg)")
+# The folders of tiles and of their simplified copies, and the names of the files in each.
+OWN_FOLDERS = {
+    "tiles": re.compile(r"\d+(_-?\d+){3}\.glb"),
+    "lod": re.compile(r"\d+(_-?\d+){3}\.bin"),
+}
+
+
+def foreign_entry(outdir):
+    """The first entry of outdir (a path relative to it) that a run does not write, or None."""
+    for entry in sorted(outdir.iterdir()):
+        if entry.name in OWN_FOLDERS and entry.is_dir() and not entry.is_symlink():
+            for inner in sorted(entry.iterdir()):
+                if not (OWN_FOLDERS[entry.name].fullmatch(inner.name) and inner.is_file() and not inner.is_symlink()):
+                    return "%s/%s" % (entry.name, inner.name)
+        elif not ((entry.name in OWN_ENTRIES or OWN_IMAGES.fullmatch(entry.name)) and entry.is_file()):
+            return entry.name
+    return None
 
 
 def previous_output(outdir, params):
@@ -644,12 +667,12 @@ def previous_output(outdir, params):
         if any(outdir.iterdir()):
             raise TilesError("%s exists and is not a folder of tiles written by tailor.tiles" % outdir)
         return {}
-    for entry in sorted(outdir.iterdir()):
-        if entry.name not in OWN_ENTRIES and not OWN_IMAGES.fullmatch(entry.name):
-            raise TilesError(
-                "%s holds %s, which is not part of its tileset (a run replaces the folder): move it, or write "
-                "the tiles elsewhere" % (outdir, entry.name)
-            )
+    foreign = foreign_entry(outdir)
+    if foreign is not None:
+        raise TilesError(
+            "%s holds %s, which is not part of its tileset (a run replaces the folder): move it, or write "
+            "the tiles elsewhere" % (outdir, foreign)
+        )
     try:
         old = json.loads(manifest.read_text())
     except ValueError:
@@ -806,7 +829,12 @@ class ClientStart:
         return self.client, self.cluster
 
     def close(self):
-        self.thread.join()
+        # Bounded: a start that cannot finish must not hold the driver's exit (the thread is a
+        # daemon). Ctrl-C reaches every process of the terminal's group: a worker it ends while still
+        # importing (before the plugin above) leaves the cluster's start waiting for it for minutes.
+        self.thread.join(CLIENT_CLOSE_WAIT)
+        if self.thread.is_alive():
+            return
         if self.client is not None:
             self.client.close()
         if self.cluster is not None:
@@ -848,9 +876,10 @@ def run(args):
     """The whole command (main() without its printing): the summary."""
     outdir = pathlib.Path(args.output).resolve()
     check_outdir(outdir, args.output)
-    source = pathlib.Path(args.input).resolve()
-    if source == outdir or outdir in source.parents:
-        raise TilesError("%s is inside %s, which a run replaces" % (args.input, args.output))
+    for given in (args.input, args.texture, args.material):
+        source = pathlib.Path(given).resolve() if given else None
+        if source is not None and (source == outdir or outdir in source.parents):
+            raise TilesError("%s is inside %s, which a run replaces" % (given, args.output))
     lock = lock_outdir(outdir, args.output)
     try:
         remove_stale(outdir)
@@ -893,13 +922,15 @@ def run_locked(args, outdir):
 
     tmp = outdir.parent / (".%s.tmp-%d" % (outdir.name, os.getpid()))
     shutil.rmtree(tmp, ignore_errors=True)
-    try:
-        (tmp / "tiles").mkdir(parents=True)
-    except OSError as e:
-        raise TilesError("%s: cannot write beside it in %s (%s)" % (args.output, outdir.parent, e.strerror)) from None
     in_process = args.workers == 0 and not args.scheduler
     start = None
-    try:
+    try:  # from the folder's creation on: a signal that comes as it is made still removes it
+        try:
+            (tmp / "tiles").mkdir(parents=True)
+        except OSError as e:
+            raise TilesError(
+                "%s: cannot write beside it in %s (%s)" % (args.output, outdir.parent, e.strerror)
+            ) from None
         if not in_process and not args.cut_only:
             start = ClientStart(args)  # while the driver cuts the mesh
         # The images every tile names, once beside tileset.json (the previous run's file linked
@@ -1188,8 +1219,8 @@ def parse_args(argv):
             usage_error("%s must be a positive number, got %s" % (name, value))
     if not (0.01 <= args.max_stretch <= 4):  # the library's range (MappingOptions::max_stretch)
         usage_error("--max-stretch must be in 0.01..4, got %s" % args.max_stretch)
-    if args.texture_size < 1:
-        usage_error("--texture-size must be at least 1, got %d" % args.texture_size)
+    if not 1 <= args.texture_size <= 65536:  # as tailor map and tailor eval take it
+        usage_error("--texture-size must be in 1..65536, got %d" % args.texture_size)
     if args.chunk_cell is not None and not -60 <= args.chunk_cell <= 60:  # the library's (ChunkOptions)
         usage_error("--chunk-cell must be a whole number in -60..60 (the cell side is 2^N world units), got %d"
                     % args.chunk_cell)

@@ -861,11 +861,23 @@ def test_one_run_at_a_time_writes_a_folder_and_nothing_but_its_tileset_is_replac
     assert code == 1 and "holds index.html, which is not part of its tileset" in stderr
     assert (out / "index.html").read_text() == "a viewer page"
     (out / "index.html").unlink()
-    # Nor is the input, when it lies in OUTDIR.
+    # Nor one inside its tiles' folders, nor an image by the name of the texture's in another format.
+    for foreign in ("tiles/notes.txt", "tiles/0_1_2_3.glb.bak", "texture.psd"):
+        (out / foreign).write_text("mine")
+        code, _, stderr = run_tiles(*common)
+        assert code == 1 and "holds %s, which is not part of its tileset" % foreign in stderr, stderr
+        assert (out / foreign).read_text() == "mine"
+        (out / foreign).unlink()
+    # Nor is the input, nor the texture, when it lies in OUTDIR.
     shutil.copy(HORSE, out / "scan.ply")
     code, _, stderr = run_tiles(out / "scan.ply", *common[1:])
     assert code == 1 and "scan.ply is inside" in stderr and (out / "scan.ply").is_file()
     (out / "scan.ply").unlink()
+    shutil.copy(TEXTURE, out / "texture.png")
+    code, _, stderr = run_tiles(*common, "--texture", out / "texture.png")
+    assert code == 1 and "texture.png is inside" in stderr, stderr
+    (out / "texture.png").unlink()
+    assert folder_bytes(out) == good
     # A manifest of the wrong shape keeps nothing: every tile is written again, the same bytes.
     manifest = json.loads((out / "tailor-tiles.json").read_text())
     manifest["tiles"] = {name: dict(r, faces="many") for name, r in manifest["tiles"].items()}
@@ -873,6 +885,32 @@ def test_one_run_at_a_time_writes_a_folder_and_nothing_but_its_tileset_is_replac
     code, stdout, stderr = run_tiles(*common[:-1], "--json")
     assert code == 0, stderr
     assert json.loads(stdout)["kept"] == 0 and folder_bytes(out) == good
+
+
+def test_a_texture_that_does_not_wrap_is_warned_of_as_tailor_map_does(tmp_path):
+    photo = DATA / "textures" / "water-caustics-300.jpg"
+    code, _, stderr = run_tiles(HORSE, "-o", tmp_path / "out", "--texture", photo, "--chunk-cell", CELL, "--workers",
+                                0, "--no-lod")
+    assert code == 0, stderr
+    expected = "tailor.tiles: warning: %s does not wrap (wrap ratio " % photo
+    assert stderr.count(expected) == 1 and "make it tileable with: tailor tile" in stderr, stderr
+
+
+def test_closing_does_not_wait_for_a_cluster_start_that_cannot_end(monkeypatch):
+    # Ctrl-C reaches the local cluster's worker processes too: one it ends while still importing
+    # leaves the cluster's start waiting for it for minutes. The driver leaves it behind.
+    import threading
+    import time
+
+    release = threading.Event()
+    monkeypatch.setattr(tiles, "start_client", lambda args: (release.wait(), None))
+    monkeypatch.setattr(tiles, "CLIENT_CLOSE_WAIT", 0.5)
+    start = tiles.ClientStart(None)
+    began = time.monotonic()
+    start.close()
+    assert time.monotonic() - began < 5 and start.thread.is_alive()
+    release.set()
+    start.thread.join()
 
 
 def test_a_terminated_run_cleans_up_like_an_interrupted_one(tmp_path):
