@@ -292,6 +292,9 @@ void bind_map(py::module_& m) {
         if (smooth > 1000) raise_error("--smooth: value " + std::to_string(smooth) + " not in range [0 - 1000]");
         options.orientation.smooth_passes = smooth;
         if (texture_size <= 0) raise_error("--texture-size must be positive");
+        if (texture_size > kMaxTextureSize)
+          raise_error("--texture-size must be at most 65536 (what tailor eval reads), got " +
+                      std::to_string(texture_size));
         if (Status s = check_map_options(options); !s) raise_status(s);
         // The texture sets the texture size, as --texture does; a material's colour map (else its
         // maps' size), as --material does.
@@ -456,6 +459,15 @@ void bind_map(py::module_& m) {
       "The size of an image file, decoded whole as tailor map reads a texture: tailor.Error when it\n"
       "cannot be (missing, truncated or corrupt, too large). For callers that name a texture\n"
       "without mapping with it (tailor.tiles).");
+  m.def(
+      "_texture_look",
+      [](const py::object& texture, const std::string& name) {
+        const Image image = read_image(texture);
+        return py::make_tuple(image.width, image.height, utf8_text(texture_wrap_warning(image, name)));
+      },
+      py::arg("texture"), py::arg("name"),
+      "_texture_look(texture, name) -> (width, height, warning): for tailor.tiles, image_size and what\n"
+      "tailor map says of a texture that does not wrap ('' when it does), naming it `name`, from one decoding.");
 }
 
 }  // namespace tailor::python

@@ -32,11 +32,14 @@ TAILOR_API std::string far_from_origin_warning(const Mesh& mesh);
 //! streamed file). Empty when either is not positive and finite.
 TAILOR_API std::string far_from_origin_warning(double largest_coordinate, double median_edge);
 
+//! The sentence about a texture whose wrap is a cut (a wrap ratio, eval-tile's measure, above
+//! kWrapRatioSeamless: every repeat shows it), starting with texture_name and naming the `tailor
+//! tile` command that fixes it; empty when it wraps or `texture` is empty. O(texture pixels).
+TAILOR_API std::string texture_wrap_warning(const Image& texture, const std::string& texture_name);
+
 //! The warnings of mapping `mesh` with `options` under `texture` (may be empty: not looked at),
 //! one sentence each, empty when there is nothing to say. Any mode: positions far from the origin
-//! (far_from_origin_warning); the texture does not wrap
-//! (a wrap ratio, eval-tile's measure, above kWrapRatioSeamless: every repeat shows a cut; the
-//! sentence names the `tailor tile` command that fixes it); the texture repeats less than once
+//! (far_from_origin_warning); the texture does not wrap (texture_wrap_warning); the texture repeats less than once
 //! across the mesh (map_repeats; part of it is never seen). With symmetry 4: the texture is not
 //! unchanged by a quarter turn (quarter_turn_difference over kQuarterTurnNoiseLevels), or turns
 //! into itself only about a point off its centre and corner (quarter-turn seams would show or jump

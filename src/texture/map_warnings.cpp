@@ -77,24 +77,29 @@ std::string far_from_origin_warning(double largest, double median) {
   return line;
 }
 
+std::string texture_wrap_warning(const Image& texture, const std::string& texture_name) {
+  // A texture whose wrap is a cut (eval-tile's wrap ratio above its target): every repeat shows it.
+  double wrap_x = 0.0, wrap_y = 0.0;
+  if (texture.empty() || !wrap_ratios(texture, wrap_x, wrap_y).is_ok() ||
+      (wrap_x <= kWrapRatioSeamless && wrap_y <= kWrapRatioSeamless))
+    return {};
+  const std::filesystem::path name = std::filesystem::path(texture_name).lexically_normal();
+  std::string tile = name.stem().string() + "_tile.png";
+  tile = name.has_parent_path() ? (name.parent_path() / tile).string() : tile;
+  char figures[160];
+  std::snprintf(figures, sizeof figures, " does not wrap (wrap ratio %.2f in x, %.2f in y; seamless is 0.8-1.2)",
+                wrap_x, wrap_y);
+  return texture_name + figures + ": every repeat shows a cut; make it tileable with: tailor tile " +
+         internal::shell_path(name.string()) + " -o " + internal::shell_path(tile);
+}
+
 std::vector<std::string> map_warnings(const Mesh& mesh, const MapTextureOptions& options, const Image& texture,
                                       const std::string& texture_name) {
   std::vector<std::string> warnings;
   if (std::string far = far_from_origin_warning(mesh); !far.empty()) warnings.push_back(std::move(far));
   const MappingOptions& mapping = options.mapping;
-  // A texture whose wrap is a cut (eval-tile's wrap ratio above its target): every repeat shows it.
-  double wrap_x = 0.0, wrap_y = 0.0;
-  if (!texture.empty() && wrap_ratios(texture, wrap_x, wrap_y).is_ok() &&
-      (wrap_x > kWrapRatioSeamless || wrap_y > kWrapRatioSeamless)) {
-    const std::filesystem::path name = std::filesystem::path(texture_name).lexically_normal();
-    std::string tile = name.stem().string() + "_tile.png";
-    tile = name.has_parent_path() ? (name.parent_path() / tile).string() : tile;
-    char figures[160];
-    std::snprintf(figures, sizeof figures, " does not wrap (wrap ratio %.2f in x, %.2f in y; seamless is 0.8-1.2)",
-                  wrap_x, wrap_y);
-    warnings.push_back(texture_name + figures + ": every repeat shows a cut; make it tileable with: tailor tile " +
-                       internal::shell_path(name.string()) + " -o " + internal::shell_path(tile));
-  }
+  if (std::string wrap = texture_wrap_warning(texture, texture_name); !wrap.empty())
+    warnings.push_back(std::move(wrap));
   // The texture repeats less than once across the mesh's longest side: part of the picture is
   // never seen, and with symmetry 4 quarter-turn seams land on the lattice less often.
   const double repeats = map_repeats(mesh, options);
