@@ -2,6 +2,7 @@
 #include <chrono>
 
 #include "bindings.h"
+#include "tailor/mapping.h"
 #include "tailor/metrics.h"
 #include "tailor/report.h"
 #include "tailor/topology.h"
@@ -32,7 +33,7 @@ void bind_eval(py::module_& m) {
         } catch (const py::cast_error&) {
           raise_error("texture_size must be an int or (width, height)");
         }
-        if (width < 1 || height < 1 || width > (1 << 16) || height > (1 << 16))
+        if (width < 1 || height < 1 || width > kMaxTextureSize || height > kMaxTextureSize)
           raise_error("texture_size must be between 1 and 65536, got " + std::to_string(width) + "x" +
                       std::to_string(height));
         if (symmetry != 1 && symmetry != 4) raise_error("symmetry must be 1 or 4, got " + std::to_string(symmetry));

@@ -175,7 +175,7 @@ void register_eval(CLI::App& app, Runner& run) {
          "file names, read from its header (a .glb or .gltf's base colour texture, embedded or a file next "
          "to it; an .obj's map_Kd in its .mtl; a .ply's comment TextureFile), else " +
              std::to_string(static_cast<int>(MetricsOptions{}.texture_width_px)))
-      ->check(CLI::Range(1, 1 << 16));
+      ->check(CLI::Range(1, kMaxTextureSize));
   add_symmetry_option(cmd, option_doc(kMetricsOptionDocs, "symmetry"), opt->symmetry);
   cmd->add_flag("--json", opt->json, "Print the full report as a JSON object");
   cmd->add_flag("-q,--quiet", opt->quiet, "Print nothing but the result and errors");

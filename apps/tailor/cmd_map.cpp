@@ -513,8 +513,7 @@ void register_map(CLI::App& app, Runner& run) {
       "of 'tailor tile --set --symmetry 4' are mapped with --symmetry 4 unless --symmetry says otherwise");
   cmd->add_option("--texture-size", opt->mapping_args.texture_size,
                   "Texture size in pixels when no --texture is given (at most 65536, as 'tailor eval' reads)")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 1 << 16));
+      ->capture_default_str();
   add_documented(cmd, option_doc(kImageLoadOptionDocs, "max_pixels"), opt->image_options.max_pixels)
       ->check(kAtLeastOne);
   add_documented(cmd, option_doc(kExportOptionDocs, "compression"), opt->compress);

@@ -282,6 +282,10 @@ TAILOR_API Status check_map_options(const MapTextureOptions& options);
 //! size is not positive or symmetry 4 meets a texture that is not square. O(1).
 TAILOR_API Status set_map_texture_size(MapTextureOptions& options, int texture_width, int texture_height);
 
+//! The largest texture size in pixels a user may give (--texture-size of map and eval): what the
+//! metrics measure in float pixels with sub-pixel gaps.
+inline constexpr int kMaxTextureSize = 65536;
+
 //! The name of a mode, "patches" or "thesis" (CLI --mode).
 TAILOR_API const char* mapping_mode_name(MappingMode mode);
 
