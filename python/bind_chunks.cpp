@@ -36,6 +36,7 @@ void bind_chunks(py::module_& m) {
                        float max_stretch, const py::object& texture_size, const py::object& crack_rings,
                        const py::object& chunk_split) {
              MapTextureOptions options;
+             if (threads > 64) raise_error("threads: value " + std::to_string(threads) + " not in range [0 - 64]");
              options.mapping.threads = threads;
              options.mapping.field_following = field_following;
              options.mapping.max_stretch = max_stretch;

@@ -33,6 +33,8 @@ def test_a_chunk_set_alone_matches_the_mesh_and_the_cli_density():
     assert np.array_equal(mapper.chunk(other)["corner_uvs"], before)
     with pytest.raises(tailor.Error, match="texels per unit"):
         tailor.ChunkedMapper(-4, 0.0)
+    with pytest.raises(tailor.Error, match="threads: value 1000000 not in range"):
+        tailor.ChunkedMapper(-4, 4096.0, threads=10**6)
 
 
 def test_cells_cut_into_parts_match_the_map_with_the_same_split():
