@@ -316,6 +316,9 @@ expect_error 2 "symmetry" -- "$tailor" eval "$tmp/a.glb" --symmetry 3
   ! cmp -s "$tmp/seams1.png" "$tmp/seams4.png" && cmp -s "$tmp/seams4.png" "$tmp/seams4d.png" &&
   ok || fail "render --symmetry 4 drew the seams as with 1, or a 4-fold map's .glb not as with 4"
 expect_error 2 "symmetry" -- "$tailor" render "$tmp/s4a.glb" --view seams --symmetry 2 -o "$tmp/seams2.png"
+expect_error 2 "symmetry 4 needs a square texture, got 64x48" -- "$tailor" render "$tmp/s4a.glb" --view seams \
+  --symmetry 4 --texture "$tmp/wide.png" -o "$tmp/seamsw.png"
+[[ ! -e $tmp/seamsw.png ]] && ok || fail "render --symmetry 4 with a non-square texture wrote its picture"
 # With --texture, the seams are drawn as visible under that texture: the map's own gravel (not
 # quarter-turn symmetric) as with 1, whatever the .glb's record; a 4-fold tile of its size as with 4.
 "$tailor" tile "$texture" -o "$tmp/gravel_q.png" --symmetry 4 --same-size -q --allow-misses &&
