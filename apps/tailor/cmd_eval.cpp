@@ -187,7 +187,8 @@ void register_eval(CLI::App& app, Runner& run) {
       "cut) and how far the others moved (thesis 2.6)");
   // The options of --stability's mappings: refused without it, where they would do nothing.
   const auto with_stability = [stability](CLI::Option* o) {
-    o->description("With --stability: " + o->get_description())->needs(stability);
+    const std::string prefix = "With --stability: ", text = o->get_description();
+    o->description(text.starts_with(prefix) ? text : prefix + text)->needs(stability);
   };
   with_stability(cmd->add_flag("--pin-frame", opt->stability_options.pin_frame,
                                "the thesis's experiment instead: both runs keep the full mesh's axis, "

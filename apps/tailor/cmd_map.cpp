@@ -53,7 +53,8 @@ struct MapArgs {
   MapTextureOptions options;
   MappingArgs mapping_args;  // the mapping options given as text (map_shared.h)
   bool stability = false;
-  bool keep_winding = false;  // --keep-winding: faces wound against their neighbours stay as they are
+  StabilityOptions stability_options;  // --pin-frame, --remove-fraction (with --stability)
+  bool keep_winding = false;           // --keep-winding: faces wound against their neighbours stay as they are
   bool quiet = false;
 };
 
@@ -332,7 +333,8 @@ int run_map(const MapArgs& opt) {
   if (opt.stability) {
     StabilityReport stability;
     const KeepScratch keep;
-    if (Status s = measure_stability(mesh, options, stability); !s) return report_error(s.with_file(opt.input));
+    if (Status s = measure_stability(mesh, options, stability, opt.stability_options); !s)
+      return report_error(s.with_file(opt.input));
     run.stability = stability;
   }
 
@@ -538,9 +540,17 @@ void register_map(CLI::App& app, Runner& run) {
   const MappingOptionHandles handles = add_mapping_options(group, opt->mapping_args, opt->options, true);
   tile_size->excludes(handles.scale);
   texels->excludes(handles.scale);
-  cmd->add_flag("--stability", opt->stability,
-                "Also map the mesh again in another file order, and with ~10% of its faces removed (fresh runs, "
-                "as tailor eval --stability), and report how many UVs kept their bits and how far the others moved");
+  auto* stability = cmd->add_flag(
+      "--stability", opt->stability,
+      "Also map the mesh again in another file order, and with ~10% of its faces removed (fresh runs, "
+      "as tailor eval --stability), and report how many UVs kept their bits and how far the others moved");
+  cmd->add_flag("--pin-frame", opt->stability_options.pin_frame,
+                "With --stability: the thesis's experiment instead: both runs keep the full mesh's axis, "
+                "normalisation and seed point (no reordered run)")
+      ->needs(stability);
+  add_documented(cmd, option_doc(kStabilityOptionDocs, "remove_fraction"), opt->stability_options.remove_fraction)
+      ->check(CLI::Range(0.01f, 0.9f))
+      ->needs(stability);
   cmd->add_option("--threads", mapping.threads,
                   "Threads: chunks (--chunks) are planned on them and mapped one per thread (0 = one per core); a "
                   "mesh mapped whole uses "
