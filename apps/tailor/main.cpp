@@ -19,7 +19,7 @@ namespace {
 int run_command(int argc, char** argv) {
   using namespace tailor::cli;
   CLI::App app{
-      "tailor: texture-map large triangle meshes at millions of faces per second,\n"
+      "tailor: texture-map large triangle meshes by homogeneous patch discovery, in parallel chunks,\n"
       "and make texture images self-tileable so the mapping needs no atlas."};
   app.name("tailor");
   app.require_subcommand(1);
