@@ -307,6 +307,10 @@ mkdir -p "$tmp/set_in" && cp tests/data/textures/vistex-sand05-128.png "$tmp/set
   "$tailor" map "$mesh" --material "$tmp/set4" --symmetry 1 -o "$tmp/m1.glb" 2>"$tmp/m1.txt" &&
   ! grep -q "quarter-turn tiles" "$tmp/m1.txt" && "$tailor" eval "$tmp/m1.glb" --json -q | grep -q '"symmetry": 1' &&
   ok || fail "a map of a 4-fold material set is not a 4-fold map by itself: $(cat "$tmp/m4.txt" "$tmp/m1.txt")"
+# -o with a trailing slash names the folder: the messages join its files with one slash.
+"$tailor" tile --set "$tmp/set_in/sand_color.png" "$tmp/set_in/sand_normal.png" -o "$tmp/set_slash/" --allow-misses \
+  >"$tmp/slash.txt" 2>&1 && [[ -s $tmp/set_slash/sand_color.png ]] && ! grep -q "set_slash//" "$tmp/slash.txt" &&
+  ok || fail "tile --set -o DIR/ doubled the slash: $(cat "$tmp/slash.txt")"
 sed 's/"symmetry": 4/"symmetry": 3/' "$tmp/set4/material.json" >"$tmp/set4/bad.json"
 expect_error 2 "bad.json: \"symmetry\" must be 1 or 4" -- "$tailor" map "$mesh" --material "$tmp/set4/bad.json" -o "$tmp/x.glb"
 [[ ! -e $tmp/x.glb ]] && ok || fail "map of a material with a bad symmetry record wrote its output"

@@ -264,7 +264,9 @@ int run_tile_set(TileCliOptions opt) {
   if (!opt.material.empty()) {
     if (Status s = read_material(opt); !s) return report_error(s);
   }
-  const std::string outdir = opt.output;
+  // Without its trailing slashes ("tiled/" names the folder "tiled"): the names below join one.
+  std::string outdir = opt.output;
+  while (outdir.size() > 1 && outdir.back() == '/') outdir.pop_back();
   struct stat st {};
   const bool existed = ::stat(outdir.c_str(), &st) == 0;
   if (existed && !S_ISDIR(st.st_mode))
