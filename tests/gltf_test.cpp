@@ -511,10 +511,13 @@ TEST(GltfScene, BaseColourImageThatDoesNotDecodeLeavesTheMeshReadAndSaysWhy) {
   std::string corrupt = png;  // a good header, broken pixel data
   for (size_t i = 64; i < corrupt.size(); ++i) corrupt[i] = static_cast<char>(i * 7);
   const std::string dir = test::empty_temp_dir("gltf_bad_image");
-  for (const std::string& bytes : {std::string("not an image at all"), corrupt}) {
+  const auto write_triangle_with = [](const std::string& image, const std::string& path) {
     Builder b = textured_triangle();
-    embed_image(b, bytes);
-    std::ofstream(dir + "/bad.glb", std::ios::binary) << b.glb();
+    embed_image(b, image);
+    std::ofstream(path, std::ios::binary) << b.glb();
+  };
+  for (const std::string& bytes : {std::string("not an image at all"), corrupt}) {
+    write_triangle_with(bytes, dir + "/bad.glb");
     Mesh mesh;
     Image texture;
     LoadReport report;
@@ -527,9 +530,7 @@ TEST(GltfScene, BaseColourImageThatDoesNotDecodeLeavesTheMeshReadAndSaysWhy) {
     EXPECT_EQ(report.texture_named, "image 0");
   }
   // An image over the pixel limit is still refused: the limit is the caller's, with a flag to raise it.
-  Builder b = textured_triangle();
-  embed_image(b, png);
-  std::ofstream(dir + "/big.glb", std::ios::binary) << b.glb();
+  write_triangle_with(png, dir + "/big.glb");
   Mesh mesh;
   Image texture;
   ImageLoadOptions small;
