@@ -297,6 +297,22 @@ void bind_map(py::module_& m) {
           raise_error("--texture-size must be at most 65536 (what tailor eval reads), got " +
                       std::to_string(texture_size));
         if (Status s = check_map_options(options); !s) raise_status(s);
+        // A keyword the mode does not read, away from its default, would be taken and do nothing.
+        const MappingOptions md;
+        const std::pair<bool, const char*> patches_only[] = {
+            {mapping.max_stretch != md.max_stretch, "--max-stretch"},
+            {!field_following_auto, "--field-following"},
+            {mapping.min_patch_faces != md.min_patch_faces, "--min-patch-faces"},
+            {mapping.hop_age != md.hop_age, "--hop-age"},
+            {!mapping.shorten_seams, "--no-seam-shortening"},
+            {!mapping.close_cracks, "--no-crack-closing"},
+            {!crack_rings.is_none(), "--crack-rings"},
+            {mapping.relax_iterations != md.relax_iterations, "--relax-iterations"}};
+        std::string_view given;
+        for (const auto& [differs, flag] : patches_only)
+          if (differs && given.empty()) given = flag;
+        if (Status s = check_mode_options(mapping.mode, given, mapping.threshold_px != md.threshold_px); !s)
+          raise_status(s);
         // The texture sets the texture size, as --texture does; a material's colour map (else its
         // maps' size), as --material does.
         int width = texture_size, height = texture_size;

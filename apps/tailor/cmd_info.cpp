@@ -61,6 +61,11 @@ int run_info(const InfoOptions& opt) {
     j["zero_area_faces"] = report.zero_area_faces;
     j["unreferenced_vertices"] = report.unreferenced_vertices;
     j["welded_vertices"] = report.welded_vertices;
+    if (report.mesh_instances) {  // a glTF scene: what `tailor map` warns of
+      j["mesh_instances"] = report.mesh_instances;
+      j["skipped_primitives"] = report.skipped_primitives;
+      j["not_kept"] = report.not_kept;
+    }
     j["has_uvs"] = !mesh.corner_uvs.empty();
     j["seam_faces_marked"] = !mesh.seam_faces.empty();
     j["bbox_min"] = {lo[0], lo[1], lo[2]};
@@ -88,6 +93,12 @@ int run_info(const InfoOptions& opt) {
   std::printf("  zero-area faces        %zu (kept)\n", report.zero_area_faces);
   std::printf("  unreferenced vertices  %zu (kept)\n", report.unreferenced_vertices);
   if (report.welded_vertices) std::printf("  welded corners         %zu\n", report.welded_vertices);
+  if (report.mesh_instances) {  // a glTF scene: what `tailor map` warns of
+    std::printf("  mesh instances         %zu (placed by the scene's nodes, in world space)\n", report.mesh_instances);
+    if (report.skipped_primitives)
+      std::printf("  skipped primitives     %zu (points and lines, not read)\n", report.skipped_primitives);
+    if (!report.not_kept.empty()) std::printf("  not kept in outputs    %s\n", report.not_kept.c_str());
+  }
   std::printf("  texture coordinates    %s\n", mesh.corner_uvs.empty() ? "no" : "yes");
   std::printf("  bounding box           [%g, %g, %g] - [%g, %g, %g]\n", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
   std::printf("  time                   load %.1f ms, topology %.1f ms\n", report.load_seconds * 1e3,

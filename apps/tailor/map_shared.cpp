@@ -123,12 +123,7 @@ Status apply_mapping_args(const MappingArgs& args, MapTextureOptions& options) {
   MappingOptions& mapping = options.mapping;
   if (!mapping_mode_from_name(args.mode, mapping.mode))
     return usage_error("--mode must be patches or thesis, got '" + args.mode + "'");
-  // An option the chosen mode does not read would be taken and do nothing.
-  if (mapping.mode == MappingMode::kThesis && !args.patches_only_given.empty())
-    return usage_error(args.patches_only_given +
-                       " has no effect with --mode thesis (one UV per vertex, placed by --threshold; no seam work)");
-  if (mapping.mode != MappingMode::kThesis && args.threshold_given)
-    return usage_error("--threshold is read by --mode thesis only (--mode patches bounds its faces by --max-stretch)");
+  if (Status s = check_mode_options(mapping.mode, args.patches_only_given, args.threshold_given); !s) return s;
   if (!args.seed_point.empty()) {
     if (!parse_vec3(args.seed_point, mapping.seed_point))
       return usage_error("--seed-point must be three numbers X,Y,Z, got '" + args.seed_point + "'");

@@ -276,6 +276,14 @@ TAILOR_API Status measure_texture_map(const Mesh& mesh, const Topology& topology
 //! in [0, 1]. Fails with kInvalidArgument. map_texture's own checks still apply. O(1).
 TAILOR_API Status check_map_options(const MapTextureOptions& options);
 
+//! Refuses an option the mode does not read, which would be taken and do nothing, by its flag
+//! (the Python module raises the same): `patches_only`, the first given of the options only the
+//! patches mode reads (--max-stretch, --field-following, --min-patch-faces, --hop-age,
+//! --no-seam-shortening, --no-crack-closing, --crack-rings, --relax-iterations; "" when none), with
+//! the thesis mode; `threshold_given` (--threshold, read by the thesis mode only) with the
+//! patches mode. Fails with kInvalidArgument. O(1).
+TAILOR_API Status check_mode_options(MappingMode mode, std::string_view patches_only, bool threshold_given);
+
 //! Sets what the texture's size and the thread count decide, as `tailor map` does: the lattice
 //! period of symmetry 4 (texture_period_px), the metrics' texture size and symmetry, and
 //! mapping.threads for the orientation and the metrics too. Fails with kInvalidArgument when a

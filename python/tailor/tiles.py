@@ -835,10 +835,11 @@ class ClientStart:
         self.thread.join(CLIENT_CLOSE_WAIT)
         if self.thread.is_alive():
             return
-        if self.client is not None:
-            self.client.close()
-        if self.cluster is not None:
-            self.cluster.close()
+        client, cluster, self.client, self.cluster = self.client, self.cluster, None, None  # closed once
+        if client is not None:
+            client.close()
+        if cluster is not None:
+            cluster.close()
 
 
 def worker_ready():
@@ -1057,6 +1058,11 @@ def run_locked(args, outdir):
                 record = fut.result()
                 records[record["name"]] = record
                 progress.step(record["written"])
+            # The cluster closed before the folder is finished: when a worker died, Dask computes
+            # again the results it held, and such a task, still running, would write into the folder
+            # after it is renamed into place (a stray temporary file in OUTDIR).
+            futures.clear()
+            start.close()
         records = sorted(records.values(), key=lambda r: (-r["level"], r["tile"][2], r["tile"][1], r["tile"][0]))
         shutil.rmtree(scratch, ignore_errors=True)
         # A worker process that died while writing a file (killed, out of memory) leaves that

@@ -1,6 +1,7 @@
 // The option checks and the texture-size settings `tailor map` applies before map_texture, shared
 // with the Python module so both refuse the same options with the same message.
 #include <string>
+#include <string_view>
 
 #include "tailor/mapping.h"
 
@@ -19,6 +20,15 @@ Status check_map_options(const MapTextureOptions& options) {
     return usage_error("--hop-age must be between 0 and 1 radians");
   if (options.chunks.split_above != 0 && options.chunks.split_above < 64)
     return usage_error("--chunk-split must be 0 (never cut) or at least 64 faces");
+  return Status::ok();
+}
+
+Status check_mode_options(MappingMode mode, std::string_view patches_only, bool threshold_given) {
+  if (mode == MappingMode::kThesis && !patches_only.empty())
+    return usage_error(std::string(patches_only) +
+                       " has no effect with --mode thesis (one UV per vertex, placed by --threshold; no seam work)");
+  if (mode != MappingMode::kThesis && threshold_given)
+    return usage_error("--threshold is read by --mode thesis only (--mode patches bounds its faces by --max-stretch)");
   return Status::ok();
 }
 

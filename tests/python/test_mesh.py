@@ -50,6 +50,14 @@ def test_load_report_has_what_the_command_warns_about(tmp_path, tailor_binary):
     code, _, err = run_cli(tailor_binary, "map", path, "-o", tmp_path / "out.glb")
     assert code == 0, err
     assert f"tailor: warning: {path}: not kept in the output: {report['not_kept']}\n" in err
+    # tailor info says the same of the file, before any map.
+    code, out, err = run_cli(tailor_binary, "info", path, "--json")
+    assert code == 0, err
+    info = json.loads(out)
+    assert (info["mesh_instances"], info["skipped_primitives"], info["not_kept"]) == (1, 1, report["not_kept"])
+    code, out, _ = run_cli(tailor_binary, "info", path)
+    assert "  skipped primitives     1 (points and lines, not read)\n" in out
+    assert "  not kept in outputs    %s\n" % report["not_kept"] in out
 
 
 def test_arrays_round_trip_and_views_are_read_only():
