@@ -298,20 +298,20 @@ void bind_map(py::module_& m) {
                       std::to_string(texture_size));
         if (Status s = check_map_options(options); !s) raise_status(s);
         // A keyword the mode does not read, away from its default, would be taken and do nothing.
-        const MappingOptions md;
+        const MappingOptions unset;
         const std::pair<bool, const char*> patches_only[] = {
-            {mapping.max_stretch != md.max_stretch, "--max-stretch"},
+            {mapping.max_stretch != unset.max_stretch, "--max-stretch"},
             {!field_following_auto, "--field-following"},
-            {mapping.min_patch_faces != md.min_patch_faces, "--min-patch-faces"},
-            {mapping.hop_age != md.hop_age, "--hop-age"},
+            {mapping.min_patch_faces != unset.min_patch_faces, "--min-patch-faces"},
+            {mapping.hop_age != unset.hop_age, "--hop-age"},
             {!mapping.shorten_seams, "--no-seam-shortening"},
             {!mapping.close_cracks, "--no-crack-closing"},
             {!crack_rings.is_none(), "--crack-rings"},
-            {mapping.relax_iterations != md.relax_iterations, "--relax-iterations"}};
+            {mapping.relax_iterations != unset.relax_iterations, "--relax-iterations"}};
         std::string_view given;
         for (const auto& [differs, flag] : patches_only)
           if (differs && given.empty()) given = flag;
-        if (Status s = check_mode_options(mapping.mode, given, mapping.threshold_px != md.threshold_px); !s)
+        if (Status s = check_mode_options(mapping.mode, given, mapping.threshold_px != unset.threshold_px); !s)
           raise_status(s);
         // The texture sets the texture size, as --texture does; a material's colour map (else its
         // maps' size), as --material does.
