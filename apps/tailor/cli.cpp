@@ -15,6 +15,8 @@
 #include <filesystem>
 #include <sstream>
 
+#include "tailor/stability.h"
+
 namespace tailor::cli {
 
 namespace {
@@ -70,6 +72,27 @@ void warn_texture_transform(bool quiet, const std::string& input, bool transform
 }
 
 Status usage_error(const std::string& what) { return Status::error(ErrorCode::kInvalidArgument, "", what); }
+
+Status check_quarter_turn_texture(uint32_t symmetry, int width, int height) {
+  if (symmetry != 4 || width == height) return Status::ok();
+  return usage_error("--symmetry 4 needs a square texture, got " + std::to_string(width) + "x" +
+                     std::to_string(height));
+}
+
+CLI::Option* with_stability(CLI::Option* option, CLI::Option* stability) {
+  const std::string prefix = "With --stability: ", text = option->get_description();
+  return option->description(text.starts_with(prefix) ? text : prefix + text)->needs(stability);
+}
+
+void add_stability_options(CLI::App* cmd, CLI::Option* stability, bool& pin_frame, float& remove_fraction) {
+  with_stability(cmd->add_flag("--pin-frame", pin_frame,
+                               "the thesis's experiment instead: both runs keep the full mesh's axis, "
+                               "normalisation and seed point (no reordered run)"),
+                 stability);
+  with_stability(add_documented(cmd, option_doc(kStabilityOptionDocs, "remove_fraction"), remove_fraction)
+                     ->check(CLI::Range(0.01f, 0.9f)),
+                 stability);
+}
 
 std::string base_name(const std::string& path) {
   const size_t slash = path.rfind('/');

@@ -51,6 +51,17 @@ void warn_texture_transform(bool quiet, const std::string& input, bool transform
 //! A bad command line: reported by report_error with exit code 2.
 Status usage_error(const std::string& what);
 
+//! Refuses symmetry 4 with a texture that is not square, as map's set_map_texture_size does: a
+//! quarter turn maps the lattice onto itself only when it is square (eval, render).
+Status check_quarter_turn_texture(uint32_t symmetry, int width, int height);
+
+//! `option` as one of --stability's: its help starts "With --stability: " and it is refused
+//! without `stability` (where it would do nothing).
+CLI::Option* with_stability(CLI::Option* option, CLI::Option* stability);
+
+//! --pin-frame and --remove-fraction (StabilityOptions), with_stability (tailor map, tailor eval).
+void add_stability_options(CLI::App* cmd, CLI::Option* stability, bool& pin_frame, float& remove_fraction);
+
 //! "dir/a.B.glb" -> "a.B.glb", "dir", "glb" (lower case, without the dot; "" when there is none).
 std::string base_name(const std::string& path);
 std::string dir_name(const std::string& path);

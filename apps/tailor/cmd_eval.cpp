@@ -113,10 +113,7 @@ int run_eval(const EvalOptions& opt) {
   // A 4-fold map says so in its .glb's material or its .obj's .mtl (tailor map --symmetry 4):
   // measured as the map was.
   const uint32_t symmetry = opt.symmetry_given ? opt.symmetry : report.texture_symmetry;
-  if (symmetry == 4 && width != height)
-    return report_error(Status::error(
-        ErrorCode::kInvalidArgument, "",
-        "--symmetry 4 needs a square texture, got " + std::to_string(width) + "x" + std::to_string(height)));
+  if (Status s = check_quarter_turn_texture(symmetry, width, height); !s) return report_error(s);
 
   // The figures of the file as `tailor map` reports them for the file it writes: UVs in repeats
   // scaled to pixels, vertices at identical positions joined, patches as the UVs join faces.
@@ -186,20 +183,12 @@ void register_eval(CLI::App& app, Runner& run) {
       "share of corners whose UVs keep their bits (all, and farther than the locality radius from the "
       "cut) and how far the others moved (thesis 2.6)");
   // The options of --stability's mappings: refused without it, where they would do nothing.
-  const auto with_stability = [stability](CLI::Option* o) {
-    const std::string prefix = "With --stability: ", text = o->get_description();
-    o->description(text.starts_with(prefix) ? text : prefix + text)->needs(stability);
-  };
-  with_stability(cmd->add_flag("--pin-frame", opt->stability_options.pin_frame,
-                               "the thesis's experiment instead: both runs keep the full mesh's axis, "
-                               "normalisation and seed point (no reordered run)"));
-  with_stability(add_documented(cmd, option_doc(kChunkOptionDocs, "mode"), opt->chunks));
-  with_stability(add_documented(cmd, option_doc(kChunkOptionDocs, "cell_exponent"), opt->chunk_cell));
+  add_stability_options(cmd, stability, opt->stability_options.pin_frame, opt->stability_options.remove_fraction);
+  with_stability(add_documented(cmd, option_doc(kChunkOptionDocs, "mode"), opt->chunks), stability);
+  with_stability(add_documented(cmd, option_doc(kChunkOptionDocs, "cell_exponent"), opt->chunk_cell), stability);
   with_stability(
-      cmd->add_option("--seed-point", opt->seed_point, std::string(option_doc(kMappingOptionDocs, "seed_point").help)));
-  with_stability(
-      add_documented(cmd, option_doc(kStabilityOptionDocs, "remove_fraction"), opt->stability_options.remove_fraction)
-          ->check(CLI::Range(0.01f, 0.9f)));
+      cmd->add_option("--seed-point", opt->seed_point, std::string(option_doc(kMappingOptionDocs, "seed_point").help)),
+      stability);
   cmd->add_option("--threads", opt->threads,
                   "Threads of the metrics (0 = one per 100k faces, up to the cores and 8) and, with --stability, of "
                   "the mappings (0 = one per core); the figures are the same for any count")

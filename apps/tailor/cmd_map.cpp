@@ -544,13 +544,7 @@ void register_map(CLI::App& app, Runner& run) {
       "--stability", opt->stability,
       "Also map the mesh again in another file order, and with ~10% of its faces removed (fresh runs, "
       "as tailor eval --stability), and report how many UVs kept their bits and how far the others moved");
-  cmd->add_flag("--pin-frame", opt->stability_options.pin_frame,
-                "With --stability: the thesis's experiment instead: both runs keep the full mesh's axis, "
-                "normalisation and seed point (no reordered run)")
-      ->needs(stability);
-  add_documented(cmd, option_doc(kStabilityOptionDocs, "remove_fraction"), opt->stability_options.remove_fraction)
-      ->check(CLI::Range(0.01f, 0.9f))
-      ->needs(stability);
+  add_stability_options(cmd, stability, opt->stability_options.pin_frame, opt->stability_options.remove_fraction);
   cmd->add_option("--threads", mapping.threads,
                   "Threads: chunks (--chunks) are planned on them and mapped one per thread (0 = one per core); a "
                   "mesh mapped whole uses "

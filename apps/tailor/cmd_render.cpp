@@ -137,12 +137,9 @@ int run_render(const RenderArgs& args) {
       warn(args.quiet, "no texture in " + args.input + " and no --texture: showing a neutral checker");
   }
 
-  // As tailor map and tailor eval: a quarter turn maps a lattice onto itself only when it is square.
-  if (options.view == PreviewView::kSeams && options.seam_symmetry == 4 && !texture.empty() &&
-      texture.width != texture.height)
-    return report_error(Status::error(ErrorCode::kInvalidArgument, "",
-                                      "--symmetry 4 needs a square texture, got " + std::to_string(texture.width) +
-                                          "x" + std::to_string(texture.height)));
+  if (options.view == PreviewView::kSeams && !texture.empty())
+    if (Status s = check_quarter_turn_texture(options.seam_symmetry, texture.width, texture.height); !s)
+      return report_error(s);
   Image picture;
   status = render_preview(mesh, mesh.corner_uvs, {}, texture.empty() ? nullptr : &texture, material, options, picture);
   if (!status) return report_error(status);

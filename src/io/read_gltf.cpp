@@ -906,8 +906,7 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
       bool file = false;
       for (const size_t max_bytes : {size_t{64} << 10, size_t{16} << 20}) {  // a JPEG's frame header may lie far in
         if (!doc.image_uri_bytes(first_image, max_bytes, head, file)) break;
-        sized = internal::image_header_size({reinterpret_cast<const unsigned char*>(head.data()), head.size()}, width,
-                                            height, false);
+        sized = internal::image_header_size(as_bytes(head), width, height, false);
         if (sized || head.size() < max_bytes) break;
       }
       report.texture_file = sized && file;
