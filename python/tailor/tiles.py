@@ -1309,7 +1309,7 @@ def main(argv=None):
 
 if __name__ == "__main__":
     # Run as the module tailor.tiles, not as __main__: cloudpickle sends a function of __main__ by
-    # value, with every function it calls, in each task (9 ms of this process's time per task);
+    # value, with every function it calls, in each task (milliseconds of this process's time each);
     # one of an importable module goes by name.
     from tailor import tiles as _tiles
 
