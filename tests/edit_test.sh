@@ -145,7 +145,7 @@ vr="$(curl -s "${url}api/status" | json_field version)"
   || fail "redo did not bring the 9 seam faces back"
 
 # A stroke and an option, then save and replay.
-answer="$(post edit '{"strokes": [{"points": [[-0.3, 0.2, 0.1], [0.0, 0.25, 0.1], [0.3, 0.2, 0.1]], "radius": 0.3}], "options": {"smooth_passes": 2}}')"
+answer="$(post edit '{"strokes": [{"points": [[-0.3, 0.2, 0.1], [0.0, 0.25, 0.1], [0.3, 0.2, 0.1]], "radius": 0.3}], "options": {"smooth_passes": 2, "axis": "1,0.37,0"}}')"
 [ "$(code)" = 200 ] || fail "a stroke edit answered $(code): $answer"
 answer="$(post save '{}')"
 [ "$(code)" = 200 ] || fail "save answered $(code): $answer"
@@ -153,6 +153,8 @@ for f in spot.glb spot_seam_faces.txt spot_strokes.json; do [ -s "$tmp/out/$f" ]
 [ "$(grep -cv '^#' "$tmp/out/spot_seam_faces.txt")" -eq 9 ] || fail "the saved seam faces are not the 9 marked ones"
 command="$(echo "$answer" | json_field command)"
 case "$command" in "tailor map "*" --seam-faces "*" --strokes "*" -o "*) ;; *) fail "unexpected replay command: $command" ;; esac
+case "$command" in *" --max-stretch 0.25 "*" --hop-age 0.02 "*" --axis 1,0.37,0 "*) ;;
+  *) fail "the replay command does not name the options as given (--max-stretch 0.25, --hop-age 0.02, --axis 1,0.37,0): $command" ;; esac
 replay="${command/#tailor /\'$tailor\' }"
 replay="${replay% -o *} -o '$tmp/replay.glb' -q"
 bash -c "$replay" || fail "the replay command failed: $replay"

@@ -2,7 +2,6 @@
 #include "edit_api.h"
 
 #include <bit>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -161,11 +160,7 @@ std::string stroke_list(const json& j, std::vector<OrientationStroke>& out) {
 }
 
 // A float as the shortest decimal that reads back to it (0.02f is 0.02, not 0.0199999995529...).
-json json_float(float x) {
-  char text[32];
-  const auto [end, error] = std::to_chars(text, text + sizeof text, x);
-  return error == std::errc() ? json(std::strtod(std::string(text, end).c_str(), nullptr)) : json(x);
-}
+json json_float(float x) { return json(std::strtod(float_text(x).c_str(), nullptr)); }
 
 json options_json(const MapTextureOptions& options) {
   const MappingOptions& m = options.mapping;
@@ -200,12 +195,6 @@ json strokes_array(const std::vector<OrientationStroke>& strokes) {
   return list;
 }
 
-std::string number(double x) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.9g", x);
-  return text;
-}
-
 Status read_file(const std::string& path, std::string& out) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return Status::error(ErrorCode::kIo, path, "cannot read the exported file");
@@ -226,12 +215,12 @@ std::string replay_command(const EditContext& c, const MapTextureOptions& option
       " --seam-faces " + internal::shell_path(c.seam_faces_path) + " --strokes " + internal::shell_path(c.strokes_path);
   // Every mapping option the mode reads, explicitly (--field-following as a number: auto was
   // resolved when chosen).
-  cmd += " --mode " + std::string(mapping_mode_name(m.mode)) + " --scale " + number(m.scale);
+  cmd += " --mode " + std::string(mapping_mode_name(m.mode)) + " --scale " + float_text(m.scale);
   if (m.mode == MappingMode::kThesis) {
-    cmd += " --threshold " + number(m.threshold_px);
+    cmd += " --threshold " + float_text(m.threshold_px);
   } else {
-    cmd += " --max-stretch " + number(m.max_stretch) + " --field-following " + number(m.field_following) +
-           " --min-patch-faces " + std::to_string(m.min_patch_faces) + " --hop-age " + number(m.hop_age) +
+    cmd += " --max-stretch " + float_text(m.max_stretch) + " --field-following " + float_text(m.field_following) +
+           " --min-patch-faces " + std::to_string(m.min_patch_faces) + " --hop-age " + float_text(m.hop_age) +
            " --crack-rings " + std::to_string(m.crack_rings) + " --relax-iterations " +
            std::to_string(m.relax_iterations);
     if (!m.shorten_seams) cmd += " --no-seam-shortening";
@@ -246,7 +235,8 @@ std::string replay_command(const EditContext& c, const MapTextureOptions& option
                                           : " --chunks auto";
   if (chunks.cell_exponent != kAutoCellExponent) cmd += " --chunk-cell " + std::to_string(chunks.cell_exponent);
   if (m.use_seed_point)
-    cmd += " --seed-point " + number(m.seed_point[0]) + "," + number(m.seed_point[1]) + "," + number(m.seed_point[2]);
+    cmd += " --seed-point " + float_text(m.seed_point[0]) + "," + float_text(m.seed_point[1]) + "," +
+           float_text(m.seed_point[2]);
   if (c.output.compression != MeshCompression::kNone)
     cmd += " --compress " + std::string(mesh_compression_name(c.output.compression));
   if (c.output.uv_set != 0) cmd += " --uv-set " + std::to_string(c.output.uv_set);

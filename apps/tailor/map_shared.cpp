@@ -3,6 +3,7 @@
 #include "map_shared.h"
 
 #include <array>
+#include <charconv>
 #include <cstdio>
 #include <cstdlib>
 
@@ -17,9 +18,13 @@ std::string axis_text(const OrientationOptions& o) {
   if (a == std::array<float, 3>{1, 0, 0}) return "x";
   if (a == std::array<float, 3>{0, 1, 0}) return "y";
   if (a == std::array<float, 3>{0, 0, 1}) return "z";
-  char text[64];
-  std::snprintf(text, sizeof text, "%.9g,%.9g,%.9g", a[0], a[1], a[2]);
-  return text;
+  return float_text(a[0]) + "," + float_text(a[1]) + "," + float_text(a[2]);
+}
+
+std::string float_text(float x) {
+  char text[32];
+  const auto [end, error] = std::to_chars(text, text + sizeof text, x);
+  return error == std::errc() ? std::string(text, end) : std::to_string(x);
 }
 
 Status parse_axis(const std::string& text, OrientationOptions& o) {

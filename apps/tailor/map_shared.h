@@ -23,6 +23,10 @@ namespace tailor::cli {
 //! --axis as the user writes it: pca, skeleton, x, y, z or X,Y,Z (the inverse of parse_axis).
 std::string axis_text(const OrientationOptions& o);
 
+//! The shortest text that reads back as the same float (0.02, not 0.0199999996): options echoed in
+//! commands and replies.
+std::string float_text(float x);
+
 //! Parses --axis (pca, skeleton, x, y, z or three numbers X,Y,Z; not auto, which the commands resolve
 //! by choose_orientation_axis). Fails with kInvalidArgument naming the text.
 Status parse_axis(const std::string& text, OrientationOptions& o);
