@@ -124,6 +124,7 @@ py::dict load_report_dict(const LoadReport& r) {
   d["mesh_instances"] = r.mesh_instances;
   d["skipped_primitives"] = r.skipped_primitives;
   d["not_kept"] = utf8_text(r.not_kept);
+  d["not_read"] = utf8_text(r.not_read);
   d["texture_width"] = r.texture_width;
   d["texture_height"] = r.texture_height;
   d["texture_file"] = r.texture_file;
@@ -203,7 +204,7 @@ void bind_mesh(py::module_& m) {
       .def_property_readonly(
           "load_report", [](const PyMesh& mesh) { return load_report_dict(mesh.load); },
           "what loading found and repaired: tailor::LoadReport's fields by name (format, source_faces, "
-          "degenerate_faces, duplicate_faces, not_kept, skipped_primitives, mesh_instances, ...)")
+          "degenerate_faces, duplicate_faces, not_kept, not_read, skipped_primitives, mesh_instances, ...)")
       .def("__repr__", [](const PyMesh& mesh) {
         const std::string text = "<tailor.Mesh " + std::to_string(mesh.mesh.vertex_count()) + " vertices, " +
                                  std::to_string(mesh.mesh.face_count()) + " faces" +

@@ -683,6 +683,14 @@ for key in ("visible_seam_ratio", "seam_length_ratio", "flipped"):
     assert mapped[key] == evaluated[key], (key, mapped[key], evaluated[key])
 PY
 
+# --- an OFF header that counts too few faces: map warns that the rest is not read, info shows it ---
+printf 'OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n3 1 3 2\n' >"$tmp/short.off"
+"$tailor" map "$tmp/short.off" -o "$tmp/short.glb" 2>"$tmp/short.err" >/dev/null &&
+  grep -qF "tailor: warning: $tmp/short.off: not read: 1 line after the 1 face the OFF header declares (from line 8)" \
+    "$tmp/short.err" && ok || fail "map read past an OFF's undeclared face without a word: $(cat "$tmp/short.err")"
+"$tailor" info "$tmp/short.off" | grep -qF "  not read               1 line after the 1 face the OFF header declares" &&
+  ok || fail "info does not name what the OFF reader read past"
+
 # --- eval joins a file's vertices at identical positions: a face that then repeats one is dropped, and it says so ---
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\nf 2 5 4\n' >"$tmp/dup.obj"
 "$tailor" map "$tmp/dup.obj" -o "$tmp/dup.glb" -q && "$tailor" eval "$tmp/dup.glb" 2>"$tmp/dup.err" >/dev/null &&

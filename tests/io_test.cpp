@@ -300,6 +300,28 @@ TEST(Ply, BinaryShuffledLayoutsAllListTypes) {
   }
 }
 
+TEST(Ply, RepeatedPropertyIsReported) {
+  // x given twice: the first is the coordinate, the second is named in the report.
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "property float x\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0 9\n1 0 0 9\n"
+      "0 1 0 9\n3 0 1 2\n";
+  Mesh m;
+  LoadReport r;
+  ASSERT_TRUE(parse(ply, MeshFormat::kPly, m, &r).is_ok());
+  EXPECT_EQ(m.positions, (std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}));
+  EXPECT_EQ(r.not_read, "PLY vertex property x (x before it is read in its place)");
+  // Two names for one value: u and s both name the texture's u; a lone name of half a pair is no uv.
+  const std::string alias =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "property float u\nproperty float v\nproperty float s\nproperty float nx\nproperty float nx\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0 0 0 9 1 1\n1 0 0 1 0 9 1 1\n"
+      "0 1 0 0 1 9 1 1\n3 0 1 2\n";
+  LoadReport a;
+  ASSERT_TRUE(parse(alias, MeshFormat::kPly, m, &a).is_ok());
+  EXPECT_EQ(a.not_read, "PLY vertex property s (u before it is read in its place); PLY vertex property nx");
+}
+
 TEST(Ply, TristripsWithRestartsAlternateWinding) {
   Mesh m;
   LoadReport r;
@@ -496,6 +518,21 @@ TEST(Off, KeywordVariantsColoursAndComments) {
   Mesh m;
   EXPECT_EQ(parse("4OFF\n1 1 0\n0 0 0 0\n", MeshFormat::kOff, m).code(), ErrorCode::kUnsupported);
   EXPECT_EQ(parse("OFF BINARY\n", MeshFormat::kOff, m).code(), ErrorCode::kUnsupported);
+}
+
+TEST(Off, ContentAfterTheDeclaredFacesIsReported) {
+  // A header that counts one face of two: the second is not read, and the report says so.
+  Mesh m;
+  LoadReport r;
+  ASSERT_TRUE(
+      parse("OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n3 1 3 2\n# end\n\n", MeshFormat::kOff, m, &r).is_ok());
+  EXPECT_EQ(m.face_count(), 1u);
+  EXPECT_EQ(r.not_read, "1 line after the 1 face the OFF header declares (from line 8)");
+  // Trailing blank lines and comments are nothing unread.
+  LoadReport clean;
+  ASSERT_TRUE(parse("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n\n# written by a tool\n\n", MeshFormat::kOff, m, &clean)
+                  .is_ok());
+  EXPECT_EQ(clean.not_read, "");
 }
 
 TEST(Stl, AsciiPolygonLoopsAndBinaryStartingWithSolid) {

@@ -61,6 +61,7 @@ int run_info(const InfoOptions& opt) {
     j["zero_area_faces"] = report.zero_area_faces;
     j["unreferenced_vertices"] = report.unreferenced_vertices;
     j["welded_vertices"] = report.welded_vertices;
+    if (!report.not_read.empty()) j["not_read"] = report.not_read;
     if (report.mesh_instances) {  // a glTF scene: what `tailor map` warns of
       j["mesh_instances"] = report.mesh_instances;
       j["skipped_primitives"] = report.skipped_primitives;
@@ -93,6 +94,7 @@ int run_info(const InfoOptions& opt) {
   std::printf("  zero-area faces        %zu (kept)\n", report.zero_area_faces);
   std::printf("  unreferenced vertices  %zu (kept)\n", report.unreferenced_vertices);
   if (report.welded_vertices) std::printf("  welded corners         %zu\n", report.welded_vertices);
+  if (!report.not_read.empty()) std::printf("  not read               %s\n", report.not_read.c_str());
   if (report.mesh_instances) {  // a glTF scene: what `tailor map` warns of
     std::printf("  mesh instances         %zu (placed by the scene's nodes, in world space)\n", report.mesh_instances);
     if (report.skipped_primitives)

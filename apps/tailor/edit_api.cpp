@@ -2,8 +2,10 @@
 #include "edit_api.h"
 
 #include <bit>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <iterator>

@@ -40,7 +40,7 @@ class Mesh:
         """LoadReport's fields by name: format, file_bytes, source_faces, polygons_triangulated,
         concave_polygons, degenerate_faces, duplicate_faces, zero_area_faces, unreferenced_vertices,
         welded_vertices, faces_collapsed_by_weld, faces_without_uv, primitive_without_uv, faces_turned,
-        mesh_instances, skipped_primitives, not_kept, texture_width, texture_height, texture_file,
+        mesh_instances, skipped_primitives, not_kept, not_read, texture_width, texture_height, texture_file,
         texture_path, texture_named, texture_problem, texture_transform, texture_symmetry, load_seconds."""
 
 class Result:

@@ -759,10 +759,12 @@ def start_client(args):
     from dask.distributed import Client, LocalCluster
 
     # For each task submitted, Dask's client reads the source of the first function on the stack
-    # outside its ignored modules (for its dashboard): run(), hundreds of lines tokenized per task,
-    # or the whole script. Leaving tailor and the script that runs it out, it finds none.
-    ignored = list(dask.config.get("distributed.diagnostics.computations.ignore-modules"))
-    ignored += [m for m in ("tailor", "__main__", "runpy") if m not in ignored]
+    # outside its ignored modules (for its dashboard): run_locked(), hundreds of lines tokenized per
+    # task, or the whole script. Leaving out tailor, the script that runs it and the partition's
+    # helper thread, it finds none. (Process-wide, as the settings below: a script that calls
+    # main() is left out of the dashboard's code view too.)
+    ignored = list(dask.config.get("distributed.diagnostics.computations.ignore-modules", []))
+    ignored += [m for m in (r"tailor(\.|$)", "__main__", "runpy", "threading") if m not in ignored]
     dask.config.set({"distributed.diagnostics.computations.ignore-modules": ignored})
     if args.scheduler:
         try:

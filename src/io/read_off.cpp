@@ -141,6 +141,19 @@ Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh,
     if (mesh.indices.size() / 3 > kMaxFaces) return Status::error(ErrorCode::kLimit, name, "too many faces", s.where());
     s.next_line();
   }
+  // What follows the faces the header declares is not read: a header that counts too few faces
+  // would lose the rest without a word.
+  s.skip_space();
+  if (!s.at_end()) {
+    const std::string from = s.where();
+    size_t lines = 0;
+    for (; !s.at_end(); s.skip_space()) {
+      ++lines;
+      s.next_line();
+    }
+    report.not_read = std::to_string(lines) + (lines == 1 ? " line" : " lines") + " after the " + std::to_string(nf) +
+                      (nf == 1 ? " face" : " faces") + " the OFF header declares (from " + from + ")";
+  }
   return Status::ok();
 }
 

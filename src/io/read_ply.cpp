@@ -258,10 +258,16 @@ Status parse_header(std::string_view data, const std::string& name, PlyHeader& h
 }
 
 // Assigns roles; fails when the vertex element lacks x, y, z or the face element lacks indices.
-Status assign_roles(PlyHeader& h, const std::string& name) {
+Status assign_roles(PlyHeader& h, const std::string& name, LoadReport& report) {
   bool have_vertex = false;
   for (PlyElement& e : h.elements) {
     std::array<bool, kRoles> seen{};
+    std::array<const PlyProperty*, kRoles> first{};  // per role: the property read for it
+    struct Repeat {
+      const PlyProperty *property, *first;
+      Role role;
+    };
+    std::vector<Repeat> repeats;  // properties of a role an earlier one has: not read
     for (PlyProperty& p : e.props) {
       const std::string& n = p.name;
       Role r = Role::kNone;
@@ -297,10 +303,13 @@ Status assign_roles(PlyHeader& h, const std::string& name) {
         if (p.is_list() && !seen[static_cast<size_t>(Role::kIndices)]) r = Role::kIndices;
       }
       if (r != Role::kNone) {
-        if (seen[static_cast<size_t>(r)])
-          r = Role::kNone;  // a repeated name: first one wins
-        else
+        if (seen[static_cast<size_t>(r)]) {
+          repeats.push_back({&p, first[static_cast<size_t>(r)], r});  // the first one wins
+          r = Role::kNone;
+        } else {
           seen[static_cast<size_t>(r)] = true;
+          first[static_cast<size_t>(r)] = &p;
+        }
       }
       p.role = r;
     }
@@ -324,6 +333,10 @@ Status assign_roles(PlyHeader& h, const std::string& name) {
         if (!normals && (p.role == Role::kNx || p.role == Role::kNy || p.role == Role::kNz)) p.role = Role::kNone;
         if (!colours && p.role >= Role::kRed) p.role = Role::kNone;
       }
+    }
+    for (const Repeat& r : repeats) {
+      report.not_read += (report.not_read.empty() ? "PLY " : "; PLY ") + e.name + " property " + r.property->name +
+                         (r.first->role == r.role ? " (" + r.first->name + " before it is read in its place)" : "");
     }
     if ((e.kind == ElementKind::kFace || e.kind == ElementKind::kTristrips) &&
         !seen[static_cast<size_t>(Role::kIndices)]) {
@@ -931,7 +944,7 @@ Status read_ply(std::span<const char> data, const std::string& name, Mesh& mesh,
   TAILOR_RETURN_IF_ERROR(parse_header(text, name, h));
   if (texture_file) *texture_file = h.texture_file;
   report.texture_symmetry = h.symmetry;
-  TAILOR_RETURN_IF_ERROR(assign_roles(h, name));
+  TAILOR_RETURN_IF_ERROR(assign_roles(h, name, report));
   const char* body = data.data() + h.body_offset;
   const char* end = data.data() + data.size();
   TAILOR_RETURN_IF_ERROR(check_counts(h, static_cast<size_t>(end - body), name));

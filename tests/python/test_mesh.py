@@ -60,6 +60,23 @@ def test_load_report_has_what_the_command_warns_about(tmp_path, tailor_binary):
     assert "  not kept in outputs    %s\n" % report["not_kept"] in out
 
 
+def test_load_report_names_what_the_reader_read_past(tmp_path, tailor_binary):
+    # An OFF header that counts one face of two: load_report, the map's warning and info agree.
+    path = tmp_path / "short.off"
+    path.write_text("OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n3 1 3 2\n")
+    mesh = tailor.load(path)
+    assert mesh.face_count == 1
+    said = "1 line after the 1 face the OFF header declares (from line 8)"
+    assert mesh.load_report["not_read"] == said
+    code, _, err = run_cli(tailor_binary, "map", path, "-o", tmp_path / "out.glb")
+    assert code == 0, err
+    assert f"tailor: warning: {path}: not read: {said}\n" in err
+    code, out, err = run_cli(tailor_binary, "info", path, "--json")
+    assert code == 0, err
+    assert json.loads(out)["not_read"] == said
+    assert tailor.load(SPOT).load_report["not_read"] == ""
+
+
 def test_arrays_round_trip_and_views_are_read_only():
     loaded = tailor.load(DATA / "meshes" / "fandisk.off")
     mesh = tailor.Mesh(loaded.positions, loaded.faces)
