@@ -322,6 +322,19 @@ TEST(Ply, RepeatedPropertyIsReported) {
   EXPECT_EQ(a.not_read, "PLY vertex property s (u before it is read in its place); PLY vertex property nx");
 }
 
+TEST(Ply, AsciiLinesAfterTheDeclaredElementsAreReported) {
+  // The header counts one face of two: the second is not read, and the report says where it starts.
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n"
+      "3 0 1 2\n3 1 3 2\n\n";
+  Mesh m;
+  LoadReport r;
+  ASSERT_TRUE(parse(ply, MeshFormat::kPly, m, &r).is_ok());
+  EXPECT_EQ(m.face_count(), 1u);
+  EXPECT_EQ(r.not_read, "1 line after the elements the PLY header declares (from line 15)");
+}
+
 TEST(Ply, TristripsWithRestartsAlternateWinding) {
   Mesh m;
   LoadReport r;

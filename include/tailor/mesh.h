@@ -94,9 +94,9 @@ struct LoadReport {
   size_t skipped_primitives = 0;       //!< glTF: point and line primitives of those instances, not read
   std::string not_kept;                //!< what the file has that the output will not (", "-separated), e.g.
                                        //!< "material textures, TANGENT"; empty when nothing is lost
-  std::string not_read;                //!< what the reader read past ("; "-separated): lines after the faces
-                                       //!< an OFF header declares, e.g. "3 lines after the 1 face the OFF
-                                       //!< header declares (from line 8)"; a PLY property of a role an
+  std::string not_read;                //!< what the reader read past ("; "-separated): lines after what an OFF
+                                       //!< or ascii PLY header declares, e.g. "3 lines after the 1 face the
+                                       //!< OFF header declares (from line 8)"; a PLY property of a role an
                                        //!< earlier one has, e.g. "PLY vertex property s (u before it is
                                        //!< read in its place)"; empty when none
   int texture_width = 0;               //!< the base colour texture's size, read from its header without decoding

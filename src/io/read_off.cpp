@@ -143,17 +143,10 @@ Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh,
   }
   // What follows the faces the header declares is not read: a header that counts too few faces
   // would lose the rest without a word.
-  s.skip_space();
-  if (!s.at_end()) {
-    const std::string from = s.where();
-    size_t lines = 0;
-    for (; !s.at_end(); s.skip_space()) {
-      ++lines;
-      s.next_line();
-    }
-    report.not_read = std::to_string(lines) + (lines == 1 ? " line" : " lines") + " after the " + std::to_string(nf) +
-                      (nf == 1 ? " face" : " faces") + " the OFF header declares (from " + from + ")";
-  }
+  if (const std::string rest =
+          lines_after(s, 0, std::to_string(nf) + (nf == 1 ? " face" : " faces") + " the OFF header declares");
+      !rest.empty())
+    add_not_read(report, rest);
   return Status::ok();
 }
 

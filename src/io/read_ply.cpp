@@ -335,8 +335,9 @@ Status assign_roles(PlyHeader& h, const std::string& name, LoadReport& report) {
       }
     }
     for (const Repeat& r : repeats) {
-      report.not_read += (report.not_read.empty() ? "PLY " : "; PLY ") + e.name + " property " + r.property->name +
-                         (r.first->role == r.role ? " (" + r.first->name + " before it is read in its place)" : "");
+      add_not_read(report,
+                   "PLY " + e.name + " property " + r.property->name +
+                       (r.first->role == r.role ? " (" + r.first->name + " before it is read in its place)" : ""));
     }
     if ((e.kind == ElementKind::kFace || e.kind == ElementKind::kTristrips) &&
         !seen[static_cast<size_t>(Role::kIndices)]) {
@@ -462,6 +463,8 @@ class AsciiSource {
     double d;
     return value(t, d);
   }
+  // After the last element: the lines left (a header that counts too few records).
+  std::string rest() { return lines_after(s_, first_line_, "elements the PLY header declares"); }
 
  private:
   static constexpr size_t kNoLine = SIZE_MAX;
@@ -505,6 +508,9 @@ class BodyReader {
       }
     }
     finish_uvs();
+    if constexpr (!Source::kBinary) {
+      if (const std::string rest = src_.rest(); !rest.empty()) add_not_read(report_, rest);
+    }
     return Status::ok();
   }
 

@@ -15,8 +15,30 @@
 #include "tailor/mesh.h"
 #include "tailor/progress.h"
 #include "tailor/status.h"
+#include "util/text_scan.h"
 
 namespace tailor::internal {
+
+// Adds one item to LoadReport::not_read ("; " between items).
+inline void add_not_read(LoadReport& report, const std::string& what) {
+  report.not_read += (report.not_read.empty() ? "" : "; ") + what;
+}
+
+// What a text reader leaves after the records its header declares (blank lines and, where the
+// scanner skips them, comments aside): "" or "N lines after the <declared> (from line L)", L
+// counted from line_offset + the scanner's line. Advances the scanner to the end.
+inline std::string lines_after(TextScanner& s, size_t line_offset, const std::string& declared) {
+  s.skip_space();
+  if (s.at_end()) return "";
+  const size_t from = s.line() + line_offset;
+  size_t lines = 0;
+  for (; !s.at_end(); s.skip_space()) {
+    ++lines;
+    s.next_line();
+  }
+  return std::to_string(lines) + (lines == 1 ? " line" : " lines") + " after the " + declared + " (from line " +
+         std::to_string(from) + ")";
+}
 
 //! `text` without the blanks (spaces, tabs, carriage returns) at either end: names on the rest of
 //! a header line (an .mtl's map_Kd, a PLY's TextureFile).
