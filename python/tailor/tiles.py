@@ -910,6 +910,8 @@ def run_locked(args, outdir):
             raise TilesError(str(e)) from None
     look = read_look(args)
     if not args.quiet:
+        if mesh is not None and mesh.load_report["not_read"]:  # as tailor map warns of the same file
+            print("tailor.tiles: warning: %s: not read: %s" % (args.input, mesh.load_report["not_read"]), file=sys.stderr)
         for note in look["notes"]:
             print("tailor.tiles: warning: %s" % note, file=sys.stderr)
     if mesh is not None:

@@ -1032,3 +1032,13 @@ def test_positions_far_from_the_origin_are_warned_of(tmp_path):
             assert code == 0, stderr
             found = "warning: positions reach 4e+06 units from the origin, where 32-bit floats are 0.25 apart" in stderr
             assert found == warned, (extra, stderr)
+
+
+def test_what_the_reader_read_past_is_warned_of(tmp_path):
+    # An OFF header that counts one face of two: tiles warns as tailor map does, and maps the one.
+    path = tmp_path / "short.off"
+    path.write_text("OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n3 1 3 2\n")
+    code, _, stderr = run_tiles(path, "-o", tmp_path / "out", "--workers", 0, "--no-lod", "--texture-size", 64)
+    assert code == 0, stderr
+    said = "1 line after the 1 face the OFF header declares (from line 8)"
+    assert f"tailor.tiles: warning: {path}: not read: {said}\n" in stderr, stderr
