@@ -685,9 +685,11 @@ PY
 
 # --- an OFF header that counts too few faces: map warns that the rest is not read, info shows it ---
 printf 'OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n3 1 3 2\n' >"$tmp/short.off"
-"$tailor" map "$tmp/short.off" -o "$tmp/short.glb" 2>"$tmp/short.err" >/dev/null &&
+"$tailor" map "$tmp/short.off" -o "$tmp/short.glb" --stats "$tmp/short.json" 2>"$tmp/short.err" >/dev/null &&
   grep -qF "tailor: warning: $tmp/short.off: not read: 1 line after the 1 face the OFF header declares (from line 8)" \
     "$tmp/short.err" && ok || fail "map read past an OFF's undeclared face without a word: $(cat "$tmp/short.err")"
+python3 -c 'import json, sys; sys.exit(json.load(open(sys.argv[1]))["mesh"]["not_read"] != sys.argv[2])' "$tmp/short.json" \
+  "1 line after the 1 face the OFF header declares (from line 8)" && ok || fail "the stats JSON does not keep what was not read"
 "$tailor" info "$tmp/short.off" | grep -qF "  not read               1 line after the 1 face the OFF header declares" &&
   ok || fail "info does not name what the OFF reader read past"
 

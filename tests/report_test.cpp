@@ -44,9 +44,17 @@ TEST(Report, MapJsonHoldsTheOptionsAndResults) {
   EXPECT_EQ(j["options"]["axis"], "pca");
   EXPECT_EQ(j["options"]["symmetry"], defaults.symmetry);
   EXPECT_EQ(j["mesh"]["faces"], 12);
+  EXPECT_EQ(j["mesh"]["not_read"], "");
   EXPECT_EQ(j["metrics"]["patches"], 2);
   EXPECT_DOUBLE_EQ(j["time_ms"]["mapping"].get<double>(), 2.0);
   EXPECT_EQ(j["previews"], nlohmann::json::array({"a.png"}));
+
+  // What the map warns of the input, the report keeps.
+  run.load.not_read = "1 line after the 1 face the OFF header declares (from line 8)";
+  run.load.not_kept = "TANGENT";
+  const nlohmann::json warned = nlohmann::json::parse(map_report_json(run));
+  EXPECT_EQ(warned["mesh"]["not_read"], run.load.not_read);
+  EXPECT_EQ(warned["mesh"]["not_kept"], "TANGENT");
 
   run.stability = StabilityReport{};
   run.stability->removed_faces = 3;

@@ -75,7 +75,9 @@ std::string map_report_json(const MapRun& run) {
                {"degenerate_faces_dropped", run.load.degenerate_faces},
                {"duplicate_faces_dropped", run.load.duplicate_faces},
                {"faces_turned", run.load.faces_turned},
-               {"unreferenced_vertices", run.load.unreferenced_vertices}};
+               {"unreferenced_vertices", run.load.unreferenced_vertices},
+               {"not_read", run.load.not_read},   // what the reader read past (the map's warning)
+               {"not_kept", run.load.not_kept}};  // what the output does not carry (the map's warning)
   j["mapping"] = {{"patches", stats.patches},
                   {"patches_before_absorb", stats.patches_before_absorb},
                   {"deferrals", stats.deferrals},
