@@ -292,10 +292,7 @@ void bind_map(py::module_& m) {
         set_chunk_split(chunk_split, options.chunks.split_above);
         if (smooth > 1000) raise_error("--smooth: value " + std::to_string(smooth) + " not in range [0 - 1000]");
         options.orientation.smooth_passes = smooth;
-        if (texture_size <= 0) raise_error("--texture-size must be positive");
-        if (texture_size > kMaxTextureSize)
-          raise_error("--texture-size must be at most 65536 (what tailor eval reads), got " +
-                      std::to_string(texture_size));
+        if (Status s = check_texture_size(texture_size); !s) raise_status(s);
         if (Status s = check_map_options(options); !s) raise_status(s);
         // A keyword the mode does not read, away from its default, would be taken and do nothing.
         const MappingOptions unset;

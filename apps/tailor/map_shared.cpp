@@ -133,10 +133,7 @@ Status apply_mapping_args(const MappingArgs& args, MapTextureOptions& options) {
       return usage_error("--seed-point must be three numbers X,Y,Z, got '" + args.seed_point + "'");
     mapping.use_seed_point = true;
   }
-  if (args.texture_size <= 0) return usage_error("--texture-size must be positive");
-  if (args.texture_size > kMaxTextureSize)
-    return usage_error("--texture-size must be at most 65536 (what tailor eval reads), got " +
-                       std::to_string(args.texture_size));
+  if (Status s = check_texture_size(args.texture_size); !s) return s;
   if (Status s = parse_chunk_args(args.chunks, args.chunk_cell, options.chunks); !s) return s;
   if (Status s = check_map_options(options); !s) return s;  // scale, hop age, symmetry
   if (!args.auto_field_following() && !parse_unit_float(args.field_following, mapping.field_following))

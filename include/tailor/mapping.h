@@ -294,6 +294,10 @@ TAILOR_API Status set_map_texture_size(MapTextureOptions& options, int texture_w
 //! metrics measure in float pixels with sub-pixel gaps.
 inline constexpr int kMaxTextureSize = 65536;
 
+//! Refuses a --texture-size (the square texture assumed without a texture) that is not positive or
+//! above kMaxTextureSize, as `tailor map` and the Python module do. Fails with kInvalidArgument. O(1).
+TAILOR_API Status check_texture_size(int texture_size);
+
 //! The name of a mode, "patches" or "thesis" (CLI --mode).
 TAILOR_API const char* mapping_mode_name(MappingMode mode);
 

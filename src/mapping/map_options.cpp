@@ -32,6 +32,14 @@ Status check_mode_options(MappingMode mode, std::string_view patches_only, bool 
   return Status::ok();
 }
 
+Status check_texture_size(int texture_size) {
+  if (texture_size <= 0) return usage_error("--texture-size must be positive");
+  if (texture_size > kMaxTextureSize)
+    return usage_error("--texture-size must be at most 65536 (what tailor eval reads), got " +
+                       std::to_string(texture_size));
+  return Status::ok();
+}
+
 Status set_map_texture_size(MapTextureOptions& options, int texture_width, int texture_height) {
   if (texture_width <= 0 || texture_height <= 0) return usage_error("--texture-size must be positive");
   MappingOptions& mapping = options.mapping;
