@@ -2,14 +2,16 @@
 
     PYTHONPATH=build/python /usr/bin/python3 bench/border_gaps.py MESH [--axis pca|x|y|z|X,Y,Z]
         [--chunk-cell E] [--scale S] [--texture-size N] [--max-stretch X]
-    PYTHONPATH=build/python /usr/bin/python3 bench/border_gaps.py plane [--axis ...]
+    PYTHONPATH=build/python /usr/bin/python3 bench/border_gaps.py plane [--noise F] [--height Z] [--axis ...]
 
-MESH "plane" is a scanned floor: a 400 x 400-vertex grid at z = 0 (79.2 x 79.1 units, its corner at
-(-37.3, -12.1): the grid's planes fall inside it), heights with Gaussian noise of 5 % of the edge
-length (seed 1).
+MESH "plane" is a scanned floor: a 400 x 400-vertex grid at z = Z (0 by default; 79.2 x 79.1 units, its corner at
+(-37.3, -12.1): the grid's planes fall inside it), heights with Gaussian noise of F times the edge
+length (seed 1; F = 0.05 by default, 0 for a flat floor).
 
 Maps MESH in chunks (`--chunks on`, the default for an isotropic tile: field following 0, 32 crack
-rings) and, for every edge whose two faces lie in different chunks, measures the lattice gap: the
+rings), prints the whole map's patches and seams (visible: the share of the edge length on seams
+whose gap is 1 px or more; invisible: the share of the seam length whose gap is under 1 px), and,
+for every edge whose two faces lie in different chunks, measures the lattice gap: the
 larger, over its two end vertices, of the distance between the two sides' UVs after removing whole
 repeats (0 = the texture continues across the border). A zip of a border band within max_stretch
 can only absorb a gap of about max_stretch times the band's width, so the table says which share of
@@ -54,10 +56,10 @@ def border_gaps(mesh, result, chunk_of_face, period):
     return gap, length, edge_px
 
 
-def noisy_plane():
+def noisy_plane(noise, height):
     n, step = 400, 0.1985
     x, y = np.meshgrid(-37.3 + step * np.arange(n), -12.1 + step * np.arange(n), indexing="xy")
-    z = np.random.default_rng(1).normal(0.0, 0.05 * step, x.shape)
+    z = height + np.random.default_rng(1).normal(0.0, noise * step, x.shape)
     positions = np.stack([x, y, z], axis=-1).reshape(-1, 3).astype(np.float32)
     i = np.arange(n - 1)
     a = (i[:, None] * n + i[None, :]).reshape(-1)  # lower-left vertex of each square
@@ -69,13 +71,15 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("mesh")
     parser.add_argument("--axis", default="pca")
+    parser.add_argument("--noise", type=float, default=0.05, help="plane: height noise over the edge length")
+    parser.add_argument("--height", type=float, default=0.0, help="plane: its z")
     parser.add_argument("--chunk-cell", type=int, default=None)
     parser.add_argument("--scale", type=float, default=800.0)
     parser.add_argument("--texture-size", type=int, default=512)
     parser.add_argument("--max-stretch", type=float, default=0.25)
     args = parser.parse_args()
     axis = args.axis if "," not in args.axis else [float(c) for c in args.axis.split(",")]
-    mesh = noisy_plane() if args.mesh == "plane" else tailor.load(args.mesh)
+    mesh = noisy_plane(args.noise, args.height) if args.mesh == "plane" else tailor.load(args.mesh)
     plan = tailor.plan_chunks(mesh, chunk_cell=args.chunk_cell)
     chunk_of_face = np.empty(mesh.face_count, np.int64)
     for c in range(len(plan["cells"])):
@@ -83,6 +87,9 @@ def main():
     result = tailor.map(mesh, texture_size=args.texture_size, scale=args.scale, axis=axis,
                         field_following=0, crack_rings=32, max_stretch=args.max_stretch, chunks="on",
                         chunk_cell=args.chunk_cell)
+    m = result.metrics
+    print(f"{args.mesh}: {m['patches']} patches, visible seams {100 * m['visible_seam_ratio']:.2f} % of the edge "
+          f"length, invisible {100 * m['seam_invisible_ratio']:.1f} % of the seam length")
     gap, length, edge_px = border_gaps(mesh, result, chunk_of_face, float(args.texture_size))
     if len(gap) == 0:
         print(f"{args.mesh}: one chunk, no border")
