@@ -258,4 +258,11 @@ cmp -s "$tmp/replay_chunks.glb" "$tmp/out/spot_chunks.glb" || fail "the chunked 
 echo "chunked session: save + replay identical ($(stat -c %s "$tmp/replay_chunks.glb") bytes)"
 stop_server
 
+# --- 7. what the input holds that is not read: said as tailor map says it --------------------------
+printf 'OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n3 1 3 2\n' >"$tmp/short.off"
+start_server "$tmp/short.off" -o "$tmp/out/short.glb"
+grep -qF "tailor: warning: $tmp/short.off: not read: 1 line after the 1 face the OFF header declares (from line 8)" \
+  "$tmp/edit.log" || fail "tailor edit read past an OFF's undeclared face without a word: $(cat "$tmp/edit.log")"
+stop_server
+
 echo "PASS: tailor edit and its API work"

@@ -128,6 +128,7 @@ int run_edit(const EditArgs& opt) {
   if (load.degenerate_faces || load.duplicate_faces)
     warn(opt.quiet, opt.input + ": dropped " + std::to_string(load.degenerate_faces + load.duplicate_faces) +
                         " degenerate or duplicate faces (face ids are those of the loaded mesh)");
+  warn_unused_input(opt.input, load, opt.quiet);
   std::vector<uint8_t> seam_faces;
   if (!args.seam_faces.empty()) {
     if (Status s = load_seam_faces(args.seam_faces, mesh.face_count(), seam_faces); !s) return report_error(s);

@@ -173,11 +173,7 @@ int run_map(const MapArgs& opt) {
     warn(opt.quiet, opt.input + ": dropped " + std::to_string(load.degenerate_faces) + " degenerate faces");
   if (load.duplicate_faces)
     warn(opt.quiet, opt.input + ": dropped " + std::to_string(load.duplicate_faces) + " duplicate faces");
-  if (!load.not_kept.empty()) warn(opt.quiet, opt.input + ": not kept in the output: " + load.not_kept);
-  if (!load.not_read.empty()) warn(opt.quiet, opt.input + ": not read: " + load.not_read);
-  if (load.skipped_primitives)
-    warn(opt.quiet, opt.input + ": skipped " + std::to_string(load.skipped_primitives) +
-                        " point and line primitives (only triangles are mapped)");
+  warn_unused_input(opt.input, load, opt.quiet);
   warn_texture_transform(opt.quiet, opt.input, load.texture_transform);
   std::vector<uint8_t> seam_faces;
   if (!args.seam_faces.empty()) {

@@ -158,6 +158,14 @@ Status write_mapped_mesh(const std::string& path, const Mesh& mesh, const Atlas&
   return export_mesh(path, mesh, atlas, export_options);
 }
 
+void warn_unused_input(const std::string& input, const LoadReport& load, bool quiet) {
+  if (!load.not_kept.empty()) warn(quiet, input + ": not kept in the output: " + load.not_kept);
+  if (!load.not_read.empty()) warn(quiet, input + ": not read: " + load.not_read);
+  if (load.skipped_primitives)
+    warn(quiet, input + ": skipped " + std::to_string(load.skipped_primitives) +
+                    " point and line primitives (only triangles are mapped)");
+}
+
 bool turn_wound_faces(const std::string& input, Mesh& mesh, const Topology& topology, LoadReport& load, bool quiet,
                       const std::string& hint) {
   load.faces_turned = orient_faces_coherently(mesh, topology);

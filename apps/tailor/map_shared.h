@@ -98,6 +98,10 @@ struct MeshOutput {
 Status write_mapped_mesh(const std::string& path, const Mesh& mesh, const Atlas& atlas, const MeshOutput& output,
                          const ProgressCallback& progress = {});
 
+//! Warns (one line each) of what `input` holds that the map neither reads nor keeps: load.not_kept,
+//! load.not_read and the point and line primitives skipped (tailor map and tailor edit alike).
+void warn_unused_input(const std::string& input, const LoadReport& load, bool quiet);
+
 //! Turns the faces of `mesh` wound against their neighbours (orient_faces_coherently over
 //! `topology`, the mesh's), counts them in load.faces_turned and says how many in one warning line
 //! ending in `hint`. True when any turned: `topology` then no longer describes the mesh.
