@@ -477,11 +477,20 @@ void bind_map(py::module_& m) {
       "_texture_look",
       [](const py::object& texture, const std::string& name) {
         const Image image = read_image(texture);
-        return py::make_tuple(image.width, image.height, utf8_text(texture_wrap_warning(image, name)));
+        MappingOptions mapping;
+        std::string warning;
+        {
+          const py::gil_scoped_release release;
+          warning = texture_wrap_warning(image, name);
+          adapt_mapping_to_texture(image, mapping);
+        }
+        return py::make_tuple(image.width, image.height, utf8_text(warning), mapping.field_following,
+                              mapping.crack_rings);
       },
       py::arg("texture"), py::arg("name"),
-      "_texture_look(texture, name) -> (width, height, warning): for tailor.tiles, image_size and what\n"
-      "tailor map says of a texture that does not wrap ('' when it does), naming it `name`, from one decoding.");
+      "_texture_look(texture, name) -> (width, height, warning, field_following, crack_rings): for\n"
+      "tailor.tiles, from one decoding: image_size, what tailor map says of a texture that does not wrap\n"
+      "('' when it does), naming it `name`, and auto_field_following.");
 }
 
 }  // namespace tailor::python

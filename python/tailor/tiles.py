@@ -500,32 +500,33 @@ PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
 
 def texture_image(path, notes):
-    """(suffix, bytes, [width, height]) of an image every tile names by URI: decoded whole as tailor map
-    reads a texture (a truncated or corrupt file is an error here, not in a client's viewer), and PNG
-    or JPEG, the images glTF allows, named by what its bytes are rather than by its file name. What
-    tailor map says of a texture that does not wrap goes to notes."""
+    """(suffix, bytes, [width, height], (field_following, crack_rings) that auto picks for it) of an
+    image every tile names by URI, from one decoding: decoded whole as tailor map reads a texture (a
+    truncated or corrupt file is an error here, not in a client's viewer), and PNG or JPEG, the images
+    glTF allows, named by what its bytes are rather than by its file name. What tailor map says of a
+    texture that does not wrap goes to notes."""
     try:
-        width, height, wrap = tailor._tailor._texture_look(path, os.fsdecode(path))
+        width, height, wrap, following, rings = tailor._tailor._texture_look(path, os.fsdecode(path))
     except tailor.Error as e:
         raise TilesError(str(e)) from None
     if wrap:
         notes.append(wrap)
     data = pathlib.Path(path).read_bytes()
     if data.startswith(PNG_SIGNATURE):
-        return ".png", data, [width, height]
+        return ".png", data, [width, height], (following, rings)
     if data.startswith(b"\xff\xd8\xff"):
-        return ".jpg", data, [width, height]
+        return ".jpg", data, [width, height], (following, rings)
     raise TilesError("%s: texture is neither PNG nor JPEG" % path)
 
 
 def read_look(args):
     """What every tile's material shows, read once: images {role: (file name beside tileset.json,
     bytes)} (color, normal, orm), orm_roles (what the orm image serves as), size (the repeat in
-    pixels, None without a texture) and colour (the colour map's path, for --field-following auto)."""
-    look = {"images": {}, "orm_roles": [], "size": None, "colour": None, "notes": []}
+    pixels, None without a texture) and auto ((field_following, crack_rings) that --field-following
+    auto picks for the colour map, None without one)."""
+    look = {"images": {}, "orm_roles": [], "size": None, "auto": None, "notes": []}
     if args.texture:
-        suffix, data, look["size"] = texture_image(args.texture, look["notes"])
-        look["colour"] = args.texture
+        suffix, data, look["size"], look["auto"] = texture_image(args.texture, look["notes"])
         look["images"]["color"] = ("texture" + suffix, data)
     elif args.material:
         m = tailor.load_material(args.material)
@@ -537,8 +538,7 @@ def read_look(args):
                 % args.material
             )
         if m["color"]:
-            look["colour"] = m["color"]
-            suffix, data, _ = texture_image(m["color"], look["notes"])
+            suffix, data, _, look["auto"] = texture_image(m["color"], look["notes"])
             look["images"]["color"] = ("material_color" + suffix, data)
         if m["normal_png"]:
             look["images"]["normal"] = ("material_normal.png", m["normal_png"])
@@ -582,7 +582,7 @@ def tile_params(args, look, e, density):
             )
     tpu = args.texels_per_unit if args.texels_per_unit is not None else density()
     width, height = look["size"] if look["size"] else (args.texture_size, args.texture_size)
-    field_following, crack_rings = resolve_field_following(args, look["colour"])
+    field_following, crack_rings = resolve_field_following(args, look["auto"])
     params = {
         "format": FORMAT,
         "tailor": tailor.__version__,
@@ -601,14 +601,14 @@ def tile_params(args, look, e, density):
     return params
 
 
-def resolve_field_following(args, colour):
+def resolve_field_following(args, auto):
     """(field_following, crack_rings) as tailor map resolves them: auto follows the direction of the
-    texture (or of the material's colour map)."""
+    texture (or of the material's colour map): `auto`, what read_look found for it (None without one)."""
     if args.field_following != "auto":  # a number in [0, 1] (parse_args)
         return float(args.field_following), args.crack_rings
-    if not colour:
+    if auto is None:
         return 1.0, args.crack_rings
-    value, rings = tailor.auto_field_following(colour)
+    value, rings = auto
     return float(value), (args.crack_rings if args.crack_rings is not None else int(rings))
 
 
