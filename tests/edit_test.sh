@@ -119,7 +119,8 @@ for body in 'not json' '[1, 2]' '{"bogus": 1}' '{"add_seam_faces": [99999999]}' 
     '{"add_seam_faces": "1"}' '{"strokes": [{"points": [[0, 0, 0]], "radius": 0.1}]}' \
     '{"strokes": [{"points": [[0, 0, 0], [1, 1, 1]], "radius": -1}]}' '{"options": {"axis": "w"}}' \
     '{"options": {"scale": -3}}' '{"options": {"crack_rings": 99}}' '{"options": {"bogus": 1}}' \
-    '{"add_seam_faces": [1], "options": {"mode": "none"}}'; do
+    '{"add_seam_faces": [1], "options": {"mode": "none"}}' '{"options": {"mode": "thesis", "max_stretch": 0.3}}' \
+    '{"options": {"mode": "thesis", "crack_rings": 8}}' '{"options": {"threshold_px": 2}}'; do
   answer="$(post edit "$body")"
   [ "$(code)" = 400 ] || fail "the malformed edit '$body' answered $(code): $answer"
   [ "$(printf '%s\n' "$answer" | wc -l)" -eq 1 ] || fail "the 400 answer to '$body' is not one line: $answer"

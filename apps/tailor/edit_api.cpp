@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
+#include <string_view>
 #include <thread>
 
 #include "cli.h"
@@ -120,6 +121,17 @@ std::string apply_options(const json& j, const EditContext& context, const std::
     } else {
       return "unknown option '" + key + "'";
     }
+  }
+  // As tailor map refuses such flags: a key the resulting mode does not read would be taken and do
+  // nothing (the page sends the one it changed).
+  if (m.mode == MappingMode::kThesis) {
+    for (const char* key : {"max_stretch", "field_following", "min_patch_faces", "hop_age", "shorten_seams",
+                            "close_cracks", "crack_rings", "relax_iterations"})
+      if (j.contains(key) && !(auto_following && std::string_view(key) == "field_following"))
+        return field_name(key) +
+               " has no effect in thesis mode (one UV per vertex, placed by threshold_px; no seam work)";
+  } else if (j.contains("threshold_px")) {
+    return "options.threshold_px is read in thesis mode only (patches mode bounds its faces by max_stretch)";
   }
   if (Status s = check_map_options(options); !s) return s.message();
   const int width = context.output.texture_width, height = context.output.texture_height;
