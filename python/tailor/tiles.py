@@ -32,6 +32,7 @@ import functools
 import glob
 import hashlib
 import json
+import logging
 import math
 import os
 import pathlib
@@ -753,8 +754,6 @@ def remove_stale(outdir):
 
 
 def start_client(args):
-    import logging
-
     import dask
     from dask.distributed import Client, LocalCluster
 
@@ -1265,16 +1264,34 @@ class Terminated(BaseException):
         self.signum = signum
 
 
+def _quiet_cluster():
+    """From a Ctrl-C or a signal on: the local cluster's scheduler runs in this process and logs, as
+    errors, the results it cannot gather from workers the signal ended; the driver says what happened
+    in its one line."""
+    logger = logging.getLogger("distributed")
+    logger.setLevel(logging.CRITICAL + 1)
+    for handler in logger.handlers:
+        handler.setLevel(logging.CRITICAL + 1)
+
+
 def _terminate(signum, frame):
     for other in (signal.SIGTERM, signal.SIGHUP):  # a second signal must not cut the clean-up short
         signal.signal(other, signal.SIG_IGN)
+    _quiet_cluster()
     raise Terminated(signum)
+
+
+def _interrupt(signum, frame):
+    _quiet_cluster()
+    raise KeyboardInterrupt
 
 
 def main(argv=None):
     args = parse_args(argv)
     for signum in (signal.SIGTERM, signal.SIGHUP):
         signal.signal(signum, _terminate)
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # not where a caller chose its own
+        signal.signal(signal.SIGINT, _interrupt)
     try:
         summary = run(args)
     except TilesError as e:
