@@ -20,7 +20,7 @@ pytest.importorskip("distributed")
 
 HORSE = DATA / "meshes" / "horse.ply"
 TEXTURE = GRAVEL
-CELL = -4  # horse.ply spans 0.18 units: 23 cells of 1/16
+CELL = -4  # horse.ply spans 0.18 units: 20 cells of 1/16
 
 
 def read_glb(path):
