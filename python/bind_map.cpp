@@ -461,7 +461,7 @@ void bind_map(py::module_& m) {
       "auto_field_following(texture) -> (field_following, crack_rings)\n\n"
       "What field_following='auto' (tailor.map, tailor map) picks for a texture: (0.0, 32) for one\n"
       "without a direction (gravel, grass), else (1.0, 16). For callers that set the options\n"
-      "themselves (ChunkedMapper, tailor.tiles).");
+      "themselves (ChunkedMapper).");
   m.def(
       "image_size",
       [](const py::object& texture) {
@@ -472,25 +472,26 @@ void bind_map(py::module_& m) {
       "image_size(texture) -> (width, height)\n\n"
       "The size of an image file, decoded whole as tailor map reads a texture: tailor.Error when it\n"
       "cannot be (missing, truncated or corrupt, too large). For callers that name a texture\n"
-      "without mapping with it (tailor.tiles).");
+      "without mapping with it.");
   m.def(
       "_texture_look",
-      [](const py::object& texture, const std::string& name) {
+      [](const py::object& texture, const std::string& name, bool direction) {
         const Image image = read_image(texture);
         MappingOptions mapping;
         std::string warning;
         {
           const py::gil_scoped_release release;
           warning = texture_wrap_warning(image, name);
-          adapt_mapping_to_texture(image, mapping);
+          if (direction) adapt_mapping_to_texture(image, mapping);
         }
+        if (!direction) return py::make_tuple(image.width, image.height, utf8_text(warning), py::none(), py::none());
         return py::make_tuple(image.width, image.height, utf8_text(warning), mapping.field_following,
                               mapping.crack_rings);
       },
-      py::arg("texture"), py::arg("name"),
-      "_texture_look(texture, name) -> (width, height, warning, field_following, crack_rings): for\n"
+      py::arg("texture"), py::arg("name"), py::arg("direction"),
+      "_texture_look(texture, name, direction) -> (width, height, warning, field_following, crack_rings): for\n"
       "tailor.tiles, from one decoding: image_size, what tailor map says of a texture that does not wrap\n"
-      "('' when it does), naming it `name`, and auto_field_following.");
+      "('' when it does), naming it `name`, and with `direction` auto_field_following (else None, None).");
 }
 
 }  // namespace tailor::python

@@ -500,23 +500,24 @@ def tileset_json(records, lod, up):
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
 
-def texture_image(path, notes):
-    """(suffix, bytes, [width, height], (field_following, crack_rings) that auto picks for it) of an
-    image every tile names by URI, from one decoding: decoded whole as tailor map reads a texture (a
+def texture_image(path, notes, direction):
+    """(suffix, bytes, [width, height], (field_following, crack_rings) that auto picks for it, or None
+    without `direction`) of an image every tile names by URI, from one decoding: decoded whole as tailor map reads a texture (a
     truncated or corrupt file is an error here, not in a client's viewer), and PNG or JPEG, the images
     glTF allows, named by what its bytes are rather than by its file name. What tailor map says of a
     texture that does not wrap goes to notes."""
     try:
-        width, height, wrap, following, rings = tailor._tailor._texture_look(path, os.fsdecode(path))
+        width, height, wrap, following, rings = tailor._tailor._texture_look(path, os.fsdecode(path), direction)
     except tailor.Error as e:
         raise TilesError(str(e)) from None
     if wrap:
         notes.append(wrap)
     data = pathlib.Path(path).read_bytes()
+    auto = (following, rings) if direction else None
     if data.startswith(PNG_SIGNATURE):
-        return ".png", data, [width, height], (following, rings)
+        return ".png", data, [width, height], auto
     if data.startswith(b"\xff\xd8\xff"):
-        return ".jpg", data, [width, height], (following, rings)
+        return ".jpg", data, [width, height], auto
     raise TilesError("%s: texture is neither PNG nor JPEG" % path)
 
 
@@ -524,10 +525,11 @@ def read_look(args):
     """What every tile's material shows, read once: images {role: (file name beside tileset.json,
     bytes)} (color, normal, orm), orm_roles (what the orm image serves as), size (the repeat in
     pixels, None without a texture) and auto ((field_following, crack_rings) that --field-following
-    auto picks for the colour map, None without one)."""
+    auto picks for the colour map, None without one or when the flag is a number)."""
     look = {"images": {}, "orm_roles": [], "size": None, "auto": None, "notes": []}
+    direction = args.field_following == "auto"  # measured only for auto
     if args.texture:
-        suffix, data, look["size"], look["auto"] = texture_image(args.texture, look["notes"])
+        suffix, data, look["size"], look["auto"] = texture_image(args.texture, look["notes"], direction)
         look["images"]["color"] = ("texture" + suffix, data)
     elif args.material:
         m = tailor.load_material(args.material)
@@ -539,7 +541,7 @@ def read_look(args):
                 % args.material
             )
         if m["color"]:
-            suffix, data, _, look["auto"] = texture_image(m["color"], look["notes"])
+            suffix, data, _, look["auto"] = texture_image(m["color"], look["notes"], direction)
             look["images"]["color"] = ("material_color" + suffix, data)
         if m["normal_png"]:
             look["images"]["normal"] = ("material_normal.png", m["normal_png"])
@@ -1288,9 +1290,12 @@ def _interrupt(signum, frame):
 
 def main(argv=None):
     args = parse_args(argv)
+    # Only where the signal would otherwise end the process: one ignored at start (nohup, a
+    # background job's SIGINT) stays ignored, and a caller's own handler stays.
     for signum in (signal.SIGTERM, signal.SIGHUP):
-        signal.signal(signum, _terminate)
-    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # not where a caller chose its own
+        if signal.getsignal(signum) is signal.SIG_DFL:
+            signal.signal(signum, _terminate)
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
         signal.signal(signal.SIGINT, _interrupt)
     try:
         summary = run(args)

@@ -947,6 +947,19 @@ def test_a_terminated_run_cleans_up_like_an_interrupted_one(tmp_path):
     assert stderr == "tailor.tiles: terminated (SIGTERM); %s left as it was\n" % out
     assert sorted(p.name for p in tmp_path.iterdir()) == ["field.ply"]
 
+    # Under nohup (SIGHUP ignored at start) a hang-up leaves the run going to its end.
+    run = subprocess.Popen(
+        [sys.executable, "-m", "tailor.tiles", str(mesh), "-o", str(out), "--workers", "0", "--threads", "1", "-q"],
+        env=env, stderr=subprocess.PIPE, text=True, preexec_fn=lambda: signal.signal(signal.SIGHUP, signal.SIG_IGN),
+    )
+    deadline = time.monotonic() + 120
+    while not list(tmp_path.glob(".out.tmp-*")) and run.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.005)
+    run.send_signal(signal.SIGHUP)
+    _, stderr = run.communicate(timeout=300)
+    assert run.returncode == 0 and stderr == "", stderr
+    assert (out / "tileset.json").is_file()
+
 
 def test_ctrl_c_on_a_cluster_prints_one_line(tmp_path):
     import signal
