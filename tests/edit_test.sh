@@ -264,6 +264,15 @@ printf 'OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n3 1 3 2\n' >"$tmp/short
 start_server "$tmp/short.off" -o "$tmp/out/short.glb"
 grep -qF "tailor: warning: $tmp/short.off: not read: 1 line after the 1 face the OFF header declares (from line 8)" \
   "$tmp/edit.log" || fail "tailor edit read past an OFF's undeclared face without a word: $(cat "$tmp/edit.log")"
+# A mode change keeps the stored values; only what a request gives that its mode does not read is refused.
+for body in '{"options": {"max_stretch": 0.3}}' '{"options": {"mode": "thesis"}}' \
+    '{"options": {"field_following": "auto", "threshold_px": 2}}' '{"options": {"mode": "patches", "max_stretch": 0.2}}'; do
+  answer="$(post edit "$body")"
+  [ "$(code)" = 200 ] || fail "the edit '$body' answered $(code): $answer"
+  wait_settled
+done
+post edit '{"options": {"mode": "thesis", "max_stretch": 0.3}}' | grep -qF "options.max_stretch has no effect in thesis mode" ||
+  fail "a thesis request with max_stretch was not refused for it"
 stop_server
 
 echo "PASS: tailor edit and its API work"

@@ -541,6 +541,9 @@ function moveBrushRing(event) {
 
 const kOptionInputs = ['axis', 'smooth_passes', 'field_following', 'mode', 'scale', 'max_stretch', 'min_patch_faces',
   'crack_rings', 'shorten_seams', 'close_cracks'];
+// What the thesis mode does not read (the server refuses a change of them there, as tailor map does).
+const kPatchesOnlyInputs = ['field_following', 'max_stretch', 'min_patch_faces', 'crack_rings', 'shorten_seams',
+  'close_cracks'];
 
 /** Shows the session's options in the mapping panel (axis auto and field following auto stay shown). */
 function showOptions(options) {
@@ -559,6 +562,7 @@ function showOptions(options) {
       input.value = String(value);
     } else input.value = String(value);
   }
+  for (const key of kPatchesOnlyInputs) document.getElementById(`opt-${key}`).disabled = options.mode === 'thesis';
 }
 
 function optionValue(key) {

@@ -123,7 +123,8 @@ std::string apply_options(const json& j, const EditContext& context, const std::
     }
   }
   // As tailor map refuses such flags: a key the resulting mode does not read would be taken and do
-  // nothing (the page sends the one it changed).
+  // nothing. Only the keys this request gives are checked (the session's stored values stay), and
+  // field_following "auto" passes, as tailor.map's default does.
   if (m.mode == MappingMode::kThesis) {
     for (const char* key : {"max_stretch", "field_following", "min_patch_faces", "hop_age", "shorten_seams",
                             "close_cracks", "crack_rings", "relax_iterations"})
