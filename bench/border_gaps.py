@@ -78,6 +78,8 @@ def main():
     parser.add_argument("--texture-size", type=int, default=512)
     parser.add_argument("--max-stretch", type=float, default=0.25)
     args = parser.parse_args()
+    if not args.noise >= 0:
+        parser.error("--noise must be 0 or more")
     axis = args.axis if "," not in args.axis else [float(c) for c in args.axis.split(",")]
     mesh = noisy_plane(args.noise, args.height) if args.mesh == "plane" else tailor.load(args.mesh)
     plan = tailor.plan_chunks(mesh, chunk_cell=args.chunk_cell)
