@@ -261,10 +261,10 @@ Status parse_header(std::string_view data, const std::string& name, PlyHeader& h
 Status assign_roles(PlyHeader& h, const std::string& name, LoadReport& report) {
   bool have_vertex = false;
   for (PlyElement& e : h.elements) {
-    std::array<bool, kRoles> seen{};
-    std::array<const PlyProperty*, kRoles> first{};  // per role: the property read for it
+    std::array<const PlyProperty*, kRoles> first{};  // per role: the property read for it, or none
+    const auto seen = [&first](Role r) { return first[static_cast<size_t>(r)] != nullptr; };
     struct Repeat {
-      const PlyProperty *property, *first;
+      const PlyProperty* property;
       Role role;
     };
     std::vector<Repeat> repeats;  // properties of a role an earlier one has: not read
@@ -300,14 +300,13 @@ Status assign_roles(PlyHeader& h, const std::string& name, LoadReport& report) {
         else if (!p.is_list() && n == "seam")
           r = Role::kSeam;
       } else if (e.kind == ElementKind::kTristrips) {
-        if (p.is_list() && !seen[static_cast<size_t>(Role::kIndices)]) r = Role::kIndices;
+        if (p.is_list() && !seen(Role::kIndices)) r = Role::kIndices;
       }
       if (r != Role::kNone) {
-        if (seen[static_cast<size_t>(r)]) {
-          repeats.push_back({&p, first[static_cast<size_t>(r)], r});  // the first one wins
+        if (seen(r)) {
+          repeats.push_back({&p, r});  // the first one wins
           r = Role::kNone;
         } else {
-          seen[static_cast<size_t>(r)] = true;
           first[static_cast<size_t>(r)] = &p;
         }
       }
@@ -315,18 +314,15 @@ Status assign_roles(PlyHeader& h, const std::string& name, LoadReport& report) {
     }
     if (e.kind == ElementKind::kVertex) {
       have_vertex = true;
-      if (!seen[static_cast<size_t>(Role::kX)] || !seen[static_cast<size_t>(Role::kY)] ||
-          !seen[static_cast<size_t>(Role::kZ)]) {
+      if (!seen(Role::kX) || !seen(Role::kY) || !seen(Role::kZ)) {
         return Status::error(ErrorCode::kParse, name, "PLY vertex element has no x, y and z properties");
       }
-      if (seen[static_cast<size_t>(Role::kU)] != seen[static_cast<size_t>(Role::kV)]) {
+      if (seen(Role::kU) != seen(Role::kV)) {
         for (PlyProperty& p : e.props) {
           if (p.role == Role::kU || p.role == Role::kV) p.role = Role::kNone;  // half a uv pair is no uv
         }
       }
-      auto all = [&](std::initializer_list<Role> roles) {
-        return std::all_of(roles.begin(), roles.end(), [&](Role r) { return seen[static_cast<size_t>(r)]; });
-      };
+      auto all = [&](std::initializer_list<Role> roles) { return std::all_of(roles.begin(), roles.end(), seen); };
       const bool normals = all({Role::kNx, Role::kNy, Role::kNz}),
                  colours = all({Role::kRed, Role::kGreen, Role::kBlue});
       for (PlyProperty& p : e.props) {  // part of a normal or a colour is neither
@@ -335,12 +331,11 @@ Status assign_roles(PlyHeader& h, const std::string& name, LoadReport& report) {
       }
     }
     for (const Repeat& r : repeats) {
-      add_not_read(report,
-                   "PLY " + e.name + " property " + r.property->name +
-                       (r.first->role == r.role ? " (" + r.first->name + " before it is read in its place)" : ""));
+      const PlyProperty& read = *first[static_cast<size_t>(r.role)];  // unless a half pair dropped it
+      add_not_read(report, "PLY " + e.name + " property " + r.property->name +
+                               (read.role == r.role ? " (" + read.name + " before it is read in its place)" : ""));
     }
-    if ((e.kind == ElementKind::kFace || e.kind == ElementKind::kTristrips) &&
-        !seen[static_cast<size_t>(Role::kIndices)]) {
+    if ((e.kind == ElementKind::kFace || e.kind == ElementKind::kTristrips) && !seen(Role::kIndices)) {
       return Status::error(ErrorCode::kParse, name, "PLY " + e.name + " element has no vertex_indices list");
     }
   }
