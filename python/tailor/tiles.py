@@ -502,10 +502,10 @@ PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
 def texture_image(path, notes, direction):
     """(suffix, bytes, [width, height], (field_following, crack_rings) that auto picks for it, or None
-    without `direction`) of an image every tile names by URI, from one decoding: decoded whole as tailor map reads a texture (a
-    truncated or corrupt file is an error here, not in a client's viewer), and PNG or JPEG, the images
-    glTF allows, named by what its bytes are rather than by its file name. What tailor map says of a
-    texture that does not wrap goes to notes."""
+    without `direction`) of an image every tile names by URI, from one decoding: decoded whole as
+    tailor map reads a texture (a truncated or corrupt file is an error here, not in a client's
+    viewer), and PNG or JPEG, the images glTF allows, named by what its bytes are rather than by its
+    file name. What tailor map says of a texture that does not wrap goes to notes."""
     try:
         width, height, wrap, following, rings = tailor._tailor._texture_look(path, os.fsdecode(path), direction)
     except tailor.Error as e:
