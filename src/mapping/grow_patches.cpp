@@ -722,7 +722,7 @@ class PatchMapper {
 
   // === Absorption of small patches ==============================================================
   // Faces of patches below min_patch_faces (except the largest patch of each component) are
-  // re-placed from their neighbours in kept patches, breadth first from the kept border.
+  // re-placed from their neighbours in kept patches, from the kept border inwards.
   void absorb_small_patches() {
     const uint32_t min_faces = in_.options.min_patch_faces;
     const size_t patch_count = patch_size_.size();
@@ -755,24 +755,30 @@ class PatchMapper {
       }
     }
     absorbing_ = true;
-    std::vector<uint32_t> fifo;
-    fifo.reserve(removed.size() + 16);
-    for (const uint32_t f : removed) {
-      for (int k = 0; k < 3; ++k) {
-        const uint32_t g = rec[f].neighbour[k];
-        if (g != kInvalid && rec[g].patch != kInvalid) {
-          fifo.push_back(f);
-          break;
-        }
-      }
-    }
-    for (size_t head = 0; head < fifo.size(); ++head) {
-      const uint32_t f = fifo[head];
+    // Faces with more placed neighbours first (three, then two, then one; first come first within
+    // each), as the growth's rank: a face held on more sides is placed with fewer cuts. Plain
+    // breadth first took them in face order, which on sliver fans ran cuts along the long edges
+    // (adis16480 with field following: 20.9 % visible seams, 5.4 % so; other shared meshes within
+    // 0.2 points).
+    auto placed_neighbours = [&](uint32_t f) {
+      int n = 0;
+      for (const uint32_t g : rec[f].neighbour) n += g != kInvalid && rec[g].patch != kInvalid;
+      return n;
+    };
+    std::vector<uint32_t> level[3];
+    size_t head[3] = {0, 0, 0};
+    for (const uint32_t f : removed)
+      if (const int n = placed_neighbours(f); n > 0) level[n - 1].push_back(f);
+    for (;;) {
+      int l = 2;
+      while (l >= 0 && head[l] == level[l].size()) --l;
+      if (l < 0) break;
+      const uint32_t f = level[l][head[l]++];
       if (rec[f].patch != kInvalid) continue;
       if (!try_place(f, kAnyPatch)) join_rigidly(f);
       for (int k = 0; k < 3; ++k) {
         const uint32_t g = rec[f].neighbour[k];
-        if (g != kInvalid && rec[g].patch == kInvalid) fifo.push_back(g);
+        if (g != kInvalid && rec[g].patch == kInvalid) level[placed_neighbours(g) - 1].push_back(g);
       }
     }
     absorbing_ = false;
