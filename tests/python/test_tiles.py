@@ -803,9 +803,8 @@ def test_a_bad_streamed_ply_is_one_line_and_leaves_nothing(tmp_path):
         assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")], name
 
 
-def test_the_streamed_driver_holds_a_block_not_the_mesh(tmp_path):
-    # A 2.9 M-face height field: the driver's peak memory through the partition, both paths.
-    n = 1200
+def write_height_field(ply, n):
+    """A binary PLY of an n x n grid of quads as 2 n^2 triangles over a wavy height field."""
     x, y = np.meshgrid(np.arange(n + 1, dtype=np.float32), np.arange(n + 1, dtype=np.float32))
     z = np.sin(x * 0.05) * np.cos(y * 0.07) * 3
     v = (np.stack([x.ravel(), y.ravel(), z.ravel()], 1) / np.float32(n)).astype("<f4")
@@ -815,14 +814,19 @@ def test_the_streamed_driver_holds_a_block_not_the_mesh(tmp_path):
     f["n"] = 3
     f["i"][0::2] = np.stack([a, a + 1, a + n + 2], 1)
     f["i"][1::2] = np.stack([a, a + n + 2, a + n + 1], 1)
-    ply = tmp_path / "grid.ply"
     with open(ply, "wb") as out:
         out.write(b"ply\nformat binary_little_endian 1.0\nelement vertex %d\n" % len(v))
         out.write(b"property float x\nproperty float y\nproperty float z\nelement face %d\n" % len(f))
         out.write(b"property list uchar int vertex_indices\nend_header\n")
         out.write(v.tobytes())
         out.write(f.tobytes())
-    del x, y, z, v, i, a, f
+
+
+def test_the_streamed_driver_holds_a_block_not_the_mesh(tmp_path):
+    # A 2.9 M-face height field: the driver's peak memory through the partition, both paths.
+    n = 1200
+    ply = tmp_path / "grid.ply"
+    write_height_field(ply, n)
     peaks = {}
     for path in ("streamed", "in memory"):
         extra = ["--in-memory"] if path == "in memory" else ["--block-faces", 32768]
@@ -832,8 +836,51 @@ def test_the_streamed_driver_holds_a_block_not_the_mesh(tmp_path):
         assert summary["input"] == path and summary["faces"] == 2 * n * n
         peaks[path] = summary["driver_peak_rss"]
     assert not (tmp_path / "out").exists()
-    # The interpreter, numpy and tailor take about 45 MB; a block of 32768 faces about 10 MB more.
-    assert peaks["streamed"] < 80e6 and peaks["streamed"] < peaks["in memory"] / 2, peaks
+    # The interpreter, numpy and tailor take about 45 MB; a block of 32768 faces about 10 MB more,
+    # the vertex element (kept mapped: under VERTEX_PAGES_KEPT) 17 MB; the face records, 37 MB, go.
+    assert peaks["streamed"] < 90e6 and peaks["streamed"] < peaks["in memory"] / 2, peaks
+
+
+def mapped_rss(path):
+    """Resident bytes of this process's mappings of `path` (/proc/self/smaps)."""
+    total, inside = 0, False
+    for line in pathlib.Path("/proc/self/smaps").read_text().splitlines():
+        if "-" in line.split(" ", 1)[0]:  # a mapping's first line: "start-end perms offset dev inode path"
+            inside = line.endswith(" " + str(path))
+        elif inside and line.startswith("Rss:"):
+            total += int(line.split()[1]) * 1024
+    return total
+
+
+def test_the_vertex_pages_stay_mapped_up_to_a_budget_and_the_faces_are_released(tmp_path, monkeypatch):
+    from tailor import tiles_stream
+
+    ply = tmp_path / "grid.ply"
+    write_height_field(ply, 300)  # 180,000 faces, 90,601 vertices: 1.1 MB of vertices, 2.3 MB of faces
+    layout = tiles_stream.read_layout(ply)
+    vertex_bytes = layout.vertex_count * layout.vertex_dtype.itemsize
+    block_bytes = 4096 * layout.face_dtype.itemsize
+    resident, surveys = {}, {}
+    for budget in (0, tiles_stream.VERTEX_PAGES_KEPT):
+        monkeypatch.setattr(tiles_stream, "VERTEX_PAGES_KEPT", budget)
+        body = tiles_stream._Body(layout)
+        try:
+            for _ in body.blocks(4096):
+                pass
+            resident[budget] = mapped_rss(ply)
+        finally:
+            body.close()
+        surveys[budget] = tiles_stream.survey(layout, None, block_faces=4096)
+    # Under the budget the vertex element stays (every vertex was gathered; its last page, shared
+    # with the first face records, goes with them), the face records go.
+    kept = resident[tiles_stream.VERTEX_PAGES_KEPT]
+    assert vertex_bytes - 2 * 4096 <= kept < vertex_bytes + block_bytes, resident
+    # Over it (a budget of 0) both go after every block.
+    assert resident[0] < block_bytes, resident
+    # The same survey either way.
+    assert surveys[0].keys() == surveys[tiles_stream.VERTEX_PAGES_KEPT].keys()
+    for key, value in surveys[0].items():
+        assert np.array_equal(value, surveys[tiles_stream.VERTEX_PAGES_KEPT][key]), key
 
 
 def test_one_run_at_a_time_writes_a_folder_and_nothing_but_its_tileset_is_replaced(tmp_path):
