@@ -296,18 +296,20 @@ void bind_map(py::module_& m) {
         if (Status s = check_map_options(options); !s) raise_status(s);
         // A keyword the mode does not read, away from its default, would be taken and do nothing.
         const MappingOptions unset;
-        const std::pair<bool, const char*> patches_only[] = {
-            {mapping.max_stretch != unset.max_stretch, "--max-stretch"},
-            {!field_following_auto, "--field-following"},
-            {mapping.min_patch_faces != unset.min_patch_faces, "--min-patch-faces"},
-            {mapping.hop_age != unset.hop_age, "--hop-age"},
-            {!mapping.shorten_seams, "--no-seam-shortening"},
-            {!mapping.close_cracks, "--no-crack-closing"},
-            {!crack_rings.is_none(), "--crack-rings"},
-            {mapping.relax_iterations != unset.relax_iterations, "--relax-iterations"}};
+        const auto differs = [&](std::string_view key) {
+          if (key == "max_stretch") return mapping.max_stretch != unset.max_stretch;
+          if (key == "field_following") return !field_following_auto;
+          if (key == "min_patch_faces") return mapping.min_patch_faces != unset.min_patch_faces;
+          if (key == "hop_age") return mapping.hop_age != unset.hop_age;
+          if (key == "shorten_seams") return !mapping.shorten_seams;
+          if (key == "close_cracks") return !mapping.close_cracks;
+          if (key == "crack_rings") return !crack_rings.is_none();
+          if (key == "relax_iterations") return mapping.relax_iterations != unset.relax_iterations;
+          raise_error("internal: map() does not check the patches-mode option '" + std::string(key) + "'");
+        };
         std::string_view given;
-        for (const auto& [differs, flag] : patches_only)
-          if (differs && given.empty()) given = flag;
+        for (const OptionDoc* doc : kPatchesOnlyOptions)
+          if (differs(doc->field) && given.empty()) given = doc->flag;
         if (Status s = check_mode_options(mapping.mode, given, mapping.threshold_px != unset.threshold_px); !s)
           raise_status(s);
         // The texture sets the texture size, as --texture does; a material's colour map (else its

@@ -126,11 +126,12 @@ std::string apply_options(const json& j, const EditContext& context, const std::
   // nothing. Only the keys this request gives are checked (the session's stored values stay), and
   // field_following "auto" passes, as tailor.map's default does.
   if (m.mode == MappingMode::kThesis) {
-    for (const char* key : {"max_stretch", "field_following", "min_patch_faces", "hop_age", "shorten_seams",
-                            "close_cracks", "crack_rings", "relax_iterations"})
-      if (j.contains(key) && !(auto_following && std::string_view(key) == "field_following"))
+    for (const OptionDoc* doc : kPatchesOnlyOptions) {
+      const std::string key(doc->field);
+      if (j.contains(key) && !(auto_following && key == "field_following"))
         return field_name(key) +
                " has no effect in thesis mode (one UV per vertex, placed by threshold_px; no seam work)";
+    }
   } else if (j.contains("threshold_px")) {
     return "options.threshold_px is read in thesis mode only (patches mode bounds its faces by max_stretch)";
   }

@@ -76,23 +76,21 @@ MappingOptionHandles add_mapping_options(CLI::Option_group* group, MappingArgs& 
   MappingOptionHandles handles;
   add_documented(group, option_doc(kMappingOptionDocs, "mode"), args.mode);
   handles.scale = add_documented(group, option_doc(kMappingOptionDocs, "scale"), mapping.scale);
-  std::vector<CLI::Option*>& patches_only = handles.patches_only;
-  patches_only.push_back(add_documented(group, option_doc(kMappingOptionDocs, "max_stretch"), mapping.max_stretch));
-  patches_only.push_back(group
-                             ->add_option("--field-following", args.field_following,
-                                          std::string(option_doc(kMappingOptionDocs, "field_following").help))
-                             ->capture_default_str());
-  patches_only.push_back(
-      add_documented(group, option_doc(kMappingOptionDocs, "min_patch_faces"), mapping.min_patch_faces));
-  patches_only.push_back(add_documented(group, option_doc(kMappingOptionDocs, "hop_age"), mapping.hop_age));
-  patches_only.push_back(add_off_switch(group, option_doc(kMappingOptionDocs, "shorten_seams"), mapping.shorten_seams));
-  patches_only.push_back(add_off_switch(group, option_doc(kMappingOptionDocs, "close_cracks"), mapping.close_cracks));
+  add_documented(group, option_doc(kMappingOptionDocs, "max_stretch"), mapping.max_stretch);
+  group
+      ->add_option("--field-following", args.field_following,
+                   std::string(option_doc(kMappingOptionDocs, "field_following").help))
+      ->capture_default_str();
+  add_documented(group, option_doc(kMappingOptionDocs, "min_patch_faces"), mapping.min_patch_faces);
+  add_documented(group, option_doc(kMappingOptionDocs, "hop_age"), mapping.hop_age);
+  add_off_switch(group, option_doc(kMappingOptionDocs, "shorten_seams"), mapping.shorten_seams);
+  add_off_switch(group, option_doc(kMappingOptionDocs, "close_cracks"), mapping.close_cracks);
   handles.crack_rings = add_documented(group, option_doc(kMappingOptionDocs, "crack_rings"), mapping.crack_rings)
                             ->check(CLI::Range(2u, 64u));
-  patches_only.push_back(handles.crack_rings);
-  patches_only.push_back(
-      add_documented(group, option_doc(kMappingOptionDocs, "relax_iterations"), mapping.relax_iterations)
-          ->check(CLI::Range(0u, 1000u)));
+  add_documented(group, option_doc(kMappingOptionDocs, "relax_iterations"), mapping.relax_iterations)
+      ->check(CLI::Range(0u, 1000u));
+  for (const OptionDoc* doc : kPatchesOnlyOptions)
+    handles.patches_only.push_back(group->get_option(std::string(doc->flag)));
   handles.threshold = add_documented(group, option_doc(kMappingOptionDocs, "threshold_px"), mapping.threshold_px);
   add_documented(group, option_doc(kOrientationOptionDocs, "axis"), args.axis);
   handles.smooth =

@@ -276,12 +276,19 @@ TAILOR_API Status measure_texture_map(const Mesh& mesh, const Topology& topology
 //! in [0, 1]. Fails with kInvalidArgument. map_texture's own checks still apply. O(1).
 TAILOR_API Status check_map_options(const MapTextureOptions& options);
 
+//! The options only the patches mode reads, as their kMappingOptionDocs entries: `tailor map`, the
+//! Python module and `tailor edit`'s API refuse them with the thesis mode, where they would be taken
+//! and do nothing.
+inline constexpr const OptionDoc* kPatchesOnlyOptions[] = {
+    &option_doc(kMappingOptionDocs, "max_stretch"),     &option_doc(kMappingOptionDocs, "field_following"),
+    &option_doc(kMappingOptionDocs, "min_patch_faces"), &option_doc(kMappingOptionDocs, "hop_age"),
+    &option_doc(kMappingOptionDocs, "shorten_seams"),   &option_doc(kMappingOptionDocs, "close_cracks"),
+    &option_doc(kMappingOptionDocs, "crack_rings"),     &option_doc(kMappingOptionDocs, "relax_iterations")};
+
 //! Refuses an option the mode does not read, which would be taken and do nothing, by its flag
-//! (the Python module raises the same): `patches_only`, the first given of the options only the
-//! patches mode reads (--max-stretch, --field-following, --min-patch-faces, --hop-age,
-//! --no-seam-shortening, --no-crack-closing, --crack-rings, --relax-iterations; "" when none), with
-//! the thesis mode; `threshold_given` (--threshold, read by the thesis mode only) with the
-//! patches mode. Fails with kInvalidArgument. O(1).
+//! (the Python module raises the same): `patches_only`, the flag of the first given of
+//! kPatchesOnlyOptions ("" when none), with the thesis mode; `threshold_given` (--threshold, read
+//! by the thesis mode only) with the patches mode. Fails with kInvalidArgument. O(1).
 TAILOR_API Status check_mode_options(MappingMode mode, std::string_view patches_only, bool threshold_given);
 
 //! Sets what the texture's size and the thread count decide, as `tailor map` does: the lattice
