@@ -37,6 +37,7 @@ import math
 import os
 import pathlib
 import re
+import secrets
 import shutil
 import signal
 import struct
@@ -164,11 +165,25 @@ def coarse_path(folder, name):
 def save_coarse(path, positions, faces, uvs, error):
     """What a node hands its parent: its content simplified to a quarter, and that step's error."""
     head = struct.pack("<QQd", positions.shape[0], faces.shape[0], error)
-    tmp = str(path) + ".part"
-    with open(tmp, "wb") as f:
-        for block in (head, positions.astype("<f4"), faces.astype("<u4"), uvs.astype("<f4")):
-            f.write(block if isinstance(block, bytes) else block.tobytes())
-    os.replace(tmp, path)
+    # A temporary name of its own, as the library's writes take (".tailor-XXXXXX"): a task Dask runs
+    # again while its first run, on a worker it declared lost, still writes must not write into the
+    # same file (one run's truncation could leave zeros in what the other renames into place).
+    folder = os.path.dirname(str(path)) or "."
+    while True:
+        tmp = os.path.join(folder, ".tailor-" + secrets.token_hex(3))
+        try:  # 0666 less the umask, as a plain open() creates
+            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC, 0o666)
+            break
+        except FileExistsError:
+            continue
+    try:
+        with os.fdopen(fd, "wb") as f:
+            for block in (head, positions.astype("<f4"), faces.astype("<u4"), uvs.astype("<f4")):
+                f.write(block if isinstance(block, bytes) else block.tobytes())
+        os.replace(tmp, path)
+    except BaseException:
+        pathlib.Path(tmp).unlink(missing_ok=True)
+        raise
 
 
 def load_coarse(path):

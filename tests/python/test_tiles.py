@@ -883,6 +883,34 @@ def test_the_vertex_pages_stay_mapped_up_to_a_budget_and_the_faces_are_released(
         assert np.array_equal(value, surveys[tiles_stream.VERTEX_PAGES_KEPT][key]), key
 
 
+def test_a_node_written_twice_at_once_is_written_whole(tmp_path):
+    # Dask runs a task again when it declares its worker lost, which may still be writing: two runs
+    # then write the same node's simplified copy at once. Here the second writes the whole file while
+    # the first is half-way (after its header, before its positions).
+    path = tmp_path / "lod" / "0_0_0_0.bin"
+    path.parent.mkdir()
+    positions = np.arange(12, dtype=np.float32).reshape(4, 3)
+    faces = np.array([[0, 1, 2], [0, 2, 3]], dtype=np.uint32)
+    uvs = np.linspace(0, 1, 12, dtype=np.float32).reshape(2, 3, 2)
+
+    class Interleaved(np.ndarray):
+        def astype(self, *args, **kwargs):
+            tiles.save_coarse(path, positions, faces, uvs, 0.5)
+            return np.asarray(self).astype(*args, **kwargs)
+
+    tiles.save_coarse(path, positions.view(Interleaved), faces, uvs, 0.5)
+    got = tiles.load_coarse(path)
+    assert all(np.array_equal(a, b) for a, b in zip(got[:3], (positions, faces, uvs))) and got[3] == 0.5
+    assert [p.name for p in path.parent.iterdir()] == [path.name]  # no temporary file left
+    assert path.stat().st_mode & 0o777 == 0o666 & ~current_umask()
+
+
+def current_umask():
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
 def test_one_run_at_a_time_writes_a_folder_and_nothing_but_its_tileset_is_replaced(tmp_path):
     import fcntl
 
