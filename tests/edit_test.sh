@@ -273,6 +273,9 @@ for body in '{"options": {"max_stretch": 0.3}}' '{"options": {"mode": "thesis"}}
 done
 post edit '{"options": {"mode": "thesis", "max_stretch": 0.3}}' | grep -qF "options.max_stretch has no effect in thesis mode" ||
   fail "a thesis request with max_stretch was not refused for it"
+# The page greys what the state names as patches-only: the keys the server refuses in thesis mode.
+[ "$(curl -s "${url}api/state" | json_field patches_only)" = "['max_stretch', 'field_following', 'min_patch_faces', 'hop_age', 'shorten_seams', 'close_cracks', 'crack_rings', 'relax_iterations']" ] ||
+  fail "the state's patches_only is not the options the thesis mode refuses: $(curl -s "${url}api/state")"
 stop_server
 
 echo "PASS: tailor edit and its API work"

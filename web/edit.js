@@ -297,7 +297,7 @@ async function refreshState() {
   session.surface.setMarked(flags);
   session.surface.setSymmetry(info.options?.symmetry);
   drawStrokes(info.strokes);
-  showOptions(info.options);
+  showOptions(info.options, info.patches_only);
   redrawAll();
 }
 
@@ -541,12 +541,13 @@ function moveBrushRing(event) {
 
 const kOptionInputs = ['axis', 'smooth_passes', 'field_following', 'mode', 'scale', 'max_stretch', 'min_patch_faces',
   'crack_rings', 'shorten_seams', 'close_cracks'];
-// What the thesis mode does not read (the server refuses a change of them there, as tailor map does).
-const kPatchesOnlyInputs = ['field_following', 'max_stretch', 'min_patch_faces', 'crack_rings', 'shorten_seams',
-  'close_cracks'];
 
-/** Shows the session's options in the mapping panel (axis auto and field following auto stay shown). */
-function showOptions(options) {
+/**
+ * Shows the session's options in the mapping panel (axis auto and field following auto stay shown),
+ * those the thesis mode does not read (`patchesOnly`: the server refuses a change of them there, as
+ * tailor map does) greyed in that mode.
+ */
+function showOptions(options, patchesOnly) {
   session.options = options;
   for (const key of kOptionInputs) {
     const input = document.getElementById(`opt-${key}`);
@@ -562,7 +563,8 @@ function showOptions(options) {
       input.value = String(value);
     } else input.value = String(value);
   }
-  for (const key of kPatchesOnlyInputs) document.getElementById(`opt-${key}`).disabled = options.mode === 'thesis';
+  for (const key of kOptionInputs)
+    document.getElementById(`opt-${key}`).disabled = options.mode === 'thesis' && patchesOnly.includes(key);
 }
 
 function optionValue(key) {

@@ -200,6 +200,13 @@ json options_json(const MapTextureOptions& options) {
   return j;
 }
 
+// The option keys the thesis mode does not read (kPatchesOnlyOptions): the page greys their inputs.
+json patches_only_keys() {
+  json keys = json::array();
+  for (const OptionDoc* doc : kPatchesOnlyOptions) keys.push_back(doc->field);
+  return keys;
+}
+
 json strokes_array(const std::vector<OrientationStroke>& strokes) {
   json list = json::array();
   for (const OrientationStroke& s : strokes) {
@@ -391,6 +398,7 @@ HttpResponse EditApi::state() const {
             {"version", version},
             {"settled", settled},
             {"options", options_json(options)},
+            {"patches_only", patches_only_keys()},
             {"seam_faces", std::move(marked)},
             {"strokes", strokes_array(strokes)},
             {"output", context_.glb_path},

@@ -218,6 +218,16 @@ try {
     const same = fs.readFileSync(replay).equals(glb);
     console.log(`save: ${glb.length} bytes; replay with tailor map: ${same ? 'identical' : 'DIFFERENT'}`);
     if (!same) fail(`replaying '${command}' gave other bytes than the saved .glb`);
+
+    // Thesis mode greys the inputs of the options it does not read (the state's patches_only), no others.
+    await page.selectOption('#opt-mode', 'thesis');
+    await page.waitForFunction(() => document.getElementById('opt-max_stretch').disabled, null,
+      { timeout: kSettleTimeoutMs });
+    await waitSettled(page);
+    const greyed = await page.evaluate(() =>
+      [...document.querySelectorAll('[id^="opt-"]')].filter((e) => e.disabled).map((e) => e.id.slice(4)).sort());
+    const expected = ['close_cracks', 'crack_rings', 'field_following', 'max_stretch', 'min_patch_faces', 'shorten_seams'];
+    if (greyed.join() !== expected.join()) fail(`thesis mode greyed ${greyed.join(', ')}, not ${expected.join(', ')}`);
   }
 
   await page.waitForTimeout(200);
