@@ -20,8 +20,14 @@ deps:
 deps-blender:
 	@TAILOR_BLENDER=1 bash scripts/deps.sh
 
+# Compiles through ccache when it is there (make deps installs it): a rebuild after a pull, and
+# tests/install_test.sh's shared-library build of the same sources, come from its cache
+# (~/.cache/ccache). Its base directory is the build folder: paths in it are hashed relative to
+# where the compiler runs, so the shared build beneath it (unity sources in its own folder) finds
+# the objects. CMAKE_FLAGS="-DCMAKE_CXX_COMPILER_LAUNCHER=" turns it off.
 configure: deps
-	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS) >/dev/null
+	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release $$(command -v ccache >/dev/null && \
+	   echo "-DCMAKE_CXX_COMPILER_LAUNCHER=env;CCACHE_BASEDIR=$(abspath $(BUILD_DIR));ccache") $(CMAKE_FLAGS) >/dev/null
 
 build: configure
 	@cmake --build $(BUILD_DIR) -j $(JOBS)

@@ -5,7 +5,7 @@ set -euo pipefail
 
 # Build tools and libraries (all Debian packages; see docs/ARCHITECTURE.md for why each is used).
 packages=(
-  g++ cmake make pkg-config
+  g++ cmake make pkg-config ccache
   libeigen3-dev libstb-dev zlib1g-dev libcli11-dev nlohmann-json3-dev libfast-float-dev
   libmeshoptimizer-dev libdraco-dev
   libopencv-core-dev libopencv-imgproc-dev libosmesa6-dev
@@ -15,6 +15,7 @@ packages=(
   libcgal-dev
   chromium
 )
+# ccache: the Makefile compiles through it (rebuilds, and the install test's shared libraries).
 # pybind11, Python's headers, numpy and pytest: the Python module and its tests (/usr/bin/python3).
 # python3-distributed (Dask): python3 -m tailor.tiles maps tiles as Dask tasks on a cluster.
 # python3-jsonschema: tests/tiles_schema_test.sh checks the tilesets against the 3D Tiles 1.1 schema.

@@ -116,6 +116,24 @@ TEST(Skeleton, OpenTubeIsClosedFirstAndTinyComponentsKeepPca) {
   for (float v : frames.orientation) ASSERT_TRUE(std::isfinite(v));
 }
 
+// The flow's linear solve fills in a dense block among a vertex's neighbours, so a vertex of n
+// neighbours costs n^2 memory: a fan cap of 128 faces, or an open end of 128 edges closed with one,
+// is replaced by rings of fewer vertices before the flow, and the skeleton still runs along the tube.
+TEST(Skeleton, LongHolesAndVerticesOfManyNeighboursAreClosedWithRings) {
+  for (const bool open : {true, false}) {
+    const Mesh tube = bent_tube(open, 120, 128);
+    internal::CurveSkeleton skeleton;
+    ASSERT_TRUE(internal::compute_curve_skeleton(tube, build_topology(tube), skeleton).is_ok());
+    EXPECT_EQ(skeleton.component_done, std::vector<uint8_t>{1}) << "open " << open;
+    EXPECT_EQ(skeleton.closed_holes, open ? 2u : 0u);
+    EXPECT_GT(skeleton.flow_max_valence, 6u);
+    EXPECT_LE(skeleton.flow_max_valence, 64u) << "open " << open;
+    const std::vector<double> along = tube_alignment(tube, frames_of(tube, AxisSource::kSkeleton));
+    ASSERT_GT(along.size(), 1000u);
+    EXPECT_GT(aligned(along, std::cos(kPi / 12)), along.size() * 95 / 100) << "open " << open;
+  }
+}
+
 // A wavy sheet whose vertices are snapped to a coarse grid: many faces with collinear or
 // coincident corners, on which CGAL's inside test (the flow's medial centering) finds no ray that
 // misses every edge. The flow contracts without the centering and every face gets a finite frame.

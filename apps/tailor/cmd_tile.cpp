@@ -310,6 +310,10 @@ int run_tile_set(TileCliOptions opt) {
     maps[m].directx = maps[m].normal && (opt.normal_convention == "dx" || dx_name ||
                                          std::find(opt.directx_maps.begin(), opt.directx_maps.end(), opt.set[m]) !=
                                              opt.directx_maps.end());
+    if (maps[m].normal && maps[m].image.channels < 3)  // make_tileable_set says "map N": name the file
+      return report_error(Status::error(ErrorCode::kInvalidArgument, opt.set[m],
+                                        "marked as a normal map (--normal-map) but has " +
+                                            std::to_string(maps[m].image.channels) + " channel(s), not 3 or 4"));
     if (maps[m].image.width != maps[0].image.width || maps[m].image.height != maps[0].image.height)
       return report_error(
           Status::error(ErrorCode::kInvalidImage, opt.set[m], "every map of a set must have the same size",

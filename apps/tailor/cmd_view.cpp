@@ -17,6 +17,7 @@
 #include "cli.h"
 #include "http_server.h"
 #include "tailor/image.h"
+#include "util/atomic_file.h"
 #include "util/bounded_json.h"
 
 namespace tailor::cli {
@@ -38,12 +39,14 @@ bool file_exists(const std::string& path) { return std::ifstream(path).good(); }
 //! Cheap check that `path` is a binary glTF 2.0 file, so a wrong file fails here with one line
 //! rather than in the browser.
 Status check_glb(const std::string& path) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) return Status::error(ErrorCode::kIo, path, "cannot open file");
-  const auto size = static_cast<uint64_t>(in.tellg());
-  in.seekg(0);
+  // A directory, FIFO or device gets the readers' own line (open_input), not "not a glTF file".
+  int fd = -1;
+  size_t size = 0;
+  TAILOR_RETURN_IF_ERROR(internal::open_input(path, fd, size));
   std::array<unsigned char, 12> head{};
-  if (size < 12 || !in.read(reinterpret_cast<char*>(head.data()), 12)) {
+  const bool read = size >= 12 && ::read(fd, head.data(), head.size()) == static_cast<ssize_t>(head.size());
+  ::close(fd);
+  if (!read) {
     return Status::error(ErrorCode::kParse, path, "not a binary glTF file", "shorter than its 12-byte header");
   }
   const auto u32 = [&](size_t at) {

@@ -199,11 +199,15 @@ Status load_material(const std::string& dir_or_json, MaterialMaps& out, const Im
           continue;
         bool dx = false;
         const MaterialRole role = role_from_word(key, &dx);
-        if (role == MaterialRole::kNone || !value.is_string())
+        if (role == MaterialRole::kNone)
           return Status::error(ErrorCode::kInvalidArgument, dir_or_json,
                                "unknown entry \"" + key +
                                    "\" (expected color, normal, roughness, metallic, "
                                    "occlusion or height naming a file)");
+        if (!value.is_string())
+          return Status::error(
+              ErrorCode::kInvalidArgument, dir_or_json,
+              "entry \"" + key + "\" must name a file (a string), not a " + std::string(value.type_name()));
         TAILOR_RETURN_IF_ERROR(claim(role, resolve(value.get<std::string>()), dx));
       }
     }

@@ -13,6 +13,7 @@
 #include "mapping/sum_smallest_first.h"
 #include "tailor/chunks.h"
 #include "util/bin_select.h"
+#include "util/huge_pages.h"
 #include "util/parallel_chunks.h"
 
 namespace tailor {
@@ -335,7 +336,7 @@ Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& pla
 
   // Each face's cell, packed in 63 bits (21 per axis, offset to be unsigned): x fastest; and each
   // part's distinct cells (a run of faces in one cell is looked up once).
-  std::vector<uint64_t> key(face_count);
+  internal::HugeArray<uint64_t> key = internal::huge_uninitialized<uint64_t>(face_count);  // each written first
   std::vector<CellTable> part_cells(parts);
   std::atomic<bool> outside{false};
   internal::for_each_part(face_count, parts, [&](size_t t, size_t begin, size_t end) {
@@ -387,12 +388,13 @@ Status plan_chunks(const Mesh& mesh, const ChunkOptions& options, ChunkPlan& pla
     }
     plan.chunk_start[c + 1] = at;
   }
+  internal::reserve_huge(plan.faces, face_count);
   plan.faces.resize(face_count);
   internal::for_each_part(face_count, groups, [&](size_t t, size_t begin, size_t end) {
     uint32_t* fill = count.data() + t * chunks;
     for (size_t f = begin; f < end; ++f) plan.faces[fill[key[f]]++] = static_cast<uint32_t>(f);
   });
-  std::vector<uint64_t>().swap(key);
+  key.reset();
   CellSplitter(mesh, plan, options.split_above ? options.split_above : ~uint32_t{0}).run(parts);
   return Status::ok();
 }

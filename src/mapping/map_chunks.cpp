@@ -21,6 +21,7 @@
 #include "tailor/chunks.h"
 #include "tailor/mapping.h"
 #include "tailor/topology.h"
+#include "util/huge_pages.h"
 #include "util/mesh_bounds.h"
 
 namespace tailor::internal {
@@ -131,6 +132,8 @@ Status map_whole_canonical(const Mesh& mesh, const MapTextureOptions& options, T
     TAILOR_RETURN_IF_ERROR(map_texture_in_order(w.mesh, topology, o, w.map));
   }
   // Back to the mesh's faces and corners (write_chunk_atlas), the frames too.
+  reserve_huge(map.atlas.corner_uv, 6 * face_count);
+  reserve_huge(map.atlas.patch, face_count);
   map.atlas.corner_uv.resize(6 * face_count);
   map.atlas.patch.resize(face_count);
   map.atlas.patch_count = w.map.atlas.patch_count;
@@ -234,6 +237,10 @@ Status map_chunks(const Mesh& mesh, const MapTextureOptions& options, TextureMap
     return plan.chunk_start[a + 1] - plan.chunk_start[a] > plan.chunk_start[b + 1] - plan.chunk_start[b];
   });
 
+  // Every corner is written by its chunk: on huge pages, the zero-fill before that is nearly free
+  // (in 4 KiB pages it was a tenth of the time outside the chunks' own stages).
+  reserve_huge(map.atlas.corner_uv, 6 * face_count);
+  reserve_huge(map.atlas.patch, face_count);
   map.atlas.corner_uv.resize(6 * face_count);
   map.atlas.patch.resize(face_count);
   std::vector<uint32_t> chunk_patches(chunks, 0);

@@ -6,7 +6,9 @@
 // The flow needs a closed, manifold, connected triangle mesh. Each edge component (faces joined by
 // paired edges, which are manifold and consistently oriented by construction of the topology) is
 // copied into a CGAL Surface_mesh; each hole is closed with a fan of triangles around the hole's
-// centroid, so open meshes (scans, disks like camelhead) get a skeleton of their closed-up shape.
+// centroid (a long hole with rings of fewer vertices first: fill_with_rings), so open meshes
+// (scans, disks like camelhead) get a skeleton of their closed-up shape, and a vertex of very many
+// neighbours is replaced by such rings around its position (replace_hubs).
 // A component that still is not a manifold surface (a pinched vertex), one with fewer than 4
 // faces, or one where the flow throws is skipped: its faces keep the PCA field. A component of more
 // than kFlowEdges edges is simplified first (the flow's cost is that of its first step on the
@@ -26,6 +28,8 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <stdexcept>
+#include <vector>
 
 namespace tailor::internal::skeleton_types {
 using Kernel = CGAL::Simple_cartesian<double>;
@@ -87,30 +91,105 @@ void contract_until_convergence(Skeletonization& flow) {
   }
 }
 
-// Closes every border cycle of `sm` with a fan around its centroid; returns the number closed.
+// A vertex of the flow's mesh with more neighbours than this is replaced by rings (fill_with_rings):
+// the flow's linear solve fills in a dense block among a vertex's neighbours, so one of valence n
+// costs n^2 memory (a disc of 8,000 faces around one vertex, or a hole of 8,000 edges closed
+// with a fan: over 3 GB and a minute; 1,000: 73 MB, 0.5 s).
+constexpr size_t kMaxFlowValence = 64;
+
+using Halfedge = SurfaceMesh::Halfedge_index;
+using Vertex = SurfaceMesh::Vertex_index;
+
+// Closes the border cycle of h: while it has more than kMaxFlowValence vertices, with a ring of
+// half as many (each on the mean of the two or three border vertices it joins, moved towards
+// `centre` by about the border's mean edge, at most half way), then with a fan around `centre`.
+// Every new vertex has at most ~9 neighbours, the border's at most 3 more than before.
+void fill_with_rings(SurfaceMesh& sm, Halfedge h, const Point& centre) {
+  std::vector<Vertex> ring, inner;
+  for (Halfedge g = h;;) {
+    ring.push_back(sm.source(g));
+    g = sm.next(g);
+    if (g == h) break;
+  }
+  const auto towards = [&](double x, double y, double z, double step) {
+    const double dx = x - centre.x(), dy = y - centre.y(), dz = z - centre.z();
+    const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
+    const double keep = d > 0 ? std::max(0.5, 1.0 - step / d) : 0.0;
+    return Point(centre.x() + keep * dx, centre.y() + keep * dy, centre.z() + keep * dz);
+  };
+  while (ring.size() > kMaxFlowValence) {
+    const size_t n = ring.size(), m = (n + 1) / 2;
+    double perimeter = 0;
+    for (size_t i = 0; i < n; ++i)
+      perimeter += std::sqrt(CGAL::squared_distance(sm.point(ring[i]), sm.point(ring[(i + 1) % n])));
+    const double step = perimeter / static_cast<double>(n);
+    inner.clear();
+    for (size_t j = 0; j < m; ++j) {  // w_j joins the border edges 2j and 2j + 1 (the last may have one)
+      double sum[3] = {0, 0, 0}, count = 0;
+      for (size_t i = 2 * j; i <= std::min(2 * j + 2, n); ++i) {
+        const Point& p = sm.point(ring[i % n]);
+        sum[0] += p.x(), sum[1] += p.y(), sum[2] += p.z();
+        ++count;
+      }
+      inner.push_back(sm.add_vertex(towards(sum[0] / count, sum[1] / count, sum[2] / count, step)));
+    }
+    const auto add = [&sm](Vertex a, Vertex b, Vertex c) {
+      if (sm.add_face(a, b, c) == SurfaceMesh::null_face()) throw std::runtime_error("hole not closed");
+    };
+    for (size_t j = 0; j < m; ++j) {
+      for (size_t i = 2 * j; i < std::min(2 * j + 2, n); ++i) add(ring[i], ring[(i + 1) % n], inner[j]);
+      add(inner[j], ring[std::min(2 * j + 2, n) % n], inner[(j + 1) % m]);  // to the next ring vertex
+    }
+    ring.swap(inner);
+    h = sm.halfedge(ring[0], ring[1]);  // the new ring's border runs the same way
+  }
+  CGAL::Euler::fill_hole(h, sm);
+  const Halfedge middle = CGAL::Euler::add_center_vertex(h, sm);
+  sm.point(sm.target(middle)) = centre;
+}
+
+// Closes every border cycle of `sm` (fill_with_rings towards its centroid); returns the number
+// closed.
 uint32_t close_holes(SurfaceMesh& sm) {
-  std::vector<SurfaceMesh::Halfedge_index> borders;
+  std::vector<Halfedge> borders;
   std::vector<uint8_t> seen(sm.number_of_halfedges(), 0);
-  for (SurfaceMesh::Halfedge_index h : sm.halfedges()) {
+  for (Halfedge h : sm.halfedges()) {
     if (!sm.is_border(h) || seen[h.idx()]) continue;
     borders.push_back(h);
-    for (SurfaceMesh::Halfedge_index g = h; !seen[g.idx()]; g = sm.next(g)) seen[g.idx()] = 1;
+    for (Halfedge g = h; !seen[g.idx()]; g = sm.next(g)) seen[g.idx()] = 1;
   }
-  for (SurfaceMesh::Halfedge_index h : borders) {
+  for (Halfedge h : borders) {
     double sum[3] = {0, 0, 0};
     double n = 0;
-    SurfaceMesh::Halfedge_index g = h;
+    Halfedge g = h;
     do {
       const Point& p = sm.point(sm.target(g));
       sum[0] += p.x(), sum[1] += p.y(), sum[2] += p.z();
       ++n;
       g = sm.next(g);
     } while (g != h);
-    CGAL::Euler::fill_hole(h, sm);
-    const SurfaceMesh::Halfedge_index centre = CGAL::Euler::add_center_vertex(h, sm);
-    sm.point(sm.target(centre)) = Point(sum[0] / n, sum[1] / n, sum[2] / n);
+    fill_with_rings(sm, h, Point(sum[0] / n, sum[1] / n, sum[2] / n));
   }
   return static_cast<uint32_t>(borders.size());
+}
+
+// Replaces each vertex of more than kMaxFlowValence neighbours (a fan: a large polygon of the file
+// triangulated around one corner, a cone's apex) by rings towards its own position. Returns the
+// largest valence left.
+size_t replace_hubs(SurfaceMesh& sm) {
+  std::vector<Vertex> hubs;
+  for (Vertex v : sm.vertices())
+    if (sm.degree(v) > kMaxFlowValence && !sm.is_border(v)) hubs.push_back(v);
+  for (Vertex v : hubs) {
+    const Point at = sm.point(v);
+    const Halfedge merged = CGAL::Euler::remove_center_vertex(sm.halfedge(v), sm);
+    CGAL::Euler::remove_face(merged, sm);  // its halfedges are now the border of a hole
+    fill_with_rings(sm, merged, at);
+  }
+  if (!hubs.empty()) sm.collect_garbage();
+  size_t most = 0;
+  for (Vertex v : sm.vertices()) most = std::max<size_t>(most, sm.degree(v));
+  return most;
 }
 
 }  // namespace
@@ -163,16 +242,18 @@ Status compute_curve_skeleton(const Mesh& mesh, const Topology& topology, CurveS
       ++skeleton.skipped_components;
       continue;
     }
-    const uint32_t holes = close_holes(sm);
-    // The flow's first step runs on the whole mesh (168 s and 3.7 GB on a 1.55M-face horse):
-    // above kFlowEdges, a simplified copy goes into the flow; the skeleton is coarse anyway.
-    if (sm.number_of_edges() > kFlowEdges) {
-      CGAL::Surface_mesh_simplification::Count_stop_predicate<SurfaceMesh> stop(kFlowEdges);
-      CGAL::Surface_mesh_simplification::edge_collapse(sm, stop);
-      sm.collect_garbage();
-    }
+    uint32_t holes = 0;
     SkeletonGraph graph;
     try {
+      holes = close_holes(sm);
+      skeleton.flow_max_valence = std::max(skeleton.flow_max_valence, static_cast<uint32_t>(replace_hubs(sm)));
+      // The flow's first step runs on the whole mesh (168 s and 3.7 GB on a 1.55M-face horse):
+      // above kFlowEdges, a simplified copy goes into the flow; the skeleton is coarse anyway.
+      if (sm.number_of_edges() > kFlowEdges) {
+        CGAL::Surface_mesh_simplification::Count_stop_predicate<SurfaceMesh> stop(kFlowEdges);
+        CGAL::Surface_mesh_simplification::edge_collapse(sm, stop);
+        sm.collect_garbage();
+      }
       // The flow's Delaunay step shuffles points with CGAL's default generator, which is seeded
       // from the clock (and is per thread): a fixed seed per component makes the skeleton
       // the same on every run.

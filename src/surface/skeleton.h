@@ -2,7 +2,9 @@
 //
 // compute_curve_skeleton (skeleton.cpp, the only file that includes CGAL) runs CGAL's
 // mean-curvature-flow skeletonization on each edge component of the mesh, after closing the
-// component's holes with a fan around each hole's centroid; skeleton_face_directions
+// component's holes (a fan around each hole's centroid, rings of fewer vertices first around a
+// long one, and the same around a vertex of very many neighbours: the flow's cost grows with the
+// square of a vertex's valence); skeleton_face_directions
 // (skeleton_field.cpp) gives each face the direction of its nearest skeleton edge.
 #pragma once
 
@@ -23,6 +25,7 @@ struct CurveSkeleton {
   std::vector<uint8_t> component_done;   //!< per mesh edge component: 1 if it has a skeleton
   uint32_t closed_holes = 0;             //!< holes closed before skeletonizing
   uint32_t skipped_components = 0;       //!< components left without a skeleton (see skeleton.cpp)
+  uint32_t flow_max_valence = 0;         //!< the most neighbours of a vertex handed to the flow
   double seconds = 0.0;                  //!< wall time
 
   size_t edge_count() const { return edges.size() / 2; }
