@@ -87,6 +87,7 @@ void seam_flags(const py::array& seams, size_t face_count, std::vector<uint8_t>&
     for (size_t f = 0; f < face_count; ++f) flags[f] = mask.data()[f] ? 1 : 0;
     return;
   }
+  if (seams.shape(0) == 0) return;  // no index: [] is float64 to numpy, and means no seam face
   if (seams.dtype().kind() != 'i' && seams.dtype().kind() != 'u')
     raise_error("seam_faces must hold integer face indices or bools, got " + describe(seams));
   const auto ids = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(seams);

@@ -149,10 +149,21 @@ void bind_mesh(py::module_& m) {
                      "coordinates and indices out of range raise\n"
                      "tailor.Error; faces with a repeated vertex and exact duplicate faces are dropped and\n"
                      "counted in load_report (compare face_count with len(faces)).")
-      .def(py::init([](const py::array& positions, const py::array& faces) {
+      .def(py::init([](const py::object& positions, const py::object& faces) {
+             // Any array-like (nested lists too), as numpy reads it; what it cannot read is a
+             // tailor.Error like a wrong shape, not pybind11's list of signatures.
+             const auto array_of = [](const py::object& o, const char* name) {
+               const py::array a = py::array::ensure(o);
+               if (!a) {
+                 PyErr_Clear();
+                 raise_error(std::string(name) + " must be an array of numbers, got " +
+                             py::str(py::type::of(o)).cast<std::string>());
+               }
+               return a;
+             };
              auto mesh = std::make_unique<PyMesh>();
-             copy_positions(positions, mesh->mesh.positions);
-             copy_faces(faces, mesh->mesh.vertex_count(), mesh->mesh.indices);
+             copy_positions(array_of(positions, "positions"), mesh->mesh.positions);
+             copy_faces(array_of(faces, "faces"), mesh->mesh.vertex_count(), mesh->mesh.indices);
              mesh->load.format = "arrays";
              mesh->load.source_faces = mesh->mesh.face_count();
              Status status;

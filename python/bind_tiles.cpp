@@ -6,6 +6,7 @@
 #include <meshoptimizer.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <limits>
 
@@ -205,10 +206,14 @@ chunk k's face ids are faces[chunk_start[k]:chunk_start[k+1]].)");
         const auto uv = corner_uv_array(corner_uvs, faces);
         if (py::len(size) != 2) raise_error("texture_size must be (width, height), got " + sequence_text(size));
         ExportOptions options;
-        options.texture_width = size[0].cast<int>();
-        options.texture_height = size[1].cast<int>();
+        try {
+          options.texture_width = size[0].cast<int>();
+          options.texture_height = size[1].cast<int>();
+        } catch (const py::cast_error&) {  // not integers, or beyond int: as the range below says
+          options.texture_width = options.texture_height = 0;
+        }
         if (options.texture_width <= 0 || options.texture_height <= 0)
-          raise_error("texture_size must be positive, got " + sequence_text(size));
+          raise_error("texture_size must be two positive integers (pixels), got " + sequence_text(size));
         if (up != "y" && up != "z") raise_error("--up must be y or z, got '" + up + "'");
         options.up = up == "z" ? SceneUp::kZ : SceneUp::kY;
         if (!texture.is_none() && !material.is_none())
@@ -281,6 +286,10 @@ void bind_simplify(py::module_& m) {
       [](const PyMesh& mesh, const py::array& corner_uvs, size_t target_faces, bool lock_border) {
         const size_t faces = mesh.mesh.face_count();
         const auto uv = corner_uv_array(corner_uvs, faces);
+        const float* const values = uv.data();
+        for (size_t i = 0; i < 6 * faces; ++i)  // the simplifier would carry NaN through silently
+          if (!std::isfinite(values[i]))
+            raise_error("corner_uvs: UV is not finite (corner " + std::to_string(i / 2) + ")");
         SplitMesh split;
         std::vector<uint32_t> kept;
         float error = 0.f, scale = 0.f;

@@ -69,7 +69,11 @@ std::string sequence_text(const py::handle& value) {
 
 void set_chunk_split(const py::object& chunk_split, uint32_t& split_above) {
   if (chunk_split.is_none()) return;
-  const long long n = chunk_split.cast<long long>();
+  long long n = -1;
+  try {
+    n = chunk_split.cast<long long>();
+  } catch (const py::cast_error&) {  // not an integer, or beyond 64 bits: the same line as out of range
+  }
   if (n < 0 || n > 0xffffffffLL) raise_error("chunk_split must be None, 0 (never cut) or at least 64 faces");
   split_above = static_cast<uint32_t>(n);
 }
@@ -79,7 +83,11 @@ std::string path_of(const py::handle& path) {
     raise_error("expected a path (str or os.PathLike), got " + py::str(py::type::of(path)).cast<std::string>());
   // The file system's bytes (os.fsencode): a name that is not UTF-8 (decoded by Python with
   // surrogate escapes) names the same file, where a UTF-8 cast of the str would fail.
-  return py::module_::import("os").attr("fsencode")(path).cast<py::bytes>().cast<std::string>();
+  std::string bytes = py::module_::import("os").attr("fsencode")(path).cast<py::bytes>().cast<std::string>();
+  // The C library stops at a NUL: "a\0.glb" would write "a". Python's own open() refuses it too.
+  if (bytes.find('\0') != std::string::npos)
+    raise_error("path contains a NUL character: " + py::repr(path).cast<std::string>());
+  return bytes;
 }
 
 py::object utf8_text(const std::string& text) {

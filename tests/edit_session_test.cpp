@@ -184,7 +184,7 @@ TEST(EditSession, BadEditsChangeNothing) {
   ASSERT_TRUE(session);
   const Atlas before = current_atlas(*session);
   const uint32_t faces = static_cast<uint32_t>(mesh.face_count());
-  std::vector<EditRequest> bad(7);
+  std::vector<EditRequest> bad(8);
   bad[0].add_seam_faces = {1, faces};
   bad[1].remove_seam_faces = {faces + 10};
   bad[2].strokes.push_back({{0.f, 0.f, 0.f}, 1.f});                 // one point
@@ -194,6 +194,9 @@ TEST(EditSession, BadEditsChangeNothing) {
   bad[5].options->mapping.scale = 0.f;  // check_map_options refuses
   bad[6].options = default_options();
   bad[6].options->mapping.max_stretch = 100.f;  // map_texture refuses
+  // More stroke points than a session holds (each edit samples all of them): 2^20 + 1.
+  bad[7].strokes.push_back({std::vector<float>(3 * ((size_t{1} << 20) + 1)), 1.f});
+  for (size_t i = 0; i < bad[7].strokes[0].points.size(); i += 3) bad[7].strokes[0].points[i] = static_cast<float>(i);
   for (EditRequest& edit : bad) {
     edit.add_seam_faces.push_back(5);  // a valid part that must not be applied either
     EditResult result;

@@ -56,7 +56,7 @@ MANIFEST = "tailor-tiles.json"
 # Seconds the driver waits, when it stops, for the cluster's start to end before it exits anyway (a
 # start takes a few seconds).
 CLIENT_CLOSE_WAIT = 10
-FORMAT = 1  # of the manifest: a different number means every tile is written again
+FORMAT = 2  # of the manifest: a different number means every tile is written again
 # The streamed partition's ranges of the file (at least a block each): enough for every worker of a
 # cluster to take several, so that the driver and the workers finish together.
 PARTITION_PARTS = 256
@@ -188,7 +188,9 @@ def save_coarse(path, positions, faces, uvs, error):
 
 def load_coarse(path):
     data = pathlib.Path(path).read_bytes()
-    v, f, error = struct.unpack_from("<QQd", data, 0)
+    v, f, error = struct.unpack_from("<QQd", data, 0) if len(data) >= 24 else (0, 0, 0.0)
+    if len(data) < 24 or len(data) != 24 + 12 * v + 36 * f or not math.isfinite(error):
+        raise TilesError("%s: damaged (%d bytes, not what its header counts): remove the output folder" % (path, len(data)))
     at = 24
     positions = np.frombuffer(data, "<f4", 3 * v, at).reshape(v, 3)
     at += 12 * v
@@ -218,20 +220,37 @@ def simplify(positions, faces, uvs, target):
     return r["positions"], f, t, r["error"]
 
 
-def kept(keep_from, digest, folder, name, lod):
-    """Links the previous run's files of this node into folder when its digest is the same."""
+def kept(keep_from, digest, folder, name, lod, record):
+    """Links the previous run's files of this node into folder when its digest is the same and
+    each file still has the size that run wrote (a truncated or replaced file is written again);
+    record takes the sizes."""
     if not keep_from or keep_from.get("digest") != digest:
         return False
-    pairs = [(keep_from["glb"], glb_path(folder, name))] if keep_from.get("faces", 1) > 0 else []
+    pairs = [(keep_from["glb"], glb_path(folder, name), "glb_bytes")] if keep_from.get("faces", 1) > 0 else []
     if lod:
-        pairs.append((keep_from["coarse"], coarse_path(folder, name)))
-    if not all(os.path.exists(old) for old, _ in pairs):
-        return False
-    for old, new in pairs:
+        pairs.append((keep_from["coarse"], coarse_path(folder, name), "coarse_bytes"))
+    for old, _, size in pairs:
+        try:
+            if os.path.getsize(old) != keep_from.get(size):
+                return False
+        except OSError:
+            return False
+    for old, new, size in pairs:
         if os.path.exists(new):  # a retried task
             os.unlink(new)
         os.link(old, new)
+        record[size] = keep_from[size]
     return True
+
+
+def file_sizes(record, folder, lod):
+    """The sizes of the node's files as written, which a later run checks before it keeps them."""
+    name = record["name"]
+    if record.get("faces", 1) > 0:
+        record["glb_bytes"] = os.path.getsize(glb_path(folder, name))
+    if lod:
+        record["coarse_bytes"] = os.path.getsize(coarse_path(folder, name))
+    return record
 
 
 def finish_node(record, folder, positions, faces, uvs, params, lod, mesh=None):
@@ -245,7 +264,7 @@ def finish_node(record, folder, positions, faces, uvs, params, lod, mesh=None):
         save_coarse(coarse_path(folder, record["name"]), p, f, t, error)
         record["coarse_error"] = error
     record["written"] = True
-    return record
+    return file_sizes(record, folder, lod)
 
 
 def leaf_record(job, positions, faces, params):
@@ -268,7 +287,7 @@ def map_tile(job, positions, faces, params, folder, keep_from, threads, lod):
     links the previous run's files when the digest is the same. Returns the node's record."""
     positions, faces = tailor.canonical_tile(positions, faces)
     record = leaf_record(job, positions, faces, params)
-    if kept(keep_from, record["digest"], folder, job["name"], lod):
+    if kept(keep_from, record["digest"], folder, job["name"], lod, record):
         record["coarse_error"] = keep_from.get("coarse_error", 0.0)
         record["written"] = False
         return record
@@ -384,7 +403,7 @@ def build_parent(job, params, folder, keep_from, *children):
         "children": [c["name"] for c in children],
     }
     below = max(c["error"] + c["coarse_error"] for c in children)
-    if kept(keep_from, record["digest"], folder, job["name"], True):
+    if kept(keep_from, record["digest"], folder, job["name"], True, record):
         record.update(faces=keep_from["faces"], error=keep_from["error"], coarse_error=keep_from["coarse_error"])
         record["written"] = False
         return record
@@ -400,7 +419,7 @@ def build_parent(job, params, folder, keep_from, *children):
     if f.shape[0] == 0:  # the children's copies collapse where they are welded: a node without content
         save_coarse(coarse_path(folder, job["name"]), p, f, t, 0.0)
         record.update(coarse_error=0.0, written=True)
-        return record
+        return file_sizes(record, folder, True)
     return finish_node(record, folder, p, f, t, params, True)
 
 
@@ -1098,8 +1117,8 @@ def run_locked(args, outdir):
             stray.unlink(missing_ok=True)
         t_map = time.monotonic()
         (tmp / "tileset.json").write_text(json.dumps(tileset_json(records, args.lod, args.up), indent=1) + "\n")
-        fields = ("digest", "faces", "error", "coarse_error")
-        manifest = {"params": params, "tiles": {r["name"]: {k: r[k] for k in fields} for r in records}}
+        fields = ("digest", "faces", "error", "coarse_error", "glb_bytes", "coarse_bytes")
+        manifest = {"params": params, "tiles": {r["name"]: {k: r[k] for k in fields if k in r} for r in records}}
         (tmp / MANIFEST).write_text(json.dumps(manifest, indent=1, sort_keys=True) + "\n")
         # Into place: the old folder aside, the new one in, the old one removed.
         aside = None
@@ -1265,8 +1284,14 @@ def parse_args(argv):
             value = float("nan")
         if not 0.0 <= value <= 1.0:
             usage_error("--field-following must be auto or a number in [0, 1], got '%s'" % args.field_following)
-    if args.workers < 0:
-        p.error("--workers must be 0 or more")
+    # Each local worker is a process of ~100 MB before its first tile: a cap well above the cores,
+    # so that a mistyped count fails here instead of starting processes until memory runs out.
+    most_workers = max(256, 4 * (os.cpu_count() or 1))
+    if args.workers < 0 or args.workers > most_workers:
+        p.error(
+            "--workers must be in 0..%d (local worker processes; a larger cluster: start it and give --scheduler)"
+            % most_workers
+        )
     if args.threads < 0 or args.threads > 64:
         p.error("--threads must be in 0..64")
     return args

@@ -237,8 +237,11 @@ class _Body:
     def positions(self, first, count):
         v = self.vertices[first : first + count]
         out = np.empty((v.shape[0], 3), dtype=np.float32)
-        for k, axis in enumerate("xyz"):
-            out[:, k] = v[axis]
+        # A double beyond float32 becomes inf here, which the checks that follow name in one line;
+        # numpy's own overflow warning would come first.
+        with np.errstate(over="ignore", invalid="ignore"):
+            for k, axis in enumerate("xyz"):
+                out[:, k] = v[axis]
         return out
 
     def blocks(self, block_faces, begin=0, end=None):

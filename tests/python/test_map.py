@@ -143,7 +143,14 @@ def test_bad_seam_faces_and_mismatched_save(tmp_path):
         tailor.save(tmp_path / "x.glb", mesh, tailor.map(other))
     with pytest.raises(tailor.Error, match="directory"):
         tailor.save(tmp_path / "missing" / "x.glb", mesh, tailor.map(mesh))
+    # The C library ends a name at a NUL: "x\0.glb" would write "x", "SPOT\0.xyz" read SPOT.
+    with pytest.raises(tailor.Error, match="path contains a NUL character"):
+        tailor.save(str(tmp_path / "x\0.glb"), mesh, tailor.map(mesh))
+    with pytest.raises(tailor.Error, match="path contains a NUL character"):
+        tailor.load(str(SPOT) + "\0.xyz")
     assert list(tmp_path.iterdir()) == []
+    # No index is no seam face, whatever dtype numpy gives an empty list.
+    assert np.array_equal(tailor.map(mesh, seam_faces=[]).corner_uvs, tailor.map(mesh).corner_uvs)
 
 
 def test_unit_scale_gives_one_texel_density_whatever_the_size():
@@ -157,6 +164,20 @@ def test_unit_scale_gives_one_texel_density_whatever_the_size():
     assert densities[0] == pytest.approx(100**2, rel=0.05) and densities[1] == pytest.approx(100**2, rel=0.05)
     with pytest.raises(tailor.Error, match="unit_scale"):
         tailor.map(tailor.Mesh(positions, faces), unit_scale=-1)
+
+
+def test_numbers_beyond_their_range_and_non_finite_uvs_are_errors(tmp_path):
+    mesh = tailor.load(SPOT)
+    with pytest.raises(tailor.Error, match="chunk_split must be"):
+        tailor.map(mesh, chunk_split=2**70)
+    uvs = tailor.map(mesh).corner_uvs
+    with pytest.raises(tailor.Error, match="texture_size must be two positive integers"):
+        tailor.save_uvs(tmp_path / "x.glb", mesh, uvs, (2**40, 512))
+    with pytest.raises(tailor.Error, match=r"UV is not finite \(corner 3\)"):
+        bad = uvs.copy()
+        bad[1, 0, 0] = np.nan
+        tailor.simplify_uvs(mesh, bad, 100)
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_seam_faces_that_are_no_array():

@@ -182,12 +182,20 @@ GOOD_FACES = np.array([[0, 1, 2]], np.int32)
         (GOOD_POSITIONS, np.array([[0, 1, 2], [0, -1, 2]]), r"face index -1 out of range .*\(face 1\)"),
         (GOOD_POSITIONS, np.array([[0, 1, 2 ** 40]], np.int64), "face index 1099511627776 out of range"),
         (GOOD_POSITIONS, np.zeros((0, 3), np.int32), "mesh has no faces"),
+        (object(), GOOD_FACES, r"positions must be a \(V, 3\) array, got object \(\)"),
+        ([[0, 0, 0], [1, 0], [0, 1, 0]], GOOD_FACES, "positions must be an array of numbers, got <class 'list'>"),
+        (GOOD_POSITIONS, "abc", r"faces must be an \(F, 3\) array"),
     ],
 )
 def test_bad_arrays_raise_tailor_error(positions, faces, message):
     with pytest.raises(tailor.Error, match=message) as caught:
         tailor.Mesh(positions, faces)
     assert isinstance(caught.value, ValueError)
+
+
+def test_nested_lists_are_arrays():
+    mesh = tailor.Mesh([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], [[0, 1, 2]])
+    assert mesh.face_count == 1 and np.array_equal(mesh.positions, GOOD_POSITIONS.astype(np.float32))
 
 
 def test_bad_files_raise_the_cli_message(tmp_path, tailor_binary):

@@ -215,6 +215,20 @@ def test_a_rerun_rewrites_only_the_tiles_that_changed(tmp_path):
     assert json.loads(stdout)["written"] == 0
     assert {p.name: (p.stat().st_mtime_ns, p.read_bytes()) for p in (out / "tiles").iterdir()} == before
 
+    # A tile cut short and another node's level-of-detail file replaced: those two nodes are
+    # written again, as they were.
+    damaged = sorted((out / "tiles").iterdir())[0]
+    damaged.write_bytes(damaged.read_bytes()[:100])
+    coarse = next(p for p in sorted((out / "lod").iterdir()) if p.stem != damaged.stem)
+    coarse_bytes = coarse.read_bytes()
+    coarse.write_bytes(b"junk")
+    code, stdout, stderr = run_tiles(shuffled, "-o", out, *args)
+    assert code == 0, stderr
+    assert json.loads(stdout)["written"] == 2
+    assert {p.name: p.read_bytes() for p in (out / "tiles").iterdir()} == {n: b for n, (_, b) in before.items()}
+    assert coarse.read_bytes() == coarse_bytes
+    before = {p.name: (p.stat().st_mtime_ns, p.read_bytes()) for p in (out / "tiles").iterdir()}
+
     # A ball of faces removed around one vertex: only the tiles it touches are written again.
     centre = mesh.positions[mesh.faces[0, 0]]
     centroids = mesh.positions[mesh.faces].mean(axis=1)
@@ -463,6 +477,10 @@ def test_bounding_boxes_hold_the_content_as_a_client_places_it(tmp_path, up):
         assert code == 2 and stderr.count("\n") == 1, stderr
         assert stderr.startswith("tailor.tiles: error: %s must be a positive number" % option), stderr
         assert not (tmp_path / "bad").exists()
+    # A worker count no machine runs as local processes: refused before any starts.
+    code, _, stderr = run_tiles(HORSE, "-o", tmp_path / "bad", "--workers", 1000000)
+    assert code == 2 and stderr.count("\n") == 1 and "--workers must be in 0.." in stderr, stderr
+    assert not (tmp_path / "bad").exists()
     # What argparse itself rejects is one line too, without argparse's usage block.
     for args in (("--workers", "abc"), ("--threads",)):
         code, _, stderr = run_tiles(HORSE, "-o", tmp_path / "bad", *args)
