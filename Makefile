@@ -24,10 +24,12 @@ deps-blender:
 # tests/install_test.sh's shared-library build of the same sources, come from its cache
 # (~/.cache/ccache). Its base directory is the build folder: paths in it are hashed relative to
 # where the compiler runs, so the shared build beneath it (unity sources in its own folder) finds
-# the objects. CMAKE_FLAGS="-DCMAKE_CXX_COMPILER_LAUNCHER=" turns it off.
+# the objects. CMAKE_FLAGS="-DCMAKE_CXX_COMPILER_LAUNCHER=" configures without it (each make
+# configures again: give it every time).
 configure: deps
 	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release $$(command -v ccache >/dev/null && \
-	   echo "-DCMAKE_CXX_COMPILER_LAUNCHER=env;CCACHE_BASEDIR=$(abspath $(BUILD_DIR));ccache") $(CMAKE_FLAGS) >/dev/null
+	   echo "-DCMAKE_CXX_COMPILER_LAUNCHER=env;CCACHE_BASEDIR=$(abspath $(BUILD_DIR));ccache" || \
+	   echo "-DCMAKE_CXX_COMPILER_LAUNCHER=") $(CMAKE_FLAGS) >/dev/null
 
 build: configure
 	@cmake --build $(BUILD_DIR) -j $(JOBS)

@@ -154,11 +154,9 @@ void bind_mesh(py::module_& m) {
              // tailor.Error like a wrong shape, not pybind11's list of signatures.
              const auto array_of = [](const py::object& o, const char* name) {
                const py::array a = py::array::ensure(o);
-               if (!a) {
-                 PyErr_Clear();
-                 raise_error(std::string(name) + " must be an array of numbers, got " +
-                             py::str(py::type::of(o)).cast<std::string>());
-               }
+               if (!a)
+                 raise_error(std::string(name) + " must be an array of numbers, got a " +
+                             py::type::of(o).attr("__name__").cast<std::string>() + " numpy cannot read as one");
                return a;
              };
              auto mesh = std::make_unique<PyMesh>();

@@ -206,14 +206,8 @@ chunk k's face ids are faces[chunk_start[k]:chunk_start[k+1]].)");
         const auto uv = corner_uv_array(corner_uvs, faces);
         if (py::len(size) != 2) raise_error("texture_size must be (width, height), got " + sequence_text(size));
         ExportOptions options;
-        try {
-          options.texture_width = size[0].cast<int>();
-          options.texture_height = size[1].cast<int>();
-        } catch (const py::cast_error&) {  // not integers, or beyond int: as the range below says
-          options.texture_width = options.texture_height = 0;
-        }
-        if (options.texture_width <= 0 || options.texture_height <= 0)
-          raise_error("texture_size must be two positive integers (pixels), got " + sequence_text(size));
+        options.texture_width = static_cast<int>(whole_number(size[0], "texture_size's width", 1, INT32_MAX));
+        options.texture_height = static_cast<int>(whole_number(size[1], "texture_size's height", 1, INT32_MAX));
         if (up != "y" && up != "z") raise_error("--up must be y or z, got '" + up + "'");
         options.up = up == "z" ? SceneUp::kZ : SceneUp::kY;
         if (!texture.is_none() && !material.is_none())

@@ -69,12 +69,7 @@ std::string sequence_text(const py::handle& value) {
 
 void set_chunk_split(const py::object& chunk_split, uint32_t& split_above) {
   if (chunk_split.is_none()) return;
-  long long n = -1;
-  try {
-    n = chunk_split.cast<long long>();
-  } catch (const py::cast_error&) {  // not an integer, or beyond 64 bits: the same line as out of range
-  }
-  if (n < 0 || n > 0xffffffffLL) raise_error("chunk_split must be None, 0 (never cut) or at least 64 faces");
+  const int64_t n = whole_number(chunk_split, "chunk_split", 0, 0xffffffffLL);
   split_above = static_cast<uint32_t>(n);
 }
 

@@ -184,7 +184,7 @@ TEST(EditSession, BadEditsChangeNothing) {
   ASSERT_TRUE(session);
   const Atlas before = current_atlas(*session);
   const uint32_t faces = static_cast<uint32_t>(mesh.face_count());
-  std::vector<EditRequest> bad(8);
+  std::vector<EditRequest> bad(7);
   bad[0].add_seam_faces = {1, faces};
   bad[1].remove_seam_faces = {faces + 10};
   bad[2].strokes.push_back({{0.f, 0.f, 0.f}, 1.f});                 // one point
@@ -194,9 +194,6 @@ TEST(EditSession, BadEditsChangeNothing) {
   bad[5].options->mapping.scale = 0.f;  // check_map_options refuses
   bad[6].options = default_options();
   bad[6].options->mapping.max_stretch = 100.f;  // map_texture refuses
-  // More stroke points than a session holds (each edit samples all of them): 2^20 + 1.
-  bad[7].strokes.push_back({std::vector<float>(3 * ((size_t{1} << 20) + 1)), 1.f});
-  for (size_t i = 0; i < bad[7].strokes[0].points.size(); i += 3) bad[7].strokes[0].points[i] = static_cast<float>(i);
   for (EditRequest& edit : bad) {
     edit.add_seam_faces.push_back(5);  // a valid part that must not be applied either
     EditResult result;
@@ -222,6 +219,38 @@ TEST(EditSession, BadEditsChangeNothing) {
   EXPECT_EQ(result.version, 0u);
   EXPECT_EQ(result.changed_faces, 0u);
   EXPECT_TRUE(result.settled);
+}
+
+// A stroke of n points along x, far beyond the mesh (its field reaches no face).
+OrientationStroke far_stroke(size_t n) {
+  OrientationStroke s{std::vector<float>(3 * n, 100.f), 0.01f};
+  for (size_t i = 0; i < n; ++i) s.points[3 * i] = 100.f + 0.001f * static_cast<float>(i);
+  return s;
+}
+
+// Every edit samples all the strokes a session holds: at most 2^20 points, counted over the
+// session's strokes and the edit's, and over a file's strokes when it opens.
+TEST(EditSession, TheStrokePointsOfASessionAreBounded) {
+  const Mesh mesh = test::load_test_mesh("spot.obj");
+  const auto session = open_session(mesh, default_options());
+  ASSERT_TRUE(session);
+  EditRequest half;
+  half.strokes.push_back(far_stroke((size_t{1} << 19) + 1));
+  EditResult result;
+  ASSERT_TRUE(session->apply(half, result).is_ok());
+  const uint64_t version = session->version();
+  half.strokes[0] = far_stroke(size_t{1} << 19);
+  const Status refused = session->apply(half, result);
+  EXPECT_EQ(refused.code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(refused.message().find("at most 1048576 stroke points, these are 1048577"), std::string::npos)
+      << refused.message();
+  EXPECT_EQ(session->version(), version);
+  MapTextureOptions options = default_options();
+  const std::vector<OrientationStroke> file_strokes = {far_stroke((size_t{1} << 20) + 1)};
+  options.orientation.strokes = file_strokes;
+  std::unique_ptr<EditSession> too_many;
+  EXPECT_EQ(EditSession::open(mesh, options, too_many).code(), ErrorCode::kInvalidArgument);
+  EXPECT_FALSE(too_many);
 }
 
 // The most a local update may change: faces of the patches holding `edited` faces and of the

@@ -233,14 +233,16 @@ server_pid=""
 # --- 5. shared libraries ---
 shared_build=$build/install-test-shared
 shared=$tmp/shared
-# The build's compiler, launcher and the options that change how a source compiles: with ccache
-# (the Makefile's default) the libraries' objects, the same in both builds, come from its cache.
+# The build's compiler, launcher, unity batches and warning flags (the Makefile's build sets no
+# other): with ccache (the Makefile's default) the libraries' objects, the same in both builds,
+# come from its cache.
 cached() { sed -n "s/^$1:[A-Z]*=//p" "$build/CMakeCache.txt"; }
 start=$SECONDS
 if cmake -S "$repo" -B "$shared_build" -DCMAKE_BUILD_TYPE=Release -DBUILD_SHARED_LIBS=ON \
   -DTAILOR_BUILD_TESTS=OFF -DTAILOR_BUILD_BENCH=OFF -DCMAKE_CXX_COMPILER="$(cached CMAKE_CXX_COMPILER)" \
   -DCMAKE_CXX_COMPILER_LAUNCHER="$(cached CMAKE_CXX_COMPILER_LAUNCHER)" \
-  -DTAILOR_UNITY_BUILD="$(cached TAILOR_UNITY_BUILD)" -DTAILOR_WERROR="$(cached TAILOR_WERROR)" >"$tmp/shared.log" 2>&1 &&
+  -DTAILOR_UNITY_BUILD="$(unity=$(cached TAILOR_UNITY_BUILD); echo "${unity:-ON}")" \
+  -DTAILOR_WERROR="$(werror=$(cached TAILOR_WERROR); echo "${werror:-OFF}")" >"$tmp/shared.log" 2>&1 &&
   cmake --build "$shared_build" -j "$jobs" --target tailor_core tailor_texture tailor_render >>"$tmp/shared.log" 2>&1 &&
   cmake --install "$shared_build" --component library --prefix "$shared" >>"$tmp/shared.log" 2>&1; then
   ok

@@ -190,7 +190,10 @@ def load_coarse(path):
     data = pathlib.Path(path).read_bytes()
     v, f, error = struct.unpack_from("<QQd", data, 0) if len(data) >= 24 else (0, 0, 0.0)
     if len(data) < 24 or len(data) != 24 + 12 * v + 36 * f or not math.isfinite(error):
-        raise TilesError("%s: damaged (%d bytes, not what its header counts): remove the output folder" % (path, len(data)))
+        raise TilesError(
+            "lod/%s of the output folder is damaged (%d bytes, not what its header counts): remove the folder"
+            % (pathlib.Path(path).name, len(data))
+        )
     at = 24
     positions = np.frombuffer(data, "<f4", 3 * v, at).reshape(v, 3)
     at += 12 * v
@@ -1198,8 +1201,8 @@ def parse_args(argv):
         type=int,
         default=os.cpu_count() or 1,
         metavar="N",
-        help="worker processes of a local Dask cluster (default: one per core); 0 maps in this process, "
-        "without Dask",
+        help="worker processes of a local Dask cluster (default: one per core, at most max(256, 4 x cores)); "
+        "0 maps in this process, without Dask",
     )
     p.add_argument("--scheduler", metavar="tcp://HOST:8786", help="a running Dask scheduler to use instead")
     p.add_argument(
@@ -1287,7 +1290,7 @@ def parse_args(argv):
     # Each local worker is a process of ~100 MB before its first tile: a cap well above the cores,
     # so that a mistyped count fails here instead of starting processes until memory runs out.
     most_workers = max(256, 4 * (os.cpu_count() or 1))
-    if args.workers < 0 or args.workers > most_workers:
+    if args.workers < 0 or (args.workers > most_workers and not args.scheduler):
         p.error(
             "--workers must be in 0..%d (local worker processes; a larger cluster: start it and give --scheduler)"
             % most_workers

@@ -11,6 +11,8 @@
 #include <chrono>
 #include <deque>
 #include <mutex>
+#include <span>
+#include <string>
 #include <system_error>
 #include <thread>
 #include <utility>
@@ -32,6 +34,18 @@ constexpr size_t kKeptVersions = 8;
 constexpr size_t kKeptAtlases = 8;
 // From this many UV floats on (2 per corner: 100k faces) publish copies on two threads.
 constexpr size_t kParallelPublishCorners = 600000;
+
+// The stroke points of these lists together, refused beyond kMaxSessionStrokePoints.
+Status check_session_stroke_points(std::span<const OrientationStroke> held, std::span<const OrientationStroke> added) {
+  size_t points = 0;
+  for (const auto list : {held, added})
+    for (const OrientationStroke& s : list) points += s.points.size() / 3;
+  if (points <= kMaxSessionStrokePoints) return Status::ok();
+  return Status::error(ErrorCode::kInvalidArgument, "",
+                       "a session holds at most " + std::to_string(kMaxSessionStrokePoints) +
+                           " stroke points, these are " + std::to_string(points) +
+                           ": map them with tailor map --strokes instead");
+}
 
 double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -322,6 +336,7 @@ Status EditSession::open(Mesh mesh, const MapTextureOptions& options, std::uniqu
   else
     st.seam.assign(options.mapping.seam_faces.begin(), options.mapping.seam_faces.end());
   TAILOR_RETURN_IF_ERROR(internal::check_strokes(options.orientation.strokes));
+  TAILOR_RETURN_IF_ERROR(check_session_stroke_points(options.orientation.strokes, {}));
   st.strokes.assign(options.orientation.strokes.begin(), options.orientation.strokes.end());
   MapTextureOptions first = State::with_state(st.options, st.seam, st.strokes);
   first.mapping.progress = options.mapping.progress;
@@ -350,16 +365,7 @@ Status EditSession::apply(const EditRequest& edit, EditResult& result) {
             ErrorCode::kInvalidArgument, "",
             "face " + std::to_string(f) + " out of range (mesh has " + std::to_string(face_count) + " faces)");
   TAILOR_RETURN_IF_ERROR(internal::check_strokes(edit.strokes));
-  if (!edit.strokes.empty()) {
-    size_t points = 0;
-    for (const OrientationStroke& s : st.strokes) points += s.points.size() / 3;
-    for (const OrientationStroke& s : edit.strokes) points += s.points.size() / 3;
-    if (points > kMaxSessionStrokePoints)
-      return Status::error(ErrorCode::kInvalidArgument, "",
-                           "the session would hold " + std::to_string(points) + " stroke points, more than " +
-                               std::to_string(kMaxSessionStrokePoints) +
-                               ": save, then map the saved strokes file or open a new session");
-  }
+  if (!edit.strokes.empty()) TAILOR_RETURN_IF_ERROR(check_session_stroke_points(st.strokes, edit.strokes));
   std::optional<MapTextureOptions> new_options;
   if (edit.options) {
     TAILOR_RETURN_IF_ERROR(check_map_options(*edit.options));

@@ -510,10 +510,10 @@ Status finalize_mesh(const std::string& name, Mesh& mesh, LoadReport& report) {
   report.degenerate_faces += degenerate;
   report.duplicate_faces += duplicates;
   report.zero_area_faces += zero_area;
-  if (mesh.indices.empty())  // every face was dropped: say why, as the zero-area case does
-    return Status::error(ErrorCode::kInvalidMesh, name,
-                         "mesh has no faces left: every face repeats a corner (" + std::to_string(degenerate) +
-                             " dropped) or another face (" + std::to_string(duplicates) + " dropped)");
+  if (mesh.indices.empty())  // every face named a vertex twice (a duplicate always keeps one copy)
+    return Status::error(
+        ErrorCode::kInvalidMesh, name,
+        "mesh has no faces left: all " + std::to_string(degenerate) + " name a vertex twice and were dropped");
   report.unreferenced_vertices += unreferenced;
   return Status::ok();
 }

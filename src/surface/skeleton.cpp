@@ -103,7 +103,8 @@ using Vertex = SurfaceMesh::Vertex_index;
 // Closes the border cycle of h: while it has more than kMaxFlowValence vertices, with a ring of
 // half as many (each on the mean of the two or three border vertices it joins, moved towards
 // `centre` by about the border's mean edge, at most half way), then with a fan around `centre`.
-// Every new vertex has at most ~9 neighbours, the border's at most 3 more than before.
+// A ring vertex has 5 neighbours and at most 2 more from the ring inside it; a border vertex gains
+// at most 2.
 void fill_with_rings(SurfaceMesh& sm, Halfedge h, const Point& centre) {
   std::vector<Vertex> ring, inner;
   for (Halfedge g = h;;) {
@@ -174,11 +175,10 @@ uint32_t close_holes(SurfaceMesh& sm) {
 }
 
 // Replaces each vertex of more than kMaxFlowValence neighbours (a fan: a large polygon of the file
-// triangulated around one corner, a cone's apex) by rings towards its own position. Returns the
-// largest valence left.
-size_t replace_hubs(SurfaceMesh& sm) {
+// triangulated around one corner, a cone's apex) by rings towards its own position.
+void replace_hubs(SurfaceMesh& sm) {
   std::vector<Vertex> hubs;
-  for (Vertex v : sm.vertices())
+  for (Vertex v : sm.vertices())  // interior: close_holes ran (remove_center_vertex needs a closed fan)
     if (sm.degree(v) > kMaxFlowValence && !sm.is_border(v)) hubs.push_back(v);
   for (Vertex v : hubs) {
     const Point at = sm.point(v);
@@ -187,9 +187,6 @@ size_t replace_hubs(SurfaceMesh& sm) {
     fill_with_rings(sm, merged, at);
   }
   if (!hubs.empty()) sm.collect_garbage();
-  size_t most = 0;
-  for (Vertex v : sm.vertices()) most = std::max<size_t>(most, sm.degree(v));
-  return most;
 }
 
 }  // namespace
@@ -246,7 +243,7 @@ Status compute_curve_skeleton(const Mesh& mesh, const Topology& topology, CurveS
     SkeletonGraph graph;
     try {
       holes = close_holes(sm);
-      skeleton.flow_max_valence = std::max(skeleton.flow_max_valence, static_cast<uint32_t>(replace_hubs(sm)));
+      replace_hubs(sm);
       // The flow's first step runs on the whole mesh (168 s and 3.7 GB on a 1.55M-face horse):
       // above kFlowEdges, a simplified copy goes into the flow; the skeleton is coarse anyway.
       if (sm.number_of_edges() > kFlowEdges) {
@@ -254,6 +251,8 @@ Status compute_curve_skeleton(const Mesh& mesh, const Topology& topology, CurveS
         CGAL::Surface_mesh_simplification::edge_collapse(sm, stop);
         sm.collect_garbage();
       }
+      for (Vertex v : sm.vertices())
+        skeleton.flow_max_valence = std::max(skeleton.flow_max_valence, static_cast<uint32_t>(sm.degree(v)));
       // The flow's Delaunay step shuffles points with CGAL's default generator, which is seeded
       // from the clock (and is per thread): a fixed seed per component makes the skeleton
       // the same on every run.

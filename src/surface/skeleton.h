@@ -25,7 +25,7 @@ struct CurveSkeleton {
   std::vector<uint8_t> component_done;   //!< per mesh edge component: 1 if it has a skeleton
   uint32_t closed_holes = 0;             //!< holes closed before skeletonizing
   uint32_t skipped_components = 0;       //!< components left without a skeleton (see skeleton.cpp)
-  uint32_t flow_max_valence = 0;         //!< the most neighbours of a vertex handed to the flow
+  uint32_t flow_max_valence = 0;         //!< the most neighbours of a vertex of the meshes handed to the flow
   double seconds = 0.0;                  //!< wall time
 
   size_t edge_count() const { return edges.size() / 2; }

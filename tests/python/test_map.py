@@ -168,10 +168,10 @@ def test_unit_scale_gives_one_texel_density_whatever_the_size():
 
 def test_numbers_beyond_their_range_and_non_finite_uvs_are_errors(tmp_path):
     mesh = tailor.load(SPOT)
-    with pytest.raises(tailor.Error, match="chunk_split must be"):
+    with pytest.raises(tailor.Error, match=r"chunk_split must be a whole number in 0..4294967295, got 1180591620717411303424"):
         tailor.map(mesh, chunk_split=2**70)
     uvs = tailor.map(mesh).corner_uvs
-    with pytest.raises(tailor.Error, match="texture_size must be two positive integers"):
+    with pytest.raises(tailor.Error, match=r"texture_size's width must be a whole number in 1..2147483647, got 1099511627776"):
         tailor.save_uvs(tmp_path / "x.glb", mesh, uvs, (2**40, 512))
     with pytest.raises(tailor.Error, match=r"UV is not finite \(corner 3\)"):
         bad = uvs.copy()

@@ -183,7 +183,7 @@ GOOD_FACES = np.array([[0, 1, 2]], np.int32)
         (GOOD_POSITIONS, np.array([[0, 1, 2 ** 40]], np.int64), "face index 1099511627776 out of range"),
         (GOOD_POSITIONS, np.zeros((0, 3), np.int32), "mesh has no faces"),
         (object(), GOOD_FACES, r"positions must be a \(V, 3\) array, got object \(\)"),
-        ([[0, 0, 0], [1, 0], [0, 1, 0]], GOOD_FACES, "positions must be an array of numbers, got <class 'list'>"),
+        ([[0, 0, 0], [1, 0], [0, 1, 0]], GOOD_FACES, "positions must be an array of numbers, got a list numpy cannot read as one"),
         (GOOD_POSITIONS, "abc", r"faces must be an \(F, 3\) array"),
     ],
 )
