@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "tailor/atlas.h"
+#include "tailor/chunked_mapper.h"
 #include "tailor/mesh.h"
 #include "tailor/status.h"
 
@@ -120,6 +121,10 @@ class ProgressBridge {
   std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
 };
 
+//! Raises tailor.Error when `src` is an instance of the bound class `type` that was made by
+//! `__new__` without `__init__` (pybind11 would hand its methods an unconstructed object).
+void require_constructed(py::handle src, const std::type_info& type);
+
 void bind_errors(py::module_& m);
 void bind_mesh(py::module_& m);
 void bind_map(py::module_& m);
@@ -131,3 +136,23 @@ void bind_chunks(py::module_& m);
 void bind_tiles(py::module_& m);
 
 }  // namespace tailor::python
+
+// The argument casters of the bound classes: an object made by `Cls.__new__(Cls)` and never
+// initialised holds no C++ object, and pybind11 (2.10) would allocate one without constructing it
+// and read its garbage. Every function taking one of these refuses such an object instead.
+namespace pybind11::detail {
+template <class T>
+class constructed_caster : public type_caster_base<T> {
+ public:
+  bool load(handle src, bool convert) {
+    tailor::python::require_constructed(src, typeid(T));
+    return type_caster_base<T>::load(src, convert);
+  }
+};
+template <>
+class type_caster<tailor::python::PyMesh> : public constructed_caster<tailor::python::PyMesh> {};
+template <>
+class type_caster<tailor::python::PyResult> : public constructed_caster<tailor::python::PyResult> {};
+template <>
+class type_caster<tailor::ChunkedMapper> : public constructed_caster<tailor::ChunkedMapper> {};
+}  // namespace pybind11::detail

@@ -33,6 +33,19 @@ void raise_status(const Status& status) { raise_with_code(status.message(), code
 
 void raise_error(const std::string& what) { raise_with_code(what, code_name(ErrorCode::kInvalidArgument)); }
 
+void require_constructed(py::handle src, const std::type_info& type) {
+  const py::detail::type_info* info = py::detail::get_type_info(type);
+  if (info == nullptr || !src || !PyObject_TypeCheck(src.ptr(), info->type)) return;  // not ours: the caster says no
+  const auto holder = reinterpret_cast<py::detail::instance*>(src.ptr())->get_value_and_holder(info, false);
+  if (holder && holder.holder_constructed()) return;
+  const char* how = type == typeid(PyMesh)     ? "tailor.Mesh was made by __new__ without __init__: make one with "
+                                                 "tailor.Mesh(positions, faces) or tailor.load(path)"
+                    : type == typeid(PyResult) ? "tailor.Result was made by __new__: tailor.map returns one"
+                                               : "tailor.ChunkedMapper was made by __new__ without __init__: make one "
+                                                 "with tailor.ChunkedMapper(cell_exponent, texels_per_unit)";
+  raise_error(how);
+}
+
 int64_t whole_number(const py::handle& value, const std::string& name, int64_t lo, int64_t hi) {
   const auto refuse = [&] {
     raise_error(name + " must be a whole number in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got " +

@@ -198,6 +198,27 @@ def test_nested_lists_are_arrays():
     assert mesh.face_count == 1 and np.array_equal(mesh.positions, GOOD_POSITIONS.astype(np.float32))
 
 
+def test_objects_made_without_init_are_refused():
+    # cls.__new__(cls) without __init__ holds no C++ object: every use raises instead of reading
+    # unconstructed memory (pybind11 allocates the value lazily and would hand it over).
+    mesh = tailor.Mesh.__new__(tailor.Mesh)
+    for use in (lambda: mesh.face_count, lambda: mesh.positions, lambda: repr(mesh),
+                lambda: tailor.map(mesh), lambda: tailor.evaluate(mesh, np.zeros((0, 3, 2), np.float32))):
+        with pytest.raises(tailor.Error, match=r"tailor.Mesh was made by __new__ without __init__"):
+            use()
+    result = tailor.Result.__new__(tailor.Result)
+    with pytest.raises(tailor.Error, match="tailor.map returns one"):
+        result.corner_uvs
+    mapper = tailor.ChunkedMapper.__new__(tailor.ChunkedMapper)
+    with pytest.raises(tailor.Error, match=r"tailor.ChunkedMapper\(cell_exponent, texels_per_unit\)"):
+        mapper.set_chunk((0, 0, 0), tailor.Mesh(GOOD_POSITIONS, GOOD_FACES))
+    # A subclass that initialises its base is a Mesh like any other.
+    class Named(tailor.Mesh):
+        def __init__(self, positions, faces):
+            super().__init__(positions, faces)
+    assert Named(GOOD_POSITIONS, GOOD_FACES).face_count == 1
+
+
 def test_bad_files_raise_the_cli_message(tmp_path, tailor_binary):
     from conftest import run_cli
 
