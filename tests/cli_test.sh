@@ -167,7 +167,7 @@ expect_error 1 "nan.obj" -- "$tailor" map "$tmp/nan.obj" -o "$tmp/keep.glb"
 cmp -s "$tmp/a.glb" "$tmp/keep.glb" && ok || fail "failed map damaged the existing output"
 
 # --- outputs checked before any work: nothing written when one of them cannot be ---
-expect_error 2 "share" -- "$tailor" map "$mesh" -o "$tmp/same.glb" --preview "$tmp/same.glb"
+expect_error 2 "share" -- "$tailor" map "$mesh" -o "$tmp/same.glb" --stats "$tmp/same.png" --preview "$tmp/same.png"
 expect_error 2 "overwrite an input" -- "$tailor" map "$mesh" -o "$tmp/z.obj" --texture "$tmp/z.mtl"
 expect_error 2 "does not exist" -- "$tailor" map "$mesh" -o "$tmp/ok.glb" --stats "$tmp/missing/s.json"
 expect_error 2 "needs a .glb output" -- "$tailor" map "$mesh" -o "$tmp/cx.obj" --compress draco
@@ -314,6 +314,24 @@ mkdir -p "$tmp/set_in" && cp tests/data/textures/vistex-sand05-128.png "$tmp/set
 sed 's/"symmetry": 4/"symmetry": 3/' "$tmp/set4/material.json" >"$tmp/set4/bad.json"
 expect_error 2 "bad.json: \"symmetry\" must be 1 or 4" -- "$tailor" map "$mesh" --material "$tmp/set4/bad.json" -o "$tmp/x.glb"
 [[ ! -e $tmp/x.glb ]] && ok || fail "map of a material with a bad symmetry record wrote its output"
+# A material's files are inputs: no output of map replaces its JSON or one of its maps, and tile
+# --material does not write over the JSON it reads; the files are left as they were.
+cp "$tmp/set4/material.json" "$tmp/set4_before.json" && cp "$tmp/set4/sand_color.png" "$tmp/set4_before.png"
+expect_error 2 "set4/sand_color.png: output \(--preview\) would overwrite an input" -- \
+  "$tailor" map "$mesh" --material "$tmp/set4" -o "$tmp/x.glb" --preview "$tmp/set4/sand_color.png"
+expect_error 2 "set4/material.json: output \(--stats\) would overwrite an input" -- \
+  "$tailor" map "$mesh" --material "$tmp/set4" -o "$tmp/x.glb" --stats "$tmp/set4/material.json"
+expect_error 2 "set4/material.json: output \(--json\) would overwrite an input" -- \
+  "$tailor" tile --material "$tmp/set4/material.json" -o "$tmp/set4_again" --json "$tmp/set4/material.json"
+cmp -s "$tmp/set4/material.json" "$tmp/set4_before.json" && [[ ! -e $tmp/x.glb ]] &&
+  cmp -s "$tmp/set4/sand_color.png" "$tmp/set4_before.png" && ok || fail "a refused output touched the material"
+mkdir -p "$tmp/set_self/t" && cp tests/data/textures/vistex-sand05-128.png "$tmp/set_self/t/s.png" &&
+  echo '{"maps": [{"file": "t/s.png"}]}' >"$tmp/set_self/material.json"
+expect_error 2 "set_self/material.json: output \(the material description\) would overwrite an input" -- \
+  "$tailor" tile --material "$tmp/set_self/material.json" -o "$tmp/set_self" --allow-misses
+# A preview is a PNG whatever its name says: another extension is refused before any work.
+expect_error 2 "--preview must name a .png file, got '.*x.jpg'" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --preview "$tmp/x.jpg"
+[[ ! -e $tmp/x.jpg && ! -e $tmp/x.glb ]] && ok || fail "a refused preview name left files"
 "$tailor" render "$mesh" --size 64x48 -o "$tmp/wide.png" -q || fail "render of a 64x48 picture failed"
 expect_error 2 "symmetry 4 needs a square texture, got 64x48" -- "$tailor" map "$mesh" --texture "$tmp/wide.png" -o "$tmp/x.glb" --symmetry 4
 [[ ! -e $tmp/x.glb ]] && ok || fail "map --symmetry 4 with a non-square texture wrote its output"

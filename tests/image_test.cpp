@@ -8,8 +8,10 @@
 #include <array>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -164,6 +166,32 @@ TEST(ImageIo, ReadsTgaAndBmp) {
     EXPECT_EQ(back.channels, 3);
     EXPECT_EQ(back.pixels, im.pixels) << path;
   }
+}
+
+TEST(ImageIo, ReadsTopDownBmp) {
+  // A negative height says the rows are stored top first: the same picture as the bottom-up file
+  // stbi_write_bmp writes, with its rows reversed (128 px of 3 bytes: 384 bytes a row, no padding).
+  Image im;
+  ASSERT_TRUE(load_image(kData + "vistex-tile04-128.png", im).is_ok());
+  const std::string bottom_up = temp_path("bottom_up.bmp"), top_down = temp_path("top_down.bmp");
+  ASSERT_NE(stbi_write_bmp(bottom_up.c_str(), im.width, im.height, im.channels, im.pixels.data()), 0);
+  std::ifstream in(bottom_up, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GE(bytes.size(), 54u);
+  const size_t offset = static_cast<uint8_t>(bytes[10]) | static_cast<size_t>(static_cast<uint8_t>(bytes[11])) << 8;
+  const size_t row = 128 * 3;
+  ASSERT_EQ(bytes.size(), offset + 128 * row);
+  std::string flipped = bytes;
+  for (size_t y = 0; y < 128; ++y) flipped.replace(offset + y * row, row, bytes, offset + (127 - y) * row, row);
+  const int32_t height = -128;
+  std::memcpy(&flipped[22], &height, 4);  // little-endian, as BMP stores it
+  write_bytes(top_down, flipped);
+  Image back;
+  const Status s = load_image(top_down, back);
+  ASSERT_TRUE(s.is_ok()) << s.message();
+  EXPECT_EQ(back.width, 128);
+  EXPECT_EQ(back.height, 128);
+  EXPECT_EQ(back.pixels, im.pixels);
 }
 
 TEST(ImageIo, ReadsGreyAndRgbPngsWithATransparentColour) {

@@ -111,6 +111,8 @@ int run_map(const MapArgs& opt) {
   if (Status s = apply_mapping_args(args, options); !s) return report_error(s);
   const bool auto_axis = args.auto_axis();
   MappingOptions& mapping = options.mapping;
+  if (!opt.preview.empty() && !ends_with_png(opt.preview))
+    return report_error(usage_error("--preview must name a .png file, got '" + opt.preview + "'"));
   UpAxis preview_up = RenderOptions{}.up;
   if (!up_axis_from_name(opt.preview_up, preview_up))
     return report_error(usage_error("--preview-up must be x, y, z, -x, -y or -z, got '" + opt.preview_up + "'"));
@@ -132,6 +134,11 @@ int run_map(const MapArgs& opt) {
   std::string texture_path = opt.texture;
   if (!opt.material.empty()) {
     if (Status s = load_material(opt.material, material, opt.image_options); !s) return report_error(s);
+    // The material's files are inputs too: its JSON (a folder's material.json) and every map read.
+    std::vector<std::string> material_inputs = {opt.material,
+                                                (std::filesystem::path(opt.material) / "material.json").string()};
+    for (const std::string& file : material.files) material_inputs.push_back(file.substr(file.find(": ") + 2));
+    if (Status s = check_outputs(output_paths(opt), material_inputs); !s) return report_error(s);
     for (const std::string& note : material.notes) warn(opt.quiet, note);
     texture_path = material.color;
     // A set of quarter-turn tiles (`tailor tile --set --symmetry 4`) is mapped for them unless told.

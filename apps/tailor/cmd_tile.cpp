@@ -290,15 +290,18 @@ int run_tile_set(TileCliOptions opt) {
     const std::string stem = names[m].substr(0, names[m].size() - 4);
     return outdir + "/" + (opt.variants == 1 ? names[m] : stem + "_" + std::to_string(k) + ".png");
   };
+  // The inputs: the maps, and the material description that named them.
+  std::vector<std::string> inputs = opt.set;
+  if (!opt.material.empty()) inputs.push_back(opt.material);
   if (existed) {
     std::vector<OutputPath> outputs;
     for (size_t m = 0; m < names.size(); ++m)
       for (int k = 0; k < opt.variants; ++k) outputs.push_back({file_of(m, k), "--output"});
     outputs.push_back({outdir + "/material.json", "the material description"});
     if (!opt.json.empty()) outputs.push_back({opt.json, "--json"});
-    if (Status s = check_outputs(outputs, opt.set); !s) return report_error(s);
+    if (Status s = check_outputs(outputs, inputs); !s) return report_error(s);
   } else if (!opt.json.empty()) {
-    if (Status s = check_outputs({{opt.json, "--json"}}, opt.set); !s) return report_error(s);
+    if (Status s = check_outputs({{opt.json, "--json"}}, inputs); !s) return report_error(s);
   }
   std::vector<TileMap> maps(opt.set.size());
   for (size_t m = 0; m < opt.set.size(); ++m) {

@@ -182,6 +182,9 @@ Status load_pixels(const std::string& path, Image& image, Image16* deep, const I
     return Status::error(ErrorCode::kInvalidImage, path, "not a readable PNG, JPEG, TGA or BMP image",
                          std::string("header: ") + (reason ? reason : "unknown format"));
   }
+  // A top-down BMP (rows stored first to last) says so with a negative height, which stb_image's
+  // info passes on as it is (its loader reads the rows in either order).
+  if (height < 0 && height != INT_MIN && bytes.size() >= 2 && bytes[0] == 'B' && bytes[1] == 'M') height = -height;
   // stb reads Radiance .hdr files too, clipping their light values to 8 bits without a word: a
   // tile of one would be a white picture.
   if (stbi_is_hdr_from_memory(data, length))
