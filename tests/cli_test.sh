@@ -595,6 +595,15 @@ expect_error 1 "in.png: $notreg" -- timeout 5 "$tailor" tile "$tmp/img/in.png" -
 expect_error 1 "in.png: $notreg" -- timeout 5 "$tailor" map "$mesh" --texture "$tmp/img/in.png" -o "$tmp/img/o.glb"
 expect_error 1 "in.obj: $notreg" -- timeout 5 "$tailor" map "$mesh" --seam-faces "$tmp/img/in.obj" -o "$tmp/img/o.glb"
 expect_error 1 "img: is a directory, not a regular file" -- timeout 5 "$tailor" info "$tmp/img"
+# A material (its JSON, or a folder's material.json) and a view's tileset or variants JSON too.
+mkfifo "$tmp/img/m.json" && mkdir "$tmp/img/mat" && cp "$texture" "$tmp/img/mat/g_color.png" &&
+  mkfifo "$tmp/img/mat/material.json"
+expect_error 1 "m.json: $notreg" -- timeout 5 "$tailor" map "$mesh" --material "$tmp/img/m.json" -o "$tmp/img/o.glb"
+expect_error 1 "mat/material.json: $notreg" -- timeout 5 "$tailor" map "$mesh" --material "$tmp/img/mat" -o "$tmp/img/o.glb"
+expect_error 1 "m.json: $notreg" -- timeout 5 "$tailor" tile --material "$tmp/img/m.json" -o "$tmp/img/set"
+expect_error 1 "m.json: $notreg" -- timeout 5 "$tailor" view "$tmp/m4.glb" --texture "$tmp/img/m.json"
+mkfifo "$tmp/img/tileset.json"
+expect_error 1 "tileset.json: $notreg" -- timeout 5 "$tailor" view "$tmp/img/tileset.json"
 # A material or texture that a mesh names is only a FIFO: the mesh loads, its texture is unknown.
 mkdir "$tmp/named"
 mkfifo "$tmp/named/m.mtl" "$tmp/named/t.png"

@@ -5,11 +5,10 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <fstream>
+#include <filesystem>
 #include <initializer_list>
 #include <memory>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -208,12 +207,13 @@ void warn_unknown_keys(const TileCliOptions& opt, const nlohmann::json& object,
 //! --material JSON: {"maps": [{"file": "color.png"}, {"file": "normal.png", "normal": true}, ...],
 //! "normal_convention": "gl"}; files relative to the JSON's folder. Fills opt.set / normal_maps.
 Status read_material(TileCliOptions& opt) {
-  std::ifstream in(opt.material);
-  if (!in) return Status::error(ErrorCode::kIo, opt.material, "cannot open the material description");
-  std::stringstream text;
-  text << in.rdbuf();
+  std::string text;  // read_file: a FIFO or device is refused, not waited on
+  if (Status s = internal::read_file(opt.material, text); !s)
+    return s.code() == ErrorCode::kIo && !std::filesystem::exists(opt.material)
+               ? Status::error(ErrorCode::kIo, opt.material, "cannot open the material description")
+               : s;
   nlohmann::json j;
-  if (const auto parsed = internal::parse_json_bounded(text.str(), j); parsed == internal::JsonParse::kTooDeep)
+  if (const auto parsed = internal::parse_json_bounded(text, j); parsed == internal::JsonParse::kTooDeep)
     return Status::error(ErrorCode::kInvalidArgument, opt.material, internal::json_problem(parsed));
   if (j.is_discarded() || !j.is_object() || !j.contains("maps") || !j["maps"].is_array() || j["maps"].empty())
     return Status::error(ErrorCode::kInvalidArgument, opt.material,

@@ -7,8 +7,6 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -34,7 +32,10 @@ struct ViewArgs {
   bool quiet = false;
 };
 
-bool file_exists(const std::string& path) { return std::ifstream(path).good(); }
+bool file_exists(const std::string& path) {
+  std::error_code ec;
+  return std::filesystem::is_regular_file(path, ec);
+}
 
 //! Cheap check that `path` is a binary glTF 2.0 file, so a wrong file fails here with one line
 //! rather than in the browser.
@@ -70,9 +71,8 @@ Status add_texture(const std::string& path, std::vector<Route>& routes, nlohmann
     config["texture"] = url;
     return Status::ok();
   }
-  std::ifstream in(path);
-  if (!in) return Status::error(ErrorCode::kIo, path, "cannot open file");
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string text;  // read_file: a FIFO or device is refused, not waited on
+  TAILOR_RETURN_IF_ERROR(internal::read_file(path, text));
   nlohmann::json j;
   if (const auto parsed = internal::parse_json_bounded(text, j); parsed == internal::JsonParse::kTooDeep)
     return Status::error(ErrorCode::kParse, path, internal::json_problem(parsed));
@@ -108,9 +108,8 @@ Status add_texture(const std::string& path, std::vector<Route>& routes, nlohmann
 //! tileset names them; hidden files and folders are not.
 Status add_tileset(const std::string& path, std::vector<Route>& routes, nlohmann::json& config) {
   namespace fs = std::filesystem;
-  std::ifstream in(path);
-  if (!in) return Status::error(ErrorCode::kIo, path, "cannot open file");
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string text;
+  TAILOR_RETURN_IF_ERROR(internal::read_file(path, text));
   nlohmann::json tileset;
   if (const auto parsed = internal::parse_json_bounded(text, tileset); parsed == internal::JsonParse::kTooDeep)
     return Status::error(ErrorCode::kParse, path, internal::json_problem(parsed));

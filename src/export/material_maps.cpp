@@ -3,9 +3,7 @@
 #include <array>
 #include <cctype>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "tailor/material.h"
 #include "util/atomic_file.h"
@@ -92,15 +90,14 @@ MaterialRole material_role_from_name(const std::string& file_name, bool* directx
 namespace {
 
 //! The JSON in the file at `path` (discarded when it does not parse or nests too deep, which
-//! `result` then says); false when it cannot be opened.
-bool read_json(const std::string& path, nlohmann::json& out, internal::JsonParse* result = nullptr) {
-  std::ifstream in(path);
-  if (!in) return false;
-  std::stringstream text;
-  text << in.rdbuf();
-  const internal::JsonParse parsed = internal::parse_json_bounded(text.str(), out);
+//! `result` then says). read_file's error when it cannot be read: missing, a directory, or not a
+//! regular file (a FIFO would block the read until a writer came).
+Status read_json(const std::string& path, nlohmann::json& out, internal::JsonParse* result = nullptr) {
+  std::string text;
+  TAILOR_RETURN_IF_ERROR(internal::read_file(path, text));
+  const internal::JsonParse parsed = internal::parse_json_bounded(text, out);
   if (result) *result = parsed;
-  return true;
+  return Status::ok();
 }
 
 //! The "symmetry" a material JSON records (`tailor tile --set` writes 1 or 4), into `symmetry`;
@@ -145,8 +142,10 @@ Status load_material(const std::string& dir_or_json, MaterialMaps& out, const Im
     // tiles (the maps themselves are found by name, as in any folder).
     const std::string record = dir_or_json + "/material.json";
     nlohmann::json j;
-    if (read_json(record, j) && !j.is_discarded() && j.is_object())
-      TAILOR_RETURN_IF_ERROR(read_symmetry(j, record, out.symmetry));
+    if (fs::exists(fs::symlink_status(record, ec))) {
+      TAILOR_RETURN_IF_ERROR(read_json(record, j));
+      if (!j.is_discarded() && j.is_object()) TAILOR_RETURN_IF_ERROR(read_symmetry(j, record, out.symmetry));
+    }
     std::sort(names.begin(), names.end());  // deterministic whatever the listing order
     for (const std::string& name : names) {
       bool dx = false;
@@ -156,8 +155,9 @@ Status load_material(const std::string& dir_or_json, MaterialMaps& out, const Im
   } else {
     nlohmann::json j;
     internal::JsonParse parsed = internal::JsonParse::kOk;
-    if (!read_json(dir_or_json, j, &parsed))
+    if (!fs::exists(fs::symlink_status(dir_or_json, ec)))
       return Status::error(ErrorCode::kIo, dir_or_json, "cannot open the material (a folder of maps or a JSON)");
+    TAILOR_RETURN_IF_ERROR(read_json(dir_or_json, j, &parsed));
     if (parsed == internal::JsonParse::kTooDeep)
       return Status::error(ErrorCode::kInvalidArgument, dir_or_json, internal::json_problem(parsed));
     if (j.is_discarded() || !j.is_object())

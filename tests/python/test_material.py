@@ -1,6 +1,7 @@
 """tailor.map(material=...) and tailor.save(material=...): the material of `tailor map --material`,
 bit for bit; material_role and the Blender add-on's copy of the suffix table agree."""
 import importlib.util
+import os
 import shutil
 import struct
 import zlib
@@ -88,6 +89,18 @@ def test_material_errors_are_the_cli_messages(tmp_path, material_dir):
     (material_dir / "gravel.height.png").write_bytes((material_dir / "gravel_roughness.png").read_bytes())
     with pytest.warns(UserWarning, match="height map not embedded"):
         tailor.map(mesh, material=material_dir)
+
+
+def test_a_material_that_is_a_fifo_is_refused_not_waited_on(tmp_path, material_dir):
+    # Opening a FIFO for reading would block until a writer came: a material JSON, or a folder's
+    # material.json, that is one is an error at once.
+    fifo = tmp_path / "m.json"
+    os.mkfifo(fifo)
+    with pytest.raises(tailor.Error, match="m.json: not a regular file"):
+        tailor.load_material(fifo)
+    os.mkfifo(material_dir / "material.json")
+    with pytest.raises(tailor.Error, match="material.json: not a regular file"):
+        tailor.map(tailor.load(SPOT), material=material_dir)
 
 
 def test_save_uvs_writes_a_material_read_once(tmp_path, material_dir):
