@@ -34,22 +34,18 @@ void bind_canonical(py::module_& m) {
       "canonical_tile",
       [](const py::array& positions_in, const py::array& faces_in) {
         const auto positions = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(positions_in);
-        const auto faces = py::array_t<uint32_t, py::array::c_style | py::array::forcecast>::ensure(faces_in);
         if (!positions || positions.ndim() != 2 || positions.shape(1) != 3)
           raise_error("positions must be a (V, 3) array, got " + describe(positions_in));
-        if (!faces || faces.ndim() != 2 || faces.shape(1) != 3)
-          raise_error("faces must be an (F, 3) array, got " + describe(faces_in));
         constexpr py::ssize_t kMost = std::numeric_limits<uint32_t>::max();
-        if (positions.shape(0) > kMost || faces.shape(0) > kMost)
-          raise_error("a tile holds at most 2^32 - 1 vertices and faces");
+        if (positions.shape(0) > kMost) raise_error("a tile holds at most 2^32 - 1 vertices");
         const size_t vertex_count = static_cast<uint32_t>(positions.shape(0));
-        const size_t face_count = static_cast<uint32_t>(faces.shape(0));
+        // Integer indices each below the vertex count, as tailor.Mesh takes them (a cast would wrap
+        // 2^32 + 2 to 2 and truncate 1.5 to 1).
+        std::vector<uint32_t> face_indices;
+        copy_faces(faces_in, vertex_count, face_indices, "tailor.canonical_tile");
+        const size_t face_count = face_indices.size() / 3;
         const float* p = positions.data();
-        const uint32_t* f = faces.data();
-        for (size_t i = 0; i < 3 * face_count; ++i)
-          if (f[i] >= vertex_count)
-            raise_error("face " + std::to_string(i / 3) + " has vertex " + std::to_string(f[i]) + ", the tile has " +
-                        std::to_string(vertex_count));
+        const uint32_t* f = face_indices.data();
         std::vector<uint32_t> turned(3 * face_count);
         std::vector<Keyed> keys(face_count);
         std::vector<uint32_t> by_use;

@@ -356,9 +356,9 @@ void bind_map(py::module_& m) {
         for (const std::string& line : map_warnings(mesh.mesh, options, image, run.texture)) warn(line);
         std::vector<uint8_t> seams;
         if (!seam_faces.is_none()) {
-          const py::array seam_array = py::array::ensure(seam_faces);
+          const std::optional<py::array> seam_array = as_array(seam_faces);
           if (!seam_array) raise_error("seam_faces must be face indices or an (F,) bool mask");
-          seam_flags(seam_array, mesh.mesh.face_count(), seams);
+          seam_flags(*seam_array, mesh.mesh.face_count(), seams);
           mapping.seam_faces = seams;
         } else if (!mesh.mesh.seam_faces.empty()) {
           mapping.seam_faces = mesh.mesh.seam_faces;

@@ -53,57 +53,6 @@ void copy_positions(const py::array& positions, std::vector<float>& out) {
   }
 }
 
-// One face row of any integer type -> uint32 indices; a negative or too large index is refused
-// with finalize_mesh's message for an index out of range.
-template <class T>
-void copy_indices(const py::array& faces, size_t vertex_count, std::vector<uint32_t>& out) {
-  const auto typed = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(faces);
-  const T* in = typed.data();
-  const size_t count = out.size();
-  size_t bad = count;
-  {
-    const py::gil_scoped_release release;
-    for (size_t i = 0; i < count; ++i) {
-      const T v = in[i];
-      if constexpr (std::is_signed_v<T>) {
-        if (v < 0) {
-          bad = i;
-          break;
-        }
-      }
-      if (static_cast<uint64_t>(v) >= vertex_count) {  // finalize_mesh would name it too; uint32 may not hold it
-        bad = i;
-        break;
-      }
-      out[i] = static_cast<uint32_t>(v);
-    }
-  }
-  if (bad != count)
-    raise_status(Status::error(ErrorCode::kInvalidMesh, kArraysName,
-                               "face index " + std::to_string(in[bad]) + " out of range (mesh has " +
-                                   std::to_string(vertex_count) + " vertices)",
-                               "face " + std::to_string(bad / 3)));
-}
-
-void copy_faces(const py::array& faces, size_t vertex_count, std::vector<uint32_t>& out) {
-  if (faces.ndim() != 2 || faces.shape(1) != 3) raise_error("faces must be an (F, 3) array, got " + describe(faces));
-  if (static_cast<size_t>(faces.shape(0)) > kMaxFaces)
-    raise_status(Status::error(ErrorCode::kLimit, kArraysName, "too many faces"));
-  out.resize(static_cast<size_t>(faces.shape(0)) * 3);
-  const char kind = faces.dtype().kind();
-  const py::ssize_t size = faces.dtype().itemsize();
-  if (kind == 'u' && size == 4)
-    copy_indices<uint32_t>(faces, vertex_count, out);
-  else if (kind == 'i' && size == 4)
-    copy_indices<int32_t>(faces, vertex_count, out);
-  else if (kind == 'i' && size == 8)
-    copy_indices<int64_t>(faces, vertex_count, out);
-  else if (kind == 'u' && size == 8)
-    copy_indices<uint64_t>(faces, vertex_count, out);
-  else
-    raise_error("faces must be int32, int64, uint32 or uint64, got " + describe(faces));
-}
-
 // LoadReport's fields by their C++ names. Texts may quote the file (names, paths): not always UTF-8.
 py::dict load_report_dict(const LoadReport& r) {
   py::dict d;
@@ -139,6 +88,57 @@ py::dict load_report_dict(const LoadReport& r) {
 
 }  // namespace
 
+// One face row of any integer type -> uint32 indices; a negative or too large index is refused
+// with finalize_mesh's message for an index out of range.
+template <class T>
+void copy_indices(const py::array& faces, size_t vertex_count, std::vector<uint32_t>& out, const char* name) {
+  const auto typed = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(faces);
+  const T* in = typed.data();
+  const size_t count = out.size();
+  size_t bad = count;
+  {
+    const py::gil_scoped_release release;
+    for (size_t i = 0; i < count; ++i) {
+      const T v = in[i];
+      if constexpr (std::is_signed_v<T>) {
+        if (v < 0) {
+          bad = i;
+          break;
+        }
+      }
+      if (static_cast<uint64_t>(v) >= vertex_count) {  // finalize_mesh would name it too; uint32 may not hold it
+        bad = i;
+        break;
+      }
+      out[i] = static_cast<uint32_t>(v);
+    }
+  }
+  if (bad != count)
+    raise_status(Status::error(ErrorCode::kInvalidMesh, name,
+                               "face index " + std::to_string(in[bad]) + " out of range (mesh has " +
+                                   std::to_string(vertex_count) + " vertices)",
+                               "face " + std::to_string(bad / 3)));
+}
+
+void copy_faces(const py::array& faces, size_t vertex_count, std::vector<uint32_t>& out, const char* name) {
+  if (faces.ndim() != 2 || faces.shape(1) != 3) raise_error("faces must be an (F, 3) array, got " + describe(faces));
+  if (static_cast<size_t>(faces.shape(0)) > kMaxFaces)
+    raise_status(Status::error(ErrorCode::kLimit, name, "too many faces"));
+  out.resize(static_cast<size_t>(faces.shape(0)) * 3);
+  const char kind = faces.dtype().kind();
+  const py::ssize_t size = faces.dtype().itemsize();
+  if (kind == 'u' && size == 4)
+    copy_indices<uint32_t>(faces, vertex_count, out, name);
+  else if (kind == 'i' && size == 4)
+    copy_indices<int32_t>(faces, vertex_count, out, name);
+  else if (kind == 'i' && size == 8)
+    copy_indices<int64_t>(faces, vertex_count, out, name);
+  else if (kind == 'u' && size == 8)
+    copy_indices<uint64_t>(faces, vertex_count, out, name);
+  else
+    raise_error("faces must be int32, int64, uint32 or uint64, got " + describe(faces));
+}
+
 void bind_mesh(py::module_& m) {
   py::class_<PyMesh>(m, "Mesh",
                      "A triangle mesh: positions (V, 3) float32 and faces (F, 3) uint32, counter-clockwise.\n\n"
@@ -153,15 +153,15 @@ void bind_mesh(py::module_& m) {
              // Any array-like (nested lists too), as numpy reads it; what it cannot read is a
              // tailor.Error like a wrong shape, not pybind11's list of signatures.
              const auto array_of = [](const py::object& o, const char* name) {
-               const py::array a = py::array::ensure(o);
+               const std::optional<py::array> a = as_array(o);
                if (!a)
                  raise_error(std::string(name) + " must be an array of numbers, got a " +
                              py::type::of(o).attr("__name__").cast<std::string>() + " numpy cannot read as one");
-               return a;
+               return *a;
              };
              auto mesh = std::make_unique<PyMesh>();
              copy_positions(array_of(positions, "positions"), mesh->mesh.positions);
-             copy_faces(array_of(faces, "faces"), mesh->mesh.vertex_count(), mesh->mesh.indices);
+             copy_faces(array_of(faces, "faces"), mesh->mesh.vertex_count(), mesh->mesh.indices, kArraysName);
              mesh->load.format = "arrays";
              mesh->load.source_faces = mesh->mesh.face_count();
              Status status;

@@ -54,6 +54,14 @@ struct PyResult {
 //! neither the argument nor the range).
 int64_t whole_number(const py::handle& value, const std::string& name, int64_t lo, int64_t hi);
 
+//! `o` as a numpy array (any array-like, as numpy.asarray reads it), or nothing when numpy cannot
+//! read it as one; KeyboardInterrupt, SystemExit and MemoryError raised meanwhile pass through.
+std::optional<py::array> as_array(const py::handle& o);
+
+//! An (F, 3) array of int32, int64, uint32 or uint64 face indices -> `out` (3F uint32); a wrong
+//! shape or dtype, or an index negative or not below vertex_count, raises tailor.Error naming `name`.
+void copy_faces(const py::array& faces, size_t vertex_count, std::vector<uint32_t>& out, const char* name);
+
 //! A read-only numpy view of `data` (shape given) that keeps `owner` alive: no copy.
 template <class T>
 py::array readonly_view(const T* data, std::vector<py::ssize_t> shape, py::handle owner) {

@@ -46,6 +46,18 @@ void require_constructed(py::handle src, const std::type_info& type) {
   raise_error(how);
 }
 
+std::optional<py::array> as_array(const py::handle& o) {
+  if (py::isinstance<py::array>(o)) return py::reinterpret_borrow<py::array>(o);
+  try {
+    return py::module_::import("numpy").attr("asarray")(o).cast<py::array>();
+  } catch (py::error_already_set& e) {
+    // What stops the program rather than the conversion passes through: Ctrl-C in an __array__,
+    // SystemExit, running out of memory.
+    if (!e.matches(PyExc_Exception) || e.matches(PyExc_MemoryError)) throw;
+    return std::nullopt;
+  }
+}
+
 int64_t whole_number(const py::handle& value, const std::string& name, int64_t lo, int64_t hi) {
   const auto refuse = [&] {
     raise_error(name + " must be a whole number in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got " +

@@ -198,6 +198,25 @@ def test_nested_lists_are_arrays():
     assert mesh.face_count == 1 and np.array_equal(mesh.positions, GOOD_POSITIONS.astype(np.float32))
 
 
+def test_interrupts_inside_array_conversion_pass_through():
+    # An __array__ that raises Ctrl-C or runs out of memory stops the call with that exception;
+    # one that fails otherwise is an array numpy cannot read (tailor.Error).
+    class Raising:
+        def __init__(self, error):
+            self.error = error
+
+        def __array__(self, *args, **kwargs):
+            raise self.error
+
+    for error in (KeyboardInterrupt, MemoryError):
+        with pytest.raises(error):
+            tailor.Mesh(Raising(error), GOOD_FACES)
+        with pytest.raises(error):
+            tailor.map(tailor.Mesh(GOOD_POSITIONS, GOOD_FACES), seam_faces=Raising(error))
+    with pytest.raises(tailor.Error, match="positions must be an array of numbers"):
+        tailor.Mesh(Raising(RuntimeError("no")), GOOD_FACES)
+
+
 def test_objects_made_without_init_are_refused():
     # cls.__new__(cls) without __init__ holds no C++ object: every use raises instead of reading
     # unconstructed memory (pybind11 allocates the value lazily and would hand it over).

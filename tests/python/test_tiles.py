@@ -699,8 +699,15 @@ def test_a_tile_in_canonical_order_is_the_same_for_any_input_order():
     moved[renumber[-1]] = 7.0
     p2, f2 = tailor.canonical_tile(moved, renumber[shuffled])
     assert np.array_equal(p2, p) and np.array_equal(f2, f)
-    with pytest.raises(tailor.Error, match="face 1 has vertex 9"):
+    with pytest.raises(tailor.Error, match=r"face index 9 out of range \(mesh has 9 vertices\) \(face 1\)"):
         tailor.canonical_tile(positions[:9], np.array([[0, 1, 2], [3, 4, 9]]))
+    # Indices are checked as they are given, not after a cast to uint32 (2^32 + 2 is not 2), and
+    # float indices are refused as tailor.Mesh refuses them.
+    for wrapped in (np.array([[0, 1, 2**32 + 2]], np.int64), np.array([[0, 1, 2**63]], np.uint64)):
+        with pytest.raises(tailor.Error, match="out of range"):
+            tailor.canonical_tile(positions[:9], wrapped)
+    with pytest.raises(tailor.Error, match="faces must be int32, int64, uint32 or uint64, got float64"):
+        tailor.canonical_tile(positions[:9], np.array([[0, 1, 2.0]]))
     with pytest.raises(tailor.Error, match="positions must be a"):
         tailor.canonical_tile(positions[:, :2], faces)
 
