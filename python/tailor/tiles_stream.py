@@ -76,15 +76,21 @@ def read_layout(path):
         return None
     if not head.startswith(b"ply\n") and not head.startswith(b"ply\r\n"):
         return None
-    end = head.find(b"end_header")
-    if end < 0:
-        return None
-    eol = head.find(b"\n", end)
-    if eol < 0:
-        return None
+    # The header's lines up to the one whose first word is end_header, as tailor.load reads it (a
+    # comment may hold the word too).
+    lines, pos = [], head.index(b"\n") + 1
+    while True:
+        eol = head.find(b"\n", pos)
+        if eol < 0:
+            return None
+        words = head[pos:eol].split()
+        if words and words[0] == b"end_header":
+            break
+        lines.append(head[pos:eol])
+        pos = eol + 1
     body = eol + 1
     elements, fmt = [], None
-    for raw in head[:end].split(b"\n")[1:]:
+    for raw in lines:
         w = raw.decode("latin-1").split()
         if not w or w[0] in ("comment", "obj_info"):
             continue

@@ -758,6 +758,20 @@ def test_a_streamed_ply_gives_the_in_memory_tiles(tmp_path):
     assert folder_bytes(streamed) == folder_bytes(in_memory)
 
 
+def test_a_comment_that_says_end_header_does_not_end_the_header(tmp_path):
+    # The header ends at the line whose first word is end_header, as tailor.load reads it.
+    from tailor import tiles_stream
+
+    plain = HORSE.read_bytes()
+    tricked = tmp_path / "comment.ply"
+    tricked.write_bytes(plain.replace(b"\nend_header\n", b"\ncomment end_header here\nend_header\n", 1))
+    a, b = tiles_stream.read_layout(str(HORSE)), tiles_stream.read_layout(str(tricked))
+    extra = len(b"comment end_header here\n")
+    assert (b.vertex_count, b.face_count) == (a.vertex_count, a.face_count)
+    assert (b.vertex_offset, b.face_offset) == (a.vertex_offset + extra, a.face_offset + extra)
+    assert tailor.load(tricked).face_count == tailor.load(HORSE).face_count
+
+
 def test_the_partition_in_parts_is_the_partition_in_one(tmp_path):
     # The file cut into ranges (as the driver and a cluster's workers share it): each tile's files,
     # read one after the other, hold the faces the one-range partition gives it, in the same order;
