@@ -13,6 +13,7 @@
 #include "bindings.h"
 #include "tailor/chunks.h"
 #include "tailor/export.h"
+#include "tailor/image.h"
 #include "tailor/map_warnings.h"
 #include "tailor/material.h"
 
@@ -30,22 +31,46 @@ py::array_t<float, py::array::c_style | py::array::forcecast> corner_uv_array(co
   return uv;
 }
 
-// A material as tailor.load_material returns it: the dict's fields into the export options.
+// A material as tailor.load_material returns it: the dict's fields into the export options, each
+// checked (a dict may have been edited): a size of whole numbers, flags that are bools, maps that
+// are PNGs of the material's size.
 void material_from_dict(const py::dict& d, ExportOptions& options) {
-  auto bytes_of = [&](const char* key) {
-    return d.contains(key) && !d[key].is_none() ? d[key].cast<std::string>() : std::string();
-  };
-  if (d.contains("color") && !d["color"].is_none()) options.texture_path = path_of(d["color"]);
-  options.material.normal_png = bytes_of("normal_png");
-  options.material.orm_png = bytes_of("orm_png");
-  options.material.orm_roughness_metallic =
-      d.contains("orm_roughness_metallic") && d["orm_roughness_metallic"].cast<bool>();
-  options.material.orm_occlusion = d.contains("orm_occlusion") && d["orm_occlusion"].cast<bool>();
   if (!d.contains("width") || !d.contains("height"))
     raise_error("material must be a folder, a JSON or what tailor.load_material returns");
-  if (d["width"].cast<int>() != options.texture_width || d["height"].cast<int>() != options.texture_height)
-    raise_error("the material is " + std::to_string(d["width"].cast<int>()) + "x" +
-                std::to_string(d["height"].cast<int>()) + " but texture_size is " +
+  const int64_t width = whole_number(d["width"], "material['width']", 1, kMaxImageSide);
+  const int64_t height = whole_number(d["height"], "material['height']", 1, kMaxImageSide);
+  auto png_of = [&](const char* key) {
+    if (!d.contains(key) || d[key].is_none()) return std::string();
+    if (!py::isinstance<py::bytes>(d[key])) raise_error(std::string("material['") + key + "'] must be bytes or None");
+    std::string png = d[key].cast<std::string>();
+    // The PNG signature, then the IHDR chunk's big-endian width and height.
+    const auto be32 = [&](size_t at) {
+      int64_t v = 0;
+      for (size_t k = 0; k < 4; ++k) v = (v << 8) | static_cast<unsigned char>(png[at + k]);
+      return v;
+    };
+    if (png.size() < 24 || png.compare(0, 8, std::string("\x89PNG\r\n\x1a\n", 8)) != 0 ||
+        png.compare(12, 4, "IHDR") != 0 || be32(16) != width || be32(20) != height)
+      raise_error(std::string("material['") + key + "'] must be a PNG of the material's " + std::to_string(width) +
+                  "x" + std::to_string(height) + " px");
+    return png;
+  };
+  auto flag_of = [&](const char* key) {
+    if (!d.contains(key)) return false;
+    if (!py::isinstance<py::bool_>(d[key])) raise_error(std::string("material['") + key + "'] must be True or False");
+    return d[key].cast<bool>();
+  };
+  if (d.contains("symmetry") && !d["symmetry"].is_none()) {
+    const int64_t symmetry = whole_number(d["symmetry"], "material['symmetry']", 0, 4);
+    if (symmetry != 0 && symmetry != 1 && symmetry != 4) raise_error("material['symmetry'] must be 0, 1 or 4");
+  }
+  if (d.contains("color") && !d["color"].is_none()) options.texture_path = path_of(d["color"]);
+  options.material.normal_png = png_of("normal_png");
+  options.material.orm_png = png_of("orm_png");
+  options.material.orm_roughness_metallic = flag_of("orm_roughness_metallic");
+  options.material.orm_occlusion = flag_of("orm_occlusion");
+  if (width != options.texture_width || height != options.texture_height)
+    raise_error("the material is " + std::to_string(width) + "x" + std::to_string(height) + " but texture_size is " +
                 std::to_string(options.texture_width) + "x" + std::to_string(options.texture_height));
 }
 

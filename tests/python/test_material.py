@@ -128,6 +128,17 @@ def test_save_uvs_writes_a_material_read_once(tmp_path, material_dir):
         tailor.save_uvs(tmp_path / "x.glb", mesh, uv, (256, 256), material=loaded)
     with pytest.raises(tailor.Error, match="^--up must be y or z, got 'x'"):
         tailor.save_uvs(tmp_path / "x.glb", mesh, uv, (512, 512), up="x")
+    # An edited dict is checked as it is read: sizes, maps, flags, symmetry.
+    for key, value, message in [
+        ("width", 10**12, r"material\['width'\] must be a whole number in 1..16384"),
+        ("normal_png", b"notapng", r"material\['normal_png'\] must be a PNG of the material's 512x512 px"),
+        ("orm_png", "text", r"material\['orm_png'\] must be bytes or None"),
+        ("orm_occlusion", "yes", r"material\['orm_occlusion'\] must be True or False"),
+        ("symmetry", 3, r"material\['symmetry'\] must be 0, 1 or 4"),
+    ]:
+        with pytest.raises(tailor.Error, match=message):
+            tailor.save_uvs(tmp_path / "x.glb", mesh, uv, (512, 512), material=dict(loaded, **{key: value}))
+    assert not (tmp_path / "x.glb").exists()
     with pytest.raises(tailor.Error, match="no map recognised"):
         tailor.load_material(tmp_path)
     # image_uris: the maps named instead of embedded; a bad role, URI or output is one error, no file.
