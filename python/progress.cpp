@@ -18,10 +18,15 @@ bool ProgressBridge::report(double fraction) {
   const py::gil_scoped_acquire gil;
   try {
     if (PyErr_CheckSignals() != 0) throw py::error_already_set();  // Ctrl-C: KeyboardInterrupt
-    if (!callback_.is_none()) {
+    // Only news reaches the callback: the stages' own ends repeat 1.0.
+    if (!callback_.is_none() && fraction > last_fraction_) {
       last_fraction_ = fraction;
       const py::object answer = callback_(fraction);
-      if (answer.ptr() == Py_False) {
+      // False stops, and any other false value but None (numpy's False from `f < 0.5`, 0); a
+      // truth test that raises propagates.
+      const int truth = answer.is_none() ? 1 : PyObject_IsTrue(answer.ptr());
+      if (truth < 0) throw py::error_already_set();
+      if (truth == 0) {
         stopped_by_callback_ = true;
         return false;
       }
