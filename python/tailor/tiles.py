@@ -1132,6 +1132,10 @@ def run_locked(args, outdir):
         if aside:
             shutil.rmtree(aside, ignore_errors=True)
     except BaseException:
+        # The cluster first: a worker still running a task would write into the folder after it is
+        # removed (a stray temporary folder beside OUTDIR until the next run).
+        if start is not None:
+            start.close()
         shutil.rmtree(tmp, ignore_errors=True)
         raise
     finally:
