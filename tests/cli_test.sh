@@ -720,6 +720,15 @@ python3 -c 'import json, sys; sys.exit(json.load(open(sys.argv[1]))["mesh"]["not
 "$tailor" info "$tmp/short.off" | grep -qF "  not read               1 line after the 1 face the OFF header declares" &&
   ok || fail "info does not name what the OFF reader read past"
 
+# ... and a binary STL whose header counts too few triangles: the bytes after them are named.
+python3 -c '
+import struct, sys
+tri = struct.pack("<12fH", 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0) + struct.pack("<12fH", 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0)
+open(sys.argv[1], "wb").write(bytes(80) + struct.pack("<I", 1) + tri)' "$tmp/short.stl"
+"$tailor" map "$tmp/short.stl" -o "$tmp/short_stl.glb" 2>"$tmp/short.err" >/dev/null &&
+  grep -qF "tailor: warning: $tmp/short.stl: not read: 50 bytes after the 1 triangle the binary STL header declares" \
+    "$tmp/short.err" && ok || fail "map read a binary STL's undeclared triangles without a word: $(cat "$tmp/short.err")"
+
 # --- eval joins a file's vertices at identical positions: a face that then repeats one is dropped, and it says so ---
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\nf 2 5 4\n' >"$tmp/dup.obj"
 "$tailor" map "$tmp/dup.obj" -o "$tmp/dup.glb" -q && "$tailor" eval "$tmp/dup.glb" 2>"$tmp/dup.err" >/dev/null &&

@@ -80,6 +80,10 @@ Status read_binary(std::span<const char> data, const std::string& name, std::vec
   const char* p = data.data() + kBinaryHeader;
   for (size_t f = 0; f < n; ++f, p += kBinaryFacet) std::memcpy(&corners[9 * f], p + 12, 36);
   report.source_faces = n;
+  // A header that counts too few triangles would lose the rest without a word.
+  if (data.size() > need)
+    add_not_read(report, std::to_string(data.size() - need) + " bytes after the " + std::to_string(n) +
+                             (n == 1 ? " triangle" : " triangles") + " the binary STL header declares");
   return Status::ok();
 }
 
