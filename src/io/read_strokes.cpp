@@ -50,8 +50,9 @@ Status strokes_from_json(const nlohmann::json& array, const std::string& name, s
       stroke.points.insert(stroke.points.end(), x, x + 3);
     }
     const auto radius = s.find("radius");
-    if (radius == s.end() || !finite_float(*radius, stroke.radius) || !(stroke.radius > 0.f))
-      return fail("\"radius\" must be a finite number > 0", where + ".radius");
+    if (radius == s.end() || !finite_float(*radius, stroke.radius) ||
+        !(stroke.radius >= std::numeric_limits<float>::min()))
+      return fail("\"radius\" must be a number from 1.2e-38 to 3.4e38 (a positive 32-bit float)", where + ".radius");
     out.push_back(std::move(stroke));
   }
   return Status::ok();
