@@ -614,6 +614,16 @@ for obj in a b; do
   timeout 5 "$tailor" eval "$tmp/named/$obj.obj" 2>&1 | grep -q "texture 512x512 px, default)" && ok ||
     fail "eval of an .obj whose material or texture is a FIFO did not fall back to the default size"
 done
+# ... and one whose header claims more than any command reads (16384 px a side): the same.
+python3 -c '
+import struct, sys, zlib
+ihdr = struct.pack(">IIBBBBB", 100000, 1, 8, 0, 0, 0, 0)
+open(sys.argv[1], "wb").write(b"\x89PNG\r\n\x1a\n" + struct.pack(">I", 13) + b"IHDR" + ihdr + struct.pack(">I", zlib.crc32(b"IHDR" + ihdr)))' \
+  "$tmp/named/wide.png"
+printf 'mtllib w.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n' >"$tmp/named/w.obj"
+printf 'newmtl m\nmap_Kd wide.png\n' >"$tmp/named/w.mtl"
+"$tailor" eval "$tmp/named/w.obj" 2>&1 | grep -q "texture 512x512 px, default)" && ok ||
+  fail "eval took the size of a texture beyond 16384 px a side from its header"
 [[ ! -e $tmp/img/o.png && ! -e $tmp/img/o.glb ]] && ok || fail "a refused input left an output"
 
 ls "$tmp"/*.tmp-* "$tmp"/.tailor-* >/dev/null 2>&1 && fail "temporary files left behind" || ok

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "io/readers.h"
+#include "tailor/image.h"
 #include "tailor/io.h"
 #include "util/atomic_file.h"
 #include "util/file_view.h"
@@ -195,7 +196,8 @@ void read_texture_header(const std::filesystem::path& image, LoadReport& report)
       break;
     if (head.size() < max_bytes) return;
   }
-  if (width <= 0 || height <= 0 || width > INT_MAX || height > INT_MAX) return;
+  // Beyond the sides any command reads (kMaxImageSide) the image is as unreadable as a missing one.
+  if (width <= 0 || height <= 0 || width > kMaxImageSide || height > kMaxImageSide) return;
   report.texture_width = static_cast<int>(width);
   report.texture_height = static_cast<int>(height);
   report.texture_file = true;

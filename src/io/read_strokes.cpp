@@ -50,9 +50,10 @@ Status strokes_from_json(const nlohmann::json& array, const std::string& name, s
       stroke.points.insert(stroke.points.end(), x, x + 3);
     }
     const auto radius = s.find("radius");
-    if (radius == s.end() || !finite_float(*radius, stroke.radius) ||
-        !(stroke.radius >= std::numeric_limits<float>::min()))
-      return fail("\"radius\" must be a number from 1.2e-38 to 3.4e38 (a positive 32-bit float)", where + ".radius");
+    if (radius == s.end() || !finite_float(*radius, stroke.radius) || !(radius->get<double>() > 0))
+      return fail("\"radius\" must be a finite number > 0", where + ".radius");
+    if (!(stroke.radius >= std::numeric_limits<float>::min()))  // 1e-300 would be 0 as a float
+      return fail("\"radius\" must be at least 1.2e-38 (the smallest normal 32-bit float)", where + ".radius");
     out.push_back(std::move(stroke));
   }
   return Status::ok();
