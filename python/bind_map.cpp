@@ -387,7 +387,8 @@ void bind_map(py::module_& m) {
           if (run.axis_auto) {
             topology = build_topology(mesh.mesh, {}, options.mapping.threads);
             const auto axis_start = std::chrono::steady_clock::now();
-            mapping.progress = [&report_progress](float f) { return report_progress(f); };
+            // One range for the callback: the axis choice its first half, the mapping the second.
+            mapping.progress = [&report_progress](float f) { return report_progress(0.5f * f); };
             AxisChoice choice;
             status = choose_orientation_axis(mesh.mesh, topology, options, choice);
             if (status) {
@@ -398,7 +399,9 @@ void bind_map(py::module_& m) {
           }
           TextureMap map;
           if (status) {
-            mapping.progress = [&report_progress](float f) { return report_progress(f); };
+            mapping.progress = [&report_progress, half = run.axis_auto](float f) {
+              return report_progress(half ? 0.5f + 0.5f * f : f);
+            };
             MapTextureOptions unmeasured = options;
             unmeasured.measure = false;
             status = map_texture(mesh.mesh, topology, unmeasured, map);

@@ -108,8 +108,8 @@ py::object json_to_dict(const std::string& text);
 
 //! Connects the library's progress callbacks to Python while the GIL is released: at most every
 //! 50 ms (and at the end) it takes the GIL, checks for signals (Ctrl-C raises KeyboardInterrupt)
-//! and calls the user's callback(fraction); an exception there, or a return value of False,
-//! cancels the work. finish() then re-raises that exception, or tailor.Error for a False.
+//! and calls the user's callback(fraction), 1.0 once; an exception there, or a false return value
+//! other than None, cancels the work. finish() then re-raises that exception, or tailor.Error.
 class ProgressBridge {
  public:
   explicit ProgressBridge(py::object callback) : callback_(std::move(callback)) {}

@@ -36,8 +36,10 @@ void raise_error(const std::string& what) { raise_with_code(what, code_name(Erro
 void require_constructed(py::handle src, const std::type_info& type) {
   const py::detail::type_info* info = py::detail::get_type_info(type);
   if (info == nullptr || !src || !PyObject_TypeCheck(src.ptr(), info->type)) return;  // not ours: the caster says no
-  const auto holder = reinterpret_cast<py::detail::instance*>(src.ptr())->get_value_and_holder(info, false);
-  if (holder && holder.holder_constructed()) return;
+  auto* instance = reinterpret_cast<py::detail::instance*>(src.ptr());
+  const auto holder = instance->get_value_and_holder(info, false);
+  // Constructed: a value, and a holder unless the object only refers to one it does not own.
+  if (holder && holder.value_ptr() != nullptr && (holder.holder_constructed() || !instance->owned)) return;
   const char* how = type == typeid(PyMesh)     ? "tailor.Mesh was made by __new__ without __init__: make one with "
                                                  "tailor.Mesh(positions, faces) or tailor.load(path)"
                     : type == typeid(PyResult) ? "tailor.Result was made by __new__: tailor.map returns one"

@@ -18,8 +18,9 @@ bool ProgressBridge::report(double fraction) {
   const py::gil_scoped_acquire gil;
   try {
     if (PyErr_CheckSignals() != 0) throw py::error_already_set();  // Ctrl-C: KeyboardInterrupt
-    // Only news reaches the callback: the stages' own ends repeat 1.0.
-    if (!callback_.is_none() && fraction > last_fraction_) {
+    // The end once: the last stages each report 1.0. Other repeats go through (throttled above):
+    // a retry or the closing's tail repeats its fraction, and the callback may cancel there.
+    if (!callback_.is_none() && !(fraction >= 1.0 && last_fraction_ >= 1.0)) {
       last_fraction_ = fraction;
       const py::object answer = callback_(fraction);
       // False stops, and any other false value but None (numpy's False from `f < 0.5`, 0); a

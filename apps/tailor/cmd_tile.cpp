@@ -208,8 +208,9 @@ void warn_unknown_keys(const TileCliOptions& opt, const nlohmann::json& object,
 //! "normal_convention": "gl"}; files relative to the JSON's folder. Fills opt.set / normal_maps.
 Status read_material(TileCliOptions& opt) {
   std::string text;  // read_file: a FIFO or device is refused, not waited on
+  std::error_code ec;
   if (Status s = internal::read_file(opt.material, text); !s)
-    return s.code() == ErrorCode::kIo && !std::filesystem::exists(opt.material)
+    return s.code() == ErrorCode::kIo && !std::filesystem::exists(std::filesystem::status(opt.material, ec))
                ? Status::error(ErrorCode::kIo, opt.material, "cannot open the material description")
                : s;
   nlohmann::json j;

@@ -1133,10 +1133,13 @@ def run_locked(args, outdir):
             shutil.rmtree(aside, ignore_errors=True)
     except BaseException:
         # The cluster first: a worker still running a task would write into the folder after it is
-        # removed (a stray temporary folder beside OUTDIR until the next run).
-        if start is not None:
-            start.close()
-        shutil.rmtree(tmp, ignore_errors=True)
+        # removed (a stray temporary folder beside OUTDIR until the next run). The folder goes even
+        # when closing fails or a second Ctrl-C cuts it short.
+        try:
+            if start is not None:
+                start.close()
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
         raise
     finally:
         if start is not None:

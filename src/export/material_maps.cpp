@@ -142,7 +142,7 @@ Status load_material(const std::string& dir_or_json, MaterialMaps& out, const Im
     // tiles (the maps themselves are found by name, as in any folder).
     const std::string record = dir_or_json + "/material.json";
     nlohmann::json j;
-    if (fs::exists(fs::symlink_status(record, ec))) {
+    if (fs::exists(fs::status(record, ec))) {  // absent (or a dangling link): no record
       TAILOR_RETURN_IF_ERROR(read_json(record, j));
       if (!j.is_discarded() && j.is_object()) TAILOR_RETURN_IF_ERROR(read_symmetry(j, record, out.symmetry));
     }
