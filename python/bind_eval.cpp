@@ -21,17 +21,26 @@ void bind_eval(py::module_& m) {
         if (!shape_ok || corner_uvs.dtype().kind() != 'f')
           raise_error("corner_uvs must be a float (F, 3, 2) array with F = " + std::to_string(nf) + ", got " +
                       describe(corner_uvs));
-        int width = 0, height = 0;
-        try {
-          if (py::isinstance<py::int_>(texture_size)) {
-            width = height = texture_size.cast<int>();
-          } else {
-            const auto wh = texture_size.cast<std::pair<int, int>>();
-            width = wh.first;
-            height = wh.second;
+        // Whole numbers as Python has them (numpy's integers too, through __index__), then the range.
+        const auto whole = [](const py::handle& h, long long& out) {
+          const py::object index = py::reinterpret_steal<py::object>(PyNumber_Index(h.ptr()));
+          if (!index) {
+            PyErr_Clear();
+            raise_error("texture_size must be an int or (width, height)");
           }
-        } catch (const py::cast_error&) {
-          raise_error("texture_size must be an int or (width, height)");
+          int overflow = 0;
+          out = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
+          if (overflow != 0) out = overflow > 0 ? std::numeric_limits<long long>::max() : -1;
+        };
+        long long width = 0, height = 0;
+        if (py::isinstance<py::sequence>(texture_size) && !py::isinstance<py::str>(texture_size)) {
+          const auto wh = texture_size.cast<py::sequence>();
+          if (wh.size() != 2) raise_error("texture_size must be an int or (width, height)");
+          whole(wh[0], width);
+          whole(wh[1], height);
+        } else {
+          whole(texture_size, width);
+          height = width;
         }
         if (width < 1 || height < 1 || width > kMaxTextureSize || height > kMaxTextureSize)
           raise_error("texture_size must be between 1 and 65536, got " + std::to_string(width) + "x" +
@@ -56,8 +65,8 @@ void bind_eval(py::module_& m) {
           run.file = mesh.source;
           run.format = mesh.load.format;
           run.vertices = mesh.mesh.vertex_count();
-          run.texture_width = width;
-          run.texture_height = height;
+          run.texture_width = static_cast<int>(width);
+          run.texture_height = static_cast<int>(height);
           run.texture_size_from = "option";
           run.symmetry = symmetry;
           run.boundary_edges = surface.boundary_edges;

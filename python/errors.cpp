@@ -137,6 +137,9 @@ void bind_errors(py::module_& m) {
       "Raised by every tailor call on bad input, bad options or failed I/O. str(error) is the line the "
       "tailor command prints after 'tailor: error: ' (file: what (where)); error.code names the kind: "
       "io, parse, invalid_mesh, invalid_image, unsupported, limit, invalid_argument or cancelled.";
+  // An Error raised by Python code (a caller's own, or tailor.tiles') has the class's code until
+  // it is given one.
+  type.attr("code") = "error";
 }
 
 }  // namespace tailor::python

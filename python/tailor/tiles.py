@@ -1239,7 +1239,7 @@ def parse_args(argv):
         "--texture-size", type=int, default=defaults["texture_size"], help="pixels of one repeat without --texture"
     )
     p.add_argument(
-        "--scale", type=float, default=defaults["scale"], help="as tailor map --scale (density from the bounding box)"
+        "--scale", type=float, help="as tailor map --scale (density from the bounding box; default %g)" % defaults["scale"]
     )
     p.add_argument(
         "--texels-per-unit",
@@ -1274,10 +1274,14 @@ def parse_args(argv):
         usage_error("give --texture or --material, not both (the material's colour map is the texture)")
     if args.up not in ("y", "z"):
         usage_error("--up must be y or z, got '%s'" % args.up)
+    if args.scale is not None and args.texels_per_unit is not None:
+        usage_error("give --scale or --texels-per-unit, not both (the density is one or the other)")
     for name, value in (("--tile-size", args.tile_size), ("--texels-per-unit", args.texels_per_unit),
                         ("--scale", args.scale)):
         if value is not None and not (0 < value < math.inf):
             usage_error("%s must be a positive number, got %s" % (name, value))
+    if args.scale is None:
+        args.scale = defaults["scale"]
     if not (0.01 <= args.max_stretch <= 4):  # the library's range (MappingOptions::max_stretch)
         usage_error("--max-stretch must be in 0.01..4, got %s" % args.max_stretch)
     if not 1 <= args.texture_size <= 65536:  # as tailor map and tailor eval take it

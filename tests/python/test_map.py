@@ -103,6 +103,15 @@ def test_evaluate_matches_the_map_and_the_cli(tmp_path, tailor_binary):
     # Errors name the keywords, not the command's flags.
     with pytest.raises(tailor.Error, match=r"^texture_size must be between 1 and 65536, got 0x512$"):
         tailor.evaluate(mesh, result.corner_uvs, (0, 512))
+    # numpy's integers are whole numbers as map takes them; a float or a triple is not a size.
+    figures = {k: v for k, v in report.items() if k != "seconds"}
+    for size in (np.int64(512), (np.int32(512), np.uint16(512))):
+        assert {k: v for k, v in tailor.evaluate(mesh, result.corner_uvs, size).items() if k != "seconds"} == figures
+    for not_a_size in (512.0, (512, 512, 1), "512"):
+        with pytest.raises(tailor.Error, match=r"^texture_size must be an int or \(width, height\)$"):
+            tailor.evaluate(mesh, result.corner_uvs, not_a_size)
+    with pytest.raises(tailor.Error, match=r"^texture_size must be between 1 and 65536, got 1099511627776x"):
+        tailor.evaluate(mesh, result.corner_uvs, 2**40)
     with pytest.raises(tailor.Error, match=r"^symmetry must be 1 or 4, got 2$"):
         tailor.evaluate(mesh, result.corner_uvs, 512, symmetry=2)
     with pytest.raises(tailor.Error, match=r"^symmetry=4 needs a square texture_size, got 512x256$"):

@@ -393,6 +393,9 @@ def test_a_material_is_named_by_every_tile_and_written_once(tmp_path):
     code, _, stderr = run_tiles(*common, "-o", tmp_path / "both", "--material", material, "--texture", colour)
     assert code == 2 and stderr.count("\n") == 1 and "give --texture or --material, not both" in stderr
     assert not (tmp_path / "both").exists()
+    code, _, stderr = run_tiles(*common, "-o", tmp_path / "both", "--scale", 5, "--texels-per-unit", 5)
+    assert code == 2 and stderr.count("\n") == 1 and "give --scale or --texels-per-unit, not both" in stderr
+    assert not (tmp_path / "both").exists()
     code, _, stderr = run_tiles(*common, "-o", tmp_path / "bad", "--material", tmp_path / "missing.json")
     assert code == 1 and stderr.count("\n") == 1 and stderr.startswith("tailor.tiles: error: ")
     assert not (tmp_path / "bad").exists()
