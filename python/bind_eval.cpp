@@ -33,9 +33,12 @@ void bind_eval(py::module_& m) {
           if (overflow != 0) out = overflow > 0 ? std::numeric_limits<long long>::max() : -1;
         };
         long long width = 0, height = 0;
-        if (py::isinstance<py::sequence>(texture_size) && !py::isinstance<py::str>(texture_size)) {
+        // A sequence by its length (a 0-d numpy array claims to be one and has none: a number).
+        const Py_ssize_t length = py::isinstance<py::str>(texture_size) ? -1 : PySequence_Size(texture_size.ptr());
+        if (length < 0) PyErr_Clear();
+        if (length >= 0) {
+          if (length != 2) raise_error("texture_size must be an int or (width, height)");
           const auto wh = texture_size.cast<py::sequence>();
-          if (wh.size() != 2) raise_error("texture_size must be an int or (width, height)");
           whole(wh[0], width);
           whole(wh[1], height);
         } else {
