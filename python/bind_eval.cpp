@@ -23,14 +23,7 @@ void bind_eval(py::module_& m) {
                       describe(corner_uvs));
         // Whole numbers as Python has them (numpy's integers too, through __index__), then the range.
         const auto whole = [](const py::handle& h, long long& out) {
-          const py::object index = py::reinterpret_steal<py::object>(PyNumber_Index(h.ptr()));
-          if (!index) {
-            PyErr_Clear();
-            raise_error("texture_size must be an int or (width, height)");
-          }
-          int overflow = 0;
-          out = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
-          if (overflow != 0) out = overflow > 0 ? std::numeric_limits<long long>::max() : -1;
+          if (!whole_value(h, out)) raise_error("texture_size must be an int or (width, height)");
         };
         long long width = 0, height = 0;
         // A sequence by its length (a 0-d numpy array claims to be one and has none: a number).

@@ -53,6 +53,9 @@ struct PyResult {
 //! in lo..hi; else tailor.Error naming `name` (pybind11's own casts raise a RuntimeError that names
 //! neither the argument nor the range).
 int64_t whole_number(const py::handle& value, const std::string& name, int64_t lo, int64_t hi);
+//! `value` as a whole number (an int, or anything with __index__) into `out`, saturated to 64 bits;
+//! false when it is none (whole_number's test, for callers with their own message).
+bool whole_value(const py::handle& value, long long& out);
 
 //! `o` as a numpy array (any array-like, as numpy.asarray reads it), or nothing when numpy cannot
 //! read it as one; KeyboardInterrupt, SystemExit and MemoryError raised meanwhile pass through.

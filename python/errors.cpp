@@ -1,4 +1,6 @@
 // tailor.Error and the small helpers every binding uses (paths, JSON, array descriptions).
+#include <limits>
+
 #include "bindings.h"
 
 namespace tailor::python {
@@ -60,23 +62,27 @@ std::optional<py::array> as_array(const py::handle& o) {
   }
 }
 
-int64_t whole_number(const py::handle& value, const std::string& name, int64_t lo, int64_t hi) {
-  const auto refuse = [&] {
-    raise_error(name + " must be a whole number in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got " +
-                py::repr(value).cast<std::string>());
-  };
+bool whole_value(const py::handle& value, long long& out) {
   const py::object index = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
   if (!index) {
     PyErr_Clear();
-    refuse();
+    return false;
   }
   int overflow = 0;
-  const long long v = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
-  if (overflow != 0 || (v == -1 && PyErr_Occurred())) {
+  out = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
+  if (out == -1 && PyErr_Occurred()) {
     PyErr_Clear();
-    refuse();
+    return false;
   }
-  if (v < lo || v > hi) refuse();
+  if (overflow != 0) out = overflow > 0 ? std::numeric_limits<long long>::max() : std::numeric_limits<long long>::min();
+  return true;
+}
+
+int64_t whole_number(const py::handle& value, const std::string& name, int64_t lo, int64_t hi) {
+  long long v = 0;
+  if (!whole_value(value, v) || v < lo || v > hi)  // saturated beyond 64 bits: out of every range asked
+    raise_error(name + " must be a whole number in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got " +
+                py::repr(value).cast<std::string>());
   return v;
 }
 
