@@ -1,11 +1,13 @@
 // The per-block work of the streamed input (tiles_stream), which the driver does before any tile
 // can be mapped: tailor._survey_block (the first pass: the bounding box and the histogram of the
-// edge lengths' high bits) and tailor._partition_block (a block cut by tile: each face's chunk
-// cell, its tile's key, the faces' records grouped by tile in file order, the distinct cells).
+// edge lengths' high bits), tailor._partition_block (a block cut by tile: each face's chunk
+// cell, its tile's key, the faces' records grouped by tile in file order, the distinct cells) and
+// tailor._gather_corners (a block's corners from the memory-mapped vertex element).
 // One pass over a block each, in C++: in numpy the same work takes a pass per reduction, the
 // keys packed twice, np.unique, a stable argsort and a gather of the records, most of those
 // passes' processor time.
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cstdint>
 #include <cstring>
@@ -36,6 +38,26 @@ T* writable(const py::array& a, py::ssize_t size, const char* what) {
                 (sizeof(T) == 4 ? "float32" : "int64") + ", got " + describe(a));
   return static_cast<T*>(py::array(a).mutable_data());
 }
+
+// A filter in front of a sort + unique of a block's keys: a key found in its slot of a small
+// direct-mapped table was listed already. A block holds a few hundred distinct cells, and a file
+// whose face order is not spatial changes cell at nearly every face: sorting every change took a
+// tenth of the partition's time. A key it lets through twice is removed by the unique.
+class RecentKeys {
+ public:
+  RecentKeys() { slots_.fill(-1); }  // no packed key is negative (pack_cell)
+
+  bool first_time(int64_t key) {
+    int64_t& slot = slots_[static_cast<uint64_t>(key) * 0x9E3779B97F4A7C15ull >> (64 - kBits)];
+    if (slot == key) return false;
+    slot = key;
+    return true;
+  }
+
+ private:
+  static constexpr int kBits = 10;
+  std::array<int64_t, size_t{1} << kBits> slots_;
+};
 
 }  // namespace
 
@@ -111,11 +133,12 @@ void bind_stream_blocks(py::module_& m) {
           status = chunk_cells({corners.data(), 9 * face_count}, cell_exponent, cells);
         }
         if (!status) raise_status(status);
-        // A block holds few tiles and cells, and file order keeps a face's neighbours in its cell
-        // as often as not: the distinct keys are sorted from the runs of equal keys, and the faces
-        // are grouped by a counting sort over their tile's rank (no sort over the faces).
+        // A block holds few tiles and cells: the distinct keys are sorted from the keys not among
+        // the recently seen (RecentKeys), and the faces are grouped by a counting sort over their
+        // tile's rank (no sort over the faces).
         std::vector<int64_t> tile_of(face_count), tile_keys, cell_keys;
         std::vector<uint32_t> order(face_count), start(1, 0);
+        RecentKeys cell_seen, tile_seen;
         {
           const py::gil_scoped_release release;
           for (size_t f = 0; f < face_count; ++f) {
@@ -123,8 +146,8 @@ void bind_stream_blocks(py::module_& m) {
             const int64_t cell = pack_cell(c[0], c[1], c[2]);
             // >> on a negative int32 is floor division by 2^level, as numpy's on int64.
             tile_of[f] = tile_level ? pack_cell(c[0] >> tile_level, c[1] >> tile_level, c[2] >> tile_level) : cell;
-            if (f == 0 || cell != cell_keys.back()) cell_keys.push_back(cell);
-            if (f == 0 || tile_of[f] != tile_of[f - 1]) tile_keys.push_back(tile_of[f]);
+            if (cell_seen.first_time(cell)) cell_keys.push_back(cell);
+            if (tile_seen.first_time(tile_of[f])) tile_keys.push_back(tile_of[f]);
           }
           std::vector<int32_t>().swap(cells);
           for (std::vector<int64_t>* keys : {&cell_keys, &tile_keys}) {
@@ -181,6 +204,47 @@ void bind_stream_blocks(py::module_& m) {
       "tiles (T,) int64, starts (T + 1,) int64, cells (C,) int64): for tailor.tiles: the faces' records\n"
       "(ids as index_bytes-wide unsigned integers, then the corners) grouped by tile (file order within a\n"
       "tile), tile t's records at [starts[t], starts[t + 1]); tiles and cells as packed keys, sorted");
+  m.def(
+      "_gather_corners",
+      [](const py::buffer& source, size_t offset, size_t stride, size_t count, const py::array& ids_in) {
+        // numpy's take of 12-byte records copies each one by a call of its own: a third of the
+        // streamed partition's time.
+        auto ids = IdArray::ensure(ids_in);
+        if (!ids || ids.ndim() != 2 || ids.shape(1) != 3)
+          raise_error("ids must be an (F, 3) array, got " + describe(ids_in));
+        const py::buffer_info info = source.request();  // held: the buffer stays mapped while we read
+        const auto size = static_cast<size_t>(info.size * info.itemsize);
+        if (stride < 12 || count == 0 || offset > size || size - offset < 12 ||
+            (size - offset - 12) / stride < count - 1)
+          raise_error("a vertex element of " + std::to_string(count) + " rows of " + std::to_string(stride) +
+                      " bytes at byte " + std::to_string(offset) + " does not fit a buffer of " + std::to_string(size));
+        const size_t n = static_cast<size_t>(ids.shape(0));
+        py::array_t<float> out({static_cast<py::ssize_t>(n), py::ssize_t{3}, py::ssize_t{3}});
+        const auto* base = static_cast<const uint8_t*>(info.ptr) + offset;
+        const int64_t* id = ids.data();
+        float* p = out.mutable_data();
+        size_t bad = 3 * n;
+        {
+          const py::gil_scoped_release release;
+          constexpr size_t kAhead = 16;  // the rows are read in the ids' order, scattered: fetched ahead
+          for (size_t c = 0; c < 3 * n; ++c) {
+            if (c + kAhead < 3 * n && static_cast<uint64_t>(id[c + kAhead]) < count)
+              __builtin_prefetch(base + static_cast<size_t>(id[c + kAhead]) * stride);
+            if (static_cast<uint64_t>(id[c]) >= count) {  // negative ids too
+              bad = c;
+              break;
+            }
+            std::memcpy(p + 3 * c, base + static_cast<size_t>(id[c]) * stride, 12);
+          }
+        }
+        if (bad < 3 * n)
+          raise_error("vertex id " + std::to_string(id[bad]) + " of face " + std::to_string(bad / 3) +
+                      " is not below " + std::to_string(count));
+        return out;
+      },
+      py::arg("source"), py::arg("offset"), py::arg("stride"), py::arg("count"), py::arg("ids"),
+      "_gather_corners(source, offset, stride, count, ids) -> (F, 3, 3) float32: for tailor.tiles: each\n"
+      "id's three float32 at byte offset + id * stride of the buffer source (count rows), ids (F, 3)");
 }
 
 }  // namespace tailor::python

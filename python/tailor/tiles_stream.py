@@ -206,23 +206,16 @@ class _Body:
             (layout.vertex_count,), dtype=layout.vertex_dtype, buffer=self.map, offset=layout.vertex_offset
         )
         # x, y, z as three consecutive float32 (the usual vertex): one gather of 12 bytes per corner
-        # instead of one per axis. The rows are opaque 12-byte records, never float32 rows: the
-        # header's length leaves floats unaligned as often as not, and numpy copies a whole
-        # unaligned array before it gathers from it.
+        # (tailor._gather_corners) instead of one per axis. The header's length leaves the floats
+        # unaligned as often as not, which numpy would copy whole before it gathers.
         fields = layout.vertex_dtype.fields
         x = fields["x"][1]
-        self.rows = None
+        self.xyz_at = None
         if all(fields[a][0] == np.dtype("<f4") and fields[a][1] == x + 4 * k for k, a in enumerate("xyz")):
-            self.rows = np.ndarray(
-                (layout.vertex_count,),
-                dtype=np.dtype((np.void, 12)),
-                buffer=self.map,
-                offset=layout.vertex_offset + x,
-                strides=(layout.vertex_dtype.itemsize,),
-            )
+            self.xyz_at = layout.vertex_offset + x
 
     def close(self):
-        del self.vertices, self.rows
+        del self.vertices
         try:
             self.map.close()
         except BufferError:  # a block still viewed by a frame an error left: closed when collected
@@ -277,14 +270,12 @@ class _Body:
             kept = (ids[:, 0] != ids[:, 1]) & (ids[:, 1] != ids[:, 2]) & (ids[:, 0] != ids[:, 2])
             if kept.all():
                 kept = slice(None)
-            if self.rows is None:
+            if self.xyz_at is None:
                 corners = np.empty((n, 3, 3), dtype=np.float32)
                 for k, axis in enumerate("xyz"):
                     corners[:, :, k] = self.vertices[axis][ids]
-            elif self.rows.flags.c_contiguous:
-                corners = self.rows.take(ids.reshape(-1)).view("<f4").reshape(n, 3, 3)
-            else:  # take would copy the whole vertex element first
-                corners = self.rows[ids.reshape(-1)].view("<f4").reshape(n, 3, 3)
+            else:
+                corners = tailor._tailor._gather_corners(self.map, self.xyz_at, layout.vertex_dtype.itemsize, nv, ids)
             # Every face record read so far, not only this block's: faulting a page in maps the
             # cached pages around it too (the kernel's fault-around), earlier blocks' among them.
             self.release(layout.face_offset, (first + n) * dtype.itemsize)

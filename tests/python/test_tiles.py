@@ -650,6 +650,28 @@ def test_a_block_of_the_partition_is_its_records_grouped_by_tile():
         tailor._tailor._partition_block(np.array([[0, 1, 1 << 32]]), corners[:1], CELL, 0, 4)
 
 
+def test_a_block_gathers_its_corners_from_the_vertex_rows():
+    # The streamed vertex element as a PLY holds it: rows of x, y, z and one more property, after
+    # a header of an odd length (the floats unaligned).
+    positions, faces = horse_arrays()
+    rows = np.zeros(positions.shape[0], dtype=[("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("s", "<f4")])
+    for k, axis in enumerate("xyz"):
+        rows[axis] = positions[:, k]
+    data = b"header!" + rows.tobytes()
+    ids = faces[np.random.default_rng(3).permutation(faces.shape[0])].astype(np.int64)
+    got = tailor._tailor._gather_corners(data, 7, 16, rows.shape[0], ids)
+    assert got.dtype == np.float32 and np.array_equal(got, positions.astype(np.float32)[ids])
+    assert tailor._tailor._gather_corners(data, 7, 16, rows.shape[0], np.empty((0, 3), np.int64)).shape == (0, 3, 3)
+    for bad in (rows.shape[0], -1):
+        with pytest.raises(tailor.Error, match="vertex id %d of face 1 is not below %d" % (bad, rows.shape[0])):
+            tailor._tailor._gather_corners(data, 7, 16, rows.shape[0], np.array([[0, 1, 2], [3, bad, 4]]))
+    with pytest.raises(tailor.Error, match="does not fit a buffer of"):  # one row more than the bytes hold
+        tailor._tailor._gather_corners(data, 7, 16, rows.shape[0] + 1, ids[:1])
+    with pytest.raises(tailor.Error, match="does not fit a buffer of"):
+        tailor._tailor._gather_corners(data, len(data) - 11, 16, 1, ids[:1] * 0)
+    assert tailor._tailor._gather_corners(data, len(data) - 12, 16, 1, ids[:1] * 0).shape == (1, 3, 3)
+
+
 def test_the_survey_gives_the_box_and_the_cell_that_loading_gives(tmp_path):
     # The first streaming pass: the box of the referenced vertices and plan_chunks' cell. The horse
     # as it is (the coarse histogram's bin decides the cell), then scaled so that its median edge
