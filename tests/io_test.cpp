@@ -531,6 +531,12 @@ TEST(Off, KeywordVariantsColoursAndComments) {
   Mesh m;
   EXPECT_EQ(parse("4OFF\n1 1 0\n0 0 0 0\n", MeshFormat::kOff, m).code(), ErrorCode::kUnsupported);
   EXPECT_EQ(parse("OFF BINARY\n", MeshFormat::kOff, m).code(), ErrorCode::kUnsupported);
+  // The data run on after the counts, on the keyword's line or the counts' own: named, not "too short".
+  for (const char* one_line : {"OFF 3 1 0 0 0 0 1 0 0 0 1 0 3 0 1 2\n", "OFF\n3 1 0 0 0 0 1 0 0 0 1 0 3 0 1 2\n"}) {
+    const Status s = parse(one_line, MeshFormat::kOff, m);
+    EXPECT_EQ(s.code(), ErrorCode::kUnsupported) << one_line;
+    EXPECT_NE(s.message().find("values after the OFF counts on their line ('0'...)"), std::string::npos) << s.message();
+  }
 }
 
 TEST(Off, ContentAfterTheDeclaredFacesIsReported) {

@@ -71,6 +71,13 @@ Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh,
   if (!s.at_line_end() && !s.read_uint(ne)) {
     return Status::error(ErrorCode::kParse, name, "bad OFF header (expected edge count)", s.where());
   }
+  // Vertices and faces are read a line each (the rest of a line ignored: colours, normals), so a
+  // file that runs its data on after the counts would be misread from its first vertex on.
+  if (!s.at_line_end())
+    return Status::error(ErrorCode::kUnsupported, name,
+                         "values after the OFF counts on their line (" + quote_input(s.word()) +
+                             "...): this reader takes each vertex and each face on a line of its own",
+                         s.where());
   s.next_line();
   // Checked before any allocation: the counts must fit in the bytes that are left.
   const uint64_t need = mul_sat(nv, kMinVertexBytes) + mul_sat(nf, kMinFaceBytes);
