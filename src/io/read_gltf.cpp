@@ -782,7 +782,15 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
   const auto materials_it = doc.json().find("materials");
   const size_t material_count = materials_it != doc.json().end() && materials_it->is_array() ? materials_it->size() : 0;
   std::vector<uint32_t> material_slot(material_count, kInvalid);  // input material -> scene.materials
+  size_t collapsed = 0;  // instances whose transform scales them to nothing (a zero scale hides a node)
+  uint64_t first_collapsed = UINT64_MAX;
   for (const Instance& instance : instances) {
+    // Their faces would have no area: the welding would drop every one as naming a vertex twice,
+    // which does not say why. Skipped and named instead.
+    if (determinant3(instance.world) == 0) {
+      if (collapsed++ == 0) first_collapsed = instance.node;
+      continue;
+    }
     const size_t mi = instance.mesh;
     const Json& m = meshes[mi];
     const Json* node = instance.node == UINT64_MAX ? nullptr : get_element(doc.json(), "nodes", instance.node);
@@ -872,6 +880,14 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
       }
     }
   }
+  const std::string collapsed_text =
+      collapsed == 0 ? ""
+                     : std::to_string(collapsed) + (collapsed == 1 ? " mesh instance" : " mesh instances") +
+                           " under a transform that scales to nothing (node " + std::to_string(first_collapsed) +
+                           (collapsed == 1 ? ")" : ", ...)");
+  if (triangle_primitives == 0 && collapsed > 0)
+    return Status::error(ErrorCode::kInvalidMesh, name, "no face with an area in the scene: " + collapsed_text);
+  if (collapsed > 0) lost.push_back(collapsed_text);
   if (triangle_primitives == 0)
     return Status::error(ErrorCode::kUnsupported, name,
                          report.skipped_primitives
