@@ -222,6 +222,14 @@ expect_error 2 "\(run 'tailor --help'\)$" -- "$tailor"
 expect_error 2 "unknown argument '--bogus' \(run 'tailor --help'\)$" -- "$tailor" --bogus
 expect_error 2 "unknown argument '--ouput' \(run 'tailor map --help'\)$" -- "$tailor" map "$mesh" --ouput "$tmp/x.glb"
 expect_error 2 "unknown argument '--nope' \(run 'tailor map --help'\)$" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --nope
+# An empty value ('--texture "$TEX"' with TEX unset) is refused, not taken for the option left out:
+# in an option group too (--seed-point, --seam-faces), and in the other commands.
+for option in --texture --stats --seed-point --seam-faces --preview; do
+  expect_error 2 "$option was given an empty value: give one, or leave the option out \(run 'tailor map --help'\)$" -- "$tailor" map "$mesh" -o "$tmp/empty.glb" "$option" ''
+done
+[[ -e "$tmp/empty.glb" ]] && fail "a refused empty value wrote $tmp/empty.glb" || ok
+expect_error 2 "--json was given an empty value" -- "$tailor" tile "$texture" -o "$tmp/t.png" --json ''
+expect_error 2 "--texture was given an empty value: give one, or leave the option out \(run 'tailor view --help'\)$" -- "$tailor" view "$mesh" --texture ''
 # Whole numbers are whole: no 0 pixels, no negative seed read as 2^64 - 1.
 expect_error 2 "--max-image-pixels: must be a whole number, at least 1 \(run 'tailor tile --help'\)$" -- "$tailor" tile "$texture" -o "$tmp/t.png" --max-image-pixels 0
 expect_error 2 "--seed: must be a whole number, 0 to 2\^64 - 1" -- "$tailor" tile "$texture" -o "$tmp/t.png" --seed -1

@@ -16,6 +16,22 @@
 
 namespace {
 
+// An option given an empty value ('--texture "$TEX"' with TEX unset) would read as the option left
+// out, and the run would go on without what was asked for: none of tailor's options takes an empty
+// value. Returns the first such option's name, or "".
+std::string option_given_empty(const CLI::App& app) {
+  for (const CLI::Option* option : app.get_options()) {
+    if (option->get_positional() || option->get_expected_min() == 0) continue;  // flags take no value
+    for (const std::string& value : option->results())
+      if (value.empty()) return option->get_name();
+  }
+  // The command run, and its option groups (CLI11 keeps a group's options in an App of its own).
+  for (const CLI::App* part :
+       app.get_subcommands([](const CLI::App* a) { return a->parsed() || a->get_name().empty(); }))
+    if (const std::string name = option_given_empty(*part); !name.empty()) return name;
+  return {};
+}
+
 int run_command(int argc, char** argv) {
   using namespace tailor::cli;
   CLI::App app{
@@ -76,6 +92,13 @@ int run_command(int argc, char** argv) {
       }
     }
     std::fprintf(stderr, "tailor: error: %s (run '%s')\n", message.c_str(), help.c_str());
+    return kExitUsage;
+  }
+  if (const std::string empty = option_given_empty(app); !empty.empty()) {
+    std::fprintf(
+        stderr,
+        "tailor: error: %s was given an empty value: give one, or leave the option out (run 'tailor %s --help')\n",
+        empty.c_str(), app.get_subcommands().back()->get_name().c_str());
     return kExitUsage;
   }
   if (!run) return kExitUsage;
