@@ -125,6 +125,16 @@ for body in 'not json' '[1, 2]' '{"bogus": 1}' '{"add_seam_faces": [99999999]}' 
   [ "$(code)" = 400 ] || fail "the malformed edit '$body' answered $(code): $answer"
   [ "$(printf '%s\n' "$answer" | wc -l)" -eq 1 ] || fail "the 400 answer to '$body' is not one line: $answer"
 done
+post edit '{"options": {"scale": "x"}}' | grep -qF "options.scale must be a number of pixels per unit, 0.001 to 1e7" ||
+  fail "a scale that is no number was not refused with its range"
+post edit '{"options": {"max_stretch": 9}}' | grep -qF "options.max_stretch must be a number in [0.01, 4]" ||
+  fail "a max_stretch out of range was not refused with its range"
+# Undo, redo and save take nothing: a body asking for something is refused, not ignored.
+for request in undo redo save; do
+  answer="$(post "$request" '{"add_seam_faces": [1]}')"
+  [ "$(code)" = 400 ] && echo "$answer" | grep -qF "POST /api/$request takes no body (or {})" ||
+    fail "POST /api/$request with a body answered $(code): $answer"
+done
 [ "$(curl -s "${url}api/status" | json_field version)" = "$before" ] || fail "a malformed edit changed the version"
 [ "$(uvs 999999 /dev/null)" = 404 ] || fail "an unknown version is not 404"
 [ "$(uvs abc /dev/null)" = 400 ] || fail "a malformed version is not 400"

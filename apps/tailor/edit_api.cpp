@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string_view>
 #include <thread>
 
@@ -21,6 +22,7 @@
 #include "util/atomic_file.h"
 #include "util/bounded_json.h"
 #include "util/shell_word.h"
+#include "util/text_scan.h"
 
 namespace tailor::cli {
 namespace {
@@ -69,7 +71,6 @@ std::string apply_options(const json& j, const EditContext& context, const std::
   OrientationOptions& o = options.orientation;
   bool auto_axis = false, auto_following = false;
   for (const auto& [key, v] : j.items()) {
-    const std::string bad = field_name(key) + " is invalid";
     if (key == "axis") {
       if (!v.is_string()) return field_name(key) + " must be a string";
       const std::string text = v.get<std::string>();
@@ -84,9 +85,11 @@ std::string apply_options(const json& j, const EditContext& context, const std::
       if (!v.is_string() || !mapping_mode_from_name(v.get<std::string>(), m.mode))
         return "options.mode must be \"patches\" or \"thesis\"";
     } else if (key == "scale") {
-      if (!as_float(v, m.scale)) return bad;
+      if (!as_float(v, m.scale) || !(m.scale >= 1e-3f && m.scale <= 1e7f))
+        return field_name(key) + " must be a number of pixels per unit, 0.001 to 1e7";
     } else if (key == "max_stretch") {
-      if (!as_float(v, m.max_stretch)) return bad;
+      if (!as_float(v, m.max_stretch) || !(m.max_stretch >= 0.01f && m.max_stretch <= 4.f))
+        return field_name(key) + " must be a number in [0.01, 4]";
     } else if (key == "field_following") {
       if (v.is_string() && v.get<std::string>() == "auto") {
         auto_following = true;
@@ -96,7 +99,8 @@ std::string apply_options(const json& j, const EditContext& context, const std::
     } else if (key == "min_patch_faces") {
       if (!as_uint(v, 0, UINT32_MAX, m.min_patch_faces)) return field_name(key) + " must be an unsigned integer";
     } else if (key == "hop_age") {
-      if (!as_float(v, m.hop_age)) return bad;
+      if (!as_float(v, m.hop_age) || !(m.hop_age >= 0.f && m.hop_age <= 1.f))
+        return field_name(key) + " must be a number of radians in [0, 1]";
     } else if (key == "shorten_seams" || key == "close_cracks") {
       if (!v.is_boolean()) return field_name(key) + " must be true or false";
       (key == "shorten_seams" ? m.shorten_seams : m.close_cracks) = v.get<bool>();
@@ -105,7 +109,8 @@ std::string apply_options(const json& j, const EditContext& context, const std::
     } else if (key == "relax_iterations") {
       if (!as_uint(v, 0, 1000, m.relax_iterations)) return field_name(key) + " must be an integer 0..1000";
     } else if (key == "threshold_px") {
-      if (!as_float(v, m.threshold_px)) return bad;
+      if (!as_float(v, m.threshold_px) || !(m.threshold_px > 0.f))
+        return field_name(key) + " must be a positive number of pixels";
     } else if (key == "symmetry") {
       if (!as_uint(v, 1, 4, m.symmetry) || (m.symmetry != 1 && m.symmetry != 4))
         return "options.symmetry must be 1 or 4";
@@ -154,6 +159,17 @@ std::string apply_options(const json& j, const EditContext& context, const std::
     o = orientation_for(choice.best, o);
   }
   return {};
+}
+
+// For the requests that take nothing (undo, redo, save): an answer refusing a body other than
+// none, whitespace or {}, else nothing.
+std::optional<HttpResponse> body_refused(const HttpRequest& request) {
+  if (request.body.find_first_not_of(" \t\r\n") == std::string::npos) return std::nullopt;
+  json j;
+  if (internal::parse_json_bounded(request.body, j) == internal::JsonParse::kOk && j.is_object() && j.empty())
+    return std::nullopt;
+  return HttpResponse::error(
+      400, "POST " + request.path + " takes no body (or {}), got " + internal::quote_input(request.body.substr(0, 80)));
 }
 
 // Reads a JSON array of face ids into `out`; "" or the reason.
@@ -291,9 +307,20 @@ void EditApi::install(StaticServer& server) {
   server.add_handler("GET", "/api/uv", [this](const HttpRequest& r) { return uv(r); });
   server.add_handler("GET", "/api/model.glb", [this](const HttpRequest&) { return model(); });
   server.add_handler("POST", "/api/edit", [this](const HttpRequest& r) { return edit(r); });
-  server.add_handler("POST", "/api/undo", [this](const HttpRequest&) { return undo_redo(false); });
-  server.add_handler("POST", "/api/redo", [this](const HttpRequest&) { return undo_redo(true); });
-  server.add_handler("POST", "/api/save", [this](const HttpRequest&) { return save(); });
+  // These take nothing: a body that asks for something (a key of /api/edit sent here by mistake)
+  // is refused rather than ignored.
+  server.add_handler("POST", "/api/undo", [this](const HttpRequest& r) {
+    if (std::optional<HttpResponse> refused = body_refused(r)) return *refused;
+    return undo_redo(false);
+  });
+  server.add_handler("POST", "/api/redo", [this](const HttpRequest& r) {
+    if (std::optional<HttpResponse> refused = body_refused(r)) return *refused;
+    return undo_redo(true);
+  });
+  server.add_handler("POST", "/api/save", [this](const HttpRequest& r) {
+    if (std::optional<HttpResponse> refused = body_refused(r)) return *refused;
+    return save();
+  });
 }
 
 HttpResponse EditApi::edit(const HttpRequest& request) {
