@@ -832,11 +832,14 @@ def start_client(args):
             "distributed.worker.memory.monitor-interval": "1s",
         }
     )
+    # The scheduler's HTTP server (its health and metrics routes, no dashboard) on a free port: on
+    # Dask's default, 8787, a second run at the same time printed a four-line warning.
     cluster = LocalCluster(
         n_workers=args.workers,
         threads_per_worker=1,
         processes=True,
-        dashboard_address=None,
+        dashboard_address=":0",
+        scheduler_kwargs={"dashboard": False},
         silence_logs=logging.ERROR,
     )
     client = Client(cluster)

@@ -1101,6 +1101,24 @@ def test_a_terminated_run_cleans_up_like_an_interrupted_one(tmp_path):
     assert (out / "tileset.json").is_file()
 
 
+def test_a_run_beside_another_cluster_says_nothing(tmp_path):
+    # Another Dask cluster (a second run at the same time) holds Dask's default dashboard port:
+    # the local cluster takes a free port without a word.
+    import socket
+
+    held = socket.socket()
+    try:
+        held.bind(("127.0.0.1", 8787))
+        held.listen()
+    except OSError:  # already held by something else: the same situation
+        pass
+    try:
+        code, _, stderr = run_tiles(HORSE, "-o", tmp_path / "out", "--workers", 1, "--chunk-cell", CELL, "--no-lod", "-q")
+    finally:
+        held.close()
+    assert code == 0 and stderr == "", stderr
+
+
 def test_ctrl_c_on_a_cluster_prints_one_line(tmp_path):
     import signal
     import time
