@@ -202,25 +202,35 @@ TEST(GltfScene, BadHierarchiesFailWithOneLine) {
   EXPECT_TRUE(mesh.empty());
 }
 
-TEST(GltfScene, NodesScaledToNothingAreSkippedByName) {
-  // A zero scale (how scenes hide a node) or an all-zero matrix: its faces would have no area.
+TEST(GltfScene, NodesFlattenedToALineOrAPointAreSkippedByName) {
+  // A zero scale (how scenes hide a node) or an all-zero matrix: no face of it has an area. Such a
+  // node keeps its name in the scene; a flattening scale of rank 2 keeps the faces across it.
   Mesh mesh;
   LoadReport report;
-  Builder hidden = one_triangle({{{"mesh", 0}, {"scale", {0, 0, 0}}}, {{"mesh", 0}, {"translation", {5, 0, 0}}}},
-                                {{{"nodes", {0, 1}}}});
+  Builder hidden =
+      one_triangle({{{"name", "hidden"}, {"mesh", 0}, {"scale", {0, 0, 0}}}, {{"mesh", 0}, {"translation", {5, 0, 0}}}},
+                   {{{"nodes", {0, 1}}}});
   ASSERT_TRUE(read(hidden.glb(), mesh, &report).is_ok());
   EXPECT_EQ(mesh.face_count(), 1u);
   EXPECT_FLOAT_EQ(mesh.positions[0], 5.f);
-  EXPECT_EQ(report.mesh_instances, 1u);
-  EXPECT_TRUE(report.not_kept.starts_with("1 mesh instance under a transform that scales to nothing (node 0), "))
+  EXPECT_EQ(report.mesh_instances, 2u);
+  ASSERT_EQ(mesh.scene.instances.size(), 2u);
+  EXPECT_EQ(mesh.scene.instances[0].node_name, "hidden");
+  EXPECT_TRUE(
+      report.not_kept.starts_with("1 mesh instance under a transform that flattens it to a line or a point (node 0), "))
       << report.not_kept;
   Builder all_zero = one_triangle({{{"mesh", 0}, {"matrix", std::vector<double>(16, 0.0)}}}, {{{"nodes", {0}}}});
   const Status s = read(all_zero.glb(), mesh);
   EXPECT_EQ(s.code(), ErrorCode::kInvalidMesh);
-  EXPECT_NE(s.message().find("no face with an area in the scene: 1 mesh instance under a transform that scales to "
-                             "nothing (node 0)"),
+  EXPECT_NE(s.message().find("no face with an area in the scene: 1 mesh instance under a transform that flattens it "
+                             "to a line or a point (node 0)"),
             std::string::npos)
       << s.message();
+  // The triangle lies in z = 0: flattening z keeps it whole.
+  Builder flat = one_triangle({{{"mesh", 0}, {"scale", {2, 1, 0}}}}, {{{"nodes", {0}}}});
+  ASSERT_TRUE(read(flat.glb(), mesh, &report).is_ok());
+  EXPECT_EQ(mesh.face_count(), 1u);
+  EXPECT_EQ(report.not_kept.find("flattens"), std::string::npos) << report.not_kept;
 }
 
 // A node's extras nested 100,000 levels deep (a 200 KB file) is refused in one line: copying or

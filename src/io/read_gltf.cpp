@@ -165,6 +165,21 @@ double determinant3(const Matrix& m) {
   return m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2]) + m[8] * (m[1] * m[6] - m[5] * m[2]);
 }
 
+// Whether the transform's linear part has rank 1 or 0 (every pair of its columns parallel): it
+// maps every face to a line or a point. A rank of 2 (a flattening scale such as [1, 1, 0]) keeps
+// the area of the faces across the flattened direction.
+bool flattens_to_a_line(const Matrix& m) {
+  const double* c[3] = {&m[0], &m[4], &m[8]};
+  for (size_t i = 0; i < 3; ++i)
+    for (size_t j = i + 1; j < 3; ++j) {
+      const double* a = c[i];
+      const double* b = c[j];
+      if (a[1] * b[2] - a[2] * b[1] != 0 || a[2] * b[0] - a[0] * b[2] != 0 || a[0] * b[1] - a[1] * b[0] != 0)
+        return false;
+    }
+  return true;
+}
+
 // The mesh instances of the default scene, parents' transforms first. A node reached twice (the
 // hierarchy is not a tree, or has a cycle) is an error.
 Status scene_instances(GltfDocument& doc, std::vector<Instance>& instances) {
@@ -782,15 +797,9 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
   const auto materials_it = doc.json().find("materials");
   const size_t material_count = materials_it != doc.json().end() && materials_it->is_array() ? materials_it->size() : 0;
   std::vector<uint32_t> material_slot(material_count, kInvalid);  // input material -> scene.materials
-  size_t collapsed = 0;  // instances whose transform scales them to nothing (a zero scale hides a node)
+  size_t collapsed = 0;  // instances flattened to a line or a point (a zero scale hides a node)
   uint64_t first_collapsed = UINT64_MAX;
   for (const Instance& instance : instances) {
-    // Their faces would have no area: the welding would drop every one as naming a vertex twice,
-    // which does not say why. Skipped and named instead.
-    if (determinant3(instance.world) == 0) {
-      if (collapsed++ == 0) first_collapsed = instance.node;
-      continue;
-    }
     const size_t mi = instance.mesh;
     const Json& m = meshes[mi];
     const Json* node = instance.node == UINT64_MAX ? nullptr : get_element(doc.json(), "nodes", instance.node);
@@ -803,6 +812,13 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
     TAILOR_RETURN_IF_ERROR(doc.charge(kept_texts.node_name.size() + kept_texts.node_extras.size() +
                                           kept_texts.mesh_name.size() + kept_texts.mesh_extras.size(),
                                       "mesh " + std::to_string(mi)));
+    // No face of it would have an area: the welding would drop every one as naming a vertex twice,
+    // which does not say why. Its faces are skipped and named; it keeps its name as a node.
+    if (flattens_to_a_line(instance.world)) {
+      if (collapsed++ == 0) first_collapsed = instance.node;
+      ++report.mesh_instances;
+      continue;
+    }
     const auto primitives = m.is_object() ? m.find("primitives") : m.end();
     if (!m.is_object() || primitives == m.end() || !primitives->is_array())
       return doc.parse_error("mesh without primitives", "mesh " + std::to_string(mi));
@@ -883,8 +899,8 @@ Status parse_gltf(std::span<const char> data, const std::string& name, const std
   const std::string collapsed_text =
       collapsed == 0 ? ""
                      : std::to_string(collapsed) + (collapsed == 1 ? " mesh instance" : " mesh instances") +
-                           " under a transform that scales to nothing (node " + std::to_string(first_collapsed) +
-                           (collapsed == 1 ? ")" : ", ...)");
+                           " under a transform that flattens it to a line or a point (node " +
+                           std::to_string(first_collapsed) + (collapsed == 1 ? ")" : ", ...)");
   if (triangle_primitives == 0 && collapsed > 0)
     return Status::error(ErrorCode::kInvalidMesh, name, "no face with an area in the scene: " + collapsed_text);
   if (collapsed > 0) lost.push_back(collapsed_text);
