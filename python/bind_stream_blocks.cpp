@@ -209,16 +209,24 @@ void bind_stream_blocks(py::module_& m) {
       [](const py::buffer& source, size_t offset, size_t stride, size_t count, const py::array& ids_in) {
         // numpy's take of 12-byte records copies each one by a call of its own: a third of the
         // streamed partition's time.
+        const char kind = ids_in.dtype().kind();
         auto ids = IdArray::ensure(ids_in);
-        if (!ids || ids.ndim() != 2 || ids.shape(1) != 3)
-          raise_error("ids must be an (F, 3) array, got " + describe(ids_in));
+        if (!ids || (kind != 'i' && kind != 'u') || ids.ndim() != 2 || ids.shape(1) != 3)
+          raise_error("ids must be an (F, 3) array of integers, got " + describe(ids_in));
+        const size_t n = static_cast<size_t>(ids.shape(0));
         const py::buffer_info info = source.request();  // held: the buffer stays mapped while we read
+        // Read as one run of bytes from its start: a strided view (a numpy slice) is refused.
+        py::ssize_t step = info.itemsize;
+        for (size_t d = info.shape.size(); d-- > 0;) {
+          if (info.shape[d] > 1 && info.strides[d] != step) raise_error("source must be a contiguous buffer");
+          step *= info.shape[d];
+        }
+        if (n == 0) return py::array_t<float>({py::ssize_t{0}, py::ssize_t{3}, py::ssize_t{3}});
         const auto size = static_cast<size_t>(info.size * info.itemsize);
         if (stride < 12 || count == 0 || offset > size || size - offset < 12 ||
             (size - offset - 12) / stride < count - 1)
           raise_error("a vertex element of " + std::to_string(count) + " rows of " + std::to_string(stride) +
                       " bytes at byte " + std::to_string(offset) + " does not fit a buffer of " + std::to_string(size));
-        const size_t n = static_cast<size_t>(ids.shape(0));
         py::array_t<float> out({static_cast<py::ssize_t>(n), py::ssize_t{3}, py::ssize_t{3}});
         const auto* base = static_cast<const uint8_t*>(info.ptr) + offset;
         const int64_t* id = ids.data();
@@ -226,10 +234,7 @@ void bind_stream_blocks(py::module_& m) {
         size_t bad = 3 * n;
         {
           const py::gil_scoped_release release;
-          constexpr size_t kAhead = 16;  // the rows are read in the ids' order, scattered: fetched ahead
           for (size_t c = 0; c < 3 * n; ++c) {
-            if (c + kAhead < 3 * n && static_cast<uint64_t>(id[c + kAhead]) < count)
-              __builtin_prefetch(base + static_cast<size_t>(id[c + kAhead]) * stride);
             if (static_cast<uint64_t>(id[c]) >= count) {  // negative ids too
               bad = c;
               break;

@@ -670,6 +670,10 @@ def test_a_block_gathers_its_corners_from_the_vertex_rows():
     with pytest.raises(tailor.Error, match="does not fit a buffer of"):
         tailor._tailor._gather_corners(data, len(data) - 11, 16, 1, ids[:1] * 0)
     assert tailor._tailor._gather_corners(data, len(data) - 12, 16, 1, ids[:1] * 0).shape == (1, 3, 3)
+    with pytest.raises(tailor.Error, match="source must be a contiguous buffer"):
+        tailor._tailor._gather_corners(np.arange(24, dtype="<f4")[::-2], 0, 12, 1, np.zeros((1, 3), np.int64))
+    with pytest.raises(tailor.Error, match="ids must be an .F, 3. array of integers"):
+        tailor._tailor._gather_corners(data, 7, 16, rows.shape[0], np.array([[0.9, 1.5, 2.2]]))
 
 
 def test_the_survey_gives_the_box_and_the_cell_that_loading_gives(tmp_path):
