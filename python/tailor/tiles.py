@@ -819,12 +819,8 @@ def start_client(args):
     # memory monitor reads /proc every 100 ms. Beside tasks that keep every core busy they took
     # 11-18 % of the CPU (a worker's event loop 5.5 % of a core, the scheduler's 7.5 %); the tasks
     # here are seconds long and need none of that resolution.
-    # Worker processes forked from one server process that imported distributed and numpy once
-    # (Python's forkserver), not each started afresh and importing them again: on 2 cores the
-    # workers' start took 0.8 s of processor time beside the driver's partition, 0.4 s forked.
     dask.config.set(
         {
-            "distributed.worker.multiprocessing-method": "forkserver",
             "distributed.nanny.pre-spawn-environ": environ,
             "distributed.worker.profile.enabled": False,
             "distributed.admin.tick.interval": "1s",
@@ -832,16 +828,30 @@ def start_client(args):
             "distributed.worker.memory.monitor-interval": "1s",
         }
     )
+    # The workers are forked from one server process that imported Dask, numpy and tailor once
+    # (Python's forkserver), not each started afresh: on 2 cores the workers' start took 0.85 s of
+    # processor time beside the driver's partition, 0.43 s forked. Only this start (a worker the
+    # nanny starts again later is spawned), and the server preloads what the workers import, not
+    # Dask's list (every optional package installed, pandas among them, imported into this
+    # process first); where distributed has no such list, its own preload stands.
+    import multiprocessing
+
+    import distributed.utils
+
+    if getattr(distributed.utils, "_forkserver_preload_set", True) is False:
+        multiprocessing.get_context("forkserver").set_forkserver_preload(["distributed", "numpy", "tailor"])
+        distributed.utils._forkserver_preload_set = True
     # The scheduler's HTTP server (its health and metrics routes, no dashboard) on a free port: on
     # Dask's default, 8787, a second run at the same time printed a four-line warning.
-    cluster = LocalCluster(
-        n_workers=args.workers,
-        threads_per_worker=1,
-        processes=True,
-        dashboard_address=":0",
-        scheduler_kwargs={"dashboard": False},
-        silence_logs=logging.ERROR,
-    )
+    with dask.config.set({"distributed.worker.multiprocessing-method": "forkserver"}):
+        cluster = LocalCluster(
+            n_workers=args.workers,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=":0",
+            scheduler_kwargs={"dashboard": False},
+            silence_logs=logging.ERROR,
+        )
     client = Client(cluster)
     client.register_worker_plugin(_DriverAnswersInterrupts(), name="tailor-driver-answers-interrupts")
     return client, cluster
