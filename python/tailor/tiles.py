@@ -56,6 +56,8 @@ MANIFEST = "tailor-tiles.json"
 # Seconds the driver waits, when it stops, for the cluster's start to end before it exits anyway (a
 # start takes a few seconds).
 CLIENT_CLOSE_WAIT = 10
+# What a terminal (Ctrl-C, closing it) or a service manager sends to a whole process group.
+GROUP_SIGNALS = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
 FORMAT = 2  # of the manifest: a different number means every tile is written again
 # The streamed partition's ranges of the file (at least a block each): enough for every worker of a
 # cluster to take several, so that the driver and the workers finish together.
@@ -832,14 +834,16 @@ def start_client(args):
     # (Python's forkserver), not each started afresh: on 2 cores the workers' start took 0.85 s of
     # processor time beside the driver's partition, 0.43 s forked. Only this start (a worker the
     # nanny starts again later is spawned), and the server preloads what the workers import, not
-    # Dask's list (every optional package installed, pandas among them, imported into this
-    # process first); where distributed has no such list, its own preload stands.
+    # Dask's list (every optional package installed, pandas among them, imported into this process
+    # first); where distributed has no such list, its own preload stands.
     import multiprocessing
 
     import distributed.utils
 
     if getattr(distributed.utils, "_forkserver_preload_set", True) is False:
-        multiprocessing.get_context("forkserver").set_forkserver_preload(["distributed", "numpy", "tailor"])
+        multiprocessing.get_context("forkserver").set_forkserver_preload(
+            ["distributed", "numpy", "tailor"]
+        )
         distributed.utils._forkserver_preload_set = True
     # The scheduler's HTTP server (its health and metrics routes, no dashboard) on a free port: on
     # Dask's default, 8787, a second run at the same time printed a four-line warning.
@@ -875,10 +879,30 @@ class ClientStart:
     def __init__(self, args):
         self.client = self.cluster = self.error = None
         self.thread = threading.Thread(target=self._run, args=(args,), name="tailor.tiles client", daemon=True)
-        self.thread.start()
+        # The thread, and so every process it starts (the workers, the server they are forked from,
+        # multiprocessing's resource tracker), holds the signals that a terminal or a service manager
+        # sends to the whole process group blocked: the driver answers them alone, closes the
+        # cluster (Dask stops a worker through a queue, and kills it when that does not end it) and
+        # says so in one line. Workers that died of such a signal printed their tracebacks, and
+        # their nannies started them again while the driver closed the cluster, which could then
+        # wait for them at exit for minutes.
+        previous = signal.pthread_sigmask(signal.SIG_BLOCK, GROUP_SIGNALS)
+        try:
+            self.thread.start()
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
     def _run(self, args):
         try:
+            if not args.scheduler:
+                # multiprocessing's resource tracker first: starting it unblocks SIGINT and SIGTERM in
+                # the thread that starts it (Python's bpo-33613 guard), so they are blocked again
+                # after it, before this thread starts any other process or thread. The tracker
+                # itself ignores those two and keeps SIGHUP blocked.
+                import multiprocessing.resource_tracker
+
+                multiprocessing.resource_tracker.ensure_running()
+                signal.pthread_sigmask(signal.SIG_BLOCK, GROUP_SIGNALS)
             self.client, self.cluster = start_client(args)
             if self.cluster is not None:
                 self.client.run(worker_ready)  # each worker imports tailor.tiles now, not at its first task
@@ -1339,12 +1363,13 @@ class Terminated(BaseException):
 
 def _quiet_cluster():
     """From a Ctrl-C or a signal on: the local cluster's scheduler runs in this process and logs, as
-    errors, the results it cannot gather from workers the signal ended; the driver says what happened
-    in its one line."""
-    logger = logging.getLogger("distributed")
-    logger.setLevel(logging.CRITICAL + 1)
-    for handler in logger.handlers:
-        handler.setLevel(logging.CRITICAL + 1)
+    errors, the results it cannot gather from workers the signal ended, and asyncio the failed start
+    of a worker the signal caught starting; the driver says what happened in its one line."""
+    for name in ("distributed", "asyncio"):
+        logger = logging.getLogger(name)
+        logger.setLevel(logging.CRITICAL + 1)
+        for handler in logger.handlers:
+            handler.setLevel(logging.CRITICAL + 1)
 
 
 def _terminate(signum, frame):

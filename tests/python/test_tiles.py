@@ -1041,15 +1041,15 @@ def test_a_texture_that_does_not_wrap_is_warned_of_as_tailor_map_does(tmp_path):
 
 
 def test_closing_does_not_wait_for_a_cluster_start_that_cannot_end(monkeypatch):
-    # Ctrl-C reaches the local cluster's worker processes too: one it ends while still importing
-    # leaves the cluster's start waiting for it for minutes. The driver leaves it behind.
+    # A cluster's start that does not end (a scheduler that does not answer) is left behind.
+    import argparse
     import threading
     import time
 
     release = threading.Event()
     monkeypatch.setattr(tiles, "start_client", lambda args: (release.wait(), None))
     monkeypatch.setattr(tiles, "CLIENT_CLOSE_WAIT", 0.5)
-    start = tiles.ClientStart(None)
+    start = tiles.ClientStart(argparse.Namespace(scheduler=None))
     began = time.monotonic()
     start.close()
     assert time.monotonic() - began < 5 and start.thread.is_alive()
@@ -1121,6 +1121,51 @@ def test_a_run_beside_another_cluster_says_nothing(tmp_path):
     finally:
         held.close()
     assert code == 0 and stderr == "", stderr
+
+
+@pytest.mark.parametrize("signum", ["SIGTERM", "SIGINT", "SIGHUP"])
+def test_a_signal_to_the_group_while_the_cluster_starts_prints_one_line(tmp_path, signum):
+    # A terminal or a service manager signals the whole process group, here while the local
+    # cluster's processes start: they hold it blocked, the driver alone answers, in one line, and
+    # leaves no process behind. (Workers that died of it printed tracebacks, and the driver could
+    # wait for their restarts at exit.)
+    import signal
+    import time
+
+    import psutil
+
+    out = tmp_path / "out"
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    run = subprocess.Popen(
+        [sys.executable, "-m", "tailor.tiles", str(HORSE), "-o", str(out), "--workers", "2", "--chunk-cell", str(CELL),
+         "--no-lod", "-q"],
+        env=env, stderr=subprocess.PIPE, text=True, start_new_session=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),  # as a terminal's foreground job
+    )
+    driver = psutil.Process(run.pid)
+    deadline = time.monotonic() + 60
+    while run.poll() is None and time.monotonic() < deadline and len(driver.children(recursive=True)) < 3:
+        time.sleep(0.002)
+    os.killpg(run.pid, getattr(signal, signum))
+    _, stderr = run.communicate(timeout=60)
+    number = getattr(signal, signum)
+    words = "interrupted" if number == signal.SIGINT else "terminated (%s)" % signum
+    assert run.returncode == 128 + number, stderr
+    assert stderr == "tailor.tiles: %s; %s left as it was\n" % (words, out)
+    time.sleep(1)
+    left = [
+        p.info
+        for p in psutil.process_iter(["pid", "status", "cmdline"])
+        if p.info["status"] != psutil.STATUS_ZOMBIE and _group_of(p.pid) == run.pid  # a zombie has ended
+    ]
+    assert left == []
+
+
+def _group_of(pid):
+    try:
+        return os.getpgid(pid)
+    except OSError:
+        return None
 
 
 def test_ctrl_c_on_a_cluster_prints_one_line(tmp_path):
