@@ -28,6 +28,7 @@ failed run leaves OUTDIR as it was. With --scheduler the workers write the tiles
 OUTDIR must be on a file system every worker sees, and each worker must import the same tailor.
 """
 import argparse
+import contextlib
 import functools
 import glob
 import hashlib
@@ -877,23 +878,23 @@ class ClientStart:
     close() waits too, then closes what it started."""
 
     def __init__(self, args):
+        import multiprocessing
+
         self.client = self.cluster = self.error = None
+        self.before = {p.pid for p in multiprocessing.active_children()}  # not the cluster's
         self.thread = threading.Thread(target=self._run, args=(args,), name="tailor.tiles client", daemon=True)
-        # The thread, and so every process it starts (the workers, the server they are forked from,
-        # multiprocessing's resource tracker), holds the signals that a terminal or a service manager
-        # sends to the whole process group blocked: the driver answers them alone, closes the
-        # cluster (Dask stops a worker through a queue, and kills it when that does not end it) and
-        # says so in one line. Workers that died of such a signal printed their tracebacks, and
-        # their nannies started them again while the driver closed the cluster, which could then
-        # wait for them at exit for minutes.
-        previous = signal.pthread_sigmask(signal.SIG_BLOCK, GROUP_SIGNALS)
-        try:
-            self.thread.start()
-        finally:
-            signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+        self.thread.start()
 
     def _run(self, args):
         try:
+            # This thread, and so every process and thread it starts (the workers, the server they
+            # are forked from, multiprocessing's resource tracker), holds the signals that a
+            # terminal or a service manager sends to the whole process group blocked: the driver
+            # answers them alone, closes the cluster (Dask stops a worker through a queue, and kills
+            # it when that does not end it) and says so in one line. Workers that died of such a
+            # signal printed their tracebacks, and their nannies started them again while the
+            # driver closed the cluster, which could then wait for them at exit for minutes.
+            signal.pthread_sigmask(signal.SIG_BLOCK, GROUP_SIGNALS)
             if not args.scheduler:
                 # multiprocessing's resource tracker first: starting it unblocks SIGINT and SIGTERM in
                 # the thread that starts it (Python's bpo-33613 guard), so they are blocked again
@@ -916,17 +917,31 @@ class ClientStart:
         return self.client, self.cluster
 
     def close(self):
-        # Bounded: a start that cannot finish must not hold the driver's exit (the thread is a
-        # daemon). Ctrl-C reaches every process of the terminal's group: a worker it ends while still
-        # importing (before the plugin above) leaves the cluster's start waiting for it for minutes.
-        self.thread.join(CLIENT_CLOSE_WAIT)
-        if self.thread.is_alive():
-            return
-        client, cluster, self.client, self.cluster = self.client, self.cluster, None, None  # closed once
-        if client is not None:
-            client.close()
-        if cluster is not None:
-            cluster.close()
+        try:
+            # Bounded: a start that cannot finish (a scheduler that does not answer) must not hold
+            # the driver's exit (the thread is a daemon).
+            self.thread.join(CLIENT_CLOSE_WAIT)
+            if self.thread.is_alive():
+                return
+            client, cluster, self.client, self.cluster = self.client, self.cluster, None, None  # closed once
+            if client is not None:
+                client.close()
+            if cluster is not None:
+                cluster.close()
+        finally:
+            self.kill_left_workers()
+
+    def kill_left_workers(self):
+        """Kills the worker processes of the cluster still alive after its close (one cut short by a
+        second Ctrl-C, a start left behind): they hold SIGTERM blocked, and multiprocessing's exit
+        hook, which ends its daemon children with SIGTERM and then waits for them, would wait
+        forever."""
+        import multiprocessing
+
+        for p in multiprocessing.active_children():
+            if p.pid not in self.before:
+                with contextlib.suppress(Exception):
+                    p.kill()
 
 
 def worker_ready():

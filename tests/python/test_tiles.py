@@ -1140,7 +1140,7 @@ def test_a_signal_to_the_group_while_the_cluster_starts_prints_one_line(tmp_path
         [sys.executable, "-m", "tailor.tiles", str(HORSE), "-o", str(out), "--workers", "2", "--chunk-cell", str(CELL),
          "--no-lod", "-q"],
         env=env, stderr=subprocess.PIPE, text=True, start_new_session=True,
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),  # as a terminal's foreground job
+        preexec_fn=_default_group_signals,  # as a terminal's foreground job (not nohup, not in the background)
     )
     driver = psutil.Process(run.pid)
     deadline = time.monotonic() + 60
@@ -1159,6 +1159,13 @@ def test_a_signal_to_the_group_while_the_cluster_starts_prints_one_line(tmp_path
         if p.info["status"] != psutil.STATUS_ZOMBIE and _group_of(p.pid) == run.pid  # a zombie has ended
     ]
     assert left == []
+
+
+def _default_group_signals():
+    import signal
+
+    for signum in tiles.GROUP_SIGNALS:
+        signal.signal(signum, signal.SIG_DFL)
 
 
 def _group_of(pid):
