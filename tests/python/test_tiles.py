@@ -1134,14 +1134,7 @@ def test_a_signal_to_the_group_while_the_cluster_starts_prints_one_line(tmp_path
 
     import psutil
 
-    out = tmp_path / "out"
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
-    run = subprocess.Popen(
-        [sys.executable, "-m", "tailor.tiles", str(HORSE), "-o", str(out), "--workers", "2", "--chunk-cell", str(CELL),
-         "--no-lod", "-q"],
-        env=env, stderr=subprocess.PIPE, text=True, start_new_session=True,
-        preexec_fn=_default_group_signals,  # as a terminal's foreground job (not nohup, not in the background)
-    )
+    run, out = start_in_own_group(tmp_path)
     driver = psutil.Process(run.pid)
     deadline = time.monotonic() + 60
     while run.poll() is None and time.monotonic() < deadline and len(driver.children(recursive=True)) < 3:
@@ -1159,6 +1152,19 @@ def test_a_signal_to_the_group_while_the_cluster_starts_prints_one_line(tmp_path
         if p.info["status"] != psutil.STATUS_ZOMBIE and _group_of(p.pid) == run.pid  # a zombie has ended
     ]
     assert left == []
+
+
+def start_in_own_group(tmp_path):
+    """A 2-worker run of the horse into tmp_path/out, in a process group of its own, every group
+    signal at its default (as a terminal's foreground job: not nohup, not in the background)."""
+    out = tmp_path / "out"
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    run = subprocess.Popen(
+        [sys.executable, "-m", "tailor.tiles", str(HORSE), "-o", str(out), "--workers", "2", "--chunk-cell", str(CELL),
+         "--no-lod", "-q"],
+        env=env, stderr=subprocess.PIPE, text=True, start_new_session=True, preexec_fn=_default_group_signals,
+    )
+    return run, out
 
 
 def _default_group_signals():
@@ -1181,13 +1187,7 @@ def test_ctrl_c_on_a_cluster_prints_one_line(tmp_path):
 
     # Ctrl-C reaches the terminal's whole process group: the driver and every Dask worker. The
     # workers leave it to the driver, which closes the cluster and says so in one line.
-    out = tmp_path / "out"
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
-    run = subprocess.Popen(
-        [sys.executable, "-m", "tailor.tiles", str(HORSE), "-o", str(out), "--workers", "2", "--chunk-cell", str(CELL),
-         "--no-lod", "-q"],
-        env=env, stderr=subprocess.PIPE, text=True, start_new_session=True,
-    )
+    run, out = start_in_own_group(tmp_path)
     deadline = time.monotonic() + 120
     while not list(tmp_path.glob(".out.tmp-*/**/*.glb")) and run.poll() is None and time.monotonic() < deadline:
         time.sleep(0.005)
