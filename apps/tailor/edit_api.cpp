@@ -309,18 +309,15 @@ void EditApi::install(StaticServer& server) {
   server.add_handler("POST", "/api/edit", [this](const HttpRequest& r) { return edit(r); });
   // These take nothing: a body that asks for something (a key of /api/edit sent here by mistake)
   // is refused rather than ignored.
-  server.add_handler("POST", "/api/undo", [this](const HttpRequest& r) {
-    if (std::optional<HttpResponse> refused = body_refused(r)) return *refused;
-    return undo_redo(false);
-  });
-  server.add_handler("POST", "/api/redo", [this](const HttpRequest& r) {
-    if (std::optional<HttpResponse> refused = body_refused(r)) return *refused;
-    return undo_redo(true);
-  });
-  server.add_handler("POST", "/api/save", [this](const HttpRequest& r) {
-    if (std::optional<HttpResponse> refused = body_refused(r)) return *refused;
-    return save();
-  });
+  const auto taking_nothing = [](auto answer) {
+    return [answer](const HttpRequest& r) {
+      if (std::optional<HttpResponse> refused = body_refused(r)) return *refused;
+      return answer();
+    };
+  };
+  server.add_handler("POST", "/api/undo", taking_nothing([this] { return undo_redo(false); }));
+  server.add_handler("POST", "/api/redo", taking_nothing([this] { return undo_redo(true); }));
+  server.add_handler("POST", "/api/save", taking_nothing([this] { return save(); }));
 }
 
 HttpResponse EditApi::edit(const HttpRequest& request) {
