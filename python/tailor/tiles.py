@@ -35,6 +35,8 @@ import hashlib
 import json
 import logging
 import math
+import multiprocessing
+import multiprocessing.resource_tracker
 import os
 import pathlib
 import re
@@ -837,8 +839,6 @@ def start_client(args):
     # nanny starts again later is spawned), and the server preloads what the workers import, not
     # Dask's list (every optional package installed, pandas among them, imported into this process
     # first); where distributed has no such list, its own preload stands.
-    import multiprocessing
-
     import distributed.utils
 
     if getattr(distributed.utils, "_forkserver_preload_set", True) is False:
@@ -878,8 +878,6 @@ class ClientStart:
     close() waits too, then closes what it started."""
 
     def __init__(self, args):
-        import multiprocessing
-
         self.client = self.cluster = self.error = None
         self.before = {p.pid for p in multiprocessing.active_children()}  # not the cluster's
         self.thread = threading.Thread(target=self._run, args=(args,), name="tailor.tiles client", daemon=True)
@@ -900,8 +898,6 @@ class ClientStart:
                 # the thread that starts it (Python's bpo-33613 guard), so they are blocked again
                 # after it, before this thread starts any other process or thread. The tracker
                 # itself ignores those two and keeps SIGHUP blocked.
-                import multiprocessing.resource_tracker
-
                 multiprocessing.resource_tracker.ensure_running()
                 signal.pthread_sigmask(signal.SIG_BLOCK, GROUP_SIGNALS)
             self.client, self.cluster = start_client(args)
@@ -936,8 +932,6 @@ class ClientStart:
         second Ctrl-C, a start left behind): they hold SIGTERM blocked, and multiprocessing's exit
         hook, which ends its daemon children with SIGTERM and then waits for them, would wait
         forever."""
-        import multiprocessing
-
         for p in multiprocessing.active_children():
             if p.pid not in self.before:
                 with contextlib.suppress(Exception):
