@@ -8,7 +8,8 @@ mesh: tests/data/meshes/horse.ply (96,966 faces) refined three times by 1-to-4 m
 (6,205,824 faces), written as binary PLY. time: wall seconds of `tailor map --chunks on -o x.glb`,
 then of `python3 -m tailor.tiles --no-lod` with --workers 0 (no Dask), 1 and 2, each run into a
 fresh folder, then with levels of detail at 2 workers, and of its re-run (every tile kept), with
-each run's peak memory (the driver's, and the largest of a worker process that ran a task).
+each run's peak memory (the driver's, and the largest of a worker process that ran a task), then
+the 2-worker speed-up again as the median of three alternated 1- and 2-worker runs.
 borders: the share of visible edges between tiles and inside them (an edge is visible when its two
 sides are not whole texture repeats apart: a gap of 1 px or more at either end).
 """
@@ -26,6 +27,7 @@ import numpy as np
 import tailor
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
+PAIRS = 3  # alternated 1- and 2-worker runs for the scaling ratio
 
 
 def subdivide(positions, faces):
@@ -136,6 +138,19 @@ def time_runs(path, binary):
     w2 = wall["tailor.tiles --workers 2 --threads 1 --no-lod"]
     print("2 workers over 1: %.2fx; 1 worker over the same tiles without Dask (--workers 0): %+.0f %%" % (
         w1 / w2, 100 * (w1 / w0 - 1)))
+    # The ratio again from alternated pairs: a virtual machine's speed drifts by more than a tenth
+    # between minutes, which single runs minutes apart take for the ratio.
+    ratios = []
+    for _ in range(PAIRS):
+        pair = []
+        for workers in (1, 2):
+            out = work / ("pair_w%d" % workers)
+            shutil.rmtree(out, ignore_errors=True)
+            pair.append(timed([sys.executable, "-m", "tailor.tiles", str(path), "-o", str(out), "--texture", texture,
+                               "--chunk-cell", str(cell), "--workers", str(workers), "--no-lod", "--quiet"], env)[0])
+        ratios.append(pair[0] / pair[1])
+    print("2 workers over 1, %d alternated pairs: median %.2fx (%s)" % (
+        PAIRS, float(np.median(ratios)), ", ".join("%.2f" % r for r in ratios)))
     print("tile folders identical for workers 0/1/2 and threads 1/2: %s" % same)
     print("load average: %s" % " ".join("%.2f" % x for x in os.getloadavg()))
     shutil.rmtree(work)

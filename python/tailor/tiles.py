@@ -65,6 +65,8 @@ FORMAT = 2  # of the manifest: a different number means every tile is written ag
 # The streamed partition's ranges of the file (at least a block each): enough for every worker of a
 # cluster to take several, so that the driver and the workers finish together.
 PARTITION_PARTS = 256
+# The local cluster's folder for its workers' spilled data and locks, inside a run's temporary one.
+WORKER_SPACE = "dask"
 # A tile is at most 2^20 chunk cells on a side: the streamed partition packs its coordinates in 21 bits
 # (_partition_block); the in-memory path keeps the same limit, so that both cut the same tiles.
 MAX_TILE_LEVEL = 20
@@ -797,7 +799,12 @@ def remove_stale(outdir):
                 shutil.rmtree(path, ignore_errors=True)
 
 
-def start_client(args):
+def start_client(args, space=None):
+    """A Dask client: of the scheduler args.scheduler names, else of a local cluster of args.workers
+    processes, whose folders for spilled data and locks are made inside `space` (a run's temporary
+    folder: Dask's default, one folder under /tmp shared by every cluster, kept the locks of a run
+    that was killed, and the next run's workers printed a line for each as they removed them).
+    Returns (client, the local cluster or None)."""
     import dask
     from dask.distributed import Client, LocalCluster
 
@@ -856,6 +863,8 @@ def start_client(args):
             dashboard_address=":0",
             scheduler_kwargs={"dashboard": False},
             silence_logs=logging.ERROR,
+            # A folder the user gave Dask (its temporary-directory setting) stands.
+            local_directory=None if space is None or dask.config.get("temporary-directory", None) else str(space),
         )
     client = Client(cluster)
     client.register_worker_plugin(_DriverAnswersInterrupts(), name="tailor-driver-answers-interrupts")
@@ -877,13 +886,13 @@ class ClientStart:
     the local cluster's worker processes start and import tailor meanwhile. result() waits for it;
     close() waits too, then closes what it started."""
 
-    def __init__(self, args):
+    def __init__(self, args, space=None):
         self.client = self.cluster = self.error = None
         self.before = {p.pid for p in multiprocessing.active_children()}  # not the cluster's
-        self.thread = threading.Thread(target=self._run, args=(args,), name="tailor.tiles client", daemon=True)
+        self.thread = threading.Thread(target=self._run, args=(args, space), name="tailor.tiles client", daemon=True)
         self.thread.start()
 
-    def _run(self, args):
+    def _run(self, args, space):
         try:
             # This thread, and so every process and thread it starts (the workers, the server they
             # are forked from, multiprocessing's resource tracker), holds the signals that a
@@ -900,7 +909,7 @@ class ClientStart:
                 # itself ignores those two and keeps SIGHUP blocked.
                 multiprocessing.resource_tracker.ensure_running()
                 signal.pthread_sigmask(signal.SIG_BLOCK, GROUP_SIGNALS)
-            self.client, self.cluster = start_client(args)
+            self.client, self.cluster = start_client(args, space)
             if self.cluster is not None:
                 self.client.run(worker_ready)  # each worker imports tailor.tiles now, not at its first task
         except BaseException as e:  # raised again by result()
@@ -1002,6 +1011,47 @@ def run_locked(args, outdir):
             print("tailor.tiles: warning: %s: not read: %s" % (args.input, mesh.load_report["not_read"]), file=sys.stderr)
         for note in look["notes"]:
             print("tailor.tiles: warning: %s" % note, file=sys.stderr)
+    in_process = args.workers == 0 and not args.scheduler
+    tmp = temporary_folder(outdir)
+    start = None
+    try:  # from the folder's creation on: a failure or a signal closes the cluster and removes it
+        shutil.rmtree(tmp, ignore_errors=True)
+        try:
+            (tmp / "tiles").mkdir(parents=True)
+        except OSError as e:
+            raise TilesError(
+                "%s: cannot write beside it in %s (%s)" % (args.output, outdir.parent, e.strerror)
+            ) from None
+        if not in_process and not args.cut_only:
+            # The cluster starts in a thread of its own once the input is known to be readable: its
+            # worker processes start and import tailor while this process surveys and cuts the mesh.
+            start = ClientStart(args, tmp / WORKER_SPACE)
+        summary = run_started(args, outdir, t0, layout, mesh, look, start)
+    except BaseException:
+        # The cluster first: a worker still running a task would write into the folder after it is
+        # removed (a stray temporary folder beside OUTDIR until the next run). The folder goes even
+        # when closing fails or a second Ctrl-C cuts it short.
+        try:
+            if start is not None:
+                start.close()
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    finally:
+        if start is not None:
+            start.close()
+    if "map_write" in summary["seconds"]:  # the cluster's close included
+        summary["seconds"]["total"] = time.monotonic() - t0
+    return summary
+
+
+def temporary_folder(outdir):
+    """Where a run writes its output before renaming it into place as OUTDIR."""
+    return outdir.parent / (".%s.tmp-%d" % (outdir.name, os.getpid()))
+
+
+def run_started(args, outdir, t0, layout, mesh, look, start):
+    in_process = args.workers == 0 and not args.scheduler
     if mesh is not None:
         plan, params, tiles = plan_tiles(mesh, args, look)
         chunk_count, cell_size = int(plan["cells"].shape[0]), plan["cell_size"]
@@ -1019,181 +1069,157 @@ def run_locked(args, outdir):
     old = previous_output(outdir, params)
     t_plan = time.monotonic()
 
-    tmp = outdir.parent / (".%s.tmp-%d" % (outdir.name, os.getpid()))
-    shutil.rmtree(tmp, ignore_errors=True)
-    in_process = args.workers == 0 and not args.scheduler
-    start = None
-    try:  # from the folder's creation on: a signal that comes as it is made still removes it
-        try:
-            (tmp / "tiles").mkdir(parents=True)
-        except OSError as e:
-            raise TilesError(
-                "%s: cannot write beside it in %s (%s)" % (args.output, outdir.parent, e.strerror)
-            ) from None
-        if not in_process and not args.cut_only:
-            start = ClientStart(args)  # while the driver cuts the mesh
-        # The images every tile names, once beside tileset.json (the previous run's file linked
-        # when it has the same bytes, so that it keeps its time).
-        for name, data in look["images"].values():
-            previous = outdir / name
-            if previous.is_file() and previous.read_bytes() == data:
-                os.link(previous, tmp / name)
-            else:
-                (tmp / name).write_bytes(data)
-        if args.lod:
-            (tmp / "lod").mkdir()
-        jobs = []
-        scratch = tmp / "partition"
-        if mesh is not None:
-            positions = mesh.positions
-            faces = mesh.faces
-            for tile in sorted(tiles, key=lambda t: (t[2], t[1], t[0])):
-                # The tile's own vertices; its canonical order is the task's work (in parallel).
-                used, compact = np.unique(faces[tiles[tile]], return_inverse=True)
-                p, f = positions[used], compact.reshape(-1, 3).astype(np.uint32)
-                name = node_name(0, tile)
+    tmp = temporary_folder(outdir)
+    # The images every tile names, once beside tileset.json (the previous run's file linked
+    # when it has the same bytes, so that it keeps its time).
+    for name, data in look["images"].values():
+        previous = outdir / name
+        if previous.is_file() and previous.read_bytes() == data:
+            os.link(previous, tmp / name)
+        else:
+            (tmp / name).write_bytes(data)
+    if args.lod:
+        (tmp / "lod").mkdir()
+    jobs = []
+    scratch = tmp / "partition"
+    if mesh is not None:
+        positions = mesh.positions
+        faces = mesh.faces
+        for tile in sorted(tiles, key=lambda t: (t[2], t[1], t[0])):
+            # The tile's own vertices; its canonical order is the task's work (in parallel).
+            used, compact = np.unique(faces[tiles[tile]], return_inverse=True)
+            p, f = positions[used], compact.reshape(-1, 3).astype(np.uint32)
+            name = node_name(0, tile)
+            jobs.append(({"name": name, "tile": list(tile)}, p, f, old.get(name)))
+        del positions, faces, mesh
+        sizes = [job[2].shape[0] for job in jobs]
+    else:
+        # One pass: each face appended to its tile's file in the scratch folder. With a local
+        # cluster the file is cut into ranges of a few blocks, shared between this process and
+        # the cluster's workers (a cluster of --scheduler may not see the input file).
+        parts, run_parts = 1, None
+        if start is not None and not args.scheduler:
+            parts = PARTITION_PARTS
+            run_parts = functools.partial(run_shared, start, "partition-%s" % tmp.name)
+        counts, files, chunk_count = tiles_stream.partition_parts(
+            layout, params["cell_exponent"], params["tile_level"], scratch, parts, run_parts, args.block_faces
+        )
+        index_dtype = layout.index_dtype.str
+        for tile in sorted(counts, key=lambda t: (t[2], t[1], t[0])):
+            name = node_name(0, tile)
+            if in_process:  # mapped in this process: all of them
+                p, f = tiles_stream.read_tile(
+                    files[tile], layout.index_dtype, params["cell_exponent"], params["tile_level"]
+                )
                 jobs.append(({"name": name, "tile": list(tile)}, p, f, old.get(name)))
-            del positions, faces, mesh
-            sizes = [job[2].shape[0] for job in jobs]
-        else:
-            # One pass: each face appended to its tile's file in the scratch folder. With a local
-            # cluster the file is cut into ranges of a few blocks, shared between this process and
-            # the cluster's workers (a cluster of --scheduler may not see the input file).
-            parts, run_parts = 1, None
-            if start is not None and not args.scheduler:
-                parts = PARTITION_PARTS
-                run_parts = functools.partial(run_shared, start, "partition-%s" % tmp.name)
-            counts, files, chunk_count = tiles_stream.partition_parts(
-                layout, params["cell_exponent"], params["tile_level"], scratch, parts, run_parts, args.block_faces
-            )
-            index_dtype = layout.index_dtype.str
-            for tile in sorted(counts, key=lambda t: (t[2], t[1], t[0])):
-                name = node_name(0, tile)
-                if in_process:  # mapped in this process: all of them
-                    p, f = tiles_stream.read_tile(
-                        files[tile], layout.index_dtype, params["cell_exponent"], params["tile_level"]
-                    )
-                    jobs.append(({"name": name, "tile": list(tile)}, p, f, old.get(name)))
-                else:
-                    jobs.append(({"name": name, "tile": list(tile), "files": files[tile]}, None, None, old.get(name)))
-            sizes = [counts[tuple(job[0]["tile"])] for job in jobs]
-        levels = parent_levels([job[0]["tile"] for job in jobs]) if args.lod else []
-        t_cut = time.monotonic()
-        if args.cut_only:  # tests: the driver's work without the tasks; nothing is written
-            shutil.rmtree(tmp, ignore_errors=True)
-            return {
-                "leaves": len(sizes),
-                "faces": int(sum(sizes)),
-                "input": "streamed" if layout is not None else "in memory",
-                "driver_peak_rss": peak_rss(),
-                "seconds": {"load_plan": t_plan - t0, "cut": t_cut - t_plan},
-            }
-        # Largest first, so that the last tasks to finish are small ones.
-        order = sorted(range(len(jobs)), key=lambda i: -sizes[i])
-        progress = Progress(len(jobs) + sum(len(groups) for groups in levels), not args.quiet)
-        records = {}
-        folder = str(tmp)
-        if in_process:
-            for i, record in map_in_process(jobs, order, params, folder, args.threads, args.lod):
-                records[record["name"]] = record
+            else:
+                jobs.append(({"name": name, "tile": list(tile), "files": files[tile]}, None, None, old.get(name)))
+        sizes = [counts[tuple(job[0]["tile"])] for job in jobs]
+    levels = parent_levels([job[0]["tile"] for job in jobs]) if args.lod else []
+    t_cut = time.monotonic()
+    if args.cut_only:  # tests: the driver's work without the tasks; nothing is written
+        shutil.rmtree(tmp, ignore_errors=True)
+        return {
+            "leaves": len(sizes),
+            "faces": int(sum(sizes)),
+            "input": "streamed" if layout is not None else "in memory",
+            "driver_peak_rss": peak_rss(),
+            "seconds": {"load_plan": t_plan - t0, "cut": t_cut - t_plan},
+        }
+    # Largest first, so that the last tasks to finish are small ones.
+    order = sorted(range(len(jobs)), key=lambda i: -sizes[i])
+    progress = Progress(len(jobs) + sum(len(groups) for groups in levels), not args.quiet)
+    records = {}
+    folder = str(tmp)
+    if in_process:
+        for i, record in map_in_process(jobs, order, params, folder, args.threads, args.lod):
+            records[record["name"]] = record
+            progress.step(record["written"])
+        for level, groups in enumerate(levels, start=1):
+            for tile, names in groups:
+                job = {"name": node_name(level, tile), "level": level, "tile": list(tile)}
+                kids = [records[n] for n in names]
+                record = build_parent(job, params, folder, old.get(job["name"]), *kids)
+                records[job["name"]] = record
                 progress.step(record["written"])
-            for level, groups in enumerate(levels, start=1):
-                for tile, names in groups:
-                    job = {"name": node_name(level, tile), "level": level, "tile": list(tile)}
-                    kids = [records[n] for n in names]
-                    record = build_parent(job, params, folder, old.get(job["name"]), *kids)
-                    records[job["name"]] = record
-                    progress.step(record["written"])
-        else:
-            from dask.distributed import as_completed
+    else:
+        from dask.distributed import as_completed
 
-            client, _ = start.result()
-            threads = args.threads or 1
-            futures = {}
-            for i in order:
-                job, p, f, keep = jobs[i]
-                key = "tile-%s-%s" % (tmp.name, job["name"])
-                if "files" in job:
-                    job = dict(job)
-                    paths = job.pop("files")
+        client, _ = start.result()
+        threads = args.threads or 1
+        futures = {}
+        for i in order:
+            job, p, f, keep = jobs[i]
+            key = "tile-%s-%s" % (tmp.name, job["name"])
+            if "files" in job:
+                job = dict(job)
+                paths = job.pop("files")
+                futures[job["name"]] = client.submit(
+                    on_worker,
+                    map_tile_file,
+                    job,
+                    paths,
+                    index_dtype,
+                    params,
+                    folder,
+                    keep,
+                    threads,
+                    args.lod,
+                    key=key,
+                )
+            else:
+                # A tile loaded whole goes to its worker in the task itself (scattering it first
+                # would send the same bytes); Dask warns about every such task of over 1 MB.
+                with warnings.catch_warnings():
+                    warnings.filterwarnings("ignore", message="Large object of size", category=UserWarning)
                     futures[job["name"]] = client.submit(
-                        on_worker,
-                        map_tile_file,
-                        job,
-                        paths,
-                        index_dtype,
-                        params,
-                        folder,
-                        keep,
-                        threads,
-                        args.lod,
-                        key=key,
+                        on_worker, map_tile, job, p, f, params, folder, keep, threads, args.lod, key=key
                     )
-                else:
-                    # A tile loaded whole goes to its worker in the task itself (scattering it first
-                    # would send the same bytes); Dask warns about every such task of over 1 MB.
-                    with warnings.catch_warnings():
-                        warnings.filterwarnings("ignore", message="Large object of size", category=UserWarning)
-                        futures[job["name"]] = client.submit(
-                            on_worker, map_tile, job, p, f, params, folder, keep, threads, args.lod, key=key
-                        )
-            del jobs[:]
-            for level, groups in enumerate(levels, start=1):
-                for tile, names in groups:
-                    job = {"name": node_name(level, tile), "level": level, "tile": list(tile)}
-                    kids = [futures[n] for n in names]
-                    futures[job["name"]] = client.submit(
-                        on_worker,
-                        build_parent,
-                        job,
-                        params,
-                        folder,
-                        old.get(job["name"]),
-                        *kids,
-                        key="tile-%s-%s" % (tmp.name, job["name"]),
-                    )
-            for fut in as_completed(list(futures.values())):
-                record = fut.result()
-                records[record["name"]] = record
-                progress.step(record["written"])
-            # The cluster closed before the folder is finished: when a worker died, Dask computes
-            # again the results it held, and such a task, still running, would write into the folder
-            # after it is renamed into place (a stray temporary file in OUTDIR).
-            futures.clear()
-            start.close()
-        records = sorted(records.values(), key=lambda r: (-r["level"], r["tile"][2], r["tile"][1], r["tile"][0]))
-        shutil.rmtree(scratch, ignore_errors=True)
-        # A worker process that died while writing a file (killed, out of memory) leaves that
-        # write's temporary file (".tailor-XXXXXX", beside its target); every node is written now
-        # (its task ran again elsewhere), so those are stray.
-        for stray in tmp.rglob(".tailor-*"):
-            stray.unlink(missing_ok=True)
-        t_map = time.monotonic()
-        (tmp / "tileset.json").write_text(json.dumps(tileset_json(records, args.lod, args.up), indent=1) + "\n")
-        fields = ("digest", "faces", "error", "coarse_error", "glb_bytes", "coarse_bytes")
-        manifest = {"params": params, "tiles": {r["name"]: {k: r[k] for k in fields if k in r} for r in records}}
-        (tmp / MANIFEST).write_text(json.dumps(manifest, indent=1, sort_keys=True) + "\n")
-        # Into place: the old folder aside, the new one in, the old one removed.
-        aside = None
-        if outdir.exists():
-            aside = outdir.parent / (".%s.old-%d" % (outdir.name, os.getpid()))
-            os.rename(outdir, aside)
-        os.rename(tmp, outdir)
-        if aside:
-            shutil.rmtree(aside, ignore_errors=True)
-    except BaseException:
-        # The cluster first: a worker still running a task would write into the folder after it is
-        # removed (a stray temporary folder beside OUTDIR until the next run). The folder goes even
-        # when closing fails or a second Ctrl-C cuts it short.
-        try:
-            if start is not None:
-                start.close()
-        finally:
-            shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    finally:
-        if start is not None:
-            start.close()
+        del jobs[:]
+        for level, groups in enumerate(levels, start=1):
+            for tile, names in groups:
+                job = {"name": node_name(level, tile), "level": level, "tile": list(tile)}
+                kids = [futures[n] for n in names]
+                futures[job["name"]] = client.submit(
+                    on_worker,
+                    build_parent,
+                    job,
+                    params,
+                    folder,
+                    old.get(job["name"]),
+                    *kids,
+                    key="tile-%s-%s" % (tmp.name, job["name"]),
+                )
+        for fut in as_completed(list(futures.values())):
+            record = fut.result()
+            records[record["name"]] = record
+            progress.step(record["written"])
+        # The cluster closed before the folder is finished: when a worker died, Dask computes
+        # again the results it held, and such a task, still running, would write into the folder
+        # after it is renamed into place (a stray temporary file in OUTDIR).
+        futures.clear()
+        start.close()
+        shutil.rmtree(tmp / WORKER_SPACE, ignore_errors=True)
+    records = sorted(records.values(), key=lambda r: (-r["level"], r["tile"][2], r["tile"][1], r["tile"][0]))
+    shutil.rmtree(scratch, ignore_errors=True)
+    # A worker process that died while writing a file (killed, out of memory) leaves that
+    # write's temporary file (".tailor-XXXXXX", beside its target); every node is written now
+    # (its task ran again elsewhere), so those are stray.
+    for stray in tmp.rglob(".tailor-*"):
+        stray.unlink(missing_ok=True)
+    t_map = time.monotonic()
+    (tmp / "tileset.json").write_text(json.dumps(tileset_json(records, args.lod, args.up), indent=1) + "\n")
+    fields = ("digest", "faces", "error", "coarse_error", "glb_bytes", "coarse_bytes")
+    manifest = {"params": params, "tiles": {r["name"]: {k: r[k] for k in fields if k in r} for r in records}}
+    (tmp / MANIFEST).write_text(json.dumps(manifest, indent=1, sort_keys=True) + "\n")
+    # Into place: the old folder aside, the new one in, the old one removed.
+    aside = None
+    if outdir.exists():
+        aside = outdir.parent / (".%s.old-%d" % (outdir.name, os.getpid()))
+        os.rename(outdir, aside)
+    os.rename(tmp, outdir)
+    if aside:
+        shutil.rmtree(aside, ignore_errors=True)
     written = sum(1 for r in records if r["written"])
     summary = {
         "tiles": len(records),
@@ -1215,7 +1241,6 @@ def run_locked(args, outdir):
             "load_plan": t_plan - t0,
             "cut": t_cut - t_plan,
             "map_write": t_map - t_cut,
-            "total": time.monotonic() - t0,
         },
     }
     return summary

@@ -1047,7 +1047,7 @@ def test_closing_does_not_wait_for_a_cluster_start_that_cannot_end(monkeypatch):
     import time
 
     release = threading.Event()
-    monkeypatch.setattr(tiles, "start_client", lambda args: (release.wait(), None))
+    monkeypatch.setattr(tiles, "start_client", lambda args, space=None: (release.wait(), None))
     monkeypatch.setattr(tiles, "CLIENT_CLOSE_WAIT", 0.5)
     start = tiles.ClientStart(argparse.Namespace(scheduler=None))
     began = time.monotonic()
@@ -1196,6 +1196,27 @@ def test_ctrl_c_on_a_cluster_prints_one_line(tmp_path):
     assert run.returncode == 130, stderr
     assert stderr == "tailor.tiles: interrupted; %s left as it was\n" % out
     assert sorted(p.name for p in tmp_path.iterdir()) == []
+
+
+def test_a_run_after_a_killed_one_says_nothing_of_it(tmp_path):
+    import signal
+    import time
+
+    # A run killed outright (kill -9, the machine's out-of-memory killer) leaves its workers' locks:
+    # they are in its temporary folder, which the next run into the same folder removes, not in a
+    # folder every cluster shares, whose next workers printed a line for each.
+    run, out = start_in_own_group(tmp_path)
+    deadline = time.monotonic() + 120
+    while not list(tmp_path.glob(".out.tmp-*/%s/**/worker-*.dirlock" % tiles.WORKER_SPACE)) and time.monotonic() < deadline:
+        assert run.poll() is None, run.communicate()[1]
+        time.sleep(0.005)
+    os.killpg(run.pid, signal.SIGKILL)
+    run.communicate(timeout=60)
+    assert sorted(p.name.split("-")[0] for p in tmp_path.iterdir()) == [".out.lock", ".out.tmp"]
+    code, _, stderr = run_tiles(HORSE, "-o", out, "--workers", 2, "--chunk-cell", CELL, "--no-lod", "-q")
+    assert code == 0 and stderr == "", stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+    assert tiles.WORKER_SPACE not in {p.name for p in out.iterdir()}
 
 
 def test_textures_are_read_as_tailor_map_reads_them(tmp_path):
