@@ -32,6 +32,18 @@ std::string option_given_empty(const CLI::App& app) {
   return {};
 }
 
+// Says so and returns true when an option of the command was given an empty value.
+bool refused_empty_value(const CLI::App& app) {
+  const std::string empty = option_given_empty(app);
+  const std::vector<CLI::App*> commands = app.get_subcommands();
+  if (empty.empty() || commands.empty()) return false;
+  std::fprintf(stderr,
+               "tailor: error: %s was given an empty value: give one, or leave the option out (run 'tailor %s "
+               "--help')\n",
+               empty.c_str(), commands.back()->get_name().c_str());
+  return true;
+}
+
 int run_command(int argc, char** argv) {
   using namespace tailor::cli;
   CLI::App app{
@@ -79,6 +91,9 @@ int run_command(int argc, char** argv) {
                    tailor::internal::quote_input(argv[1]).c_str(), names.c_str());
       return kExitUsage;
     }
+    // An empty value first: CLI11's check of the option's range or file would name the value
+    // (--port '': "Value  not in range"), not that it is missing.
+    if (refused_empty_value(app)) return kExitUsage;
     // CLI11 checks the required options before the unknown ones: 'tailor map m.ply --ouput o.glb'
     // would say "--output is required", 'tailor --bogus' "A subcommand is required". The argument
     // it did not know is the cause, so it is named first, in the same words as any unknown one.
@@ -94,13 +109,7 @@ int run_command(int argc, char** argv) {
     std::fprintf(stderr, "tailor: error: %s (run '%s')\n", message.c_str(), help.c_str());
     return kExitUsage;
   }
-  if (const std::string empty = option_given_empty(app); !empty.empty()) {
-    std::fprintf(
-        stderr,
-        "tailor: error: %s was given an empty value: give one, or leave the option out (run 'tailor %s --help')\n",
-        empty.c_str(), app.get_subcommands().back()->get_name().c_str());
-    return kExitUsage;
-  }
+  if (refused_empty_value(app)) return kExitUsage;
   if (!run) return kExitUsage;
   // The library returns Status and never throws; this is the last line of defence (out of memory,
   // a bug) so that a failure is still one line and exit 1, never an abort.
