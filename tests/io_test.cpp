@@ -518,7 +518,9 @@ TEST(Off, KeywordVariantsColoursAndComments) {
       "STOFF\n3 1 0\n0 0 0 0 0\n1 0 0 1 0\n0 1 0 0 1\n3 0 1 2\n",
       "nOFF\n3\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
       "3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
-      "off\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",  // lower case, as some writers give it
+      "off\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",             // lower case, as some writers give it
+      "OFF\n3\n1\n0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",           // the counts one per line
+      "OFF\n3\n1\n# no edges\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",  // and without the edge count
   };
   for (const std::string& c : cases) {
     SCOPED_TRACE(c.substr(0, 6));

@@ -1,5 +1,5 @@
 // OFF reader (Geomview Object File Format): OFF, COFF, NOFF, CNOFF, STOFF, ... keywords, counts on
-// the keyword line or the next, `#` comments, one vertex per line (extra values such as normals,
+// the keyword line, the next or one per line, `#` comments, one vertex per line (extra values such as normals,
 // colours or texture coordinates ignored), polygon faces fan-triangulated (concave ones cut again: polygon_fans.h),
 // optional colour values after the face indices ignored. 4D (4OFF, nOFF with n != 3) and binary OFF are rejected.
 #include <string_view>
@@ -68,8 +68,19 @@ Status read_off(std::span<const char> data, const std::string& name, Mesh& mesh,
   s.skip_space();
   if (!s.read_uint(nf))
     return Status::error(ErrorCode::kParse, name, "bad OFF header (expected face count)", s.where());
-  if (!s.at_line_end() && !s.read_uint(ne)) {
-    return Status::error(ErrorCode::kParse, name, "bad OFF header (expected edge count)", s.where());
+  if (!s.at_line_end()) {
+    if (!s.read_uint(ne))
+      return Status::error(ErrorCode::kParse, name, "bad OFF header (expected edge count)", s.where());
+  } else {
+    // Counts one per line ("3\n1\n0", as some writers put them): a line of one whole number after
+    // the face count is the edge count, never a vertex (which has three coordinates).
+    TextScanner ahead = s;
+    ahead.next_line();
+    ahead.skip_space();
+    if (uint64_t edges = 0; ahead.read_uint(edges) && ahead.at_line_end()) {
+      ne = edges;
+      s = ahead;
+    }
   }
   // Vertices and faces are read a line each (the rest of a line ignored: colours, normals), so a
   // file that runs its data on after the counts would be misread from its first vertex on.
