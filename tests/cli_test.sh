@@ -233,6 +233,9 @@ expect_error 2 "--texture was given an empty value: give one, or leave the optio
 # Before a check of the value's range or kind, which would name the value, not its absence.
 expect_error 2 "--port was given an empty value: give one, or leave the option out \(run 'tailor view --help'\)$" -- "$tailor" view "$mesh" --port ''
 expect_error 2 "--threads was given an empty value" -- "$tailor" map "$mesh" -o "$tmp/empty.glb" --threads ''
+# '--texture=' ("$TEX" unset after '='): CLI11 would take the next argument for its value.
+expect_error 2 "--texture was given an empty value: give one, or leave the option out \(run 'tailor map --help'\)$" -- "$tailor" map "$mesh" --texture= -o "$tmp/empty.glb"
+expect_error 2 "unknown argument '--bogus=' \(run 'tailor map --help'\)$" -- "$tailor" map "$mesh" -o "$tmp/empty.glb" --bogus=
 # Whole numbers are whole: no 0 pixels, no negative seed read as 2^64 - 1.
 expect_error 2 "--max-image-pixels: must be a whole number, at least 1 \(run 'tailor tile --help'\)$" -- "$tailor" tile "$texture" -o "$tmp/t.png" --max-image-pixels 0
 expect_error 2 "--seed: must be a whole number, 0 to 2\^64 - 1" -- "$tailor" tile "$texture" -o "$tmp/t.png" --seed -1

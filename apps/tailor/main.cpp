@@ -32,15 +32,39 @@ std::string option_given_empty(const CLI::App& app) {
   return {};
 }
 
+// '--texture=' with nothing after '=' ('--texture="$TEX"' with TEX unset): CLI11 reads it as the
+// option without a value and takes the next argument for it ('--texture= -o out.glb' took -o for
+// the texture). Returns such an option of the command named by argv[1], or "".
+std::string option_with_empty_equals(CLI::App& app, int argc, char** argv) {
+  if (argc < 2) return {};
+  const std::string_view command_name = argv[1];
+  const std::vector<CLI::App*> commands =
+      app.get_subcommands([&](CLI::App* a) { return !a->get_name().empty() && a->get_name() == command_name; });
+  if (commands.empty()) return {};
+  for (int i = 2; i < argc; ++i) {
+    const std::string_view argument = argv[i];
+    if (argument == "--") break;
+    if (argument.size() > 3 && argument.starts_with("--") && argument.find('=') == argument.size() - 1) {
+      const std::string name(argument.substr(0, argument.size() - 1));
+      if (commands.front()->get_option_no_throw(name) != nullptr) return name;
+    }
+  }
+  return {};
+}
+
+void say_empty_value(const std::string& option, const std::string& command) {
+  std::fprintf(stderr,
+               "tailor: error: %s was given an empty value: give one, or leave the option out (run 'tailor %s "
+               "--help')\n",
+               option.c_str(), command.c_str());
+}
+
 // Says so and returns true when an option of the command was given an empty value.
 bool refused_empty_value(const CLI::App& app) {
   const std::string empty = option_given_empty(app);
   const std::vector<CLI::App*> commands = app.get_subcommands();
   if (empty.empty() || commands.empty()) return false;
-  std::fprintf(stderr,
-               "tailor: error: %s was given an empty value: give one, or leave the option out (run 'tailor %s "
-               "--help')\n",
-               empty.c_str(), commands.back()->get_name().c_str());
+  say_empty_value(empty, commands.back()->get_name());
   return true;
 }
 
@@ -71,6 +95,10 @@ int run_command(int argc, char** argv) {
   register_view(app, run);
   register_edit(app, run);
 
+  if (const std::string empty = option_with_empty_equals(app, argc, argv); !empty.empty()) {
+    say_empty_value(empty, argv[1]);
+    return kExitUsage;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

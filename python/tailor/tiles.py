@@ -1345,6 +1345,13 @@ def parse_args(argv):
     p.add_argument("--cut-only", action="store_true", help=argparse.SUPPRESS)
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     args = p.parse_args(argv)
+    # An empty value ('--texture "$TEX"' with TEX unset) would read as the option left out, and the
+    # run would go on without what was asked for: no option here takes one (as tailor's CLI).
+    for action in p._actions:
+        if getattr(args, action.dest, None) == "":
+            if not action.option_strings:
+                usage_error("the %s was given as an empty path" % action.dest)
+            usage_error("%s was given an empty value: give one, or leave the option out" % action.option_strings[-1])
     if args.texture and args.material:
         usage_error("give --texture or --material, not both (the material's colour map is the texture)")
     if args.up not in ("y", "z"):

@@ -1245,6 +1245,20 @@ def test_textures_are_read_as_tailor_map_reads_them(tmp_path):
     assert (out / "texture.png").read_bytes() == GRAVEL.read_bytes() and not (out / "texture.jpg").exists()
 
 
+def test_an_empty_value_is_refused_not_taken_for_the_option_left_out(tmp_path):
+    # '--texture "$TEX"' with TEX unset mapped without the texture, and -o '' named the working folder.
+    out = tmp_path / "out"
+    for extra, name in ((["--texture", ""], "--texture"), (["--texture="], "--texture"), (["--material", ""], "--material"),
+                        (["--scheduler", ""], "--scheduler")):
+        code, _, stderr = run_tiles(HORSE, "-o", out, "--workers", 0, *extra)
+        assert code == 2 and stderr == "tailor.tiles: error: %s was given an empty value: give one, or leave the option out\n" % name, stderr
+    code, _, stderr = run_tiles(HORSE, "-o", "", "--workers", 0)
+    assert code == 2 and "--output was given an empty value" in stderr, stderr
+    code, _, stderr = run_tiles("", "-o", out, "--workers", 0)
+    assert code == 2 and stderr == "tailor.tiles: error: the input was given as an empty path\n", stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
+
+
 def test_options_out_of_range_are_usage_errors(tmp_path):
     out = tmp_path / "out"
     for option, value, message in (
