@@ -119,20 +119,20 @@ int run_command(int argc, char** argv) {
                    tailor::internal::quote_input(argv[1]).c_str(), names.c_str());
       return kExitUsage;
     }
-    // An empty value first: CLI11's check of the option's range or file would name the value
-    // (--port '': "Value  not in range"), not that it is missing.
-    if (refused_empty_value(app)) return kExitUsage;
     // CLI11 checks the required options before the unknown ones: 'tailor map m.ply --ouput o.glb'
     // would say "--output is required", 'tailor --bogus' "A subcommand is required". The argument
     // it did not know is the cause, so it is named first, in the same words as any unknown one.
     std::string message = e.what();
-    if (dynamic_cast<const CLI::RequiredError*>(&e) != nullptr ||
-        dynamic_cast<const CLI::ExtrasError*>(&e) != nullptr) {
-      const std::vector<std::string> unknown = commands.empty() ? app.remaining() : commands.back()->remaining();
-      if (!unknown.empty()) {
-        message = unknown.size() > 1 ? "unknown arguments" : "unknown argument";
-        for (const std::string& argument : unknown) message += " " + tailor::internal::quote_input(argument);
-      }
+    std::vector<std::string> unknown;
+    if (dynamic_cast<const CLI::RequiredError*>(&e) != nullptr || dynamic_cast<const CLI::ExtrasError*>(&e) != nullptr)
+      unknown = commands.empty() ? app.remaining() : commands.back()->remaining();
+    if (!unknown.empty()) {
+      message = unknown.size() > 1 ? "unknown arguments" : "unknown argument";
+      for (const std::string& argument : unknown) message += " " + tailor::internal::quote_input(argument);
+    } else if (refused_empty_value(app)) {
+      // Said before CLI11's check of the option's range or file, which names the value instead
+      // (--port '': "Value  not in range").
+      return kExitUsage;
     }
     std::fprintf(stderr, "tailor: error: %s (run '%s')\n", message.c_str(), help.c_str());
     return kExitUsage;

@@ -44,6 +44,7 @@ import secrets
 import shutil
 import signal
 import struct
+import tempfile
 import sys
 import threading
 import time
@@ -65,8 +66,6 @@ FORMAT = 2  # of the manifest: a different number means every tile is written ag
 # The streamed partition's ranges of the file (at least a block each): enough for every worker of a
 # cluster to take several, so that the driver and the workers finish together.
 PARTITION_PARTS = 256
-# The local cluster's folder for its workers' spilled data and locks, inside a run's temporary one.
-WORKER_SPACE = "dask"
 # A tile is at most 2^20 chunk cells on a side: the streamed partition packs its coordinates in 21 bits
 # (_partition_block); the in-memory path keeps the same limit, so that both cut the same tiles.
 MAX_TILE_LEVEL = 20
@@ -801,10 +800,10 @@ def remove_stale(outdir):
 
 def start_client(args, space=None):
     """A Dask client: of the scheduler args.scheduler names, else of a local cluster of args.workers
-    processes, whose folders for spilled data and locks are made inside `space` (a run's temporary
-    folder: Dask's default, one folder under /tmp shared by every cluster, kept the locks of a run
-    that was killed, and the next run's workers printed a line for each as they removed them).
-    Returns (client, the local cluster or None)."""
+    processes, whose folders for spilled data and locks are made inside `space` when given (Dask's
+    default is one folder of the temporary directory that every cluster shares: a cluster's workers
+    remove the locks a killed run left there, with a line each on the terminal). Returns (client,
+    the local cluster or None)."""
     import dask
     from dask.distributed import Client, LocalCluster
 
@@ -863,8 +862,7 @@ def start_client(args, space=None):
             dashboard_address=":0",
             scheduler_kwargs={"dashboard": False},
             silence_logs=logging.ERROR,
-            # A folder the user gave Dask (its temporary-directory setting) stands.
-            local_directory=None if space is None or dask.config.get("temporary-directory", None) else str(space),
+            local_directory=None if space is None else str(space),
         )
     client = Client(cluster)
     client.register_worker_plugin(_DriverAnswersInterrupts(), name="tailor-driver-answers-interrupts")
@@ -882,17 +880,20 @@ class _DriverAnswersInterrupts:
 
 
 class ClientStart:
-    """start_client in a thread of its own, started while the driver still reads and cuts the mesh:
-    the local cluster's worker processes start and import tailor meanwhile. result() waits for it;
-    close() waits too, then closes what it started."""
+    """start_client in a thread of its own, started while the driver still surveys and cuts the mesh:
+    the local cluster's worker processes start and import tailor meanwhile, their folders in one of
+    the run's own in the temporary directory (unless Dask's temporary-directory setting names
+    another). result() waits for the start; close() waits too, then closes what it started and
+    removes that folder."""
 
-    def __init__(self, args, space=None):
-        self.client = self.cluster = self.error = None
+    def __init__(self, args):
+        self.client = self.cluster = self.error = self.space = None
+        self.closed = False
         self.before = {p.pid for p in multiprocessing.active_children()}  # not the cluster's
-        self.thread = threading.Thread(target=self._run, args=(args, space), name="tailor.tiles client", daemon=True)
+        self.thread = threading.Thread(target=self._run, args=(args,), name="tailor.tiles client", daemon=True)
         self.thread.start()
 
-    def _run(self, args, space):
+    def _run(self, args):
         try:
             # This thread, and so every process and thread it starts (the workers, the server they
             # are forked from, multiprocessing's resource tracker), holds the signals that a
@@ -909,7 +910,11 @@ class ClientStart:
                 # itself ignores those two and keeps SIGHUP blocked.
                 multiprocessing.resource_tracker.ensure_running()
                 signal.pthread_sigmask(signal.SIG_BLOCK, GROUP_SIGNALS)
-            self.client, self.cluster = start_client(args, space)
+                import dask
+
+                if not dask.config.get("temporary-directory", None):
+                    self.space = tempfile.mkdtemp(prefix="tailor-tiles-")
+            self.client, self.cluster = start_client(args, self.space)
             if self.cluster is not None:
                 self.client.run(worker_ready)  # each worker imports tailor.tiles now, not at its first task
         except BaseException as e:  # raised again by result()
@@ -922,19 +927,24 @@ class ClientStart:
         return self.client, self.cluster
 
     def close(self):
+        if self.closed:  # once: a start that did not finish is waited for once
+            return
+        self.closed = True
         try:
             # Bounded: a start that cannot finish (a scheduler that does not answer) must not hold
             # the driver's exit (the thread is a daemon).
             self.thread.join(CLIENT_CLOSE_WAIT)
             if self.thread.is_alive():
                 return
-            client, cluster, self.client, self.cluster = self.client, self.cluster, None, None  # closed once
+            client, cluster, self.client, self.cluster = self.client, self.cluster, None, None
             if client is not None:
                 client.close()
             if cluster is not None:
                 cluster.close()
         finally:
             self.kill_left_workers()
+            if self.space is not None and not self.thread.is_alive():
+                shutil.rmtree(self.space, ignore_errors=True)
 
     def kill_left_workers(self):
         """Kills the worker processes of the cluster still alive after its close (one cut short by a
@@ -1023,9 +1033,10 @@ def run_locked(args, outdir):
                 "%s: cannot write beside it in %s (%s)" % (args.output, outdir.parent, e.strerror)
             ) from None
         if not in_process and not args.cut_only:
-            # The cluster starts in a thread of its own once the input is known to be readable: its
-            # worker processes start and import tailor while this process surveys and cuts the mesh.
-            start = ClientStart(args, tmp / WORKER_SPACE)
+            # The cluster starts in a thread of its own once the input's header is read (a streamed
+            # PLY) or the mesh loaded: its worker processes start and import tailor while this
+            # process surveys and cuts the mesh.
+            start = ClientStart(args)
         summary = run_started(args, outdir, t0, layout, mesh, look, start)
     except BaseException:
         # The cluster first: a worker still running a task would write into the folder after it is
@@ -1040,7 +1051,7 @@ def run_locked(args, outdir):
     finally:
         if start is not None:
             start.close()
-    if "map_write" in summary["seconds"]:  # the cluster's close included
+    if not args.cut_only:  # the cluster's close included
         summary["seconds"]["total"] = time.monotonic() - t0
     return summary
 
@@ -1199,7 +1210,6 @@ def run_started(args, outdir, t0, layout, mesh, look, start):
         # after it is renamed into place (a stray temporary file in OUTDIR).
         futures.clear()
         start.close()
-        shutil.rmtree(tmp / WORKER_SPACE, ignore_errors=True)
     records = sorted(records.values(), key=lambda r: (-r["level"], r["tile"][2], r["tile"][1], r["tile"][0]))
     shutil.rmtree(scratch, ignore_errors=True)
     # A worker process that died while writing a file (killed, out of memory) leaves that
