@@ -1372,6 +1372,8 @@ def parse_args(argv):
                         ("--scale", args.scale)):
         if value is not None and not (0 < value < math.inf):
             usage_error("%s must be a positive number, got %s" % (name, value))
+    if args.tile_size is not None and math.frexp(args.tile_size)[0] != 0.5:
+        usage_error("--tile-size must be the chunk cell times a power of two (a power of two), got %g" % args.tile_size)
     if args.scale is None:
         args.scale = defaults["scale"]
     if not (0.01 <= args.max_stretch <= 4):  # the library's range (MappingOptions::max_stretch)

@@ -255,8 +255,12 @@ def test_errors_are_one_line_and_leave_the_output_as_it_was(tmp_path):
     code, _, stderr = run_tiles(tmp_path / "missing.ply", "-o", out, "--workers", 0)
     assert code == 1 and stderr.count("\n") == 1 and stderr.startswith("tailor.tiles: error: ")
     assert not out.exists() and list(tmp_path.iterdir()) == []
+    # Not a power of two: refused with the options, before any work; one under the cell, once the
+    # cell is known.
     code, _, stderr = run_tiles(HORSE, "-o", out, "--workers", 0, "--chunk-cell", CELL, "--tile-size", 0.3)
-    assert code == 1 and "--tile-size must be the chunk cell" in stderr
+    assert code == 2 and "--tile-size must be the chunk cell times a power of two (a power of two), got 0.3" in stderr
+    code, _, stderr = run_tiles(HORSE, "-o", out, "--workers", 0, "--chunk-cell", CELL, "--tile-size", 2.0**(CELL - 1))
+    assert code == 1 and "--tile-size must be the chunk cell (0.0625) times a power of two, got 0.03125" in stderr
     assert list(tmp_path.iterdir()) == []
     # A tile of 2x2x2 cells; then a bad texture: the folder written before stays as it was.
     code, stdout, stderr = run_tiles(HORSE, "-o", out, "--workers", 0, "--chunk-cell", CELL, "--tile-size", 0.125)
