@@ -112,6 +112,9 @@ std::string path_of(const py::handle& path) {
   // The file system's bytes (os.fsencode): a name that is not UTF-8 (decoded by Python with
   // surrogate escapes) names the same file, where a UTF-8 cast of the str would fail.
   std::string bytes = py::module_::import("os").attr("fsencode")(path).cast<py::bytes>().cast<std::string>();
+  // An empty path (texture=os.environ.get("TEX", "") with TEX unset) would read as the argument
+  // left out where it is optional, and the call would go on without what was asked for.
+  if (bytes.empty()) raise_error("expected a path, got an empty one");
   // The C library stops at a NUL: "a\0.glb" would write "a". Python's own open() refuses it too.
   if (bytes.find('\0') != std::string::npos)
     raise_error("path contains a NUL character: " + py::repr(path).cast<std::string>());

@@ -157,6 +157,12 @@ def test_bad_seam_faces_and_mismatched_save(tmp_path):
         tailor.save(str(tmp_path / "x\0.glb"), mesh, tailor.map(mesh))
     with pytest.raises(tailor.Error, match="path contains a NUL character"):
         tailor.load(str(SPOT) + "\0.xyz")
+    # An empty path (texture=os.environ.get("TEX", "") with TEX unset) is refused, not taken for no
+    # texture: map() went on without it.
+    for call in (lambda: tailor.map(mesh, texture=""), lambda: tailor.map(mesh, material=""),
+                 lambda: tailor.load(""), lambda: tailor.save("", mesh, tailor.map(mesh))):
+        with pytest.raises(tailor.Error, match="expected a path, got an empty one"):
+            call()
     assert list(tmp_path.iterdir()) == []
     # No index is no seam face, whatever dtype numpy gives an empty list.
     assert np.array_equal(tailor.map(mesh, seam_faces=[]).corner_uvs, tailor.map(mesh).corner_uvs)
