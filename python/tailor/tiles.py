@@ -44,8 +44,8 @@ import secrets
 import shutil
 import signal
 import struct
-import tempfile
 import sys
+import tempfile
 import threading
 import time
 import warnings
