@@ -247,7 +247,8 @@ void bind_map(py::module_& m) {
         mapping.shorten_seams = shorten_seams;
         mapping.close_cracks = close_cracks;
         if (!crack_rings.is_none())  // else as auto decides
-          mapping.crack_rings = static_cast<uint32_t>(whole_number(crack_rings, "crack_rings", 2, 64));
+          mapping.crack_rings = static_cast<uint32_t>(
+              whole_number(crack_rings, "crack_rings", MappingLimits::min_crack_rings, MappingLimits::max_crack_rings));
         mapping.relax_iterations = relax_iterations;
         mapping.threshold_px = threshold;
         if (!symmetry.is_none()) {
@@ -451,6 +452,15 @@ void bind_map(py::module_& m) {
   defaults["max_stretch"] = md.max_stretch;
   defaults["crack_rings"] = md.crack_rings;
   m.attr("MAP_DEFAULTS") = defaults;
+  // Their ranges (MappingLimits), (lowest, highest), which map() and tailor.tiles check against.
+  using L = MappingLimits;
+  py::dict limits;
+  limits["scale"] = py::make_tuple(L::min_scale, L::max_scale);
+  limits["max_stretch"] = py::make_tuple(L::min_max_stretch, L::max_max_stretch);
+  limits["hop_age"] = py::make_tuple(0.f, L::max_hop_age);
+  limits["crack_rings"] = py::make_tuple(L::min_crack_rings, L::max_crack_rings);
+  limits["relax_iterations"] = py::make_tuple(0u, L::max_relax_iterations);
+  m.attr("MAP_LIMITS") = limits;
 
   m.def(
       "auto_field_following",

@@ -246,11 +246,12 @@ int run_map(const MapArgs& opt) {
     options.orientation.fixed_origin = {static_cast<float>(lo[0]), static_cast<float>(lo[1]),
                                         static_cast<float>(lo[2])};
     const double scale = texels_per_unit / options.orientation.fixed_unit_scale;
-    if (!(scale >= 1e-3 && scale <= 1e7)) {
+    if (!(scale >= MappingLimits::min_scale && scale <= MappingLimits::max_scale)) {
       char figure[32];
       std::snprintf(figure, sizeof figure, "%.3g", scale);  // std::to_string's %f printed 0.000000
       return report_error(usage_error("--tile-size / --texels-per-unit give " + std::string(figure) +
-                                      " pixels per mesh size, outside 0.001 to 1e7"));
+                                      " pixels per mesh size, outside " + limit_text(MappingLimits::min_scale) +
+                                      " to " + limit_text(MappingLimits::max_scale)));
     }
     mapping.scale = static_cast<float>(scale);
   }

@@ -67,6 +67,7 @@ std::string field_name(const std::string& key) { return "options." + key; }
 std::string apply_options(const json& j, const EditContext& context, const std::vector<uint8_t>& seam_faces,
                           MapTextureOptions& options) {
   if (!j.is_object()) return "\"options\" must be an object";
+  using L = MappingLimits;
   MappingOptions& m = options.mapping;
   OrientationOptions& o = options.orientation;
   bool auto_axis = false, auto_following = false;
@@ -85,11 +86,13 @@ std::string apply_options(const json& j, const EditContext& context, const std::
       if (!v.is_string() || !mapping_mode_from_name(v.get<std::string>(), m.mode))
         return "options.mode must be \"patches\" or \"thesis\"";
     } else if (key == "scale") {
-      if (!as_float(v, m.scale) || !(m.scale >= 1e-3f && m.scale <= 1e7f))
-        return field_name(key) + " must be a number of pixels per unit, 0.001 to 1e7";
+      if (!as_float(v, m.scale) || !(m.scale >= L::min_scale && m.scale <= L::max_scale))
+        return field_name(key) + " must be a number of pixels per unit, " + limit_text(L::min_scale) + " to " +
+               limit_text(L::max_scale);
     } else if (key == "max_stretch") {
-      if (!as_float(v, m.max_stretch) || !(m.max_stretch >= 0.01f && m.max_stretch <= 4.f))
-        return field_name(key) + " must be a number in [0.01, 4]";
+      if (!as_float(v, m.max_stretch) || !(m.max_stretch >= L::min_max_stretch && m.max_stretch <= L::max_max_stretch))
+        return field_name(key) + " must be a number in [" + limit_text(L::min_max_stretch) + ", " +
+               limit_text(L::max_max_stretch) + "]";
     } else if (key == "field_following") {
       if (v.is_string() && v.get<std::string>() == "auto") {
         auto_following = true;
@@ -99,15 +102,18 @@ std::string apply_options(const json& j, const EditContext& context, const std::
     } else if (key == "min_patch_faces") {
       if (!as_uint(v, 0, UINT32_MAX, m.min_patch_faces)) return field_name(key) + " must be an unsigned integer";
     } else if (key == "hop_age") {
-      if (!as_float(v, m.hop_age) || !(m.hop_age >= 0.f && m.hop_age <= 1.f))
-        return field_name(key) + " must be a number of radians in [0, 1]";
+      if (!as_float(v, m.hop_age) || !(m.hop_age >= 0.f && m.hop_age <= L::max_hop_age))
+        return field_name(key) + " must be a number of radians in [0, " + limit_text(L::max_hop_age) + "]";
     } else if (key == "shorten_seams" || key == "close_cracks") {
       if (!v.is_boolean()) return field_name(key) + " must be true or false";
       (key == "shorten_seams" ? m.shorten_seams : m.close_cracks) = v.get<bool>();
     } else if (key == "crack_rings") {
-      if (!as_uint(v, 2, 64, m.crack_rings)) return field_name(key) + " must be an integer 2..64";
+      if (!as_uint(v, L::min_crack_rings, L::max_crack_rings, m.crack_rings))
+        return field_name(key) + " must be an integer " + std::to_string(L::min_crack_rings) + ".." +
+               std::to_string(L::max_crack_rings);
     } else if (key == "relax_iterations") {
-      if (!as_uint(v, 0, 1000, m.relax_iterations)) return field_name(key) + " must be an integer 0..1000";
+      if (!as_uint(v, 0, L::max_relax_iterations, m.relax_iterations))
+        return field_name(key) + " must be an integer 0.." + std::to_string(L::max_relax_iterations);
     } else if (key == "threshold_px") {
       if (!as_float(v, m.threshold_px) || !(m.threshold_px > 0.f))
         return field_name(key) + " must be a positive number of pixels";

@@ -39,6 +39,7 @@
 #include <cstdint>
 #include <functional>
 #include <span>
+#include <string>
 #include <string_view>
 
 #include "tailor/api.h"
@@ -62,9 +63,23 @@ enum class MappingMode {
 // ProgressCallback (tailor/progress.h): called now and then with progress in [0, 1]; return false
 // to cancel (map_texture then returns kCancelled and leaves the atlas empty).
 
+//! The ranges of MappingOptions' numbers, one table for every check of them: map_texture's own,
+//! check_map_options (the CLI's and the Python module's words), the CLI's flags, `tailor edit`'s
+//! API and python3 -m tailor.tiles (tailor.MAP_LIMITS).
+struct MappingLimits {
+  static constexpr float min_scale = 1e-3f, max_scale = 1e7f;  //!< pixels per unit
+  static constexpr float min_max_stretch = 0.01f, max_max_stretch = 4.f;
+  static constexpr float max_hop_age = 1.f;  //!< radians, from 0
+  static constexpr uint32_t min_crack_rings = 2, max_crack_rings = 64;
+  static constexpr uint32_t max_relax_iterations = 1000;
+};
+
+//! A limit as messages and docs write it: 0.001, 4, 1e7 (printf's %g, its exponent without "+0").
+TAILOR_API std::string limit_text(double value);
+
 struct MappingOptions {
   MappingMode mode = MappingMode::kPatches;  //!< algorithm (CLI --mode patches|thesis)
-  float scale = 800.f;          //!< texture pixels per unit of the mesh normalised into the unit cube (> 0)
+  float scale = 800.f;          //!< texture pixels per unit of the mesh normalised into the unit cube (MappingLimits)
   bool use_seed_point = false;  //!< true: first face = the face whose centroid is nearest to seed_point
   std::array<float, 3> seed_point{0.f, 0.f, 0.f};  //!< mesh coordinates (not normalised); default rule when
                                                    //!< unused: the face nearest to the centre of the bounding box
@@ -77,7 +92,7 @@ struct MappingOptions {
                               //!< grow rounder patches (more seam), smaller follow the field's variation
   // kPatches ------------------------------------------------------------------------------------
   float max_stretch = 0.25f;           //!< per-face bound: singular values of the face->UV Jacobian (in units of
-                                       //!< `scale`) must lie in [1/(1+x), 1+x]; 0.01..4. 0.25 keeps every face
+                                       //!< `scale`) must lie in [1/(1+x), 1+x] (MappingLimits). 0.25 keeps every face
                                        //!< within 25% of its length in any direction (so Sander Linf <= ~1.25)
                                        //!< and the thesis stretch under 0.08 on the shared meshes; larger values
                                        //!< give fewer seams and more distortion (docs/mapping.md)
@@ -93,13 +108,13 @@ struct MappingOptions {
   bool close_cracks = true;            //!< last, zip cracks (seams inside one patch) shut from their tips, spreading
                                        //!< each gap over the faces around it within max_stretch (ARAP relaxation):
                                        //!< 23-57% less seam length on scans, mapping 3-10x slower (docs/mapping.md)
-  uint32_t crack_rings = 16;           //!< effort of the crack closing (2..64): the largest region a zip relaxes, in
-                                       //!< rings of faces around it (a first try takes crack_rings / 2 rings per unit
-                                       //!< of gap / edge length); more closes wider gaps and takes longer
-  uint32_t relax_iterations = 10;      //!< last, local/global ARAP iterations over the UV vertices (0 = off, at most
-                                       //!< 1000): median angle distortion 6.7 -> 1.8 degrees on the shared meshes for
-                                       //!< ~20% more mapping time; patches and seam edges unchanged, invisible seams
-                                       //!< (< 1 px) untouched, every moved face within max_stretch (docs/mapping.md)
+  uint32_t crack_rings = 16;  //!< effort of the crack closing (MappingLimits): the largest region a zip relaxes, in
+                              //!< rings of faces around it (a first try takes crack_rings / 2 rings per unit
+                              //!< of gap / edge length); more closes wider gaps and takes longer
+  uint32_t relax_iterations = 10;  //!< last, local/global ARAP iterations over the UV vertices (0 = off, at most
+                                   //!< 1000): median angle distortion 6.7 -> 1.8 degrees on the shared meshes for
+                                   //!< ~20% more mapping time; patches and seam edges unchanged, invisible seams
+                                   //!< (< 1 px) untouched, every moved face within max_stretch (docs/mapping.md)
   uint32_t threads = 0;  //!< threads: chunked, one chunk per thread (0 = one per core); whole, those of the crack
                          //!< closing, the relaxation and symmetry 4's fields (0 = one per 10k / 20k faces, at most the
                          //!< cores and 8; the growth is sequential); the result is identical for any count

@@ -13,6 +13,7 @@ large mesh as 3D Tiles on a Dask cluster (docs/scale.md).
 """
 from ._tailor import (
     MAP_DEFAULTS,
+    MAP_LIMITS,
     ChunkedMapper,
     Error,
     Mesh,
@@ -40,6 +41,7 @@ from ._tailor import (
 
 __all__ = [
     "MAP_DEFAULTS",
+    "MAP_LIMITS",
     "ChunkedMapper",
     "Error",
     "Mesh",

@@ -8,6 +8,8 @@ import numpy.typing as npt
 __version__: str
 # map()'s defaults of texture_size, scale, max_stretch and crack_rings (the library's, by name).
 MAP_DEFAULTS: Dict[str, Union[int, float]]
+# The ranges map() accepts of scale, max_stretch, hop_age, crack_rings and relax_iterations: (lowest, highest).
+MAP_LIMITS: Dict[str, Tuple[Union[int, float], Union[int, float]]]
 
 _Path = Union[str, os.PathLike[str]]
 _Progress = Callable[[float], Optional[bool]]

@@ -1376,15 +1376,18 @@ def parse_args(argv):
         usage_error("--tile-size must be the chunk cell times a power of two (a power of two), got %g" % args.tile_size)
     if args.scale is None:
         args.scale = defaults["scale"]
-    if not (0.01 <= args.max_stretch <= 4):  # the library's range (MappingOptions::max_stretch)
-        usage_error("--max-stretch must be in 0.01..4, got %s" % args.max_stretch)
+    limits = tailor.MAP_LIMITS  # the library's ranges, as tailor map and tailor.map check them
+    low, high = limits["max_stretch"]
+    if not (np.float32(low) <= np.float32(args.max_stretch) <= np.float32(high)):
+        usage_error("--max-stretch must be in %g..%g, got %s" % (low, high, args.max_stretch))
     if not 1 <= args.texture_size <= 65536:  # as tailor map and tailor eval take it
         usage_error("--texture-size must be in 1..65536, got %d" % args.texture_size)
     if args.chunk_cell is not None and not -60 <= args.chunk_cell <= 60:  # the library's (ChunkOptions)
         usage_error("--chunk-cell must be a whole number in -60..60 (the cell side is 2^N world units), got %d"
                     % args.chunk_cell)
-    if args.crack_rings is not None and not 2 <= args.crack_rings <= 64:  # MappingOptions::crack_rings
-        usage_error("--crack-rings must be in 2..64, got %d" % args.crack_rings)
+    low, high = limits["crack_rings"]
+    if args.crack_rings is not None and not low <= args.crack_rings <= high:
+        usage_error("--crack-rings must be in %d..%d, got %d" % (low, high, args.crack_rings))
     if args.field_following != "auto":
         try:
             value = float(args.field_following)

@@ -72,18 +72,18 @@ MapTextureOptions chunk_map_options(const MapTextureOptions& options, const std:
 }
 
 // A chunk is mapped in its cell's frame at texels_per_unit * size pixels per cell side, which the
-// mapping takes within 0.001..1e7 (its scale's range). Out of range says what a user can change;
+// mapping takes within its scale's range (MappingLimits). Out of range says what a user can change;
 // the cell's exponent is -60..60, so a mesh far from unit scale may need no chunks at all.
 Status check_chunk_scale(double texels_per_unit, double size) {
   const double chunk_scale = texels_per_unit * size;
-  if (chunk_scale >= 1e-3 && chunk_scale <= 1e7) return Status::ok();
+  if (chunk_scale >= MappingLimits::min_scale && chunk_scale <= MappingLimits::max_scale) return Status::ok();
   char figures[96];
   std::snprintf(figures, sizeof figures, "%.3g pixels per chunk cell of side 2^%d units", chunk_scale,
                 std::ilogb(size));
   return Status::error(ErrorCode::kInvalidArgument, "",
-                       std::string("the texel density gives ") + figures +
-                           ", outside 0.001 to 1e7: give another chunk cell (2^-60 to 2^60) or texel density, "
-                           "or map without chunks");
+                       std::string("the texel density gives ") + figures + ", outside " +
+                           limit_text(MappingLimits::min_scale) + " to " + limit_text(MappingLimits::max_scale) +
+                           ": give another chunk cell (2^-60 to 2^60) or texel density, or map without chunks");
 }
 
 Status map_chunk(const MapTextureOptions& options, const std::array<double, 3>& origin, double size,

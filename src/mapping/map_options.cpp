@@ -1,5 +1,6 @@
 // The option checks and the texture-size settings `tailor map` applies before map_texture, shared
 // with the Python module so both refuse the same options with the same message.
+#include <cstdio>
 #include <string>
 #include <string_view>
 
@@ -10,14 +11,28 @@ namespace {
 Status usage_error(const std::string& what) { return Status::error(ErrorCode::kInvalidArgument, "", what); }
 }  // namespace
 
+std::string limit_text(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", value);
+  std::string s = text;
+  if (const size_t e = s.find("e+"); e != std::string::npos) {
+    size_t digits = e + 2;
+    while (digits + 1 < s.size() && s[digits] == '0') ++digits;
+    s = s.substr(0, e + 1) + s.substr(digits);
+  }
+  return s;
+}
+
 Status check_map_options(const MapTextureOptions& options) {
+  using L = MappingLimits;
   const MappingOptions& mapping = options.mapping;
   if (mapping.symmetry == 4 && mapping.mode != MappingMode::kPatches)
     return usage_error("--symmetry 4 needs --mode patches");
-  if (!(mapping.scale >= 1e-3f && mapping.scale <= 1e7f))
-    return usage_error("--scale must be between 0.001 and 1e7 pixels per unit");
-  if (!(mapping.hop_age >= 0.f && mapping.hop_age <= 1.f))
-    return usage_error("--hop-age must be between 0 and 1 radians");
+  if (!(mapping.scale >= L::min_scale && mapping.scale <= L::max_scale))
+    return usage_error("--scale must be between " + limit_text(L::min_scale) + " and " + limit_text(L::max_scale) +
+                       " pixels per unit");
+  if (!(mapping.hop_age >= 0.f && mapping.hop_age <= L::max_hop_age))
+    return usage_error("--hop-age must be between 0 and " + limit_text(L::max_hop_age) + " radians");
   if (options.chunks.split_above != 0 && options.chunks.split_above < 64)
     return usage_error("--chunk-split must be 0 (never cut) or at least 64 faces");
   return Status::ok();

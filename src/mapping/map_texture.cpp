@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -106,10 +107,15 @@ void clear_atlas(Atlas& atlas) {
 namespace internal {
 
 Status check_mapping_values(const MappingOptions& options) {
-  if (!(options.scale > 0.f) || !std::isfinite(options.scale) || options.scale > 1e7f)
-    return Status::error(ErrorCode::kInvalidArgument, "", "scale must be a positive finite number of pixels (<= 1e7)");
-  if (!(options.max_stretch >= 0.01f && options.max_stretch <= 4.f))
-    return Status::error(ErrorCode::kInvalidArgument, "", "max stretch must be in [0.01, 4]");
+  using L = MappingLimits;
+  if (!(options.scale >= L::min_scale && options.scale <= L::max_scale))
+    return Status::error(
+        ErrorCode::kInvalidArgument, "",
+        "scale must be in [" + limit_text(L::min_scale) + ", " + limit_text(L::max_scale) + "] pixels");
+  if (!(options.max_stretch >= L::min_max_stretch && options.max_stretch <= L::max_max_stretch))
+    return Status::error(
+        ErrorCode::kInvalidArgument, "",
+        "max stretch must be in [" + limit_text(L::min_max_stretch) + ", " + limit_text(L::max_max_stretch) + "]");
   if (!(options.field_following >= 0.f && options.field_following <= 1.f))
     return Status::error(ErrorCode::kInvalidArgument, "", "field following must be in [0, 1]");
   if (!(options.max_seed_rotation_deg >= 0.f && options.max_seed_rotation_deg <= 180.f))
@@ -117,12 +123,16 @@ Status check_mapping_values(const MappingOptions& options) {
   if (!(options.threshold_px > 0.f) || !std::isfinite(options.threshold_px) || !(options.threshold_step_px > 0.f) ||
       !std::isfinite(options.threshold_step_px))
     return Status::error(ErrorCode::kInvalidArgument, "", "threshold and its step must be positive pixels");
-  if (!(options.hop_age >= 0.f && options.hop_age <= 1.f))
-    return Status::error(ErrorCode::kInvalidArgument, "", "hop age must be in [0, 1] radians");
-  if (options.crack_rings < 2 || options.crack_rings > 64)
-    return Status::error(ErrorCode::kInvalidArgument, "", "crack rings must be in [2, 64]");
-  if (options.relax_iterations > 1000)
-    return Status::error(ErrorCode::kInvalidArgument, "", "relax iterations must be at most 1000");
+  if (!(options.hop_age >= 0.f && options.hop_age <= L::max_hop_age))
+    return Status::error(ErrorCode::kInvalidArgument, "",
+                         "hop age must be in [0, " + limit_text(L::max_hop_age) + "] radians");
+  if (options.crack_rings < L::min_crack_rings || options.crack_rings > L::max_crack_rings)
+    return Status::error(ErrorCode::kInvalidArgument, "",
+                         "crack rings must be in [" + std::to_string(L::min_crack_rings) + ", " +
+                             std::to_string(L::max_crack_rings) + "]");
+  if (options.relax_iterations > L::max_relax_iterations)
+    return Status::error(ErrorCode::kInvalidArgument, "",
+                         "relax iterations must be at most " + std::to_string(L::max_relax_iterations));
   if (!std::isfinite(options.factor_step) || options.factor_step > 1.0)
     return Status::error(ErrorCode::kInvalidArgument, "", "factor step must be finite and at most 1");
   if (options.use_seed_point && !(std::isfinite(options.seed_point[0]) && std::isfinite(options.seed_point[1]) &&

@@ -195,6 +195,31 @@ def test_numbers_beyond_their_range_and_non_finite_uvs_are_errors(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_the_limits_are_those_map_and_the_cli_check(tailor_binary, tmp_path):
+    # One table (MappingLimits): map() takes each end and refuses a step beyond it, as the CLI does.
+    mesh = tailor.Mesh(*bumpy_grid(6))
+    flags = {"scale": "--scale", "max_stretch": "--max-stretch", "hop_age": "--hop-age", "crack_rings": "--crack-rings",
+             "relax_iterations": "--relax-iterations"}
+    path = tmp_path / "grid.glb"
+    tailor.save(path, mesh, tailor.map(mesh))
+    assert sorted(tailor.MAP_LIMITS) == sorted(flags)
+    for name, (low, high) in tailor.MAP_LIMITS.items():
+        whole = isinstance(low, int)
+        with warnings.catch_warnings():  # the scale's ends repeat the texture far too little or often
+            warnings.simplefilter("ignore")
+            for value in (low, high):
+                tailor.map(mesh, **{name: value})
+        beyond = [high + 1] + ([low - 1] if low > 0 else []) if whole else [float(np.nextafter(np.float32(high), np.float32(np.inf)))]
+        for value in beyond:
+            with pytest.raises(tailor.Error):
+                tailor.map(mesh, **{name: value})
+            code, _, stderr = run_cli(tailor_binary, "map", path, "-o", tmp_path / "x.glb", flags[name], repr(value))
+            assert code != 0 and "error" in stderr, (name, value, stderr)
+        if not whole and low > 0:
+            with pytest.raises(tailor.Error):
+                tailor.map(mesh, **{name: float(np.nextafter(np.float32(low), np.float32(0)))})
+
+
 def test_seam_faces_that_are_no_array():
     mesh = tailor.load(SPOT)
     for bad in ("abc", [[1, 2], [3, 4]], [0.5, 2.0], object()):
