@@ -927,10 +927,10 @@ class ClientStart:
         return self.client, self.cluster
 
     def close(self):
-        if self.closed:  # once: a start that did not finish is waited for once
-            return
-        self.closed = True
         try:
+            if self.closed:  # a start that did not finish is waited for once; the clean-up runs again
+                return
+            self.closed = True
             # Bounded: a start that cannot finish (a scheduler that does not answer) must not hold
             # the driver's exit (the thread is a daemon).
             self.thread.join(CLIENT_CLOSE_WAIT)
