@@ -236,6 +236,10 @@ expect_error 2 "--threads was given an empty value" -- "$tailor" map "$mesh" -o 
 # '--texture=' ("$TEX" unset after '='): CLI11 would take the next argument for its value.
 expect_error 2 "--texture was given an empty value: give one, or leave the option out \(run 'tailor map --help'\)$" -- "$tailor" map "$mesh" --texture= -o "$tmp/empty.glb"
 expect_error 2 "unknown argument '--bogus=' \(run 'tailor map --help'\)$" -- "$tailor" map "$mesh" -o "$tmp/empty.glb" --bogus=
+# Beside an argument the command does not know, CLI11's own message stands (it names that one).
+"$tailor" map "$mesh" --ouput "$tmp/empty.glb" --texture= 2>&1 | grep -q "empty value" && fail "an empty value was named before an unknown argument" || ok
+# A flag given '--quiet=' is the flag, as CLI11 reads it.
+"$tailor" info "$mesh" --json= > /dev/null || fail "info --json= was refused"
 # Whole numbers are whole: no 0 pixels, no negative seed read as 2^64 - 1.
 expect_error 2 "--max-image-pixels: must be a whole number, at least 1 \(run 'tailor tile --help'\)$" -- "$tailor" tile "$texture" -o "$tmp/t.png" --max-image-pixels 0
 expect_error 2 "--seed: must be a whole number, 0 to 2\^64 - 1" -- "$tailor" tile "$texture" -o "$tmp/t.png" --seed -1

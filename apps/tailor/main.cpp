@@ -33,23 +33,27 @@ std::string option_given_empty(const CLI::App& app) {
 }
 
 // '--texture=' with nothing after '=' ('--texture="$TEX"' with TEX unset): CLI11 reads it as the
-// option without a value and takes the next argument for it ('--texture= -o out.glb' took -o for
-// the texture). Returns such an option of the command named by argv[1], or "".
+// option without a value and takes the next argument for it ('--texture= -o out.glb' takes -o for
+// the texture). Returns the first such option of the command named by argv[1] that takes a value
+// (a flag given '--json=' is the flag), or "" (also when an argument names no option of the
+// command: CLI11 names that one first).
 std::string option_with_empty_equals(CLI::App& app, int argc, char** argv) {
   if (argc < 2) return {};
   const std::string_view command_name = argv[1];
   const std::vector<CLI::App*> commands =
       app.get_subcommands([&](CLI::App* a) { return !a->get_name().empty() && a->get_name() == command_name; });
   if (commands.empty()) return {};
+  std::string found;
   for (int i = 2; i < argc; ++i) {
     const std::string_view argument = argv[i];
     if (argument == "--") break;
-    if (argument.size() > 3 && argument.starts_with("--") && argument.find('=') == argument.size() - 1) {
-      const std::string name(argument.substr(0, argument.size() - 1));
-      if (commands.front()->get_option_no_throw(name) != nullptr) return name;
-    }
+    if (argument.size() < 3 || !argument.starts_with("--")) continue;
+    const std::string name(argument.substr(0, argument.find('=')));
+    const CLI::Option* option = commands.front()->get_option_no_throw(name);
+    if (option == nullptr) return {};
+    if (found.empty() && argument.find('=') == argument.size() - 1 && option->get_expected_min() > 0) found = name;
   }
-  return {};
+  return found;
 }
 
 void say_empty_value(const std::string& option, const std::string& command) {

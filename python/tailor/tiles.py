@@ -618,7 +618,7 @@ def tile_params(args, look, e, density):
         t = math.log2(args.tile_size) if args.tile_size > 0 else float("nan")
         if not (t == math.floor(t)) or t < e:
             raise TilesError(
-                "--tile-size must be the chunk cell (%g) times a power of two, got %g" % (math.ldexp(1.0, e), args.tile_size)
+                "--tile-size must be the chunk cell (%g) times a power of two, got %r" % (math.ldexp(1.0, e), args.tile_size)
             )
         level = int(t) - e
         if level > MAX_TILE_LEVEL:
@@ -927,23 +927,24 @@ class ClientStart:
         return self.client, self.cluster
 
     def close(self):
+        # Bounded, and waited for once: a start that cannot finish (a scheduler that does not
+        # answer) must not hold the driver's exit (the thread is a daemon). A later close closes
+        # what the start made by then.
+        self.thread.join(0 if self.closed else CLIENT_CLOSE_WAIT)
+        self.closed = True
+        started = not self.thread.is_alive()
         try:
-            if self.closed:  # a start that did not finish is waited for once; the clean-up runs again
-                return
-            self.closed = True
-            # Bounded: a start that cannot finish (a scheduler that does not answer) must not hold
-            # the driver's exit (the thread is a daemon).
-            self.thread.join(CLIENT_CLOSE_WAIT)
-            if self.thread.is_alive():
-                return
-            client, cluster, self.client, self.cluster = self.client, self.cluster, None, None
-            if client is not None:
-                client.close()
-            if cluster is not None:
-                cluster.close()
+            if started:
+                client, cluster, self.client, self.cluster = self.client, self.cluster, None, None
+                if client is not None:
+                    client.close()
+                if cluster is not None:
+                    cluster.close()
         finally:
             self.kill_left_workers()
-            if self.space is not None and not self.thread.is_alive():
+            # After the cluster's close only: a nanny still open starts its worker again, which
+            # makes the folder anew.
+            if started and self.space is not None:
                 shutil.rmtree(self.space, ignore_errors=True)
 
     def kill_left_workers(self):
@@ -1373,7 +1374,7 @@ def parse_args(argv):
         if value is not None and not (0 < value < math.inf):
             usage_error("%s must be a positive number, got %s" % (name, value))
     if args.tile_size is not None and math.frexp(args.tile_size)[0] != 0.5:
-        usage_error("--tile-size must be the chunk cell times a power of two (a power of two), got %g" % args.tile_size)
+        usage_error("--tile-size must be the chunk cell times a power of two (a power of two), got %r" % args.tile_size)
     if args.scale is None:
         args.scale = defaults["scale"]
     limits = tailor.MAP_LIMITS  # the library's ranges, as tailor map and tailor.map check them

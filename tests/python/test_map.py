@@ -158,7 +158,7 @@ def test_bad_seam_faces_and_mismatched_save(tmp_path):
     with pytest.raises(tailor.Error, match="path contains a NUL character"):
         tailor.load(str(SPOT) + "\0.xyz")
     # An empty path (texture=os.environ.get("TEX", "") with TEX unset) is refused, not taken for no
-    # texture: map() went on without it.
+    # texture.
     for call in (lambda: tailor.map(mesh, texture=""), lambda: tailor.map(mesh, material=""),
                  lambda: tailor.load(""), lambda: tailor.save("", mesh, tailor.map(mesh))):
         with pytest.raises(tailor.Error, match="expected a path, got an empty one"):

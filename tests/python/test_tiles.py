@@ -1258,7 +1258,8 @@ def test_textures_are_read_as_tailor_map_reads_them(tmp_path):
 
 
 def test_an_empty_value_is_refused_not_taken_for_the_option_left_out(tmp_path):
-    # '--texture "$TEX"' with TEX unset mapped without the texture, and -o '' named the working folder.
+    # '--texture "$TEX"' with TEX unset would map without the texture, and -o '' name the working
+    # folder.
     out = tmp_path / "out"
     for extra, name in ((["--texture", ""], "--texture"), (["--texture="], "--texture"), (["--material", ""], "--material"),
                         (["--scheduler", ""], "--scheduler")):
