@@ -1022,7 +1022,6 @@ def run_locked(args, outdir):
             print("tailor.tiles: warning: %s: not read: %s" % (args.input, mesh.load_report["not_read"]), file=sys.stderr)
         for note in look["notes"]:
             print("tailor.tiles: warning: %s" % note, file=sys.stderr)
-    in_process = args.workers == 0 and not args.scheduler
     tmp = temporary_folder(outdir)
     start = None
     try:  # from the folder's creation on: a failure or a signal closes the cluster and removes it
@@ -1033,12 +1032,12 @@ def run_locked(args, outdir):
             raise TilesError(
                 "%s: cannot write beside it in %s (%s)" % (args.output, outdir.parent, e.strerror)
             ) from None
-        if not in_process and not args.cut_only:
+        if not maps_in_process(args) and not args.cut_only:
             # The cluster starts in a thread of its own once the input's header is read (a streamed
             # PLY) or the mesh loaded: its worker processes start and import tailor while this
             # process surveys and cuts the mesh.
             start = ClientStart(args)
-        summary = run_started(args, outdir, t0, layout, mesh, look, start)
+        summary = run_started(args, outdir, tmp, t0, layout, mesh, look, start)
     except BaseException:
         # The cluster first: a worker still running a task would write into the folder after it is
         # removed (a stray temporary folder beside OUTDIR until the next run). The folder goes even
@@ -1062,8 +1061,14 @@ def temporary_folder(outdir):
     return outdir.parent / (".%s.tmp-%d" % (outdir.name, os.getpid()))
 
 
-def run_started(args, outdir, t0, layout, mesh, look, start):
-    in_process = args.workers == 0 and not args.scheduler
+def maps_in_process(args):
+    """--workers 0 without --scheduler: the tiles are mapped in this process, without Dask."""
+    return args.workers == 0 and not args.scheduler
+
+
+def run_started(args, outdir, tmp, t0, layout, mesh, look, start):
+    """run_locked's work once the temporary folder tmp is made and the cluster (start) starting."""
+    in_process = maps_in_process(args)
     if mesh is not None:
         plan, params, tiles = plan_tiles(mesh, args, look)
         chunk_count, cell_size = int(plan["cells"].shape[0]), plan["cell_size"]
@@ -1081,7 +1086,6 @@ def run_started(args, outdir, t0, layout, mesh, look, start):
     old = previous_output(outdir, params)
     t_plan = time.monotonic()
 
-    tmp = temporary_folder(outdir)
     # The images every tile names, once beside tileset.json (the previous run's file linked
     # when it has the same bytes, so that it keeps its time).
     for name, data in look["images"].values():
