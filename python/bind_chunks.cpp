@@ -8,6 +8,9 @@ namespace tailor::python {
 namespace {
 
 ChunkCell cell_of(const py::sequence& cell) {
+  // A string is a sequence too ("abc": three letters, then "got 'a'"): refused whole.
+  if (py::isinstance<py::str>(cell))
+    raise_error("cell must be three whole numbers (x, y, z), got " + py::repr(cell).cast<std::string>());
   if (py::len(cell) != 3) raise_error("cell must be three whole numbers (x, y, z), got " + sequence_text(cell));
   ChunkCell c;
   for (size_t k = 0; k < 3; ++k) c[k] = static_cast<int32_t>(whole_number(cell[k], "cell", INT32_MIN, INT32_MAX));

@@ -137,7 +137,7 @@ const std::string& map_docstring() {
         if (name == "threshold_px") name = "threshold";
         if (name == "smooth_passes") name = "smooth";
         if (name == "shorten_seams" || name == "close_cracks") name += "=False";
-        doc += name + " (" + std::string(d.flag) + "): " + std::string(d.help) + "\n";
+        doc += name + " (" + std::string(d.flag) + "): " + help_with_range(d) + "\n";
       }
     };
     add(kMappingOptionDocs);
@@ -292,7 +292,6 @@ void bind_map(py::module_& m) {
           options.chunks.cell_exponent = e;
         }
         set_chunk_split(chunk_split, options.chunks.split_above);
-        if (smooth > 1000) raise_error("--smooth: value " + std::to_string(smooth) + " not in range [0 - 1000]");
         options.orientation.smooth_passes = smooth;
         if (Status s = check_texture_size(texture_size); !s) raise_status(s);
         if (Status s = check_map_options(options); !s) raise_status(s);
@@ -452,7 +451,7 @@ void bind_map(py::module_& m) {
   defaults["max_stretch"] = md.max_stretch;
   defaults["crack_rings"] = md.crack_rings;
   m.attr("MAP_DEFAULTS") = defaults;
-  // Their ranges (MappingLimits), (lowest, highest), which map() and tailor.tiles check against.
+  // Their ranges (MappingLimits, OrientationLimits), (lowest, highest), which map() and tailor.tiles check against.
   using L = MappingLimits;
   py::dict limits;
   limits["scale"] = py::make_tuple(L::min_scale, L::max_scale);
@@ -460,7 +459,17 @@ void bind_map(py::module_& m) {
   limits["hop_age"] = py::make_tuple(0.f, L::max_hop_age);
   limits["crack_rings"] = py::make_tuple(L::min_crack_rings, L::max_crack_rings);
   limits["relax_iterations"] = py::make_tuple(0u, L::max_relax_iterations);
+  limits["smooth"] = py::make_tuple(0u, OrientationLimits::max_smooth_passes);
   m.attr("MAP_LIMITS") = limits;
+  m.def(
+      "_range_error",
+      [](const std::string& flag, double value) {
+        const Status s = check_option_range(flag, value);
+        return s ? std::string() : s.message();
+      },
+      py::arg("flag"), py::arg("value"),
+      "_range_error(flag, value) -> str\n\nThe message tailor map gives for `value` outside the range of `flag` "
+      "(--max-stretch, --crack-rings...), or '' (for python3 -m tailor.tiles).");
 
   m.def(
       "auto_field_following",

@@ -74,7 +74,7 @@ TEST(Options, MapHelpShowsTheTablesAndTheStructsDefaults) {
   EXPECT_TRUE(shows(help, "--max-stretch FLOAT", m.max_stretch));
   EXPECT_TRUE(shows(help, "--hop-age FLOAT", m.hop_age));
   EXPECT_TRUE(shows(help, "--min-patch-faces UINT", m.min_patch_faces));
-  EXPECT_TRUE(shows(help, "]", m.crack_rings));  // after the range check
+  EXPECT_TRUE(shows(help, "--crack-rings UINT", m.crack_rings));
   EXPECT_TRUE(shows(help, "--threshold FLOAT", m.threshold_px));
   EXPECT_TRUE(shows(help, "--symmetry UINT:{1,4}", m.symmetry));
   EXPECT_TRUE(shows(help, "--smooth UINT", OrientationOptions{}.smooth_passes));

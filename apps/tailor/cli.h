@@ -7,13 +7,18 @@
 #include <atomic>
 #include <charconv>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <functional>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
+#include "tailor/mapping.h"
 #include "tailor/option_doc.h"
 #include "tailor/status.h"
 
@@ -92,10 +97,30 @@ Status check_outputs(const std::vector<OutputPath>& outputs, const std::vector<s
 
 //! Adds the option `doc` names (flag and help from the library's table, tailor/option_doc.h), bound
 //! to `field`; the default shown is the field's value now: its options struct's default, or for a
-//! text option, that default's name.
+//! text option, that default's name. A number with a range (MappingLimits, OrientationLimits) shows
+//! it in the help; check_map_options refuses a value outside it after parsing, in the words the
+//! Python module uses too, and a whole number the field cannot even hold (-1) is refused here with
+//! the range.
 template <class T>
 CLI::Option* add_documented(CLI::App* app, const OptionDoc& doc, T& field) {
-  return app->add_option(std::string(doc.flag), field, std::string(doc.help))->capture_default_str();
+  CLI::Option* option = app->add_option(std::string(doc.flag), field, help_with_range(doc))->capture_default_str();
+  if constexpr (std::is_integral_v<T>) {
+    option->check(CLI::Validator(
+        [flag = std::string(doc.flag)](std::string& text) -> std::string {
+          char* end = nullptr;
+          const double value = std::strtod(text.c_str(), &end);
+          if (text.empty() || *end != '\0') return "";  // not a number: CLI11's conversion names it
+          const bool fits = value >= static_cast<double>(std::numeric_limits<T>::min()) &&
+                            value <= static_cast<double>(std::numeric_limits<T>::max());
+          const Status s = check_option_range(flag, value);
+          if (fits || s) return "";
+          // CLI11 puts "--flag: " before it; the value as given, not as a double prints.
+          const std::string what = s.message();
+          return what.substr(flag.size() + 1, what.rfind(", got ") - flag.size() - 1) + ", got " + text;
+        },
+        ""));
+  }
+  return option;
 }
 
 //! Whether `text` is a whole number that fits 64 bits unsigned (CLI11 reads "-1" into one as

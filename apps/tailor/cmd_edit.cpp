@@ -226,7 +226,6 @@ void register_edit(CLI::App& app, Runner& run) {
   cmd->add_option("--web-root", opt->web_root, "folder holding the pages (edit.html, node_modules)");
   auto* group = cmd->add_option_group("Mapping (as 'tailor map'; the page changes them too)");
   const MappingOptionHandles handles = add_mapping_options(group, opt->mapping_args, opt->options, false);
-  handles.smooth->check(CLI::Range(0u, 1000u));  // rejected at parsing here (in `tailor map`, by the orientation)
   cmd->add_option("--threads", mapping.threads,
                   "Threads for the chunk plan, the orientation, the crack closing and the metrics (0 = one per "
                   "core, up to 8); "

@@ -81,7 +81,8 @@ std::string apply_options(const json& j, const EditContext& context, const std::
         return "options.axis must be pca, skeleton, auto, x, y, z or \"X,Y,Z\", got '" + text + "'";
       }
     } else if (key == "smooth_passes") {
-      if (!as_uint(v, 0, 1000, o.smooth_passes)) return field_name(key) + " must be an integer 0..1000";
+      if (!as_uint(v, 0, OrientationLimits::max_smooth_passes, o.smooth_passes))
+        return field_name(key) + " must be an integer 0.." + std::to_string(OrientationLimits::max_smooth_passes);
     } else if (key == "mode") {
       if (!v.is_string() || !mapping_mode_from_name(v.get<std::string>(), m.mode))
         return "options.mode must be \"patches\" or \"thesis\"";

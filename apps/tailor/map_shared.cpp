@@ -85,10 +85,8 @@ MappingOptionHandles add_mapping_options(CLI::Option_group* group, MappingArgs& 
   add_documented(group, option_doc(kMappingOptionDocs, "hop_age"), mapping.hop_age);
   add_off_switch(group, option_doc(kMappingOptionDocs, "shorten_seams"), mapping.shorten_seams);
   add_off_switch(group, option_doc(kMappingOptionDocs, "close_cracks"), mapping.close_cracks);
-  handles.crack_rings = add_documented(group, option_doc(kMappingOptionDocs, "crack_rings"), mapping.crack_rings)
-                            ->check(CLI::Range(MappingLimits::min_crack_rings, MappingLimits::max_crack_rings));
-  add_documented(group, option_doc(kMappingOptionDocs, "relax_iterations"), mapping.relax_iterations)
-      ->check(CLI::Range(0u, MappingLimits::max_relax_iterations));
+  handles.crack_rings = add_documented(group, option_doc(kMappingOptionDocs, "crack_rings"), mapping.crack_rings);
+  add_documented(group, option_doc(kMappingOptionDocs, "relax_iterations"), mapping.relax_iterations);
   for (const OptionDoc* doc : kPatchesOnlyOptions)
     handles.patches_only.push_back(group->get_option(std::string(doc->flag)));
   handles.threshold = add_documented(group, option_doc(kMappingOptionDocs, "threshold_px"), mapping.threshold_px);

@@ -64,7 +64,7 @@ enum class MappingMode {
 // to cancel (map_texture then returns kCancelled and leaves the atlas empty).
 
 //! The ranges of MappingOptions' numbers, one table for every check of them: map_texture's own,
-//! check_map_options (the CLI's and the Python module's words), the CLI's flags, `tailor edit`'s
+//! check_map_options (the CLI's and the Python module's words), the CLI's help, `tailor edit`'s
 //! API and python3 -m tailor.tiles (tailor.MAP_LIMITS).
 struct MappingLimits {
   static constexpr float min_scale = 1e-3f, max_scale = 1e7f;  //!< pixels per unit
@@ -76,6 +76,15 @@ struct MappingLimits {
 
 //! A limit as messages and docs write it: 0.001, 4, 1e7 (printf's %g, its exponent without "+0").
 TAILOR_API std::string limit_text(double value);
+
+//! `doc`'s help as the CLI and the Python module show it: the table's text, and for an option
+//! MappingLimits or OrientationLimits bounds, its range from there (" (0.01 to 4)").
+TAILOR_API std::string help_with_range(const OptionDoc& doc);
+
+//! Fails with kInvalidArgument, check_map_options' message ("--max-stretch must be between 0.01
+//! and 4, got 5"), when `value` is outside the range of `flag`, one of the options
+//! MappingLimits or OrientationLimits bound (NaN is outside); ok for any other flag.
+TAILOR_API Status check_option_range(std::string_view flag, double value);
 
 struct MappingOptions {
   MappingMode mode = MappingMode::kPatches;  //!< algorithm (CLI --mode patches|thesis)
@@ -156,7 +165,7 @@ inline constexpr OptionDoc kMappingOptionDocs[] = {
     {"min_patch_faces", "--min-patch-faces",
      "patches mode: smaller patches are absorbed into a neighbour (0 keeps all)"},
     {"hop_age", "--hop-age",
-     "patches mode: growth-order age per face of path from the seed, radians (0..1); keeps the order local so "
+     "patches mode: growth-order age per face of path from the seed, radians; keeps the order local so "
      "removing part of a mesh changes little elsewhere; 0 = the thesis's global counter"},
     {"shorten_seams", "--no-seam-shortening",
      "patches mode: seam shortening re-places faces along the seams after the growth where that shortens them; "
@@ -165,10 +174,10 @@ inline constexpr OptionDoc kMappingOptionDocs[] = {
      "patches mode: crack closing zips the cracks (cuts inside a patch) shut, last; off, the mapping is 3-10x "
      "faster with about twice the seam length"},
     {"crack_rings", "--crack-rings",
-     "patches mode: effort of the crack closing, the largest region (rings of faces) a zip may relax (2..64); "
-     "more closes wider cracks and takes longer. Fewest seams: --field-following 0 --crack-rings 32"},
+     "patches mode: effort of the crack closing, the largest region (rings of faces) a zip may relax; more "
+     "closes wider cracks and takes longer. Fewest seams: --field-following 0 --crack-rings 32"},
     {"relax_iterations", "--relax-iterations",
-     "patches mode: last, iterations of a local/global ARAP relaxation of the UVs (0 = off, at most 1000): the "
+     "patches mode: last, iterations of a local/global ARAP relaxation of the UVs (0 = off): the "
      "median angle distortion of the shared meshes falls from 6.7 to 1.8 degrees for ~20% more time; invisible "
      "seams and the per-face bound are kept"},
     {"threshold_px", "--threshold", "thesis mode: initial error threshold in pixels"},
@@ -286,9 +295,10 @@ TAILOR_API Status measure_texture_map(const Mesh& mesh, const Topology& topology
                                       TextureMap& map);
 
 //! The checks `tailor map` makes on its options before any work, with its messages (the Python
-//! module raises the same): symmetry 4 only in the patches mode, scale in [1e-3, 1e7] pixels per
-//! unit (below, every UV rounds to the same float; above, faces span millions of pixels), hop_age
-//! in [0, 1]. Fails with kInvalidArgument. map_texture's own checks still apply. O(1).
+//! module raises the same): symmetry 4 only in the patches mode, and every number MappingLimits
+//! and OrientationLimits bound within its range (a scale below 1e-3 rounds every UV to the same
+//! float; above 1e7 faces span millions of pixels), each message naming the flag. Fails with
+//! kInvalidArgument. map_texture's own checks still apply. O(1).
 TAILOR_API Status check_map_options(const MapTextureOptions& options);
 
 //! The options only the patches mode reads, as their kMappingOptionDocs entries: `tailor map`, the

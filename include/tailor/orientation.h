@@ -53,12 +53,18 @@ struct OrientationStroke {
   float radius = 0.f;         //!< reach of the stroke, mesh units (> 0)
 };
 
+//! The range of OrientationOptions' passes, read by compute_frames and every check of it (as
+//! MappingLimits, tailor/mapping.h).
+struct OrientationLimits {
+  static constexpr uint32_t max_smooth_passes = 1000;
+};
+
 struct OrientationOptions {
   AxisSource axis = AxisSource::kPca;              //!< source of the global axis projected on each face
   std::array<float, 3> user_axis{0.f, 1.f, 0.f};   //!< kUser: axis, any non-zero length (normalised inside)
   std::array<float, 3> user_axis2{0.f, 0.f, 0.f};  //!< kUser: fallback axis where user_axis is ~normal
                                                    //!< to a face; zero = pick one perpendicular to user_axis
-  uint32_t smooth_passes = 0;                      //!< passes of neighbour averaging of o (0 = off, 0..1000)
+  uint32_t smooth_passes = 0;                      //!< passes of neighbour averaging of o (0 = off; OrientationLimits)
   float degenerate_cos = 0.995f;                   //!< |axis . n| above this counts as "axis normal to face"
                                                    //!< and the second axis is projected instead (0.5..1)
   // Normalisation into the unit cube. Leave fixed_unit_scale at 0 to derive it from the mesh's

@@ -1381,18 +1381,21 @@ def parse_args(argv):
         usage_error("--tile-size must be the chunk cell times a power of two (a power of two), got %r" % args.tile_size)
     if args.scale is None:
         args.scale = defaults["scale"]
-    limits = tailor.MAP_LIMITS  # the library's ranges, as tailor map and tailor.map check them
-    low, high = limits["max_stretch"]
-    if not (np.float32(low) <= np.float32(args.max_stretch) <= np.float32(high)):
-        usage_error("--max-stretch must be in %g..%g, got %s" % (low, high, args.max_stretch))
+    # The library's ranges and words, as tailor map and tailor.map check them (the value as the
+    # mapping's float holds it).
+    for flag, value in (
+        ("--scale", float(np.float32(args.scale))),
+        ("--max-stretch", float(np.float32(args.max_stretch))),
+        ("--crack-rings", args.crack_rings),
+    ):
+        message = tailor._range_error(flag, value) if value is not None else ""
+        if message:
+            usage_error(message)
     if not 1 <= args.texture_size <= 65536:  # as tailor map and tailor eval take it
         usage_error("--texture-size must be in 1..65536, got %d" % args.texture_size)
     if args.chunk_cell is not None and not -60 <= args.chunk_cell <= 60:  # the library's (ChunkOptions)
         usage_error("--chunk-cell must be a whole number in -60..60 (the cell side is 2^N world units), got %d"
                     % args.chunk_cell)
-    low, high = limits["crack_rings"]
-    if args.crack_rings is not None and not low <= args.crack_rings <= high:
-        usage_error("--crack-rings must be in %d..%d, got %d" % (low, high, args.crack_rings))
     if args.field_following != "auto":
         try:
             value = float(args.field_following)

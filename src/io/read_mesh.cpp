@@ -452,7 +452,9 @@ Status finalize_mesh(const std::string& name, Mesh& mesh, LoadReport& report) {
   if (non_finite) {
     for (size_t i = 0; i < mesh.positions.size(); ++i) {
       if (!std::isfinite(pos[i])) {
-        return Status::error(ErrorCode::kInvalidMesh, name, "non-finite vertex coordinate",
+        // A text file's 1e39 reads as infinity: say so, it is no NaN.
+        return Status::error(ErrorCode::kInvalidMesh, name,
+                             "vertex coordinate not finite or beyond the range of 32-bit floats (3.4e38)",
                              "vertex " + std::to_string(i / 3));
       }
     }

@@ -46,12 +46,13 @@ Status strokes_from_json(const nlohmann::json& array, const std::string& name, s
       float x[3];
       if (!p.is_array() || p.size() != 3 || !finite_float(p[0], x[0]) || !finite_float(p[1], x[1]) ||
           !finite_float(p[2], x[2]))
-        return fail("a point must be three finite numbers [x, y, z]", where + ".points[" + std::to_string(k) + "]");
+        return fail("a point must be three finite numbers [x, y, z] within 32-bit floats (3.4e38)",
+                    where + ".points[" + std::to_string(k) + "]");
       stroke.points.insert(stroke.points.end(), x, x + 3);
     }
     const auto radius = s.find("radius");
     if (radius == s.end() || !finite_float(*radius, stroke.radius) || !(radius->get<double>() > 0))
-      return fail("\"radius\" must be a finite number > 0", where + ".radius");
+      return fail("\"radius\" must be a number > 0 within 32-bit floats (3.4e38)", where + ".radius");
     if (!(stroke.radius >= std::numeric_limits<float>::min()))  // 1e-300 would be 0 as a float
       return fail("\"radius\" must be at least 1.2e-38 (the smallest normal 32-bit float)", where + ".radius");
     out.push_back(std::move(stroke));

@@ -73,7 +73,8 @@ MapTextureOptions chunk_map_options(const MapTextureOptions& options, const std:
 
 // A chunk is mapped in its cell's frame at texels_per_unit * size pixels per cell side, which the
 // mapping takes within its scale's range (MappingLimits). Out of range says what a user can change;
-// the cell's exponent is -60..60, so a mesh far from unit scale may need no chunks at all.
+// the cell's exponent is -60..60, so a mesh far from unit scale may need no chunks at all (map_chunks
+// says so: a ChunkedMapper or a tile has no other way).
 Status check_chunk_scale(double texels_per_unit, double size) {
   const double chunk_scale = texels_per_unit * size;
   if (chunk_scale >= MappingLimits::min_scale && chunk_scale <= MappingLimits::max_scale) return Status::ok();
@@ -83,7 +84,7 @@ Status check_chunk_scale(double texels_per_unit, double size) {
   return Status::error(ErrorCode::kInvalidArgument, "",
                        std::string("the texel density gives ") + figures + ", outside " +
                            limit_text(MappingLimits::min_scale) + " to " + limit_text(MappingLimits::max_scale) +
-                           ": give another chunk cell (2^-60 to 2^60) or texel density, or map without chunks");
+                           ": give another chunk cell (2^-60 to 2^60) or texel density");
 }
 
 Status map_chunk(const MapTextureOptions& options, const std::array<double, 3>& origin, double size,
@@ -212,7 +213,8 @@ Status map_chunks(const Mesh& mesh, const MapTextureOptions& options, TextureMap
   ChunkPlan plan;
   TAILOR_RETURN_IF_ERROR(plan_chunks(mesh, options.chunks, plan, options.mapping.threads));
   const double texels_per_unit = chunk_texels_per_unit(mesh, options);
-  TAILOR_RETURN_IF_ERROR(check_chunk_scale(texels_per_unit, plan.cell_size));
+  if (Status s = check_chunk_scale(texels_per_unit, plan.cell_size); !s)
+    return Status::error(s.code(), s.file(), s.what() + ", or map without chunks (chunks off)", s.where());
 
   const size_t chunks = plan.chunk_count();
   const size_t cores = std::max<size_t>(std::thread::hardware_concurrency(), 1);

@@ -1,6 +1,7 @@
 // The option checks and the texture-size settings `tailor map` applies before map_texture, shared
 // with the Python module so both refuse the same options with the same message.
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <string_view>
 
@@ -9,6 +10,32 @@
 namespace tailor {
 namespace {
 Status usage_error(const std::string& what) { return Status::error(ErrorCode::kInvalidArgument, "", what); }
+
+// An option MappingLimits or OrientationLimits bounds: its flag, its range and the range's unit.
+struct LimitedOption {
+  std::string_view flag;
+  double low, high;
+  std::string_view unit;
+};
+using L = MappingLimits;
+constexpr LimitedOption kLimitedOptions[] = {
+    {"--scale", L::min_scale, L::max_scale, " pixels per unit"},
+    {"--max-stretch", L::min_max_stretch, L::max_max_stretch, ""},
+    {"--hop-age", 0., L::max_hop_age, " radians"},
+    {"--crack-rings", L::min_crack_rings, L::max_crack_rings, " rings"},
+    {"--relax-iterations", 0., L::max_relax_iterations, " iterations"},
+    {"--smooth", 0., OrientationLimits::max_smooth_passes, " passes"},
+};
+
+// A value as a message shows it: as a limit is written when that reads back the same, else with
+// the digits a float needs (4.0000005 is not 4).
+std::string value_text(double value) {
+  std::string text = limit_text(value);
+  if (std::strtod(text.c_str(), nullptr) == value || value != value) return text;
+  char digits[32];
+  std::snprintf(digits, sizeof digits, "%.9g", value);
+  return digits;
+}
 }  // namespace
 
 std::string limit_text(double value) {
@@ -23,16 +50,35 @@ std::string limit_text(double value) {
   return s;
 }
 
+std::string help_with_range(const OptionDoc& doc) {
+  std::string help(doc.help);
+  for (const LimitedOption& option : kLimitedOptions)
+    if (option.flag == doc.flag)
+      help += " (" + limit_text(option.low) + " to " + limit_text(option.high) + std::string(option.unit) + ")";
+  return help;
+}
+
+Status check_option_range(std::string_view flag, double value) {
+  for (const LimitedOption& option : kLimitedOptions) {
+    if (option.flag != flag || (value >= option.low && value <= option.high)) continue;  // NaN is outside
+    return usage_error(std::string(flag) + " must be between " + limit_text(option.low) + " and " +
+                       limit_text(option.high) + std::string(option.unit) + ", got " + value_text(value));
+  }
+  return Status::ok();
+}
+
 Status check_map_options(const MapTextureOptions& options) {
-  using L = MappingLimits;
   const MappingOptions& mapping = options.mapping;
   if (mapping.symmetry == 4 && mapping.mode != MappingMode::kPatches)
     return usage_error("--symmetry 4 needs --mode patches");
-  if (!(mapping.scale >= L::min_scale && mapping.scale <= L::max_scale))
-    return usage_error("--scale must be between " + limit_text(L::min_scale) + " and " + limit_text(L::max_scale) +
-                       " pixels per unit");
-  if (!(mapping.hop_age >= 0.f && mapping.hop_age <= L::max_hop_age))
-    return usage_error("--hop-age must be between 0 and " + limit_text(L::max_hop_age) + " radians");
+  // Every bounded number, before any work (map_texture checks them again, for callers that skip this).
+  for (const auto& [flag, value] : {std::pair<std::string_view, double>{"--scale", mapping.scale},
+                                    {"--max-stretch", mapping.max_stretch},
+                                    {"--hop-age", mapping.hop_age},
+                                    {"--crack-rings", mapping.crack_rings},
+                                    {"--relax-iterations", mapping.relax_iterations},
+                                    {"--smooth", options.orientation.smooth_passes}})
+    if (Status s = check_option_range(flag, value); !s) return s;
   if (options.chunks.split_above != 0 && options.chunks.split_above < 64)
     return usage_error("--chunk-split must be 0 (never cut) or at least 64 faces");
   return Status::ok();

@@ -193,8 +193,9 @@ Status compute_orientation_setup(const Mesh& mesh, const Topology& topology, con
   if (face_count == 0) return Status::error(ErrorCode::kInvalidMesh, "", "mesh has no face");
   if (topology.opposite.size() != 3 * face_count)
     return Status::error(ErrorCode::kInvalidMesh, "", "topology does not match the mesh");
-  if (options.smooth_passes > 1000)
-    return Status::error(ErrorCode::kInvalidArgument, "", "smoothing passes must be at most 1000");
+  if (options.smooth_passes > OrientationLimits::max_smooth_passes)
+    return Status::error(ErrorCode::kInvalidArgument, "",
+                         "smoothing passes must be at most " + std::to_string(OrientationLimits::max_smooth_passes));
   if (!(options.degenerate_cos >= 0.5f && options.degenerate_cos <= 1.f))
     return Status::error(ErrorCode::kInvalidArgument, "", "degenerate_cos must be in [0.5, 1]");
   if (!(options.anchor_period[0] >= 0.0) || !(options.anchor_period[1] >= 0.0) ||

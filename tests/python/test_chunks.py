@@ -59,6 +59,9 @@ def test_bad_arguments_are_tailor_errors_naming_them():
     for call, message in (
         (lambda: tailor.ChunkedMapper(-4, 4096.0).chunk((2**31, 0, 0)), r"^cell must be a whole number in"),
         (lambda: tailor.ChunkedMapper(-4, 4096.0).chunk((0.5, 0, 0)), r"^cell must be a whole number in .*got 0\.5$"),
+        # A mapper has chunks or nothing: no advice to map without them.
+        (lambda: tailor.ChunkedMapper(40, 4096.0), r"^the texel density gives .* chunk cell \(2\^-60 to 2\^60\) or texel density$"),
+        (lambda: tailor.ChunkedMapper(-4, 4096.0).chunk("abc"), r"^cell must be three whole numbers \(x, y, z\), got 'abc'$"),
         (lambda: tailor.ChunkedMapper(-4, 4096.0, texture_size=(1.5, 2)), r"^texture_size's width must be a whole"),
         (lambda: tailor.ChunkedMapper(-4, 4096.0, crack_rings=10**12), r"^crack_rings must be a whole number in 2"),
         (lambda: tailor.plan_chunks(mesh, 2**40), r"^chunk_cell must be a whole number in -60\.\.60"),

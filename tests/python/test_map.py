@@ -1,5 +1,6 @@
 """tailor.map, save and evaluate: identity with the tailor command, options, errors."""
 import json
+import re
 import warnings
 
 import numpy as np
@@ -123,6 +124,9 @@ def test_evaluate_matches_the_map_and_the_cli(tmp_path, tailor_binary):
     [
         (dict(scale=0), ["--scale", "0"]),
         (dict(hop_age=2.0), ["--hop-age", "2"]),
+        (dict(max_stretch=5.0), ["--max-stretch", "5"]),
+        (dict(relax_iterations=1001), ["--relax-iterations", "1001"]),
+        (dict(smooth=1001), ["--smooth", "1001"]),
         (dict(axis="w"), ["--axis", "w"]),
         (dict(mode="thesis", symmetry=4), ["--mode", "thesis", "--symmetry", "4"]),
         (dict(mode="thesis", max_stretch=3.0), ["--mode", "thesis", "--max-stretch", "3"]),
@@ -196,13 +200,25 @@ def test_numbers_beyond_their_range_and_non_finite_uvs_are_errors(tmp_path):
 
 
 def test_the_limits_are_those_map_and_the_cli_check(tailor_binary, tmp_path):
-    # One table (MappingLimits): map() takes each end and refuses a step beyond it, as the CLI does.
+    # One table (MappingLimits, OrientationLimits): map() takes each end and refuses a step beyond
+    # it, as the CLI does; the CLI's help shows the range, takes its ends as the help writes them
+    # and refuses a step beyond before it reads the mesh, naming the flag.
     mesh = tailor.Mesh(*bumpy_grid(6))
     flags = {"scale": "--scale", "max_stretch": "--max-stretch", "hop_age": "--hop-age", "crack_rings": "--crack-rings",
-             "relax_iterations": "--relax-iterations"}
+             "relax_iterations": "--relax-iterations", "smooth": "--smooth"}
     path = tmp_path / "grid.glb"
     tailor.save(path, mesh, tailor.map(mesh))
     assert sorted(tailor.MAP_LIMITS) == sorted(flags)
+    _, help_text, _ = run_cli(tailor_binary, "map", "--help")
+    for name, flag in flags.items():
+        entry = help_text[help_text.index("  " + flag + " "):]
+        entry = entry[: entry.index("\n    --")]
+        low_text, high_text = re.findall(r"\((\S+) to (\S+?)[ )]", entry)[-1]
+        assert (float(low_text), float(high_text)) == pytest.approx(tailor.MAP_LIMITS[name], rel=1e-6), (flag, entry)
+        assert name in tailor.map.__doc__ and f"({low_text} to {high_text}" in tailor.map.__doc__, name
+        for text in (low_text, high_text):
+            code, _, stderr = run_cli(tailor_binary, "map", path, "-o", tmp_path / "x.glb", flag, text)
+            assert code == 0, (flag, text, stderr)
     for name, (low, high) in tailor.MAP_LIMITS.items():
         whole = isinstance(low, int)
         with warnings.catch_warnings():  # the scale's ends repeat the texture far too little or often
@@ -213,8 +229,9 @@ def test_the_limits_are_those_map_and_the_cli_check(tailor_binary, tmp_path):
         for value in beyond:
             with pytest.raises(tailor.Error):
                 tailor.map(mesh, **{name: value})
-            code, _, stderr = run_cli(tailor_binary, "map", path, "-o", tmp_path / "x.glb", flags[name], repr(value))
-            assert code != 0 and "error" in stderr, (name, value, stderr)
+            code, _, stderr = run_cli(tailor_binary, "map", tmp_path / "missing.glb", "-o", tmp_path / "x.glb",
+                                      flags[name], repr(value))
+            assert code == 2 and f"{flags[name]} must be between" in stderr, (name, value, stderr)
         if not whole and low > 0:
             with pytest.raises(tailor.Error):
                 tailor.map(mesh, **{name: float(np.nextafter(np.float32(low), np.float32(0)))})

@@ -174,7 +174,7 @@ GOOD_FACES = np.array([[0, 1, 2]], np.int32)
         (GOOD_POSITIONS.astype(np.int32), GOOD_FACES, "positions must be float32 or float64"),
         (GOOD_POSITIONS, GOOD_FACES.astype(np.float32), "faces must be int32, int64, uint32 or uint64"),
         (np.array([[0, 0, 0], [1, 0, 0], [0, np.nan, 0]]), GOOD_FACES,
-         r"^tailor.Mesh: non-finite vertex coordinate \(vertex 2\)$"),
+         r"^tailor.Mesh: vertex coordinate not finite or beyond the range of 32-bit floats \(3.4e38\) \(vertex 2\)$"),
         (np.array([[0, 0, 0], [1e39, 0, 0], [0, 1, 0]]), GOOD_FACES,
          r"^tailor.Mesh: vertex coordinate 1e\+39 beyond the range of 32-bit floats \(vertex 1\)$"),
         (GOOD_POSITIONS, np.array([[0, 1, 3]]),

@@ -1276,7 +1276,8 @@ def test_options_out_of_range_are_usage_errors(tmp_path):
     out = tmp_path / "out"
     for option, value, message in (
         ("--chunk-cell", 61, "--chunk-cell must be a whole number in -60..60"),
-        ("--crack-rings", 1, "--crack-rings must be in 2..64"),
+        ("--crack-rings", 1, "--crack-rings must be between 2 and 64 rings, got 1"),
+        ("--max-stretch", 5, "--max-stretch must be between 0.01 and 4, got 5"),
         ("--field-following", 2, "--field-following must be auto or a number in [0, 1]"),
     ):
         code, _, stderr = run_tiles(HORSE, "-o", out, "--workers", 0, option, value)
