@@ -289,7 +289,10 @@ def _check_finite(body, block):
         p = body.positions(first, block)
         bad = ~np.isfinite(p).all(axis=1)
         if bad.any():
-            raise StreamError("%s: vertex coordinate not finite or beyond the range of 32-bit floats (3.4e38) at vertex %d" % (body.layout.path, first + int(np.flatnonzero(bad)[0])))
+            raise StreamError(
+                "%s: vertex coordinate not finite or beyond the range of 32-bit floats (3.4e38) at vertex %d"
+                % (body.layout.path, first + int(np.flatnonzero(bad)[0]))
+            )
         if not body.keeps_vertices():  # every vertex read so far (see blocks)
             body.release(body.layout.vertex_offset, (first + p.shape[0]) * body.layout.vertex_dtype.itemsize)
 
