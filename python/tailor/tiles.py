@@ -1005,6 +1005,16 @@ def run(args):
         unlock_outdir(lock)
 
 
+def warn_dropped(args, degenerate, duplicate):
+    """tailor map's warnings of the faces the load drops (a streamed input learns the duplicates
+    only from its tiles, after the map)."""
+    if args.quiet:
+        return
+    for count, kind in ((degenerate, "degenerate"), (duplicate, "duplicate")):
+        if count:
+            print("tailor.tiles: warning: %s: dropped %d %s faces" % (args.input, count, kind), file=sys.stderr)
+
+
 def run_locked(args, outdir):
     t0 = time.monotonic()
     # A binary little-endian PLY of triangles is partitioned by streaming it (tiles_stream); any
@@ -1020,6 +1030,8 @@ def run_locked(args, outdir):
     if not args.quiet:
         if mesh is not None and mesh.load_report["not_read"]:  # as tailor map warns of the same file
             print("tailor.tiles: warning: %s: not read: %s" % (args.input, mesh.load_report["not_read"]), file=sys.stderr)
+        if mesh is not None:
+            warn_dropped(args, mesh.load_report["degenerate_faces"], mesh.load_report["duplicate_faces"])
         for note in look["notes"]:
             print("tailor.tiles: warning: %s" % note, file=sys.stderr)
     tmp = temporary_folder(outdir)
@@ -1075,6 +1087,7 @@ def run_started(args, outdir, tmp, t0, layout, mesh, look, start):
         far = tailor._tailor._far_from_origin_warning(mesh)
     else:
         survey = tiles_stream.survey(layout, args.chunk_cell, args.block_faces)
+        warn_dropped(args, layout.face_count - survey["faces"], 0)  # those that repeat a vertex
         largest = float(max(np.abs(survey["lo"]).max(), np.abs(survey["hi"]).max()))
         far = tailor._tailor._far_from_origin_warning(largest, survey["about_median"])
         params = tile_params(
@@ -1131,6 +1144,7 @@ def run_started(args, outdir, tmp, t0, layout, mesh, look, start):
             else:
                 jobs.append(({"name": name, "tile": list(tile), "files": files[tile]}, None, None, old.get(name)))
         sizes = [counts[tuple(job[0]["tile"])] for job in jobs]
+        partitioned = sum(counts.values())
     levels = parent_levels([job[0]["tile"] for job in jobs]) if args.lod else []
     t_cut = time.monotonic()
     if args.cut_only:  # tests: the driver's work without the tasks; nothing is written
@@ -1236,6 +1250,8 @@ def run_started(args, outdir, tmp, t0, layout, mesh, look, start):
     if aside:
         shutil.rmtree(aside, ignore_errors=True)
     written = sum(1 for r in records if r["written"])
+    if layout is not None:  # the tiles' tasks dropped the faces that repeat another's vertices
+        warn_dropped(args, 0, partitioned - sum(int(r["faces"]) for r in records if r["level"] == 0))
     summary = {
         "tiles": len(records),
         "leaves": len(sizes),

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import tailor
-from conftest import DATA, GRAVEL
+from conftest import DATA, GRAVEL, bumpy_grid
 
 tiles = pytest.importorskip("tailor.tiles")
 pytest.importorskip("distributed")
@@ -1318,3 +1318,27 @@ def test_what_the_reader_read_past_is_warned_of(tmp_path):
     assert code == 0, stderr
     said = "1 line after the 1 face the OFF header declares (from line 8)"
     assert f"tailor.tiles: warning: {path}: not read: {said}\n" in stderr, stderr
+
+
+def test_dropped_faces_are_said_as_tailor_map_says_them(tmp_path, tailor_binary):
+    # A grid with two faces that repeat another's vertices and one that repeats a vertex: the
+    # tiles drop them as the load does, and say so in tailor map's words, streamed or loaded.
+    positions, faces = bumpy_grid(6)
+    faces = np.concatenate([faces, faces[3:5], [[0, 0, 1]]]).astype(np.uint32)
+    path = tmp_path / "grid.ply"
+    write_ply(path, positions, faces)
+    map_said = subprocess.run(
+        [tailor_binary, "map", path, "-o", tmp_path / "x.glb"], capture_output=True, text=True, timeout=120
+    ).stderr
+    for extra in ([], ["--in-memory"]):
+        out = tmp_path / ("out%d" % len(extra))
+        code, _, stderr = run_tiles(path, "-o", out, "--workers", 0, *extra)
+        assert code == 0, stderr
+        lines = [l for l in stderr.splitlines() if "dropped" in l]
+        assert lines == [
+            "tailor.tiles: warning: %s: dropped 1 degenerate faces" % path,
+            "tailor.tiles: warning: %s: dropped 2 duplicate faces" % path,
+        ], (extra, stderr)
+        for line in lines:
+            assert line.replace("tailor.tiles:", "tailor:") in map_said, (line, map_said)
+        assert json.loads((out / "tileset.json").read_text())["root"]
