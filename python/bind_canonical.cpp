@@ -3,6 +3,7 @@
 // numpy form made nine passes over the faces and took about a sixth of a streamed tile's task.
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
@@ -39,6 +40,10 @@ void bind_canonical(py::module_& m) {
         constexpr py::ssize_t kMost = std::numeric_limits<uint32_t>::max();
         if (positions.shape(0) > kMost) raise_error("a tile holds at most 2^32 - 1 vertices");
         const size_t vertex_count = static_cast<uint32_t>(positions.shape(0));
+        // NaN compares false both ways: the order, and so the tile's bytes, would depend on the input's.
+        for (size_t i = 0; i < 3 * vertex_count; ++i)
+          if (!std::isfinite(positions.data()[i]))
+            raise_error("tailor.canonical_tile: vertex coordinate not finite (vertex " + std::to_string(i / 3) + ")");
         // Integer indices each below the vertex count, as tailor.Mesh takes them (a cast would wrap
         // 2^32 + 2 to 2 and truncate 1.5 to 1).
         std::vector<uint32_t> face_indices;

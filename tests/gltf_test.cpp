@@ -251,6 +251,26 @@ TEST(GltfScene, JsonNestedTooDeepIsOneLineNotACrash) {
   EXPECT_EQ(mesh.face_count(), 1u);
 }
 
+// Invalid JSON is named with the offset where it stops being JSON (in the file: a .glb's JSON chunk
+// starts at byte 20); valid JSON that is no object says so.
+TEST(GltfScene, InvalidJsonNamesTheByteWhereItBreaks) {
+  Builder b = one_triangle({{{"mesh", 0}}}, {{{"nodes", {0}}}});
+  std::string text = b.gltf();
+  const size_t at = text.find("\"nodes\"");
+  Mesh mesh;
+  const Status broken = read(text.substr(0, at) + "," + text.substr(at), mesh);
+  EXPECT_EQ(broken.code(), ErrorCode::kParse);
+  EXPECT_EQ(broken.message(), "test: not a glTF file (not valid JSON) (byte " + std::to_string(at) + ")");
+  EXPECT_EQ(read(text.substr(0, 10), mesh).message(), "test: not a glTF file (not valid JSON) (byte 10)");
+  EXPECT_EQ(read("[1, 2]", mesh).message(), "test: not a glTF file (not a JSON object)");
+  std::string glb = b.glb();
+  const size_t in_chunk = glb.find("\"nodes\"");
+  ASSERT_NE(in_chunk, std::string::npos);
+  glb[in_chunk] = '#';
+  EXPECT_EQ(read(glb, mesh).message(), "test: JSON chunk is not valid JSON (byte " + std::to_string(in_chunk) + ")");
+  EXPECT_TRUE(mesh.empty());
+}
+
 // Every instance keeps its node's and mesh's name and extras: a 100 KB mesh name under 3,000 nodes
 // (300 MB of copies from a 200 KB file) is refused by the decode budget; under 10 nodes it loads.
 TEST(GltfScene, NamesCopiedPerInstanceCountAgainstTheBudget) {

@@ -223,7 +223,12 @@ Status GltfDocument::open(std::span<const char> data, const std::string& name, c
   const std::string_view json_chars(reinterpret_cast<const char*>(json_text.data()), json_text.size());
   if (internal::parse_json_bounded(json_chars, json_) == internal::JsonParse::kTooDeep)
     return parse_error(internal::json_problem(internal::JsonParse::kTooDeep));
-  if (json_.is_discarded() || !json_.is_object())
+  if (json_.is_discarded()) {
+    const size_t at = internal::json_error_byte(json_chars);
+    return parse_error(binary_ ? "JSON chunk is not valid JSON" : "not a glTF file (not valid JSON)",
+                       at == SIZE_MAX ? "" : "byte " + std::to_string(at + (binary_ ? 20 : 0)));
+  }
+  if (!json_.is_object())
     return parse_error(binary_ ? "JSON chunk is not a valid JSON object" : "not a glTF file (not a JSON object)");
   const auto asset = json_.find("asset");
   if (asset != json_.end() && asset->is_object()) {

@@ -7,6 +7,7 @@
 // it closes: quadratic in an array of objects).
 #pragma once
 
+#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
@@ -51,6 +52,33 @@ inline JsonParse parse_json_bounded(std::string_view text, nlohmann::json& out) 
   }
   out = nlohmann::json::parse(text, nullptr, false);
   return out.is_discarded() ? JsonParse::kInvalid : JsonParse::kOk;
+}
+
+//! The offset of the byte where `text` stops being JSON (text.size() when it ends too early), or
+//! SIZE_MAX when it is valid. For the error message only: a SAX pass that builds nothing, so a
+//! deep or large text costs no memory.
+inline size_t json_error_byte(std::string_view text) {
+  struct Sax : nlohmann::json_sax<nlohmann::json> {
+    size_t byte = SIZE_MAX;
+    bool null() override { return true; }
+    bool boolean(bool) override { return true; }
+    bool number_integer(number_integer_t) override { return true; }
+    bool number_unsigned(number_unsigned_t) override { return true; }
+    bool number_float(number_float_t, const string_t&) override { return true; }
+    bool string(string_t&) override { return true; }
+    bool binary(binary_t&) override { return true; }
+    bool start_object(std::size_t) override { return true; }
+    bool key(string_t&) override { return true; }
+    bool end_object() override { return true; }
+    bool start_array(std::size_t) override { return true; }
+    bool end_array() override { return true; }
+    bool parse_error(std::size_t position, const std::string&, const nlohmann::detail::exception&) override {
+      byte = position == 0 ? 0 : position - 1;  // nlohmann counts the characters read, the offending one too
+      return false;
+    }
+  } sax;
+  nlohmann::json::sax_parse(text, &sax);
+  return sax.byte;
 }
 
 //! The words an error says for a document that is not kOk.

@@ -743,6 +743,11 @@ def test_a_tile_in_canonical_order_is_the_same_for_any_input_order():
         tailor.canonical_tile(positions[:9], np.array([[0, 1, 2.0]]))
     with pytest.raises(tailor.Error, match="positions must be a"):
         tailor.canonical_tile(positions[:, :2], faces)
+    # A NaN compares false both ways: its order would be the input's, so it is refused.
+    nan = positions[:9].copy()
+    nan[4, 1] = np.nan
+    with pytest.raises(tailor.Error, match=r"^tailor.canonical_tile: vertex coordinate not finite \(vertex 4\)$"):
+        tailor.canonical_tile(nan, np.array([[0, 1, 2], [3, 4, 5]]))
 
 
 def test_a_streamed_ply_gives_the_in_memory_tiles(tmp_path):
