@@ -43,7 +43,10 @@ void bind_canonical(py::module_& m) {
         // NaN compares false both ways: the order, and so the tile's bytes, would depend on the input's.
         for (size_t i = 0; i < 3 * vertex_count; ++i)
           if (!std::isfinite(positions.data()[i]))
-            raise_error("tailor.canonical_tile: vertex coordinate not finite (vertex " + std::to_string(i / 3) + ")");
+            raise_error(
+                "tailor.canonical_tile: vertex coordinate not finite or beyond the range of 32-bit floats "
+                "(3.4e38) (vertex " +
+                std::to_string(i / 3) + ")");
         // Integer indices each below the vertex count, as tailor.Mesh takes them (a cast would wrap
         // 2^32 + 2 to 2 and truncate 1.5 to 1).
         std::vector<uint32_t> face_indices;

@@ -8,8 +8,9 @@ namespace tailor::python {
 namespace {
 
 ChunkCell cell_of(const py::sequence& cell) {
-  // A string is a sequence too ("abc": three letters, then "got 'a'"): refused whole.
-  if (py::isinstance<py::str>(cell))
+  // A string is a sequence too ("abc": three letters, then "got 'a'"), bytes one of numbers (97,
+  // 98, 99): refused whole.
+  if (py::isinstance<py::str>(cell) || py::isinstance<py::bytes>(cell) || py::isinstance<py::bytearray>(cell))
     raise_error("cell must be three whole numbers (x, y, z), got " + py::repr(cell).cast<std::string>());
   if (py::len(cell) != 3) raise_error("cell must be three whole numbers (x, y, z), got " + sequence_text(cell));
   ChunkCell c;
@@ -44,7 +45,7 @@ void bind_chunks(py::module_& m) {
              options.mapping.field_following = field_following;
              options.mapping.max_stretch = max_stretch;
              if (!crack_rings.is_none())
-               options.mapping.crack_rings = static_cast<uint32_t>(whole_number(crack_rings, "crack_rings", 2, 64));
+               options.mapping.crack_rings = bounded_whole_number(crack_rings, "crack_rings", "--crack-rings");
              set_chunk_split(chunk_split, options.chunks.split_above);
              if (!texture_size.is_none()) {
                // The lattice of whole repeats the crack closing snaps to, as tailor.map(texture_size=...).

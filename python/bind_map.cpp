@@ -247,8 +247,7 @@ void bind_map(py::module_& m) {
         mapping.shorten_seams = shorten_seams;
         mapping.close_cracks = close_cracks;
         if (!crack_rings.is_none())  // else as auto decides
-          mapping.crack_rings = static_cast<uint32_t>(
-              whole_number(crack_rings, "crack_rings", MappingLimits::min_crack_rings, MappingLimits::max_crack_rings));
+          mapping.crack_rings = bounded_whole_number(crack_rings, "crack_rings", "--crack-rings");
         mapping.relax_iterations = relax_iterations;
         mapping.threshold_px = threshold;
         if (!symmetry.is_none()) {

@@ -47,6 +47,10 @@ struct PyResult {
 
 //! Raises tailor.Error with the CLI's one-line message (what follows "tailor: error: ").
 [[noreturn]] void raise_status(const Status& status);
+
+//! `value` as a whole number for the bounded option `flag` (--crack-rings...): a non-whole value is
+//! refused naming `name`, one outside the range in the words of tailor map (check_option_range).
+uint32_t bounded_whole_number(const py::handle& value, const std::string& name, std::string_view flag);
 //! Raises tailor.Error with `what` (a bad argument found by the binding itself).
 [[noreturn]] void raise_error(const std::string& what);
 //! `value` (an int, or anything with __index__ such as numpy's integers) when it is a whole number

@@ -86,6 +86,12 @@ int64_t whole_number(const py::handle& value, const std::string& name, int64_t l
   return v;
 }
 
+uint32_t bounded_whole_number(const py::handle& value, const std::string& name, std::string_view flag) {
+  const int64_t v = whole_number(value, name, std::numeric_limits<int64_t>::min(), std::numeric_limits<int64_t>::max());
+  if (const Status s = check_option_range(flag, static_cast<double>(v)); !s) raise_status(s);
+  return static_cast<uint32_t>(v);
+}
+
 std::string describe(const py::array& array) {
   std::string text = py::str(array.dtype()).cast<std::string>() + " (";
   for (py::ssize_t i = 0; i < array.ndim(); ++i) text += (i ? ", " : "") + std::to_string(array.shape(i));

@@ -402,7 +402,7 @@ TEST(ChunkedMapping, CancelsAndRefusesWhatNeedsTheWholeMesh) {
   EXPECT_EQ(huge.code(), ErrorCode::kInvalidArgument);
   EXPECT_NE(huge.what().find("pixels per chunk cell of side 2^40 units, outside 0.001 to 1e7"), std::string::npos)
       << huge.what();
-  EXPECT_NE(huge.what().find("or map without chunks"), std::string::npos) << huge.what();
+  EXPECT_NE(huge.what().find("or map it without chunks (chunks off)"), std::string::npos) << huge.what();
 }
 
 // The faces of `result` as a mesh of their own (vertices renumbered, in another order than the

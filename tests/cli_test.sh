@@ -211,7 +211,13 @@ expect_error 2 "output must end" -- "$tailor" map "$mesh" -o "$tmp/x.txt"
 expect_error 2 "" -- "$tailor" map "$mesh"
 expect_error 2 "" -- "$tailor" frobnicate
 # A usage error points to the help of the command it is in.
-expect_error 2 "crack-rings.*\(run 'tailor map --help'\)$" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --crack-rings -1
+expect_error 2 "crack-rings.*\(run 'tailor map --help'\)$" -- "$tailor" map "$mesh" -o "$tmp/x.glb" --crack-rings abc
+# A value out of range is refused in the library's words whether the field can hold it or not.
+for rings in -1 1; do
+  said=$("$tailor" map "$mesh" -o "$tmp/x.glb" --crack-rings "$rings" 2>&1)
+  [[ $? -eq 2 && $said == "tailor: error: --crack-rings must be between 2 and 64 rings, got $rings" ]] && ok ||
+    fail "--crack-rings $rings: $said"
+done
 expect_error 2 "\(run 'tailor map --help'\)$" -- "$tailor" map
 expect_error 2 "\(run 'tailor eval --help'\)$" -- "$tailor" eval "$tmp/a.glb" --frobnicate
 expect_error 2 "\(run 'tailor tile --help'\)$" -- "$tailor" tile "$texture"

@@ -262,6 +262,9 @@ TEST(GltfScene, InvalidJsonNamesTheByteWhereItBreaks) {
   EXPECT_EQ(broken.code(), ErrorCode::kParse);
   EXPECT_EQ(broken.message(), "test: not a glTF file (not valid JSON) (byte " + std::to_string(at) + ")");
   EXPECT_EQ(read(text.substr(0, 10), mesh).message(), "test: not a glTF file (not valid JSON) (byte 10)");
+  // A whole token where none may stand: its last byte.
+  EXPECT_EQ(read(R"({"asset" "b"})", mesh).message(), "test: not a glTF file (not valid JSON) (byte 11)");
+  EXPECT_EQ(read("{\"asset\": {}, \"x\": 12 34}", mesh).message(), "test: not a glTF file (not valid JSON) (byte 23)");
   EXPECT_EQ(read("[1, 2]", mesh).message(), "test: not a glTF file (not a JSON object)");
   std::string glb = b.glb();
   const size_t in_chunk = glb.find("\"nodes\"");

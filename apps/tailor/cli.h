@@ -95,6 +95,11 @@ bool ends_with_png(const std::string& path);
 //! Fails with kInvalidArgument (exit 2), so a refused run writes nothing.
 Status check_outputs(const std::vector<OutputPath>& outputs, const std::vector<std::string>& inputs);
 
+//! A validator's message that starts with this is the library's whole message: main prints it as
+//! the library words it, without CLI11's "--flag: " before it nor the pointer to --help (a value
+//! out of range is refused in the same words whether it parses or not).
+inline const std::string kOwnWords = "\x01";
+
 //! Adds the option `doc` names (flag and help from the library's table, tailor/option_doc.h), bound
 //! to `field`; the default shown is the field's value now: its options struct's default, or for a
 //! text option, that default's name. A number with a range (MappingLimits, OrientationLimits) shows
@@ -103,8 +108,11 @@ Status check_outputs(const std::vector<OutputPath>& outputs, const std::vector<s
 //! the range.
 template <class T>
 CLI::Option* add_documented(CLI::App* app, const OptionDoc& doc, T& field) {
-  CLI::Option* option = app->add_option(std::string(doc.flag), field, help_with_range(doc))->capture_default_str();
+  const std::string help = help_with_range(doc);
+  CLI::Option* option = app->add_option(std::string(doc.flag), field, help)->capture_default_str();
+  const bool bounded = help.size() != doc.help.size();  // the library knows its range
   if constexpr (std::is_integral_v<T>) {
+    if (!bounded) return option;
     option->check(CLI::Validator(
         [flag = std::string(doc.flag)](std::string& text) -> std::string {
           char* end = nullptr;
@@ -113,10 +121,8 @@ CLI::Option* add_documented(CLI::App* app, const OptionDoc& doc, T& field) {
           const bool fits = value >= static_cast<double>(std::numeric_limits<T>::min()) &&
                             value <= static_cast<double>(std::numeric_limits<T>::max());
           const Status s = check_option_range(flag, value);
-          if (fits || s) return "";
-          // CLI11 puts "--flag: " before it; the value as given, not as a double prints.
-          const std::string what = s.message();
-          return what.substr(flag.size() + 1, what.rfind(", got ") - flag.size() - 1) + ", got " + text;
+          // The library's message whole: main prints it as check_map_options' (kOwnWords).
+          return fits || s ? "" : kOwnWords + s.message();
         },
         ""));
   }

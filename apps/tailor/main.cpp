@@ -127,6 +127,10 @@ int run_command(int argc, char** argv) {
     // would say "--output is required", 'tailor --bogus' "A subcommand is required". The argument
     // it did not know is the cause, so it is named first, in the same words as any unknown one.
     std::string message = e.what();
+    if (const size_t own = message.find(tailor::cli::kOwnWords); own != std::string::npos) {
+      std::fprintf(stderr, "tailor: error: %s\n", message.substr(own + tailor::cli::kOwnWords.size()).c_str());
+      return kExitUsage;
+    }
     std::vector<std::string> unknown;
     if (dynamic_cast<const CLI::RequiredError*>(&e) != nullptr || dynamic_cast<const CLI::ExtrasError*>(&e) != nullptr)
       unknown = commands.empty() ? app.remaining() : commands.back()->remaining();

@@ -83,7 +83,7 @@ TAILOR_API std::string help_with_range(const OptionDoc& doc);
 
 //! Fails with kInvalidArgument, check_map_options' message ("--max-stretch must be between 0.01
 //! and 4, got 5"), when `value` is outside the range of `flag`, one of the options
-//! MappingLimits or OrientationLimits bound (NaN is outside); ok for any other flag.
+//! MappingLimits or OrientationLimits bound (NaN is outside); fails too for a flag it has no range of.
 TAILOR_API Status check_option_range(std::string_view flag, double value);
 
 struct MappingOptions {

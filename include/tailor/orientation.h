@@ -53,7 +53,7 @@ struct OrientationStroke {
   float radius = 0.f;         //!< reach of the stroke, mesh units (> 0)
 };
 
-//! The range of OrientationOptions' passes, read by compute_frames and every check of it (as
+//! The range of OrientationOptions' passes, read by the orientation and every check of it (as
 //! MappingLimits, tailor/mapping.h).
 struct OrientationLimits {
   static constexpr uint32_t max_smooth_passes = 1000;
@@ -125,7 +125,7 @@ struct FaceFrames {
 //! Computes normals, areas, the orientation field, corner positions in each face's frame and the
 //! per-face variation. Inputs: a finalised mesh and its topology (build_topology(mesh)).
 //! Never produces NaN: zero-area faces get an arbitrary orthonormal frame and variation 0 to
-//! themselves. Fails with kInvalidArgument on a zero user axis, smooth_passes > 1000 or a bad
+//! themselves. Fails with kInvalidArgument on a zero user axis, smooth_passes beyond OrientationLimits or a bad
 //! stroke (naming it: points not x, y, z triples, fewer than 2, not finite, radius <= 0), and with
 //! kInvalidMesh on an empty mesh or a topology of the wrong size. Cost: O(V + F * (1 + passes)) plus, with
 //! strokes, a uniform grid over their segments and one cell's segments per face.

@@ -19,7 +19,6 @@ from ._tailor import (
     Mesh,
     Result,
     __version__,
-    _range_error,
     auto_field_following,
     canonical_tile,
     chunk_cell_exponent,

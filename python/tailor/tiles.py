@@ -1389,8 +1389,7 @@ def parse_args(argv):
         usage_error("--up must be y or z, got '%s'" % args.up)
     if args.scale is not None and args.texels_per_unit is not None:
         usage_error("give --scale or --texels-per-unit, not both (the density is one or the other)")
-    for name, value in (("--tile-size", args.tile_size), ("--texels-per-unit", args.texels_per_unit),
-                        ("--scale", args.scale)):
+    for name, value in (("--tile-size", args.tile_size), ("--texels-per-unit", args.texels_per_unit)):
         if value is not None and not (0 < value < math.inf):
             usage_error("%s must be a positive number, got %s" % (name, value))
     if args.tile_size is not None and math.frexp(args.tile_size)[0] != 0.5:
@@ -1399,12 +1398,12 @@ def parse_args(argv):
         args.scale = defaults["scale"]
     # The library's ranges and words, as tailor map and tailor.map check them (the value as the
     # mapping's float holds it).
-    for flag, value in (
-        ("--scale", float(np.float32(args.scale))),
-        ("--max-stretch", float(np.float32(args.max_stretch))),
-        ("--crack-rings", args.crack_rings),
-    ):
-        message = tailor._range_error(flag, value) if value is not None else ""
+    with np.errstate(over="ignore"):  # 1e39 is inf as a float, and refused as such
+        floats = [("--scale", float(np.float32(args.scale))), ("--max-stretch", float(np.float32(args.max_stretch)))]
+    # A whole number beyond any double (10**400) is just as far out of range.
+    rings = None if args.crack_rings is None else float(max(-(2**63), min(args.crack_rings, 2**63)))
+    for flag, value in floats + [("--crack-rings", rings)]:
+        message = tailor._tailor._range_error(flag, value) if value is not None else ""
         if message:
             usage_error(message)
     if not 1 <= args.texture_size <= 65536:  # as tailor map and tailor eval take it

@@ -91,7 +91,7 @@ inline int32_t unpack_cell(uint64_t key, int axis) {
 Status too_many_cells() {
   return Status::error(ErrorCode::kInvalidMesh, "",
                        "a face's centroid lies 2^20 chunk cells or more from the origin along an axis, or is not "
-                       "finite: give a larger chunk cell (at most 2^60 units) or map it without chunks (chunks off)");
+                       "finite: give a larger chunk cell (at most 2^60 units)");
 }
 
 // A set of cell keys (open addressing, linear probing): the distinct cells are few (one per ~100k
@@ -415,9 +415,7 @@ Status chunk_cell_exponent(double median_edge, const ChunkOptions& options, int&
   if (!(median_edge > 0.0))
     return Status::error(ErrorCode::kInvalidMesh, "", "no edge of positive length to size the chunks by");
   if (!std::isfinite(median_edge))  // coordinates near 3.4e38: their differences overflow
-    return Status::error(ErrorCode::kInvalidMesh, "",
-                         "the edge lengths overflow 32-bit floats: give a chunk cell or map it without chunks (chunks "
-                         "off)");
+    return Status::error(ErrorCode::kInvalidMesh, "", "the edge lengths overflow 32-bit floats: give a chunk cell");
   exponent = static_cast<int>(std::lround(std::log2(double{options.cell_edges} * median_edge)));
   exponent = std::clamp(exponent, -60, 60);
   return Status::ok();

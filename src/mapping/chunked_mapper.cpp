@@ -53,8 +53,8 @@ Status ChunkedMapper::check() const {
   TAILOR_RETURN_IF_ERROR(internal::check_chunk_scale(texels_per_unit_, cell_size_));
   if (options_.orientation.axis == AxisSource::kSkeleton)
     return Status::error(ErrorCode::kInvalidArgument, "", "the skeleton axis needs the whole mesh, not chunks");
-  TAILOR_RETURN_IF_ERROR(internal::check_mapping_values(options_.mapping));
-  return check_map_options(options_);
+  TAILOR_RETURN_IF_ERROR(check_map_options(options_));  // the front ends' words first
+  return internal::check_mapping_values(options_.mapping);
 }
 
 Status ChunkedMapper::set_chunk(const ChunkCell& cell, const Mesh& faces) {

@@ -210,11 +210,16 @@ Status map_chunks(const Mesh& mesh, const MapTextureOptions& options, TextureMap
   if (options.orientation.axis == AxisSource::kSkeleton)
     return Status::error(ErrorCode::kInvalidArgument, "",
                          "the skeleton axis needs the whole mesh: map it without chunks (chunks off)");
+  // A whole mesh may be mapped without chunks, which a ChunkedMapper or a tile cannot: the refusals
+  // of a cell (too far, too large, too many pixels; each names the chunk cell) say so here only.
+  const auto or_whole = [](Status s) {
+    if (s.is_ok() || s.what().find("chunk cell") == std::string::npos) return s;
+    return Status::error(s.code(), s.file(), s.what() + ", or map it without chunks (chunks off)", s.where());
+  };
   ChunkPlan plan;
-  TAILOR_RETURN_IF_ERROR(plan_chunks(mesh, options.chunks, plan, options.mapping.threads));
+  TAILOR_RETURN_IF_ERROR(or_whole(plan_chunks(mesh, options.chunks, plan, options.mapping.threads)));
   const double texels_per_unit = chunk_texels_per_unit(mesh, options);
-  if (Status s = check_chunk_scale(texels_per_unit, plan.cell_size); !s)
-    return Status::error(s.code(), s.file(), s.what() + ", or map without chunks (chunks off)", s.where());
+  TAILOR_RETURN_IF_ERROR(or_whole(check_chunk_scale(texels_per_unit, plan.cell_size)));
 
   const size_t chunks = plan.chunk_count();
   const size_t cores = std::max<size_t>(std::thread::hardware_concurrency(), 1);

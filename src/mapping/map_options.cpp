@@ -1,7 +1,10 @@
 // The option checks and the texture-size settings `tailor map` applies before map_texture, shared
 // with the Python module so both refuse the same options with the same message.
+#include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <string>
 #include <string_view>
 
@@ -27,14 +30,20 @@ constexpr LimitedOption kLimitedOptions[] = {
     {"--smooth", 0., OrientationLimits::max_smooth_passes, " passes"},
 };
 
-// A value as a message shows it: as a limit is written when that reads back the same, else with
-// the digits a float needs (4.0000005 is not 4).
+// A value as a message shows it: a whole number in full (4000000000, not 4e9), a float in the
+// fewest digits that read back as it (0.0009999, not 0.000999900047), else as a limit is written.
 std::string value_text(double value) {
-  std::string text = limit_text(value);
-  if (std::strtod(text.c_str(), nullptr) == value || value != value) return text;
-  char digits[32];
-  std::snprintf(digits, sizeof digits, "%.9g", value);
-  return digits;
+  char digits[64];
+  if (value == std::trunc(value) && std::abs(value) < 0x1p53) {
+    std::snprintf(digits, sizeof digits, "%.0f", value);
+    return digits;
+  }
+  const float single = static_cast<float>(value);
+  if (std::abs(value) <= std::numeric_limits<float>::max() && static_cast<double>(single) == value) {
+    const auto end = std::to_chars(digits, digits + sizeof digits, single).ptr;
+    return std::string(digits, end);
+  }
+  return limit_text(value);
 }
 }  // namespace
 
@@ -60,11 +69,13 @@ std::string help_with_range(const OptionDoc& doc) {
 
 Status check_option_range(std::string_view flag, double value) {
   for (const LimitedOption& option : kLimitedOptions) {
-    if (option.flag != flag || (value >= option.low && value <= option.high)) continue;  // NaN is outside
+    if (option.flag != flag) continue;
+    if (value >= option.low && value <= option.high) return Status::ok();  // NaN is outside
     return usage_error(std::string(flag) + " must be between " + limit_text(option.low) + " and " +
                        limit_text(option.high) + std::string(option.unit) + ", got " + value_text(value));
   }
-  return Status::ok();
+  // A misspelt flag in a caller's list would turn its check off without this.
+  return usage_error("no range is known for " + std::string(flag));
 }
 
 Status check_map_options(const MapTextureOptions& options) {

@@ -54,7 +54,8 @@ inline JsonParse parse_json_bounded(std::string_view text, nlohmann::json& out) 
   return out.is_discarded() ? JsonParse::kInvalid : JsonParse::kOk;
 }
 
-//! The offset of the byte where `text` stops being JSON (text.size() when it ends too early), or
+//! The offset of the byte where `text` stops being JSON (a whole token that may not stand there:
+//! its last byte; text.size() when it ends too early), or
 //! SIZE_MAX when it is valid. For the error message only: a SAX pass that builds nothing, so a
 //! deep or large text costs no memory.
 inline size_t json_error_byte(std::string_view text) {
@@ -73,7 +74,7 @@ inline size_t json_error_byte(std::string_view text) {
     bool start_array(std::size_t) override { return true; }
     bool end_array() override { return true; }
     bool parse_error(std::size_t position, const std::string&, const nlohmann::detail::exception&) override {
-      byte = position == 0 ? 0 : position - 1;  // nlohmann counts the characters read, the offending one too
+      byte = position == 0 ? 0 : position - 1;  // nlohmann counts the characters read, the last one too
       return false;
     }
   } sax;

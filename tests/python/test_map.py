@@ -125,6 +125,7 @@ def test_evaluate_matches_the_map_and_the_cli(tmp_path, tailor_binary):
         (dict(scale=0), ["--scale", "0"]),
         (dict(hop_age=2.0), ["--hop-age", "2"]),
         (dict(max_stretch=5.0), ["--max-stretch", "5"]),
+        (dict(crack_rings=1), ["--crack-rings", "1"]),
         (dict(relax_iterations=1001), ["--relax-iterations", "1001"]),
         (dict(smooth=1001), ["--smooth", "1001"]),
         (dict(axis="w"), ["--axis", "w"]),
@@ -227,11 +228,12 @@ def test_the_limits_are_those_map_and_the_cli_check(tailor_binary, tmp_path):
                 tailor.map(mesh, **{name: value})
         beyond = [high + 1] + ([low - 1] if low > 0 else []) if whole else [float(np.nextafter(np.float32(high), np.float32(np.inf)))]
         for value in beyond:
-            with pytest.raises(tailor.Error):
+            with pytest.raises(tailor.Error) as caught:
                 tailor.map(mesh, **{name: value})
             code, _, stderr = run_cli(tailor_binary, "map", tmp_path / "missing.glb", "-o", tmp_path / "x.glb",
                                       flags[name], repr(value))
-            assert code == 2 and f"{flags[name]} must be between" in stderr, (name, value, stderr)
+            assert str(caught.value).startswith(f"{flags[name]} must be between"), (name, value, caught.value)
+            assert code == 2 and stderr == f"tailor: error: {caught.value}\n", (name, value, stderr)
         if not whole and low > 0:
             with pytest.raises(tailor.Error):
                 tailor.map(mesh, **{name: float(np.nextafter(np.float32(low), np.float32(0)))})
