@@ -460,6 +460,9 @@ void bind_map(py::module_& m) {
   limits["relax_iterations"] = py::make_tuple(0u, L::max_relax_iterations);
   limits["smooth"] = py::make_tuple(0u, OrientationLimits::max_smooth_passes);
   m.attr("MAP_LIMITS") = limits;
+  m.def("_range_text", &option_range_text, py::arg("flag"),
+        "_range_text(flag) -> str\n\nThe range of `flag` as tailor map --help writes it, or '' (for python3 -m "
+        "tailor.tiles --help).");
   m.def(
       "_range_error",
       [](const std::string& flag, double value) {

@@ -77,6 +77,10 @@ struct MappingLimits {
 //! A limit as messages and docs write it: 0.001, 4, 1e7 (printf's %g, its exponent without "+0").
 TAILOR_API std::string limit_text(double value);
 
+//! The range of `flag`, one of the options MappingLimits or OrientationLimits bound, as help texts
+//! write it ("0.01 to 4", "2 to 64 rings"); "" for any other flag.
+TAILOR_API std::string option_range_text(std::string_view flag);
+
 //! `doc`'s help as the CLI and the Python module show it: the table's text, and for an option
 //! MappingLimits or OrientationLimits bounds, its range from there (" (0.01 to 4)").
 TAILOR_API std::string help_with_range(const OptionDoc& doc);

@@ -1345,7 +1345,10 @@ def parse_args(argv):
         "--texture-size", type=int, default=defaults["texture_size"], help="pixels of one repeat without --texture"
     )
     p.add_argument(
-        "--scale", type=float, help="as tailor map --scale (density from the bounding box; default %g)" % defaults["scale"]
+        "--scale",
+        type=float,
+        help="as tailor map --scale (density from the bounding box; %s; default %g)"
+        % (tailor._tailor._range_text("--scale"), defaults["scale"]),
     )
     p.add_argument(
         "--texels-per-unit",
@@ -1359,9 +1362,17 @@ def parse_args(argv):
         default="auto",
         help="as tailor map: 0..1, or auto (default: 0 with 32 crack rings for a texture without a direction, else 1)",
     )
-    p.add_argument("--max-stretch", type=float, default=defaults["max_stretch"], help="as tailor map")
     p.add_argument(
-        "--crack-rings", type=int, default=None, help="as tailor map (default %d)" % defaults["crack_rings"]
+        "--max-stretch",
+        type=float,
+        default=defaults["max_stretch"],
+        help="as tailor map (%s; default %g)" % (tailor._tailor._range_text("--max-stretch"), defaults["max_stretch"]),
+    )
+    p.add_argument(
+        "--crack-rings",
+        type=int,
+        default=None,
+        help="as tailor map (%s; default %d)" % (tailor._tailor._range_text("--crack-rings"), defaults["crack_rings"]),
     )
     p.add_argument(
         "--no-lod",

@@ -59,12 +59,16 @@ std::string limit_text(double value) {
   return s;
 }
 
-std::string help_with_range(const OptionDoc& doc) {
-  std::string help(doc.help);
+std::string option_range_text(std::string_view flag) {
   for (const LimitedOption& option : kLimitedOptions)
-    if (option.flag == doc.flag)
-      help += " (" + limit_text(option.low) + " to " + limit_text(option.high) + std::string(option.unit) + ")";
-  return help;
+    if (option.flag == flag)
+      return limit_text(option.low) + " to " + limit_text(option.high) + std::string(option.unit);
+  return {};
+}
+
+std::string help_with_range(const OptionDoc& doc) {
+  const std::string range = option_range_text(doc.flag);
+  return range.empty() ? std::string(doc.help) : std::string(doc.help) + " (" + range + ")";
 }
 
 Status check_option_range(std::string_view flag, double value) {

@@ -1352,3 +1352,15 @@ def test_dropped_faces_are_said_as_tailor_map_says_them(tmp_path, tailor_binary)
         for line in lines:
             assert line.replace("tailor.tiles:", "tailor:") in map_said, (line, map_said)
         assert json.loads((out / "tileset.json").read_text())["root"]
+
+
+def test_help_shows_the_ranges_tailor_map_shows(tailor_binary):
+    # The library's ranges, in the same words in both helps (argparse wraps its lines).
+    map_help = " ".join(subprocess.run([tailor_binary, "map", "--help"], capture_output=True, text=True).stdout.split())
+    code, out, _ = run_tiles("--help")
+    tiles_help = " ".join(out.split())
+    assert code == 0
+    for flag in ("--scale", "--max-stretch", "--crack-rings"):
+        text = tailor._tailor._range_text(flag)
+        assert text and "(%s)" % text in map_help and text + "; default" in tiles_help, (flag, text)
+    assert tailor._tailor._range_text("--bogus") == ""
