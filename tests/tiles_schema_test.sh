@@ -76,7 +76,7 @@ for set in texture material_tiles plain; do
     || fail "$set: glTF validator: $(grep -v 'errors 0 warnings 0' "$tmp/validate.log" | head -5)"
 done
 for image in material_color.png material_normal.png material_orm.png; do
-  [ -s "$tmp/material_tiles/$image" ] || fail "no $image beside the material's tileset.json"
+  [ -s "$tmp/material_tiles/tiles/$image" ] || fail "no $image beside the material's tiles"
 done
 
 # --- 3. the check can fail -------------------------------------------------------------------------

@@ -63,7 +63,7 @@ for _ in $(seq 1 100); do
 done
 [ -n "$url" ] || fail "tailor view printed no URL within 10 s"
 curl -sf "${url}tileset/tileset.json" >/dev/null || fail "the tileset is not served at ${url}tileset/tileset.json"
-curl -sf "${url}tileset/texture.png" >/dev/null || fail "the shared texture is not served"
+curl -sf "${url}tileset/tiles/texture.png" >/dev/null || fail "the shared texture is not served"
 timeout 240 node web/test/tileset_browser_test.mjs "$url" "$tmp/horse_tiles/tileset.json" \
   ${TAILOR_SCREENSHOT:+--screenshot "$TAILOR_SCREENSHOT"} || fail "the tileset browser test failed"
 echo "tiles view test: ok"

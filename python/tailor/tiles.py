@@ -10,8 +10,8 @@ cells (--tile-size, world units). Each tile is one Dask task that maps its chunk
 tailor.ChunkedMapper and writes tiles/<x>_<y>_<z>.glb: a chunk's UVs depend on its own faces only,
 so every tile holds the bits `tailor map --chunks on` gives those faces inside the whole mesh, for
 any number of workers. The texture (or a PBR material's images: --material) is written once
-beside tileset.json and every .glb names it (image URIs), so that a 3D Tiles client downloads it
-once. --up z: Z-up coordinates, turned Y up by each .glb's node as glTF wants and back to Z up by
+in tiles/, beside the .glb files, and every .glb names it (image URIs in the same folder, which
+tailor's own reader takes too), so that a 3D Tiles client downloads it once. --up z: Z-up coordinates, turned Y up by each .glb's node as glTF wants and back to Z up by
 the client as 3D Tiles prescribes; the bounding volumes follow either choice.
 
 A binary little-endian PLY of triangles is partitioned by streaming it (tailor.tiles_stream: per-tile
@@ -62,7 +62,7 @@ MANIFEST = "tailor-tiles.json"
 CLIENT_CLOSE_WAIT = 10
 # What a terminal (Ctrl-C, closing it) or a service manager sends to a whole process group.
 GROUP_SIGNALS = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
-FORMAT = 2  # of the manifest: a different number means every tile is written again
+FORMAT = 3  # of the manifest (and of where the images are): a different number means every tile is written again
 # The streamed partition's ranges of the file (at least a block each): enough for every worker of a
 # cluster to take several, so that the driver and the workers finish together.
 PARTITION_PARTS = 256
@@ -108,15 +108,14 @@ def tile_digest(positions, faces, params):
 
 
 def tile_material(folder, params):
-    """The tile's material for tailor.save_uvs: the images beside tileset.json (written once by the
-    driver), which the tile names by URI (write_tile_glb) without reading them; None for a plain
-    material."""
+    """The tile's material for tailor.save_uvs: the images in tiles/ (written once by the driver),
+    which the tile names by URI (write_tile_glb) without reading them; None for a plain material."""
     images = params["images"]
     if not images:
         return None
     roles = params.get("orm_roles", [])
     return {
-        "color": str(pathlib.Path(folder) / images["color"]) if "color" in images else None,
+        "color": str(pathlib.Path(folder) / "tiles" / images["color"]) if "color" in images else None,
         "width": params["texture_size"][0],
         "height": params["texture_size"][1],
         "orm_roughness_metallic": "roughness_metallic" in roles,
@@ -132,10 +131,10 @@ def tile_mesh(name, positions, faces):
 
 
 def write_tile_glb(folder, name, mesh, corner_uvs, params):
-    """tiles/<name>.glb; its images name the files beside tileset.json (one copy for every tile)."""
+    """tiles/<name>.glb; its images name the files beside it (one copy for every tile)."""
     path = glb_path(folder, name)
     material = tile_material(folder, params)
-    uris = {role: "../" + file for role, file in params["images"].items()} if material is not None else {}
+    uris = dict(params["images"]) if material is not None else {}
     tailor.save_uvs(
         str(path), mesh, corner_uvs, tuple(params["texture_size"]), material=material, up=params["up"], image_uris=uris
     )
@@ -565,7 +564,7 @@ def texture_image(path, notes, direction):
 
 
 def read_look(args):
-    """What every tile's material shows, read once: images {role: (file name beside tileset.json,
+    """What every tile's material shows, read once: images {role: (file name in tiles/,
     bytes)} (color, normal, orm), orm_roles (what the orm image serves as), size (the repeat in
     pixels, None without a texture) and auto ((field_following, crack_rings) that --field-following
     auto picks for the colour map, None without one or when the flag is a number)."""
@@ -682,10 +681,12 @@ class Progress:
 # What a folder of tiles holds: anything else in OUTDIR is not this tool's, and a run (which replaces
 # the folder) refuses to delete it.
 OWN_ENTRIES = {MANIFEST, "tileset.json"}
+# The images every tile names, in tiles/ (at the top in a folder of manifest format 2, which a run
+# replaces as its own).
 OWN_IMAGES = re.compile(r"(texture|material_color|material_normal|material_orm)\.(png|jpg)")
 # The folders of tiles and of their simplified copies, and the names of the files in each.
 OWN_FOLDERS = {
-    "tiles": re.compile(r"\d+(_-?\d+){3}\.glb"),
+    "tiles": re.compile(r"\d+(_-?\d+){3}\.glb|" + OWN_IMAGES.pattern),
     "lod": re.compile(r"\d+(_-?\d+){3}\.bin"),
 }
 
@@ -1099,14 +1100,14 @@ def run_started(args, outdir, tmp, t0, layout, mesh, look, start):
     old = previous_output(outdir, params)
     t_plan = time.monotonic()
 
-    # The images every tile names, once beside tileset.json (the previous run's file linked
-    # when it has the same bytes, so that it keeps its time).
+    # The images every tile names, once in tiles/ (the previous run's file linked when it has the
+    # same bytes, so that it keeps its time).
     for name, data in look["images"].values():
-        previous = outdir / name
+        previous = outdir / "tiles" / name
         if previous.is_file() and previous.read_bytes() == data:
-            os.link(previous, tmp / name)
+            os.link(previous, tmp / "tiles" / name)
         else:
-            (tmp / name).write_bytes(data)
+            (tmp / "tiles" / name).write_bytes(data)
     if args.lod:
         (tmp / "lod").mkdir()
     jobs = []
@@ -1331,7 +1332,7 @@ def parse_args(argv):
         metavar="M",
         help="instead of --texture, a PBR material as tailor map --material (a folder of maps, or a JSON such as "
         "tailor tile --set's material.json): its maps' size sets the repeat; the tiles name its base colour, normal "
-        "and occlusion/roughness/metallic images, written once beside tileset.json",
+        "and occlusion/roughness/metallic images, written once in tiles/ beside the .glb files",
     )
     p.add_argument(
         "--up",

@@ -94,7 +94,7 @@ def test_tiles_are_the_chunked_map_for_any_worker_count(tmp_path):
     assert len(leaves) == summary["leaves"] and len(parents) == summary["tiles"] - summary["leaves"] > 2
     assert all(n["geometricError"] == 0 for n in leaves)
     assert all(n["refine"] == "REPLACE" and n["geometricError"] > 0 for n in parents)
-    assert (out / "texture.png").read_bytes() == TEXTURE.read_bytes()
+    assert (out / "tiles" / "texture.png").read_bytes() == TEXTURE.read_bytes()
 
     # Every face of the mesh in exactly one leaf tile, with the UVs of `tailor map --chunks on` (both
     # with their default field following: auto, from the texture).
@@ -119,7 +119,7 @@ def test_tiles_are_the_chunked_map_for_any_worker_count(tmp_path):
     vertices = set()  # (position, uv) of every leaf vertex
     for child in leaves:
         positions, uvs, faces, gltf = read_glb(out / child["content"]["uri"])
-        assert gltf["images"] == [{"uri": "../texture.png"}]
+        assert gltf["images"] == [{"uri": "texture.png"}]  # beside it: tailor's reader takes it too
         assert gltf["samplers"][0]["wrapS"] == 10497
         # The box holds the tile (glTF Y up -> tileset Z up: x, -z, y).
         box = np.array(child["boundingVolume"]["box"])
@@ -363,13 +363,13 @@ def test_a_material_is_named_by_every_tile_and_written_once(tmp_path):
     code, stdout, stderr = run_tiles(*common, "-o", out, "--material", material)
     assert code == 0, stderr
     summary = json.loads(stdout)
-    # The maps once beside tileset.json: the colour map as it is, the normal map and the packed
-    # occlusion / roughness / metallic image as `tailor map --material` embeds them.
+    # The maps once in tiles/: the colour map as it is, the normal map and the packed occlusion /
+    # roughness / metallic image as `tailor map --material` embeds them.
     loaded = tailor.load_material(material)
-    assert (out / "material_color.png").read_bytes() == colour.read_bytes()
-    assert (out / "material_normal.png").read_bytes() == loaded["normal_png"]
-    assert (out / "material_orm.png").read_bytes() == loaded["orm_png"]
-    expected = {"../material_color.png", "../material_normal.png", "../material_orm.png"}
+    assert (out / "tiles" / "material_color.png").read_bytes() == colour.read_bytes()
+    assert (out / "tiles" / "material_normal.png").read_bytes() == loaded["normal_png"]
+    assert (out / "tiles" / "material_orm.png").read_bytes() == loaded["orm_png"]
+    expected = {"material_color.png", "material_normal.png", "material_orm.png"}
     nodes = content_nodes(json.loads((out / "tileset.json").read_text()))
     assert len(nodes) == summary["tiles"] > summary["leaves"]
     for node in nodes:
@@ -379,9 +379,9 @@ def test_a_material_is_named_by_every_tile_and_written_once(tmp_path):
         uri = lambda ref: gltf["images"][gltf["textures"][ref["index"]]["source"]]["uri"]  # noqa: E731
         m = gltf["materials"][0]
         pbr = m["pbrMetallicRoughness"]
-        assert uri(pbr["baseColorTexture"]) == "../material_color.png"
-        assert uri(m["normalTexture"]) == "../material_normal.png"
-        assert uri(pbr["metallicRoughnessTexture"]) == uri(m["occlusionTexture"]) == "../material_orm.png"
+        assert uri(pbr["baseColorTexture"]) == "material_color.png"
+        assert uri(m["normalTexture"]) == "material_normal.png"
+        assert uri(pbr["metallicRoughnessTexture"]) == uri(m["occlusionTexture"]) == "material_orm.png"
         assert "TANGENT" in gltf["meshes"][0]["primitives"][0]["attributes"]
         # The BIN chunk holds the geometry only.
         assert gltf["buffers"][0]["byteLength"] == sum(v["byteLength"] for v in gltf["bufferViews"])
@@ -1264,7 +1264,8 @@ def test_textures_are_read_as_tailor_map_reads_them(tmp_path):
     disguised = tmp_path / "gravel.jpg"
     shutil.copy(GRAVEL, disguised)
     assert run_tiles(*common, "--texture", disguised)[0] == 0
-    assert (out / "texture.png").read_bytes() == GRAVEL.read_bytes() and not (out / "texture.jpg").exists()
+    assert (out / "tiles" / "texture.png").read_bytes() == GRAVEL.read_bytes()
+    assert not (out / "tiles" / "texture.jpg").exists()
 
 
 def test_an_empty_value_is_refused_not_taken_for_the_option_left_out(tmp_path):
