@@ -11,8 +11,9 @@ tailor.ChunkedMapper and writes tiles/<x>_<y>_<z>.glb: a chunk's UVs depend on i
 so every tile holds the bits `tailor map --chunks on` gives those faces inside the whole mesh, for
 any number of workers. The texture (or a PBR material's images: --material) is written once
 in tiles/, beside the .glb files, and every .glb names it (image URIs in the same folder, which
-tailor's own reader takes too), so that a 3D Tiles client downloads it once. --up z: Z-up coordinates, turned Y up by each .glb's node as glTF wants and back to Z up by
-the client as 3D Tiles prescribes; the bounding volumes follow either choice.
+tailor's own reader takes too), so that a 3D Tiles client downloads it once. --up z: Z-up
+coordinates, turned Y up by each .glb's node as glTF wants and back to Z up by the client as 3D
+Tiles prescribes; the bounding volumes follow either choice.
 
 A binary little-endian PLY of triangles is partitioned by streaming it (tailor.tiles_stream: per-tile
 files in a scratch folder, the driver never holds the whole mesh; the partition's ranges of the
@@ -681,24 +682,38 @@ class Progress:
 # What a folder of tiles holds: anything else in OUTDIR is not this tool's, and a run (which replaces
 # the folder) refuses to delete it.
 OWN_ENTRIES = {MANIFEST, "tileset.json"}
-# The images every tile names, in tiles/ (at the top in a folder of manifest format 2, which a run
-# replaces as its own).
+# The names of the images every tile names: in tiles/ (at the top before manifest format 3).
 OWN_IMAGES = re.compile(r"(texture|material_color|material_normal|material_orm)\.(png|jpg)")
 # The folders of tiles and of their simplified copies, and the names of the files in each.
 OWN_FOLDERS = {
-    "tiles": re.compile(r"\d+(_-?\d+){3}\.glb|" + OWN_IMAGES.pattern),
+    "tiles": re.compile(r"\d+(_-?\d+){3}\.glb"),
     "lod": re.compile(r"\d+(_-?\d+){3}\.bin"),
 }
 
 
-def foreign_entry(outdir):
-    """The first entry of outdir (a path relative to it) that a run does not write, or None."""
+def foreign_entry(outdir, old_params):
+    """The first entry of outdir (a path relative to it) that a run does not write, or None.
+    old_params: the manifest's parameters (None when unreadable), which say the images the run that
+    wrote the folder named and where it put them (tiles/; the top before manifest format 3); an image
+    of another name or place is the user's."""
+    places, names = {"tiles", "top"}, None  # unreadable: any image name, in either place
+    if isinstance(old_params, dict) and isinstance(old_params.get("images"), dict):
+        format_ = old_params.get("format")
+        places = {"top"} if isinstance(format_, int) and format_ < 3 else {"tiles"}
+        names = {name for name in old_params["images"].values() if isinstance(name, str)}
+
+    def own_image(name, place):
+        return place in places and OWN_IMAGES.fullmatch(name) and (names is None or name in names)
+
     for entry in sorted(outdir.iterdir()):
         if entry.name in OWN_FOLDERS and entry.is_dir() and not entry.is_symlink():
             for inner in sorted(entry.iterdir()):
-                if not (OWN_FOLDERS[entry.name].fullmatch(inner.name) and inner.is_file() and not inner.is_symlink()):
+                own = OWN_FOLDERS[entry.name].fullmatch(inner.name) or (
+                    entry.name == "tiles" and own_image(inner.name, "tiles")
+                )
+                if not (own and inner.is_file() and not inner.is_symlink()):
                     return "%s/%s" % (entry.name, inner.name)
-        elif not ((entry.name in OWN_ENTRIES or OWN_IMAGES.fullmatch(entry.name)) and entry.is_file()):
+        elif not ((entry.name in OWN_ENTRIES or own_image(entry.name, "top")) and entry.is_file()):
             return entry.name
     return None
 
@@ -714,15 +729,17 @@ def previous_output(outdir, params):
         if any(outdir.iterdir()):
             raise TilesError("%s exists and is not a folder of tiles written by tailor.tiles" % outdir)
         return {}
-    foreign = foreign_entry(outdir)
+    try:
+        old = json.loads(manifest.read_text())
+    except ValueError:
+        old = None
+    foreign = foreign_entry(outdir, old.get("params") if isinstance(old, dict) else None)
     if foreign is not None:
         raise TilesError(
             "%s holds %s, which is not part of its tileset (a run replaces the folder): move it, or write "
             "the tiles elsewhere" % (outdir, foreign)
         )
-    try:
-        old = json.loads(manifest.read_text())
-    except ValueError:
+    if old is None:
         return {}
     if not isinstance(old, dict) or old.get("params") != params or not isinstance(old.get("tiles"), dict):
         return {}
@@ -1016,6 +1033,13 @@ def warn_dropped(args, degenerate, duplicate):
             print("tailor.tiles: warning: %s: dropped %d %s faces" % (args.input, count, kind), file=sys.stderr)
 
 
+def warn_look(args, look):
+    """The texture's or material's warnings, after the mesh's as tailor map orders them."""
+    if not args.quiet:
+        for note in look["notes"]:
+            print("tailor.tiles: warning: %s" % note, file=sys.stderr)
+
+
 def run_locked(args, outdir):
     t0 = time.monotonic()
     # A binary little-endian PLY of triangles is partitioned by streaming it (tiles_stream); any
@@ -1031,10 +1055,9 @@ def run_locked(args, outdir):
     if not args.quiet:
         if mesh is not None and mesh.load_report["not_read"]:  # as tailor map warns of the same file
             print("tailor.tiles: warning: %s: not read: %s" % (args.input, mesh.load_report["not_read"]), file=sys.stderr)
-        if mesh is not None:
-            warn_dropped(args, mesh.load_report["degenerate_faces"], mesh.load_report["duplicate_faces"])
-        for note in look["notes"]:
-            print("tailor.tiles: warning: %s" % note, file=sys.stderr)
+    if mesh is not None:  # a streamed input's, after its survey (run_started)
+        warn_dropped(args, mesh.load_report["degenerate_faces"], mesh.load_report["duplicate_faces"])
+        warn_look(args, look)
     tmp = temporary_folder(outdir)
     start = None
     try:  # from the folder's creation on: a failure or a signal closes the cluster and removes it
@@ -1089,6 +1112,7 @@ def run_started(args, outdir, tmp, t0, layout, mesh, look, start):
     else:
         survey = tiles_stream.survey(layout, args.chunk_cell, args.block_faces)
         warn_dropped(args, layout.face_count - survey["faces"], 0)  # those that repeat a vertex
+        warn_look(args, look)
         largest = float(max(np.abs(survey["lo"]).max(), np.abs(survey["hi"]).max()))
         far = tailor._tailor._far_from_origin_warning(largest, survey["about_median"])
         params = tile_params(

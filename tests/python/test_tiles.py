@@ -1019,8 +1019,9 @@ def test_one_run_at_a_time_writes_a_folder_and_nothing_but_its_tileset_is_replac
     assert code == 1 and "holds index.html, which is not part of its tileset" in stderr
     assert (out / "index.html").read_text() == "a viewer page"
     (out / "index.html").unlink()
-    # Nor one inside its tiles' folders, nor an image by the name of the texture's in another format.
-    for foreign in ("tiles/notes.txt", "tiles/0_1_2_3.glb.bak", "texture.psd"):
+    # Nor one inside its tiles' folders, nor an image by the name of the texture's in another format,
+    # nor one by a name the tiles use where this folder's tiles (which name no image) do not put it.
+    for foreign in ("tiles/notes.txt", "tiles/0_1_2_3.glb.bak", "texture.psd", "texture.png", "tiles/texture.jpg"):
         (out / foreign).write_text("mine")
         code, _, stderr = run_tiles(*common)
         assert code == 1 and "holds %s, which is not part of its tileset" % foreign in stderr, stderr
@@ -1036,6 +1037,22 @@ def test_one_run_at_a_time_writes_a_folder_and_nothing_but_its_tileset_is_replac
     assert code == 1 and "texture.png is inside" in stderr, stderr
     (out / "texture.png").unlink()
     assert folder_bytes(out) == good
+    # A textured run puts its image in tiles/ and keeps it (and its time) on a re-run; a folder that
+    # has it at the top with a manifest of format 2 is replaced whole, nothing left at the top.
+    textured = tmp_path / "textured"
+    with_texture = [HORSE, "-o", textured, "--workers", 0, "--chunk-cell", CELL, "--no-lod", "-q", "--texture", TEXTURE]
+    assert run_tiles(*with_texture)[0] == 0
+    image = textured / "tiles" / "texture.png"
+    before = (image.stat().st_mtime_ns, folder_bytes(textured))
+    assert run_tiles(*with_texture)[0] == 0
+    assert (image.stat().st_mtime_ns, folder_bytes(textured)) == before
+    image.rename(textured / "texture.png")
+    manifest = json.loads((textured / "tailor-tiles.json").read_text())
+    manifest["params"]["format"] = 2
+    (textured / "tailor-tiles.json").write_text(json.dumps(manifest))
+    code, stdout, stderr = run_tiles(*with_texture[:-3], "--json", "--texture", TEXTURE)
+    assert code == 0 and json.loads(stdout)["kept"] == 0, stderr
+    assert folder_bytes(textured) == before[1] and not (textured / "texture.png").exists()
     # A manifest of the wrong shape keeps nothing: every tile is written again, the same bytes.
     manifest = json.loads((out / "tailor-tiles.json").read_text())
     manifest["tiles"] = {name: dict(r, faces="many") for name, r in manifest["tiles"].items()}
