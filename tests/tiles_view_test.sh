@@ -66,4 +66,23 @@ curl -sf "${url}tileset/tileset.json" >/dev/null || fail "the tileset is not ser
 curl -sf "${url}tileset/tiles/texture.png" >/dev/null || fail "the shared texture is not served"
 timeout 240 node web/test/tileset_browser_test.mjs "$url" "$tmp/horse_tiles/tileset.json" \
   ${TAILOR_SCREENSHOT:+--screenshot "$TAILOR_SCREENSHOT"} || fail "the tileset browser test failed"
+kill "$server_pid" 2>/dev/null || true
+wait "$server_pid" 2>/dev/null || true
+
+# --- 4. one tile alone: the texture it names beside it is served where the page asks for it -------
+leaf="$(ls "$tmp"/horse_tiles/tiles/0_*.glb | head -1)"
+"$tailor" view "$leaf" >"$tmp/view1.log" 2>&1 &
+server_pid=$!
+url=""
+for _ in $(seq 1 100); do
+  url="$(grep -o 'http://127\.0\.0\.1:[0-9]*/' "$tmp/view1.log" || true)"
+  [ -n "$url" ] && break
+  kill -0 "$server_pid" 2>/dev/null || fail "tailor view of one tile exited early: $(cat "$tmp/view1.log")"
+  sleep 0.1
+done
+[ -n "$url" ] || fail "tailor view of one tile printed no URL within 10 s"
+cmp <(curl -sf "${url}files/texture.png") "$tmp/horse_tiles/tiles/texture.png" ||
+  fail "one tile's texture is not served at ${url}files/texture.png"
+status="$(curl -s -o /dev/null -w '%{http_code}' "${url}files/tileset.json")"
+[ "$status" = 404 ] || fail "a file the tile does not name was served ($status)"
 echo "tiles view test: ok"

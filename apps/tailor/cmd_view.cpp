@@ -2,6 +2,7 @@
 // folder, on 127.0.0.1 until Ctrl-C.
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <csignal>
@@ -14,6 +15,7 @@
 
 #include "cli.h"
 #include "http_server.h"
+#include "io/glb_format.h"
 #include "tailor/image.h"
 #include "util/atomic_file.h"
 #include "util/bounded_json.h"
@@ -103,6 +105,42 @@ Status add_texture(const std::string& path, std::vector<Route>& routes, nlohmann
   return Status::ok();
 }
 
+//! The image files a .glb names by relative URI (a tile of `python3 -m tailor.tiles` names the
+//! texture beside it): each served under /files/ where the page's loader asks for it, beside
+//! /files/model.glb, unless a route has that URL already (the model, --texture's image). Only
+//! files in or below the .glb's folder, by the reader's own rule; a JSON chunk that does not parse
+//! names none (the model itself then fails in the page).
+void add_glb_images(const std::string& path, std::vector<Route>& routes) {
+  namespace fs = std::filesystem;
+  constexpr size_t kMaxJsonChunk = size_t{64} << 20;
+  std::string head;
+  if (!internal::read_file_head(path, 20, head).is_ok() || head.size() < 20) return;
+  const auto u32 = [&](size_t at) {
+    return uint32_t{static_cast<unsigned char>(head[at])} | uint32_t{static_cast<unsigned char>(head[at + 1])} << 8 |
+           uint32_t{static_cast<unsigned char>(head[at + 2])} << 16 |
+           uint32_t{static_cast<unsigned char>(head[at + 3])} << 24;
+  };
+  const size_t length = u32(12);
+  if (u32(16) != internal::kChunkJson || length > kMaxJsonChunk) return;
+  std::string text;
+  if (!internal::read_file_head(path, 20 + length, text).is_ok() || text.size() < 20 + length) return;
+  nlohmann::json gltf;
+  if (internal::parse_json_bounded(std::string_view(text).substr(20, length), gltf) != internal::JsonParse::kOk ||
+      !gltf.is_object() || !gltf.contains("images") || !gltf["images"].is_array())
+    return;
+  const fs::path folder = fs::path(path).has_parent_path() ? fs::path(path).parent_path() : fs::path(".");
+  for (const nlohmann::json& image : gltf["images"]) {
+    if (!image.is_object() || !image.contains("uri") || !image["uri"].is_string()) continue;
+    std::string relative;
+    if (!internal::relative_file_uri(image["uri"].get<std::string>(), relative)) continue;
+    const std::string url = "/files/" + relative;
+    if (std::any_of(routes.begin(), routes.end(), [&](const Route& r) { return r.url_path == url; })) continue;
+    std::error_code error;
+    const fs::path file = folder / relative;
+    if (fs::is_regular_file(file, error)) routes.push_back({url, file.string(), "", ""});
+  }
+}
+
 //! A 3D Tiles tileset (a tileset.json, e.g. from `python3 -m tailor.tiles`): the files in its
 //! folder and below (tile contents, the shared texture) are served under /tileset/, as the
 //! tileset names them; hidden files and folders are not.
@@ -158,6 +196,7 @@ int run_view(const ViewArgs& args) {
   if (!args.texture.empty()) {
     if (Status s = add_texture(args.texture, routes, config, args.quiet); !s) return report_error(s);
   }
+  if (!tileset) add_glb_images(args.input, routes);  // after --texture's, which keeps its URL
   routes.push_back({"/config.json", "", json_text(config, -1), "application/json"});
 
   StaticServer server;

@@ -1,5 +1,6 @@
-// The glTF enumerations and the binary container's (.glb) framing, shared by the reader
-// (gltf_document.cpp) and the writers (write_glb.cpp, write_glb_compressed.cpp).
+// The glTF enumerations, the binary container's (.glb) framing and the rule for the files a glTF
+// names, shared by the reader (gltf_document.cpp), the writers (write_glb.cpp,
+// write_glb_compressed.cpp) and `tailor view`.
 #pragma once
 
 #include <bit>
@@ -27,6 +28,11 @@ inline void append_u32(std::string& out, uint32_t value) {
   std::memcpy(bytes, &value, 4);
   out.append(bytes, 4);
 }
+
+//! A relative URI's path with %XX decoded, or false when it names anything but a file in or below
+//! the glTF's folder (a scheme, an absolute path, a '..' segment, a backslash, a NUL): the files
+//! the reader opens beside a .gltf, and those `tailor view` serves beside a .glb.
+bool relative_file_uri(const std::string& uri, std::string& path);
 
 //! Pads `out` with `fill` to a multiple of 4 bytes (glb chunks and buffer views are 4-aligned).
 inline void pad_to_4(std::string& out, char fill = '\0') {

@@ -127,6 +127,8 @@ bool decode_base64(std::string_view text, std::string& out) {
   return true;
 }
 
+}  // namespace
+
 // A relative URI's path with %XX decoded, or false when it names anything but a file in or below
 // the .gltf's folder (a scheme, an absolute path, a '..' segment, a backslash, a NUL).
 bool relative_file_uri(const std::string& uri, std::string& path) {
@@ -156,8 +158,6 @@ bool relative_file_uri(const std::string& uri, std::string& path) {
     if (part == "..") return false;
   return true;
 }
-
-}  // namespace
 
 bool get_uint(const Json& object, const char* key, uint64_t& out) {
   if (!object.is_object()) return false;
