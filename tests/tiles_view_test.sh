@@ -33,6 +33,20 @@ cleanup() {
 }
 trap cleanup EXIT
 
+# Starts `tailor view INPUT` (its log in LOG) and sets server_pid and url once it prints its URL.
+start_view() {
+  "$tailor" view "$1" >"$2" 2>&1 &
+  server_pid=$!
+  url=""
+  for _ in $(seq 1 100); do
+    url="$(grep -o 'http://127\.0\.0\.1:[0-9]*/' "$2" || true)"
+    [ -n "$url" ] && return
+    kill -0 "$server_pid" 2>/dev/null || fail "tailor view $1 exited early: $(cat "$2")"
+    sleep 0.1
+  done
+  fail "tailor view $1 printed no URL within 10 s"
+}
+
 # --- 1. the tiles ----------------------------------------------------------------------------------
 PYTHONPATH="$python_dir" timeout 120 /usr/bin/python3 -m tailor.tiles tests/data/meshes/horse.ply -o "$tmp/horse_tiles" \
   --chunk-cell -4 --texture examples/gravel.png --workers 0 -q || fail "python3 -m tailor.tiles failed"
@@ -52,16 +66,7 @@ set -e
 case "$err" in *"not a 3D Tiles tileset"*) ;; *) fail "unexpected error: $err" ;; esac
 
 # --- 3. the browser --------------------------------------------------------------------------------
-"$tailor" view "$tmp/horse_tiles/tileset.json" >"$tmp/view.log" 2>&1 &
-server_pid=$!
-url=""
-for _ in $(seq 1 100); do
-  url="$(grep -o 'http://127\.0\.0\.1:[0-9]*/' "$tmp/view.log" || true)"
-  [ -n "$url" ] && break
-  kill -0 "$server_pid" 2>/dev/null || fail "tailor view exited early: $(cat "$tmp/view.log")"
-  sleep 0.1
-done
-[ -n "$url" ] || fail "tailor view printed no URL within 10 s"
+start_view "$tmp/horse_tiles/tileset.json" "$tmp/view.log"
 curl -sf "${url}tileset/tileset.json" >/dev/null || fail "the tileset is not served at ${url}tileset/tileset.json"
 curl -sf "${url}tileset/tiles/texture.png" >/dev/null || fail "the shared texture is not served"
 timeout 240 node web/test/tileset_browser_test.mjs "$url" "$tmp/horse_tiles/tileset.json" \
@@ -71,16 +76,7 @@ wait "$server_pid" 2>/dev/null || true
 
 # --- 4. one tile alone: the texture it names beside it is served where the page asks for it -------
 leaf="$(ls "$tmp"/horse_tiles/tiles/0_*.glb | head -1)"
-"$tailor" view "$leaf" >"$tmp/view1.log" 2>&1 &
-server_pid=$!
-url=""
-for _ in $(seq 1 100); do
-  url="$(grep -o 'http://127\.0\.0\.1:[0-9]*/' "$tmp/view1.log" || true)"
-  [ -n "$url" ] && break
-  kill -0 "$server_pid" 2>/dev/null || fail "tailor view of one tile exited early: $(cat "$tmp/view1.log")"
-  sleep 0.1
-done
-[ -n "$url" ] || fail "tailor view of one tile printed no URL within 10 s"
+start_view "$leaf" "$tmp/view1.log"
 cmp <(curl -sf "${url}files/texture.png") "$tmp/horse_tiles/tiles/texture.png" ||
   fail "one tile's texture is not served at ${url}files/texture.png"
 status="$(curl -s -o /dev/null -w '%{http_code}' "${url}files/tileset.json")"
