@@ -108,11 +108,9 @@ inline const std::string kOwnWords = "\x01";
 //! the range.
 template <class T>
 CLI::Option* add_documented(CLI::App* app, const OptionDoc& doc, T& field) {
-  const std::string help = help_with_range(doc);
-  CLI::Option* option = app->add_option(std::string(doc.flag), field, help)->capture_default_str();
-  const bool bounded = help.size() != doc.help.size();  // the library knows its range
+  CLI::Option* option = app->add_option(std::string(doc.flag), field, help_with_range(doc))->capture_default_str();
   if constexpr (std::is_integral_v<T>) {
-    if (!bounded) return option;
+    if (option_range_text(doc.flag).empty()) return option;  // no range in the library's table
     option->check(CLI::Validator(
         [flag = std::string(doc.flag)](std::string& text) -> std::string {
           char* end = nullptr;

@@ -52,11 +52,9 @@ Status check_glb(const std::string& path) {
   if (!read) {
     return Status::error(ErrorCode::kParse, path, "not a binary glTF file", "shorter than its 12-byte header");
   }
-  const auto u32 = [&](size_t at) {
-    return uint32_t{head[at]} | uint32_t{head[at + 1]} << 8 | uint32_t{head[at + 2]} << 16 |
-           uint32_t{head[at + 3]} << 24;
-  };
-  if (u32(0) != 0x46546C67u) return Status::error(ErrorCode::kParse, path, "not a binary glTF file", "bad magic");
+  const auto u32 = [&](size_t at) { return internal::load_u32(head.data() + at); };
+  if (u32(0) != internal::kGlbMagic)
+    return Status::error(ErrorCode::kParse, path, "not a binary glTF file", "bad magic");
   if (u32(4) != 2) return Status::error(ErrorCode::kUnsupported, path, "only glTF 2.0 is supported", "version field");
   if (u32(8) > size) return Status::error(ErrorCode::kParse, path, "truncated glTF file", "header length exceeds file");
   return Status::ok();
@@ -116,9 +114,7 @@ void add_glb_images(const std::string& path, std::vector<Route>& routes) {
   std::string head;
   if (!internal::read_file_head(path, 20, head).is_ok() || head.size() < 20) return;
   const auto u32 = [&](size_t at) {
-    return uint32_t{static_cast<unsigned char>(head[at])} | uint32_t{static_cast<unsigned char>(head[at + 1])} << 8 |
-           uint32_t{static_cast<unsigned char>(head[at + 2])} << 16 |
-           uint32_t{static_cast<unsigned char>(head[at + 3])} << 24;
+    return internal::load_u32(reinterpret_cast<const unsigned char*>(head.data()) + at);
   };
   const size_t length = u32(12);
   if (u32(16) != internal::kChunkJson || length > kMaxJsonChunk) return;

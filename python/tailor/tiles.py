@@ -116,7 +116,7 @@ def tile_material(folder, params):
         return None
     roles = params.get("orm_roles", [])
     return {
-        "color": str(pathlib.Path(folder) / "tiles" / images["color"]) if "color" in images else None,
+        "color": str(image_path(folder, images["color"])) if "color" in images else None,
         "width": params["texture_size"][0],
         "height": params["texture_size"][1],
         "orm_roughness_metallic": "roughness_metallic" in roles,
@@ -162,6 +162,11 @@ def node_name(level, tile):
 
 def glb_path(folder, name):
     return pathlib.Path(folder) / "tiles" / (name + ".glb")
+
+
+def image_path(folder, file):
+    """An image every tile names: beside the .glb files, which name it without a folder."""
+    return pathlib.Path(folder) / "tiles" / file
 
 
 def coarse_path(folder, name):
@@ -739,8 +744,6 @@ def previous_output(outdir, params):
             "%s holds %s, which is not part of its tileset (a run replaces the folder): move it, or write "
             "the tiles elsewhere" % (outdir, foreign)
         )
-    if old is None:
-        return {}
     if not isinstance(old, dict) or old.get("params") != params or not isinstance(old.get("tiles"), dict):
         return {}
     out = {}
@@ -1127,11 +1130,11 @@ def run_started(args, outdir, tmp, t0, layout, mesh, look, start):
     # The images every tile names, once in tiles/ (the previous run's file linked when it has the
     # same bytes, so that it keeps its time).
     for name, data in look["images"].values():
-        previous = outdir / "tiles" / name
+        previous = image_path(outdir, name)
         if previous.is_file() and previous.read_bytes() == data:
-            os.link(previous, tmp / "tiles" / name)
+            os.link(previous, image_path(tmp, name))
         else:
-            (tmp / "tiles" / name).write_bytes(data)
+            image_path(tmp, name).write_bytes(data)
     if args.lod:
         (tmp / "lod").mkdir()
     jobs = []

@@ -29,6 +29,11 @@ inline void append_u32(std::string& out, uint32_t value) {
   out.append(bytes, 4);
 }
 
+//! The 4 little-endian bytes at `p` (append_u32's reverse).
+inline uint32_t load_u32(const unsigned char* p) {
+  return uint32_t{p[0]} | uint32_t{p[1]} << 8 | uint32_t{p[2]} << 16 | uint32_t{p[3]} << 24;
+}
+
 //! A relative URI's path with %XX decoded, or false when it names anything but a file in or below
 //! the glTF's folder (a scheme, an absolute path, a '..' segment, a backslash, a NUL): the files
 //! the reader opens beside a .gltf, and those `tailor view` serves beside a .glb.

@@ -17,10 +17,6 @@
 namespace tailor::internal {
 namespace {
 
-uint32_t load_u32(const unsigned char* p) {
-  return uint32_t{p[0]} | uint32_t{p[1]} << 8 | uint32_t{p[2]} << 16 | uint32_t{p[3]} << 24;
-}
-
 int component_size(int type) {
   switch (type) {
     case kGltfByte:
